@@ -1,0 +1,26 @@
+// The one public header of the OpenABLE library.
+//
+//   #include <OpenABLE/OpenABLE.h>
+//   openable::Config config = openable::LoadConfig("Config.txt");
+//   openable::ProgressReporter progress(std::cerr, true, false);
+//   openable::RunResult run = openable::ComputeRun(config, progress);
+//   // run.normalized is M' (Eq. 5) over every frame of the run.
+#pragma once
+
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/describe.h"
+#include "OpenABLE/exports.h"
+#include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/pipeline.h"
+#include "OpenABLE/preprocess.h"
+#include "OpenABLE/progress.h"
+#include "config/config.h"
+#include "descriptors/descriptor.h"
+#include "descriptors/registry.h"
+#include "matching/distances.h"
+#include "matching/normalize.h"
+#include "matching/sequence.h"
+
+namespace openable {
+inline constexpr const char* kVersion = "0.1.0";
+}  // namespace openable

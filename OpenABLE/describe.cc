@@ -1,0 +1,191 @@
+#include "OpenABLE/describe.h"
+
+#include <algorithm>
+#include <atomic>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <thread>
+
+#include <opencv2/highgui.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/preprocess.h"
+
+namespace openable {
+
+FrameDescriber::FrameDescriber(const Descriptor& descriptor, DescriptionType type, int grid_x,
+                               int grid_y)
+    : descriptor_(descriptor),
+      type_(type),
+      grid_x_(type == DescriptionType::kGrid ? grid_x : 1),
+      grid_y_(type == DescriptionType::kGrid ? grid_y : 1) {
+  if (grid_x_ < 1 || grid_y_ < 1) throw std::logic_error("FrameDescriber: grid below 1x1");
+}
+
+int FrameDescriber::RowWidth() const { return descriptor_.Width() * grid_x_ * grid_y_; }
+int FrameDescriber::RowType() const { return openable::RowType(descriptor_); }
+
+void FrameDescriber::Describe(const cv::Mat1b& gray, cv::Mat row) const {
+  if (gray.cols < grid_x_ || gray.rows < grid_y_)
+    throw std::logic_error("FrameDescriber: frame smaller than the grid");
+  const int p = descriptor_.PatchSize();
+  const int width = descriptor_.Width();
+  cv::Mat patch;
+  for (int gy = 0; gy < grid_y_; ++gy)
+    for (int gx = 0; gx < grid_x_; ++gx) {
+      const int x0 = gx * gray.cols / grid_x_, x1 = (gx + 1) * gray.cols / grid_x_;
+      const int y0 = gy * gray.rows / grid_y_, y1 = (gy + 1) * gray.rows / grid_y_;
+      const cv::Mat cell = gray(cv::Range(y0, y1), cv::Range(x0, x1));
+      // Area interpolation when shrinking (it averages, avoiding aliasing); linear when a cell
+      // is smaller than the patch.
+      const bool shrink = cell.cols >= p && cell.rows >= p;
+      cv::resize(cell, patch, cv::Size(p, p), 0, 0, shrink ? cv::INTER_AREA : cv::INTER_LINEAR);
+      const int c = gy * grid_x_ + gx;
+      descriptor_.Describe(patch, row.colRange(c * width, (c + 1) * width));
+    }
+}
+
+namespace {
+
+int ResolveThreads(int threads) {
+  return threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+std::string SizeText(const cv::Size& s) {
+  return std::to_string(s.width) + "x" + std::to_string(s.height);
+}
+
+}  // namespace
+
+DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescriber& describer,
+                                   const DescribeOptions& options,
+                                   const std::function<void(int, int)>& progress) {
+  const int n = source.Size();
+  const std::string prefix = options.key.empty() ? "" : options.key + ": ";
+  cv::Mat rows(n, describer.RowWidth(), describer.RowType(), cv::Scalar(0));
+  std::vector<char> ok(n, 0);
+  std::vector<std::string> read_errors(n);
+
+  std::mutex mutex;  // guards the first size, the first error and progress
+  std::optional<cv::Size> first_size;
+  std::string first_size_frame;
+  int error_index = n;  // lowest index whose failure stops the run
+  std::string error_message;
+  int done = 0;
+  auto fail = [&](int i, const std::string& message) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (i < error_index) error_index = i, error_message = message;
+  };
+
+  // Describes frame i once it is in memory; records a size mismatch as a failure.
+  auto describe = [&](int i, const cv::Mat& frame) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!first_size) first_size = frame.size(), first_size_frame = source.FrameName(i);
+      if (frame.size() != *first_size) {
+        const std::string message = "image \"" + source.FrameName(i) + "\" is " +
+                                    SizeText(frame.size()) + " but \"" + first_size_frame +
+                                    "\" is " + SizeText(*first_size) +
+                                    " (expected the frames of one sequence to have one size)";
+        if (i < error_index) error_index = i, error_message = message;
+        return;
+      }
+    }
+    const cv::Mat1b gray = ToGray8(frame);
+    describer.Describe(gray, rows.row(i));
+    ok[i] = 1;
+  };
+  auto report = [&]() {
+    std::lock_guard<std::mutex> lock(mutex);
+    ++done;
+    if (progress) progress(done, n);
+  };
+  auto read = [&](int i) -> std::optional<cv::Mat> {
+    try {
+      return source.Read(i);
+    } catch (const InputError& e) {
+      if (options.skip_unreadable) {
+        read_errors[i] = e.what();
+      } else {
+        fail(i, e.what());
+      }
+      return std::nullopt;
+    }
+  };
+  auto stopped = [&]() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return error_index < n;
+  };
+
+  const int threads = options.show_images ? 1 : ResolveThreads(options.threads);
+  if (options.show_images || !source.ParallelReads()) {
+    // One reader in order; description of a batch in parallel.
+    const int batch = std::max(1, threads * 8);
+    std::vector<std::pair<int, cv::Mat>> frames;
+    for (int start = 0; start < n && !stopped(); start += batch) {
+      frames.clear();
+      for (int i = start; i < std::min(n, start + batch); ++i) {
+        if (auto f = read(i)) {
+          if (options.show_images) {
+            cv::imshow("OpenABLE", *f);
+            cv::waitKey(1);
+          }
+          frames.emplace_back(i, std::move(*f));
+        } else {
+          report();
+        }
+      }
+      std::atomic<size_t> next{0};
+      auto worker = [&]() {
+        for (size_t k = next++; k < frames.size(); k = next++) {
+          describe(frames[k].first, frames[k].second);
+          report();
+        }
+      };
+      std::vector<std::thread> pool;
+      for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+      worker();
+      for (auto& t : pool) t.join();
+    }
+  } else {
+    std::atomic<int> next{0};
+    auto worker = [&]() {
+      for (int i = next++; i < n; i = next++) {
+        if (stopped()) return;
+        if (auto f = read(i)) describe(i, *f);
+        report();
+      }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+  }
+
+  if (error_index < n) throw InputError(prefix + error_message);
+
+  DescribedSequence out;
+  for (int i = 0; i < n; ++i) {
+    if (ok[i]) {
+      out.kept.push_back(i);
+    } else {
+      out.skipped.push_back(read_errors[i]);
+    }
+  }
+  if (out.kept.empty())
+    throw InputError(prefix + "none of the " + std::to_string(n) +
+                     " frames could be read (first failure: " +
+                     (out.skipped.empty() ? std::string("none") : out.skipped.front()) + ")");
+  if (out.kept.size() == static_cast<size_t>(n)) {
+    out.rows = rows;
+  } else {
+    out.rows.create(static_cast<int>(out.kept.size()), rows.cols, rows.type());
+    for (size_t k = 0; k < out.kept.size(); ++k) rows.row(out.kept[k]).copyTo(out.rows.row(k));
+  }
+  out.frame_size = first_size.value_or(cv::Size());
+  return out;
+}
+
+}  // namespace openable

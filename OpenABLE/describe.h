@@ -1,0 +1,65 @@
+// Description of whole frames: the global and grid schemes of OpenABLE, over any descriptor.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "OpenABLE/io/frame_source.h"
+#include "descriptors/descriptor.h"
+
+namespace openable {
+
+enum class DescriptionType { kGlobal = 0, kGrid = 1 };
+
+// Turns a grey frame into one descriptor row.
+//  - Global: the frame is resized to the descriptor's patch (area interpolation) and described
+//    at its centre, as ABLE does.
+//  - Grid: the frame is cut into grid_x x grid_y cells (cell c spans [floor(c W / n),
+//    floor((c+1) W / n))), each cell is resized to the patch and described at its centre, and
+//    the rows are concatenated in row-major cell order. (The original placed grid keypoints on
+//    the full-size frame; resizing each cell works for every descriptor at any frame size and
+//    keeps the patch the descriptor was designed for.)
+class FrameDescriber {
+ public:
+  FrameDescriber(const Descriptor& descriptor, DescriptionType type, int grid_x = 1,
+                 int grid_y = 1);
+  // Elements per row (descriptor width x cells) and their CV type (CV_8U or CV_32F).
+  int RowWidth() const;
+  int RowType() const;
+  // Describes `gray` (CV_8UC1, any size with at least grid_x x grid_y pixels) into `row`
+  // (1 x RowWidth(), RowType()). Thread-safe.
+  void Describe(const cv::Mat1b& gray, cv::Mat row) const;
+
+ private:
+  const Descriptor& descriptor_;
+  DescriptionType type_;
+  int grid_x_, grid_y_;
+};
+
+// Descriptors of every frame of a source, and what was skipped.
+struct DescribedSequence {
+  cv::Mat rows;                          // one row per kept frame
+  std::vector<int> kept;                 // source index of each row
+  std::vector<std::string> skipped;      // names of frames that could not be read (skip mode)
+  cv::Size frame_size;                   // size of the frames of this source
+};
+
+struct DescribeOptions {
+  int threads = 0;               // 0 = all cores
+  bool skip_unreadable = false;  // false: the first unreadable frame is an InputError
+  bool show_images = false;      // show each frame in a window (forces one thread)
+  std::string key;               // config key naming the source, prefixed to errors
+};
+
+// Reads and describes every frame of `source` (in parallel when the source allows it).
+// `progress(done, total)` is called from one thread at a time. Throws InputError naming the
+// frame when a frame cannot be read (unless skipping), when frames differ in size, or when
+// every frame was skipped.
+DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescriber& describer,
+                                   const DescribeOptions& options,
+                                   const std::function<void(int, int)>& progress = {});
+
+}  // namespace openable

@@ -1,0 +1,149 @@
+#include "OpenABLE/exports.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include <unistd.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "OpenABLE/base/error.h"
+
+namespace openable {
+
+cv::Vec3f ColorOf(float s, int map) {
+  // (blue, green, red), as the original's table in ../shared/guide/reference.md.
+  switch (map) {
+    case 0: return {s, s, s};
+    case 1: return {0, 0, s};
+    case 2: return {0, s, 0};
+    case 3: return {s, 0, 0};
+    case 4: return {1 - s, 1 - s, s};
+    case 5: return {1 - s, s, 1 - s};
+    case 6: return {s, 1 - s, 1 - s};
+    case 7: return {0, s, 1};
+    case 8: return {1, 1 - s, s};
+    case 9: return {0.4980f * s, 0.7804f * s, s};
+    case 10: return {1 - s, s, 1};
+    case 11: return {0, 0.5f * s + 0.5f, s};
+    default: throw std::logic_error("ColorOf: colour map outside 0-11");
+  }
+}
+
+cv::Mat3b ColorizeMatrix(const cv::Mat1f& normalized, int map) {
+  ColorOf(0.f, map);  // validates the map once
+  cv::Mat3b out(normalized.size());
+  for (int i = 0; i < normalized.rows; ++i) {
+    const float* in = normalized.ptr<float>(i);
+    cv::Vec3b* o = out.ptr<cv::Vec3b>(i);
+    for (int j = 0; j < normalized.cols; ++j) {
+      const cv::Vec3f c = ColorOf(std::min(1.f, std::max(0.f, in[j])), map);
+      for (int k = 0; k < 3; ++k) o[j][k] = cv::saturate_cast<std::uint8_t>(c[k] * 255.f);
+    }
+  }
+  return out;
+}
+
+std::string EncodeNpy(const cv::Mat1f& m) {
+  // The .npy format: magic, version 1.0, a little-endian uint16 header length, then a Python
+  // dict literal padded with spaces and ended by '\n' so that the data starts at a multiple
+  // of 64 bytes. Written by hand: none of our dependencies writes .npy.
+  std::string dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (" +
+                     std::to_string(m.rows) + ", " + std::to_string(m.cols) + "), }";
+  const size_t preamble = 10;  // magic (6) + version (2) + length (2)
+  size_t total = preamble + dict.size() + 1;
+  const size_t padded = (total + 63) / 64 * 64;
+  dict.append(padded - total, ' ');
+  dict.push_back('\n');
+  std::string out("\x93NUMPY\x01\x00", 8);
+  const auto len = static_cast<std::uint16_t>(dict.size());
+  out.push_back(static_cast<char>(len & 0xFF));
+  out.push_back(static_cast<char>(len >> 8));
+  out += dict;
+  static_assert(sizeof(float) == 4, "float32 expected");
+  const size_t bytes = static_cast<size_t>(m.rows) * m.cols * sizeof(float);
+  out.reserve(out.size() + bytes);
+  for (int i = 0; i < m.rows; ++i)  // x86 and ARM Linux are little-endian, like '<f4'
+    out.append(reinterpret_cast<const char*>(m.ptr<float>(i)), m.cols * sizeof(float));
+  return out;
+}
+
+std::string EncodeText(const cv::Mat& m) {
+  std::string out;
+  char buf[32];
+  for (int i = 0; i < m.rows; ++i) {
+    for (int j = 0; j < m.cols; ++j) {
+      int n;
+      if (m.depth() == CV_8U) {
+        n = std::snprintf(buf, sizeof buf, "%d", m.at<std::uint8_t>(i, j));
+      } else if (m.depth() == CV_32F) {
+        n = std::snprintf(buf, sizeof buf, "%.6g", m.at<float>(i, j));
+      } else {
+        throw std::logic_error("EncodeText: expected CV_8U or CV_32F");
+      }
+      if (j) out.push_back(' ');
+      out.append(buf, n);
+    }
+    out.push_back('\n');
+  }
+  return out;
+}
+
+std::string EncodePng(const cv::Mat& image) {
+  std::vector<std::uint8_t> buf;
+  if (!cv::imencode(".png", image, buf)) throw std::logic_error("EncodePng: encoder failed");
+  return std::string(buf.begin(), buf.end());
+}
+
+OutputBatch::~OutputBatch() {
+  for (const auto& item : items_) std::remove(item.temp.c_str());
+}
+
+void OutputBatch::Stage(const std::string& key, const std::string& path,
+                        const std::string& bytes) {
+  namespace fs = std::filesystem;
+  const fs::path dest(path);
+  const fs::path folder = dest.has_parent_path() ? dest.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec) && !fs::create_directories(folder, ec))
+    throw InputError(key + ": cannot write \"" + path + "\": folder \"" + folder.string() +
+                     "\" cannot be created (" + ec.message() + ")");
+  if (fs::is_directory(dest, ec))
+    throw InputError(key + ": cannot write \"" + path + "\": it is a folder (expected a file name)");
+  const std::string temp = (folder / ("." + dest.filename().string() + ".tmp-" +
+                                      std::to_string(::getpid()) + "-" +
+                                      std::to_string(items_.size())))
+                               .string();
+  items_.push_back({key, temp, path});
+  std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+  if (out) out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (out) out.close();
+  if (!out)
+    throw InputError(key + ": cannot write \"" + path + "\": " + std::strerror(errno) +
+                     " (expected a writable location)");
+}
+
+void OutputBatch::Commit() {
+  for (size_t k = 0; k < items_.size(); ++k) {
+    const Item& item = items_[k];
+    if (std::rename(item.temp.c_str(), item.path.c_str()) != 0) {
+      const std::string reason = std::strerror(errno);
+      items_.erase(items_.begin(), items_.begin() + static_cast<long>(k));  // renamed ones
+      throw InputError(item.key + ": cannot write \"" + item.path + "\": " + reason);
+    }
+  }
+  items_.clear();
+}
+
+std::vector<std::string> OutputBatch::Paths() const {
+  std::vector<std::string> paths;
+  for (const auto& item : items_) paths.push_back(item.path);
+  return paths;
+}
+
+}  // namespace openable

@@ -1,0 +1,56 @@
+// Outputs of a run: the matrix as text, as float32 .npy and as colour PNG images.
+//
+// Every file is first written beside its destination under a temporary name and renamed
+// only when all outputs of the run were written (OutputBatch), so a failed run never leaves
+// a half-written file, nor a set of outputs that looks complete but is not.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace openable {
+
+// The 12 colour maps of the original OpenABLE (docs/output_formats.md). Pixel of a
+// normalised distance s in [0, 1], as (blue, green, red) in [0, 1]; multiplied by 255 and
+// rounded. Throws std::logic_error for a map outside 0-11.
+cv::Vec3f ColorOf(float s, int map);
+cv::Mat3b ColorizeMatrix(const cv::Mat1f& normalized, int map);
+
+// Bytes of a NumPy .npy file (format version 1.0, little-endian float32, C order) holding
+// `m` (CV_32FC1).
+std::string EncodeNpy(const cv::Mat1f& m);
+
+// Text of the matrix: one row per line, values separated by one space. Floats are written
+// with 6 significant digits; CV_8U matrices (thresholded) as integers.
+std::string EncodeText(const cv::Mat& m);
+
+// Bytes of a PNG image (OpenCV's encoder).
+std::string EncodePng(const cv::Mat& image);
+
+// Stages files and commits them together.
+class OutputBatch {
+ public:
+  OutputBatch() = default;
+  OutputBatch(const OutputBatch&) = delete;
+  OutputBatch& operator=(const OutputBatch&) = delete;
+  // Removes every staged temporary file not yet committed.
+  ~OutputBatch();
+  // Writes `bytes` to a temporary file beside `path`, creating its folder when missing.
+  // Throws InputError naming `key` and the path when the file cannot be written.
+  void Stage(const std::string& key, const std::string& path, const std::string& bytes);
+  // Renames every staged file to its destination. Throws InputError if a rename fails (files
+  // renamed before stay; the error names the one that failed).
+  void Commit();
+  // Destinations staged so far.
+  std::vector<std::string> Paths() const;
+
+ private:
+  struct Item {
+    std::string key, temp, path;
+  };
+  std::vector<Item> items_;
+};
+
+}  // namespace openable

@@ -1,0 +1,67 @@
+// Frame sources: where the frames of a run come from (a folder of images or a video).
+//
+// A frame is returned as the image was stored, converted to floating point: CV_32FC1 (grey) or
+// CV_32FC3 (colour, BGR order as everywhere in OpenCV), values in [0, 1] whatever the bit depth
+// of the file (8- or 16-bit). Preprocessing (grey conversion, illumination invariance) happens
+// later, in OpenABLE/preprocess.h.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace openable {
+
+// "Natural" order of file names: runs of digits compare by their numeric value, so "img2"
+// comes before "img10"; the rest compares character by character. Ties (e.g. "a01" and "a1")
+// are broken by plain lexicographic order so that the order is total.
+bool NaturalLess(const std::string& a, const std::string& b);
+
+// File name extensions (lower case, no dot) that ListImages accepts when no format is given.
+const std::vector<std::string>& SupportedImageExtensions();
+
+// Lists the image files of `folder` in natural order of their file names (not recursive).
+// `extension` (e.g. "png", case-insensitive, with or without a dot) keeps only those files;
+// empty keeps every supported image extension. Throws InputError when the folder is missing,
+// is not a folder, or holds no matching image.
+std::vector<std::string> ListImages(const std::string& folder, const std::string& extension);
+
+// Reads one image file through OpenImageIO (PNG, JPEG, TIFF, PGM/PPM, BMP, ...; 8 or 16 bit;
+// 1, 2, 3 or 4 channels; alpha is dropped, grey+alpha becomes grey). Returns CV_32FC1 or
+// CV_32FC3 (BGR) in [0, 1]. Throws InputError naming the file when it cannot be opened or
+// decoded (missing, corrupt, truncated, not an image).
+cv::Mat ReadImageFile(const std::string& path);
+
+// A sequence of frames with random access by index.
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  // Number of frames.
+  virtual int Size() const = 0;
+  // Human-readable name of frame i: the file path, or "<video>#<frame index>".
+  virtual std::string FrameName(int i) const = 0;
+  // Reads frame i (see the top of this file for the format). Throws InputError naming the
+  // frame when it cannot be read. Thread-safe when ParallelReads() is true.
+  virtual cv::Mat Read(int i) const = 0;
+  // True when Read may be called from several threads at once (image folders); false for
+  // videos, which must be read in order from one thread.
+  virtual bool ParallelReads() const = 0;
+};
+
+// The images of `folder` (see ListImages), restricted to the positions [first, last) of the
+// natural order. last = -1 means "to the end". Throws InputError when the range is empty or
+// outside the folder's images (the message names the folder, the count and the keys
+// Initial_image / Final_image).
+std::unique_ptr<FrameSource> OpenImageFolder(const std::string& folder,
+                                             const std::string& extension, int first, int last);
+
+// The frames [first, last) of a video file opened with OpenCV's VideoCapture; last = -1 means
+// "to the end". Opening counts the frames by grabbing them once (a container's frame count is
+// not reliable); Read(i) is cheapest in increasing order of i (a step back reopens the file).
+// Not thread-safe: ParallelReads() is false. Throws InputError when the file cannot be opened,
+// holds no frame, or the range is outside it.
+std::unique_ptr<FrameSource> OpenVideo(const std::string& path, int first, int last);
+
+}  // namespace openable

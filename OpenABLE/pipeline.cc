@@ -1,0 +1,179 @@
+#include "OpenABLE/pipeline.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/describe.h"
+#include "OpenABLE/exports.h"
+#include "OpenABLE/io/frame_source.h"
+#include "descriptors/registry.h"
+#include "matching/distances.h"
+#include "matching/normalize.h"
+#include "matching/sequence.h"
+
+namespace openable {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// Runs `open` and prefixes the key to any InputError it throws.
+template <typename F>
+auto WithKey(const std::string& key, F open) {
+  try {
+    return open();
+  } catch (const InputError& e) {
+    throw InputError(key + ": " + e.what());
+  }
+}
+
+struct SourceSpec {
+  std::string key, path;
+  bool video;
+};
+
+std::vector<SourceSpec> Sources(const Config& c) {
+  switch (c.frame_mode) {
+    case 0: {
+      std::vector<SourceSpec> s = {{"Images_path", c.images_path, false}};
+      if (!c.images_path_2.empty()) s.push_back({"Images_path_2", c.images_path_2, false});
+      return s;
+    }
+    case 1:
+      return {{"Video_path_1", c.video_path_1, true}};
+    default:
+      return {{"Video_path_1", c.video_path_1, true}, {"Video_path_2", c.video_path_2, true}};
+  }
+}
+
+bool HasDisplay() {
+  return std::getenv("DISPLAY") != nullptr || std::getenv("WAYLAND_DISPLAY") != nullptr;
+}
+
+}  // namespace
+
+RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
+  CheckConfig(config);
+  const auto run_start = Clock::now();
+  RunResult result;
+
+  DescriptorOptions dopt;
+  dopt.patch_size = config.patch_size;
+  dopt.ldb_bits = config.ldb_bits;
+  const auto descriptor = CreateDescriptor(config.image_descriptor, dopt);
+  const FrameDescriber describer(*descriptor, static_cast<DescriptionType>(config.description_type),
+                                 config.grid_x, config.grid_y);
+  result.descriptor = descriptor->Name();
+  result.row_width = describer.RowWidth();
+  result.binary = descriptor->Kind() == DescriptorKind::kBinary;
+
+  // Open every source first, so that a bad second folder is reported before any work.
+  std::vector<std::unique_ptr<FrameSource>> sources;
+  const std::vector<SourceSpec> specs = Sources(config);
+  for (const auto& spec : specs) {
+    sources.push_back(WithKey(spec.key, [&] {
+      return spec.video ? OpenVideo(spec.path, config.initial_image, config.final_image)
+                        : OpenImageFolder(spec.path, config.images_format, config.initial_image,
+                                          config.final_image);
+    }));
+  }
+
+  DescribeOptions options;
+  options.threads = config.threads;
+  options.skip_unreadable = config.skip_unreadable == 1;
+  options.show_images = config.show_images == 1 && HasDisplay();
+
+  // Describe.
+  auto t = Clock::now();
+  std::vector<cv::Mat> blocks;
+  int row = 0;
+  for (size_t s = 0; s < sources.size(); ++s) {
+    options.key = specs[s].key;
+    progress.Begin("describing", sources[s]->Size(), "frames of " + specs[s].key);
+    DescribedSequence seq = DescribeSequence(*sources[s], describer, options,
+                                             [&](int done, int) { progress.Update(done); });
+    progress.End();
+    Traversal tr;
+    tr.key = specs[s].key;
+    tr.path = specs[s].path;
+    tr.first_row = row;
+    tr.frames = seq.rows.rows;
+    tr.skipped = seq.skipped;
+    tr.frame_size = seq.frame_size;
+    for (int i : seq.kept) tr.names.push_back(sources[s]->FrameName(i));
+    row += tr.frames;
+    result.timings.frames += sources[s]->Size();
+    result.traversals.push_back(std::move(tr));
+    blocks.push_back(seq.rows);
+  }
+  result.timings.describe_seconds = SecondsSince(t);
+  cv::Mat descriptors;
+  cv::vconcat(blocks, descriptors);
+
+  // Match: every frame against every frame of the concatenated traversals, as the original.
+  t = Clock::now();
+  const std::int64_t n = descriptors.rows;
+  result.timings.pairs = n * (n - 1) / 2;
+  progress.Begin("matching", result.timings.pairs, "pairs");
+  const PairProgress on_pairs = [&](std::int64_t done, std::int64_t) { progress.Update(done); };
+  cv::Mat1f distances = result.binary
+                            ? HammingDistances(descriptors, cv::Mat(), config.threads, on_pairs)
+                            : L2Distances(descriptors, cv::Mat(), config.threads, on_pairs);
+  progress.End();
+  result.timings.match_seconds = SecondsSince(t);
+
+  // Sequences, Eq. 5, Eq. 9.
+  t = Clock::now();
+  std::vector<int> starts;
+  for (const auto& tr : result.traversals) starts.push_back(tr.first_row);
+  result.normalized = SequenceDistances(distances, config.image_sequences, starts, starts);
+  distances.release();
+  result.max_distance = NormalizeByMax(result.normalized);
+  if (config.threshold >= 0.0)
+    result.thresholded = ThresholdMatrix(result.normalized, static_cast<float>(config.threshold));
+  result.timings.sequence_seconds = SecondsSince(t);
+  result.timings.total_seconds = SecondsSince(run_start);
+  return result;
+}
+
+std::string ThresholdPngPath(const Config& config) {
+  if (config.threshold < 0.0) return "";
+  if (!config.png_threshold_name.empty()) return config.png_threshold_name;
+  if (config.png_name.empty()) return "";
+  const std::filesystem::path p(config.png_name);
+  return (p.parent_path() / (p.stem().string() + "_thresholded" + p.extension().string()))
+      .string();
+}
+
+std::vector<std::string> WriteOutputs(const Config& config, RunResult& result) {
+  const auto t = Clock::now();
+  OutputBatch batch;
+  if (!config.txt_name.empty())
+    batch.Stage("Txt_name", config.txt_name,
+                EncodeText(result.thresholded.empty() ? cv::Mat(result.normalized)
+                                                      : cv::Mat(result.thresholded)));
+  if (!config.npy_name.empty()) batch.Stage("Npy_name", config.npy_name, EncodeNpy(result.normalized));
+  if (!config.png_name.empty())
+    batch.Stage("Png_name", config.png_name,
+                EncodePng(ColorizeMatrix(result.normalized, config.matrix_color)));
+  const std::string threshold_png = ThresholdPngPath(config);
+  if (!threshold_png.empty()) {
+    cv::Mat1f binary;
+    result.thresholded.convertTo(binary, CV_32F);
+    batch.Stage(config.png_threshold_name.empty() ? "Png_name" : "Png_threshold_name",
+                threshold_png, EncodePng(ColorizeMatrix(binary, config.matrix_color)));
+  }
+  const std::vector<std::string> paths = batch.Paths();
+  batch.Commit();
+  const double seconds = SecondsSince(t);
+  result.timings.export_seconds += seconds;
+  result.timings.total_seconds += seconds;
+  return paths;
+}
+
+}  // namespace openable

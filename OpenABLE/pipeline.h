@@ -1,0 +1,61 @@
+// One run of OpenABLE: frames -> descriptors -> distances -> sequences -> normalised matrix
+// (-> thresholded matrix) -> output files. Test_OpenABLE is a thin layer over these two calls.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "OpenABLE/progress.h"
+#include "config/config.h"
+
+namespace openable {
+
+// One traversal of the run (a folder or a video) and the rows it holds in the matrix.
+struct Traversal {
+  std::string key;                  // config key it came from ("Images_path", ...)
+  std::string path;                 // its folder or video
+  int first_row = 0;                // its first row (and column) in the matrix
+  int frames = 0;                   // rows it holds
+  std::vector<std::string> names;   // frame name of each row (file path or video#index)
+  std::vector<std::string> skipped; // frames skipped as unreadable (Skip_unreadable 1)
+  cv::Size frame_size;
+};
+
+struct RunTimings {
+  double describe_seconds = 0;   // reading and describing every frame (wall time)
+  double match_seconds = 0;      // pairwise distances (wall time)
+  double sequence_seconds = 0;   // sequence sums, normalisation and threshold
+  double export_seconds = 0;     // encoding and writing the outputs
+  double total_seconds = 0;
+  int frames = 0;                // frames described
+  std::int64_t pairs = 0;        // distinct pairs of frames compared
+};
+
+struct RunResult {
+  std::vector<Traversal> traversals;  // in matrix order
+  std::string descriptor;             // registry name
+  int row_width = 0;                  // elements per frame descriptor
+  bool binary = true;                 // Hamming (true) or L2
+  cv::Mat1f normalized;               // M' of Eq. 5 (N x N over the concatenated traversals)
+  float max_distance = 0;             // max(M), the divisor of Eq. 5
+  cv::Mat1b thresholded;              // M'' of Eq. 9; empty when Threshold is -1
+  RunTimings timings;
+};
+
+// Computes the matrices of a run. Throws InputError (one line naming the key, file or value)
+// on any problem with the configuration or the input data. Progress goes to `progress`.
+RunResult ComputeRun(const Config& config, ProgressReporter& progress);
+
+// Writes the outputs the configuration asks for (Txt_name, Npy_name, Png_name,
+// Png_threshold_name) all-or-nothing; returns the paths written. Adds the time spent to
+// result.timings.export_seconds. Throws InputError naming the key and path on failure.
+std::vector<std::string> WriteOutputs(const Config& config, RunResult& result);
+
+// The thresholded image's path: Png_threshold_name, or Png_name with "_thresholded" before
+// its extension; empty when no threshold or no PNG is asked for.
+std::string ThresholdPngPath(const Config& config);
+
+}  // namespace openable

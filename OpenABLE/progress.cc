@@ -1,0 +1,63 @@
+#include "OpenABLE/progress.h"
+
+#include <cstdio>
+#include <ostream>
+
+#include <unistd.h>
+
+namespace openable {
+
+bool IsTerminal(int fd) { return ::isatty(fd) == 1; }
+
+ProgressReporter::ProgressReporter(std::ostream& out, bool enabled, bool terminal)
+    : out_(out), enabled_(enabled), terminal_(terminal) {}
+
+void ProgressReporter::Begin(const std::string& what, std::int64_t total,
+                             const std::string& unit) {
+  what_ = what;
+  unit_ = unit;
+  total_ = total;
+  last_decile_ = -1;
+  start_ = last_print_ = std::chrono::steady_clock::now();
+}
+
+void ProgressReporter::Update(std::int64_t done) {
+  if (!enabled_ || total_ <= 0) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (terminal_) {
+    if (now - last_print_ < std::chrono::milliseconds(100) && done < total_) return;
+    last_print_ = now;
+    Print(done, false);
+  } else {
+    const int decile = static_cast<int>(done * 10 / total_);
+    if (decile <= last_decile_ || decile == 0 || done >= total_) return;
+    last_decile_ = decile;
+    Print(done, false);
+  }
+}
+
+void ProgressReporter::End() {
+  if (!enabled_) return;
+  Print(total_, true);
+}
+
+void ProgressReporter::Print(std::int64_t done, bool final) {
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  char line[256];
+  const double percent = total_ > 0 ? 100.0 * static_cast<double>(done) / total_ : 100.0;
+  int n = std::snprintf(line, sizeof line, "  %-11s %lld/%lld %s (%3.0f%%)  %.1f s",
+                        what_.c_str(), static_cast<long long>(done),
+                        static_cast<long long>(total_), unit_.c_str(), percent, elapsed);
+  if (!final && done > 0 && done < total_) {
+    const double left = elapsed * static_cast<double>(total_ - done) / static_cast<double>(done);
+    n += std::snprintf(line + n, sizeof line - n, ", about %.0f s left", left);
+  }
+  if (terminal_) {
+    out_ << "\r" << line << "\x1b[K" << (final ? "\n" : "") << std::flush;
+  } else {
+    out_ << line << "\n" << std::flush;
+  }
+}
+
+}  // namespace openable

@@ -1,0 +1,36 @@
+// Progress of long stages on a terminal or a log: "describing 1200/3576 frames (33%)".
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+namespace openable {
+
+class ProgressReporter {
+ public:
+  // Writes to `out` when `enabled`. On a terminal the line is redrawn in place (at most
+  // 10 times a second); otherwise one line is written per 10% step, so logs stay short.
+  ProgressReporter(std::ostream& out, bool enabled, bool terminal);
+  // Starts a stage: `what` ("describing"), `total` items of `unit` ("frames").
+  void Begin(const std::string& what, std::int64_t total, const std::string& unit);
+  // `done` of the stage's items are finished. Cheap to call often.
+  void Update(std::int64_t done);
+  // Ends the stage with a final line giving its wall time.
+  void End();
+
+ private:
+  void Print(std::int64_t done, bool final);
+  std::ostream& out_;
+  bool enabled_, terminal_;
+  std::string what_, unit_;
+  std::int64_t total_ = 0;
+  int last_decile_ = -1;
+  std::chrono::steady_clock::time_point start_, last_print_;
+};
+
+// True when file descriptor `fd` is a terminal.
+bool IsTerminal(int fd);
+
+}  // namespace openable

@@ -1,0 +1,425 @@
+#include "config/config.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <variant>
+
+#include "OpenABLE/base/error.h"
+
+namespace openable {
+namespace {
+
+// One key, bound once. `min`/`max` bound numbers; `choices` names the meaning of each
+// allowed integer value (shown in --help), when the key is an enumeration.
+struct Binding {
+  const char* key;
+  const char* group;
+  std::variant<int Config::*, double Config::*, std::string Config::*> field;
+  double min;
+  double max;
+  const char* meaning;
+  bool is_new;
+};
+
+constexpr double kNoLimit = std::numeric_limits<double>::infinity();
+
+// The table. Order = order in --help, in FormatConfig and in docs/configuration.md.
+const std::vector<Binding>& Bindings() {
+  static const std::vector<Binding> table = {
+      // Datasets
+      {"Frame_mode", "Datasets", &Config::frame_mode, 0, 2,
+       "Input: 0 image folder(s) (Images_path, optionally Images_path_2), 1 one video "
+       "(Video_path_1), 2 two videos matched as one concatenated sequence (Video_path_1, "
+       "Video_path_2).",
+       false},
+      {"Images_path", "Datasets", &Config::images_path, 0, 0,
+       "Folder of the image sequence (Frame_mode 0). Any file names: frames are taken in "
+       "natural order (img2 before img10). PNG, JPEG, TIFF, PGM/PPM, BMP; 8 or 16 bit; grey "
+       "or colour. Relative paths are relative to the working directory.",
+       false},
+      {"Images_path_2", "Datasets", &Config::images_path_2, 0, 0,
+       "Folder of a second traversal of the route (Frame_mode 0). The matrix covers both "
+       "sequences concatenated (Images_path first), so its lower-left block holds every frame "
+       "of this folder (rows) against every frame of Images_path (columns). Empty: one "
+       "sequence.",
+       true},
+      {"Images_path_left", "Datasets", &Config::images_path_left, 0, 0,
+       "Left image folder of a stereo camera (Camera_type 1, not built yet).", false},
+      {"Images_path_right", "Datasets", &Config::images_path_right, 0, 0,
+       "Right image folder of a stereo camera (Camera_type 1, not built yet).", false},
+      {"Calibration_path", "Datasets", &Config::calibration_path, 0, 0,
+       "Stereo calibration file (Camera_type 1, not built yet).", false},
+      {"Images_format", "Datasets", &Config::images_format, 0, 0,
+       "Extension of the images to take from the folders (e.g. png); empty takes every "
+       "supported image file. Unlike the original, names need not be %06d.<ext>.",
+       false},
+      {"Video_path_1", "Datasets", &Config::video_path_1, 0, 0,
+       "Video file read with OpenCV (Frame_mode 1 and 2).", false},
+      {"Video_path_2", "Datasets", &Config::video_path_2, 0, 0,
+       "Second video file (Frame_mode 2), concatenated after Video_path_1.", false},
+      {"Initial_image", "Datasets", &Config::initial_image, 0, kNoLimit,
+       "First frame to process: a 0-based position in the natural order of the folder's "
+       "images (or the video's frames). Applies to every folder or video of the run.",
+       false},
+      {"Final_image", "Datasets", &Config::final_image, -1, kNoLimit,
+       "One past the last frame to process (a position, as Initial_image); -1 processes to "
+       "the end.",
+       false},
+      {"Skip_unreadable", "Datasets", &Config::skip_unreadable, 0, 1,
+       "0 stops at the first frame that cannot be read, naming it; 1 skips such frames with "
+       "a warning (the matrix then has fewer rows, and the skipped frames are listed).",
+       true},
+      // Representation
+      {"Txt_name", "Representation", &Config::txt_name, 0, 0,
+       "Output: the normalised matrix M' (or M'' when Threshold is set, as the original) as "
+       "space-separated text, one row per line. Empty: not written (text is slow and large "
+       "for long runs).",
+       false},
+      {"Npy_name", "Representation", &Config::npy_name, 0, 0,
+       "Output: the normalised matrix M' (before any threshold) as a float32 NumPy .npy "
+       "file (numpy.load reads it). Empty: not written.",
+       true},
+      {"Png_name", "Representation", &Config::png_name, 0, 0,
+       "Output: the normalised matrix M' as a colour image, one pixel per pair of frames, "
+       "coloured with Matrix_color. Empty: not written.",
+       false},
+      {"Png_threshold_name", "Representation", &Config::png_threshold_name, 0, 0,
+       "Output when Threshold is set: the thresholded matrix M'' as an image (black = loop "
+       "candidate, M' < Threshold; white = not). Empty: Png_name with _thresholded before the "
+       "extension.",
+       true},
+      {"Matrix_color", "Representation", &Config::matrix_color, 0, 11,
+       "Colour map of Png_name, as the original's 12 maps (docs/output_formats.md): 0 grey, "
+       "1 red, 2 green, 3 blue, 4-11 two-colour ramps.",
+       false},
+      {"Show_images", "Representation", &Config::show_images, 0, 1,
+       "1 shows each frame in a window while it is described (needs a display; ignored with "
+       "a warning when there is none).",
+       false},
+      // Description and matching
+      {"Camera_type", "Description and matching", &Config::camera_type, 0, 2,
+       "0 monocular (ABLE-M); 1 stereo (ABLE-S) and 2 panoramic (ABLE-P) are not built yet "
+       "and are rejected.",
+       false},
+      {"Description_type", "Description and matching", &Config::description_type, 0, 1,
+       "0 global: the frame is resized to Patch_size x Patch_size and described at its centre; "
+       "1 grid: the frame is cut into Grid_x x Grid_y cells, each resized to Patch_size and "
+       "described at its centre, and the descriptors are concatenated.",
+       false},
+      {"Patch_size", "Description and matching", &Config::patch_size, 16, 1024,
+       "Side of the square patch in pixels (64 in the ABLE papers). HOG needs a multiple of "
+       "8. Used as given for every descriptor (the original forced 128 for ORB).",
+       false},
+      {"Grid_x", "Description and matching", &Config::grid_x, 1, 64,
+       "Grid cells across the frame (Description_type 1).", false},
+      {"Grid_y", "Description and matching", &Config::grid_y, 1, 64,
+       "Grid cells down the frame (Description_type 1).", false},
+      {"Panoramas", "Description and matching", &Config::panoramas, 1, 64,
+       "Sub-panoramas of a panoramic frame (Camera_type 2, not built yet).", false},
+      {"Illumination_invariance", "Description and matching", &Config::illumination_invariance,
+       0, 1, "1 applies the illumination invariant transform of Eq. 6 (not built yet).", false},
+      {"Alpha", "Description and matching", &Config::alpha, 0, 1,
+       "Alpha of Eq. 6 (0.47 for KITTI's PointGrey Flea2).", false},
+      {"Image_descriptor", "Description and matching", &Config::image_descriptor, 0, 0,
+       "LDB, ORB, BRISK (binary, Hamming distance) or SIFT, HOG (vector, L2 distance). "
+       "D-LDB, BRIEF and FREAK are not built yet; SURF is not available (non-free, absent "
+       "from Debian's OpenCV).",
+       false},
+      {"Image_sequences", "Description and matching", &Config::image_sequences, 1, 100000,
+       "Sequence length L: the distance of two places sums L single-frame distances along "
+       "the diagonal; 1 = single images. Frames with fewer than L predecessors in their "
+       "traversal use the available terms scaled to L.",
+       false},
+      {"Threshold", "Description and matching", &Config::threshold, -1, 1,
+       "Theta of Eq. 9: M'' = 0 where M' < Threshold, 1 elsewhere. -1 disables; otherwise "
+       "in [0, 1].",
+       false},
+      {"Ldb_bits", "Description and matching", &Config::ldb_bits, 1, 1386,
+       "Bits of the LDB descriptor (256 = 32 bytes, as in ABLE-P; 1386 = every test of the "
+       "2x2 to 5x5 grids). See docs/descriptors.md for the selection.",
+       true},
+      {"Threads", "Description and matching", &Config::threads, 0, 1024,
+       "Worker threads for description and matching; 0 = all cores.", true},
+  };
+  return table;
+}
+
+std::string Trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string::npos) return "";
+  const auto e = s.find_last_not_of(" \t\r\n");
+  return s.substr(b, e - b + 1);
+}
+
+std::string Lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+// Edit distance, for "did you mean".
+int Levenshtein(const std::string& a, const std::string& b) {
+  std::vector<int> prev(b.size() + 1), cur(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) prev[j] = static_cast<int>(j);
+  for (size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = static_cast<int>(i);
+    for (size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1])});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+const Binding* Find(const std::string& key) {
+  for (const auto& b : Bindings())
+    if (key == b.key) return &b;
+  return nullptr;
+}
+
+std::string Nearest(const std::string& key) {
+  std::string best;
+  int best_d = std::numeric_limits<int>::max();
+  for (const auto& b : Bindings()) {
+    const int d = Levenshtein(Lower(key), Lower(b.key));
+    if (d < best_d) best_d = d, best = b.key;
+  }
+  return best_d <= std::max<int>(3, static_cast<int>(key.size()) / 3) ? best : "";
+}
+
+std::string Quote(const std::string& v) { return "\"" + v + "\""; }
+
+std::string FormatNumber(double v) {
+  if (std::isinf(v)) return "inf";
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+std::string RangeText(const Binding& b) {
+  if (std::holds_alternative<std::string Config::*>(b.field)) return "text";
+  const bool is_int = std::holds_alternative<int Config::*>(b.field);
+  const char* kind = is_int ? "integer" : "number";
+  if (std::isinf(b.max)) return std::string(kind) + " >= " + FormatNumber(b.min);
+  return std::string(kind) + " in [" + FormatNumber(b.min) + ", " + FormatNumber(b.max) + "]";
+}
+
+std::string ValueText(const Config& c, const Binding& b) {
+  if (auto p = std::get_if<int Config::*>(&b.field)) return std::to_string(c.**p);
+  if (auto p = std::get_if<double Config::*>(&b.field)) return FormatNumber(c.**p);
+  return Quote(c.*std::get<std::string Config::*>(b.field));
+}
+
+// Strips the quotes of a YAML scalar ("..." or '...'); unquoted text is taken as is.
+std::string Unquote(const std::string& v, const std::string& where, const std::string& key) {
+  if (v.size() >= 1 && (v.front() == '"' || v.front() == '\'')) {
+    if (v.size() < 2 || v.back() != v.front())
+      throw InputError(where + ": " + key + ": unterminated quoted value " + v);
+    return v.substr(1, v.size() - 2);
+  }
+  return v;
+}
+
+void Assign(Config& c, const Binding& b, const std::string& raw, const std::string& where) {
+  const std::string value = Unquote(raw, where, b.key);
+  auto fail = [&](const std::string& expected) {
+    throw InputError(where + ": " + b.key + ": value " + Quote(value) + " is not valid; expected " +
+                     expected);
+  };
+  if (auto p = std::get_if<std::string Config::*>(&b.field)) {
+    c.**p = value;
+    return;
+  }
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(value.c_str(), &end);
+  if (value.empty() || end != value.c_str() + value.size() || errno == ERANGE || !std::isfinite(v))
+    fail(RangeText(b));
+  if (auto p = std::get_if<int Config::*>(&b.field)) {
+    if (v != std::floor(v)) fail(RangeText(b));
+    if (v < b.min || v > b.max || std::fabs(v) > std::numeric_limits<int>::max()) fail(RangeText(b));
+    c.**p = static_cast<int>(v);
+  } else {
+    if (v < b.min || v > b.max) fail(RangeText(b));
+    c.*std::get<double Config::*>(b.field) = v;
+  }
+}
+
+const Binding& Lookup(const std::string& key, const std::string& where) {
+  if (const Binding* b = Find(key)) return *b;
+  const std::string near = Nearest(key);
+  throw InputError(where + ": unknown key " + Quote(key) +
+                   (near.empty() ? "" : "; did you mean " + Quote(near) + "?") +
+                   " (Test_OpenABLE --help lists every key)");
+}
+
+// Removes a '#' comment that is not inside quotes.
+std::string StripComment(const std::string& line) {
+  char quote = 0;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char ch = line[i];
+    if (quote) {
+      if (ch == quote) quote = 0;
+    } else if (ch == '"' || ch == '\'') {
+      quote = ch;
+    } else if (ch == '#') {
+      return line.substr(0, i);
+    }
+  }
+  return line;
+}
+
+}  // namespace
+
+bool Config::operator==(const Config& o) const {
+  for (const auto& b : Bindings())
+    if (ValueText(*this, b) != ValueText(o, b)) return false;
+  return true;
+}
+
+Config LoadConfig(const std::string& path) {
+  std::ifstream in(path);
+  if (!in)
+    throw InputError("configuration file " + Quote(path) +
+                     " cannot be opened (expected a readable Config.txt; see Test_OpenABLE --help)");
+  Config config;
+  std::map<std::string, int> seen;
+  std::string line;
+  int number = 0;
+  bool any_key = false;
+  while (std::getline(in, line)) {
+    ++number;
+    const std::string where = path + ":" + std::to_string(number);
+    std::string text = Trim(StripComment(line));
+    if (number == 1 && !text.empty() && text[0] == '\xEF') text = Trim(text.substr(3));  // BOM
+    if (text.empty() || text.rfind("%YAML", 0) == 0 || text == "---" || text == "...") continue;
+    const auto colon = text.find(':');
+    if (colon == std::string::npos || colon == 0)
+      throw InputError(where + ": line " + Quote(Trim(line)) +
+                       " is not of the form Key: value");
+    const std::string key = Trim(text.substr(0, colon));
+    const std::string value = Trim(text.substr(colon + 1));
+    const Binding& b = Lookup(key, where);
+    if (auto it = seen.find(key); it != seen.end())
+      throw InputError(where + ": " + key + ": given twice (first at line " +
+                       std::to_string(it->second) + ")");
+    seen[key] = number;
+    Assign(config, b, value, where);
+    any_key = true;
+  }
+  if (in.bad()) throw InputError("configuration file " + Quote(path) + " could not be read");
+  if (!any_key)
+    throw InputError("configuration file " + Quote(path) +
+                     " holds no key (expected lines of the form Key: value)");
+  return config;
+}
+
+void ApplyOverride(Config& config, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError("--set: " + Quote(assignment) + " is not of the form Key=Value");
+  const std::string key = Trim(assignment.substr(0, eq));
+  Assign(config, Lookup(key, "--set"), Trim(assignment.substr(eq + 1)), "--set");
+}
+
+void CheckConfig(const Config& c) {
+  auto need = [](const std::string& value, const std::string& key, const std::string& why) {
+    if (value.empty()) throw InputError(key + ": empty; expected a path (" + why + ")");
+  };
+  if (c.camera_type == 1)
+    throw InputError(
+        "Camera_type: 1 (stereo, ABLE-S) is not built yet; expected 0 (monocular)");
+  if (c.camera_type == 2)
+    throw InputError(
+        "Camera_type: 2 (panoramic, ABLE-P) is not built yet; expected 0 (monocular)");
+  if (c.illumination_invariance == 1)
+    throw InputError("Illumination_invariance: 1 is not built yet; expected 0");
+  switch (c.frame_mode) {
+    case 0:
+      need(c.images_path, "Images_path", "Frame_mode 0 reads an image folder");
+      break;
+    case 1:
+      need(c.video_path_1, "Video_path_1", "Frame_mode 1 reads a video");
+      break;
+    default:
+      need(c.video_path_1, "Video_path_1", "Frame_mode 2 reads two videos");
+      need(c.video_path_2, "Video_path_2", "Frame_mode 2 reads two videos");
+  }
+  if (c.final_image != -1 && c.final_image <= c.initial_image)
+    throw InputError("Final_image: " + std::to_string(c.final_image) +
+                     " is not after Initial_image " + std::to_string(c.initial_image) +
+                     "; expected -1 (to the end) or a position > Initial_image");
+  if (c.threshold != -1.0 && (c.threshold < 0.0 || c.threshold > 1.0))
+    throw InputError("Threshold: " + FormatNumber(c.threshold) +
+                     " is not valid; expected -1 (disabled) or a number in [0, 1]");
+}
+
+std::string FormatConfig(const Config& c) {
+  std::ostringstream os;
+  os << "%YAML:1.0\n";
+  std::string group;
+  for (const auto& b : Bindings()) {
+    if (group != b.group) {
+      group = b.group;
+      os << "\n# --- " << group << " ---\n";
+    }
+    os << "# " << b.meaning << "\n" << b.key << ": " << ValueText(c, b) << "\n";
+  }
+  return os.str();
+}
+
+std::string ConfigHelpText() {
+  const Config defaults;
+  std::ostringstream os;
+  std::string group;
+  for (const auto& b : Bindings()) {
+    if (group != b.group) {
+      group = b.group;
+      os << "\n" << group << ":\n";
+    }
+    os << "  " << b.key << (b.is_new ? " (new)" : "") << "  [" << RangeText(b)
+       << ", default " << ValueText(defaults, b) << "]\n";
+    // Wrap the meaning at about 90 columns, indented.
+    std::istringstream words(b.meaning);
+    std::string word, line = "      ";
+    while (words >> word) {
+      if (line.size() + word.size() + 1 > 92) {
+        os << line << "\n";
+        line = "      ";
+      }
+      line += (line.size() > 6 ? " " : "") + word;
+    }
+    os << line << "\n";
+  }
+  return os.str();
+}
+
+std::string ConfigMarkdownReference() {
+  const Config defaults;
+  std::ostringstream os;
+  std::string group;
+  for (const auto& b : Bindings()) {
+    if (group != b.group) {
+      group = b.group;
+      os << "\n### " << group << "\n\n| key | values | default | meaning |\n|---|---|---|---|\n";
+    }
+    std::string meaning = b.meaning;
+    std::string::size_type pos = 0;
+    while ((pos = meaning.find('|', pos)) != std::string::npos) meaning.replace(pos, 1, "\\|"), pos += 2;
+    os << "| `" << b.key << "`" << (b.is_new ? " (new)" : "") << " | " << RangeText(b) << " | `"
+       << ValueText(defaults, b) << "` | " << meaning << " |\n";
+  }
+  return os.str();
+}
+
+std::vector<std::string> ConfigKeyNames() {
+  std::vector<std::string> names;
+  for (const auto& b : Bindings()) names.emplace_back(b.key);
+  return names;
+}
+
+}  // namespace openable

@@ -1,0 +1,87 @@
+// The configuration of a run: every Config.txt key bound once to a field of Config.
+//
+// The same table drives reading Config.txt, the `--set Key=Value` overrides, `--help` and the
+// configuration reference in docs/configuration.md (conventions.md, item 4). Key names and
+// meanings are those of the original OpenABLE (../shared/guide/reference.md), so an old
+// configuration runs unchanged; keys marked "new" are additions documented in the reference.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace openable {
+
+struct Config {
+  // --- Datasets ---------------------------------------------------------------------------
+  int frame_mode = 0;                 // 0 image folder(s), 1 one video, 2 two videos
+  std::string images_path;            // folder of the (first) image sequence
+  std::string images_path_2;          // new: folder of a second traversal, matched against the first
+  std::string images_path_left;       // stereo left folder (Camera_type 1)
+  std::string images_path_right;      // stereo right folder (Camera_type 1)
+  std::string calibration_path;       // stereo calibration (Camera_type 1)
+  std::string images_format;          // extension filter ("png"); empty = every image type
+  std::string video_path_1;           // video for Frame_mode 1 and 2
+  std::string video_path_2;           // second video for Frame_mode 2
+  int initial_image = 0;              // first position (natural order) to process
+  int final_image = -1;               // one past the last position; -1 = to the end
+  int skip_unreadable = 0;            // new: 1 skips unreadable frames with a warning
+  // --- Representation -----------------------------------------------------------------------
+  std::string txt_name;               // text matrix; empty = not written
+  std::string npy_name;               // new: float32 .npy of M'; empty = not written
+  std::string png_name;               // colour image of M'; empty = not written
+  std::string png_threshold_name;     // new: image of M''; empty = <Png_name>_thresholded.png
+  int matrix_color = 0;               // colour map 0-11
+  int show_images = 0;                // 1 shows frames while processing (needs a display)
+  // --- Description and matching -------------------------------------------------------------
+  int camera_type = 0;                // 0 monocular, 1 stereo, 2 panoramic
+  int description_type = 0;           // 0 global, 1 grid
+  int patch_size = 64;                // side of the square patch, pixels
+  int grid_x = 2;                     // grid cells across (Description_type 1)
+  int grid_y = 2;                     // grid cells down (Description_type 1)
+  int panoramas = 4;                  // sub-panoramas (Camera_type 2)
+  int illumination_invariance = 0;    // 1 applies Eq. 6
+  double alpha = 0.47;                // alpha of Eq. 6
+  std::string image_descriptor = "LDB";
+  int image_sequences = 1;            // sequence length L; 1 = single images
+  double threshold = -1.0;            // theta of Eq. 9 in [0, 1]; -1 disables
+  int ldb_bits = 256;                 // new: LDB bits kept, 1-1386
+  int threads = 0;                    // new: worker threads, 0 = all cores
+
+  bool operator==(const Config& other) const;
+  bool operator!=(const Config& other) const { return !(*this == other); }
+};
+
+// Where a value came from, for error messages: "Config.txt:12" or "--set".
+struct ConfigSource {
+  std::string where;
+};
+
+// Reads a configuration file: the flat "Key: value" subset of YAML that the original's
+// OpenCV FileStorage files use ("%YAML:1.0" first line optional, '#' comments, strings quoted
+// or not). Keys not present keep their defaults. Throws InputError with one line
+// "<file>:<line>: <Key>: <problem>" on a missing or unreadable file, a line that is not
+// "Key: value", an unknown key (naming the nearest valid one), a duplicated key, or a value
+// of the wrong type or out of range.
+Config LoadConfig(const std::string& path);
+
+// Applies one "Key=Value" override (from --set). Same checks and messages as LoadConfig.
+void ApplyOverride(Config& config, const std::string& assignment);
+
+// Cross-key checks that no single value shows (the mode's inputs are given, the threshold is
+// -1 or in [0, 1], parts not built yet are asked for, ...). Throws InputError naming the key.
+void CheckConfig(const Config& config);
+
+// Writes `config` in the same format LoadConfig reads (every key, with a comment each).
+std::string FormatConfig(const Config& config);
+
+// The keys for --help: grouped, one entry per key with its meaning, default and range.
+std::string ConfigHelpText();
+
+// The same information as a Markdown table, for docs/configuration.md.
+std::string ConfigMarkdownReference();
+
+// Every key name, in table order.
+std::vector<std::string> ConfigKeyNames();
+
+}  // namespace openable

@@ -1,0 +1,52 @@
+// The one descriptor interface of OpenABLE.
+//
+// A descriptor turns a square grey patch (CV_8UC1, side = patch_size) into one row of
+// Width() elements: bytes for binary descriptors (matched with the Hamming distance, Eq. 4 of
+// the OpenABLE paper) or floats for vector descriptors (matched with the L2 norm, Eq. 8).
+// The keypoint is the patch centre, with no dominant orientation and the patch as its scale,
+// as ABLE computes its global descriptor.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace openable {
+
+enum class DescriptorKind { kBinary, kFloat };
+enum class DistanceKind { kHamming, kL2 };
+
+// Options every descriptor may read; defaults are those of the ABLE papers.
+struct DescriptorOptions {
+  int patch_size = 64;  // side of the square patch, pixels, >= 16
+  int ldb_bits = 256;   // LDB bits kept after selection, 1..1386 (32 bytes = 256 in ABLE-P)
+};
+
+class Descriptor {
+ public:
+  virtual ~Descriptor() = default;
+  // Registry name, upper case as in Config.txt ("LDB", "ORB", ...).
+  virtual std::string Name() const = 0;
+  // Elements per row: bytes (kBinary) or floats (kFloat).
+  virtual int Width() const = 0;
+  virtual DescriptorKind Kind() const = 0;
+  DistanceKind Distance() const {
+    return Kind() == DescriptorKind::kBinary ? DistanceKind::kHamming : DistanceKind::kL2;
+  }
+  // Side of the square patch this descriptor expects.
+  virtual int PatchSize() const = 0;
+  // Describes `patch` (CV_8UC1, PatchSize() x PatchSize()) into `row`, a 1 x Width() matrix of
+  // CV_8U (binary) or CV_32F (float) that the caller allocated. Must be deterministic and safe
+  // to call from several threads at once. Throws std::logic_error on a patch of the wrong size
+  // or type.
+  virtual void Describe(const cv::Mat& patch, cv::Mat row) const = 0;
+};
+
+// CV type of one row element of a descriptor: CV_8U or CV_32F.
+inline int RowType(const Descriptor& d) {
+  return d.Kind() == DescriptorKind::kBinary ? CV_8U : CV_32F;
+}
+
+}  // namespace openable

@@ -1,0 +1,26 @@
+// The one table of descriptor names (conventions.md, item 2): descriptors are created only
+// here, from their configured name. Not self-registering: an explicit table.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "descriptors/descriptor.h"
+
+namespace openable {
+
+// Names that CreateDescriptor accepts, in the order shown to users.
+std::vector<std::string> RegisteredDescriptorNames();
+
+// Names the original OpenABLE knew that this build cannot provide, each with the reason
+// (SURF: patented, absent from Debian's OpenCV; others: not built yet).
+std::vector<std::pair<std::string, std::string>> UnavailableDescriptors();
+
+// Creates the descriptor `name` (case-insensitive). Throws InputError naming the value and
+// listing the valid names when `name` is unknown or unavailable, or when `options` do not
+// suit the descriptor (e.g. a HOG patch that is not a multiple of 8).
+std::unique_ptr<Descriptor> CreateDescriptor(const std::string& name,
+                                             const DescriptorOptions& options);
+
+}  // namespace openable

@@ -1,0 +1,154 @@
+// Test_OpenABLE: Config.txt in, normalised distance matrix out. A thin layer over the library.
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "OpenABLE/OpenABLE.h"
+
+namespace {
+
+constexpr int kInputError = 1;   // bad configuration or data: one line on stderr
+constexpr int kUsageError = 2;   // bad command line
+constexpr int kInternalError = 3;
+
+const char* kUsage =
+    "Usage: Test_OpenABLE [Config.txt] [--set Key=Value ...] [options]\n"
+    "\n"
+    "Computes the normalised distance matrix (Eq. 5 of the OpenABLE paper) between every pair\n"
+    "of frames of an image folder, a video, or two traversals of a route, and writes it as\n"
+    "text, .npy and colour PNG (see Txt_name, Npy_name, Png_name).\n"
+    "\n"
+    "Options:\n"
+    "  --set Key=Value   override one key of Config.txt (repeatable; also without a file)\n"
+    "  --quiet           no progress lines (errors and the final report are still printed)\n"
+    "  --print-config    print the configuration in effect (Config.txt format) and exit\n"
+    "  --help-markdown   print the key reference as Markdown (docs/configuration.md)\n"
+    "  --version         print the version\n"
+    "  -h, --help        this help\n"
+    "\n"
+    "Exit status: 0 success, 1 bad configuration or input data, 2 bad command line,\n"
+    "3 internal error.\n"
+    "\n"
+    "Example:\n"
+    "  Test_OpenABLE config/Config.txt --set Image_sequences=20 --set Image_descriptor=HOG\n"
+    "\n"
+    "Configuration keys (Config.txt: one 'Key: value' per line, '#' comments):\n";
+
+std::string Fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+void PrintReport(const openable::Config& c, const openable::RunResult& r,
+                 const std::vector<std::string>& written) {
+  std::cout << "OpenABLE " << openable::kVersion << ": " << r.descriptor << " ("
+            << r.row_width << (r.binary ? " bytes, Hamming" : " floats, L2") << "), "
+            << (c.description_type == 0 ? "global " : "grid ")
+            << (c.description_type == 0
+                    ? std::to_string(c.patch_size) + "x" + std::to_string(c.patch_size)
+                    : std::to_string(c.grid_x) + "x" + std::to_string(c.grid_y) + " cells of " +
+                          std::to_string(c.patch_size) + "x" + std::to_string(c.patch_size))
+            << ", sequence length " << c.image_sequences << "\n";
+  for (const auto& t : r.traversals) {
+    std::cout << "  " << t.key << ": " << t.frames << " frames of " << t.frame_size.width << "x"
+              << t.frame_size.height << " from \"" << t.path << "\" (rows " << t.first_row
+              << "-" << t.first_row + t.frames - 1 << ")\n";
+    for (const auto& s : t.skipped) std::cout << "    skipped: " << s << "\n";
+  }
+  const auto& tm = r.timings;
+  std::cout << "  matrix: " << r.normalized.rows << "x" << r.normalized.cols
+            << ", max distance " << r.max_distance << " (Eq. 5 divisor)";
+  if (!r.thresholded.empty())
+    std::cout << ", threshold " << c.threshold << ": "
+              << r.thresholded.total() - static_cast<size_t>(cv::countNonZero(r.thresholded))
+              << " cells below";
+  std::cout << "\nTimings (wall clock):\n"
+            << "  total            " << Fixed(tm.total_seconds, 3) << " s\n"
+            << "  description      " << Fixed(tm.describe_seconds, 3) << " s  ("
+            << Fixed(tm.frames ? 1e3 * tm.describe_seconds / tm.frames : 0, 3)
+            << " ms per image, " << tm.frames << " images, reading included)\n"
+            << "  matching         " << Fixed(tm.match_seconds, 3) << " s  ("
+            << Fixed(tm.pairs ? 1e9 * tm.match_seconds / static_cast<double>(tm.pairs) : 0, 1)
+            << " ns per pair, " << tm.pairs << " pairs)\n"
+            << "  sequences+norm.  " << Fixed(tm.sequence_seconds, 3) << " s\n"
+            << "  export           " << Fixed(tm.export_seconds, 3) << " s\n";
+  if (written.empty()) {
+    std::cout << "No output file was asked for (set Txt_name, Npy_name or Png_name).\n";
+  } else {
+    std::cout << "Wrote:\n";
+    for (const auto& p : written) std::cout << "  " << p << "\n";
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string config_path;
+  std::vector<std::string> overrides;
+  bool quiet = false, print_config = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "-h" || a == "--help") {
+      std::cout << kUsage << openable::ConfigHelpText();
+      return 0;
+    } else if (a == "--help-markdown") {
+      std::cout << openable::ConfigMarkdownReference();
+      return 0;
+    } else if (a == "--version") {
+      std::cout << "OpenABLE " << openable::kVersion << "\n";
+      return 0;
+    } else if (a == "--set") {
+      if (i + 1 >= argc) {
+        std::cerr << "Test_OpenABLE: --set needs Key=Value (see --help)\n";
+        return kUsageError;
+      }
+      overrides.push_back(argv[++i]);
+    } else if (a.rfind("--set=", 0) == 0) {
+      overrides.push_back(a.substr(6));
+    } else if (a == "--quiet" || a == "-q") {
+      quiet = true;
+    } else if (a == "--print-config") {
+      print_config = true;
+    } else if (!a.empty() && a[0] == '-') {
+      std::cerr << "Test_OpenABLE: unknown option \"" << a << "\" (see --help)\n";
+      return kUsageError;
+    } else if (config_path.empty()) {
+      config_path = a;
+    } else {
+      std::cerr << "Test_OpenABLE: more than one configuration file (\"" << config_path
+                << "\" and \"" << a << "\"); expected one (see --help)\n";
+      return kUsageError;
+    }
+  }
+  if (config_path.empty() && overrides.empty()) {
+    std::cerr << "Test_OpenABLE: no configuration file given; expected Test_OpenABLE "
+                 "Config.txt (see --help)\n";
+    return kUsageError;
+  }
+  try {
+    openable::Config config = config_path.empty() ? openable::Config() : openable::LoadConfig(config_path);
+    for (const auto& o : overrides) openable::ApplyOverride(config, o);
+    if (print_config) {
+      std::cout << openable::FormatConfig(config);
+      return 0;
+    }
+    openable::ProgressReporter progress(std::cerr, !quiet, openable::IsTerminal(2));
+    if (config.show_images == 1 && std::getenv("DISPLAY") == nullptr &&
+        std::getenv("WAYLAND_DISPLAY") == nullptr)
+      std::cerr << "Test_OpenABLE: warning: Show_images is 1 but there is no display "
+                   "(DISPLAY is not set); frames are not shown\n";
+    openable::RunResult result = openable::ComputeRun(config, progress);
+    const std::vector<std::string> written = openable::WriteOutputs(config, result);
+    PrintReport(config, result, written);
+    return 0;
+  } catch (const openable::InputError& e) {
+    std::cerr << "Test_OpenABLE: error: " << e.what() << "\n";
+    return kInputError;
+  } catch (const std::exception& e) {
+    std::cerr << "Test_OpenABLE: internal error (please report): " << e.what() << "\n";
+    return kInternalError;
+  }
+}

@@ -1,0 +1,35 @@
+// Pairwise distances between descriptor rows: Hamming (Eq. 4 of the OpenABLE paper: a real
+// count of differing bits, not the sum of XOR-ed bytes that the original computed) and L2
+// (Eq. 8).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include <opencv2/core.hpp>
+
+namespace openable {
+
+// Called now and then with (pairs done, pairs in all); may be empty. Called from one thread
+// at a time.
+using PairProgress = std::function<void(std::int64_t done, std::int64_t total)>;
+
+// Number of bits that differ between the byte strings a and b of `bytes` bytes.
+int HammingDistance(const std::uint8_t* a, const std::uint8_t* b, int bytes);
+
+// Distances between every row of `a` (N x W, CV_8U) and every row of `b` (M x W, CV_8U):
+// an N x M matrix of bit counts, stored as float. When `b` is empty, b = a and the result
+// is symmetric with a zero diagonal (only one triangle is computed). Rows are processed in
+// parallel on `threads` threads (0 = all cores).
+cv::Mat1f HammingDistances(const cv::Mat& a, const cv::Mat& b = cv::Mat(), int threads = 0,
+                           const PairProgress& progress = {});
+
+// Euclidean distances between the rows of `a` (N x W, CV_32F) and `b` (M x W, CV_32F); b
+// empty means b = a (symmetric, zero diagonal). Computed through one matrix product,
+// |a|^2 + |b|^2 - 2 a.b (Eigen); cells where that form loses precision to cancellation
+// (distance small against the norms) are recomputed directly, so every cell is within
+// float rounding of the direct sum.
+cv::Mat1f L2Distances(const cv::Mat& a, const cv::Mat& b = cv::Mat(), int threads = 0,
+                      const PairProgress& progress = {});
+
+}  // namespace openable

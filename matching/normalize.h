@@ -1,0 +1,15 @@
+// Normalisation (Eq. 5 of the OpenABLE paper) and thresholding (Eq. 9).
+#pragma once
+
+#include <opencv2/core.hpp>
+
+namespace openable {
+
+// Eq. 5: M' = M / max(M). Returns max(M). A matrix whose maximum is 0 (every frame identical)
+// is left at 0. Throws std::logic_error on a negative or non-finite entry.
+float NormalizeByMax(cv::Mat1f& m);
+
+// Eq. 9: M'' = 0 where M' < theta, 1 otherwise. 0 marks a loop candidate (a small distance).
+cv::Mat1b ThresholdMatrix(const cv::Mat1f& normalized, float theta);
+
+}  // namespace openable

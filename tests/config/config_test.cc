@@ -1,0 +1,191 @@
+#include "config/config.h"
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "OpenABLE/base/error.h"
+#include "tests/test_support.h"
+
+namespace openable {
+namespace {
+
+std::string WriteFile(const std::string& text) {
+  const std::string path = testing::TempDir() + "/Config.txt";
+  std::ofstream(path) << text;
+  return path;
+}
+
+// Runs `f`, expects an InputError, and returns its message.
+template <typename F>
+std::string ErrorOf(F f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError thrown";
+  return "";
+}
+
+TEST(Config, ReadsTheOriginalFormat) {
+  const std::string path = WriteFile(
+      "%YAML:1.0\n"
+      "# a comment\n"
+      "Frame_mode: 0\n"
+      "Images_path: \"/data/seq # not a comment\"\n"
+      "Images_format: png   # trailing comment\n"
+      "Initial_image: 10\n"
+      "Final_image: 200\n"
+      "Txt_name: 'out.txt'\n"
+      "Camera_type: 0\n"
+      "Image_descriptor: ORB\n"
+      "Patch_size: 48\n"
+      "Image_sequences: 7\n"
+      "Threshold: 0.25\n"
+      "Show_images: 0\n");
+  const Config c = LoadConfig(path);
+  EXPECT_EQ(c.images_path, "/data/seq # not a comment");
+  EXPECT_EQ(c.images_format, "png");
+  EXPECT_EQ(c.initial_image, 10);
+  EXPECT_EQ(c.final_image, 200);
+  EXPECT_EQ(c.txt_name, "out.txt");
+  EXPECT_EQ(c.image_descriptor, "ORB");
+  EXPECT_EQ(c.patch_size, 48);
+  EXPECT_EQ(c.image_sequences, 7);
+  EXPECT_DOUBLE_EQ(c.threshold, 0.25);
+  // Keys not given keep their defaults.
+  EXPECT_EQ(c.matrix_color, 0);
+  EXPECT_EQ(c.ldb_bits, 256);
+}
+
+TEST(Config, RoundTripsEveryKey) {
+  Config c;
+  c.frame_mode = 2;
+  c.video_path_1 = "a b.avi";
+  c.video_path_2 = "/x/y.mp4";
+  c.images_path_2 = "winter";
+  c.matrix_color = 11;
+  c.alpha = 0.123;
+  c.threshold = 0.5;
+  c.image_descriptor = "HOG";
+  c.ldb_bits = 1386;
+  c.threads = 3;
+  c.final_image = 77;
+  const Config back = LoadConfig(WriteFile(FormatConfig(c)));
+  EXPECT_EQ(back, c);
+  EXPECT_NE(back, Config());
+  EXPECT_EQ(back.video_path_1, "a b.avi");
+  EXPECT_DOUBLE_EQ(back.alpha, 0.123);
+}
+
+TEST(Config, MissingFileNamesIt) {
+  const std::string msg = ErrorOf([] { LoadConfig("/no/such/Config.txt"); });
+  EXPECT_NE(msg.find("/no/such/Config.txt"), std::string::npos) << msg;
+}
+
+TEST(Config, UnknownKeySuggestsTheNearest) {
+  const std::string msg = ErrorOf([&] { LoadConfig(WriteFile("Patch_sise: 64\n")); });
+  EXPECT_NE(msg.find("Config.txt:1"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("\"Patch_sise\""), std::string::npos) << msg;
+  EXPECT_NE(msg.find("did you mean \"Patch_size\""), std::string::npos) << msg;
+  const std::string far = ErrorOf([&] { LoadConfig(WriteFile("Zzzzzzzzzzzzzzzzzz: 1\n")); });
+  EXPECT_EQ(far.find("did you mean"), std::string::npos) << far;
+}
+
+TEST(Config, WrongTypeAndOutOfRangeNameKeyValueAndRange) {
+  struct Case {
+    const char* text;
+    const char* expect;
+  };
+  const Case cases[] = {
+      {"Camera_type: 7\n", "Camera_type: value \"7\" is not valid; expected integer in [0, 2]"},
+      {"Patch_size: big\n", "Patch_size: value \"big\""},
+      {"Patch_size: 64.5\n", "Patch_size: value \"64.5\""},
+      {"Patch_size: 8\n", "expected integer in [16, 1024]"},
+      {"Threshold: 1.5\n", "Threshold: value \"1.5\""},
+      {"Matrix_color: 12\n", "expected integer in [0, 11]"},
+      {"Image_sequences: 0\n", "Image_sequences: value \"0\""},
+      {"Alpha: nan\n", "Alpha: value \"nan\""},
+      {"Frame_mode:\n", "Frame_mode: value \"\""},
+  };
+  for (const auto& c : cases) {
+    const std::string msg = ErrorOf([&] { LoadConfig(WriteFile(c.text)); });
+    EXPECT_NE(msg.find(c.expect), std::string::npos) << c.text << " -> " << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+}
+
+TEST(Config, MalformedLinesDuplicatesAndEmptyFiles) {
+  EXPECT_NE(ErrorOf([&] { LoadConfig(WriteFile("Frame_mode 0\n")); }).find("Key: value"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { LoadConfig(WriteFile("Frame_mode: 0\nFrame_mode: 1\n")); })
+                .find("given twice (first at line 1)"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { LoadConfig(WriteFile("%YAML:1.0\n# nothing\n")); }).find("no key"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { LoadConfig(WriteFile("Images_path: \"abc\n")); }).find("unterminated"),
+            std::string::npos);
+}
+
+TEST(Config, OverridesUseTheSameBinding) {
+  Config c;
+  ApplyOverride(c, "Image_sequences=12");
+  ApplyOverride(c, "Images_path = /tmp/x");
+  EXPECT_EQ(c.image_sequences, 12);
+  EXPECT_EQ(c.images_path, "/tmp/x");
+  EXPECT_NE(ErrorOf([&] { ApplyOverride(c, "Image_sequence=3"); }).find("did you mean \"Image_sequences\""),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ApplyOverride(c, "Patch_size"); }).find("Key=Value"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ApplyOverride(c, "Threads=-1"); }).find("--set: Threads"), std::string::npos);
+}
+
+TEST(Config, CrossKeyChecks) {
+  Config c;
+  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Images_path: empty"), std::string::npos);
+  c.images_path = "x";
+  CheckConfig(c);
+  c.camera_type = 1;
+  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Camera_type: 1"), std::string::npos);
+  c.camera_type = 0;
+  c.frame_mode = 2;
+  c.video_path_1 = "a.avi";
+  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Video_path_2"), std::string::npos);
+  c.frame_mode = 0;
+  c.initial_image = 5;
+  c.final_image = 5;
+  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Final_image: 5"), std::string::npos);
+  c.final_image = -1;
+  c.threshold = -0.5;
+  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Threshold: -0.5"), std::string::npos);
+}
+
+TEST(Config, HelpAndReferenceListEveryKey) {
+  const std::string help = ConfigHelpText(), md = ConfigMarkdownReference();
+  for (const auto& key : ConfigKeyNames()) {
+    EXPECT_NE(help.find("  " + key + " "), std::string::npos) << key;
+    EXPECT_NE(md.find("`" + key + "`"), std::string::npos) << key;
+  }
+}
+
+TEST(Config, DocsReferenceIsUpToDate) {
+  // docs/configuration.md embeds ConfigMarkdownReference() between two markers; regenerate it
+  // with `Test_OpenABLE --help-markdown` when a key changes.
+  std::ifstream in(testing::SourceDir() + "/docs/configuration.md");
+  ASSERT_TRUE(in) << "docs/configuration.md missing";
+  const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string begin = "<!-- BEGIN KEYS -->\n", end = "<!-- END KEYS -->";
+  const auto b = doc.find(begin), e = doc.find(end);
+  ASSERT_NE(b, std::string::npos);
+  ASSERT_NE(e, std::string::npos);
+  EXPECT_EQ(doc.substr(b + begin.size(), e - b - begin.size()), ConfigMarkdownReference());
+}
+
+TEST(Config, ShippedConfigFilesLoad) {
+  const Config c = LoadConfig(testing::SourceDir() + "/config/Config.txt");
+  CheckConfig(c);
+  EXPECT_EQ(c.image_descriptor, "LDB");
+}
+
+}  // namespace
+}  // namespace openable

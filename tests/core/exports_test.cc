@@ -1,0 +1,134 @@
+#include "OpenABLE/exports.h"
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "OpenABLE/base/error.h"
+#include "tests/test_support.h"
+
+namespace openable {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+TEST(ColorMaps, MatchTheOriginalTable) {
+  // (b, g, r) of s = 0.25 for each of the 12 maps, worked out by hand from reference.md.
+  const float s = 0.25f;
+  const cv::Vec3f expected[12] = {
+      {s, s, s},     {0, 0, s},      {0, s, 0},     {s, 0, 0},
+      {0.75f, 0.75f, s}, {0.75f, s, 0.75f}, {s, 0.75f, 0.75f}, {0, s, 1},
+      {1, 0.75f, s}, {0.4980f * s, 0.7804f * s, s}, {0.75f, s, 1}, {0, 0.625f, s}};
+  for (int map = 0; map < 12; ++map)
+    for (int k = 0; k < 3; ++k) EXPECT_FLOAT_EQ(ColorOf(s, map)[k], expected[map][k]) << map;
+  EXPECT_THROW(ColorOf(s, 12), std::logic_error);
+}
+
+TEST(ColorMaps, ColorizeScalesTo8Bit) {
+  const cv::Mat1f m = (cv::Mat1f(1, 3) << 0.f, 0.5f, 1.f);
+  const cv::Mat3b grey = ColorizeMatrix(m, 0);
+  EXPECT_EQ(grey(0, 0), cv::Vec3b(0, 0, 0));
+  EXPECT_EQ(grey(0, 1), cv::Vec3b(128, 128, 128));  // 127.5 rounds to 128
+  EXPECT_EQ(grey(0, 2), cv::Vec3b(255, 255, 255));
+  const cv::Mat3b red = ColorizeMatrix(m, 1);
+  EXPECT_EQ(red(0, 2), cv::Vec3b(0, 0, 255));
+}
+
+TEST(Npy, HeaderAndDataFollowTheFormat) {
+  cv::Mat1f m(3, 5);
+  for (int k = 0; k < 15; ++k) m(k / 5, k % 5) = 0.5f * k - 1.f;
+  const std::string bytes = EncodeNpy(m);
+  ASSERT_GE(bytes.size(), 10u);
+  EXPECT_EQ(bytes.substr(0, 6), std::string("\x93NUMPY", 6));
+  EXPECT_EQ(bytes[6], 1);
+  EXPECT_EQ(bytes[7], 0);
+  const size_t header_len = static_cast<unsigned char>(bytes[8]) |
+                            (static_cast<unsigned char>(bytes[9]) << 8);
+  EXPECT_EQ((10 + header_len) % 64, 0u);
+  const std::string header = bytes.substr(10, header_len);
+  EXPECT_EQ(header.back(), '\n');
+  EXPECT_NE(header.find("'descr': '<f4'"), std::string::npos) << header;
+  EXPECT_NE(header.find("'fortran_order': False"), std::string::npos);
+  EXPECT_NE(header.find("'shape': (3, 5)"), std::string::npos);
+  ASSERT_EQ(bytes.size(), 10 + header_len + 15 * 4);
+  for (int k = 0; k < 15; ++k) {
+    float v;
+    std::memcpy(&v, bytes.data() + 10 + header_len + 4 * k, 4);
+    EXPECT_EQ(v, 0.5f * k - 1.f);
+  }
+}
+
+TEST(Npy, NumpyReadsIt) {
+  const char* python = "/usr/bin/python3";
+  if (!fs::exists(python) || std::system("/usr/bin/python3 -c 'import numpy' 2>/dev/null") != 0)
+    GTEST_SKIP() << "python3 with numpy absent (apt-get install python3-numpy)";
+  cv::Mat1f m(4, 2);
+  for (int k = 0; k < 8; ++k) m(k / 2, k % 2) = static_cast<float>(k) / 8.f;
+  const std::string path = testing::TempDir() + "/m.npy";
+  std::ofstream(path, std::ios::binary) << EncodeNpy(m);
+  const std::string cmd = std::string(python) +
+                          " -c \"import numpy as n; a=n.load('" + path +
+                          "'); assert a.dtype==n.float32 and a.shape==(4,2) and "
+                          "abs(a[3,1]-7/8)<1e-7 and abs(a[1,0]-2/8)<1e-7\"";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+}
+
+TEST(Text, SpaceSeparatedRows) {
+  const cv::Mat1f m = (cv::Mat1f(2, 3) << 0.f, 0.5f, 1.f, 0.123456789f, 1e-7f, 0.25f);
+  EXPECT_EQ(EncodeText(m), "0 0.5 1\n0.123457 1e-07 0.25\n");
+  const cv::Mat1b t = (cv::Mat1b(2, 2) << 0, 1, 1, 0);
+  EXPECT_EQ(EncodeText(t), "0 1\n1 0\n");
+}
+
+TEST(Png, DecodesToTheSamePixels) {
+  cv::Mat3b img(4, 6, cv::Vec3b(10, 20, 30));
+  img(1, 2) = cv::Vec3b(255, 0, 7);
+  const std::string bytes = EncodePng(img);
+  const cv::Mat back = cv::imdecode(std::vector<uchar>(bytes.begin(), bytes.end()), cv::IMREAD_COLOR);
+  ASSERT_EQ(back.size(), img.size());
+  EXPECT_EQ(cv::norm(back, img, cv::NORM_INF), 0.0);
+}
+
+TEST(OutputBatch, NothingVisibleUntilCommit) {
+  const std::string dir = testing::TempDir();
+  {
+    OutputBatch batch;
+    batch.Stage("Txt_name", dir + "/a.txt", "hello");
+    batch.Stage("Npy_name", dir + "/sub/b.npy", "bytes");  // folder created on demand
+    EXPECT_FALSE(fs::exists(dir + "/a.txt"));
+    batch.Commit();
+  }
+  EXPECT_EQ(ReadAll(dir + "/a.txt"), "hello");
+  EXPECT_EQ(ReadAll(dir + "/sub/b.npy"), "bytes");
+}
+
+TEST(OutputBatch, FailureLeavesNoFile) {
+  const std::string dir = testing::TempDir();
+  fs::create_directories(dir + "/is_a_folder.png");
+  {
+    OutputBatch batch;
+    batch.Stage("Txt_name", dir + "/a.txt", "hello");
+    try {
+      batch.Stage("Png_name", dir + "/is_a_folder.png", "x");
+      FAIL() << "expected an InputError";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("Png_name"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("is_a_folder.png"), std::string::npos) << e.what();
+    }
+  }  // destroyed without commit
+  EXPECT_FALSE(fs::exists(dir + "/a.txt"));
+  for (const auto& entry : fs::directory_iterator(dir))
+    EXPECT_EQ(entry.path().filename(), "is_a_folder.png") << "left behind: " << entry.path();
+}
+
+}  // namespace
+}  // namespace openable

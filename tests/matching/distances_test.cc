@@ -1,0 +1,121 @@
+#include "matching/distances.h"
+
+#include <bitset>
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+namespace openable {
+namespace {
+
+cv::Mat RandomBytes(int rows, int cols, unsigned seed) {
+  std::mt19937 rng(seed);
+  cv::Mat m(rows, cols, CV_8U);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) m.at<std::uint8_t>(i, j) = static_cast<std::uint8_t>(rng());
+  return m;
+}
+
+// Brute force: count the differing bits one bit at a time.
+int BitCount(const cv::Mat& a, int i, const cv::Mat& b, int j) {
+  int bits = 0;
+  for (int k = 0; k < a.cols; ++k)
+    for (int bit = 0; bit < 8; ++bit)
+      bits += ((a.at<std::uint8_t>(i, k) >> bit) & 1) != ((b.at<std::uint8_t>(j, k) >> bit) & 1);
+  return bits;
+}
+
+TEST(HammingDistance, CountsBitsNotBytes) {
+  // 0x01 vs 0x80 differ in 2 bits; the original's "sum of XOR-ed bytes" would say 129.
+  const std::uint8_t a[1] = {0x01}, b[1] = {0x80};
+  EXPECT_EQ(HammingDistance(a, b, 1), 2);
+  const std::uint8_t c[9] = {0xFF, 0, 0, 0, 0, 0, 0, 0, 0x0F}, z[9] = {};
+  EXPECT_EQ(HammingDistance(c, z, 9), 12);
+}
+
+class HammingWidths : public ::testing::TestWithParam<int> {};
+
+TEST_P(HammingWidths, MatrixMatchesBruteForce) {
+  const int width = GetParam();
+  const cv::Mat a = RandomBytes(37, width, 1 + width), b = RandomBytes(23, width, 99 + width);
+  for (int threads : {1, 2, 3}) {
+    const cv::Mat1f cross = HammingDistances(a, b, threads);
+    ASSERT_EQ(cross.rows, 37);
+    ASSERT_EQ(cross.cols, 23);
+    for (int i = 0; i < a.rows; ++i)
+      for (int j = 0; j < b.rows; ++j) ASSERT_EQ(cross(i, j), BitCount(a, i, b, j)) << i << "," << j;
+    const cv::Mat1f self = HammingDistances(a, cv::Mat(), threads);
+    for (int i = 0; i < a.rows; ++i)
+      for (int j = 0; j < a.rows; ++j) ASSERT_EQ(self(i, j), BitCount(a, i, a, j)) << i << "," << j;
+    for (int i = 0; i < a.rows; ++i)
+      EXPECT_EQ(HammingDistance(a.ptr<std::uint8_t>(i), b.ptr<std::uint8_t>(0), width),
+                BitCount(a, i, b, 0));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Widths, HammingWidths, ::testing::Values(1, 7, 8, 9, 32, 64, 174));
+
+TEST(HammingDistances, ReportsProgressUpToTheTotal) {
+  const cv::Mat a = RandomBytes(50, 32, 5);
+  std::int64_t last = -1, total_seen = 0;
+  HammingDistances(a, cv::Mat(), 2, [&](std::int64_t done, std::int64_t total) {
+    EXPECT_GE(done, last);
+    last = done;
+    total_seen = total;
+  });
+  EXPECT_EQ(total_seen, 50 * 49 / 2);
+  EXPECT_EQ(last, total_seen);
+}
+
+TEST(HammingDistances, RejectsMismatchedWidths) {
+  EXPECT_THROW(HammingDistances(RandomBytes(2, 8, 1), RandomBytes(2, 9, 1)), std::logic_error);
+  EXPECT_THROW(HammingDistances(cv::Mat1f(2, 8, 0.f)), std::logic_error);
+}
+
+double DirectL2(const cv::Mat& a, int i, const cv::Mat& b, int j) {
+  double s = 0;
+  for (int k = 0; k < a.cols; ++k) {
+    const double d = static_cast<double>(a.at<float>(i, k)) - b.at<float>(j, k);
+    s += d * d;
+  }
+  return std::sqrt(s);
+}
+
+TEST(L2Distances, MatchesDirectSumIncludingNearDuplicates) {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> g(0.f, 1.f);
+  const int d = 300;
+  cv::Mat1f a(40, d), b(30, d);
+  for (auto& v : a) v = 5.f + g(rng);  // large common offset: cancellation-prone
+  for (int j = 0; j < b.rows; ++j)
+    for (int k = 0; k < d; ++k)
+      b(j, k) = j < 10 ? a(j, k) + 1e-3f * g(rng) : 5.f + g(rng);  // 10 near-duplicates
+  for (int threads : {1, 2}) {
+    const cv::Mat1f cross = L2Distances(a, b, threads);
+    for (int i = 0; i < a.rows; ++i)
+      for (int j = 0; j < b.rows; ++j) {
+        const double expected = DirectL2(a, i, b, j);
+        ASSERT_NEAR(cross(i, j), expected, 1e-4 * (1.0 + expected)) << i << "," << j;
+      }
+    const cv::Mat1f self = L2Distances(a, cv::Mat(), threads);
+    for (int i = 0; i < a.rows; ++i) {
+      EXPECT_EQ(self(i, i), 0.f);
+      for (int j = 0; j < a.rows; ++j) {
+        EXPECT_EQ(self(i, j), self(j, i));
+        ASSERT_NEAR(self(i, j), DirectL2(a, i, a, j), 1e-4 * (1.0 + DirectL2(a, i, a, j)));
+      }
+    }
+  }
+}
+
+TEST(L2Distances, HandWorkedValues) {
+  cv::Mat1f a = (cv::Mat1f(2, 2) << 0, 0, 3, 4);
+  cv::Mat1f b = (cv::Mat1f(1, 2) << 6, 8);
+  const cv::Mat1f cross = L2Distances(a, b);
+  EXPECT_FLOAT_EQ(cross(0, 0), 10.f);
+  EXPECT_FLOAT_EQ(cross(1, 0), 5.f);
+}
+
+}  // namespace
+}  // namespace openable

@@ -1,0 +1,54 @@
+#include "tests/test_support.h"
+
+#include <atomic>
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+#include <vector>
+
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace openable::testing {
+namespace {
+
+struct TempRoot {
+  fs::path root;
+  TempRoot() {
+    root = fs::temp_directory_path() /
+           ("openable_tests_" + std::to_string(static_cast<long>(::getpid())));
+    fs::create_directories(root);
+  }
+  ~TempRoot() {
+    if (std::getenv("OPENABLE_KEEP_TEST_FILES") == nullptr) {
+      std::error_code ec;
+      fs::remove_all(root, ec);
+    }
+  }
+};
+
+TempRoot& Root() {
+  static TempRoot r;
+  return r;
+}
+
+}  // namespace
+
+std::string SourceDir() { return OPENABLE_SOURCE_DIR; }
+std::string DatasetsDir() { return OPENABLE_DATASETS_DIR; }
+std::string SampleDir() { return SourceDir() + "/examples/data/nordland_sample"; }
+std::string TestOpenableExe() { return OPENABLE_TEST_OPENABLE_EXE; }
+
+std::string TempDir() {
+  static std::atomic<int> counter{0};
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "none";
+  for (char& c : name)
+    if (c == '/') c = '_';
+  fs::path dir = Root().root / (name + "_" + std::to_string(counter++));
+  fs::create_directories(dir);
+  return dir.string();
+}
+
+}  // namespace openable::testing

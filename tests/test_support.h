@@ -1,0 +1,29 @@
+// Helpers shared by the tests: where the data lives, temporary folders, skipping when the
+// shared datasets are absent.
+#pragma once
+
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace openable::testing {
+
+// The repository root (the folder with the top-level CMakeLists.txt).
+std::string SourceDir();
+// ../shared/datasets beside the repository; may not exist on a user's clone.
+std::string DatasetsDir();
+// The bundled Nordland sample: <root>/examples/data/nordland_sample.
+std::string SampleDir();
+// A fresh, empty temporary folder, unique to the calling test; removed at exit of the process
+// unless OPENABLE_KEEP_TEST_FILES is set.
+std::string TempDir();
+// Path of the Test_OpenABLE program built beside the tests.
+std::string TestOpenableExe();
+
+}  // namespace openable::testing
+
+// Skips the current test with a message when `path` does not exist.
+#define OPENABLE_REQUIRE_PATH(path)                                                        \
+  do {                                                                                     \
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "dataset absent: " << (path);      \
+  } while (0)
