@@ -1,0 +1,255 @@
+// One conformance suite run over every registered descriptor (conventions.md, item 7).
+// Adding a descriptor: one line in ExpectedFor64() below.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "descriptors/descriptor.h"
+#include "descriptors/registry.h"
+
+namespace openable {
+namespace {
+
+// What each registered descriptor must declare for a 64 x 64 patch.
+struct Expected {
+  int width;
+  DescriptorKind kind;
+};
+const std::map<std::string, Expected>& ExpectedFor64() {
+  static const std::map<std::string, Expected> table = {
+      {"LDB", {32, DescriptorKind::kBinary}},    // 256 bits
+      {"ORB", {32, DescriptorKind::kBinary}},    // 256 bits
+      {"BRISK", {64, DescriptorKind::kBinary}},  // 512 bits
+      {"SIFT", {128, DescriptorKind::kFloat}},   // 4 x 4 cells x 8 bins
+      {"HOG", {1764, DescriptorKind::kFloat}},   // 7 x 7 blocks x 4 cells x 9 bins
+  };
+  return table;
+}
+
+// A natural-looking grey patch: two scales of blurred noise, fixed seed.
+cv::Mat NaturalPatch(int size, std::uint64_t seed) {
+  cv::RNG rng(seed);
+  cv::Mat coarse(size, size, CV_32F), fine(size, size, CV_32F);
+  rng.fill(coarse, cv::RNG::NORMAL, 0.0, 1.0);
+  rng.fill(fine, cv::RNG::NORMAL, 0.0, 1.0);
+  cv::GaussianBlur(coarse, coarse, cv::Size(0, 0), size / 10.0);
+  cv::GaussianBlur(fine, fine, cv::Size(0, 0), 1.5);
+  cv::normalize(coarse, coarse, -1.0, 1.0, cv::NORM_MINMAX);
+  cv::normalize(fine, fine, -1.0, 1.0, cv::NORM_MINMAX);
+  cv::Mat field = 128.0 + 80.0 * coarse + 25.0 * fine;
+  cv::Mat out;
+  field.convertTo(out, CV_8U);
+  return out;
+}
+
+cv::Mat Describe(const Descriptor& d, const cv::Mat& patch) {
+  cv::Mat row(1, d.Width(), RowType(d));
+  d.Describe(patch, row);
+  return row;
+}
+
+// Hamming distance counted bit by bit, or L2 norm as a direct sum of squares.
+double Distance(const Descriptor& d, const cv::Mat& a, const cv::Mat& b) {
+  if (d.Distance() == DistanceKind::kHamming) {
+    int bits = 0;
+    for (int i = 0; i < a.cols; ++i) {
+      const unsigned x = a.at<std::uint8_t>(0, i) ^ b.at<std::uint8_t>(0, i);
+      for (int k = 0; k < 8; ++k) bits += static_cast<int>((x >> k) & 1u);
+    }
+    return bits;
+  }
+  double sum = 0.0;
+  for (int i = 0; i < a.cols; ++i) {
+    const double diff = static_cast<double>(a.at<float>(0, i)) - b.at<float>(0, i);
+    sum += diff * diff;
+  }
+  return std::sqrt(sum);
+}
+
+bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
+  return a.type() == b.type() && a.size() == b.size() &&
+         std::memcmp(a.ptr(0), b.ptr(0), a.cols * a.elemSize()) == 0;
+}
+
+class DescriptorConformance : public ::testing::TestWithParam<std::string> {
+ protected:
+  std::unique_ptr<Descriptor> Make(int patch_size = 64) const {
+    DescriptorOptions options;
+    options.patch_size = patch_size;
+    return CreateDescriptor(GetParam(), options);
+  }
+};
+
+TEST_P(DescriptorConformance, DeclaresWidthAndRowType) {
+  const auto it = ExpectedFor64().find(GetParam());
+  ASSERT_NE(it, ExpectedFor64().end()) << "add " << GetParam() << " to ExpectedFor64()";
+  const auto d = Make();
+  EXPECT_EQ(d->Name(), GetParam());
+  EXPECT_EQ(d->PatchSize(), 64);
+  EXPECT_EQ(d->Width(), it->second.width);
+  EXPECT_EQ(d->Kind(), it->second.kind);
+  EXPECT_EQ(d->Distance(), it->second.kind == DescriptorKind::kBinary ? DistanceKind::kHamming
+                                                                      : DistanceKind::kL2);
+  EXPECT_EQ(RowType(*d), it->second.kind == DescriptorKind::kBinary ? CV_8U : CV_32F);
+
+  const cv::Mat row = Describe(*d, NaturalPatch(64, 1));
+  EXPECT_EQ(row.rows, 1);
+  EXPECT_EQ(row.cols, it->second.width);
+  EXPECT_EQ(row.type(), RowType(*d));
+  EXPECT_GT(cv::countNonZero(row), 0) << "an all-zero descriptor of a textured patch";
+  if (d->Kind() == DescriptorKind::kFloat) {
+    EXPECT_TRUE(cv::checkRange(row)) << "NaN or infinity in the descriptor";
+  }
+}
+
+TEST_P(DescriptorConformance, WritesIntoARowOfALargerBlock) {
+  // The pipeline describes straight into row i of an N x Width block.
+  const auto d = Make();
+  const cv::Mat patch = NaturalPatch(64, 2);
+  cv::Mat block(3, d->Width(), RowType(*d), cv::Scalar::all(7));
+  d->Describe(patch, block.row(1));
+  EXPECT_TRUE(SameBytes(block.row(1), Describe(*d, patch)));
+  const cv::Mat untouched(1, d->Width(), RowType(*d), cv::Scalar::all(7));
+  EXPECT_TRUE(SameBytes(block.row(0), untouched));
+  EXPECT_TRUE(SameBytes(block.row(2), untouched));
+}
+
+TEST_P(DescriptorConformance, IsDeterministic) {
+  const cv::Mat patch = NaturalPatch(64, 3);
+  const auto d = Make();
+  const cv::Mat first = Describe(*d, patch);
+  EXPECT_TRUE(SameBytes(first, Describe(*d, patch)));
+  EXPECT_TRUE(SameBytes(first, Describe(*Make(), patch))) << "a second instance differs";
+}
+
+TEST_P(DescriptorConformance, IsDeterministicAcrossThreads) {
+  const auto d = Make();
+  std::vector<cv::Mat> patches;
+  std::vector<cv::Mat> expected;
+  for (int i = 0; i < 6; ++i) {
+    patches.push_back(NaturalPatch(64, 10 + i));
+    expected.push_back(Describe(*d, patches.back()));
+  }
+  constexpr int kThreads = 4;
+  std::vector<std::vector<cv::Mat>> results(kThreads);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) {
+    threads.emplace_back([&, t] {
+      for (int repeat = 0; repeat < 3; ++repeat) {
+        for (const cv::Mat& p : patches) results[t].push_back(Describe(*d, p));
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  for (int t = 0; t < kThreads; ++t) {
+    ASSERT_EQ(results[t].size(), 3 * patches.size());
+    for (std::size_t i = 0; i < results[t].size(); ++i) {
+      EXPECT_TRUE(SameBytes(results[t][i], expected[i % patches.size()]))
+          << "thread " << t << ", call " << i;
+    }
+  }
+}
+
+TEST_P(DescriptorConformance, IdenticalImagesAreAtDistanceZero) {
+  const auto d = Make();
+  const cv::Mat patch = NaturalPatch(64, 4);
+  const cv::Mat copy = patch.clone();
+  EXPECT_EQ(Distance(*d, Describe(*d, patch), Describe(*d, copy)), 0.0);
+}
+
+TEST_P(DescriptorConformance, ViewIntoALargerImageIsDescribedFromItsOwnPixels) {
+  // The same pixels as a 64 x 64 view inside a larger, different image and as a standalone
+  // copy: the descriptor must not read pixels around the view.
+  const auto d = Make();
+  cv::Mat big = NaturalPatch(128, 5);
+  const cv::Mat view = big(cv::Rect(30, 40, 64, 64));
+  ASSERT_TRUE(view.isSubmatrix());
+  EXPECT_EQ(Distance(*d, Describe(*d, view), Describe(*d, view.clone())), 0.0);
+}
+
+TEST_P(DescriptorConformance, HandlesUniformPatches) {
+  const auto d = Make();
+  for (const int value : {0, 255}) {
+    const cv::Mat patch(64, 64, CV_8UC1, cv::Scalar(value));
+    cv::Mat row;
+    EXPECT_NO_THROW(row = Describe(*d, patch)) << "uniform patch " << value;
+    if (d->Kind() == DescriptorKind::kFloat && !row.empty()) {
+      EXPECT_TRUE(cv::checkRange(row)) << "uniform patch " << value;
+    }
+  }
+}
+
+TEST_P(DescriptorConformance, RejectsPatchOfWrongSizeOrType) {
+  const auto d = Make();
+  cv::Mat row(1, d->Width(), RowType(*d));
+  const std::vector<cv::Mat> wrong = {
+      cv::Mat(),
+      cv::Mat(63, 64, CV_8UC1, cv::Scalar(9)),
+      cv::Mat(64, 65, CV_8UC1, cv::Scalar(9)),
+      cv::Mat(32, 32, CV_8UC1, cv::Scalar(9)),
+      cv::Mat(64, 64, CV_8UC3, cv::Scalar::all(9)),
+      cv::Mat(64, 64, CV_32FC1, cv::Scalar(9)),
+      cv::Mat(64, 64, CV_16UC1, cv::Scalar(9)),
+  };
+  for (const cv::Mat& patch : wrong) {
+    EXPECT_THROW(d->Describe(patch, row), std::logic_error)
+        << patch.rows << " x " << patch.cols << " type " << patch.type();
+  }
+  const cv::Mat patch = NaturalPatch(64, 6);
+  const int other_type = RowType(*d) == CV_8U ? CV_32F : CV_8U;
+  EXPECT_THROW(d->Describe(patch, cv::Mat(1, d->Width() - 1, RowType(*d))), std::logic_error);
+  EXPECT_THROW(d->Describe(patch, cv::Mat(1, d->Width(), other_type)), std::logic_error);
+  EXPECT_THROW(d->Describe(patch, cv::Mat()), std::logic_error);
+}
+
+TEST_P(DescriptorConformance, DifferentImagesAreAtNonZeroDistance) {
+  const auto d = Make();
+  std::vector<cv::Mat> rows;
+  for (int i = 0; i < 5; ++i) rows.push_back(Describe(*d, NaturalPatch(64, 100 + i)));
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    for (std::size_t j = i + 1; j < rows.size(); ++j) {
+      EXPECT_GT(Distance(*d, rows[i], rows[j]), 0.0) << "images " << i << " and " << j;
+    }
+  }
+}
+
+TEST_P(DescriptorConformance, WorksAtOtherPatchSizes) {
+  for (const int size : {16, 24, 32, 48, 96}) {
+    const auto d = Make(size);
+    EXPECT_EQ(d->PatchSize(), size);
+    const cv::Mat a = NaturalPatch(size, 200 + size);
+    const cv::Mat b = NaturalPatch(size, 300 + size);
+    cv::Mat row_a, row_b;
+    ASSERT_NO_THROW(row_a = Describe(*d, a)) << "patch size " << size;
+    ASSERT_NO_THROW(row_b = Describe(*d, b)) << "patch size " << size;
+    EXPECT_EQ(Distance(*d, row_a, Describe(*d, a.clone())), 0.0) << "patch size " << size;
+    EXPECT_GT(Distance(*d, row_a, row_b), 0.0) << "patch size " << size;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllRegistered, DescriptorConformance,
+                         ::testing::ValuesIn(RegisteredDescriptorNames()),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           return info.param;  // registered names are alphanumeric
+                         });
+
+// The table above covers exactly the registered names.
+TEST(DescriptorConformanceTable, CoversEveryRegisteredName) {
+  const std::vector<std::string> names = RegisteredDescriptorNames();
+  EXPECT_EQ(names.size(), ExpectedFor64().size());
+  for (const std::string& name : names) EXPECT_EQ(ExpectedFor64().count(name), 1u) << name;
+}
+
+}  // namespace
+}  // namespace openable

@@ -1,0 +1,137 @@
+#include "descriptors/registry.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include "OpenABLE/base/error.h"
+#include "descriptors/hog.h"
+#include "descriptors/ldb.h"
+#include "descriptors/opencv_descriptors.h"
+
+namespace openable {
+namespace {
+
+// The message of the InputError thrown by `f`; fails the test when none is thrown.
+template <typename F>
+std::string InputErrorMessage(F f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "expected InputError, nothing was thrown";
+  return "";
+}
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+DescriptorOptions Options(int patch_size, int ldb_bits = 256) {
+  DescriptorOptions o;
+  o.patch_size = patch_size;
+  o.ldb_bits = ldb_bits;
+  return o;
+}
+
+TEST(Registry, ListsTheBuiltDescriptorsInOrder) {
+  EXPECT_EQ(RegisteredDescriptorNames(),
+            (std::vector<std::string>{"LDB", "ORB", "BRISK", "SIFT", "HOG"}));
+}
+
+TEST(Registry, ListsUnavailableDescriptorsWithReasons) {
+  const auto unavailable = UnavailableDescriptors();
+  std::set<std::string> names;
+  for (const auto& [name, reason] : unavailable) {
+    names.insert(name);
+    EXPECT_FALSE(reason.empty()) << name;
+  }
+  EXPECT_EQ(names, (std::set<std::string>{"SURF", "D-LDB", "BRIEF", "FREAK"}));
+  for (const std::string& name : RegisteredDescriptorNames()) EXPECT_EQ(names.count(name), 0u);
+}
+
+TEST(Registry, LookupIsCaseInsensitive) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"ldb", "LDB"}, {"Orb", "ORB"}, {"bRiSk", "BRISK"}, {"sift", "SIFT"}, {"Hog", "HOG"}};
+  for (const auto& [given, name] : cases) {
+    const auto d = CreateDescriptor(given, Options(64));
+    ASSERT_NE(d, nullptr) << given;
+    EXPECT_EQ(d->Name(), name);
+  }
+}
+
+TEST(Registry, UnknownNameNamesTheValueAndListsValidNames) {
+  const std::string message = InputErrorMessage([] { CreateDescriptor("XYZ", Options(64)); });
+  EXPECT_EQ(message,
+            "Image_descriptor: unknown descriptor \"XYZ\"; expected one of LDB, ORB, BRISK, "
+            "SIFT, HOG");
+  EXPECT_TRUE(Contains(InputErrorMessage([] { CreateDescriptor("", Options(64)); }), "\"\""));
+}
+
+TEST(Registry, UnavailableNamesGiveTheReason) {
+  const std::string surf = InputErrorMessage([] { CreateDescriptor("SURF", Options(64)); });
+  EXPECT_TRUE(Contains(surf, "Image_descriptor: \"SURF\" is not available: ")) << surf;
+  EXPECT_TRUE(Contains(surf, "patented")) << surf;
+  EXPECT_TRUE(Contains(surf, "use SIFT")) << surf;
+  const std::string lower = InputErrorMessage([] { CreateDescriptor("surf", Options(64)); });
+  EXPECT_TRUE(Contains(lower, "\"surf\" is not available")) << lower;
+  for (const std::string name : {"D-LDB", "BRIEF", "FREAK", "d-ldb"}) {
+    const std::string m = InputErrorMessage([&] { CreateDescriptor(name, Options(64)); });
+    EXPECT_TRUE(Contains(m, "\"" + name + "\" is not available")) << m;
+    EXPECT_TRUE(Contains(m, "not built yet")) << m;
+  }
+}
+
+TEST(Registry, MessagesAreOneLine) {
+  for (const std::string name : {"XYZ", "SURF", "D-LDB"}) {
+    const std::string m = InputErrorMessage([&] { CreateDescriptor(name, Options(64)); });
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+}
+
+TEST(Registry, RejectsSmallPatchForEveryDescriptor) {
+  for (const std::string& name : RegisteredDescriptorNames()) {
+    const std::string m = InputErrorMessage([&] { CreateDescriptor(name, Options(15)); });
+    EXPECT_TRUE(Contains(m, "Patch_size")) << name << ": " << m;
+    EXPECT_TRUE(Contains(m, "15")) << name << ": " << m;
+  }
+  EXPECT_NO_THROW(CreateDescriptor("LDB", Options(16)));
+}
+
+TEST(Registry, RejectsLdbBitsOutOfRange) {
+  for (const int bits : {0, -3, 1387}) {
+    const std::string m = InputErrorMessage([&] { CreateDescriptor("LDB", Options(64, bits)); });
+    EXPECT_TRUE(Contains(m, "Ldb_bits")) << m;
+    EXPECT_TRUE(Contains(m, std::to_string(bits))) << m;
+  }
+  EXPECT_EQ(CreateDescriptor("LDB", Options(64, 1))->Width(), 1);
+  EXPECT_EQ(CreateDescriptor("LDB", Options(64, 1386))->Width(), 174);
+}
+
+TEST(Registry, RejectsHogPatchThatIsNotAMultipleOfEight) {
+  const std::string m = InputErrorMessage([] { CreateDescriptor("HOG", Options(60)); });
+  EXPECT_TRUE(Contains(m, "Patch_size")) << m;
+  EXPECT_TRUE(Contains(m, "60")) << m;
+  EXPECT_TRUE(Contains(m, "multiple of 8")) << m;
+  EXPECT_NO_THROW(CreateDescriptor("LDB", Options(60)));
+  EXPECT_NO_THROW(CreateDescriptor("ORB", Options(60)));
+}
+
+TEST(Registry, ConstructorsCheckTheirOwnOptions) {
+  // Code that builds a descriptor directly gets the same one-line errors.
+  EXPECT_TRUE(Contains(InputErrorMessage([] { LdbDescriptor d(Options(64, 0)); }), "Ldb_bits"));
+  EXPECT_TRUE(Contains(InputErrorMessage([] { LdbDescriptor d(Options(8)); }), "Patch_size"));
+  EXPECT_TRUE(Contains(InputErrorMessage([] { OrbDescriptor d(Options(8)); }), "Patch_size"));
+  EXPECT_TRUE(Contains(InputErrorMessage([] { BriskDescriptor d(Options(8)); }), "Patch_size"));
+  EXPECT_TRUE(Contains(InputErrorMessage([] { SiftDescriptor d(Options(8)); }), "Patch_size"));
+  EXPECT_TRUE(Contains(InputErrorMessage([] { HogDescriptor d(Options(36)); }), "Patch_size"));
+}
+
+}  // namespace
+}  // namespace openable
