@@ -12,6 +12,10 @@ bool IsTerminal(int fd) { return ::isatty(fd) == 1; }
 ProgressReporter::ProgressReporter(std::ostream& out, bool enabled, bool terminal)
     : out_(out), enabled_(enabled), terminal_(terminal) {}
 
+ProgressReporter::~ProgressReporter() {
+  if (pending_) out_ << "\r\x1b[K" << std::flush;
+}
+
 void ProgressReporter::Begin(const std::string& what, std::int64_t total,
                              const std::string& unit) {
   what_ = what;
@@ -31,6 +35,7 @@ void ProgressReporter::Update(std::int64_t done) {
   } else {
     const int decile = static_cast<int>(done * 10 / total_);
     if (decile <= last_decile_ || decile == 0 || done >= total_) return;
+    if (now - start_ < std::chrono::seconds(2)) return;  // short stages: final line only
     last_decile_ = decile;
     Print(done, false);
   }
@@ -55,6 +60,7 @@ void ProgressReporter::Print(std::int64_t done, bool final) {
   }
   if (terminal_) {
     out_ << "\r" << line << "\x1b[K" << (final ? "\n" : "") << std::flush;
+    pending_ = !final;
   } else {
     out_ << line << "\n" << std::flush;
   }

@@ -12,7 +12,13 @@ class ProgressReporter {
  public:
   // Writes to `out` when `enabled`. On a terminal the line is redrawn in place (at most
   // 10 times a second); otherwise one line is written per 10% step, so logs stay short.
+  // Stages shorter than two seconds print only their final line in log mode.
   ProgressReporter(std::ostream& out, bool enabled, bool terminal);
+  // Clears a line left half-drawn on a terminal (a stage that ended by an error), so the
+  // error that follows stands on its own line.
+  ~ProgressReporter();
+  ProgressReporter(const ProgressReporter&) = delete;
+  ProgressReporter& operator=(const ProgressReporter&) = delete;
   // Starts a stage: `what` ("describing"), `total` items of `unit` ("frames").
   void Begin(const std::string& what, std::int64_t total, const std::string& unit);
   // `done` of the stage's items are finished. Cheap to call often.
@@ -24,6 +30,7 @@ class ProgressReporter {
   void Print(std::int64_t done, bool final);
   std::ostream& out_;
   bool enabled_, terminal_;
+  bool pending_ = false;  // a terminal line is drawn without its newline
   std::string what_, unit_;
   std::int64_t total_ = 0;
   int last_decile_ = -1;

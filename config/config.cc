@@ -90,9 +90,9 @@ const std::vector<Binding>& Bindings() {
        "coloured with Matrix_color. Empty: not written.",
        false},
       {"Png_threshold_name", "Representation", &Config::png_threshold_name, 0, 0,
-       "Output when Threshold is set: the thresholded matrix M'' as an image (black = loop "
-       "candidate, M' < Threshold; white = not). Empty: Png_name with _thresholded before the "
-       "extension.",
+       "Output when Threshold is set: the thresholded matrix M'' as an image, coloured with "
+       "Matrix_color at 0 (loop candidate, M' < Threshold) and 1 (not): black and white with "
+       "map 0. Empty: Png_name with _thresholded before the extension.",
        true},
       {"Matrix_color", "Representation", &Config::matrix_color, 0, 11,
        "Colour map of Png_name, as the original's 12 maps (docs/output_formats.md): 0 grey, "

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core/utils/logger.hpp>
+
 #include "OpenABLE/OpenABLE.h"
 
 namespace {
@@ -86,6 +88,9 @@ void PrintReport(const openable::Config& c, const openable::RunResult& r,
 }  // namespace
 
 int main(int argc, char** argv) {
+  // OpenCV's video back ends print [ WARN ] lines of their own when a file cannot be opened;
+  // the library already reports that as one InputError line, so keep only OpenCV errors.
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   std::string config_path;
   std::vector<std::string> overrides;
   bool quiet = false, print_config = false;
