@@ -22,6 +22,11 @@ enum class DistanceKind { kHamming, kL2 };
 struct DescriptorOptions {
   int patch_size = 64;  // side of the square patch, pixels, >= 16
   int ldb_bits = 256;   // LDB bits kept after selection, 1..1386 (32 bytes = 256 in ABLE-P)
+
+  // Throws InputError naming the key (Patch_size, Ldb_bits), the value and the valid range.
+  // CreateDescriptor calls it before building anything; descriptors add their own limits
+  // (HOG: a multiple of 8).
+  void Check() const;
 };
 
 class Descriptor {

@@ -57,18 +57,6 @@ std::string Upper(const std::string& s) {
   return out;
 }
 
-// Options every descriptor shares, checked before any descriptor is built.
-void CheckCommonOptions(const DescriptorOptions& options) {
-  if (options.patch_size < 16) {
-    throw InputError("Patch_size: " + std::to_string(options.patch_size) +
-                     " is too small; expected an integer >= 16");
-  }
-  if (options.ldb_bits < 1 || options.ldb_bits > 1386) {
-    throw InputError("Ldb_bits: " + std::to_string(options.ldb_bits) +
-                     " is out of range; expected an integer in [1, 1386]");
-  }
-}
-
 }  // namespace
 
 std::vector<std::string> RegisteredDescriptorNames() {
@@ -92,7 +80,7 @@ std::unique_ptr<Descriptor> CreateDescriptor(const std::string& name,
   const std::string key = Upper(name);
   for (const Entry& e : kDescriptors) {
     if (key == e.name) {
-      CheckCommonOptions(options);
+      options.Check();
       return e.create(options);
     }
   }
@@ -110,6 +98,17 @@ std::unique_ptr<Descriptor> CreateDescriptor(const std::string& name,
   }
   throw InputError("Image_descriptor: unknown descriptor \"" + name + "\"; expected one of " +
                    valid);
+}
+
+void DescriptorOptions::Check() const {
+  if (patch_size < 16) {
+    throw InputError("Patch_size: " + std::to_string(patch_size) +
+                     " is too small; expected an integer >= 16");
+  }
+  if (ldb_bits < 1 || ldb_bits > 1386) {
+    throw InputError("Ldb_bits: " + std::to_string(ldb_bits) +
+                     " is out of range; expected an integer in [1, 1386]");
+  }
 }
 
 }  // namespace openable

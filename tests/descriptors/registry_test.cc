@@ -135,3 +135,28 @@ TEST(Registry, ConstructorsCheckTheirOwnOptions) {
 
 }  // namespace
 }  // namespace openable
+
+namespace openable {
+namespace {
+
+TEST(DescriptorOptions, CheckRejectsOutOfRangeValuesNamingTheKey) {
+  EXPECT_NO_THROW(DescriptorOptions().Check());
+  DescriptorOptions o;
+  o.patch_size = 15;
+  try {
+    o.Check();
+    FAIL() << "patch 15 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("Patch_size: 15"), std::string::npos) << e.what();
+  }
+  o = DescriptorOptions();
+  for (int bits : {0, 1387}) {
+    o.ldb_bits = bits;
+    EXPECT_THROW(o.Check(), InputError) << bits;
+  }
+  o.ldb_bits = 1386;
+  EXPECT_NO_THROW(o.Check());
+}
+
+}  // namespace
+}  // namespace openable
