@@ -210,11 +210,16 @@ cv::Mat VideoFrameToFloat(const cv::Mat& frame) {
 }
 
 // Opens `path` with the first of OpenCV's file backends, in its order of priority (FFmpeg,
-// GStreamer, ...), that accepts it; returns the backend, or -1. CAP_IMAGES is left out: it reads
-// numbered image sequences, not video files, and logs an error for any other name.
+// GStreamer, ...), that accepts it; returns the backend, or -1. Left out: CAP_IMAGES (it reads
+// numbered image sequences, not video files, and logs an error for any other name), and
+// GStreamer whenever FFmpeg is present: FFmpeg reads every file GStreamer would, and GStreamer
+// writes its own multi-line "GStreamer-CRITICAL" messages to stderr, outside OpenCV's logging,
+// when it fails on a file, which would bury the one-line error.
 int OpenCapture(cv::VideoCapture& capture, const std::string& path) {
-  for (const cv::VideoCaptureAPIs api : cv::videoio_registry::getStreamBackends()) {
-    if (api == cv::CAP_IMAGES) continue;
+  const std::vector<cv::VideoCaptureAPIs> apis = cv::videoio_registry::getStreamBackends();
+  const bool has_ffmpeg = std::find(apis.begin(), apis.end(), cv::CAP_FFMPEG) != apis.end();
+  for (const cv::VideoCaptureAPIs api : apis) {
+    if (api == cv::CAP_IMAGES || (has_ffmpeg && api == cv::CAP_GSTREAMER)) continue;
     try {
       if (capture.open(path, api)) return api;
     } catch (const cv::Exception&) {
@@ -504,6 +509,14 @@ std::unique_ptr<FrameSource> OpenVideo(const std::string& path, int first, int l
   std::error_code ec;
   if (!fs::exists(path, ec) && path.find("://") == std::string::npos) {
     throw InputError("video " + Quoted(path) + " does not exist (" + kExpectedVideo + ")");
+  }
+  // FFmpeg's "tty" demuxer renders any text file as ANSI-art frames, so a configuration or
+  // ground-truth file given as a video by mistake would "work". Refuse the usual text types.
+  static const std::set<std::string> kTextExtensions = {"txt", "csv", "yaml", "yml", "json",
+                                                        "md", "xml"};
+  if (kTextExtensions.count(ExtensionOf(path)) != 0) {
+    throw InputError("video " + Quoted(path) + " is a text file (." + ExtensionOf(path) + "); " +
+                     kExpectedVideo);
   }
   int count = 0;
   int api = -1;

@@ -203,6 +203,9 @@ struct BadInput {
   std::string expect;              // text the error line must contain
 };
 
+// Named in test listings and CTest by its case name rather than by its bytes.
+void PrintTo(const BadInput& c, std::ostream* os) { *os << c.name; }
+
 class BadInputs : public ::testing::TestWithParam<BadInput> {};
 
 TEST_P(BadInputs, OneLineNonZeroExitNoOutput) {
@@ -218,6 +221,7 @@ TEST_P(BadInputs, OneLineNonZeroExitNoOutput) {
   cv::imwrite(dir + "/sizes/f1.png", cv::Mat(32, 64, CV_8UC1, cv::Scalar(9)));
   cv::imwrite(dir + "/sizes/f2.png", cv::Mat(40, 64, CV_8UC1, cv::Scalar(9)));
   std::ofstream(dir + "/fake.avi") << "text";
+  std::ofstream(dir + "/fake.txt") << "text that FFmpeg would render as frames\n";
 
   std::vector<std::string> args = {SampleConfig(dir)};
   for (auto s : c.sets) {
@@ -243,6 +247,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"CorruptImage", {"Images_path=$DIR/corrupt"}, "a2.png"},
         BadInput{"DifferentSizes", {"Images_path=$DIR/sizes", "Images_path_2="}, "f2.png"},
         BadInput{"UnopenableVideo", {"Frame_mode=1", "Video_path_1=$DIR/fake.avi"}, "fake.avi"},
+        BadInput{"TextAsVideo", {"Frame_mode=1", "Video_path_1=$DIR/fake.txt"}, "fake.txt"},
         BadInput{"Surf", {"Image_descriptor=SURF"}, "SURF"},
         BadInput{"UnknownDescriptor", {"Image_descriptor=XYZ"}, "Image_descriptor"},
         BadInput{"StereoNotBuilt", {"Camera_type=1"}, "Camera_type: 1"},

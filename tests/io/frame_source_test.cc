@@ -762,6 +762,11 @@ TEST(OpenVideo, TextFileIsNotAVideo) {
   WriteBytes(path, text);
   ExpectInputError([&] { OpenVideo(path, 0, -1); },
                    {"video " + Q(path), "expected a video file readable by FFmpeg/GStreamer"});
+  // Named .txt, FFmpeg's tty demuxer would render it as frames: refused by its extension.
+  const std::string txt = TempDir() + "/Config.txt";
+  WriteBytes(txt, text);
+  ExpectInputError([&] { OpenVideo(txt, 0, -1); },
+                   {"video " + Q(txt), "is a text file (.txt)", "expected a video file"});
 }
 
 }  // namespace
