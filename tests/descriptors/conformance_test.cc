@@ -15,11 +15,16 @@
 #include <thread>
 #include <vector>
 
+#include "tests/descriptors/descriptor_test_util.h"
 #include "descriptors/descriptor.h"
 #include "descriptors/registry.h"
 
 namespace openable {
 namespace {
+
+using testing_util::Describe;
+using testing_util::Options;
+using testing_util::TexturedPatch;
 
 // What each registered descriptor must declare for a 64 x 64 patch.
 struct Expected {
@@ -35,28 +40,6 @@ const std::map<std::string, Expected>& ExpectedFor64() {
       {"HOG", {1764, DescriptorKind::kFloat}},   // 7 x 7 blocks x 4 cells x 9 bins
   };
   return table;
-}
-
-// A natural-looking grey patch: two scales of blurred noise, fixed seed.
-cv::Mat NaturalPatch(int size, std::uint64_t seed) {
-  cv::RNG rng(seed);
-  cv::Mat coarse(size, size, CV_32F), fine(size, size, CV_32F);
-  rng.fill(coarse, cv::RNG::NORMAL, 0.0, 1.0);
-  rng.fill(fine, cv::RNG::NORMAL, 0.0, 1.0);
-  cv::GaussianBlur(coarse, coarse, cv::Size(0, 0), size / 10.0);
-  cv::GaussianBlur(fine, fine, cv::Size(0, 0), 1.5);
-  cv::normalize(coarse, coarse, -1.0, 1.0, cv::NORM_MINMAX);
-  cv::normalize(fine, fine, -1.0, 1.0, cv::NORM_MINMAX);
-  cv::Mat field = 128.0 + 80.0 * coarse + 25.0 * fine;
-  cv::Mat out;
-  field.convertTo(out, CV_8U);
-  return out;
-}
-
-cv::Mat Describe(const Descriptor& d, const cv::Mat& patch) {
-  cv::Mat row(1, d.Width(), RowType(d));
-  d.Describe(patch, row);
-  return row;
 }
 
 // Hamming distance counted bit by bit, or L2 norm as a direct sum of squares.
@@ -103,7 +86,7 @@ TEST_P(DescriptorConformance, DeclaresWidthAndRowType) {
                                                                       : DistanceKind::kL2);
   EXPECT_EQ(RowType(*d), it->second.kind == DescriptorKind::kBinary ? CV_8U : CV_32F);
 
-  const cv::Mat row = Describe(*d, NaturalPatch(64, 1));
+  const cv::Mat row = Describe(*d, TexturedPatch(64, 1));
   EXPECT_EQ(row.rows, 1);
   EXPECT_EQ(row.cols, it->second.width);
   EXPECT_EQ(row.type(), RowType(*d));
@@ -116,7 +99,7 @@ TEST_P(DescriptorConformance, DeclaresWidthAndRowType) {
 TEST_P(DescriptorConformance, WritesIntoARowOfALargerBlock) {
   // The pipeline describes straight into row i of an N x Width block.
   const auto d = Make();
-  const cv::Mat patch = NaturalPatch(64, 2);
+  const cv::Mat patch = TexturedPatch(64, 2);
   cv::Mat block(3, d->Width(), RowType(*d), cv::Scalar::all(7));
   d->Describe(patch, block.row(1));
   EXPECT_TRUE(SameBytes(block.row(1), Describe(*d, patch)));
@@ -126,7 +109,7 @@ TEST_P(DescriptorConformance, WritesIntoARowOfALargerBlock) {
 }
 
 TEST_P(DescriptorConformance, IsDeterministic) {
-  const cv::Mat patch = NaturalPatch(64, 3);
+  const cv::Mat patch = TexturedPatch(64, 3);
   const auto d = Make();
   const cv::Mat first = Describe(*d, patch);
   EXPECT_TRUE(SameBytes(first, Describe(*d, patch)));
@@ -138,7 +121,7 @@ TEST_P(DescriptorConformance, IsDeterministicAcrossThreads) {
   std::vector<cv::Mat> patches;
   std::vector<cv::Mat> expected;
   for (int i = 0; i < 6; ++i) {
-    patches.push_back(NaturalPatch(64, 10 + i));
+    patches.push_back(TexturedPatch(64, 10 + i));
     expected.push_back(Describe(*d, patches.back()));
   }
   constexpr int kThreads = 4;
@@ -163,7 +146,7 @@ TEST_P(DescriptorConformance, IsDeterministicAcrossThreads) {
 
 TEST_P(DescriptorConformance, IdenticalImagesAreAtDistanceZero) {
   const auto d = Make();
-  const cv::Mat patch = NaturalPatch(64, 4);
+  const cv::Mat patch = TexturedPatch(64, 4);
   const cv::Mat copy = patch.clone();
   EXPECT_EQ(Distance(*d, Describe(*d, patch), Describe(*d, copy)), 0.0);
 }
@@ -172,7 +155,7 @@ TEST_P(DescriptorConformance, ViewIntoALargerImageIsDescribedFromItsOwnPixels) {
   // The same pixels as a 64 x 64 view inside a larger, different image and as a standalone
   // copy: the descriptor must not read pixels around the view.
   const auto d = Make();
-  cv::Mat big = NaturalPatch(128, 5);
+  cv::Mat big = TexturedPatch(128, 5);
   const cv::Mat view = big(cv::Rect(30, 40, 64, 64));
   ASSERT_TRUE(view.isSubmatrix());
   EXPECT_EQ(Distance(*d, Describe(*d, view), Describe(*d, view.clone())), 0.0);
@@ -206,7 +189,7 @@ TEST_P(DescriptorConformance, RejectsPatchOfWrongSizeOrType) {
     EXPECT_THROW(d->Describe(patch, row), std::logic_error)
         << patch.rows << " x " << patch.cols << " type " << patch.type();
   }
-  const cv::Mat patch = NaturalPatch(64, 6);
+  const cv::Mat patch = TexturedPatch(64, 6);
   const int other_type = RowType(*d) == CV_8U ? CV_32F : CV_8U;
   EXPECT_THROW(d->Describe(patch, cv::Mat(1, d->Width() - 1, RowType(*d))), std::logic_error);
   EXPECT_THROW(d->Describe(patch, cv::Mat(1, d->Width(), other_type)), std::logic_error);
@@ -216,7 +199,7 @@ TEST_P(DescriptorConformance, RejectsPatchOfWrongSizeOrType) {
 TEST_P(DescriptorConformance, DifferentImagesAreAtNonZeroDistance) {
   const auto d = Make();
   std::vector<cv::Mat> rows;
-  for (int i = 0; i < 5; ++i) rows.push_back(Describe(*d, NaturalPatch(64, 100 + i)));
+  for (int i = 0; i < 5; ++i) rows.push_back(Describe(*d, TexturedPatch(64, 100 + i)));
   for (std::size_t i = 0; i < rows.size(); ++i) {
     for (std::size_t j = i + 1; j < rows.size(); ++j) {
       EXPECT_GT(Distance(*d, rows[i], rows[j]), 0.0) << "images " << i << " and " << j;
@@ -228,8 +211,8 @@ TEST_P(DescriptorConformance, WorksAtOtherPatchSizes) {
   for (const int size : {16, 24, 32, 48, 96}) {
     const auto d = Make(size);
     EXPECT_EQ(d->PatchSize(), size);
-    const cv::Mat a = NaturalPatch(size, 200 + size);
-    const cv::Mat b = NaturalPatch(size, 300 + size);
+    const cv::Mat a = TexturedPatch(size, 200 + size);
+    const cv::Mat b = TexturedPatch(size, 300 + size);
     cv::Mat row_a, row_b;
     ASSERT_NO_THROW(row_a = Describe(*d, a)) << "patch size " << size;
     ASSERT_NO_THROW(row_b = Describe(*d, b)) << "patch size " << size;

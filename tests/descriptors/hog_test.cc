@@ -1,3 +1,4 @@
+#include "tests/descriptors/descriptor_test_util.h"
 #include "descriptors/hog.h"
 
 #include <gtest/gtest.h>
@@ -11,17 +12,9 @@
 namespace openable {
 namespace {
 
-DescriptorOptions Options(int patch_size) {
-  DescriptorOptions o;
-  o.patch_size = patch_size;
-  return o;
-}
-
-cv::Mat Describe(const HogDescriptor& d, const cv::Mat& patch) {
-  cv::Mat row(1, d.Width(), CV_32F);
-  d.Describe(patch, row);
-  return row;
-}
+using testing_util::Describe;
+using testing_util::Options;
+using testing_util::TexturedPatch;
 
 TEST(HogTest, WidthIsBlocksTimesThirtySix) {
   // ((S - 16) / 8 + 1)^2 blocks of 2 x 2 cells x 9 bins.

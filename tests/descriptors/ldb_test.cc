@@ -1,3 +1,4 @@
+#include "tests/descriptors/descriptor_test_util.h"
 #include "descriptors/ldb.h"
 
 #include <gtest/gtest.h>
@@ -20,32 +21,15 @@
 namespace openable {
 namespace {
 
+using testing_util::Describe;
+using testing_util::Hamming;
+using testing_util::Options;
+using testing_util::TexturedPatch;
+
 constexpr int kLevels[] = {2, 3, 4, 5};
 enum Feature { kI = 0, kGx = 1, kGy = 2 };
 
-DescriptorOptions Options(int patch_size, int bits) {
-  DescriptorOptions o;
-  o.patch_size = patch_size;
-  o.ldb_bits = bits;
-  return o;
-}
-
-cv::Mat Describe(const LdbDescriptor& d, const cv::Mat& patch) {
-  cv::Mat row(1, d.Width(), CV_8U);
-  d.Describe(patch, row);
-  return row;
-}
-
 int Bit(const cv::Mat& row, int k) { return (row.at<std::uint8_t>(0, k / 8) >> (k % 8)) & 1; }
-
-int Hamming(const cv::Mat& a, const cv::Mat& b) {
-  int bits = 0;
-  for (int i = 0; i < a.cols; ++i) {
-    const unsigned x = a.at<std::uint8_t>(0, i) ^ b.at<std::uint8_t>(0, i);
-    for (int k = 0; k < 8; ++k) bits += static_cast<int>((x >> k) & 1u);
-  }
-  return bits;
-}
 
 // Index of test (level n, cells i < j, feature) in the canonical order, counted independently.
 int CanonicalIndex(int n, int i, int j, int feature) {
@@ -91,21 +75,6 @@ std::vector<int> AllBits(const cv::Mat& row, int count) {
   std::vector<int> bits;
   for (int k = 0; k < count; ++k) bits.push_back(Bit(row, k));
   return bits;
-}
-
-cv::Mat TexturedPatch(int size, std::uint64_t seed) {
-  cv::RNG rng(seed);
-  cv::Mat coarse(size, size, CV_32F), fine(size, size, CV_32F);
-  rng.fill(coarse, cv::RNG::NORMAL, 0.0, 1.0);
-  rng.fill(fine, cv::RNG::NORMAL, 0.0, 1.0);
-  cv::GaussianBlur(coarse, coarse, cv::Size(0, 0), size / 10.0);
-  cv::GaussianBlur(fine, fine, cv::Size(0, 0), 1.5);
-  cv::normalize(coarse, coarse, -1.0, 1.0, cv::NORM_MINMAX);
-  cv::normalize(fine, fine, -1.0, 1.0, cv::NORM_MINMAX);
-  cv::Mat field = 128.0 + 80.0 * coarse + 25.0 * fine;
-  cv::Mat out;
-  field.convertTo(out, CV_8U);
-  return out;
 }
 
 cv::Mat FromFunction(int size, int (*value)(int y, int x)) {

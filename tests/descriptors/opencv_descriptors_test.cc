@@ -1,3 +1,4 @@
+#include "tests/descriptors/descriptor_test_util.h"
 #include "descriptors/opencv_descriptors.h"
 
 #include <gtest/gtest.h>
@@ -15,41 +16,10 @@
 namespace openable {
 namespace {
 
-DescriptorOptions Options(int patch_size) {
-  DescriptorOptions o;
-  o.patch_size = patch_size;
-  return o;
-}
-
-cv::Mat TexturedPatch(int size, std::uint64_t seed) {
-  cv::RNG rng(seed);
-  cv::Mat coarse(size, size, CV_32F), fine(size, size, CV_32F);
-  rng.fill(coarse, cv::RNG::NORMAL, 0.0, 1.0);
-  rng.fill(fine, cv::RNG::NORMAL, 0.0, 1.0);
-  cv::GaussianBlur(coarse, coarse, cv::Size(0, 0), size / 10.0);
-  cv::GaussianBlur(fine, fine, cv::Size(0, 0), 1.5);
-  cv::normalize(coarse, coarse, -1.0, 1.0, cv::NORM_MINMAX);
-  cv::normalize(fine, fine, -1.0, 1.0, cv::NORM_MINMAX);
-  cv::Mat field = 128.0 + 80.0 * coarse + 25.0 * fine;
-  cv::Mat out;
-  field.convertTo(out, CV_8U);
-  return out;
-}
-
-cv::Mat Describe(const Descriptor& d, const cv::Mat& patch) {
-  cv::Mat row(1, d.Width(), RowType(d));
-  d.Describe(patch, row);
-  return row;
-}
-
-int Hamming(const cv::Mat& a, const cv::Mat& b) {
-  int bits = 0;
-  for (int i = 0; i < a.cols; ++i) {
-    const unsigned x = a.at<std::uint8_t>(0, i) ^ b.at<std::uint8_t>(0, i);
-    for (int k = 0; k < 8; ++k) bits += static_cast<int>((x >> k) & 1u);
-  }
-  return bits;
-}
+using testing_util::Describe;
+using testing_util::Hamming;
+using testing_util::Options;
+using testing_util::TexturedPatch;
 
 double L2(const cv::Mat& a, const cv::Mat& b) {
   double sum = 0.0;
