@@ -1,0 +1,72 @@
+// The two evaluation protocols of docs/evaluation.md over the evaluated block of a distance
+// matrix: per-query best match (AUC, R@100P, max F1, R@N) and the ABLE papers' cell protocol
+// (100 thresholds, temporal vicinity, average precision).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "OpenABLE/evaluation/ground_truth.h"
+#include "OpenABLE/evaluation/layout.h"
+
+namespace openable {
+
+struct EvaluationOptions {
+  int tolerance = 2;          // frames: an answer within this many frames of a true match is right
+  int exclusion = 100;        // loop closure: candidates are frames at least this far back
+  int vicinity = 7;           // ABLE-P protocol: temporal vicinity, frames
+  int able_thresholds = 100;  // ABLE-P protocol: thresholds evenly spaced in [0, 1]
+
+  // Throws InputError naming Tolerance, Exclusion or Vicinity.
+  void Check() const;
+};
+
+// One point of a precision-recall curve.
+struct CurvePoint {
+  double threshold = 0;  // accept distances <= threshold (per query) / cells < threshold (ABLE-P)
+  double precision = 0;
+  double recall = 0;
+  double f1 = 0;
+  std::int64_t tp = 0, fp = 0;
+};
+
+struct PerQueryResult {
+  int queries = 0;            // queries with at least one candidate
+  int positive_queries = 0;   // of those, queries with a true match among their candidates
+  std::int64_t truth_pairs_outside_candidates = 0;  // true pairs no candidate set contains
+  // One point per distinct best-match distance, in increasing order of threshold.
+  std::vector<CurvePoint> curve;
+  double auc = 0;             // sum of precision x recall increments along the curve
+  double recall_at_100p = 0;  // highest recall with precision exactly 1 (0 if none)
+  double max_f1 = 0;
+  double max_f1_threshold = 0;
+  double max_f1_precision = 0, max_f1_recall = 0;
+  // R@N for N = 1, 5, 10: share of positive queries with a correct match among the N best
+  // candidates (ties broken by lower column index).
+  double recall_at_1 = 0, recall_at_5 = 0, recall_at_10 = 0;
+  // Per query row of the block: best candidate column (-1 without candidates), its distance,
+  // whether the query is positive and whether its best candidate is correct.
+  std::vector<int> best;
+  std::vector<float> best_distance;
+  std::vector<std::uint8_t> positive, correct;
+};
+
+struct AblePResult {
+  // One point per threshold theta_k = k / (able_thresholds - 1), k = 0 .. able_thresholds - 1;
+  // precision is 1 by convention where nothing is detected (recall is then 0).
+  std::vector<CurvePoint> curve;
+  double average_precision = 0;  // area under the curve in percent (step-wise, as AUC)
+  std::int64_t candidate_cells = 0;
+  std::int64_t truth_cells = 0;  // ground-truth pairs among the candidate cells
+};
+
+// `matrix` is the full matrix (normalised, M'); the block of `layout` is evaluated.
+// Precondition (std::logic_error): the layout fits the matrix and the ground truth the layout.
+PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                                const GroundTruth& truth, const EvaluationOptions& options);
+AblePResult EvaluateAbleP(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                          const GroundTruth& truth, const EvaluationOptions& options);
+
+}  // namespace openable

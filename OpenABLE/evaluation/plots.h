@@ -1,0 +1,42 @@
+// Figures of an evaluation: precision-recall curves (several runs in one figure) and the ground
+// truth drawn over the distance matrix. Drawn with OpenCV (lines, Hershey text), no plotting
+// library.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "OpenABLE/evaluation/ground_truth.h"
+#include "OpenABLE/evaluation/layout.h"
+#include "OpenABLE/evaluation/metrics.h"
+
+namespace openable {
+
+// One run's curves, with its legend label ("LDB L=10").
+struct PrSeries {
+  std::string label;
+  std::vector<CurvePoint> per_query;  // PerQueryResult::curve
+  std::vector<CurvePoint> able_p;     // AblePResult::curve (may be empty)
+};
+
+// A white figure, two panels side by side: "Per-query best match" (precision against recall of
+// each series' per_query curve) and "ABLE-P cells (vicinity V)" (the able_p curves; the panel is
+// left out when every able_p is empty). Axes from 0 to 1 labelled "Recall" and "Precision" with
+// ticks every 0.1 and a light grid, one distinct colour per series, a legend with the labels
+// and each series' AUC / AP, and `title` above. About 1400 x 640 pixels with two panels.
+cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& title,
+                       int vicinity);
+
+// The evaluated block of `matrix` (normalised) in grey (dark = small distance), with the ground
+// truth tinted blue, and each query's best match marked where its distance is <= accept
+// threshold: green when correct, red when wrong. Queries are rows, references columns. Small
+// blocks are enlarged by an integer factor (nearest neighbour) to at least 600 pixels on the
+// longer side; marks are at least 3 x 3 output pixels. A legend strip below the image names the
+// colours.
+cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                        const GroundTruth& truth, const PerQueryResult& result,
+                        double accept_threshold);
+
+}  // namespace openable
