@@ -8,6 +8,8 @@
 #pragma once
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/version.h"
+#include "OpenABLE/evaluate.h"
 #include "OpenABLE/describe.h"
 #include "OpenABLE/exports.h"
 #include "OpenABLE/io/frame_source.h"
@@ -20,7 +22,3 @@
 #include "matching/distances.h"
 #include "matching/normalize.h"
 #include "matching/sequence.h"
-
-namespace openable {
-inline constexpr const char* kVersion = "0.1.0";
-}  // namespace openable

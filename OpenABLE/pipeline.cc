@@ -6,6 +6,7 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/describe.h"
+#include "OpenABLE/evaluate.h"
 #include "OpenABLE/exports.h"
 #include "OpenABLE/io/frame_source.h"
 #include "descriptors/registry.h"
@@ -150,7 +151,8 @@ std::string ThresholdPngPath(const Config& config) {
       .string();
 }
 
-std::vector<std::string> WriteOutputs(const Config& config, RunResult& result) {
+std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
+                                      const Evaluation* evaluation) {
   const auto t = Clock::now();
   OutputBatch batch;
   if (!config.txt_name.empty())
@@ -168,6 +170,9 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result) {
     batch.Stage(config.png_threshold_name.empty() ? "Png_name" : "Png_threshold_name",
                 threshold_png, EncodePng(ColorizeMatrix(binary, config.matrix_color)));
   }
+  if (evaluation != nullptr && !config.evaluation_name.empty())
+    StageEvaluation(batch, "Evaluation_name", config.evaluation_name, *evaluation,
+                    {&result.normalized});
   const std::vector<std::string> paths = batch.Paths();
   batch.Commit();
   const double seconds = SecondsSince(t);

@@ -13,6 +13,8 @@
 
 namespace openable {
 
+struct Evaluation;  // OpenABLE/evaluate.h
+
 // One traversal of the run (a folder or a video) and the rows it holds in the matrix.
 struct Traversal {
   std::string key;                  // config key it came from ("Images_path", ...)
@@ -28,6 +30,7 @@ struct RunTimings {
   double describe_seconds = 0;   // reading and describing every frame (wall time)
   double match_seconds = 0;      // pairwise distances (wall time)
   double sequence_seconds = 0;   // sequence sums, normalisation and threshold
+  double evaluate_seconds = 0;   // evaluation against ground truth (when asked for)
   double export_seconds = 0;     // encoding and writing the outputs
   double total_seconds = 0;
   int frames = 0;                // frames described
@@ -50,9 +53,11 @@ struct RunResult {
 RunResult ComputeRun(const Config& config, ProgressReporter& progress);
 
 // Writes the outputs the configuration asks for (Txt_name, Npy_name, Png_name,
-// Png_threshold_name) all-or-nothing; returns the paths written. Adds the time spent to
+// Png_threshold_name, and the files of Evaluation_name when `evaluation` is given)
+// all-or-nothing; returns the paths written. Adds the time spent to
 // result.timings.export_seconds. Throws InputError naming the key and path on failure.
-std::vector<std::string> WriteOutputs(const Config& config, RunResult& result);
+std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
+                                      const Evaluation* evaluation = nullptr);
 
 // The thresholded image's path: Png_threshold_name, or Png_name with "_thresholded" before
 // its extension; empty when no threshold or no PNG is asked for.

@@ -146,6 +146,64 @@ const std::vector<Binding>& Bindings() {
        true},
       {"Threads", "Description and matching", &Config::threads, 0, 1024,
        "Worker threads for description and matching; 0 = all cores.", true},
+      // Evaluation (docs/evaluation.md)
+      {"Ground_truth_type", "Evaluation", &Config::ground_truth_type, 0, 0,
+       "Empty: no evaluation. matrix (0/1 text, image, .npy), pairs (CSV or whitespace "
+       "row,col), aligned (two traversals, query i is reference i), kitti (3x4 poses), tum "
+       "(timestamp tx ty tz qx qy qz qw), positions (x,y[,z]): the run's matrix is evaluated "
+       "against it with both protocols of docs/evaluation.md.",
+       true},
+      {"Ground_truth", "Evaluation", &Config::ground_truth, 0, 0,
+       "Ground-truth file (not needed for aligned). Pairs and poses count frames from the "
+       "start of the source, as Initial_image does; for poses of two traversals, the poses "
+       "of the reference (Images_path).",
+       true},
+      {"Ground_truth_2", "Evaluation", &Config::ground_truth_2, 0, 0,
+       "Poses of the query traversal (Images_path_2 or Video_path_2) for kitti, tum and "
+       "positions ground truth of two traversals.",
+       true},
+      {"Ground_truth_base", "Evaluation", &Config::ground_truth_base, -1, 1,
+       "Pairs: 0 or 1 for 0- or 1-based frame numbers; -1 reads a comment line saying "
+       "\"0-based\" or \"1-based\", else 0.",
+       true},
+      {"Ground_truth_radius", "Evaluation", &Config::ground_truth_radius, 0, kNoLimit,
+       "Poses: two frames are the same place when their positions are closer than this (the "
+       "poses' unit, metres for KITTI).",
+       true},
+      {"Ground_truth_heading", "Evaluation", &Config::ground_truth_heading, -1, 180,
+       "Poses: and when their viewing directions differ by less than this many degrees (a "
+       "forward camera cannot recognise a place seen the other way); -1: no limit.",
+       true},
+      {"Ground_truth_min_gap", "Evaluation", &Config::ground_truth_min_gap, -1, kNoLimit,
+       "Poses, one sequence: only frames at least this many frames apart are loops; -1: "
+       "Exclusion.",
+       true},
+      {"Ground_truth_axes", "Evaluation", &Config::ground_truth_axes, 0, 0,
+       "Poses: axes of the distance and heading: xyz (3D), xz (the ground plane of KITTI's "
+       "camera frame, y down) or xy.",
+       true},
+      {"Tolerance", "Evaluation", &Config::tolerance, 0, kNoLimit,
+       "Frames: a best match within this many frames of a true match is correct (2 for "
+       "Nordland and Gardens Point, 3 for KITTI in docs/benchmarks.md).",
+       true},
+      {"Exclusion", "Evaluation", &Config::exclusion, 1, kNoLimit,
+       "One sequence: the candidates of frame q are frames at least this many frames "
+       "earlier (recent frames always look alike and are not loops).",
+       true},
+      {"Vicinity", "Evaluation", &Config::vicinity, 0, kNoLimit,
+       "ABLE-P protocol: a detected cell is a true positive when a ground-truth loop lies "
+       "within this many frames of it in both directions (7 in the ABLE-P paper).",
+       true},
+      {"Evaluation_name", "Evaluation", &Config::evaluation_name, 0, 0,
+       "Output prefix of the evaluation: <name>.json (figures and settings), "
+       "<name>_per_query.csv and <name>_ablep.csv (curves), <name>_pr.png (precision-recall "
+       "figure), <name>_overlay.png (ground truth and best matches over the matrix). Empty: "
+       "the figures are printed only.",
+       true},
+      {"Evaluation_label", "Evaluation", &Config::evaluation_label, 0, 0,
+       "Name of this run in the figure's legend and the JSON; empty: descriptor and L, "
+       "e.g. \"LDB L=10\".",
+       true},
   };
   return table;
 }
@@ -326,6 +384,30 @@ void ApplyOverride(Config& config, const std::string& assignment) {
   Assign(config, Lookup(key, "--set"), Trim(assignment.substr(eq + 1)), "--set");
 }
 
+void CheckEvaluationConfig(const Config& c) {
+  auto need = [](const std::string& value, const std::string& key, const std::string& why) {
+    if (value.empty()) throw InputError(key + ": empty; expected a path (" + why + ")");
+  };
+  static const char* kTruthTypes[] = {"", "matrix", "pairs", "aligned", "kitti", "tum",
+                                      "positions"};
+  if (std::find(std::begin(kTruthTypes), std::end(kTruthTypes), c.ground_truth_type) ==
+      std::end(kTruthTypes))
+    throw InputError("Ground_truth_type: " + Quote(c.ground_truth_type) +
+                     " is not a ground-truth type; expected one of matrix, pairs, aligned, "
+                     "kitti, tum, positions (or empty: no evaluation)");
+  if (!c.ground_truth_type.empty() && c.ground_truth_type != "aligned")
+    need(c.ground_truth, "Ground_truth", "Ground_truth_type " + c.ground_truth_type + " reads a file");
+  if (c.ground_truth_radius <= 0.0)
+    throw InputError("Ground_truth_radius: " + FormatNumber(c.ground_truth_radius) +
+                     " is not valid; expected a distance > 0");
+  if (c.ground_truth_heading != -1.0 && c.ground_truth_heading <= 0.0)
+    throw InputError("Ground_truth_heading: " + FormatNumber(c.ground_truth_heading) +
+                     " is not valid; expected -1 (no limit) or degrees in (0, 180]");
+  if (c.ground_truth_axes != "xyz" && c.ground_truth_axes != "xz" && c.ground_truth_axes != "xy")
+    throw InputError("Ground_truth_axes: " + Quote(c.ground_truth_axes) +
+                     " is not valid; expected xyz, xz or xy");
+}
+
 void CheckConfig(const Config& c) {
   auto need = [](const std::string& value, const std::string& key, const std::string& why) {
     if (value.empty()) throw InputError(key + ": empty; expected a path (" + why + ")");
@@ -353,6 +435,7 @@ void CheckConfig(const Config& c) {
     throw InputError("Final_image: " + std::to_string(c.final_image) +
                      " is not after Initial_image " + std::to_string(c.initial_image) +
                      "; expected -1 (to the end) or a position > Initial_image");
+  CheckEvaluationConfig(c);
   if (c.threshold != -1.0 && (c.threshold < 0.0 || c.threshold > 1.0))
     throw InputError("Threshold: " + FormatNumber(c.threshold) +
                      " is not valid; expected -1 (disabled) or a number in [0, 1]");

@@ -47,6 +47,20 @@ struct Config {
   double threshold = -1.0;            // theta of Eq. 9 in [0, 1]; -1 disables
   int ldb_bits = 256;                 // new: LDB bits kept, 1-1386
   int threads = 0;                    // new: worker threads, 0 = all cores
+  // --- Evaluation (new) ----------------------------------------------------------------------
+  std::string ground_truth_type;      // "", matrix, pairs, aligned, kitti, tum, positions
+  std::string ground_truth;           // ground-truth file (poses of the reference, for poses)
+  std::string ground_truth_2;         // poses of the query traversal (two traversals)
+  int ground_truth_base = -1;         // pairs: 0 or 1-based; -1 = from the header, else 0
+  double ground_truth_radius = 5.0;   // poses: loop when closer than this
+  double ground_truth_heading = -1.0; // poses: and headings closer than this, degrees; -1 off
+  int ground_truth_min_gap = -1;      // poses, one sequence: frames apart; -1 = Exclusion
+  std::string ground_truth_axes = "xyz";  // poses: xyz, xz or xy
+  int tolerance = 2;                  // frames: a match this close to a true one is right
+  int exclusion = 100;                // one sequence: candidates at least this many frames back
+  int vicinity = 7;                   // ABLE-P protocol: temporal vicinity, frames
+  std::string evaluation_name;        // output prefix; empty = table only
+  std::string evaluation_label;       // legend label; empty = "<descriptor> L=<L>"
 
   bool operator==(const Config& other) const;
   bool operator!=(const Config& other) const { return !(*this == other); }
@@ -71,6 +85,10 @@ void ApplyOverride(Config& config, const std::string& assignment);
 // Cross-key checks that no single value shows (the mode's inputs are given, the threshold is
 // -1 or in [0, 1], parts not built yet are asked for, ...). Throws InputError naming the key.
 void CheckConfig(const Config& config);
+
+// The checks of CheckConfig on the Evaluation keys alone (Ground_truth_type known, its file
+// given, heading, radius and axes valid), for tools that only evaluate.
+void CheckEvaluationConfig(const Config& config);
 
 // Writes `config` in the same format LoadConfig reads (every key, with a comment each).
 std::string FormatConfig(const Config& config);

@@ -1,5 +1,7 @@
 // Test_OpenABLE: Config.txt in, normalised distance matrix out. A thin layer over the library.
+#include <chrono>
 #include <cstdio>
+#include <memory>
 #include <cstring>
 #include <iostream>
 #include <string>
@@ -45,7 +47,7 @@ std::string Fixed(double v, int decimals) {
 }
 
 void PrintReport(const openable::Config& c, const openable::RunResult& r,
-                 const std::vector<std::string>& written) {
+                 const openable::Evaluation* evaluation, const std::vector<std::string>& written) {
   std::cout << "OpenABLE " << openable::kVersion << ": " << r.descriptor << " ("
             << r.row_width << (r.binary ? " bytes, Hamming" : " floats, L2") << "), "
             << (c.description_type == 0 ? "global " : "grid ")
@@ -75,8 +77,12 @@ void PrintReport(const openable::Config& c, const openable::RunResult& r,
             << "  matching         " << Fixed(tm.match_seconds, 3) << " s  ("
             << Fixed(tm.pairs ? 1e9 * tm.match_seconds / static_cast<double>(tm.pairs) : 0, 1)
             << " ns per pair, " << tm.pairs << " pairs)\n"
-            << "  sequences+norm.  " << Fixed(tm.sequence_seconds, 3) << " s\n"
-            << "  export           " << Fixed(tm.export_seconds, 3) << " s\n";
+            << "  sequences+norm.  " << Fixed(tm.sequence_seconds, 3) << " s\n";
+  if (evaluation != nullptr)
+    std::cout << "  evaluation       " << Fixed(tm.evaluate_seconds, 3) << " s\n";
+  std::cout << "  export           " << Fixed(tm.export_seconds, 3) << " s\n";
+  if (evaluation != nullptr)
+    std::cout << openable::FormatEvaluationTable(evaluation->settings, evaluation->runs);
   if (written.empty()) {
     std::cout << "No output file was asked for (set Txt_name, Npy_name or Png_name).\n";
   } else {
@@ -145,9 +151,24 @@ int main(int argc, char** argv) {
         std::getenv("WAYLAND_DISPLAY") == nullptr)
       std::cerr << "Test_OpenABLE: warning: Show_images is 1 but there is no display "
                    "(DISPLAY is not set); frames are not shown\n";
+    // Evaluation settings are checked before the long part of the run.
+    std::unique_ptr<openable::Evaluation> evaluation;
+    if (openable::EvaluationRequested(config)) {
+      evaluation = std::make_unique<openable::Evaluation>();
+      evaluation->settings = openable::EvaluationSettingsFrom(config);
+    }
     openable::RunResult result = openable::ComputeRun(config, progress);
-    const std::vector<std::string> written = openable::WriteOutputs(config, result);
-    PrintReport(config, result, written);
+    if (evaluation) {
+      const auto start = std::chrono::steady_clock::now();
+      openable::EvaluateMatrix(*evaluation, result.normalized, openable::LayoutOf(result),
+                               openable::RunLabel(config), "Test_OpenABLE run");
+      result.timings.evaluate_seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      result.timings.total_seconds += result.timings.evaluate_seconds;
+    }
+    const std::vector<std::string> written =
+        openable::WriteOutputs(config, result, evaluation.get());
+    PrintReport(config, result, evaluation.get(), written);
     return 0;
   } catch (const openable::InputError& e) {
     std::cerr << "Test_OpenABLE: error: " << e.what() << "\n";

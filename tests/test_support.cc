@@ -40,6 +40,8 @@ std::string DatasetsDir() { return OPENABLE_DATASETS_DIR; }
 std::string SampleDir() { return SourceDir() + "/examples/data/nordland_sample"; }
 std::string TestOpenableExe() { return OPENABLE_TEST_OPENABLE_EXE; }
 
+std::string OpenableEvaluateExe() { return OPENABLE_EVALUATE_EXE; }
+
 std::string TempDir() {
   static std::atomic<int> counter{0};
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();

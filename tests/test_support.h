@@ -19,6 +19,8 @@ std::string SampleDir();
 std::string TempDir();
 // Path of the Test_OpenABLE program built beside the tests.
 std::string TestOpenableExe();
+// The openable_evaluate program built with the tests.
+std::string OpenableEvaluateExe();
 
 }  // namespace openable::testing
 

@@ -19,8 +19,9 @@ struct GroundTruth {
   // same place as query row q. Size = layout.queries.
   std::vector<std::vector<int>> matches;
   int references = 0;
-  // Pairs dropped while loading: pairs on the diagonal (q, q) of a loop-closure layout, and pairs
-  // outside the processed frame range when first_frame > 0 or the range ends early. (Pairs
+  // Pairs dropped while loading: pairs on the diagonal (q, q) of a loop-closure layout, and,
+  // when a frame range was selected (first_frame > 0 or range_selected), pairs outside it
+  // (without a range, a pair past the last frame is an error: a wrong file). (Pairs
   // inside the exclusion window are kept here; the evaluation leaves them out and says so.)
   std::int64_t dropped = 0;
 
@@ -59,6 +60,8 @@ struct GroundTruthOptions {
                            // "0-based" or "1-based", else 0
   int first_frame = 0;     // frame number of row 0 (Initial_image): pair indices and pose lines
                            // count from the start of the source, rows from first_frame
+  bool range_selected = false;  // the run processes part of its source (Initial_image > 0 or
+                                // Final_image != -1): pairs outside it are dropped, not errors
   double radius = 5.0;     // poses: a pair is a loop when the positions are closer than this
                            // (same unit as the file, metres for KITTI), > 0
   double heading_limit = -1.0;  // poses: and when the viewing directions differ by less than
@@ -75,9 +78,9 @@ struct GroundTruthOptions {
 // matrix). Loop closure: a pair (a, b) is stored as (max, min), the later frame is the query;
 // pairs are symmetric. Query-reference: a pair is (query row, reference column) in the block's
 // own indices (0 = first frame of that traversal). A ground-truth matrix may have the block's
-// size or the full matrix's (then the same block is taken from it). Throws InputError with one line naming
-// the file (and line) or key: unreadable or malformed file, a matrix whose size is neither the
-// block's nor the full square matrix's, pairs outside the range, pose files whose frame count
+// size or the full matrix's (then the same block is taken from it). Throws InputError with one
+// line naming the file (and line) or key: unreadable or malformed file, a matrix whose size is
+// neither the block's nor the full matrix's, pairs outside the range, pose files whose frame count
 // does not cover the run, a heading limit without orientations, aligned ground truth on a
 // loop-closure layout.
 GroundTruth LoadGroundTruth(const GroundTruthOptions& options, const EvaluationLayout& layout,

@@ -12,71 +12,15 @@
 #include <opencv2/videoio.hpp>
 
 #include "config/config.h"
+#include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
 
 namespace openable {
 namespace {
 
+using namespace e2e;  // NOLINT: the e2e helpers are this file's vocabulary
+
 namespace fs = std::filesystem;
-
-struct Outcome {
-  int status = -1;
-  std::string out, err;
-};
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
-std::string ShellQuote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-Outcome RunProgram(const std::vector<std::string>& args, const std::string& dir) {
-  std::string cmd = "cd " + ShellQuote(dir) + " && " + ShellQuote(testing::TestOpenableExe());
-  for (const auto& a : args) cmd += " " + ShellQuote(a);
-  cmd += " >stdout.log 2>stderr.log";
-  const int raw = std::system(cmd.c_str());
-  Outcome o;
-  o.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
-  o.out = ReadAll(dir + "/stdout.log");
-  o.err = ReadAll(dir + "/stderr.log");
-  fs::remove(dir + "/stdout.log");
-  fs::remove(dir + "/stderr.log");
-  return o;
-}
-
-// Independent .npy reader: float32, C order, 2-D.
-cv::Mat1f ReadNpy(const std::string& path) {
-  const std::string b = ReadAll(path);
-  if (b.size() < 10 || b.compare(0, 6, "\x93NUMPY") != 0) return {};
-  const size_t hl = static_cast<unsigned char>(b[8]) | (static_cast<unsigned char>(b[9]) << 8);
-  const std::string header = b.substr(10, hl);
-  if (header.find("'<f4'") == std::string::npos) return {};
-  int rows = 0, cols = 0;
-  if (std::sscanf(header.c_str() + header.find("'shape': (") + 10, "%d, %d", &rows, &cols) != 2)
-    return {};
-  cv::Mat1f m(rows, cols);
-  if (b.size() != 10 + hl + static_cast<size_t>(rows) * cols * 4) return {};
-  std::memcpy(m.data, b.data() + 10 + hl, static_cast<size_t>(rows) * cols * 4);
-  return m;
-}
-
-// Share of query rows [q0, q0+n) whose smallest distance among reference columns
-// [r0, r0+m) lies within `tol` frames of the aligned frame (frame-aligned traversals).
-double AlignedRecallAt1(const cv::Mat1f& d, int q0, int r0, int n, int tol) {
-  int hits = 0;
-  for (int q = 0; q < n; ++q) {
-    int best = 0;
-    for (int r = 1; r < n; ++r)
-      if (d(q0 + q, r0 + r) < d(q0 + q, r0 + best)) best = r;
-    hits += std::abs(best - q) <= tol;
-  }
-  return static_cast<double>(hits) / n;
-}
 
 std::string SampleConfig(const std::string& dir, const std::string& extra = "") {
   const std::string path = dir + "/Config.txt";
@@ -95,13 +39,10 @@ std::string SampleConfig(const std::string& dir, const std::string& extra = "") 
   return path;
 }
 
-bool OneLine(const std::string& s) {
-  return !s.empty() && s.back() == '\n' && s.find('\n') == s.size() - 1;
-}
 
 TEST(TestOpenABLE, SampleRunWritesEveryOutputAndFindsTheSeasonDiagonal) {
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram({SampleConfig(dir)}, dir);
+  const Outcome o = RunProgram(testing::TestOpenableExe(), {SampleConfig(dir)}, dir);
   ASSERT_EQ(o.status, 0) << o.err << o.out;
   EXPECT_NE(o.out.find("ms per image"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("ns per pair"), std::string::npos) << o.out;
@@ -156,7 +97,7 @@ TEST(TestOpenABLE, SampleRunWritesEveryOutputAndFindsTheSeasonDiagonal) {
 
 TEST(TestOpenABLE, OverridesRangeAndSingleSequence) {
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram({SampleConfig(dir), "--set", "Images_path_2=", "--set", "Final_image=50",
+  const Outcome o = RunProgram(testing::TestOpenableExe(), {SampleConfig(dir), "--set", "Images_path_2=", "--set", "Final_image=50",
                          "--set", "Initial_image=10", "--set", "Image_sequences=1", "--quiet"},
                         dir);
   ASSERT_EQ(o.status, 0) << o.err;
@@ -169,7 +110,7 @@ TEST(TestOpenABLE, OverridesRangeAndSingleSequence) {
 
 TEST(TestOpenABLE, HelpListsEveryKey) {
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram({"--help"}, dir);
+  const Outcome o = RunProgram(testing::TestOpenableExe(), {"--help"}, dir);
   ASSERT_EQ(o.status, 0);
   for (const auto& key : ConfigKeyNames()) EXPECT_NE(o.out.find(key), std::string::npos) << key;
   EXPECT_NE(o.out.find("--set Key=Value"), std::string::npos);
@@ -188,7 +129,7 @@ TEST(TestOpenABLE, VideoModeReadsFrames) {
     std::sort(names.begin(), names.end());
     for (int i = 0; i < 30; ++i) writer.write(cv::imread(names[i]));
   }
-  const Outcome o = RunProgram({SampleConfig(dir), "--set", "Frame_mode=1", "--set",
+  const Outcome o = RunProgram(testing::TestOpenableExe(), {SampleConfig(dir), "--set", "Frame_mode=1", "--set",
                          "Video_path_1=" + video, "--set", "Image_sequences=3"},
                         dir);
   ASSERT_EQ(o.status, 0) << o.err;
@@ -232,7 +173,7 @@ TEST_P(BadInputs, OneLineNonZeroExitNoOutput) {
     args.push_back("--set");
     args.push_back(s);
   }
-  const Outcome o = RunProgram(args, dir);
+  const Outcome o = RunProgram(testing::TestOpenableExe(), args, dir);
   EXPECT_EQ(o.status, 1) << o.err;
   EXPECT_TRUE(OneLine(o.err)) << "stderr: " << o.err;
   EXPECT_NE(o.err.find(c.expect), std::string::npos) << "stderr: " << o.err;
@@ -258,17 +199,17 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(TestOpenABLE, MissingOrBrokenConfigFile) {
   const std::string dir = testing::TempDir();
-  Outcome o = RunProgram({dir + "/nope.txt"}, dir);
+  Outcome o = RunProgram(testing::TestOpenableExe(), {dir + "/nope.txt"}, dir);
   EXPECT_EQ(o.status, 1);
   EXPECT_TRUE(OneLine(o.err)) << o.err;
   EXPECT_NE(o.err.find("nope.txt"), std::string::npos) << o.err;
   std::ofstream(dir + "/bad.txt") << "Frame_mode: 0\nthis is not a key value line\n";
-  o = RunProgram({dir + "/bad.txt"}, dir);
+  o = RunProgram(testing::TestOpenableExe(), {dir + "/bad.txt"}, dir);
   EXPECT_EQ(o.status, 1);
   EXPECT_NE(o.err.find("bad.txt:2"), std::string::npos) << o.err;
-  o = RunProgram({}, dir);
+  o = RunProgram(testing::TestOpenableExe(), {}, dir);
   EXPECT_EQ(o.status, 2);
-  o = RunProgram({"--bogus"}, dir);
+  o = RunProgram(testing::TestOpenableExe(), {"--bogus"}, dir);
   EXPECT_EQ(o.status, 2);
 }
 
@@ -278,7 +219,7 @@ TEST(TestOpenABLE, NordlandWinterVsSummerBeatsTheOriginal) {
   const std::string data = testing::DatasetsDir() + "/nordland_trimmed";
   OPENABLE_REQUIRE_PATH(data);
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram({SampleConfig(dir), "--set", "Images_path=" + data + "/summer", "--set",
+  const Outcome o = RunProgram(testing::TestOpenableExe(), {SampleConfig(dir), "--set", "Images_path=" + data + "/summer", "--set",
                          "Images_path_2=" + data + "/winter", "--set", "Txt_name=", "--set",
                          "Png_name=", "--set", "Threshold=-1", "--quiet"},
                         dir);

@@ -1,0 +1,55 @@
+// Evaluation of a run (Test_OpenABLE with Ground_truth_type set) or of saved matrices
+// (openable_evaluate), and its output files. The protocols themselves are in
+// OpenABLE/evaluation/ (docs/evaluation.md).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "OpenABLE/evaluation/ground_truth.h"
+#include "OpenABLE/evaluation/layout.h"
+#include "OpenABLE/evaluation/metrics.h"
+#include "OpenABLE/evaluation/report.h"
+#include "OpenABLE/exports.h"
+#include "OpenABLE/pipeline.h"
+#include "config/config.h"
+
+namespace openable {
+
+// Every evaluated matrix of one evaluation, with the ground truth of each.
+struct Evaluation {
+  EvaluationSettings settings;
+  std::vector<EvaluatedRun> runs;
+  std::vector<GroundTruth> truths;  // truths[i] belongs to runs[i]
+};
+
+// True when Ground_truth_type is set.
+bool EvaluationRequested(const Config& config);
+
+// The evaluation keys of `config` as option structs (Ground_truth_min_gap -1 = Exclusion),
+// checked (InputError naming the key).
+EvaluationSettings EvaluationSettingsFrom(const Config& config);
+
+// "LDB L=10", or Evaluation_label when set.
+std::string RunLabel(const Config& config);
+
+// The block a run's matrix is evaluated on: the query-reference block of two traversals, or
+// the whole matrix of one sequence as loop closure.
+EvaluationLayout LayoutOf(const RunResult& result);
+
+// Loads the ground truth for `layout` (a block of `normalized`) and evaluates `normalized` with
+// both protocols; appends the result to `evaluation`. Throws InputError on bad ground truth.
+void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
+                    const EvaluationLayout& layout, const std::string& label,
+                    const std::string& source);
+
+// Stages the evaluation's files under `prefix` into `batch` (key = the config key to name in
+// errors): <prefix>.json, <prefix>_pr.png, and per run <prefix>[_<label>]_per_query.csv,
+// <prefix>[_<label>]_ablep.csv and <prefix>[_<label>]_overlay.png (the label part only when
+// there are several runs). matrices[i] is the normalised matrix of runs[i].
+void StageEvaluation(OutputBatch& batch, const std::string& key, const std::string& prefix,
+                     const Evaluation& evaluation, const std::vector<const cv::Mat1f*>& matrices);
+
+}  // namespace openable

@@ -1,0 +1,625 @@
+#include "OpenABLE/evaluation/ground_truth.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <opencv2/core.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/evaluation/matrix_file.h"
+
+namespace openable {
+namespace {
+
+namespace fs = std::filesystem;
+
+// `s` between double quotes, with quotes and control characters escaped so that a message
+// stays on one line whatever the file name holds.
+std::string Quoted(std::string_view s) {
+  static const char* const kHex = "0123456789abcdef";
+  std::string out = "\"";
+  for (const char c : s) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (u < 0x20 || u == 0x7f) {
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 0xf];
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string FormatNumber(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+std::string ToLower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Text files of pairs and poses
+
+std::string ReadTextFile(const std::string& path, const std::string& where) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (!fs::exists(st)) throw InputError(where + ": file not found");
+  if (fs::is_directory(st)) throw InputError(where + ": is a folder; expected a file");
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw InputError(where + ": cannot be opened for reading");
+  std::string data((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  if (f.bad()) throw InputError(where + ": read error");
+  return data;
+}
+
+bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+// One line of a text file: its number (from 1), its fields (split at blanks and commas, the
+// comment left out; "1,,2" gives an empty field, a trailing comma none) and its comment (the
+// text after '#').
+struct Line {
+  int number = 0;
+  std::vector<std::string_view> fields;
+  std::string_view comment;
+};
+
+void SplitFields(std::string_view s, std::vector<std::string_view>* out) {
+  out->clear();
+  std::size_t i = 0;
+  bool after_comma = false;
+  while (true) {
+    while (i < s.size() && IsBlank(s[i])) ++i;
+    if (i == s.size()) break;
+    if (s[i] == ',') {
+      if (out->empty() || after_comma) out->emplace_back();
+      after_comma = true;
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j < s.size() && !IsBlank(s[j]) && s[j] != ',') ++j;
+    out->push_back(s.substr(i, j - i));
+    after_comma = false;
+    i = j;
+  }
+}
+
+// Calls f(const Line&) for every line of `data`.
+template <typename F>
+void ForEachLine(const std::string& data, F&& f) {
+  Line line;
+  std::size_t pos = data.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // UTF-8 BOM
+  while (pos < data.size()) {
+    std::size_t end = data.find('\n', pos);
+    if (end == std::string::npos) end = data.size();
+    const std::string_view text(data.data() + pos, end - pos);
+    pos = end + 1;
+    ++line.number;
+    const std::size_t hash = text.find('#');
+    line.comment = hash == std::string_view::npos ? std::string_view() : text.substr(hash + 1);
+    SplitFields(text.substr(0, hash), &line.fields);
+    f(static_cast<const Line&>(line));
+  }
+}
+
+// A whole field as a number ("1", "-2.5e3", "+4", "nan").
+bool ParseNumber(std::string_view field, double* value) {
+  if (!field.empty() && field.front() == '+') field.remove_prefix(1);
+  if (field.empty()) return false;
+  const char* end = field.data() + field.size();
+  const auto r = std::from_chars(field.data(), end, *value);
+  return r.ec == std::errc() && r.ptr == end;
+}
+
+// A whole field as an integer; "12.0" is accepted as 12.
+bool ParseIndex(std::string_view field, std::int64_t* value) {
+  std::string_view f = field;
+  if (!f.empty() && f.front() == '+') f.remove_prefix(1);
+  const char* end = f.data() + f.size();
+  const auto r = std::from_chars(f.data(), end, *value);
+  if (!f.empty() && r.ec == std::errc() && r.ptr == end) return true;
+  double d = 0.0;
+  if (!ParseNumber(field, &d) || !std::isfinite(d) || d != std::floor(d) || std::abs(d) > 1e15) {
+    return false;
+  }
+  *value = static_cast<std::int64_t>(d);
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Options
+
+const struct {
+  GroundTruthType type;
+  const char* name;
+} kTypeNames[] = {
+    {GroundTruthType::kNone, "none"},           {GroundTruthType::kMatrix, "matrix"},
+    {GroundTruthType::kPairs, "pairs"},         {GroundTruthType::kAligned, "aligned"},
+    {GroundTruthType::kKitti, "kitti"},         {GroundTruthType::kTum, "tum"},
+    {GroundTruthType::kPositions, "positions"},
+};
+
+bool IsPoseType(GroundTruthType t) {
+  return t == GroundTruthType::kKitti || t == GroundTruthType::kTum ||
+         t == GroundTruthType::kPositions;
+}
+
+// The options PairsFromPoses uses.
+void CheckPoseOptions(const GroundTruthOptions& o) {
+  if (!(std::isfinite(o.radius) && o.radius > 0)) {
+    throw InputError("Ground_truth_radius: " + FormatNumber(o.radius) +
+                     " is not valid; expected a number > 0");
+  }
+  if (o.heading_limit != -1.0 && !(o.heading_limit > 0 && o.heading_limit <= 180)) {
+    throw InputError("Ground_truth_heading: " + FormatNumber(o.heading_limit) +
+                     " is not valid; expected -1 (no limit) or degrees in (0, 180]");
+  }
+  if (o.min_frame_gap < 0) {
+    throw InputError("Ground_truth_min_gap: " + std::to_string(o.min_frame_gap) +
+                     " is not valid; expected an integer >= 0");
+  }
+  if (o.axes != "xyz" && o.axes != "xz" && o.axes != "xy") {
+    throw InputError("Ground_truth_axes: " + Quoted(o.axes) +
+                     " is not valid; expected xyz, xz or xy");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Poses
+
+const char* PoseFileLabel(GroundTruthType type) {
+  switch (type) {
+    case GroundTruthType::kKitti:
+      return "KITTI poses";
+    case GroundTruthType::kTum:
+      return "TUM trajectory";
+    default:
+      return "positions";
+  }
+}
+
+// Positions and unit forward vectors over the chosen axes, flat (3 doubles per frame, the
+// unused component 0); has_forward[i] = 0 when frame i has no usable forward vector.
+struct Projected {
+  std::vector<double> position;
+  std::vector<double> forward;
+  std::vector<char> has_forward;
+};
+
+Projected Project(const std::vector<FramePose>& poses, const std::string& axes) {
+  const bool use[3] = {true, axes != "xz", axes != "xy"};
+  Projected p;
+  p.position.assign(poses.size() * 3, 0.0);
+  p.forward.assign(poses.size() * 3, 0.0);
+  p.has_forward.assign(poses.size(), 0);
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    double f[3] = {0, 0, 0};
+    double norm2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (!use[k]) continue;
+      p.position[3 * i + k] = poses[i].position[k];
+      f[k] = poses[i].forward[k];
+      norm2 += f[k] * f[k];
+    }
+    // A direction (nearly) perpendicular to the plane has no heading in it.
+    const double norm = std::sqrt(norm2);
+    if (!poses[i].has_forward || !(norm > 1e-9)) continue;
+    for (int k = 0; k < 3; ++k) p.forward[3 * i + k] = f[k] / norm;
+    p.has_forward[i] = 1;
+  }
+  return p;
+}
+
+// The poses [first, first + count) of a pose file, or an InputError saying the file is short.
+std::vector<FramePose> PosesOfRun(const std::string& path, GroundTruthType type, int first,
+                                  int count, const std::string& frames_what) {
+  std::vector<FramePose> poses = ReadPoses(path, type);
+  const std::int64_t needed = static_cast<std::int64_t>(first) + count;
+  if (static_cast<std::int64_t>(poses.size()) < needed) {
+    throw InputError(std::string(PoseFileLabel(type)) + " " + Quoted(path) + ": file has " +
+                     std::to_string(poses.size()) + " poses, the run needs " +
+                     std::to_string(needed) + " (Initial_image " + std::to_string(first) + " + " +
+                     std::to_string(count) + " " + frames_what + ")");
+  }
+  return std::vector<FramePose>(poses.begin() + first, poses.begin() + needed);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loaders; each fills gt->matches (unsorted, maybe with duplicates) and gt->dropped.
+
+void LoadMatrix(const GroundTruthOptions& o, const EvaluationLayout& layout, int full_rows,
+                int full_cols, GroundTruth* gt) {
+  cv::Mat1f m;
+  try {
+    m = ReadMatrixFile(o.path);
+  } catch (const InputError& e) {
+    throw InputError(std::string("ground truth ") + e.what());
+  }
+  const std::string where = "ground truth matrix file " + Quoted(o.path);
+  const int rows = layout.queries, cols = layout.references;
+  auto size_text = [](int r, int c) { return std::to_string(r) + "x" + std::to_string(c); };
+  cv::Mat1f block;
+  if (m.rows == rows && m.cols == cols) {
+    block = m;
+  } else if (m.rows == full_rows && m.cols == full_cols) {
+    block = m(cv::Rect(layout.col_offset, layout.row_offset, cols, rows));
+  } else {
+    std::string expected = size_text(rows, cols) + " (the evaluated block)";
+    if (full_rows != rows || full_cols != cols) {
+      expected += " or " + size_text(full_rows, full_cols) + " (the whole distance matrix)";
+    }
+    throw InputError(where + ": " + size_text(m.rows, m.cols) + " (rows x columns); expected " +
+                     expected +
+                     (o.first_frame > 0 ? "; a matrix is not cut at Initial_image" : ""));
+  }
+  const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
+  for (int r = 0; r < rows; ++r) {
+    const float* row = block[r];
+    for (int c = 0; c < cols; ++c) {
+      const float v = row[c];
+      if (!std::isfinite(v)) {
+        throw InputError(where + ": cell (" + std::to_string(r) + ", " + std::to_string(c) +
+                         ") of the block is " + FormatNumber(v) +
+                         "; expected 0 (different places) or a non-zero number (same place)");
+      }
+      if (v == 0.f) continue;
+      if (!loop) {
+        gt->matches[static_cast<std::size_t>(r)].push_back(c);
+      } else if (r == c) {
+        ++gt->dropped;
+      } else {
+        gt->matches[static_cast<std::size_t>(std::max(r, c))].push_back(std::min(r, c));
+      }
+    }
+  }
+}
+
+void LoadPairs(const GroundTruthOptions& o, const EvaluationLayout& layout, GroundTruth* gt) {
+  const std::string where = "ground truth pairs " + Quoted(o.path);
+  const std::string data = ReadTextFile(o.path, where);
+  const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
+
+  int base = o.base;
+  std::string base_note;
+  if (base == -1) {
+    bool says_1 = false, says_0 = false;
+    ForEachLine(data, [&](const Line& line) {
+      const std::string c = ToLower(std::string(line.comment));
+      says_1 = says_1 || c.find("1-based") != std::string::npos;
+      says_0 = says_0 || c.find("0-based") != std::string::npos;
+    });
+    if (says_1 && says_0) {
+      throw InputError(where +
+                       ": comments say both \"0-based\" and \"1-based\"; set "
+                       "Ground_truth_base to 0 or 1");
+    }
+    base = says_1 ? 1 : 0;
+    base_note = says_1 || says_0 ? " (" + std::to_string(base) + "-based, as a comment says)"
+                                 : " (0-based; set Ground_truth_base to 1 if the file counts "
+                                   "from 1)";
+  } else {
+    base_note = " (" + std::to_string(base) + "-based, Ground_truth_base)";
+  }
+
+  const std::int64_t rows = layout.queries, cols = layout.references;
+  const std::int64_t first = o.first_frame;
+  const bool ranged = first > 0 || o.range_selected;
+  bool first_content = true;
+  ForEachLine(data, [&](const Line& line) {
+    if (line.fields.empty()) return;
+    const std::string at = where + ":" + std::to_string(line.number);
+    double unused = 0;
+    const bool header =
+        first_content && !line.fields[0].empty() && !ParseNumber(line.fields[0], &unused);
+    first_content = false;
+    if (header) return;
+    if (line.fields.size() < 2) {
+      throw InputError(at + ": line has 1 value; expected two frame indices \"a,b\"");
+    }
+    std::int64_t raw[2];
+    for (int k = 0; k < 2; ++k) {
+      if (!ParseIndex(line.fields[static_cast<std::size_t>(k)], &raw[k])) {
+        throw InputError(at + ": value " + Quoted(line.fields[static_cast<std::size_t>(k)]) +
+                         " in column " + std::to_string(k + 1) +
+                         " is not an integer; expected two frame indices \"a,b\"");
+      }
+    }
+    const std::int64_t a = raw[0] - base - first, b = raw[1] - base - first;
+    const bool negative = raw[0] - base < 0 || raw[1] - base < 0;
+    const bool outside = a < 0 || b < 0 || a >= rows || b >= (loop ? rows : cols);
+    if (negative || (outside && !ranged)) {
+      std::string range;
+      if (ranged) {
+        range = "expected indices >= " + std::to_string(base);
+      } else if (loop) {
+        range = "expected frame indices in [" + std::to_string(base) + ", " +
+                std::to_string(base + rows - 1) + "] (" + std::to_string(rows) + " frames)";
+      } else {
+        range = "expected query indices in [" + std::to_string(base) + ", " +
+                std::to_string(base + rows - 1) + "] and reference indices in [" +
+                std::to_string(base) + ", " + std::to_string(base + cols - 1) + "]";
+      }
+      throw InputError(at + ": pair " + std::to_string(raw[0]) + "," + std::to_string(raw[1]) +
+                       " is out of range; " + range + base_note);
+    }
+    if (outside || (loop && a == b)) {  // outside the selected frames, or diagonal
+      ++gt->dropped;
+      return;
+    }
+    if (loop) {
+      gt->matches[static_cast<std::size_t>(std::max(a, b))].push_back(
+          static_cast<int>(std::min(a, b)));
+    } else {
+      gt->matches[static_cast<std::size_t>(a)].push_back(static_cast<int>(b));
+    }
+  });
+}
+
+void LoadPoses(const GroundTruthOptions& o, const EvaluationLayout& layout, GroundTruth* gt) {
+  if (layout.kind == EvaluationLayout::Kind::kLoopClosure) {
+    const std::vector<FramePose> poses =
+        PosesOfRun(o.path, o.type, o.first_frame, layout.queries, "frames");
+    gt->matches = PairsFromPoses(poses, {}, o);
+    for (std::size_t q = 0; q < gt->matches.size(); ++q) {  // a gap of 0 lets (q, q) in
+      auto& m = gt->matches[q];
+      if (!m.empty() && m.back() == static_cast<int>(q)) {
+        m.pop_back();
+        ++gt->dropped;
+      }
+    }
+    return;
+  }
+  if (o.path_2.empty()) {
+    throw InputError(
+        "Ground_truth_2: empty; expected the poses of the query traversal (with two "
+        "traversals Ground_truth holds the reference poses)");
+  }
+  if (layout.references == 0) return;  // an empty reference would mean loop closure below
+  const std::vector<FramePose> reference =
+      PosesOfRun(o.path, o.type, o.first_frame, layout.references, "reference frames");
+  const std::vector<FramePose> queries =
+      PosesOfRun(o.path_2, o.type, o.first_frame, layout.queries, "query frames");
+  gt->matches = PairsFromPoses(queries, reference, o);
+}
+
+}  // namespace
+
+GroundTruthType ParseGroundTruthType(const std::string& name) {
+  const std::string lower = ToLower(name);
+  if (lower.empty()) return GroundTruthType::kNone;
+  for (const auto& t : kTypeNames) {
+    if (lower == t.name) return t.type;
+  }
+  throw InputError("Ground_truth_type: " + Quoted(name) +
+                   " is not valid; expected matrix, pairs, aligned, kitti, tum, positions or "
+                   "empty (none)");
+}
+
+std::string GroundTruthTypeName(GroundTruthType type) {
+  for (const auto& t : kTypeNames) {
+    if (t.type == type) return t.name;
+  }
+  return "unknown";
+}
+
+void GroundTruthOptions::Check() const {
+  if (type != GroundTruthType::kNone && type != GroundTruthType::kAligned && path.empty()) {
+    throw InputError(
+        "Ground_truth: empty; expected the path of the ground-truth file "
+        "(Ground_truth_type " +
+        GroundTruthTypeName(type) + ")");
+  }
+  if (base < -1 || base > 1) {
+    throw InputError("Ground_truth_base: " + std::to_string(base) +
+                     " is not valid; expected -1 (from a comment of the file), 0 or 1");
+  }
+  if (first_frame < 0) {
+    throw InputError("Initial_image: " + std::to_string(first_frame) +
+                     " is not valid; expected an integer >= 0");
+  }
+  CheckPoseOptions(*this);
+  if (type == GroundTruthType::kPositions && heading_limit >= 0) {
+    throw InputError("Ground_truth_heading: " + FormatNumber(heading_limit) +
+                     " needs orientations, but positions have no orientation; expected -1 "
+                     "(no limit), or Ground_truth_type kitti or tum");
+  }
+}
+
+GroundTruth LoadGroundTruth(const GroundTruthOptions& options, const EvaluationLayout& layout,
+                            int full_rows, int full_cols) {
+  options.Check();
+  const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
+  if (layout.queries < 0 || layout.references < 0 || layout.row_offset < 0 ||
+      layout.col_offset < 0 || layout.row_offset + layout.queries > full_rows ||
+      layout.col_offset + layout.references > full_cols ||
+      (loop && layout.queries != layout.references)) {
+    throw std::logic_error("LoadGroundTruth: layout " + std::to_string(layout.queries) + "x" +
+                           std::to_string(layout.references) + " at (" +
+                           std::to_string(layout.row_offset) + ", " +
+                           std::to_string(layout.col_offset) + ") does not fit a " +
+                           std::to_string(full_rows) + "x" + std::to_string(full_cols) + " matrix");
+  }
+  GroundTruth gt;
+  gt.references = layout.references;
+  gt.matches.assign(static_cast<std::size_t>(layout.queries), {});
+  switch (options.type) {
+    case GroundTruthType::kNone:
+      return gt;
+    case GroundTruthType::kMatrix:
+      LoadMatrix(options, layout, full_rows, full_cols, &gt);
+      break;
+    case GroundTruthType::kPairs:
+      LoadPairs(options, layout, &gt);
+      break;
+    case GroundTruthType::kAligned:
+      if (loop) {
+        throw InputError(
+            "Ground_truth_type: aligned needs two traversals (Images_path_2 or Frame_mode 2)");
+      }
+      for (int q = 0; q < std::min(layout.queries, layout.references); ++q) {
+        gt.matches[static_cast<std::size_t>(q)].push_back(q);
+      }
+      break;
+    case GroundTruthType::kKitti:
+    case GroundTruthType::kTum:
+    case GroundTruthType::kPositions:
+      LoadPoses(options, layout, &gt);
+      break;
+  }
+  for (auto& m : gt.matches) {
+    std::sort(m.begin(), m.end());
+    m.erase(std::unique(m.begin(), m.end()), m.end());
+  }
+  return gt;
+}
+
+std::vector<FramePose> ReadPoses(const std::string& path, GroundTruthType type) {
+  if (!IsPoseType(type)) {
+    throw std::logic_error("ReadPoses: type " + GroundTruthTypeName(type) + " is not a pose type");
+  }
+  const std::string where = std::string(PoseFileLabel(type)) + " " + Quoted(path);
+  const std::string data = ReadTextFile(path, where);
+  std::vector<FramePose> poses;
+  bool first_content = true;
+  std::size_t position_count = 0;  // numbers per line of a positions file
+  int position_line = 0;
+  std::vector<double> v;
+  ForEachLine(data, [&](const Line& line) {
+    if (line.fields.empty()) return;
+    const std::string at = where + ":" + std::to_string(line.number);
+    double unused = 0;
+    const bool header = type == GroundTruthType::kPositions && first_content &&
+                        !line.fields[0].empty() && !ParseNumber(line.fields[0], &unused);
+    first_content = false;
+    if (header) return;  // "x,y,z"
+    v.resize(line.fields.size());
+    for (std::size_t k = 0; k < line.fields.size(); ++k) {
+      if (!ParseNumber(line.fields[k], &v[k]) || !std::isfinite(v[k])) {
+        throw InputError(at + ": value " + Quoted(line.fields[k]) + " in column " +
+                         std::to_string(k + 1) + " is not a finite number");
+      }
+    }
+    const std::string count = std::to_string(v.size()) + (v.size() == 1 ? " number" : " numbers");
+    FramePose pose;
+    if (type == GroundTruthType::kKitti) {
+      if (v.size() != 12) {
+        throw InputError(at + ": line has " + count +
+                         "; expected 12 (a 3x4 matrix [R | t], row by row)");
+      }
+      pose.position = Eigen::Vector3d(v[3], v[7], v[11]);
+      pose.forward = Eigen::Vector3d(v[2], v[6], v[10]);
+      const double norm = pose.forward.norm();
+      if (!(norm > 0)) throw InputError(at + ": the third column of R is zero");
+      pose.forward /= norm;
+      pose.has_forward = true;
+    } else if (type == GroundTruthType::kTum) {
+      if (v.size() != 8) {
+        throw InputError(at + ": line has " + count +
+                         "; expected 8 (timestamp tx ty tz qx qy qz qw)");
+      }
+      pose.position = Eigen::Vector3d(v[1], v[2], v[3]);
+      Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+      const double norm = q.norm();
+      if (!(norm > 0)) throw InputError(at + ": the quaternion is zero");
+      q.coeffs() /= norm;
+      pose.forward = q.toRotationMatrix().col(2);
+      pose.has_forward = true;
+    } else {
+      if (v.size() != 2 && v.size() != 3) {
+        throw InputError(at + ": line has " + count + "; expected 2 or 3 (x, y[, z])");
+      }
+      if (position_count == 0) {
+        position_count = v.size();
+        position_line = line.number;
+      } else if (v.size() != position_count) {
+        throw InputError(at + ": line has " + count + "; expected " +
+                         std::to_string(position_count) + " like the first position (line " +
+                         std::to_string(position_line) + ")");
+      }
+      pose.position = Eigen::Vector3d(v[0], v[1], v.size() == 3 ? v[2] : 0.0);
+    }
+    poses.push_back(pose);
+  });
+  if (poses.empty()) {
+    throw InputError(where +
+                     ": no poses; expected one pose per line (the file is empty or "
+                     "holds only comments)");
+  }
+  return poses;
+}
+
+std::vector<std::vector<int>> PairsFromPoses(const std::vector<FramePose>& queries,
+                                             const std::vector<FramePose>& reference,
+                                             const GroundTruthOptions& options) {
+  CheckPoseOptions(options);
+  const bool loop = reference.empty();
+  const bool heading = options.heading_limit >= 0;
+  if (heading) {
+    auto oriented = [](const FramePose& p) { return p.has_forward; };
+    if (!std::all_of(queries.begin(), queries.end(), oriented) ||
+        !std::all_of(reference.begin(), reference.end(), oriented)) {
+      throw InputError("Ground_truth_heading: " + FormatNumber(options.heading_limit) +
+                       " needs orientations, but the poses have none; expected -1 (no limit)");
+    }
+  }
+  const Projected q_proj = Project(queries, options.axes);
+  const Projected r_proj = loop ? Projected() : Project(reference, options.axes);
+  const Projected& rp = loop ? q_proj : r_proj;
+  const double radius = options.radius;
+  const double limit = options.heading_limit;
+  constexpr double kDegrees = 180.0 / 3.14159265358979323846;
+
+  std::vector<std::vector<int>> matches(queries.size());
+  const auto n_ref = static_cast<std::int64_t>(loop ? queries.size() : reference.size());
+  for (std::size_t q = 0; q < queries.size(); ++q) {
+    const std::int64_t end =
+        loop ? std::min<std::int64_t>(static_cast<std::int64_t>(q) - options.min_frame_gap + 1,
+                                      n_ref)
+             : n_ref;
+    const double* pq = &q_proj.position[3 * q];
+    const double* fq = &q_proj.forward[3 * q];
+    if (heading && !q_proj.has_forward[q]) continue;
+    for (std::int64_t j = 0; j < end; ++j) {
+      const auto ju = static_cast<std::size_t>(j);
+      const double* pj = &rp.position[3 * ju];
+      const double dx = pq[0] - pj[0], dy = pq[1] - pj[1], dz = pq[2] - pj[2];
+      if (!(std::sqrt(dx * dx + dy * dy + dz * dz) < radius)) continue;
+      if (heading) {
+        if (!rp.has_forward[ju]) continue;
+        const double* fj = &rp.forward[3 * ju];
+        const double dot = fq[0] * fj[0] + fq[1] * fj[1] + fq[2] * fj[2];
+        const double cx = fq[1] * fj[2] - fq[2] * fj[1];
+        const double cy = fq[2] * fj[0] - fq[0] * fj[2];
+        const double cz = fq[0] * fj[1] - fq[1] * fj[0];
+        const double angle = std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), dot) * kDegrees;
+        if (!(angle < limit)) continue;
+      }
+      matches[q].push_back(static_cast<int>(j));
+    }
+  }
+  return matches;
+}
+
+}  // namespace openable

@@ -1,0 +1,268 @@
+#include "OpenABLE/evaluation/metrics.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "OpenABLE/base/error.h"
+
+namespace openable {
+namespace {
+
+void CheckShapes(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                 const GroundTruth& truth) {
+  if (layout.queries < 0 || layout.references < 0 || layout.row_offset < 0 ||
+      layout.col_offset < 0 || layout.row_offset + layout.queries > matrix.rows ||
+      layout.col_offset + layout.references > matrix.cols) {
+    throw std::logic_error("evaluation: layout does not fit a " + std::to_string(matrix.rows) +
+                           " x " + std::to_string(matrix.cols) + " matrix");
+  }
+  if (static_cast<int>(truth.matches.size()) != layout.queries) {
+    throw std::logic_error("evaluation: ground truth has " +
+                           std::to_string(truth.matches.size()) + " queries, layout " +
+                           std::to_string(layout.queries));
+  }
+  if (layout.kind == EvaluationLayout::Kind::kLoopClosure && layout.queries != layout.references)
+    throw std::logic_error("evaluation: a loop-closure layout must be square");
+}
+
+// Last candidate column of query q plus one (candidates are columns [0, end)).
+int CandidateEnd(const EvaluationLayout& layout, int q, int exclusion) {
+  if (layout.kind == EvaluationLayout::Kind::kQueryReference) return layout.references;
+  return std::max(0, std::min(layout.references, q - exclusion + 1));
+}
+
+// True matches of q among its candidates (matches are sorted, so this is a prefix).
+std::vector<int> CandidateTruth(const std::vector<int>& matches, int end) {
+  return std::vector<int>(matches.begin(),
+                          std::lower_bound(matches.begin(), matches.end(), end));
+}
+
+// Whether column c lies within `tolerance` of a sorted list of true columns.
+bool NearTruth(const std::vector<int>& truth, int c, int tolerance) {
+  const auto it = std::lower_bound(truth.begin(), truth.end(), c - tolerance);
+  return it != truth.end() && *it <= c + tolerance;
+}
+
+double F1(double precision, double recall) {
+  return precision + recall > 0 ? 2 * precision * recall / (precision + recall) : 0.0;
+}
+
+// Step-wise area: sum of precision x recall increments, recall starting at 0.
+double StepArea(const std::vector<CurvePoint>& curve) {
+  double area = 0, previous = 0;
+  for (const CurvePoint& p : curve) {
+    area += p.precision * (p.recall - previous);
+    previous = p.recall;
+  }
+  return area;
+}
+
+constexpr int kRecallAtN[] = {1, 5, 10};
+constexpr int kMaxN = 10;
+
+}  // namespace
+
+void EvaluationOptions::Check() const {
+  if (tolerance < 0)
+    throw InputError("Tolerance: " + std::to_string(tolerance) +
+                     " is negative; expected a number of frames >= 0");
+  if (exclusion < 1)
+    throw InputError("Exclusion: " + std::to_string(exclusion) +
+                     " is too small; expected a number of frames >= 1 (a frame is not its own loop)");
+  if (vicinity < 0)
+    throw InputError("Vicinity: " + std::to_string(vicinity) +
+                     " is negative; expected a number of frames >= 0");
+  if (able_thresholds < 2)
+    throw std::logic_error("EvaluationOptions: able_thresholds must be >= 2");
+}
+
+PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                                const GroundTruth& truth, const EvaluationOptions& options) {
+  CheckShapes(matrix, layout, truth);
+  const int nq = layout.queries;
+  PerQueryResult r;
+  r.best.assign(nq, -1);
+  r.best_distance.assign(nq, std::numeric_limits<float>::infinity());
+  r.positive.assign(nq, 0);
+  r.correct.assign(nq, 0);
+  std::vector<std::array<std::uint8_t, 3>> correct_at_n(nq, {0, 0, 0});
+  std::vector<std::int64_t> outside(nq, 0);
+
+  // Each query row is independent: best candidate, its correctness, and the N best for R@N.
+  cv::parallel_for_(cv::Range(0, nq), [&](const cv::Range& range) {
+    std::vector<std::pair<float, int>> top;  // up to kMaxN best (distance, column), sorted
+    for (int q = range.start; q < range.end; ++q) {
+      const int end = CandidateEnd(layout, q, options.exclusion);
+      const std::vector<int> t = CandidateTruth(truth.matches[q], end);
+      outside[q] = static_cast<std::int64_t>(truth.matches[q].size() - t.size());
+      if (end == 0) continue;
+      const float* row = matrix.ptr<float>(layout.row_offset + q) + layout.col_offset;
+      top.clear();
+      for (int c = 0; c < end; ++c) {
+        const float v = row[c];
+        // Strictly smaller than the worst kept: ties keep the lower column.
+        if (static_cast<int>(top.size()) < kMaxN || v < top.back().first) {
+          auto pos = std::upper_bound(top.begin(), top.end(), v,
+                                      [](float x, const std::pair<float, int>& e) { return x < e.first; });
+          top.insert(pos, {v, c});
+          if (static_cast<int>(top.size()) > kMaxN) top.pop_back();
+        }
+      }
+      r.best[q] = top.front().second;
+      r.best_distance[q] = top.front().first;
+      r.positive[q] = t.empty() ? 0 : 1;
+      if (t.empty()) continue;
+      r.correct[q] = NearTruth(t, r.best[q], options.tolerance) ? 1 : 0;
+      bool hit = false;
+      int k = 0;
+      for (int n = 0; n < static_cast<int>(top.size()) && n < kMaxN; ++n) {
+        hit = hit || NearTruth(t, top[n].second, options.tolerance);
+        while (k < 3 && n + 1 == kRecallAtN[k]) correct_at_n[q][k++] = hit ? 1 : 0;
+      }
+      for (; k < 3; ++k) correct_at_n[q][k] = hit ? 1 : 0;  // fewer candidates than N
+    }
+  });
+
+  std::vector<int> order;
+  std::array<int, 3> hits_at_n = {0, 0, 0};
+  for (int q = 0; q < nq; ++q) {
+    r.truth_pairs_outside_candidates += outside[q];
+    if (r.best[q] < 0) continue;
+    ++r.queries;
+    order.push_back(q);
+    if (r.positive[q]) {
+      ++r.positive_queries;
+      for (int k = 0; k < 3; ++k) hits_at_n[k] += correct_at_n[q][k];
+    }
+  }
+  const double positives = r.positive_queries;
+  if (r.positive_queries > 0) {
+    r.recall_at_1 = hits_at_n[0] / positives;
+    r.recall_at_5 = hits_at_n[1] / positives;
+    r.recall_at_10 = hits_at_n[2] / positives;
+  }
+
+  // Sweep the acceptance threshold over every distinct best-match distance.
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return r.best_distance[a] < r.best_distance[b]; });
+  std::int64_t tp = 0, fp = 0;
+  for (std::size_t i = 0; i < order.size();) {
+    const float threshold = r.best_distance[order[i]];
+    for (; i < order.size() && r.best_distance[order[i]] == threshold; ++i) {
+      if (r.correct[order[i]])
+        ++tp;
+      else
+        ++fp;
+    }
+    CurvePoint p;
+    p.threshold = threshold;
+    p.tp = tp;
+    p.fp = fp;
+    p.precision = static_cast<double>(tp) / static_cast<double>(tp + fp);
+    p.recall = positives > 0 ? static_cast<double>(tp) / positives : 0.0;
+    p.f1 = F1(p.precision, p.recall);
+    r.curve.push_back(p);
+  }
+  r.auc = StepArea(r.curve);
+  for (const CurvePoint& p : r.curve) {
+    if (p.fp == 0 && p.tp > 0) r.recall_at_100p = p.recall;
+    if (p.f1 > r.max_f1) {
+      r.max_f1 = p.f1;
+      r.max_f1_threshold = p.threshold;
+      r.max_f1_precision = p.precision;
+      r.max_f1_recall = p.recall;
+    }
+  }
+  return r;
+}
+
+AblePResult EvaluateAbleP(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                          const GroundTruth& truth, const EvaluationOptions& options) {
+  CheckShapes(matrix, layout, truth);
+  const int nq = layout.queries, nr = layout.references, k_count = options.able_thresholds;
+  AblePResult result;
+  std::vector<double> thresholds(k_count);
+  for (int k = 0; k < k_count; ++k) thresholds[k] = static_cast<double>(k) / (k_count - 1);
+  // Index of the first threshold that detects value v (v < theta_k), k_count if none.
+  const auto first_detecting = [&](float v) {
+    if (!(v < 1.0f)) return k_count;  // theta_max = 1, so v >= 1 (or NaN) is never detected
+    const double vd = v;
+    int k = vd <= 0 ? 0 : static_cast<int>(std::floor(vd * (k_count - 1))) + 1;
+    k = std::min(std::max(k, 0), k_count - 1);
+    while (k > 0 && vd < thresholds[k - 1]) --k;
+    while (k < k_count && !(vd < thresholds[k])) ++k;
+    return k;
+  };
+
+  // Ground-truth cells among the candidates, and their vicinity (dilation by 2V+1).
+  cv::Mat1b truth_mask(nq, nr, std::uint8_t{0});
+  cv::Mat1f values(nq, nr);  // candidate values, +inf elsewhere
+  const float kNotCandidate = std::numeric_limits<float>::infinity();
+  for (int q = 0; q < nq; ++q) {
+    const int end = CandidateEnd(layout, q, options.exclusion);
+    const float* row = matrix.ptr<float>(layout.row_offset + q) + layout.col_offset;
+    float* out = values.ptr<float>(q);
+    for (int c = 0; c < nr; ++c) out[c] = c < end ? row[c] : kNotCandidate;
+    result.candidate_cells += end;
+    for (int c : truth.matches[q]) {
+      if (c >= end) break;
+      truth_mask(q, c) = 1;
+      ++result.truth_cells;
+    }
+  }
+  const cv::Mat kernel =
+      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * options.vicinity + 1, 2 * options.vicinity + 1));
+  cv::Mat1b near_truth;
+  cv::dilate(truth_mask, near_truth, kernel, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT,
+             cv::Scalar(0));
+  // Smallest candidate value within the vicinity of each cell: a ground-truth cell is found at
+  // theta when that minimum is below theta.
+  cv::Mat1f nearest_value;
+  cv::erode(values, nearest_value, kernel, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT,
+            cv::Scalar(kNotCandidate));
+
+  std::vector<std::int64_t> detections(k_count + 1, 0), true_detections(k_count + 1, 0),
+      found(k_count + 1, 0);
+  for (int q = 0; q < nq; ++q) {
+    const float* v = values.ptr<float>(q);
+    const std::uint8_t* nt = near_truth.ptr<std::uint8_t>(q);
+    const std::uint8_t* t = truth_mask.ptr<std::uint8_t>(q);
+    const float* nv = nearest_value.ptr<float>(q);
+    for (int c = 0; c < nr; ++c) {
+      if (v[c] != kNotCandidate) {
+        const int k = first_detecting(v[c]);
+        ++detections[k];
+        if (nt[c]) ++true_detections[k];
+      }
+      if (t[c]) ++found[first_detecting(nv[c])];
+    }
+  }
+  std::int64_t det = 0, tdet = 0, fnd = 0;
+  for (int k = 0; k < k_count; ++k) {
+    det += detections[k];
+    tdet += true_detections[k];
+    fnd += found[k];
+    CurvePoint p;
+    p.threshold = thresholds[k];
+    p.tp = tdet;
+    p.fp = det - tdet;
+    p.precision = det > 0 ? static_cast<double>(tdet) / static_cast<double>(det) : 1.0;
+    p.recall = result.truth_cells > 0
+                   ? static_cast<double>(fnd) / static_cast<double>(result.truth_cells)
+                   : 0.0;
+    p.f1 = F1(p.precision, p.recall);
+    result.curve.push_back(p);
+  }
+  result.average_precision = 100.0 * StepArea(result.curve);
+  return result;
+}
+
+}  // namespace openable

@@ -1,0 +1,457 @@
+// Figures of an evaluation, drawn with OpenCV only (lines, rectangles, Hershey text).
+//
+// RenderPrPlot layout (pixels; tests/evaluation/plots_test.cc relies on these numbers):
+//   figure: kTitleHeight (40) rows for the title, then one or two panels of kPanelWidth x
+//     kPanelHeight (700 x 600) side by side: 1400 x 640 with two panels, 700 x 640 with one.
+//   panel p (0 = per query, 1 = ABLE-P) starts at x = 700 p, y = 40. Its plot area spans
+//     x from 700 p + 75 to 700 p + 675 (600 px) and y from 40 + 50 = 90 (precision 1) down to
+//     640 - 60 = 580 (precision 0), so a curve point (recall r, precision p) is drawn at
+//     x = 700 p + 75 + 600 r, y = 580 - 490 p (sub-pixel precision, anti-aliased, 2 px wide).
+//   series i uses colour i mod 8 of the Okabe-Ito palette (kPalette).
+//
+// RenderOverlay layout: the block, enlarged by k = max(1, ceil(600 / max(rows, cols))), sits at
+// the top left: block cell (q, r) covers output pixels x in [k r, k r + k), y in [k q, k q + k).
+// The figure is max(k cols, 600) wide; a white legend strip (one or more 30 px lines) is below.
+#include "OpenABLE/evaluation/plots.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace openable {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Shared drawing helpers.
+
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+const cv::Scalar kBlack(0, 0, 0);
+const cv::Scalar kWhite(255, 255, 255);
+const cv::Scalar kGridGrey(225, 225, 225);
+const cv::Scalar kFrameGrey(160, 160, 160);
+
+// Okabe-Ito, BGR: blue, orange, bluish green, vermillion, reddish purple, sky blue, black,
+// yellow (yellow last: it is the weakest on white).
+const cv::Scalar kPalette[] = {
+    {178, 114, 0}, {0, 159, 230}, {115, 158, 0},  {0, 94, 213},
+    {167, 121, 204}, {233, 180, 86}, {0, 0, 0}, {66, 228, 240},
+};
+constexpr int kPaletteSize = static_cast<int>(sizeof(kPalette) / sizeof(kPalette[0]));
+
+cv::Size TextSize(const std::string& text, double scale, int thickness, int* baseline = nullptr) {
+  int b = 0;
+  const cv::Size s = cv::getTextSize(text, kFont, scale, thickness, &b);
+  if (baseline != nullptr) *baseline = b;
+  return s;
+}
+
+void PutText(cv::Mat3b& img, const std::string& text, cv::Point baseline_left, double scale,
+             int thickness, const cv::Scalar& colour) {
+  cv::putText(img, text, baseline_left, kFont, scale, colour, thickness, cv::LINE_AA);
+}
+
+// Largest scale <= `scale` (down to `min_scale`) at which `text` fits in `max_width`.
+double FitScale(const std::string& text, double scale, double min_scale, int thickness,
+                int max_width) {
+  while (scale > min_scale && TextSize(text, scale, thickness).width > max_width) scale -= 0.05;
+  return std::max(scale, min_scale);
+}
+
+// Bold (thickness 2) text at `scale` if it fits in `max_width` at a scale >= 0.6; else thin text
+// at a scale >= `min_scale` (thick Hershey strokes clog at small scales).
+void FitBold(const std::string& text, double scale, double min_scale, int max_width,
+             double* fitted_scale, int* thickness) {
+  *thickness = 2;
+  *fitted_scale = FitScale(text, scale, 0.6, 2, max_width);
+  if (TextSize(text, *fitted_scale, 2).width <= max_width) return;
+  *thickness = 1;
+  *fitted_scale = FitScale(text, 0.6, min_scale, 1, max_width);
+}
+
+// `text` shortened with "..." until it fits in `max_width` at `scale`.
+std::string Ellipsize(const std::string& text, double scale, int thickness, int max_width) {
+  if (TextSize(text, scale, thickness).width <= max_width) return text;
+  std::string t = text;
+  while (!t.empty() && TextSize(t + "...", scale, thickness).width > max_width) t.pop_back();
+  return t + "...";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Precision-recall figure.
+
+constexpr int kTitleHeight = 40;
+constexpr int kPanelWidth = 700;
+constexpr int kPanelHeight = 600;
+constexpr int kMarginLeft = 75;
+constexpr int kMarginRight = 25;
+constexpr int kMarginTop = 50;
+constexpr int kMarginBottom = 60;
+constexpr int kShift = 4;  // fixed-point bits of curve coordinates
+constexpr double kOne = 1 << kShift;
+
+// Area under a curve as metrics.h defines it: sum of precision x (recall - previous recall),
+// previous recall starting at 0, over the points in order.
+double StepArea(const std::vector<CurvePoint>& curve) {
+  double area = 0, previous = 0;
+  for (const CurvePoint& p : curve) {
+    area += p.precision * (p.recall - previous);
+    previous = p.recall;
+  }
+  return area;
+}
+
+std::string Format(const char* format, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), format, value);
+  return buffer;
+}
+
+double Clamp01(double v) {
+  if (!(v == v)) return 0;  // NaN
+  return std::min(1.0, std::max(0.0, v));
+}
+
+struct Axes {
+  cv::Rect plot;  // plot area: x = recall 0 .. 1, y = precision 1 (top) .. 0 (bottom)
+
+  // Fixed-point (kShift) pixel position of (recall, precision).
+  cv::Point Map(double recall, double precision) const {
+    const double x = plot.x + Clamp01(recall) * plot.width;
+    const double y = plot.y + plot.height - Clamp01(precision) * plot.height;
+    return {static_cast<int>(std::lround(x * kOne)), static_cast<int>(std::lround(y * kOne))};
+  }
+  int TickX(int i) const { return plot.x + static_cast<int>(std::lround(plot.width * i / 10.0)); }
+  int TickY(int i) const {
+    return plot.y + plot.height - static_cast<int>(std::lround(plot.height * i / 10.0));
+  }
+};
+
+std::string TickLabel(int i) {
+  if (i == 0) return "0";
+  if (i == 10) return "1.0";
+  return "0." + std::to_string(i);
+}
+
+// Text rotated by 90 degrees counter-clockwise (reads bottom to top), centred on `centre`.
+void PutVerticalText(cv::Mat3b& img, const std::string& text, cv::Point centre, double scale,
+                     int thickness) {
+  int baseline = 0;
+  const cv::Size s = TextSize(text, scale, thickness, &baseline);
+  cv::Mat3b label(s.height + baseline + 4, s.width + 4, cv::Vec3b(255, 255, 255));
+  PutText(label, text, {2, 2 + s.height}, scale, thickness, kBlack);
+  cv::Mat3b rotated;
+  cv::rotate(label, rotated, cv::ROTATE_90_COUNTERCLOCKWISE);
+  cv::Rect where(centre.x - rotated.cols / 2, centre.y - rotated.rows / 2, rotated.cols,
+                 rotated.rows);
+  const cv::Rect clipped = where & cv::Rect(0, 0, img.cols, img.rows);
+  if (clipped.empty()) return;
+  cv::Mat target = img(clipped);
+  const cv::Mat source = rotated(cv::Rect(clipped.x - where.x, clipped.y - where.y,
+                                            clipped.width, clipped.height));
+  cv::min(target, source, target);  // dark text over whatever is there (white)
+}
+
+void DrawAxes(cv::Mat3b& img, const Axes& axes, const std::string& panel_title) {
+  const cv::Rect& r = axes.plot;
+  const int left = r.x, right = r.x + r.width, top = r.y, bottom = r.y + r.height;
+  // Grid.
+  for (int i = 1; i < 10; ++i) {
+    cv::line(img, {axes.TickX(i), top}, {axes.TickX(i), bottom}, kGridGrey, 1);
+    cv::line(img, {left, axes.TickY(i)}, {right, axes.TickY(i)}, kGridGrey, 1);
+  }
+  // Frame, ticks and tick labels.
+  cv::rectangle(img, {left, top}, {right, bottom}, kBlack, 1);
+  const double tick_scale = 0.45;
+  for (int i = 0; i <= 10; ++i) {
+    const std::string label = TickLabel(i);
+    int baseline = 0;
+    const cv::Size s = TextSize(label, tick_scale, 1, &baseline);
+    const int x = axes.TickX(i);
+    cv::line(img, {x, bottom}, {x, bottom + 5}, kBlack, 1);
+    PutText(img, label, {x - s.width / 2, bottom + 9 + s.height}, tick_scale, 1, kBlack);
+    const int y = axes.TickY(i);
+    cv::line(img, {left - 5, y}, {left, y}, kBlack, 1);
+    PutText(img, label, {left - 9 - s.width, y + s.height / 2}, tick_scale, 1, kBlack);
+  }
+  // Axis labels.
+  const double label_scale = 0.6;
+  const cv::Size recall_size = TextSize("Recall", label_scale, 1);
+  PutText(img, "Recall", {left + r.width / 2 - recall_size.width / 2, bottom + 48}, label_scale,
+          1, kBlack);
+  PutVerticalText(img, "Precision", {left - 58, top + r.height / 2}, label_scale, 1);
+  // Panel title, centred over the plot area.
+  double title_scale = 0;
+  int title_thickness = 0;
+  FitBold(panel_title, 0.65, 0.45, r.width, &title_scale, &title_thickness);
+  const std::string text = Ellipsize(panel_title, title_scale, title_thickness, r.width);
+  const cv::Size ts = TextSize(text, title_scale, title_thickness);
+  PutText(img, text, {left + r.width / 2 - ts.width / 2, top - 18}, title_scale, title_thickness,
+          kBlack);
+}
+
+// Step curve through the points in order, starting at (recall 0, precision of the first point):
+// each point's precision holds from the previous point's recall to its own (vertical step at the
+// previous recall, then horizontal), so the area under the drawing is StepArea(curve).
+void DrawCurve(cv::Mat3b& img, const Axes& axes, const std::vector<CurvePoint>& curve,
+               const cv::Scalar& colour) {
+  if (curve.empty()) return;
+  std::vector<cv::Point> path;
+  path.reserve(2 * curve.size() + 1);
+  const auto push = [&path](cv::Point p) {
+    if (path.empty() || path.back() != p) path.push_back(p);
+  };
+  double previous_recall = 0;
+  push(axes.Map(0, curve.front().precision));
+  for (const CurvePoint& p : curve) {
+    push(axes.Map(previous_recall, p.precision));
+    push(axes.Map(p.recall, p.precision));
+    previous_recall = p.recall;
+  }
+  if (path.size() == 1) {  // a single point at recall 0: a dot
+    cv::circle(img, path[0], 2 << kShift, colour, cv::FILLED, cv::LINE_AA, kShift);
+    return;
+  }
+  cv::polylines(img, path, false, colour, 2, cv::LINE_AA, kShift);
+}
+
+struct LegendEntry {
+  std::string label;   // shortened with "..." when the box would not fit in the plot area
+  std::string suffix;  // " (AUC 0.612)", kept whole
+  cv::Scalar colour;
+};
+
+// Legend box in the lower left of the plot area.
+void DrawLegend(cv::Mat3b& img, const Axes& axes, const std::vector<LegendEntry>& entries) {
+  if (entries.empty()) return;
+  const cv::Rect& r = axes.plot;
+  const int pad = 8, sample = 28, gap = 8;
+  const int max_text_width = r.width - 20 - 2 * pad - sample - gap;
+  // Smaller rows when there are many series, so the box stays inside the plot area.
+  double scale = 0.48;
+  int row = 22;
+  const int rows = static_cast<int>(entries.size());
+  if (rows * row + 2 * pad > r.height - 20) {
+    row = std::max(12, (r.height - 20 - 2 * pad) / rows);
+    scale = std::max(0.3, scale * row / 22.0);
+  }
+  std::vector<std::string> texts;
+  int text_width = 0;
+  for (const LegendEntry& e : entries) {
+    const int suffix_width = TextSize(e.suffix, scale, 1).width;
+    texts.push_back(Ellipsize(e.label, scale, 1, std::max(0, max_text_width - suffix_width)) +
+                    e.suffix);
+    text_width = std::max(text_width, TextSize(texts.back(), scale, 1).width);
+  }
+  const int width = 2 * pad + sample + gap + text_width;
+  const int height = 2 * pad + rows * row - (row - TextSize("Ag", scale, 1).height) + 4;
+  const cv::Rect box(r.x + 10, r.y + r.height - 10 - height, width, height);
+  cv::rectangle(img, box, kWhite, cv::FILLED);
+  cv::rectangle(img, box, kFrameGrey, 1);
+  const int text_height = TextSize("Ag", scale, 1).height;
+  for (int i = 0; i < rows; ++i) {
+    const int baseline_y = box.y + pad + i * row + text_height + 1;
+    const int mid_y = baseline_y - text_height / 2;
+    cv::line(img, {box.x + pad, mid_y}, {box.x + pad + sample, mid_y}, entries[i].colour, 2,
+             cv::LINE_AA);
+    PutText(img, texts[i], {box.x + pad + sample + gap, baseline_y}, scale, 1, kBlack);
+  }
+}
+
+}  // namespace
+
+cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& title,
+                       int vicinity) {
+  bool any_able_p = false;
+  for (const PrSeries& s : series) any_able_p = any_able_p || !s.able_p.empty();
+  const int panels = any_able_p ? 2 : 1;
+  cv::Mat3b img(kTitleHeight + kPanelHeight, panels * kPanelWidth, cv::Vec3b(255, 255, 255));
+
+  // Overall title, centred.
+  if (!title.empty()) {
+    double scale = 0;
+    int thickness = 0;
+    FitBold(title, 0.8, 0.45, img.cols - 20, &scale, &thickness);
+    const std::string text = Ellipsize(title, scale, thickness, img.cols - 20);
+    const cv::Size s = TextSize(text, scale, thickness);
+    PutText(img, text, {img.cols / 2 - s.width / 2, kTitleHeight / 2 + s.height / 2 + 6}, scale,
+            thickness, kBlack);
+  }
+
+  for (int panel = 0; panel < panels; ++panel) {
+    Axes axes;
+    axes.plot = cv::Rect(panel * kPanelWidth + kMarginLeft, kTitleHeight + kMarginTop,
+                         kPanelWidth - kMarginLeft - kMarginRight,
+                         kPanelHeight - kMarginTop - kMarginBottom);
+    const std::string panel_title =
+        panel == 0 ? "Per-query best match"
+                   : "ABLE-P cells (vicinity " + std::to_string(vicinity) + ")";
+    DrawAxes(img, axes, panel_title);
+    std::vector<LegendEntry> legend;
+    for (std::size_t i = 0; i < series.size(); ++i) {
+      const cv::Scalar& colour = kPalette[i % kPaletteSize];
+      const std::vector<CurvePoint>& curve = panel == 0 ? series[i].per_query : series[i].able_p;
+      DrawCurve(img, axes, curve, colour);
+      std::string suffix;
+      if (curve.empty())
+        suffix = " (no points)";
+      else if (panel == 0)
+        suffix = " (AUC " + Format("%.3f", StepArea(curve)) + ")";
+      else
+        suffix = " (AP " + Format("%.1f", 100.0 * StepArea(curve)) + "%)";
+      legend.push_back({series[i].label, suffix, colour});
+    }
+    DrawLegend(img, axes, legend);
+  }
+  return img;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Overlay of the ground truth and the best matches on the matrix.
+
+namespace {
+
+constexpr int kOverlayTarget = 600;  // longer side of the enlarged block, at least
+constexpr int kLegendLine = 30;      // height of one line of the legend strip
+const cv::Vec3b kTruthTint(255, 128, 0);
+const cv::Vec3b kCorrect(0, 200, 0);
+const cv::Vec3b kWrong(0, 0, 230);
+
+// Grey level of a normalised value: 255 v rounded, clamped to [0, 255]; NaN is white.
+inline std::uint8_t Grey(float v) {
+  if (!(v == v)) return 255;
+  const float c = std::min(1.0f, std::max(0.0f, v));
+  return static_cast<std::uint8_t>(std::lround(255.0f * c));
+}
+
+// The legend strip: swatches and texts, flowing onto further lines when `width` is too small.
+cv::Mat3b OverlayLegend(int width) {
+  struct Item {
+    std::string text;
+    bool swatch;
+    cv::Vec3b colour;
+  };
+  const std::vector<Item> items = {
+      {"ground truth", true, cv::Vec3b(192, 128, 64)},  // the tint over mid grey
+      {"accepted, correct", true, kCorrect},
+      {"accepted, wrong", true, kWrong},
+      {"rows: queries, columns: references", false, cv::Vec3b()},
+  };
+  const double scale = 0.5;
+  const int swatch = 14, swatch_gap = 6, item_gap = 22, margin = 10;
+  // Lay out: positions (line, x) for each item.
+  std::vector<std::pair<int, int>> where;
+  int line = 0, x = margin;
+  for (const Item& item : items) {
+    const int w =
+        (item.swatch ? swatch + swatch_gap : 0) + TextSize(item.text, scale, 1).width;
+    if (x > margin && x + w > width - margin) {
+      ++line;
+      x = margin;
+    }
+    where.emplace_back(line, x);
+    x += w + item_gap;
+  }
+  cv::Mat3b strip((line + 1) * kLegendLine, width, cv::Vec3b(255, 255, 255));
+  const int text_height = TextSize("Ag", scale, 1).height;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const int top = where[i].first * kLegendLine;
+    int left = where[i].second;
+    const int mid = top + kLegendLine / 2;
+    if (items[i].swatch) {
+      const cv::Rect r(left, mid - swatch / 2, swatch, swatch);
+      cv::rectangle(strip, r, cv::Scalar(items[i].colour), cv::FILLED);
+      cv::rectangle(strip, r, cv::Scalar(90, 90, 90), 1);
+      left += swatch + swatch_gap;
+    }
+    PutText(strip, items[i].text, {left, mid + text_height / 2}, scale, 1, kBlack);
+  }
+  return strip;
+}
+
+}  // namespace
+
+cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                        const GroundTruth& truth, const PerQueryResult& result,
+                        double accept_threshold) {
+  const int rows = layout.queries, cols = layout.references;
+  if (rows <= 0 || cols <= 0 || layout.row_offset < 0 || layout.col_offset < 0 ||
+      layout.row_offset + rows > matrix.rows || layout.col_offset + cols > matrix.cols) {
+    throw std::logic_error("RenderOverlay: the layout's block (" + std::to_string(rows) + " x " +
+                           std::to_string(cols) + " at row " +
+                           std::to_string(layout.row_offset) + ", column " +
+                           std::to_string(layout.col_offset) + ") is not inside the " +
+                           std::to_string(matrix.rows) + " x " + std::to_string(matrix.cols) +
+                           " matrix");
+  }
+  const cv::Mat1f block = matrix(cv::Rect(layout.col_offset, layout.row_offset, cols, rows));
+
+  // One pixel per cell: grey, then the ground truth tinted (50 % blend).
+  cv::Mat3b cells(rows, cols);
+  for (int q = 0; q < rows; ++q) {
+    const float* in = block.ptr<float>(q);
+    cv::Vec3b* out = cells.ptr<cv::Vec3b>(q);
+    for (int c = 0; c < cols; ++c) {
+      const std::uint8_t g = Grey(in[c]);
+      out[c] = cv::Vec3b(g, g, g);
+    }
+  }
+  const int truth_rows = std::min(rows, static_cast<int>(truth.matches.size()));
+  for (int q = 0; q < truth_rows; ++q) {
+    cv::Vec3b* out = cells.ptr<cv::Vec3b>(q);
+    for (int c : truth.matches[q]) {
+      if (c < 0 || c >= cols) continue;
+      cv::Vec3b& p = out[c];
+      for (int ch = 0; ch < 3; ++ch) p[ch] = static_cast<std::uint8_t>((p[ch] + kTruthTint[ch] + 1) / 2);
+    }
+  }
+
+  // Nearest-neighbour enlargement by an integer factor.
+  const int k = std::max(1, (kOverlayTarget + std::max(rows, cols) - 1) / std::max(rows, cols));
+  const int image_w = cols * k, image_h = rows * k;
+  const cv::Mat3b legend = OverlayLegend(std::max(image_w, kOverlayTarget));
+  cv::Mat3b img(image_h + legend.rows, legend.cols, cv::Vec3b(255, 255, 255));
+  if (k == 1) {
+    cells.copyTo(img(cv::Rect(0, 0, cols, rows)));
+  } else {
+    for (int q = 0; q < rows; ++q) {
+      const cv::Vec3b* in = cells.ptr<cv::Vec3b>(q);
+      cv::Vec3b* out = img.ptr<cv::Vec3b>(q * k);
+      for (int c = 0; c < cols; ++c) std::fill(out + c * k, out + (c + 1) * k, in[c]);
+      for (int y = 1; y < k; ++y) std::copy(out, out + image_w, img.ptr<cv::Vec3b>(q * k + y));
+    }
+  }
+
+  // Accepted best matches. Marks are the enlarged cell, grown to at least 3 x 3 pixels (and to
+  // 5 x 5 and more on very large images, so they stay visible when the image is viewed whole).
+  int grow = k >= 3 ? 0 : 1;
+  if (k == 1) grow = std::max(grow, std::max(rows, cols) / 1200);
+  const cv::Rect image_area(0, 0, image_w, image_h);
+  const int marked = std::min(
+      rows, static_cast<int>(std::min({result.best.size(), result.best_distance.size(),
+                                       result.correct.size()})));
+  for (int pass = 0; pass < 2; ++pass) {  // wrong marks last, so a neighbour never hides them
+    for (int q = 0; q < marked; ++q) {
+      const int c = result.best[q];
+      const float d = result.best_distance[q];
+      if (c < 0 || c >= cols || !(d <= accept_threshold)) continue;
+      const bool correct = result.correct[q] != 0;
+      if (correct != (pass == 0)) continue;
+      const cv::Rect mark =
+          cv::Rect(c * k - grow, q * k - grow, k + 2 * grow, k + 2 * grow) & image_area;
+      img(mark).setTo(correct ? kCorrect : kWrong);
+    }
+  }
+
+  legend.copyTo(img(cv::Rect(0, image_h, legend.cols, legend.rows)));
+  return img;
+}
+
+}  // namespace openable

@@ -1,0 +1,141 @@
+#include "OpenABLE/evaluation/report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace openable {
+namespace {
+
+std::string Number(double v) {
+  if (!std::isfinite(v)) return "null";  // JSON has no NaN or infinity
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.9g", v);
+  return buffer;
+}
+
+// JSON string literal (OpenCV's FileStorage writes JSON too, but not null for non-finite
+// values, so the few objects here are written directly).
+std::string Quoted(const std::string& s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (c < 0x20) {
+      char buffer[8];
+      std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
+      out += buffer;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
+const char* KindName(EvaluationLayout::Kind kind) {
+  return kind == EvaluationLayout::Kind::kLoopClosure ? "loop_closure" : "query_reference";
+}
+
+}  // namespace
+
+std::string EncodeCurveCsv(const std::vector<CurvePoint>& curve) {
+  std::string out = "threshold,precision,recall,f1,tp,fp\n";
+  for (const CurvePoint& p : curve) {
+    out += Number(p.threshold) + "," + Number(p.precision) + "," + Number(p.recall) + "," +
+           Number(p.f1) + "," + std::to_string(p.tp) + "," + std::to_string(p.fp) + "\n";
+  }
+  return out;
+}
+
+std::string EncodeEvaluationJson(const EvaluationSettings& s, const std::vector<EvaluatedRun>& runs,
+                                 const std::string& version) {
+  std::ostringstream o;
+  const GroundTruthOptions& t = s.truth;
+  o << "{\n  \"openable_version\": " << Quoted(version) << ",\n";
+  o << "  \"settings\": {\n"
+    << "    \"ground_truth_type\": " << Quoted(GroundTruthTypeName(t.type)) << ",\n"
+    << "    \"ground_truth\": " << Quoted(t.path) << ",\n"
+    << "    \"ground_truth_2\": " << Quoted(t.path_2) << ",\n"
+    << "    \"ground_truth_base\": " << t.base << ",\n"
+    << "    \"first_frame\": " << t.first_frame << ",\n"
+    << "    \"radius\": " << Number(t.radius) << ",\n"
+    << "    \"heading_limit_deg\": " << Number(t.heading_limit) << ",\n"
+    << "    \"min_frame_gap\": " << t.min_frame_gap << ",\n"
+    << "    \"axes\": " << Quoted(t.axes) << ",\n"
+    << "    \"tolerance\": " << s.options.tolerance << ",\n"
+    << "    \"exclusion\": " << s.options.exclusion << ",\n"
+    << "    \"vicinity\": " << s.options.vicinity << ",\n"
+    << "    \"able_thresholds\": " << s.options.able_thresholds << "\n  },\n";
+  o << "  \"runs\": [";
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const EvaluatedRun& r = runs[i];
+    const PerQueryResult& q = r.per_query;
+    o << (i ? ",\n" : "\n") << "    {\n"
+      << "      \"label\": " << Quoted(r.label) << ",\n"
+      << "      \"source\": " << Quoted(r.source) << ",\n"
+      << "      \"layout\": {\"kind\": " << Quoted(KindName(r.layout.kind))
+      << ", \"queries\": " << r.layout.queries << ", \"references\": " << r.layout.references
+      << ", \"row_offset\": " << r.layout.row_offset << ", \"col_offset\": " << r.layout.col_offset
+      << "},\n"
+      << "      \"ground_truth\": {\"pairs\": " << r.truth_pairs << ", \"dropped\": "
+      << r.truth_dropped << "},\n"
+      << "      \"per_query\": {\n"
+      << "        \"auc\": " << Number(q.auc) << ",\n"
+      << "        \"recall_at_100p\": " << Number(q.recall_at_100p) << ",\n"
+      << "        \"max_f1\": " << Number(q.max_f1) << ",\n"
+      << "        \"max_f1_threshold\": " << Number(q.max_f1_threshold) << ",\n"
+      << "        \"max_f1_precision\": " << Number(q.max_f1_precision) << ",\n"
+      << "        \"max_f1_recall\": " << Number(q.max_f1_recall) << ",\n"
+      << "        \"recall_at_1\": " << Number(q.recall_at_1) << ",\n"
+      << "        \"recall_at_5\": " << Number(q.recall_at_5) << ",\n"
+      << "        \"recall_at_10\": " << Number(q.recall_at_10) << ",\n"
+      << "        \"queries\": " << q.queries << ",\n"
+      << "        \"positive_queries\": " << q.positive_queries << ",\n"
+      << "        \"truth_pairs_outside_candidates\": " << q.truth_pairs_outside_candidates
+      << "\n      },\n"
+      << "      \"able_p\": {\n"
+      << "        \"average_precision_percent\": " << Number(r.able_p.average_precision) << ",\n"
+      << "        \"candidate_cells\": " << r.able_p.candidate_cells << ",\n"
+      << "        \"truth_cells\": " << r.able_p.truth_cells << "\n      }\n    }";
+  }
+  o << "\n  ]\n}\n";
+  return o.str();
+}
+
+std::string FormatEvaluationTable(const EvaluationSettings& s,
+                                  const std::vector<EvaluatedRun>& runs) {
+  std::ostringstream o;
+  o << "Evaluation against " << GroundTruthTypeName(s.truth.type) << " ground truth"
+    << (s.truth.path.empty() ? "" : " \"" + s.truth.path + "\"") << ": tolerance +-"
+    << s.options.tolerance << " frames";
+  if (!runs.empty() && runs[0].layout.kind == EvaluationLayout::Kind::kLoopClosure)
+    o << ", candidates at least " << s.options.exclusion << " frames back";
+  o << "; ABLE-P vicinity " << s.options.vicinity << "\n";
+  char line[512];
+  std::snprintf(line, sizeof line, "  %-18s %7s %7s %7s %7s %16s %6s %6s %6s %8s\n", "run",
+                "queries", "pos.", "AUC", "R@100P", "max F1 (thr.)", "R@1", "R@5", "R@10",
+                "ABLE AP");
+  o << line;
+  for (const EvaluatedRun& r : runs) {
+    const PerQueryResult& q = r.per_query;
+    char f1[32];
+    std::snprintf(f1, sizeof f1, "%.3f (%.3f)", q.max_f1, q.max_f1_threshold);
+    std::snprintf(line, sizeof line,
+                  "  %-18s %7d %7d %7.3f %7.3f %16s %6.3f %6.3f %6.3f %7.1f%%\n",
+                  r.label.substr(0, 18).c_str(), q.queries, q.positive_queries, q.auc,
+                  q.recall_at_100p, f1, q.recall_at_1, q.recall_at_5, q.recall_at_10,
+                  r.able_p.average_precision);
+    o << line;
+    if (q.truth_pairs_outside_candidates > 0)
+      o << "    (" << q.truth_pairs_outside_candidates
+        << " ground-truth pairs are not candidates: inside the exclusion window)\n";
+    if (r.truth_dropped > 0)
+      o << "    (" << r.truth_dropped
+        << " ground-truth pairs dropped: on the diagonal or outside the processed frames)\n";
+  }
+  return o.str();
+}
+
+}  // namespace openable

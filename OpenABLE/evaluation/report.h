@@ -1,0 +1,48 @@
+// Text forms of an evaluation: the curves as CSV, the figures and settings as JSON, and the
+// short table printed at the end of a run.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "OpenABLE/evaluation/ground_truth.h"
+#include "OpenABLE/evaluation/layout.h"
+#include "OpenABLE/evaluation/metrics.h"
+
+namespace openable {
+
+// One evaluated matrix.
+struct EvaluatedRun {
+  std::string label;   // legend label ("LDB L=10")
+  std::string source;  // where the matrix came from (a file, or "Test_OpenABLE run")
+  EvaluationLayout layout;
+  std::int64_t truth_pairs = 0;    // ground-truth pairs loaded over the block
+  std::int64_t truth_dropped = 0;  // GroundTruth::dropped
+  PerQueryResult per_query;
+  AblePResult able_p;
+};
+
+// The settings every run of one evaluation shares.
+struct EvaluationSettings {
+  GroundTruthOptions truth;
+  EvaluationOptions options;
+};
+
+// "threshold,precision,recall,f1,tp,fp" then one line per point, 9 significant digits.
+std::string EncodeCurveCsv(const std::vector<CurvePoint>& curve);
+
+// A JSON object: {"openable_version", "settings": {...}, "runs": [{"label", "source",
+// "layout": {...}, "ground_truth": {...}, "per_query": {auc, recall_at_100p, max_f1,
+// max_f1_threshold, max_f1_precision, max_f1_recall, recall_at_1, recall_at_5, recall_at_10,
+// queries, positive_queries, truth_pairs_outside_candidates}, "able_p": {average_precision,
+// thresholds, vicinity, candidate_cells, truth_cells}}]}. Numbers with 9 significant digits.
+std::string EncodeEvaluationJson(const EvaluationSettings& settings,
+                                 const std::vector<EvaluatedRun>& runs, const std::string& version);
+
+// A few lines for a terminal: the protocol settings, then one row per run with AUC, R@100P,
+// max F1 (threshold), R@1/5/10 and ABLE-P AP.
+std::string FormatEvaluationTable(const EvaluationSettings& settings,
+                                  const std::vector<EvaluatedRun>& runs);
+
+}  // namespace openable

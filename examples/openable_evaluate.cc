@@ -1,0 +1,209 @@
+// openable_evaluate: evaluates saved distance matrices against ground truth, with the same
+// protocols, keys and outputs as Test_OpenABLE's evaluation (docs/evaluation.md). A thin layer
+// over the library.
+#include <cmath>
+#include <iostream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "OpenABLE/OpenABLE.h"
+#include "OpenABLE/evaluation/matrix_file.h"
+#include "matching/normalize.h"
+
+namespace {
+
+constexpr int kInputError = 1;
+constexpr int kUsageError = 2;
+constexpr int kInternalError = 3;
+
+// Command-line flags that stand for a Config.txt key.
+const std::pair<const char*, const char*> kFlagKeys[] = {
+    {"--gt-type", "Ground_truth_type"},     {"--ground-truth", "Ground_truth"},
+    {"--ground-truth-2", "Ground_truth_2"}, {"--gt-base", "Ground_truth_base"},
+    {"--radius", "Ground_truth_radius"},    {"--heading", "Ground_truth_heading"},
+    {"--min-gap", "Ground_truth_min_gap"},  {"--axes", "Ground_truth_axes"},
+    {"--tolerance", "Tolerance"},           {"--exclusion", "Exclusion"},
+    {"--vicinity", "Vicinity"},             {"--first-frame", "Initial_image"},
+    {"--output", "Evaluation_name"},
+};
+
+const char* kUsage =
+    "Usage: openable_evaluate --matrix M.npy [--label NAME] [--matrix M2.npy --label NAME2 ...]\n"
+    "                         --gt-type TYPE [--ground-truth FILE] [options]\n"
+    "\n"
+    "Evaluates distance matrices saved by Test_OpenABLE (Npy_name, Txt_name) or by any other\n"
+    "tool against ground truth, with both protocols of docs/evaluation.md: per-query best\n"
+    "match (AUC, R@100P, max F1, R@1/5/10) and the ABLE-P cell protocol (100 thresholds,\n"
+    "temporal vicinity, average precision). Prints a table; with --output writes\n"
+    "PREFIX.json, PREFIX_pr.png (all matrices in one figure) and, per matrix, the curves as\n"
+    "CSV and the ground truth drawn over the matrix.\n"
+    "\n"
+    "Matrices: .npy (any numeric dtype), text (.txt/.csv), normalised by their maximum (Eq. 5;\n"
+    "no change for Test_OpenABLE's M'). A non-square matrix is queries (rows) x references\n"
+    "(columns). A square matrix is one sequence (loop closure), unless --reference-frames N\n"
+    "says it covers two traversals: N reference frames, then the queries (Images_path_2).\n"
+    "\n"
+    "Options (each is also --set Key=Value with the Config.txt key in brackets):\n"
+    "  --matrix FILE           a matrix to evaluate (repeatable)\n"
+    "  --label NAME            legend label of the preceding --matrix (default: its file name)\n"
+    "  --reference-frames N    square matrix over two traversals, the first N are the reference\n"
+    "  --gt-type TYPE          matrix, pairs, aligned, kitti, tum, positions [Ground_truth_type]\n"
+    "  --ground-truth FILE     ground-truth file; for poses of two traversals, the reference's\n"
+    "                          [Ground_truth]\n"
+    "  --ground-truth-2 FILE   poses of the query traversal [Ground_truth_2]\n"
+    "  --gt-base 0|1|-1        pairs are 0- or 1-based; -1 reads the header [Ground_truth_base]\n"
+    "  --radius R              poses: same place when closer than R (5) [Ground_truth_radius]\n"
+    "  --heading DEG           poses: and headings closer than DEG (-1 off) [Ground_truth_heading]\n"
+    "  --min-gap N             poses, one sequence: frames apart (-1 = Exclusion)\n"
+    "                          [Ground_truth_min_gap]\n"
+    "  --axes xyz|xz|xy        poses: axes of distance and heading (xyz) [Ground_truth_axes]\n"
+    "  --tolerance N           frames of tolerance of a correct match (2) [Tolerance]\n"
+    "  --exclusion N           one sequence: candidates N frames back or more (100) [Exclusion]\n"
+    "  --vicinity N            ABLE-P temporal vicinity (7) [Vicinity]\n"
+    "  --first-frame N         frame number of row 0 in pairs and pose files [Initial_image]\n"
+    "  --output PREFIX         write the files [Evaluation_name]\n"
+    "  --config FILE           take the keys above from a Config.txt first\n"
+    "  --set Key=Value         any evaluation key of Config.txt\n"
+    "  --quiet                 print only errors and the list of files written\n"
+    "  --help, --version\n"
+    "\n"
+    "Example (KITTI 00, loops within 5 m seen in the same direction):\n"
+    "  openable_evaluate --matrix kitti.npy --gt-type kitti --ground-truth poses/00.txt \\\n"
+    "      --axes xz --heading 45 --exclusion 100 --tolerance 3 --output results/kitti\n"
+    "\n"
+    "Exit status: 0 success, 1 bad input (one line on stderr), 2 bad command line, 3 bug.\n";
+
+struct MatrixArg {
+  std::string path, label;
+};
+
+std::string FileLabel(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  const auto dot = name.find_last_of('.');
+  return dot == std::string::npos || dot == 0 ? name : name.substr(0, dot);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<MatrixArg> matrices;
+  std::vector<std::string> overrides;
+  std::string config_path;
+  int reference_frames = 0;
+  bool quiet = false;
+  auto value_of = [&](int& i, const std::string& flag) -> std::string {
+    if (i + 1 >= argc) throw std::invalid_argument(flag + " needs a value");
+    return argv[++i];
+  };
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      bool mapped = false;
+      for (const auto& [flag, key] : kFlagKeys) {
+        if (a == flag) {
+          overrides.push_back(std::string(key) + "=" + value_of(i, a));
+          mapped = true;
+        }
+      }
+      if (mapped) continue;
+      if (a == "--help" || a == "-h") {
+        std::cout << kUsage;
+        return 0;
+      } else if (a == "--version") {
+        std::cout << "OpenABLE " << openable::kVersion << "\n";
+        return 0;
+      } else if (a == "--matrix") {
+        matrices.push_back({value_of(i, a), ""});
+      } else if (a == "--label") {
+        if (matrices.empty()) throw std::invalid_argument("--label must follow a --matrix");
+        matrices.back().label = value_of(i, a);
+      } else if (a == "--reference-frames") {
+        const std::string v = value_of(i, a);
+        std::size_t used = 0;
+        try {
+          reference_frames = std::stoi(v, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != v.size() || reference_frames < 1)
+          throw std::invalid_argument("--reference-frames: \"" + v +
+                                      "\" is not valid; expected a number of frames >= 1");
+      } else if (a == "--config") {
+        config_path = value_of(i, a);
+      } else if (a == "--set") {
+        overrides.push_back(value_of(i, a));
+      } else if (a == "--quiet" || a == "-q") {
+        quiet = true;
+      } else {
+        throw std::invalid_argument("unknown option \"" + a + "\"");
+      }
+    }
+    if (matrices.empty()) throw std::invalid_argument("no --matrix given");
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "openable_evaluate: " << e.what() << " (see --help)\n";
+    return kUsageError;
+  }
+
+  try {
+    openable::Config config = config_path.empty() ? openable::Config() : openable::LoadConfig(config_path);
+    for (const auto& o : overrides) openable::ApplyOverride(config, o);
+    if (!openable::EvaluationRequested(config))
+      throw openable::InputError(
+          "Ground_truth_type: not set; expected --gt-type matrix, pairs, aligned, kitti, tum or "
+          "positions");
+    openable::CheckEvaluationConfig(config);
+    openable::Evaluation evaluation;
+    evaluation.settings = openable::EvaluationSettingsFrom(config);
+    std::vector<cv::Mat1f> loaded;
+    loaded.reserve(matrices.size());
+    for (const MatrixArg& m : matrices) {
+      cv::Mat1f matrix = openable::ReadMatrixFile(m.path);
+      double lo = 0, hi = 0;
+      if (!cv::checkRange(matrix, true, nullptr, 0.0, 3.0e38))
+        throw openable::InputError("matrix \"" + m.path +
+                                   "\" holds a negative, infinite or NaN value; expected "
+                                   "distances >= 0");
+      cv::minMaxLoc(matrix, &lo, &hi);
+      openable::NormalizeByMax(matrix);
+      openable::EvaluationLayout layout;
+      if (matrix.rows != matrix.cols) {
+        layout = openable::EvaluationLayout::QueryReference(matrix.rows, matrix.cols);
+      } else if (reference_frames > 0) {
+        if (reference_frames >= matrix.rows)
+          throw openable::InputError("--reference-frames: " + std::to_string(reference_frames) +
+                                     " leaves no query frame in the " +
+                                     std::to_string(matrix.rows) + "x" +
+                                     std::to_string(matrix.cols) + " matrix \"" + m.path +
+                                     "\"; expected fewer frames than its rows");
+        layout = openable::EvaluationLayout::TwoTraversals(reference_frames,
+                                                           matrix.rows - reference_frames);
+      } else {
+        layout = openable::EvaluationLayout::LoopClosure(matrix.rows);
+      }
+      openable::EvaluateMatrix(evaluation, matrix, layout,
+                               m.label.empty() ? FileLabel(m.path) : m.label, m.path);
+      loaded.push_back(std::move(matrix));
+    }
+    if (!quiet) std::cout << openable::FormatEvaluationTable(evaluation.settings, evaluation.runs);
+    if (!config.evaluation_name.empty()) {
+      openable::OutputBatch batch;
+      std::vector<const cv::Mat1f*> pointers;
+      for (const auto& m : loaded) pointers.push_back(&m);
+      openable::StageEvaluation(batch, "Evaluation_name", config.evaluation_name, evaluation,
+                                pointers);
+      const std::vector<std::string> paths = batch.Paths();
+      batch.Commit();
+      std::cout << "Wrote:\n";
+      for (const auto& p : paths) std::cout << "  " << p << "\n";
+    }
+    return 0;
+  } catch (const openable::InputError& e) {
+    std::cerr << "openable_evaluate: error: " << e.what() << "\n";
+    return kInputError;
+  } catch (const std::exception& e) {
+    std::cerr << "openable_evaluate: internal error (please report): " << e.what() << "\n";
+    return kInternalError;
+  }
+}

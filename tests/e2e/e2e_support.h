@@ -1,0 +1,88 @@
+// Helpers of the end-to-end tests: running a program, reading what it wrote.
+#pragma once
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace openable {
+namespace e2e {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int status = -1;
+  std::string out, err;
+};
+
+inline std::string ReadAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+inline std::string ShellQuote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// Runs `exe` with `args` in `dir`; captures its exit status, stdout and stderr.
+inline Outcome RunProgram(const std::string& exe, const std::vector<std::string>& args,
+                   const std::string& dir) {
+  std::string cmd = "cd " + ShellQuote(dir) + " && " + ShellQuote(exe);
+  for (const auto& a : args) cmd += " " + ShellQuote(a);
+  cmd += " >stdout.log 2>stderr.log";
+  const int raw = std::system(cmd.c_str());
+  Outcome o;
+  o.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128;
+  o.out = ReadAll(dir + "/stdout.log");
+  o.err = ReadAll(dir + "/stderr.log");
+  fs::remove(dir + "/stdout.log");
+  fs::remove(dir + "/stderr.log");
+  return o;
+}
+
+// Independent .npy reader: float32, C order, 2-D.
+inline cv::Mat1f ReadNpy(const std::string& path) {
+  const std::string b = ReadAll(path);
+  if (b.size() < 10 || b.compare(0, 6, "\x93NUMPY") != 0) return {};
+  const size_t hl = static_cast<unsigned char>(b[8]) | (static_cast<unsigned char>(b[9]) << 8);
+  const std::string header = b.substr(10, hl);
+  if (header.find("'<f4'") == std::string::npos) return {};
+  int rows = 0, cols = 0;
+  if (std::sscanf(header.c_str() + header.find("'shape': (") + 10, "%d, %d", &rows, &cols) != 2)
+    return {};
+  cv::Mat1f m(rows, cols);
+  if (b.size() != 10 + hl + static_cast<size_t>(rows) * cols * 4) return {};
+  std::memcpy(m.data, b.data() + 10 + hl, static_cast<size_t>(rows) * cols * 4);
+  return m;
+}
+
+// Share of query rows [q0, q0+n) whose smallest distance among reference columns
+// [r0, r0+m) lies within `tol` frames of the aligned frame (frame-aligned traversals).
+inline double AlignedRecallAt1(const cv::Mat1f& d, int q0, int r0, int n, int tol) {
+  int hits = 0;
+  for (int q = 0; q < n; ++q) {
+    int best = 0;
+    for (int r = 1; r < n; ++r)
+      if (d(q0 + q, r0 + r) < d(q0 + q, r0 + best)) best = r;
+    hits += std::abs(best - q) <= tol;
+  }
+  return static_cast<double>(hits) / n;
+}
+
+// True when `s` is exactly one line.
+inline bool OneLine(const std::string& s) {
+  return !s.empty() && s.back() == '\n' && s.find('\n') == s.size() - 1;
+}
+
+}  // namespace e2e
+}  // namespace openable

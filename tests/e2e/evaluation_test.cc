@@ -1,0 +1,232 @@
+// End-to-end evaluation: Test_OpenABLE with ground truth, openable_evaluate on saved
+// matrices, every input error of the issue, and the figures on real datasets checked against
+// the independent numpy implementation in tests/tools/evaluate_reference.py.
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "tests/e2e/e2e_support.h"
+#include "tests/test_support.h"
+
+namespace openable {
+namespace {
+
+using namespace e2e;  // NOLINT: the e2e helpers are this file's vocabulary
+
+// The number after "key": in a JSON text (the first occurrence), NaN when absent.
+double JsonNumber(const std::string& json, const std::string& key, std::size_t from = 0) {
+  const std::string k = "\"" + key + "\": ";
+  const auto p = json.find(k, from);
+  if (p == std::string::npos) return std::nan("");
+  return std::strtod(json.c_str() + p + k.size(), nullptr);
+}
+
+std::string SampleConfig(const std::string& dir, const std::string& extra) {
+  const std::string path = dir + "/Config.txt";
+  std::ofstream(path) << "Images_path: \"" << testing::SampleDir() << "/summer\"\n"
+                      << "Images_path_2: \"" << testing::SampleDir() << "/winter\"\n"
+                      << "Npy_name: \"out/matrix.npy\"\n"
+                      << "Image_sequences: 10\n"
+                      << extra;
+  return path;
+}
+
+TEST(Evaluation, SampleRunAgainstAlignedTruthWritesEveryFile) {
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunProgram(
+      testing::TestOpenableExe(),
+      {SampleConfig(dir, "Ground_truth_type: aligned\nTolerance: 2\nEvaluation_name: out/eval\n"),
+       "--quiet"},
+      dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_NE(o.out.find("AUC"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("ABLE AP"), std::string::npos) << o.out;
+  for (const char* f : {"eval.json", "eval_per_query.csv", "eval_ablep.csv", "eval_pr.png",
+                        "eval_overlay.png"})
+    EXPECT_TRUE(fs::exists(dir + "/out/" + f)) << f;
+
+  // R@1 computed here from the matrix, by brute force, against the JSON.
+  const cv::Mat1f m = ReadNpy(dir + "/out/matrix.npy");
+  ASSERT_EQ(m.rows, 600);
+  const double r1 = AlignedRecallAt1(m, 300, 0, 300, 2);
+  const std::string json = ReadAll(dir + "/out/eval.json");
+  EXPECT_NEAR(JsonNumber(json, "recall_at_1"), r1, 1e-6);
+  EXPECT_EQ(JsonNumber(json, "positive_queries"), 300);
+  // Every winter frame is positive, so the last point of the curve accepts all 300 answers:
+  // its recall is R@1 again and its precision too.
+  std::istringstream csv(ReadAll(dir + "/out/eval_per_query.csv"));
+  std::string line, last;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "threshold,precision,recall,f1,tp,fp");
+  while (std::getline(csv, line)) last = line;
+  double thr, p, r;
+  ASSERT_EQ(std::sscanf(last.c_str(), "%lf,%lf,%lf", &thr, &p, &r), 3) << last;
+  EXPECT_NEAR(r, r1, 1e-6);
+  EXPECT_NEAR(p, r1, 1e-6);
+  // The ABLE-P curve has 100 thresholds k / 99.
+  std::istringstream able(ReadAll(dir + "/out/eval_ablep.csv"));
+  int lines = 0;
+  while (std::getline(able, line)) ++lines;
+  EXPECT_EQ(lines, 101);
+  const cv::Mat plot = cv::imread(dir + "/out/eval_pr.png");
+  EXPECT_GT(plot.cols, 600);
+  const cv::Mat overlay = cv::imread(dir + "/out/eval_overlay.png");
+  EXPECT_GE(overlay.cols, 300);
+}
+
+TEST(Evaluation, OpenableEvaluateComparesRunsInOneFigureAndAgreesWithTheRun) {
+  const std::string dir = testing::TempDir();
+  const std::string config =
+      SampleConfig(dir, "Ground_truth_type: aligned\nEvaluation_name: out/run\n");
+  ASSERT_EQ(RunProgram(testing::TestOpenableExe(), {config, "--quiet"}, dir).status, 0);
+  ASSERT_EQ(RunProgram(testing::TestOpenableExe(),
+                       {config, "--quiet", "--set", "Image_descriptor=HOG", "--set",
+                        "Npy_name=out/hog.npy", "--set", "Evaluation_name="},
+                       dir)
+                .status,
+            0);
+  const Outcome o = RunProgram(testing::OpenableEvaluateExe(),
+                               {"--matrix", "out/matrix.npy", "--label", "LDB", "--matrix",
+                                "out/hog.npy", "--label", "HOG", "--reference-frames", "300",
+                                "--gt-type", "aligned", "--output", "out/cmp"},
+                               dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  for (const char* f : {"cmp.json", "cmp_pr.png", "cmp_LDB_per_query.csv", "cmp_HOG_per_query.csv",
+                        "cmp_LDB_overlay.png", "cmp_HOG_ablep.csv"})
+    EXPECT_TRUE(fs::exists(dir + "/out/" + f)) << f;
+  const std::string run = ReadAll(dir + "/out/run.json"), cmp = ReadAll(dir + "/out/cmp.json");
+  for (const char* key : {"auc", "recall_at_100p", "max_f1", "recall_at_1", "recall_at_10",
+                          "average_precision_percent"})
+    EXPECT_EQ(JsonNumber(run, key), JsonNumber(cmp, key)) << key;
+  EXPECT_NE(cmp.find("\"label\": \"HOG\""), std::string::npos);
+}
+
+// Bad evaluation inputs: status 1, one line naming the file or key, nothing written.
+struct BadTruth {
+  const char* name;
+  std::vector<std::string> args;
+  std::string expect;
+};
+void PrintTo(const BadTruth& c, std::ostream* os) { *os << c.name; }
+
+class BadTruthInputs : public ::testing::TestWithParam<BadTruth> {};
+
+TEST_P(BadTruthInputs, OneLineNonZeroExitNoOutput) {
+  const std::string dir = testing::TempDir();
+  {
+    std::ofstream m(dir + "/m.txt");  // a 20 x 20 distance matrix
+    for (int i = 0; i < 20; ++i) {
+      for (int j = 0; j < 20; ++j) m << std::abs(i - j) << (j < 19 ? " " : "\n");
+    }
+    std::ofstream(dir + "/gt5.txt") << "0 1 0 0 0\n1 0 0 0 0\n0 0 0 0 0\n0 0 0 0 0\n0 0 0 0 0\n";
+    std::ofstream(dir + "/far.csv") << "3,1\n25,2\n";
+    std::ofstream(dir + "/xy.csv") << "0,0\n1,0\n2,0\n";
+  }
+  std::vector<std::string> args = {"--matrix", "m.txt", "--output", "out/e"};
+  args.insert(args.end(), GetParam().args.begin(), GetParam().args.end());
+  const Outcome o = RunProgram(testing::OpenableEvaluateExe(), args, dir);
+  EXPECT_EQ(o.status, 1) << o.err;
+  EXPECT_TRUE(OneLine(o.err)) << o.err;
+  EXPECT_NE(o.err.find(GetParam().expect), std::string::npos) << o.err;
+  EXPECT_FALSE(fs::exists(dir + "/out")) << "output left behind";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Errors, BadTruthInputs,
+    ::testing::Values(
+        BadTruth{"MatrixOfWrongSize", {"--gt-type", "matrix", "--ground-truth", "gt5.txt"}, "gt5.txt"},
+        BadTruth{"PairOutsideTheRun", {"--gt-type", "pairs", "--ground-truth", "far.csv"}, "far.csv"},
+        BadTruth{"MissingFile", {"--gt-type", "pairs", "--ground-truth", "nope.csv"}, "nope.csv"},
+        BadTruth{"NegativeTolerance", {"--gt-type", "aligned", "--tolerance", "-1"}, "Tolerance"},
+        BadTruth{"ZeroRadius", {"--gt-type", "positions", "--ground-truth", "xy.csv", "--radius", "0"},
+                 "Ground_truth_radius"},
+        BadTruth{"AlignedOnOneSequence", {"--gt-type", "aligned"}, "aligned"},
+        BadTruth{"HeadingWithoutOrientation",
+                 {"--gt-type", "positions", "--ground-truth", "xy.csv", "--heading", "45"},
+                 "Ground_truth_heading"},
+        BadTruth{"PositionsDoNotCoverTheRun", {"--gt-type", "positions", "--ground-truth", "xy.csv"},
+                 "xy.csv"},
+        BadTruth{"UnknownType", {"--gt-type", "gps"}, "Ground_truth_type"},
+        BadTruth{"NegativeVicinity", {"--gt-type", "aligned", "--reference-frames", "10",
+                                      "--vicinity", "-2"}, "Vicinity"}));
+
+// --- Real data, checked against the independent numpy implementation -------------------------
+
+// Runs the reference on `json`'s matrix; returns its output, and fails the test when a figure
+// differs by more than 5e-4.
+void CheckAgainstReference(const std::string& dir, const std::vector<std::string>& args) {
+  if (std::system("/usr/bin/python3 -c 'import numpy' 2>/dev/null") != 0)
+    GTEST_SKIP() << "/usr/bin/python3 with numpy is absent (examples/setup.sh installs it)";
+  const Outcome o = RunProgram(
+      "/usr/bin/python3",
+      [&] {
+        std::vector<std::string> a = {testing::SourceDir() + "/tests/tools/evaluate_reference.py"};
+        a.insert(a.end(), args.begin(), args.end());
+        return a;
+      }(),
+      dir);
+  EXPECT_EQ(o.status, 0) << o.out << o.err;
+  std::cout << o.out.substr(o.out.rfind('\n', o.out.size() - 2) + 1);
+}
+
+TEST(EvaluationOnDatasets, NordlandWinterAgainstSummer) {
+  const std::string data = testing::DatasetsDir() + "/nordland_trimmed";
+  OPENABLE_REQUIRE_PATH(data);
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunProgram(
+      testing::TestOpenableExe(),
+      {"--quiet", "--set", "Images_path=" + data + "/summer", "--set",
+       "Images_path_2=" + data + "/winter", "--set", "Image_sequences=10", "--set",
+       "Npy_name=m.npy", "--set", "Ground_truth_type=aligned", "--set", "Tolerance=2", "--set",
+       "Evaluation_name=eval"},
+      dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  std::cout << o.out.substr(o.out.find("Evaluation"));
+  EXPECT_GE(JsonNumber(ReadAll(dir + "/eval.json"), "recall_at_1"), 0.355);
+  CheckAgainstReference(dir, {"--matrix", "m.npy", "--reference-frames", "1788", "--aligned",
+                              "--tolerance", "2", "--vicinity", "7", "--compare", "eval.json"});
+}
+
+TEST(EvaluationOnDatasets, GardensPointDayRightAgainstDayLeft) {
+  const std::string data = testing::DatasetsDir() + "/gardens_point";
+  OPENABLE_REQUIRE_PATH(data);
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunProgram(
+      testing::TestOpenableExe(),
+      {"--quiet", "--set", "Images_path=" + data + "/day_left", "--set",
+       "Images_path_2=" + data + "/day_right", "--set", "Image_sequences=5", "--set",
+       "Npy_name=m.npy", "--set", "Ground_truth_type=aligned", "--set", "Evaluation_name=eval"},
+      dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  std::cout << o.out.substr(o.out.find("Evaluation"));
+  CheckAgainstReference(dir, {"--matrix", "m.npy", "--reference-frames", "200", "--aligned",
+                              "--tolerance", "2", "--vicinity", "7", "--compare", "eval.json"});
+}
+
+TEST(EvaluationOnDatasets, Kitti00LoopsFromPosesAgainstTheLoopList) {
+  const std::string data = testing::DatasetsDir() + "/kitti00_first1700";
+  OPENABLE_REQUIRE_PATH(data);
+  const std::string dir = testing::TempDir();
+  // Loops derived here from the poses (5 m in the ground plane, headings within 45 degrees,
+  // 100 frames apart); the reference reads them from loop_gt_5m.txt instead.
+  const Outcome o = RunProgram(
+      testing::TestOpenableExe(),
+      {"--quiet", "--set", "Images_path=" + data + "/image_0", "--set", "Image_sequences=1",
+       "--set", "Npy_name=m.npy", "--set", "Ground_truth_type=kitti", "--set",
+       "Ground_truth=" + data + "/poses/00_first1700.txt", "--set", "Ground_truth_axes=xz",
+       "--set", "Ground_truth_heading=45", "--set", "Exclusion=100", "--set", "Tolerance=3",
+       "--set", "Evaluation_name=eval"},
+      dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  std::cout << o.out.substr(o.out.find("Evaluation"));
+  CheckAgainstReference(dir, {"--matrix", "m.npy", "--pairs", data + "/loop_gt_5m.txt",
+                              "--max-col4", "45", "--exclusion", "100", "--tolerance", "3",
+                              "--vicinity", "7", "--compare", "eval.json"});
+}
+
+}  // namespace
+}  // namespace openable

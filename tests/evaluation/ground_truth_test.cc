@@ -1,0 +1,605 @@
+#include "OpenABLE/evaluation/ground_truth.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <initializer_list>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/evaluation/layout.h"
+#include "tests/test_support.h"
+
+namespace openable {
+namespace {
+
+using openable::testing::DatasetsDir;
+using openable::testing::TempDir;
+using Matches = std::vector<std::vector<int>>;
+
+void WriteFile(const std::string& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary);
+  f << text;
+  ASSERT_TRUE(f.good()) << path;
+}
+
+// Runs `f`, expects an InputError whose message is one line holding every one of `parts`.
+void ExpectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts) {
+  try {
+    f();
+    ADD_FAILURE() << "no InputError thrown";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    for (const std::string& part : parts) {
+      EXPECT_NE(message.find(part), std::string::npos)
+          << "message \"" << message << "\" lacks \"" << part << "\"";
+    }
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
+  }
+}
+
+std::string Q(const std::string& path) { return "\"" + path + "\""; }
+
+// Matches of `n` queries from a map query -> references (queries not named have none).
+Matches M(int n, const std::map<int, std::vector<int>>& m) {
+  Matches out(static_cast<std::size_t>(n));
+  for (const auto& [q, refs] : m) out[static_cast<std::size_t>(q)] = refs;
+  return out;
+}
+
+GroundTruthOptions Options(GroundTruthType type, const std::string& path) {
+  GroundTruthOptions o;
+  o.type = type;
+  o.path = path;
+  return o;
+}
+
+GroundTruth LoadLoop(const GroundTruthOptions& o, int frames) {
+  return LoadGroundTruth(o, EvaluationLayout::LoopClosure(frames), frames, frames);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Type names and options
+
+TEST(GroundTruthOptions, TypeNamesRoundTrip) {
+  for (GroundTruthType t :
+       {GroundTruthType::kNone, GroundTruthType::kMatrix, GroundTruthType::kPairs,
+        GroundTruthType::kAligned, GroundTruthType::kKitti, GroundTruthType::kTum,
+        GroundTruthType::kPositions}) {
+    EXPECT_EQ(ParseGroundTruthType(GroundTruthTypeName(t)), t) << GroundTruthTypeName(t);
+  }
+  EXPECT_EQ(ParseGroundTruthType(""), GroundTruthType::kNone);
+  EXPECT_EQ(ParseGroundTruthType("kitti"), GroundTruthType::kKitti);
+  EXPECT_EQ(ParseGroundTruthType("TUM"), GroundTruthType::kTum);
+  EXPECT_EQ(GroundTruthTypeName(GroundTruthType::kPositions), "positions");
+  ExpectInputError([] { ParseGroundTruthType("gps"); }, {"Ground_truth_type", "\"gps\"", "kitti"});
+}
+
+TEST(GroundTruthOptions, CheckNamesTheKeyOfEachBadValue) {
+  const std::vector<std::pair<std::function<void(GroundTruthOptions*)>, std::string>> cases = {
+      {[](GroundTruthOptions* o) { o->path.clear(); }, "Ground_truth:"},
+      {[](GroundTruthOptions* o) { o->radius = 0; }, "Ground_truth_radius: 0"},
+      {[](GroundTruthOptions* o) { o->radius = -2; }, "Ground_truth_radius: -2"},
+      {[](GroundTruthOptions* o) { o->heading_limit = 0; }, "Ground_truth_heading: 0"},
+      {[](GroundTruthOptions* o) { o->heading_limit = 181; }, "Ground_truth_heading: 181"},
+      {[](GroundTruthOptions* o) { o->heading_limit = -2; }, "Ground_truth_heading: -2"},
+      {[](GroundTruthOptions* o) { o->min_frame_gap = -1; }, "Ground_truth_min_gap: -1"},
+      {[](GroundTruthOptions* o) { o->axes = "yz"; }, "Ground_truth_axes: \"yz\""},
+      {[](GroundTruthOptions* o) { o->base = 2; }, "Ground_truth_base: 2"},
+      {[](GroundTruthOptions* o) { o->first_frame = -1; }, "Initial_image: -1"},
+  };
+  for (const auto& [mutate, key] : cases) {
+    GroundTruthOptions o = Options(GroundTruthType::kKitti, "poses.txt");
+    EXPECT_NO_THROW(o.Check());
+    mutate(&o);
+    ExpectInputError([&] { o.Check(); }, {key});
+  }
+  GroundTruthOptions ok = Options(GroundTruthType::kAligned, "");
+  ok.heading_limit = 180;
+  EXPECT_NO_THROW(ok.Check());
+  EXPECT_NO_THROW(Options(GroundTruthType::kNone, "").Check());
+
+  GroundTruthOptions positions = Options(GroundTruthType::kPositions, "xy.txt");
+  EXPECT_NO_THROW(positions.Check());
+  positions.heading_limit = 45;
+  ExpectInputError([&] { positions.Check(); },
+                   {"Ground_truth_heading: 45", "positions have no orientation"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Matrix
+
+TEST(GroundTruthMatrix, LoopClosureIsSymmetricAndDropsTheDiagonal) {
+  const std::string path = TempDir() + "/gt.txt";
+  // (2,0), (0,3) and its mirror (3,0), the diagonal cell (1,1).
+  WriteFile(path,
+            "0 0 0 1\n"
+            "0 1 0 0\n"
+            "1 0 0 0\n"
+            "1 0 0 0\n");
+  const GroundTruth gt = LoadLoop(Options(GroundTruthType::kMatrix, path), 4);
+  EXPECT_EQ(gt.matches, M(4, {{2, {0}}, {3, {0}}}));
+  EXPECT_EQ(gt.references, 4);
+  EXPECT_EQ(gt.dropped, 1);
+  EXPECT_EQ(gt.PairCount(), 2);
+  EXPECT_EQ(gt.PositiveQueries(), 2);
+}
+
+TEST(GroundTruthMatrix, BlockOrWholeMatrixOfTwoTraversals) {
+  const std::string dir = TempDir();
+  // 3 reference frames then 2 query frames: the block is rows 3-4, columns 0-2.
+  const EvaluationLayout layout = EvaluationLayout::TwoTraversals(3, 2);
+  WriteFile(dir + "/whole.txt",
+            "0 0 0 0 1\n"
+            "0 0 0 0 0\n"
+            "0 0 0 1 0\n"
+            "0 1 0 0 0\n"
+            "0 0 1 0 1\n");
+  GroundTruth gt =
+      LoadGroundTruth(Options(GroundTruthType::kMatrix, dir + "/whole.txt"), layout, 5, 5);
+  EXPECT_EQ(gt.matches, M(2, {{0, {1}}, {1, {2}}}));
+  EXPECT_EQ(gt.references, 3);
+  EXPECT_EQ(gt.dropped, 0);
+
+  WriteFile(dir + "/block.csv", "1,0,1\n0,0,0\n");
+  gt = LoadGroundTruth(Options(GroundTruthType::kMatrix, dir + "/block.csv"), layout, 5, 5);
+  EXPECT_EQ(gt.matches, M(2, {{0, {0, 2}}}));
+
+  WriteFile(dir + "/wrong.txt", "1 0\n0 1\n");
+  ExpectInputError(
+      [&] { LoadGroundTruth(Options(GroundTruthType::kMatrix, dir + "/wrong.txt"), layout, 5, 5); },
+      {Q(dir + "/wrong.txt"), "2x2", "expected 2x3", "5x5"});
+}
+
+TEST(GroundTruthMatrix, ImageNpyAndBadCells) {
+  const std::string dir = TempDir();
+  cv::Mat1b image = cv::Mat1b::zeros(4, 4);
+  image(3, 1) = 255;
+  image(2, 0) = 1;
+  ASSERT_TRUE(cv::imwrite(dir + "/gt.png", image));
+  const GroundTruth gt = LoadLoop(Options(GroundTruthType::kMatrix, dir + "/gt.png"), 4);
+  EXPECT_EQ(gt.matches, M(4, {{2, {0}}, {3, {1}}}));
+
+  // A bool .npy, written byte by byte: (1, 0) set.
+  std::string header = "{'descr': '|b1', 'fortran_order': False, 'shape': (2, 2), }";
+  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+  header += '\n';
+  std::string npy = std::string("\x93NUMPY\x01\x00", 8);
+  npy += static_cast<char>(header.size());
+  npy += '\0';
+  npy += header;
+  npy += std::string("\x00\x00\x01\x00", 4);
+  WriteFile(dir + "/gt.npy", npy);
+  EXPECT_EQ(LoadLoop(Options(GroundTruthType::kMatrix, dir + "/gt.npy"), 2).matches,
+            M(2, {{1, {0}}}));
+
+  WriteFile(dir + "/nan.txt", "0 nan\n0 0\n");
+  ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kMatrix, dir + "/nan.txt"), 2); },
+                   {Q(dir + "/nan.txt"), "(0, 1)", "nan"});
+
+  // Errors of the reader say that the file is the ground truth.
+  WriteFile(dir + "/ragged.txt", "0 0 0\n0 0\n");
+  ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kMatrix, dir + "/ragged.txt"), 3); },
+                   {"ground truth", Q(dir + "/ragged.txt") + ":2:", "row has 2 values"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Pairs
+
+TEST(GroundTruthPairs, OneBasedHeaderCommentAndDuplicates) {
+  const std::string path = TempDir() + "/pairs.txt";
+  WriteFile(path,
+            "# query match (1-based)\n"
+            "3,1\n"
+            "4 2\n"
+            "4,2\n"
+            "2,4   # the same as 4,2\n");
+  const GroundTruth gt = LoadLoop(Options(GroundTruthType::kPairs, path), 4);
+  EXPECT_EQ(gt.matches, M(4, {{2, {0}}, {3, {1}}}));
+  EXPECT_EQ(gt.dropped, 0);
+}
+
+TEST(GroundTruthPairs, ZeroBasedCommentHeaderLineAndExtraColumns) {
+  const std::string path = TempDir() + "/pairs.csv";
+  WriteFile(path,
+            "# 0-based\n"
+            "row,col,distance\n"
+            "2,0,0.5\n"
+            "0,3,1.5\n"
+            "\n"
+            "3,1,x\n"
+            "2,2\n");
+  const GroundTruth gt = LoadLoop(Options(GroundTruthType::kPairs, path), 4);
+  EXPECT_EQ(gt.matches, M(4, {{2, {0}}, {3, {0, 1}}}));
+  EXPECT_EQ(gt.dropped, 1);  // the diagonal pair 2,2
+}
+
+TEST(GroundTruthPairs, BaseOptionAndDefault) {
+  const std::string path = TempDir() + "/pairs.txt";
+  WriteFile(path, "3 1\n4 2\n");
+  GroundTruthOptions o = Options(GroundTruthType::kPairs, path);
+  o.base = 1;
+  EXPECT_EQ(LoadLoop(o, 4).matches, M(4, {{2, {0}}, {3, {1}}}));
+  o.base = -1;  // no comment: 0-based
+  EXPECT_EQ(LoadLoop(o, 5).matches, M(5, {{3, {1}}, {4, {2}}}));
+
+  // 0-based, "4 2" is outside 4 frames; the message suggests Ground_truth_base.
+  ExpectInputError([&] { LoadLoop(o, 4); },
+                   {Q(path) + ":2:", "pair 4,2", "out of range", "[0, 3]", "Ground_truth_base"});
+
+  WriteFile(path, "# 0-based indices, converted from the 1-based originals\n1 0\n");
+  ExpectInputError([&] { LoadLoop(o, 4); }, {Q(path), "0-based", "1-based", "Ground_truth_base"});
+}
+
+TEST(GroundTruthPairs, OutOfRangeMessagesNameTheLinePairAndRange) {
+  const std::string dir = TempDir();
+  WriteFile(dir + "/one.txt", "# 1-based\n2 1\n1 0\n");
+  ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/one.txt"), 4); },
+                   {Q(dir + "/one.txt") + ":3:", "pair 1,0", "[1, 4]", "1-based"});
+
+  const EvaluationLayout layout = EvaluationLayout::QueryReference(2, 3);
+  WriteFile(dir + "/qr.txt", "1,2\n0,0\n2,0\n");
+  ExpectInputError(
+      [&] { LoadGroundTruth(Options(GroundTruthType::kPairs, dir + "/qr.txt"), layout, 2, 3); },
+      {Q(dir + "/qr.txt") + ":3:", "pair 2,0", "query indices in [0, 1]",
+       "reference indices in [0, 2]"});
+
+  WriteFile(dir + "/short.txt", "3\n");
+  ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/short.txt"), 4); },
+                   {Q(dir + "/short.txt") + ":1:", "1 value", "two frame indices"});
+  WriteFile(dir + "/word.txt", "3,1\n3,b\n");
+  ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/word.txt"), 4); },
+                   {Q(dir + "/word.txt") + ":2:", "\"b\"", "not an integer"});
+  ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/absent.txt"), 4); },
+                   {Q(dir + "/absent.txt"), "not found"});
+}
+
+TEST(GroundTruthPairs, QueryReferenceKeepsTheOrder) {
+  const std::string path = TempDir() + "/pairs.txt";
+  WriteFile(path, "1,2\n0,0\n1,0\n");
+  const GroundTruth gt = LoadGroundTruth(Options(GroundTruthType::kPairs, path),
+                                         EvaluationLayout::QueryReference(2, 3), 2, 3);
+  EXPECT_EQ(gt.matches, M(2, {{0, {0}}, {1, {0, 2}}}));
+  EXPECT_EQ(gt.references, 3);
+}
+
+TEST(GroundTruthPairs, FirstFrameShiftsAndDropsPairsOutsideTheRange) {
+  const std::string path = TempDir() + "/pairs.txt";
+  // Frames 10..14 of the source are rows 0..4.
+  WriteFile(path,
+            "12,10\n"
+            "11,14\n"
+            "15,12\n"    // 15 is after the range: dropped
+            "12,3\n"     // 3 is before it: dropped
+            "11,11\n");  // diagonal: dropped
+  GroundTruthOptions o = Options(GroundTruthType::kPairs, path);
+  o.first_frame = 10;
+  const GroundTruth gt = LoadLoop(o, 5);
+  EXPECT_EQ(gt.matches, M(5, {{2, {0}}, {4, {1}}}));
+  EXPECT_EQ(gt.dropped, 3);
+
+  // A negative index is wrong whatever the range.
+  WriteFile(path, "12,10\n-1,12\n");
+  ExpectInputError([&] { LoadLoop(o, 5); }, {Q(path) + ":2:", "pair -1,12", ">= 0"});
+
+  // A range that starts at frame 0 but ends early (Final_image set): pairs past its end are
+  // dropped too; without a range they are an error.
+  WriteFile(path, "3,1\n7,2\n");
+  o.first_frame = 0;
+  o.range_selected = true;
+  const GroundTruth ranged = LoadLoop(o, 5);
+  EXPECT_EQ(ranged.matches, M(5, {{3, {1}}}));
+  EXPECT_EQ(ranged.dropped, 1);
+  o.range_selected = false;
+  EXPECT_THROW(LoadLoop(o, 5), InputError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Aligned
+
+TEST(GroundTruthAligned, QueryIIsReferenceI) {
+  GroundTruthOptions o = Options(GroundTruthType::kAligned, "");
+  const GroundTruth gt = LoadGroundTruth(o, EvaluationLayout::TwoTraversals(2, 3), 5, 5);
+  EXPECT_EQ(gt.matches, M(3, {{0, {0}}, {1, {1}}}));
+  EXPECT_EQ(gt.references, 2);
+  try {
+    LoadLoop(o, 4);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "Ground_truth_type: aligned needs two traversals (Images_path_2 or Frame_mode "
+                 "2)");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Poses
+
+// A square loop in KITTI's ground plane (x, z; y points down), the camera looking along its
+// third column: frames 0-3 go round a 10 m square, 4 comes back 1 m beside the start facing
+// -x, 5 is 1 m from the start facing +z but 3 m higher, 6 and 7 repeat frames 1 and 2.
+//   frame:     0        1        2         3         4        5        6        7
+//   (x, z):  (0,0)   (0,10)  (10,10)   (10,0)    (1,0)    (0,1)   (0,10)  (10,10)
+//   facing:   +z       +z       +x        -z        -x       +z       +z       +x
+const char* const kSquareKitti[] = {
+    "1 0 0 0 0 1 0 0 0 0 1 0",     // 0
+    "1 0 0 0 0 1 0 0 0 0 1 10",    // 1
+    "0 0 1 10 0 1 0 0 -1 0 0 10",  // 2
+    "-1 0 0 10 0 1 0 0 0 0 -1 0",  // 3
+    "0 0 -1 1 0 1 0 0 1 0 0 0",    // 4
+    "1 0 0 0 0 1 0 -3 0 0 1 1",    // 5
+    "1 0 0 0 0 1 0 0 0 0 1 10",    // 6
+    "0 0 1 10 0 1 0 0 -1 0 0 10",  // 7
+};
+
+std::string KittiLines(int begin, int end) {
+  std::string s;
+  for (int i = begin; i < end; ++i) s += std::string(kSquareKitti[i]) + "\n";
+  return s;
+}
+
+TEST(PosesKitti, ReadsPositionsAndForwardVectors) {
+  const std::string path = TempDir() + "/poses.txt";
+  WriteFile(path, KittiLines(0, 8));
+  const std::vector<FramePose> poses = ReadPoses(path, GroundTruthType::kKitti);
+  ASSERT_EQ(poses.size(), 8u);
+  EXPECT_EQ(poses[2].position, Eigen::Vector3d(10, 0, 10));
+  EXPECT_EQ(poses[2].forward, Eigen::Vector3d(1, 0, 0));
+  EXPECT_EQ(poses[3].forward, Eigen::Vector3d(0, 0, -1));
+  EXPECT_EQ(poses[4].forward, Eigen::Vector3d(-1, 0, 0));
+  EXPECT_EQ(poses[5].position, Eigen::Vector3d(0, -3, 1));
+  EXPECT_TRUE(poses[0].has_forward);
+}
+
+TEST(PosesKitti, SquareLoopWithRadiusHeadingGapAndAxes) {
+  const std::string path = TempDir() + "/poses.txt";
+  WriteFile(path, KittiLines(0, 8));
+  GroundTruthOptions o = Options(GroundTruthType::kKitti, path);
+  o.radius = 2;
+  o.axes = "xz";
+  o.min_frame_gap = 3;
+  // 4-0 and 5-0 are 1 m apart, 6-1 and 7-2 at the same place.
+  GroundTruth gt = LoadLoop(o, 8);
+  EXPECT_EQ(gt.matches, M(8, {{4, {0}}, {5, {0}}, {6, {1}}, {7, {2}}}));
+  EXPECT_EQ(gt.dropped, 0);
+
+  // 4 faces -x where 0 faces +z: 90 degrees.
+  o.heading_limit = 45;
+  EXPECT_EQ(LoadLoop(o, 8).matches, M(8, {{5, {0}}, {6, {1}}, {7, {2}}}));
+  o.heading_limit = -1;
+
+  // 4-0 is only 4 frames apart.
+  o.min_frame_gap = 5;
+  EXPECT_EQ(LoadLoop(o, 8).matches, M(8, {{5, {0}}, {6, {1}}, {7, {2}}}));
+
+  // Gap 0: 5-4 (1.41 m) joins, the diagonal pairs are dropped and counted.
+  o.min_frame_gap = 0;
+  gt = LoadLoop(o, 8);
+  EXPECT_EQ(gt.matches, M(8, {{4, {0}}, {5, {0, 4}}, {6, {1}}, {7, {2}}}));
+  EXPECT_EQ(gt.dropped, 8);
+  o.min_frame_gap = 3;
+
+  // The distance must be below the radius: 1 m is not below 1 m.
+  o.radius = 1;
+  EXPECT_EQ(LoadLoop(o, 8).matches, M(8, {{6, {1}}, {7, {2}}}));
+  o.radius = 2;
+
+  // In 3D, 5 is sqrt(1 + 9) m from 0.
+  o.axes = "xyz";
+  EXPECT_EQ(LoadLoop(o, 8).matches, M(8, {{4, {0}}, {6, {1}}, {7, {2}}}));
+
+  // Over x and y, frames 0, 1, 6 (x = 0) and 2, 3, 7 (x = 10) coincide, 4 is 1 m from x = 0.
+  o.axes = "xy";
+  EXPECT_EQ(LoadLoop(o, 8).matches, M(8, {{4, {0, 1}}, {6, {0, 1}}, {7, {2, 3}}}));
+}
+
+TEST(PosesKitti, FirstFrameSelectsPoseLines) {
+  const std::string path = TempDir() + "/poses.txt";
+  WriteFile(path, KittiLines(0, 8));
+  GroundTruthOptions o = Options(GroundTruthType::kKitti, path);
+  o.radius = 2;
+  o.axes = "xz";
+  o.min_frame_gap = 3;
+  o.first_frame = 2;
+  // Rows 0..5 are frames 2..7: only 7-2 remains.
+  EXPECT_EQ(LoadLoop(o, 6).matches, M(6, {{5, {0}}}));
+  ExpectInputError([&] { LoadLoop(o, 7); },
+                   {"KITTI poses " + Q(path), "file has 8 poses", "needs 9", "Initial_image 2"});
+}
+
+TEST(PosesKitti, TwoTraversals) {
+  const std::string dir = TempDir();
+  WriteFile(dir + "/reference.txt", KittiLines(0, 4));
+  WriteFile(dir + "/query.txt", KittiLines(4, 8));
+  GroundTruthOptions o = Options(GroundTruthType::kKitti, dir + "/reference.txt");
+  o.path_2 = dir + "/query.txt";
+  o.radius = 2;
+  o.axes = "xz";
+  const EvaluationLayout layout = EvaluationLayout::TwoTraversals(4, 4);
+  GroundTruth gt = LoadGroundTruth(o, layout, 8, 8);
+  EXPECT_EQ(gt.matches, M(4, {{0, {0}}, {1, {0}}, {2, {1}}, {3, {2}}}));
+  EXPECT_EQ(gt.references, 4);
+  o.heading_limit = 45;
+  EXPECT_EQ(LoadGroundTruth(o, layout, 8, 8).matches, M(4, {{1, {0}}, {2, {1}}, {3, {2}}}));
+
+  o.path_2.clear();
+  ExpectInputError([&] { LoadGroundTruth(o, layout, 8, 8); }, {"Ground_truth_2"});
+  o.path_2 = dir + "/query.txt";
+  ExpectInputError([&] { LoadGroundTruth(o, EvaluationLayout::TwoTraversals(4, 5), 9, 9); },
+                   {"KITTI poses " + Q(dir + "/query.txt"), "file has 4 poses", "needs 5"});
+}
+
+TEST(PosesTum, QuaternionHeadingExcludesOppositeViews) {
+  const std::string path = TempDir() + "/trajectory.txt";
+  // Same spot: facing +z; facing -z (180 degrees about y, quaternion not normalised); 0.5 m
+  // away turned by 30 degrees about y.
+  WriteFile(path,
+            "# timestamp tx ty tz qx qy qz qw\n"
+            "1305031102.175304 1 2 3 0 0 0 1\n"
+            "1305031102.211214 1 2 3 0 2 0 0\n"
+            "1305031102.243211 1.5 2 3 0 0.25881904510252074 0 0.9659258262890683\n");
+  const std::vector<FramePose> poses = ReadPoses(path, GroundTruthType::kTum);
+  ASSERT_EQ(poses.size(), 3u);
+  EXPECT_EQ(poses[2].position, Eigen::Vector3d(1.5, 2, 3));
+  EXPECT_TRUE(poses[1].forward.isApprox(Eigen::Vector3d(0, 0, -1), 1e-12)) << poses[1].forward;
+  EXPECT_TRUE(poses[2].forward.isApprox(Eigen::Vector3d(0.5, 0, std::sqrt(3.0) / 2), 1e-12))
+      << poses[2].forward;
+
+  GroundTruthOptions o = Options(GroundTruthType::kTum, path);
+  o.radius = 1;
+  o.min_frame_gap = 1;
+  EXPECT_EQ(LoadLoop(o, 3).matches, M(3, {{1, {0}}, {2, {0, 1}}}));
+  o.heading_limit = 45;  // 180, 30 and 150 degrees
+  EXPECT_EQ(LoadLoop(o, 3).matches, M(3, {{2, {0}}}));
+}
+
+TEST(PosesPositions, HeaderTwoColumnsAndNoHeading) {
+  const std::string path = TempDir() + "/positions.csv";
+  WriteFile(path, "x,y\n0,0\n0.5,0\n3,0\n0.6,0.1\n");
+  const std::vector<FramePose> poses = ReadPoses(path, GroundTruthType::kPositions);
+  ASSERT_EQ(poses.size(), 4u);
+  EXPECT_EQ(poses[3].position, Eigen::Vector3d(0.6, 0.1, 0));
+  EXPECT_FALSE(poses[3].has_forward);
+
+  GroundTruthOptions o = Options(GroundTruthType::kPositions, path);
+  o.radius = 1;
+  o.min_frame_gap = 2;
+  EXPECT_EQ(LoadLoop(o, 4).matches, M(4, {{3, {0, 1}}}));
+
+  o.heading_limit = 45;
+  ExpectInputError([&] { LoadLoop(o, 4); },
+                   {"Ground_truth_heading", "positions have no orientation"});
+  ExpectInputError([&] { PairsFromPoses(poses, {}, o); }, {"Ground_truth_heading"});
+
+  WriteFile(path, "0 0\n1 2 3\n");
+  ExpectInputError(
+      [&] { ReadPoses(path, GroundTruthType::kPositions); },
+      {"positions " + Q(path) + ":2:", "3 numbers", "expected 2", "first position (line 1)"});
+}
+
+TEST(PosesHeading, ProjectionAndStrictLimit) {
+  auto pose = [](Eigen::Vector3d forward) {
+    FramePose p;
+    p.forward = forward;
+    p.has_forward = true;
+    return p;
+  };
+  // Both at the origin; the query looks down (y), the reference along z.
+  const std::vector<FramePose> down = {pose({0, 1, 0})};
+  const std::vector<FramePose> ahead = {pose({0, 0, 1})};
+  GroundTruthOptions o;
+  o.radius = 1;
+  o.axes = "xz";
+  EXPECT_EQ(PairsFromPoses(down, ahead, o), M(1, {{0, {0}}}));
+  o.heading_limit = 180;  // a direction with no projection on xz has no heading
+  EXPECT_EQ(PairsFromPoses(down, ahead, o), M(1, {}));
+  o.axes = "xyz";  // 90 degrees in 3D
+  EXPECT_EQ(PairsFromPoses(down, ahead, o), M(1, {{0, {0}}}));
+  o.heading_limit = 90;  // not below 90
+  EXPECT_EQ(PairsFromPoses(down, ahead, o), M(1, {}));
+  o.heading_limit = 90.001;
+  EXPECT_EQ(PairsFromPoses(down, ahead, o), M(1, {{0, {0}}}));
+
+  // Opposite directions are 180 degrees apart, not below a limit of 180.
+  o.heading_limit = 180;
+  EXPECT_EQ(PairsFromPoses({pose({0, 0, -1})}, ahead, o), M(1, {}));
+}
+
+TEST(PosesErrors, MalformedFilesNameFileAndLine) {
+  const std::string dir = TempDir();
+  WriteFile(dir + "/k.txt", std::string(kSquareKitti[0]) + "\n1 0 0 0 0 1 0 0 0 0 1\n");
+  ExpectInputError([&] { ReadPoses(dir + "/k.txt", GroundTruthType::kKitti); },
+                   {"KITTI poses " + Q(dir + "/k.txt") + ":2:", "11 numbers", "expected 12"});
+  WriteFile(dir + "/x.txt", "1 0 0 0 0 1 0 0 0 0 1 x\n");
+  ExpectInputError([&] { ReadPoses(dir + "/x.txt", GroundTruthType::kKitti); },
+                   {Q(dir + "/x.txt") + ":1:", "\"x\"", "column 12"});
+  WriteFile(dir + "/t.txt", "# tum\n0 1 2 3 0 0 0\n");
+  ExpectInputError([&] { ReadPoses(dir + "/t.txt", GroundTruthType::kTum); },
+                   {"TUM trajectory " + Q(dir + "/t.txt") + ":2:", "7 numbers", "expected 8"});
+  WriteFile(dir + "/q.txt", "0 1 2 3 0 0 0 0\n");
+  ExpectInputError([&] { ReadPoses(dir + "/q.txt", GroundTruthType::kTum); },
+                   {Q(dir + "/q.txt") + ":1:", "quaternion"});
+  WriteFile(dir + "/empty.txt", "# nothing\n");
+  ExpectInputError([&] { ReadPoses(dir + "/empty.txt", GroundTruthType::kKitti); },
+                   {Q(dir + "/empty.txt"), "no poses"});
+  ExpectInputError([&] { ReadPoses(dir + "/absent.txt", GroundTruthType::kTum); },
+                   {Q(dir + "/absent.txt"), "not found"});
+  EXPECT_THROW(ReadPoses(dir + "/k.txt", GroundTruthType::kMatrix), std::logic_error);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Real data
+
+std::set<std::pair<int, int>> PairSet(const Matches& m) {
+  std::set<std::pair<int, int>> s;
+  for (std::size_t q = 0; q < m.size(); ++q) {
+    for (int r : m[q]) s.insert({static_cast<int>(q), r});
+  }
+  return s;
+}
+
+TEST(GroundTruthKitti00, PosesReproduceLoopGt5m) {
+  const std::string dir = DatasetsDir() + "/kitti00_first1700";
+  OPENABLE_REQUIRE_PATH(dir + "/loop_gt_5m.txt");
+  // "query candidate dist_m heading_deg" per line.
+  std::set<std::pair<int, int>> all, below_45;
+  std::ifstream f(dir + "/loop_gt_5m.txt");
+  std::string line;
+  while (std::getline(f, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream is(line);
+    int q = 0, c = 0;
+    double dist = 0, heading = 0;
+    ASSERT_TRUE(is >> q >> c >> dist >> heading) << line;
+    all.insert({q, c});
+    if (heading < 45) below_45.insert({q, c});
+  }
+  ASSERT_EQ(all.size(), 1263u);
+
+  GroundTruthOptions o = Options(GroundTruthType::kKitti, dir + "/poses/00_first1700.txt");
+  o.radius = 5;
+  o.axes = "xz";
+  o.min_frame_gap = 100;
+  GroundTruth gt = LoadLoop(o, 1700);
+  EXPECT_EQ(PairSet(gt.matches), all);
+  EXPECT_EQ(gt.PairCount(), 1263);
+  EXPECT_EQ(gt.dropped, 0);
+
+  o.heading_limit = 45;
+  gt = LoadLoop(o, 1700);
+  EXPECT_EQ(PairSet(gt.matches), below_45);
+  EXPECT_LT(below_45.size(), all.size());
+}
+
+TEST(GroundTruthRtabmap, OneBasedPairsEqualTheMatrixAndTheBmp) {
+  const std::string dir = DatasetsDir() + "/rtabmap_samples";
+  OPENABLE_REQUIRE_PATH(dir + "/ground_truth_pairs.txt");
+  const GroundTruth pairs =
+      LoadLoop(Options(GroundTruthType::kPairs, dir + "/ground_truth_pairs.txt"), 84);
+  const GroundTruth matrix =
+      LoadLoop(Options(GroundTruthType::kMatrix, dir + "/ground_truth_matrix.txt"), 84);
+  const GroundTruth bmp = LoadLoop(Options(GroundTruthType::kMatrix, dir + "/samples_GT.bmp"), 84);
+  EXPECT_EQ(pairs.PairCount(), 228);
+  EXPECT_EQ(pairs.matches, matrix.matches);
+  EXPECT_EQ(pairs.matches, bmp.matches);
+  // Images 41..84 revisit 1..44: 1-based 41,1 is row 40, column 0.
+  EXPECT_EQ(pairs.matches[40], std::vector<int>({0, 1, 2}));
+  EXPECT_EQ(pairs.dropped, 0);
+  EXPECT_EQ(matrix.dropped, 0);
+}
+
+}  // namespace
+}  // namespace openable

@@ -1,0 +1,213 @@
+// The two protocols on hand-made matrices; every expected figure is worked out by hand in the
+// comments (docs/evaluation.md gives the definitions).
+#include "OpenABLE/evaluation/metrics.h"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "OpenABLE/base/error.h"
+
+namespace openable {
+namespace {
+
+GroundTruth Truth(std::vector<std::vector<int>> matches, int references) {
+  GroundTruth t;
+  t.matches = std::move(matches);
+  t.references = references;
+  return t;
+}
+
+// 4 queries x 5 references.
+//   q0: best c1 (0.10), truth {1}: correct
+//   q1: best c2 (0.20), truth {4}: wrong with tolerance 1 (|2 - 4| = 2)
+//   q2: best c3 (0.35), no truth: a negative query, any accepted answer is false
+//   q3: best c4 (0.45), truth {3}: correct with tolerance 1
+cv::Mat1f QueryReferenceBlock() {
+  return (cv::Mat1f(4, 5) << 0.9f, 0.1f, 0.5f, 0.7f, 0.8f,  //
+          0.3f, 0.6f, 0.2f, 0.9f, 0.4f,                     //
+          0.5f, 0.5f, 0.6f, 0.35f, 0.9f,                    //
+          0.8f, 0.7f, 0.6f, 0.5f, 0.45f);
+}
+
+TEST(PerQuery, HandWorkedQueryReferenceExample) {
+  EvaluationOptions o;
+  o.tolerance = 1;
+  const PerQueryResult r = EvaluatePerQuery(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
+                                            Truth({{1}, {4}, {}, {3}}, 5), o);
+  EXPECT_EQ(r.queries, 4);
+  EXPECT_EQ(r.positive_queries, 3);
+  EXPECT_EQ(r.best, (std::vector<int>{1, 2, 3, 4}));
+  // Accepted in order 0.10 (TP), 0.20 (FP), 0.35 (FP), 0.45 (TP); recall over 3 positives.
+  ASSERT_EQ(r.curve.size(), 4u);
+  const double p[] = {1.0, 0.5, 1.0 / 3, 0.5}, rc[] = {1.0 / 3, 1.0 / 3, 1.0 / 3, 2.0 / 3};
+  const double thr[] = {0.1, 0.2, 0.35, 0.45};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(r.curve[i].precision, p[i], 1e-12) << i;
+    EXPECT_NEAR(r.curve[i].recall, rc[i], 1e-12) << i;
+    EXPECT_NEAR(r.curve[i].threshold, thr[i], 1e-6) << i;
+  }
+  // AUC = 1 x 1/3 + 0.5 x 0 + 1/3 x 0 + 0.5 x 1/3 = 0.5.
+  EXPECT_NEAR(r.auc, 0.5, 1e-12);
+  EXPECT_NEAR(r.recall_at_100p, 1.0 / 3, 1e-12);
+  // F1 at the last point: 2 x 0.5 x 2/3 / (0.5 + 2/3) = 4/7, the largest.
+  EXPECT_NEAR(r.max_f1, 4.0 / 7, 1e-12);
+  EXPECT_NEAR(r.max_f1_threshold, 0.45, 1e-6);
+  // R@1: q0 and q3 of 3 positives; R@5: q1's c4 is among its 5 candidates.
+  EXPECT_NEAR(r.recall_at_1, 2.0 / 3, 1e-12);
+  EXPECT_NEAR(r.recall_at_5, 1.0, 1e-12);
+  EXPECT_NEAR(r.recall_at_10, 1.0, 1e-12);
+}
+
+TEST(PerQuery, ToleranceZeroAndTwoChangeOnlyTheAmbiguousQuery) {
+  EvaluationOptions o;
+  o.tolerance = 0;
+  PerQueryResult r = EvaluatePerQuery(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
+                                      Truth({{1}, {4}, {}, {3}}, 5), o);
+  EXPECT_NEAR(r.recall_at_1, 1.0 / 3, 1e-12);  // q3's best c4 is 1 away from 3
+  o.tolerance = 2;
+  r = EvaluatePerQuery(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
+                       Truth({{1}, {4}, {}, {3}}, 5), o);
+  EXPECT_NEAR(r.recall_at_1, 1.0, 1e-12);
+  // Now 0.10 TP, 0.20 TP, 0.35 FP, 0.45 TP: AUC = 1 x 2/3 + 0.75 x 1/3 = 11/12.
+  EXPECT_NEAR(r.auc, 11.0 / 12, 1e-12);
+  EXPECT_NEAR(r.recall_at_100p, 2.0 / 3, 1e-12);
+}
+
+// Loop closure over 6 frames, exclusion 2: the candidates of q are j <= q - 2.
+//   q2: {0}; q3: {0, 1}; q4: {0, 1, 2}; q5: {0, 1, 2, 3}; q0 and q1 have none.
+// Truth: (4, 0), (5, 1) and (3, 2), the last inside the exclusion window.
+TEST(PerQuery, LoopClosureUsesEarlierFramesOutsideTheExclusionWindow) {
+  cv::Mat1f m(6, 6, 1.0f);
+  const float lower[6][4] = {{}, {}, {0.6f}, {0.5f, 0.9f}, {0.2f, 0.7f, 0.8f}, {0.9f, 0.85f, 0.3f, 0.4f}};
+  for (int q = 2; q < 6; ++q)
+    for (int j = 0; j <= q - 2; ++j) m(q, j) = m(j, q) = lower[q][j];
+  for (int q = 0; q < 6; ++q) m(q, q) = 0.0f;  // the diagonal is never a candidate
+  EvaluationOptions o;
+  o.exclusion = 2;
+  o.tolerance = 0;
+  const PerQueryResult r = EvaluatePerQuery(m, EvaluationLayout::LoopClosure(6),
+                                            Truth({{}, {}, {}, {2}, {0}, {1}}, 6), o);
+  EXPECT_EQ(r.queries, 4);
+  EXPECT_EQ(r.positive_queries, 2);  // q4, q5 (q3's only match is excluded)
+  EXPECT_EQ(r.truth_pairs_outside_candidates, 1);
+  EXPECT_EQ(r.best, (std::vector<int>{-1, -1, 0, 0, 0, 2}));
+  // 0.2 TP (q4), 0.3 FP (q5), 0.5 FP (q3, negative), 0.6 FP (q2): AUC = 1 x 0.5.
+  ASSERT_EQ(r.curve.size(), 4u);
+  EXPECT_NEAR(r.curve[3].precision, 0.25, 1e-12);
+  EXPECT_NEAR(r.auc, 0.5, 1e-12);
+  EXPECT_NEAR(r.recall_at_100p, 0.5, 1e-12);
+  EXPECT_NEAR(r.max_f1, 2.0 / 3, 1e-12);
+  EXPECT_NEAR(r.recall_at_1, 0.5, 1e-12);
+  // q5's candidates by distance: c2 0.3, c3 0.4, c1 0.85: its match c1 is third.
+  EXPECT_NEAR(r.recall_at_5, 1.0, 1e-12);
+}
+
+TEST(PerQuery, TiesKeepTheLowerColumnAndShareOneCurvePoint) {
+  const cv::Mat1f m = (cv::Mat1f(2, 3) << 0.4f, 0.2f, 0.2f, 0.2f, 0.9f, 0.9f);
+  EvaluationOptions o;
+  o.tolerance = 0;
+  const PerQueryResult r =
+      EvaluatePerQuery(m, EvaluationLayout::QueryReference(2, 3), Truth({{2}, {0}}, 3), o);
+  EXPECT_EQ(r.best, (std::vector<int>{1, 0}));
+  ASSERT_EQ(r.curve.size(), 1u);  // both best distances are 0.2
+  EXPECT_EQ(r.curve[0].tp, 1);
+  EXPECT_EQ(r.curve[0].fp, 1);
+  EXPECT_NEAR(r.recall_at_100p, 0.0, 1e-12);
+}
+
+TEST(PerQuery, TwoTraversalLayoutReadsTheLowerLeftBlock) {
+  // 2 reference frames then 2 query frames; the block is rows 2-3, columns 0-1.
+  const cv::Mat1f m = (cv::Mat1f(4, 4) << 0, 9, 0.3f, 0.1f,  //
+                       9, 0, 0.2f, 0.8f,                     //
+                       0.3f, 0.2f, 0, 9,                     //
+                       0.1f, 0.8f, 9, 0);
+  const PerQueryResult r = EvaluatePerQuery(m, EvaluationLayout::TwoTraversals(2, 2),
+                                            Truth({{1}, {0}}, 2), EvaluationOptions());
+  EXPECT_EQ(r.best, (std::vector<int>{1, 0}));
+  EXPECT_NEAR(r.recall_at_1, 1.0, 1e-12);
+}
+
+// ABLE-P protocol with 3 thresholds (0, 0.5, 1) on the query-reference block above; truth
+// cells (0,1), (1,4), (3,3).
+TEST(AbleP, HandWorkedVicinityZero) {
+  EvaluationOptions o;
+  o.able_thresholds = 3;
+  o.vicinity = 0;
+  const AblePResult r = EvaluateAbleP(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
+                                      Truth({{1}, {4}, {}, {3}}, 5), o);
+  EXPECT_EQ(r.candidate_cells, 20);
+  EXPECT_EQ(r.truth_cells, 3);
+  ASSERT_EQ(r.curve.size(), 3u);
+  // theta 0: nothing detected (precision 1 by convention, recall 0).
+  EXPECT_EQ(r.curve[0].tp + r.curve[0].fp, 0);
+  EXPECT_NEAR(r.curve[0].precision, 1.0, 1e-12);
+  EXPECT_NEAR(r.curve[0].recall, 0.0, 1e-12);
+  // theta 0.5: 6 cells below (0.1, 0.3, 0.2, 0.4, 0.35, 0.45), 2 of them truth; (3,3) = 0.5 is
+  // not below 0.5, so 2 of 3 truth cells are found.
+  EXPECT_EQ(r.curve[1].tp, 2);
+  EXPECT_EQ(r.curve[1].fp, 4);
+  EXPECT_NEAR(r.curve[1].recall, 2.0 / 3, 1e-12);
+  // theta 1: all 20 cells, 3 true.
+  EXPECT_EQ(r.curve[2].tp, 3);
+  EXPECT_EQ(r.curve[2].fp, 17);
+  EXPECT_NEAR(r.curve[2].recall, 1.0, 1e-12);
+  // AP = 100 x (1/3 x 2/3 + 3/20 x 1/3) = 100 x 49/180.
+  EXPECT_NEAR(r.average_precision, 100.0 * 49 / 180, 1e-9);
+}
+
+TEST(AbleP, HandWorkedVicinityOne) {
+  EvaluationOptions o;
+  o.able_thresholds = 3;
+  o.vicinity = 1;
+  const AblePResult r = EvaluateAbleP(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
+                                      Truth({{1}, {4}, {}, {3}}, 5), o);
+  // theta 0.5: each of the 6 detections is within one row and column of a truth cell; (3,3)
+  // is found through its neighbour (2,3) = 0.35.
+  EXPECT_EQ(r.curve[1].tp, 6);
+  EXPECT_EQ(r.curve[1].fp, 0);
+  EXPECT_NEAR(r.curve[1].recall, 1.0, 1e-12);
+  // theta 1: 16 of the 20 cells lie in the union of the three 3x3 neighbourhoods.
+  EXPECT_EQ(r.curve[2].tp, 16);
+  EXPECT_EQ(r.curve[2].fp, 4);
+  EXPECT_NEAR(r.average_precision, 100.0, 1e-9);
+}
+
+TEST(AbleP, LoopClosureCountsOnlyCandidateCells) {
+  cv::Mat1f m(5, 5, 0.3f);
+  EvaluationOptions o;
+  o.exclusion = 2;
+  o.vicinity = 0;
+  // Candidates: (2,0), (3,0), (3,1), (4,0), (4,1), (4,2) = 6 cells; truth (4,1) and (1,0), the
+  // second inside the window.
+  const AblePResult r =
+      EvaluateAbleP(m, EvaluationLayout::LoopClosure(5), Truth({{}, {0}, {}, {}, {1}}, 5), o);
+  EXPECT_EQ(r.candidate_cells, 6);
+  EXPECT_EQ(r.truth_cells, 1);
+  // Every candidate is 0.3: 29/99 = 0.2929 detects nothing, 30/99 = 0.3030 detects all six;
+  // then precision 1/6, recall 1.
+  EXPECT_EQ(r.curve[29].tp + r.curve[29].fp, 0);
+  EXPECT_EQ(r.curve[30].tp, 1);
+  EXPECT_EQ(r.curve[30].fp, 5);
+  EXPECT_NEAR(r.average_precision, 100.0 / 6, 1e-9);
+}
+
+TEST(EvaluationOptions, CheckNamesTheKey) {
+  EvaluationOptions o;
+  o.tolerance = -1;
+  try {
+    o.Check();
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("Tolerance: -1"), std::string::npos);
+  }
+  o = EvaluationOptions();
+  o.exclusion = 0;
+  EXPECT_THROW(o.Check(), InputError);
+  o = EvaluationOptions();
+  o.vicinity = -3;
+  EXPECT_THROW(o.Check(), InputError);
+}
+
+}  // namespace
+}  // namespace openable
