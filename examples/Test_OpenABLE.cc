@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <malloc.h>
+
 #include <opencv2/core/utils/logger.hpp>
 
 #include "OpenABLE/OpenABLE.h"
@@ -97,6 +99,12 @@ int main(int argc, char** argv) {
   // OpenCV's video back ends print [ WARN ] lines of their own when a file cannot be opened;
   // the library already reports that as one InputError line, so keep only OpenCV errors.
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+  // Every frame passes through buffers of several MB (a 960x540 colour frame as float is
+  // 6 MB). glibc serves such blocks with mmap and returns them at free, so each frame paid
+  // for fresh zeroed pages: 63% of a Gardens Point run was page faults in the kernel. Keeping
+  // blocks up to 256 MB on the heap lets them be reused (Gardens Point 3.0 s -> 1.1 s).
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
   std::string config_path;
   std::vector<std::string> overrides;
   bool quiet = false, print_config = false;

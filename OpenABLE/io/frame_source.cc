@@ -461,16 +461,33 @@ cv::Mat ReadImageFile(const std::string& path) {
       throw fail("has " + std::to_string(spec.nchannels) + " channels (1 to 4 are supported)");
   }
 
+  // 8- and 16-bit files are read as stored and converted to float by OpenCV afterwards:
+  // OpenImageIO's own conversion to float costs more than decoding (measured: 6.8 ms against
+  // 2.3 ms for a 960x540 JPEG).
+  const OIIO::TypeDesc::BASETYPE base = static_cast<OIIO::TypeDesc::BASETYPE>(spec.format.basetype);
+  const bool uniform = spec.channelformats.empty();
+  int stored_depth = CV_32F;
+  OIIO::TypeDesc read_as = OIIO::TypeDesc::FLOAT;
+  double scale = 1.0;
+  if (uniform && base == OIIO::TypeDesc::UINT8) {
+    stored_depth = CV_8U;
+    read_as = OIIO::TypeDesc::UINT8;
+    scale = 1.0 / 255.0;
+  } else if (uniform && base == OIIO::TypeDesc::UINT16) {
+    stored_depth = CV_16U;
+    read_as = OIIO::TypeDesc::UINT16;
+    scale = 1.0 / 65535.0;
+  }
   cv::Mat image;
   try {
-    image.create(spec.height, spec.width, CV_MAKETYPE(CV_32F, channels));
+    image.create(spec.height, spec.width, CV_MAKETYPE(stored_depth, channels));
   } catch (const std::exception&) {  // cv::Exception or std::bad_alloc: a corrupt header?
     throw fail("is too large to read: " + std::to_string(spec.width) + " x " +
                std::to_string(spec.height) + " pixels x " + std::to_string(channels) +
                " channels do not fit in memory");
   }
   const bool read = in->read_image(/*subimage=*/0, /*miplevel=*/0, /*chbegin=*/0,
-                                   /*chend=*/channels, OIIO::TypeDesc::FLOAT, image.data);
+                                   /*chend=*/channels, read_as, image.data);
   // Some readers (JPEG) fill a truncated file with grey and succeed with an error recorded.
   if (!read || in->has_error()) {
     std::string reason = in->geterror();
@@ -480,9 +497,9 @@ cv::Mat ReadImageFile(const std::string& path) {
   if (!in->close() || in->has_error()) {
     throw fail("cannot be decoded: " + FirstLine(in->geterror()));
   }
+  if (stored_depth != CV_32F) image.convertTo(image, CV_MAKETYPE(CV_32F, channels), scale);
 
   if (channels == 3) cv::cvtColor(image, image, cv::COLOR_RGB2BGR);
-  const OIIO::TypeDesc::BASETYPE base = static_cast<OIIO::TypeDesc::BASETYPE>(spec.format.basetype);
   const bool unsigned_integer = base == OIIO::TypeDesc::UINT8 || base == OIIO::TypeDesc::UINT16 ||
                                 base == OIIO::TypeDesc::UINT32 || base == OIIO::TypeDesc::UINT64;
   if (!unsigned_integer || !spec.channelformats.empty()) {
