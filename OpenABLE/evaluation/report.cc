@@ -16,7 +16,7 @@ std::string Number(double v) {
 
 // JSON string literal (OpenCV's FileStorage writes JSON too, but not null for non-finite
 // values, so the few objects here are written directly).
-std::string Quoted(const std::string& s) {
+std::string JsonString(const std::string& s) {
   std::string out = "\"";
   for (const char ch : s) {
     const auto c = static_cast<unsigned char>(ch);
@@ -53,17 +53,17 @@ std::string EncodeEvaluationJson(const EvaluationSettings& s, const std::vector<
                                  const std::string& version) {
   std::ostringstream o;
   const GroundTruthOptions& t = s.truth;
-  o << "{\n  \"openable_version\": " << Quoted(version) << ",\n";
+  o << "{\n  \"openable_version\": " << JsonString(version) << ",\n";
   o << "  \"settings\": {\n"
-    << "    \"ground_truth_type\": " << Quoted(GroundTruthTypeName(t.type)) << ",\n"
-    << "    \"ground_truth\": " << Quoted(t.path) << ",\n"
-    << "    \"ground_truth_2\": " << Quoted(t.path_2) << ",\n"
+    << "    \"ground_truth_type\": " << JsonString(GroundTruthTypeName(t.type)) << ",\n"
+    << "    \"ground_truth\": " << JsonString(t.path) << ",\n"
+    << "    \"ground_truth_2\": " << JsonString(t.path_2) << ",\n"
     << "    \"ground_truth_base\": " << t.base << ",\n"
     << "    \"first_frame\": " << t.first_frame << ",\n"
     << "    \"radius\": " << Number(t.radius) << ",\n"
     << "    \"heading_limit_deg\": " << Number(t.heading_limit) << ",\n"
     << "    \"min_frame_gap\": " << t.min_frame_gap << ",\n"
-    << "    \"axes\": " << Quoted(t.axes) << ",\n"
+    << "    \"axes\": " << JsonString(t.axes) << ",\n"
     << "    \"tolerance\": " << s.options.tolerance << ",\n"
     << "    \"exclusion\": " << s.options.exclusion << ",\n"
     << "    \"vicinity\": " << s.options.vicinity << ",\n"
@@ -73,9 +73,9 @@ std::string EncodeEvaluationJson(const EvaluationSettings& s, const std::vector<
     const EvaluatedRun& r = runs[i];
     const PerQueryResult& q = r.per_query;
     o << (i ? ",\n" : "\n") << "    {\n"
-      << "      \"label\": " << Quoted(r.label) << ",\n"
-      << "      \"source\": " << Quoted(r.source) << ",\n"
-      << "      \"layout\": {\"kind\": " << Quoted(KindName(r.layout.kind))
+      << "      \"label\": " << JsonString(r.label) << ",\n"
+      << "      \"source\": " << JsonString(r.source) << ",\n"
+      << "      \"layout\": {\"kind\": " << JsonString(KindName(r.layout.kind))
       << ", \"queries\": " << r.layout.queries << ", \"references\": " << r.layout.references
       << ", \"row_offset\": " << r.layout.row_offset << ", \"col_offset\": " << r.layout.col_offset
       << "},\n"

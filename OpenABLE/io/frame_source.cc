@@ -38,31 +38,6 @@ std::string ToLower(std::string s) {
   return s;
 }
 
-// `s` between double quotes, with quotes and control characters escaped so that a message
-// stays on one line whatever the file name holds.
-std::string Quoted(const std::string& s) {
-  static const char* const kHex = "0123456789abcdef";
-  std::string out = "\"";
-  for (const char c : s) {
-    const auto u = static_cast<unsigned char>(c);
-    if (c == '"') {
-      out += "\\\"";
-    } else if (c == '\n') {
-      out += "\\n";
-    } else if (c == '\r') {
-      out += "\\r";
-    } else if (c == '\t') {
-      out += "\\t";
-    } else if (u < 0x20 || u == 0x7f) {
-      out += "\\x";
-      out += kHex[u >> 4];
-      out += kHex[u & 0xf];
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
 
 // The first non-blank line of a library's error text, trimmed, without control characters.
 std::string FirstLine(const std::string& text) {
