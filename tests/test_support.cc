@@ -1,5 +1,9 @@
 #include "tests/test_support.h"
 
+#include <fstream>
+
+#include "OpenABLE/base/error.h"
+
 #include <atomic>
 #include <cstdlib>
 #include <filesystem>
@@ -11,6 +15,29 @@
 namespace fs = std::filesystem;
 
 namespace openable::testing {
+
+void WriteBytes(const std::string& path, const std::string& bytes) {
+  std::ofstream f(path, std::ios::binary);
+  f << bytes;
+  ASSERT_TRUE(f.good()) << path;
+}
+
+void ExpectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts) {
+  try {
+    f();
+    ADD_FAILURE() << "no InputError thrown";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    EXPECT_EQ(message.find('\r'), std::string::npos) << message;
+    for (const std::string& part : parts) {
+      EXPECT_NE(message.find(part), std::string::npos)
+          << "message \"" << message << "\" lacks \"" << part << "\"";
+    }
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
+  }
+}
 namespace {
 
 struct TempRoot {

@@ -2,11 +2,23 @@
 // shared datasets are absent.
 #pragma once
 
+#include <functional>
+#include <initializer_list>
 #include <string>
 
 #include <gtest/gtest.h>
 
 namespace openable::testing {
+
+// Writes `bytes` to `path` as they are (fails the test when the file cannot be written).
+void WriteBytes(const std::string& path, const std::string& bytes);
+
+// Runs `f` and expects an InputError whose message is one line (no '\n' or '\r') holding every
+// one of `parts`.
+void ExpectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts);
+
+// `path` between double quotes, as error messages quote file names.
+inline std::string Q(const std::string& path) { return "\"" + path + "\""; }
 
 // The repository root (the folder with the top-level CMakeLists.txt).
 std::string SourceDir();

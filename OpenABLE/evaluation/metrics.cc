@@ -55,8 +55,12 @@ double F1(double precision, double recall) {
   return precision + recall > 0 ? 2 * precision * recall / (precision + recall) : 0.0;
 }
 
-// Step-wise area: sum of precision x recall increments, recall starting at 0.
-double StepArea(const std::vector<CurvePoint>& curve) {
+constexpr int kRecallAtN[] = {1, 5, 10};
+constexpr int kMaxN = 10;
+
+}  // namespace
+
+double CurveArea(const std::vector<CurvePoint>& curve) {
   double area = 0, previous = 0;
   for (const CurvePoint& p : curve) {
     area += p.precision * (p.recall - previous);
@@ -64,11 +68,6 @@ double StepArea(const std::vector<CurvePoint>& curve) {
   }
   return area;
 }
-
-constexpr int kRecallAtN[] = {1, 5, 10};
-constexpr int kMaxN = 10;
-
-}  // namespace
 
 void EvaluationOptions::Check() const {
   if (tolerance < 0)
@@ -171,7 +170,7 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
     p.f1 = F1(p.precision, p.recall);
     r.curve.push_back(p);
   }
-  r.auc = StepArea(r.curve);
+  r.auc = CurveArea(r.curve);
   for (const CurvePoint& p : r.curve) {
     if (p.fp == 0 && p.tp > 0) r.recall_at_100p = p.recall;
     if (p.f1 > r.max_f1) {
@@ -261,7 +260,7 @@ AblePResult EvaluateAbleP(const cv::Mat1f& matrix, const EvaluationLayout& layou
     p.f1 = F1(p.precision, p.recall);
     result.curve.push_back(p);
   }
-  result.average_precision = 100.0 * StepArea(result.curve);
+  result.average_precision = 100.0 * CurveArea(result.curve);
   return result;
 }
 

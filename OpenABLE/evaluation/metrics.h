@@ -62,6 +62,11 @@ struct AblePResult {
   std::int64_t truth_cells = 0;  // ground-truth pairs among the candidate cells
 };
 
+// Step-wise area under a curve: the sum over its points, in order, of
+// precision x (recall - previous recall), previous recall starting at 0. PerQueryResult::auc,
+// and AblePResult::average_precision / 100.
+double CurveArea(const std::vector<CurvePoint>& curve);
+
 // `matrix` is the full matrix (normalised, M'); the block of `layout` is evaluated.
 // Precondition (std::logic_error): the layout fits the matrix and the ground truth the layout.
 PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout& layout,

@@ -97,17 +97,6 @@ constexpr int kMarginBottom = 60;
 constexpr int kShift = 4;  // fixed-point bits of curve coordinates
 constexpr double kOne = 1 << kShift;
 
-// Area under a curve as metrics.h defines it: sum of precision x (recall - previous recall),
-// previous recall starting at 0, over the points in order.
-double StepArea(const std::vector<CurvePoint>& curve) {
-  double area = 0, previous = 0;
-  for (const CurvePoint& p : curve) {
-    area += p.precision * (p.recall - previous);
-    previous = p.recall;
-  }
-  return area;
-}
-
 std::string Format(const char* format, double value) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), format, value);
@@ -199,7 +188,7 @@ void DrawAxes(cv::Mat3b& img, const Axes& axes, const std::string& panel_title) 
 
 // Step curve through the points in order, starting at (recall 0, precision of the first point):
 // each point's precision holds from the previous point's recall to its own (vertical step at the
-// previous recall, then horizontal), so the area under the drawing is StepArea(curve).
+// previous recall, then horizontal), so the area under the drawing is CurveArea(curve).
 void DrawCurve(cv::Mat3b& img, const Axes& axes, const std::vector<CurvePoint>& curve,
                const cv::Scalar& colour) {
   if (curve.empty()) return;
@@ -303,9 +292,9 @@ cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& t
       if (curve.empty())
         suffix = " (no points)";
       else if (panel == 0)
-        suffix = " (AUC " + Format("%.3f", StepArea(curve)) + ")";
+        suffix = " (AUC " + Format("%.3f", CurveArea(curve)) + ")";
       else
-        suffix = " (AP " + Format("%.1f", 100.0 * StepArea(curve)) + "%)";
+        suffix = " (AP " + Format("%.1f", 100.0 * CurveArea(curve)) + "%)";
       legend.push_back({series[i].label, suffix, colour});
     }
     DrawLegend(img, axes, legend);

@@ -26,32 +26,12 @@ namespace {
 
 using openable::testing::DatasetsDir;
 using openable::testing::TempDir;
+using openable::testing::ExpectInputError;
+using openable::testing::Q;
+using openable::testing::WriteBytes;
 using Matches = std::vector<std::vector<int>>;
 
-void WriteFile(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary);
-  f << text;
-  ASSERT_TRUE(f.good()) << path;
-}
 
-// Runs `f`, expects an InputError whose message is one line holding every one of `parts`.
-void ExpectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError thrown";
-  } catch (const InputError& e) {
-    const std::string message = e.what();
-    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-    for (const std::string& part : parts) {
-      EXPECT_NE(message.find(part), std::string::npos)
-          << "message \"" << message << "\" lacks \"" << part << "\"";
-    }
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
-  }
-}
-
-std::string Q(const std::string& path) { return "\"" + path + "\""; }
 
 // Matches of `n` queries from a map query -> references (queries not named have none).
 Matches M(int n, const std::map<int, std::vector<int>>& m) {
@@ -125,7 +105,7 @@ TEST(GroundTruthOptions, CheckNamesTheKeyOfEachBadValue) {
 TEST(GroundTruthMatrix, LoopClosureIsSymmetricAndDropsTheDiagonal) {
   const std::string path = TempDir() + "/gt.txt";
   // (2,0), (0,3) and its mirror (3,0), the diagonal cell (1,1).
-  WriteFile(path,
+  WriteBytes(path,
             "0 0 0 1\n"
             "0 1 0 0\n"
             "1 0 0 0\n"
@@ -142,7 +122,7 @@ TEST(GroundTruthMatrix, BlockOrWholeMatrixOfTwoTraversals) {
   const std::string dir = TempDir();
   // 3 reference frames then 2 query frames: the block is rows 3-4, columns 0-2.
   const EvaluationLayout layout = EvaluationLayout::TwoTraversals(3, 2);
-  WriteFile(dir + "/whole.txt",
+  WriteBytes(dir + "/whole.txt",
             "0 0 0 0 1\n"
             "0 0 0 0 0\n"
             "0 0 0 1 0\n"
@@ -154,11 +134,11 @@ TEST(GroundTruthMatrix, BlockOrWholeMatrixOfTwoTraversals) {
   EXPECT_EQ(gt.references, 3);
   EXPECT_EQ(gt.dropped, 0);
 
-  WriteFile(dir + "/block.csv", "1,0,1\n0,0,0\n");
+  WriteBytes(dir + "/block.csv", "1,0,1\n0,0,0\n");
   gt = LoadGroundTruth(Options(GroundTruthType::kMatrix, dir + "/block.csv"), layout, 5, 5);
   EXPECT_EQ(gt.matches, M(2, {{0, {0, 2}}}));
 
-  WriteFile(dir + "/wrong.txt", "1 0\n0 1\n");
+  WriteBytes(dir + "/wrong.txt", "1 0\n0 1\n");
   ExpectInputError(
       [&] { LoadGroundTruth(Options(GroundTruthType::kMatrix, dir + "/wrong.txt"), layout, 5, 5); },
       {Q(dir + "/wrong.txt"), "2x2", "expected 2x3", "5x5"});
@@ -182,16 +162,16 @@ TEST(GroundTruthMatrix, ImageNpyAndBadCells) {
   npy += '\0';
   npy += header;
   npy += std::string("\x00\x00\x01\x00", 4);
-  WriteFile(dir + "/gt.npy", npy);
+  WriteBytes(dir + "/gt.npy", npy);
   EXPECT_EQ(LoadLoop(Options(GroundTruthType::kMatrix, dir + "/gt.npy"), 2).matches,
             M(2, {{1, {0}}}));
 
-  WriteFile(dir + "/nan.txt", "0 nan\n0 0\n");
+  WriteBytes(dir + "/nan.txt", "0 nan\n0 0\n");
   ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kMatrix, dir + "/nan.txt"), 2); },
                    {Q(dir + "/nan.txt"), "(0, 1)", "nan"});
 
   // Errors of the reader say that the file is the ground truth.
-  WriteFile(dir + "/ragged.txt", "0 0 0\n0 0\n");
+  WriteBytes(dir + "/ragged.txt", "0 0 0\n0 0\n");
   ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kMatrix, dir + "/ragged.txt"), 3); },
                    {"ground truth", Q(dir + "/ragged.txt") + ":2:", "row has 2 values"});
 }
@@ -201,7 +181,7 @@ TEST(GroundTruthMatrix, ImageNpyAndBadCells) {
 
 TEST(GroundTruthPairs, OneBasedHeaderCommentAndDuplicates) {
   const std::string path = TempDir() + "/pairs.txt";
-  WriteFile(path,
+  WriteBytes(path,
             "# query match (1-based)\n"
             "3,1\n"
             "4 2\n"
@@ -214,7 +194,7 @@ TEST(GroundTruthPairs, OneBasedHeaderCommentAndDuplicates) {
 
 TEST(GroundTruthPairs, ZeroBasedCommentHeaderLineAndExtraColumns) {
   const std::string path = TempDir() + "/pairs.csv";
-  WriteFile(path,
+  WriteBytes(path,
             "# 0-based\n"
             "row,col,distance\n"
             "2,0,0.5\n"
@@ -229,7 +209,7 @@ TEST(GroundTruthPairs, ZeroBasedCommentHeaderLineAndExtraColumns) {
 
 TEST(GroundTruthPairs, BaseOptionAndDefault) {
   const std::string path = TempDir() + "/pairs.txt";
-  WriteFile(path, "3 1\n4 2\n");
+  WriteBytes(path, "3 1\n4 2\n");
   GroundTruthOptions o = Options(GroundTruthType::kPairs, path);
   o.base = 1;
   EXPECT_EQ(LoadLoop(o, 4).matches, M(4, {{2, {0}}, {3, {1}}}));
@@ -240,27 +220,27 @@ TEST(GroundTruthPairs, BaseOptionAndDefault) {
   ExpectInputError([&] { LoadLoop(o, 4); },
                    {Q(path) + ":2:", "pair 4,2", "out of range", "[0, 3]", "Ground_truth_base"});
 
-  WriteFile(path, "# 0-based indices, converted from the 1-based originals\n1 0\n");
+  WriteBytes(path, "# 0-based indices, converted from the 1-based originals\n1 0\n");
   ExpectInputError([&] { LoadLoop(o, 4); }, {Q(path), "0-based", "1-based", "Ground_truth_base"});
 }
 
 TEST(GroundTruthPairs, OutOfRangeMessagesNameTheLinePairAndRange) {
   const std::string dir = TempDir();
-  WriteFile(dir + "/one.txt", "# 1-based\n2 1\n1 0\n");
+  WriteBytes(dir + "/one.txt", "# 1-based\n2 1\n1 0\n");
   ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/one.txt"), 4); },
                    {Q(dir + "/one.txt") + ":3:", "pair 1,0", "[1, 4]", "1-based"});
 
   const EvaluationLayout layout = EvaluationLayout::QueryReference(2, 3);
-  WriteFile(dir + "/qr.txt", "1,2\n0,0\n2,0\n");
+  WriteBytes(dir + "/qr.txt", "1,2\n0,0\n2,0\n");
   ExpectInputError(
       [&] { LoadGroundTruth(Options(GroundTruthType::kPairs, dir + "/qr.txt"), layout, 2, 3); },
       {Q(dir + "/qr.txt") + ":3:", "pair 2,0", "query indices in [0, 1]",
        "reference indices in [0, 2]"});
 
-  WriteFile(dir + "/short.txt", "3\n");
+  WriteBytes(dir + "/short.txt", "3\n");
   ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/short.txt"), 4); },
                    {Q(dir + "/short.txt") + ":1:", "1 value", "two frame indices"});
-  WriteFile(dir + "/word.txt", "3,1\n3,b\n");
+  WriteBytes(dir + "/word.txt", "3,1\n3,b\n");
   ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/word.txt"), 4); },
                    {Q(dir + "/word.txt") + ":2:", "\"b\"", "not an integer"});
   ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/absent.txt"), 4); },
@@ -269,7 +249,7 @@ TEST(GroundTruthPairs, OutOfRangeMessagesNameTheLinePairAndRange) {
 
 TEST(GroundTruthPairs, QueryReferenceKeepsTheOrder) {
   const std::string path = TempDir() + "/pairs.txt";
-  WriteFile(path, "1,2\n0,0\n1,0\n");
+  WriteBytes(path, "1,2\n0,0\n1,0\n");
   const GroundTruth gt = LoadGroundTruth(Options(GroundTruthType::kPairs, path),
                                          EvaluationLayout::QueryReference(2, 3), 2, 3);
   EXPECT_EQ(gt.matches, M(2, {{0, {0}}, {1, {0, 2}}}));
@@ -279,7 +259,7 @@ TEST(GroundTruthPairs, QueryReferenceKeepsTheOrder) {
 TEST(GroundTruthPairs, FirstFrameShiftsAndDropsPairsOutsideTheRange) {
   const std::string path = TempDir() + "/pairs.txt";
   // Frames 10..14 of the source are rows 0..4.
-  WriteFile(path,
+  WriteBytes(path,
             "12,10\n"
             "11,14\n"
             "15,12\n"    // 15 is after the range: dropped
@@ -292,12 +272,12 @@ TEST(GroundTruthPairs, FirstFrameShiftsAndDropsPairsOutsideTheRange) {
   EXPECT_EQ(gt.dropped, 3);
 
   // A negative index is wrong whatever the range.
-  WriteFile(path, "12,10\n-1,12\n");
+  WriteBytes(path, "12,10\n-1,12\n");
   ExpectInputError([&] { LoadLoop(o, 5); }, {Q(path) + ":2:", "pair -1,12", ">= 0"});
 
   // A range that starts at frame 0 but ends early (Final_image set): pairs past its end are
   // dropped too; without a range they are an error.
-  WriteFile(path, "3,1\n7,2\n");
+  WriteBytes(path, "3,1\n7,2\n");
   o.first_frame = 0;
   o.range_selected = true;
   const GroundTruth ranged = LoadLoop(o, 5);
@@ -353,7 +333,7 @@ std::string KittiLines(int begin, int end) {
 
 TEST(PosesKitti, ReadsPositionsAndForwardVectors) {
   const std::string path = TempDir() + "/poses.txt";
-  WriteFile(path, KittiLines(0, 8));
+  WriteBytes(path, KittiLines(0, 8));
   const std::vector<FramePose> poses = ReadPoses(path, GroundTruthType::kKitti);
   ASSERT_EQ(poses.size(), 8u);
   EXPECT_EQ(poses[2].position, Eigen::Vector3d(10, 0, 10));
@@ -366,7 +346,7 @@ TEST(PosesKitti, ReadsPositionsAndForwardVectors) {
 
 TEST(PosesKitti, SquareLoopWithRadiusHeadingGapAndAxes) {
   const std::string path = TempDir() + "/poses.txt";
-  WriteFile(path, KittiLines(0, 8));
+  WriteBytes(path, KittiLines(0, 8));
   GroundTruthOptions o = Options(GroundTruthType::kKitti, path);
   o.radius = 2;
   o.axes = "xz";
@@ -408,7 +388,7 @@ TEST(PosesKitti, SquareLoopWithRadiusHeadingGapAndAxes) {
 
 TEST(PosesKitti, FirstFrameSelectsPoseLines) {
   const std::string path = TempDir() + "/poses.txt";
-  WriteFile(path, KittiLines(0, 8));
+  WriteBytes(path, KittiLines(0, 8));
   GroundTruthOptions o = Options(GroundTruthType::kKitti, path);
   o.radius = 2;
   o.axes = "xz";
@@ -422,8 +402,8 @@ TEST(PosesKitti, FirstFrameSelectsPoseLines) {
 
 TEST(PosesKitti, TwoTraversals) {
   const std::string dir = TempDir();
-  WriteFile(dir + "/reference.txt", KittiLines(0, 4));
-  WriteFile(dir + "/query.txt", KittiLines(4, 8));
+  WriteBytes(dir + "/reference.txt", KittiLines(0, 4));
+  WriteBytes(dir + "/query.txt", KittiLines(4, 8));
   GroundTruthOptions o = Options(GroundTruthType::kKitti, dir + "/reference.txt");
   o.path_2 = dir + "/query.txt";
   o.radius = 2;
@@ -446,7 +426,7 @@ TEST(PosesTum, QuaternionHeadingExcludesOppositeViews) {
   const std::string path = TempDir() + "/trajectory.txt";
   // Same spot: facing +z; facing -z (180 degrees about y, quaternion not normalised); 0.5 m
   // away turned by 30 degrees about y.
-  WriteFile(path,
+  WriteBytes(path,
             "# timestamp tx ty tz qx qy qz qw\n"
             "1305031102.175304 1 2 3 0 0 0 1\n"
             "1305031102.211214 1 2 3 0 2 0 0\n"
@@ -468,7 +448,7 @@ TEST(PosesTum, QuaternionHeadingExcludesOppositeViews) {
 
 TEST(PosesPositions, HeaderTwoColumnsAndNoHeading) {
   const std::string path = TempDir() + "/positions.csv";
-  WriteFile(path, "x,y\n0,0\n0.5,0\n3,0\n0.6,0.1\n");
+  WriteBytes(path, "x,y\n0,0\n0.5,0\n3,0\n0.6,0.1\n");
   const std::vector<FramePose> poses = ReadPoses(path, GroundTruthType::kPositions);
   ASSERT_EQ(poses.size(), 4u);
   EXPECT_EQ(poses[3].position, Eigen::Vector3d(0.6, 0.1, 0));
@@ -484,7 +464,7 @@ TEST(PosesPositions, HeaderTwoColumnsAndNoHeading) {
                    {"Ground_truth_heading", "positions have no orientation"});
   ExpectInputError([&] { PairsFromPoses(poses, {}, o); }, {"Ground_truth_heading"});
 
-  WriteFile(path, "0 0\n1 2 3\n");
+  WriteBytes(path, "0 0\n1 2 3\n");
   ExpectInputError(
       [&] { ReadPoses(path, GroundTruthType::kPositions); },
       {"positions " + Q(path) + ":2:", "3 numbers", "expected 2", "first position (line 1)"});
@@ -520,19 +500,19 @@ TEST(PosesHeading, ProjectionAndStrictLimit) {
 
 TEST(PosesErrors, MalformedFilesNameFileAndLine) {
   const std::string dir = TempDir();
-  WriteFile(dir + "/k.txt", std::string(kSquareKitti[0]) + "\n1 0 0 0 0 1 0 0 0 0 1\n");
+  WriteBytes(dir + "/k.txt", std::string(kSquareKitti[0]) + "\n1 0 0 0 0 1 0 0 0 0 1\n");
   ExpectInputError([&] { ReadPoses(dir + "/k.txt", GroundTruthType::kKitti); },
                    {"KITTI poses " + Q(dir + "/k.txt") + ":2:", "11 numbers", "expected 12"});
-  WriteFile(dir + "/x.txt", "1 0 0 0 0 1 0 0 0 0 1 x\n");
+  WriteBytes(dir + "/x.txt", "1 0 0 0 0 1 0 0 0 0 1 x\n");
   ExpectInputError([&] { ReadPoses(dir + "/x.txt", GroundTruthType::kKitti); },
                    {Q(dir + "/x.txt") + ":1:", "\"x\"", "column 12"});
-  WriteFile(dir + "/t.txt", "# tum\n0 1 2 3 0 0 0\n");
+  WriteBytes(dir + "/t.txt", "# tum\n0 1 2 3 0 0 0\n");
   ExpectInputError([&] { ReadPoses(dir + "/t.txt", GroundTruthType::kTum); },
                    {"TUM trajectory " + Q(dir + "/t.txt") + ":2:", "7 numbers", "expected 8"});
-  WriteFile(dir + "/q.txt", "0 1 2 3 0 0 0 0\n");
+  WriteBytes(dir + "/q.txt", "0 1 2 3 0 0 0 0\n");
   ExpectInputError([&] { ReadPoses(dir + "/q.txt", GroundTruthType::kTum); },
                    {Q(dir + "/q.txt") + ":1:", "quaternion"});
-  WriteFile(dir + "/empty.txt", "# nothing\n");
+  WriteBytes(dir + "/empty.txt", "# nothing\n");
   ExpectInputError([&] { ReadPoses(dir + "/empty.txt", GroundTruthType::kKitti); },
                    {Q(dir + "/empty.txt"), "no poses"});
   ExpectInputError([&] { ReadPoses(dir + "/absent.txt", GroundTruthType::kTum); },

@@ -18,12 +18,9 @@ namespace openable {
 namespace {
 
 using openable::testing::TempDir;
-
-void WriteBytes(const std::string& path, const std::string& bytes) {
-  std::ofstream f(path, std::ios::binary);
-  f << bytes;
-  ASSERT_TRUE(f.good()) << path;
-}
+using openable::testing::ExpectInputError;
+using openable::testing::Q;
+using openable::testing::WriteBytes;
 
 // A .npy file from its parts: magic, version, little-endian header length (2 bytes for 1.0,
 // 4 for 2.0 and 3.0), the dict padded to a multiple of 64 bytes with '\n' last, then `data`
@@ -61,24 +58,6 @@ void ExpectMatrix(const cv::Mat1f& m, const std::vector<std::vector<float>>& exp
   }
 }
 
-// Runs `f`, expects an InputError whose message is one line holding every one of `parts`.
-void ExpectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError thrown";
-  } catch (const InputError& e) {
-    const std::string message = e.what();
-    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-    for (const std::string& part : parts) {
-      EXPECT_NE(message.find(part), std::string::npos)
-          << "message \"" << message << "\" lacks \"" << part << "\"";
-    }
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
-  }
-}
-
-std::string Q(const std::string& path) { return "\"" + path + "\""; }
 
 // ---------------------------------------------------------------------------------------------
 // .npy

@@ -28,6 +28,9 @@ namespace {
 
 namespace fs = std::filesystem;
 using openable::testing::TempDir;
+using openable::testing::ExpectInputError;
+using openable::testing::Q;
+using openable::testing::WriteBytes;
 
 // ---------------------------------------------------------------------------------------------
 // Helpers
@@ -45,12 +48,6 @@ void WriteOiio(const std::string& path, int width, int height, int channels,
   ASSERT_TRUE(out->open(path, spec)) << out->geterror();
   ASSERT_TRUE(out->write_image(type, pixels.data())) << out->geterror();
   ASSERT_TRUE(out->close()) << out->geterror();
-}
-
-void WriteBytes(const std::string& path, const std::string& bytes) {
-  std::ofstream f(path, std::ios::binary);
-  f << bytes;
-  ASSERT_TRUE(f.good()) << path;
 }
 
 std::string ReadBytes(const std::string& path) {
@@ -72,25 +69,6 @@ cv::Mat Noise(int width, int height, int type, std::uint64_t seed) {
   return m;
 }
 
-// Runs `f`, expects an InputError whose message is one line holding every one of `parts`.
-void ExpectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError thrown";
-  } catch (const InputError& e) {
-    const std::string message = e.what();
-    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-    EXPECT_EQ(message.find('\r'), std::string::npos) << message;
-    for (const std::string& part : parts) {
-      EXPECT_NE(message.find(part), std::string::npos)
-          << "message \"" << message << "\" lacks \"" << part << "\"";
-    }
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
-  }
-}
-
-std::string Q(const std::string& path) { return "\"" + path + "\""; }
 
 // ---------------------------------------------------------------------------------------------
 // NaturalLess
