@@ -160,12 +160,10 @@ int main(int argc, char** argv) {
     loaded.reserve(matrices.size());
     for (const MatrixArg& m : matrices) {
       cv::Mat1f matrix = openable::ReadMatrixFile(m.path);
-      double lo = 0, hi = 0;
       if (!cv::checkRange(matrix, true, nullptr, 0.0, 3.0e38))
         throw openable::InputError("matrix \"" + m.path +
                                    "\" holds a negative, infinite or NaN value; expected "
                                    "distances >= 0");
-      cv::minMaxLoc(matrix, &lo, &hi);
       openable::NormalizeByMax(matrix);
       openable::EvaluationLayout layout;
       if (matrix.rows != matrix.cols) {

@@ -20,10 +20,16 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/evaluation/text_parsing.h"
 #include "OpenABLE/evaluation/matrix_file.h"
 
 namespace openable {
 namespace {
+
+using evaluation_internal::IsBlank;
+using evaluation_internal::ParseNumber;
+using evaluation_internal::ReadWholeFile;
+using evaluation_internal::ToLower;
 
 namespace fs = std::filesystem;
 
@@ -33,27 +39,8 @@ std::string FormatNumber(double v) {
   return os.str();
 }
 
-std::string ToLower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 // ---------------------------------------------------------------------------------------------
 // Text files of pairs and poses
-
-std::string ReadTextFile(const std::string& path, const std::string& where) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (!fs::exists(st)) throw InputError(where + ": file not found");
-  if (fs::is_directory(st)) throw InputError(where + ": is a folder; expected a file");
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(where + ": cannot be opened for reading");
-  std::string data((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  if (f.bad()) throw InputError(where + ": read error");
-  return data;
-}
-
-bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
 // One line of a text file: its number (from 1), its fields (split at blanks and commas, the
 // comment left out; "1,,2" gives an empty field, a trailing comma none) and its comment (the
@@ -101,15 +88,6 @@ void ForEachLine(const std::string& data, F&& f) {
     SplitFields(text.substr(0, hash), &line.fields);
     f(static_cast<const Line&>(line));
   }
-}
-
-// A whole field as a number ("1", "-2.5e3", "+4", "nan").
-bool ParseNumber(std::string_view field, double* value) {
-  if (!field.empty() && field.front() == '+') field.remove_prefix(1);
-  if (field.empty()) return false;
-  const char* end = field.data() + field.size();
-  const auto r = std::from_chars(field.data(), end, *value);
-  return r.ec == std::errc() && r.ptr == end;
 }
 
 // A whole field as an integer; "12.0" is accepted as 12.
@@ -277,7 +255,7 @@ void LoadMatrix(const GroundTruthOptions& o, const EvaluationLayout& layout, int
 
 void LoadPairs(const GroundTruthOptions& o, const EvaluationLayout& layout, GroundTruth* gt) {
   const std::string where = "ground truth pairs " + Quoted(o.path);
-  const std::string data = ReadTextFile(o.path, where);
+  const std::string data = ReadWholeFile(o.path, where);
   const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
 
   int base = o.base;
@@ -479,7 +457,7 @@ std::vector<FramePose> ReadPoses(const std::string& path, GroundTruthType type) 
     throw std::logic_error("ReadPoses: type " + GroundTruthTypeName(type) + " is not a pose type");
   }
   const std::string where = std::string(PoseFileLabel(type)) + " " + Quoted(path);
-  const std::string data = ReadTextFile(path, where);
+  const std::string data = ReadWholeFile(path, where);
   std::vector<FramePose> poses;
   bool first_content = true;
   std::size_t position_count = 0;  // numbers per line of a positions file

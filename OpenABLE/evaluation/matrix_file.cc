@@ -18,16 +18,18 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/evaluation/text_parsing.h"
 
 namespace openable {
 namespace {
 
-namespace fs = std::filesystem;
+using evaluation_internal::IsBlank;
+using evaluation_internal::ParseNumber;
+using evaluation_internal::ReadWholeFile;
+using evaluation_internal::RequireFile;
+using evaluation_internal::ToLower;
 
-std::string ToLower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
+namespace fs = std::filesystem;
 
 // Lower-case extension without the dot ("" when none).
 std::string ExtensionOf(const std::string& path) {
@@ -45,38 +47,11 @@ bool IsImageExtension(const std::string& e) {
   return std::find(std::begin(kImage), std::end(kImage), e) != std::end(kImage);
 }
 
-// Throws unless `path` is an existing regular file; `where` starts the message.
-void RequireFile(const std::string& path, const std::string& where) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (!fs::exists(st)) throw InputError(where + ": file not found");
-  if (fs::is_directory(st)) throw InputError(where + ": is a folder; expected a file");
-}
-
-std::string ReadBytes(const std::string& path, const std::string& where) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(where + ": cannot be opened for reading");
-  std::string data((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  if (f.bad()) throw InputError(where + ": read error");
-  return data;
-}
-
 // ---------------------------------------------------------------------------------------------
 // Text
 
-bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-// A whole token as a number ("1", "-2.5e3", "+4", "nan", "inf").
-bool ParseNumber(std::string_view token, double* value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  if (token.empty()) return false;
-  const char* end = token.data() + token.size();
-  const auto r = std::from_chars(token.data(), end, *value);
-  return r.ec == std::errc() && r.ptr == end;
-}
-
 cv::Mat1f ReadText(const std::string& path, const std::string& where) {
-  const std::string data = ReadBytes(path, where);
+  const std::string data = ReadWholeFile(path, where);
   std::size_t pos = data.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // UTF-8 BOM
   std::vector<float> values;
   int cols = -1;
@@ -351,7 +326,7 @@ std::string ShapeText(const std::vector<std::int64_t>& shape) {
 }
 
 cv::Mat1f ReadNpy(const std::string& path, const std::string& where) {
-  const std::string data = ReadBytes(path, where);
+  const std::string data = ReadWholeFile(path, where);
   const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
   if (data.size() < 10 || data.compare(0, 6, "\x93NUMPY") != 0) {
     throw InputError(where + ": not a NumPy .npy file (no \\x93NUMPY magic at the start)");
