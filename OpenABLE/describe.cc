@@ -7,10 +7,11 @@
 #include <stdexcept>
 #include <thread>
 
-#include <opencv2/highgui.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/io/module_api.h"
+#include "OpenABLE/io/module_loader.h"
 #include "OpenABLE/preprocess.h"
 
 namespace openable {
@@ -129,8 +130,7 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
       for (int i = start; i < std::min(n, start + batch); ++i) {
         if (auto f = read(i)) {
           if (options.show_images) {
-            cv::imshow("OpenABLE", *f);
-            cv::waitKey(1);
+            reinterpret_cast<OpenableGuiShow>(ModuleSymbol("gui", "openable_gui_show"))(*f);
           }
           frames.emplace_back(i, std::move(*f));
         } else {

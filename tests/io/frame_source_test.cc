@@ -12,6 +12,7 @@
 #include <initializer_list>
 #include <iterator>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <random>
 #include <stdexcept>
@@ -21,6 +22,8 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/io/module_api.h"
+#include "OpenABLE/io/module_loader.h"
 #include "tests/test_support.h"
 
 namespace openable {
@@ -481,6 +484,69 @@ TEST(ReadImageFile, ErrorsPrintNothing) {
     EXPECT_THROW(ReadImageFile(dir + "/" + name), InputError) << name;
   }
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+}
+
+// The common formats are decoded by OpenCV's codecs, the rest by the OpenImageIO module: both
+// must give the same frame for the files either can read.
+TEST(ReadImageFile, OpenCVAndOpenImageIOPathsAgree) {
+  const std::string dir = TempDir();
+  const auto oiio_read =
+      reinterpret_cast<OpenableOiioRead>(ModuleSymbol("oiio", "openable_oiio_read"));
+  cv::Mat grey16(20, 30, CV_16UC1);
+  cv::randu(grey16, 0, 65536);
+  cv::Mat rgba = Noise(30, 20, CV_8UC4, 21);
+  std::vector<std::pair<std::string, cv::Mat>> files = {
+      {"grey.png", Noise(30, 20, CV_8UC1, 11)}, {"grey16.png", grey16},
+      {"colour.png", Noise(30, 20, CV_8UC3, 12)}, {"rgba.png", rgba},
+      {"grey.pgm", Noise(30, 20, CV_8UC1, 13)},  {"grey16.pgm", grey16},
+      {"colour.ppm", Noise(30, 20, CV_8UC3, 14)}, {"colour.bmp", Noise(30, 20, CV_8UC3, 15)},
+      {"colour.jpg", Noise(30, 20, CV_8UC3, 16)}};
+  for (const auto& [name, image] : files) {
+    const std::string path = dir + "/" + name;
+    ASSERT_TRUE(cv::imwrite(path, image)) << name;
+    const cv::Mat fast = ReadImageFile(path);
+    cv::Mat reference;
+    oiio_read(path, reference);
+    ASSERT_EQ(fast.type(), reference.type()) << name;
+    ASSERT_EQ(fast.size(), reference.size()) << name;
+    // JPEG: both decode with libjpeg, possibly with different IDCT or upsampling settings.
+    // 16-bit PNM: OpenImageIO reads it through float and loses one step at the top
+    // (65535 -> 65534); OpenCV is exact, as checked against the written values below.
+    const double tolerance =
+        name == "colour.jpg" ? 3.0 / 255.0 : name == "grey16.pgm" ? 1.0 / 65535 + 1e-7 : 1e-6;
+    EXPECT_LE(cv::norm(fast, reference, cv::NORM_INF), tolerance) << name;
+    if (name == "colour.jpg") continue;
+    cv::Mat expected = image;
+    if (image.channels() == 4) cv::cvtColor(image, expected, cv::COLOR_BGRA2BGR);
+    expected.convertTo(expected, CV_MAKETYPE(CV_32F, expected.channels()),
+                       image.depth() == CV_8U ? 1.0 / 255 : 1.0 / 65535);
+    EXPECT_LE(cv::norm(fast, expected, cv::NORM_INF), 1e-6) << name;
+  }
+}
+
+// A PNG whose chunk CRC does not match is left to OpenImageIO, which names the problem without
+// printing libpng's messages.
+TEST(ReadImageFile, PngWithBadCrcIsRefusedQuietly) {
+  const std::string dir = TempDir();
+  const std::string path = dir + "/crc.png";
+  ASSERT_TRUE(cv::imwrite(path, Noise(64, 64, CV_8UC1, 8)));
+  std::string bytes = ReadBytes(path);
+  const std::size_t idat = bytes.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  bytes[idat + 10] = static_cast<char>(bytes[idat + 10] ^ 0x5a);
+  WriteBytes(path, bytes);
+  ::testing::internal::CaptureStderr();
+  ExpectInputError([&] { ReadImageFile(path); },
+                   {"image " + Q(path) + " cannot be decoded: damaged PNG: the checksum (CRC) "
+                    "of its IDAT chunk does not match its data"});
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+}
+
+TEST(ModuleSymbol, MissingModuleIsNamed) {
+  ExpectInputError([] { ModuleSymbol("no_such_module", "f"); },
+                   {"libopenable_no_such_module.so", "cannot be loaded", "OPENABLE_MODULE_PATH"});
+  ExpectInputError([] { ModuleSymbol("oiio", "no_such_symbol"); },
+                   {"libopenable_oiio.so", "no_such_symbol"});
 }
 
 // Damaged files (bytes flipped in their second half, or cut at any length) either read as an

@@ -1,0 +1,25 @@
+// The entry points of the modules loaded at run time (module_loader.h). A module and the
+// program that loads it come from the same build, so C++ types cross the boundary.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "OpenABLE/io/frame_source.h"
+
+// libopenable_oiio.so: decodes `path` with OpenImageIO into the frame format of
+// frame_source.h. Throws InputError naming the file.
+extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame);
+using OpenableOiioRead = void (*)(const std::string&, cv::Mat&);
+
+// libopenable_video.so: the frames [first, last) of a video (see OpenVideo).
+extern "C" void openable_video_open(const std::string& path, int first, int last,
+                                    std::unique_ptr<openable::FrameSource>& source);
+using OpenableVideoOpen = void (*)(const std::string&, int, int,
+                                   std::unique_ptr<openable::FrameSource>&);
+
+// libopenable_gui.so: shows a frame in the window "OpenABLE" (Show_images 1).
+extern "C" void openable_gui_show(const cv::Mat& frame);
+using OpenableGuiShow = void (*)(const cv::Mat&);

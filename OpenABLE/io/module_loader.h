@@ -1,0 +1,25 @@
+// Parts of OpenABLE that need heavy libraries are built as modules loaded on first use
+// (dlopen), so that a run that does not need them does not pay for loading them:
+//
+//   openable_oiio   OpenImageIO reading (TIFF and the files OpenCV's decoders refuse)
+//   openable_video  OpenCV videoio (FFmpeg, GStreamer)
+//   openable_gui    OpenCV highgui (Show_images)
+//
+// Debian's OpenImageIO and videoio pull in about 250 shared libraries each (FFmpeg, GDAL,
+// OpenVDB, Qt, ...), all bound at start-up (BIND_NOW): linking them into Test_OpenABLE cost
+// 0.3 s of every run before main(), more than the whole computation on Nordland.
+//
+// Modules are searched in the folders of the environment variable OPENABLE_MODULE_PATH
+// (colon-separated), then in the build tree, then in the install tree.
+#pragma once
+
+#include <string>
+
+namespace openable {
+
+// The address of `symbol` in module `name` (e.g. "video" loads libopenable_video.so), loading
+// the module on first use; thread-safe. Throws InputError naming the module, the folders
+// searched and the loader's reason when it cannot be loaded (e.g. a partial installation).
+void* ModuleSymbol(const std::string& name, const char* symbol);
+
+}  // namespace openable
