@@ -1,6 +1,8 @@
 #include "OpenABLE/exports.h"
 
+#include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -10,6 +12,7 @@
 
 #include <unistd.h>
 
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
@@ -36,16 +39,21 @@ cv::Vec3f ColorOf(float s, int map) {
 }
 
 cv::Mat3b ColorizeMatrix(const cv::Mat1f& normalized, int map) {
-  ColorOf(0.f, map);  // validates the map once
+  // Every map is affine in s per channel: c = b + a s, with b = ColorOf(0), a = ColorOf(1) - b,
+  // which gives the same floats as ColorOf (the slopes are 0, +-1, 0.4980 or 0.5).
+  const cv::Vec3f b = ColorOf(0.f, map);  // also validates the map
+  const cv::Vec3f a = ColorOf(1.f, map) - b;
   cv::Mat3b out(normalized.size());
-  for (int i = 0; i < normalized.rows; ++i) {
-    const float* in = normalized.ptr<float>(i);
-    cv::Vec3b* o = out.ptr<cv::Vec3b>(i);
-    for (int j = 0; j < normalized.cols; ++j) {
-      const cv::Vec3f c = ColorOf(std::min(1.f, std::max(0.f, in[j])), map);
-      for (int k = 0; k < 3; ++k) o[j][k] = cv::saturate_cast<std::uint8_t>(c[k] * 255.f);
+  cv::parallel_for_(cv::Range(0, normalized.rows), [&](const cv::Range& rows) {
+    for (int i = rows.start; i < rows.end; ++i) {
+      const float* in = normalized.ptr<float>(i);
+      std::uint8_t* o = out.ptr<std::uint8_t>(i);
+      for (int j = 0; j < normalized.cols; ++j) {
+        const float v = std::min(1.f, std::max(0.f, in[j]));
+        for (int k = 0; k < 3; ++k) o[3 * j + k] = cv::saturate_cast<std::uint8_t>((b[k] + a[k] * v) * 255.f);
+      }
     }
-  }
+  });
   return out;
 }
 
@@ -74,23 +82,35 @@ std::string EncodeNpy(const cv::Mat1f& m) {
 }
 
 std::string EncodeText(const cv::Mat& m) {
-  std::string out;
-  char buf[32];
-  for (int i = 0; i < m.rows; ++i) {
-    for (int j = 0; j < m.cols; ++j) {
-      int n;
-      if (m.depth() == CV_8U) {
-        n = std::snprintf(buf, sizeof buf, "%d", m.at<std::uint8_t>(i, j));
-      } else if (m.depth() == CV_32F) {
-        n = std::snprintf(buf, sizeof buf, "%.6g", m.at<float>(i, j));
-      } else {
-        throw std::logic_error("EncodeText: expected CV_8U or CV_32F");
+  if (m.depth() != CV_8U && m.depth() != CV_32F)
+    throw std::logic_error("EncodeText: expected CV_8U or CV_32F");
+  // Blocks of rows are formatted in parallel, then joined. std::to_chars with a precision
+  // formats as printf's "%.6g" does, without locale or format-string parsing.
+  const int block = 64;
+  std::vector<std::string> parts(static_cast<size_t>((m.rows + block - 1) / block));
+  cv::parallel_for_(cv::Range(0, static_cast<int>(parts.size())), [&](const cv::Range& r) {
+    char buf[32];
+    for (int b = r.start; b < r.end; ++b) {
+      std::string& out = parts[static_cast<size_t>(b)];
+      for (int i = b * block; i < std::min(m.rows, (b + 1) * block); ++i) {
+        for (int j = 0; j < m.cols; ++j) {
+          const std::to_chars_result res =
+              m.depth() == CV_8U
+                  ? std::to_chars(buf, buf + sizeof buf, int{m.at<std::uint8_t>(i, j)})
+                  : std::to_chars(buf, buf + sizeof buf, m.at<float>(i, j),
+                                  std::chars_format::general, 6);
+          if (j) out.push_back(' ');
+          out.append(buf, res.ptr);
+        }
+        out.push_back('\n');
       }
-      if (j) out.push_back(' ');
-      out.append(buf, n);
     }
-    out.push_back('\n');
-  }
+  });
+  size_t size = 0;
+  for (const auto& part : parts) size += part.size();
+  std::string out;
+  out.reserve(size);
+  for (const auto& part : parts) out += part;
   return out;
 }
 

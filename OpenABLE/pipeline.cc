@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <future>
 #include <filesystem>
 
 #include "OpenABLE/base/error.h"
@@ -120,7 +121,7 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   t = Clock::now();
   const std::int64_t n = descriptors.rows;
   result.timings.pairs = n * (n - 1) / 2;
-  progress.Begin("matching", result.timings.pairs, "pairs");
+  progress.Begin("matching", n * n, "cells");
   const PairProgress on_pairs = [&](std::int64_t done, std::int64_t) { progress.Update(done); };
   cv::Mat1f distances = result.binary
                             ? HammingDistances(descriptors, cv::Mat(), config.threads, on_pairs)
@@ -132,7 +133,10 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   t = Clock::now();
   std::vector<int> starts;
   for (const auto& tr : result.traversals) starts.push_back(tr.first_row);
-  result.normalized = SequenceDistances(distances, config.image_sequences, starts, starts);
+  SequenceDistancesInPlace(distances, config.image_sequences, starts, starts,
+                           static_cast<SequenceDirection>(config.sequence_direction),
+                           config.threads);
+  result.normalized = distances;
   distances.release();
   result.max_distance = NormalizeByMax(result.normalized);
   if (config.threshold >= 0.0)
@@ -154,22 +158,37 @@ std::string ThresholdPngPath(const Config& config) {
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
                                       const Evaluation* evaluation) {
   const auto t = Clock::now();
-  OutputBatch batch;
+  // The encodings are independent; the two PNG images dominate (OpenCV's PNG encoder is
+  // single-threaded), so every output is encoded on its own thread, then staged in order.
+  struct Pending {
+    std::string key, path;
+    std::future<std::string> bytes;
+  };
+  std::vector<Pending> pending;
+  auto encode = [&](const std::string& key, const std::string& path, auto make) {
+    pending.push_back({key, path, std::async(std::launch::async, make)});
+  };
   if (!config.txt_name.empty())
-    batch.Stage("Txt_name", config.txt_name,
-                EncodeText(result.thresholded.empty() ? cv::Mat(result.normalized)
-                                                      : cv::Mat(result.thresholded)));
-  if (!config.npy_name.empty()) batch.Stage("Npy_name", config.npy_name, EncodeNpy(result.normalized));
+    encode("Txt_name", config.txt_name, [&] {
+      return EncodeText(result.thresholded.empty() ? cv::Mat(result.normalized)
+                                                   : cv::Mat(result.thresholded));
+    });
+  if (!config.npy_name.empty())
+    encode("Npy_name", config.npy_name, [&] { return EncodeNpy(result.normalized); });
   if (!config.png_name.empty())
-    batch.Stage("Png_name", config.png_name,
-                EncodePng(ColorizeMatrix(result.normalized, config.matrix_color)));
+    encode("Png_name", config.png_name,
+           [&] { return EncodePng(ColorizeMatrix(result.normalized, config.matrix_color)); });
   const std::string threshold_png = ThresholdPngPath(config);
   if (!threshold_png.empty()) {
-    cv::Mat1f binary;
-    result.thresholded.convertTo(binary, CV_32F);
-    batch.Stage(config.png_threshold_name.empty() ? "Png_name" : "Png_threshold_name",
-                threshold_png, EncodePng(ColorizeMatrix(binary, config.matrix_color)));
+    encode(config.png_threshold_name.empty() ? "Png_name" : "Png_threshold_name", threshold_png,
+           [&] {
+             cv::Mat1f binary;
+             result.thresholded.convertTo(binary, CV_32F);
+             return EncodePng(ColorizeMatrix(binary, config.matrix_color));
+           });
   }
+  OutputBatch batch;
+  for (Pending& p : pending) batch.Stage(p.key, p.path, p.bytes.get());
   if (evaluation != nullptr && !config.evaluation_name.empty())
     StageEvaluation(batch, "Evaluation_name", config.evaluation_name, *evaluation,
                     {&result.normalized});

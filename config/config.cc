@@ -146,6 +146,44 @@ const std::vector<Binding>& Bindings() {
        true},
       {"Threads", "Description and matching", &Config::threads, 0, 1024,
        "Worker threads for description and matching; 0 = all cores.", true},
+      {"Sequence_direction", "Description and matching", &Config::sequence_direction, 0, 2,
+       "0 sums along diagonals (both routes driven the same way, the original); 1 along "
+       "anti-diagonals (the reference route driven the opposite way); 2 the smaller of the "
+       "two for every cell (needs a second matrix in dense mode).",
+       true},
+      // Scale
+      {"Matrix_mode", "Scale", &Config::matrix_mode, 0, 2,
+       "0 auto: dense when the N x N matrix fits in Memory_limit, bounded otherwise (the run "
+       "says which and why); 1 dense: the whole matrix, every output; 2 bounded: the matrix "
+       "is computed in tiles of rows and only the matches of Best_matches and Band_width are "
+       "kept (Matches_name); with two traversals only queries (Images_path_2) against "
+       "references (Images_path) are computed.",
+       true},
+      {"Memory_limit", "Scale", &Config::memory_limit, 0, kNoLimit,
+       "GiB the dense matrices may take before auto mode switches to bounded; 0 = three "
+       "quarters of the machine's memory.",
+       true},
+      {"Best_matches", "Scale", &Config::best_matches, 0, 100000,
+       "k: the k smallest distances of every query are kept in Matches_name (one "
+       "sequence: among frames at least Exclusion frames earlier). 0 keeps none.",
+       true},
+      {"Band_width", "Scale", &Config::band_width, -1, kNoLimit,
+       "Also keep every cell with |i - j| <= Band_width, frames counted from the start of "
+       "each traversal (aligned traversals); -1 keeps no band.",
+       true},
+      {"Matches_name", "Scale", &Config::matches_name, 0, 0,
+       "Kept matches: .npy (structured: query, reference int32; distance float32 = M'; rank "
+       "int32, 1 = best, 0 = band only) or .csv. Frame numbers count from the start of their "
+       "traversal. Required in bounded mode; optional in dense mode (taken from the matrix).",
+       true},
+      {"Approximate_search", "Scale", &Config::approximate_search, 0, 1,
+       "1: bounded mode finds the Best_matches candidates of each query with FLANN (LSH for "
+       "binary descriptors, k-d trees for vector ones) instead of comparing every pair, then "
+       "scores them with the sequence sum; faster on very large runs, recall below 1 "
+       "(docs/benchmarks.md). No band.",
+       true},
+      {"Approximate_checks", "Scale", &Config::approximate_checks, 1, 100000,
+       "FLANN leaves checked per query (more: better recall, slower).", true},
       // Evaluation (docs/evaluation.md)
       {"Ground_truth_type", "Evaluation", &Config::ground_truth_type, 0, 0,
        "Empty: no evaluation. matrix (0/1 text, image, .npy), pairs (CSV or whitespace "
@@ -436,6 +474,20 @@ void CheckConfig(const Config& c) {
                      " is not after Initial_image " + std::to_string(c.initial_image) +
                      "; expected -1 (to the end) or a position > Initial_image");
   CheckEvaluationConfig(c);
+  if (c.approximate_search == 1 && c.matrix_mode == 1)
+    throw InputError("Approximate_search: 1 needs Matrix_mode 2 (bounded) or 0 (auto); "
+                     "Matrix_mode is 1 (dense), which compares every pair");
+  if (c.matrix_mode == 2 && c.matches_name.empty())
+    throw InputError("Matches_name: empty, but Matrix_mode 2 (bounded) keeps only matches; "
+                     "expected a .npy or .csv path");
+  if (!c.matches_name.empty()) {
+    const std::string& m = c.matches_name;
+    const auto dot = m.find_last_of('.');
+    const std::string ext = dot == std::string::npos ? "" : m.substr(dot);
+    if (ext != ".npy" && ext != ".csv")
+      throw InputError("Matches_name: " + Quote(m) + " has extension " +
+                       (ext.empty() ? std::string("(none)") : ext) + "; expected .npy or .csv");
+  }
   if (c.threshold != -1.0 && (c.threshold < 0.0 || c.threshold > 1.0))
     throw InputError("Threshold: " + FormatNumber(c.threshold) +
                      " is not valid; expected -1 (disabled) or a number in [0, 1]");

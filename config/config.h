@@ -47,6 +47,15 @@ struct Config {
   double threshold = -1.0;            // theta of Eq. 9 in [0, 1]; -1 disables
   int ldb_bits = 256;                 // new: LDB bits kept, 1-1386
   int threads = 0;                    // new: worker threads, 0 = all cores
+  int sequence_direction = 0;         // new: 0 diagonals, 1 anti-diagonals, 2 min of both
+  // --- Scale (new; docs/configuration.md) ----------------------------------------------------
+  int matrix_mode = 0;                // 0 auto, 1 dense N x N, 2 bounded (tiles, kept matches)
+  double memory_limit = 0.0;          // GiB the dense matrix may use; 0 = 3/4 of the RAM
+  int best_matches = 10;              // k best matches kept per query
+  int band_width = -1;                // also keep |i - j| <= this (frames); -1 none
+  std::string matches_name;           // matches file (.npy or .csv); empty = not written
+  int approximate_search = 0;         // 1: FLANN candidates instead of every pair (bounded)
+  int approximate_checks = 128;       // FLANN checks per query
   // --- Evaluation (new) ----------------------------------------------------------------------
   std::string ground_truth_type;      // "", matrix, pairs, aligned, kitti, tum, positions
   std::string ground_truth;           // ground-truth file (poses of the reference, for poses)

@@ -5,12 +5,13 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 
 #include <opencv2/core.hpp>
 
 namespace openable {
 
-// Called now and then with (pairs done, pairs in all); may be empty. Called from one thread
+// Called now and then with (cells done, cells in all) of the matrix computed; may be empty. Called from one thread
 // at a time.
 using PairProgress = std::function<void(std::int64_t done, std::int64_t total)>;
 
@@ -19,10 +20,38 @@ int HammingDistance(const std::uint8_t* a, const std::uint8_t* b, int bytes);
 
 // Distances between every row of `a` (N x W, CV_8U) and every row of `b` (M x W, CV_8U):
 // an N x M matrix of bit counts, stored as float. When `b` is empty, b = a and the result
-// is symmetric with a zero diagonal (only one triangle is computed). Rows are processed in
-// parallel on `threads` threads (0 = all cores).
+// is symmetric with a zero diagonal. Every cell is computed (for a symmetric matrix too: rows
+// written in order cost less than a mirrored triangle). Blocks of rows run in parallel on
+// `threads` threads (0 = all cores).
 cv::Mat1f HammingDistances(const cv::Mat& a, const cv::Mat& b = cv::Mat(), int threads = 0,
                            const PairProgress& progress = {});
+
+// Hamming kernels. The fastest one the CPU has is chosen at run time (AVX2 > POPCNT >
+// portable), so one binary runs everywhere.
+enum class HammingKernel { kAuto, kPortable, kPopcnt, kAvx2 };
+// Name of the kernel in use: "avx2", "popcnt" or "portable".
+const char* HammingKernelName();
+// Forces a kernel for the whole process (tests and benchmarks); kAuto restores the choice.
+// Returns false, changing nothing, when the CPU lacks it.
+bool ForceHammingKernel(HammingKernel kernel);
+
+// Distances of one query row (`bytes` bytes, the width of the references) to every reference
+// of a packed set, with the kernel in use. For kernels and benchmarks that reuse an output.
+class HammingReferences {
+ public:
+  explicit HammingReferences(const cv::Mat& references);  // N x W, CV_8U
+  ~HammingReferences();
+  HammingReferences(const HammingReferences&) = delete;
+  HammingReferences& operator=(const HammingReferences&) = delete;
+  int Size() const;
+  // out[j] = bits differing between `query` and reference j, for j in [0, Size()).
+  void Distances(const std::uint8_t* query, float* out) const;
+
+ private:
+  struct Packed;
+  std::unique_ptr<Packed> packed_;
+  int bytes_ = 0;
+};
 
 // Euclidean distances between the rows of `a` (N x W, CV_32F) and `b` (M x W, CV_32F); b
 // empty means b = a (symmetric, zero diagonal). Computed through one matrix product,

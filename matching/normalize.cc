@@ -1,6 +1,10 @@
 #include "matching/normalize.h"
 
+#include <algorithm>
 #include <cmath>
+#include <mutex>
+
+#include <opencv2/core/utility.hpp>
 #include <limits>
 #include <stdexcept>
 
@@ -8,12 +12,34 @@ namespace openable {
 
 float NormalizeByMax(cv::Mat1f& m) {
   if (m.empty()) return 0.0f;
-  if (!cv::checkRange(m, /*quiet=*/true, nullptr, 0.0, std::numeric_limits<double>::max()))
-    throw std::logic_error("NormalizeByMax: negative or non-finite distance");
-  double max_value = 0.0;
-  cv::minMaxLoc(m, nullptr, &max_value);
-  if (max_value > 0.0) m /= max_value;
-  return static_cast<float>(max_value);
+  // One parallel pass for the check and the maximum, one for the division.
+  std::mutex mutex;
+  float max_value = 0.0f;
+  bool valid = true;
+  cv::parallel_for_(cv::Range(0, m.rows), [&](const cv::Range& r) {
+    float local = 0.0f;
+    bool ok = true;
+    for (int i = r.start; i < r.end; ++i) {
+      const float* p = m.ptr<float>(i);
+      for (int j = 0; j < m.cols; ++j) {
+        ok &= p[j] >= 0.0f && p[j] <= std::numeric_limits<float>::max();  // false for NaN
+        local = std::max(local, p[j]);
+      }
+    }
+    std::lock_guard<std::mutex> lock(mutex);
+    valid &= ok;
+    max_value = std::max(max_value, local);
+  });
+  if (!valid) throw std::logic_error("NormalizeByMax: negative or non-finite distance");
+  if (max_value > 0.0f) {
+    cv::parallel_for_(cv::Range(0, m.rows), [&](const cv::Range& r) {
+      for (int i = r.start; i < r.end; ++i) {
+        float* p = m.ptr<float>(i);
+        for (int j = 0; j < m.cols; ++j) p[j] /= max_value;
+      }
+    });
+  }
+  return max_value;
 }
 
 cv::Mat1b ThresholdMatrix(const cv::Mat1f& normalized, float theta) {

@@ -1,63 +1,142 @@
 #include "matching/sequence.h"
 
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
+#include <thread>
+
+#include "matching/large_matrix.h"
 
 namespace openable {
 namespace {
 
-// is_start[x] is true when frame x begins a traversal.
-std::vector<char> StartFlags(const std::vector<int>& starts, int n, const char* what) {
-  std::vector<char> flags(static_cast<size_t>(n) + 1, 0);
-  if (n > 0) flags[0] = 1;
+// first[x] = first frame of the traversal holding x; last[x] = its last frame.
+struct Traversals {
+  std::vector<int> first, last;
+};
+
+Traversals Bounds(const std::vector<int>& starts, int n, const char* what) {
+  std::vector<int> s = starts.empty() ? std::vector<int>{0} : starts;
   int prev = -1;
-  for (int s : starts) {
-    if (s <= prev || s < 0 || (prev < 0 && s != 0))
+  for (int v : s) {
+    if (v <= prev || v < 0 || (prev < 0 && v != 0))
       throw std::logic_error(std::string("SequenceDistances: ") + what +
                              " starts must increase from 0");
-    if (s < n) flags[s] = 1;
-    prev = s;
+    prev = v;
   }
-  return flags;
+  Traversals t;
+  t.first.resize(static_cast<size_t>(n));
+  t.last.resize(static_cast<size_t>(n));
+  for (size_t k = 0; k < s.size(); ++k) {
+    const int begin = std::min(s[k], n);
+    const int end = k + 1 < s.size() ? std::min(s[k + 1], n) : n;
+    for (int x = begin; x < end; ++x) {
+      t.first[static_cast<size_t>(x)] = begin;
+      t.last[static_cast<size_t>(x)] = end - 1;
+    }
+  }
+  return t;
+}
+
+// A barrier for a handful of threads that meet once per row (thousands of times per run):
+// spinning costs far less than a condition variable at that rate. Written by hand: std::barrier
+// is C++20.
+class SpinBarrier {
+ public:
+  explicit SpinBarrier(int threads) : threads_(threads) {}
+  void Wait() {
+    const int generation = generation_.load(std::memory_order_acquire);
+    if (arrived_.fetch_add(1, std::memory_order_acq_rel) + 1 == threads_) {
+      arrived_.store(0, std::memory_order_relaxed);
+      generation_.store(generation + 1, std::memory_order_release);
+      return;
+    }
+    for (int spins = 0; generation_.load(std::memory_order_acquire) == generation; ++spins)
+      if (spins > 1000) std::this_thread::yield();
+  }
+
+ private:
+  const int threads_;
+  std::atomic<int> arrived_{0};
+  std::atomic<int> generation_{0};
+};
+
+// One direction, in place. step = +1: diagonals (predecessor (i-1, j-1)); -1: anti-diagonals
+// (predecessor (i-1, j+1)).
+void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, bool reverse,
+           int threads) {
+  const int n = d.rows, m = d.cols;
+  // ring[r % R] holds row r of D once row r has been overwritten by S. Row i - L is read only
+  // when L < n, so R = min(L, n) + 1 slots suffice (and i - L sits in slot (i + 1) % R).
+  const int R = std::min(L, n) + 1;
+  std::vector<float> ring(static_cast<size_t>(R) * m);
+  std::vector<double> prev(static_cast<size_t>(m)), cur(static_cast<size_t>(m));
+  threads = std::max(1, std::min(threads, m / 256 + 1));
+  SpinBarrier barrier(threads);
+  auto work = [&](int c0, int c1) {
+    for (int i = 0; i < n; ++i) {
+      float* row = d.ptr<float>(i);
+      float* keep = &ring[static_cast<size_t>(i % R) * m];
+      const float* old = &ring[static_cast<size_t>((i + 1) % R) * m];  // row i - L
+      const int ti = i - rows.first[static_cast<size_t>(i)];  // steps back within i's traversal
+      for (int j = c0; j < c1; ++j) {
+        const float dij = row[j];
+        keep[j] = dij;
+        // Steps the run can go back from (i, j) without leaving either traversal.
+        const int tj = reverse ? cols.last[static_cast<size_t>(j)] - j
+                               : j - cols.first[static_cast<size_t>(j)];
+        const int t = std::min(ti, tj);
+        double w = dij;
+        if (t > 0) {
+          w += prev[static_cast<size_t>(reverse ? j + 1 : j - 1)];
+          if (t >= L) w -= old[reverse ? j + L : j - L];
+        }
+        cur[static_cast<size_t>(j)] = w;
+        const int c = std::min(L, t + 1);
+        row[j] = static_cast<float>(c == L ? w : w * L / c);
+      }
+      barrier.Wait();  // every column of row i done before anyone reads it as row i - 1
+      if (c0 == 0) std::swap(prev, cur);
+      barrier.Wait();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t)
+    pool.emplace_back(work, static_cast<int>(static_cast<long>(m) * t / threads),
+                      static_cast<int>(static_cast<long>(m) * (t + 1) / threads));
+  work(0, m / threads);
+  for (auto& t : pool) t.join();
 }
 
 }  // namespace
 
+void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length,
+                              const std::vector<int>& row_starts,
+                              const std::vector<int>& col_starts, SequenceDirection direction,
+                              int threads) {
+  if (sequence_length < 1) throw std::logic_error("SequenceDistances: sequence length < 1");
+  const Traversals rows = Bounds(row_starts, d.rows, "row");
+  const Traversals cols = Bounds(col_starts, d.cols, "column");
+  if (sequence_length == 1 || d.empty()) return;
+  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (direction == SequenceDirection::kBoth) {
+    cv::Mat1f reverse = LargeMatrix(d.rows, d.cols);
+    d.copyTo(reverse);
+    Sweep(d, sequence_length, rows, cols, false, threads);
+    Sweep(reverse, sequence_length, rows, cols, true, threads);
+    cv::min(cv::InputArray(d), cv::InputArray(reverse), cv::OutputArray(d));
+    return;
+  }
+  Sweep(d, sequence_length, rows, cols, direction == SequenceDirection::kReverse, threads);
+}
+
 cv::Mat1f SequenceDistances(const cv::Mat1f& d, int sequence_length,
                             const std::vector<int>& row_starts,
-                            const std::vector<int>& col_starts) {
-  if (sequence_length < 1) throw std::logic_error("SequenceDistances: sequence length < 1");
-  const int n = d.rows, m = d.cols;
-  const std::vector<char> row_start = StartFlags(row_starts, n, "row");
-  const std::vector<char> col_start = StartFlags(col_starts, m, "column");
-  cv::Mat1f out(n, m);
-  if (sequence_length == 1) {
-    d.copyTo(out);
-    return out;
-  }
-  const int L = sequence_length;
-  // Walk every diagonal from its top-left end. The window holds the last `count` terms of
-  // the current run; a run restarts where the row or the column frame begins a traversal.
-  // Sums are kept in double so that long diagonals do not accumulate float rounding.
-  auto walk = [&](int i, int j) {
-    double sum = 0.0;
-    int count = 0;
-    for (; i < n && j < m; ++i, ++j) {
-      if (row_start[i] || col_start[j]) {
-        sum = 0.0;
-        count = 0;
-      }
-      sum += d(i, j);
-      if (count == L) {
-        sum -= d(i - L, j - L);
-      } else {
-        ++count;
-      }
-      out(i, j) = static_cast<float>(count == L ? sum : sum * L / count);
-    }
-  };
-  for (int j = 0; j < m; ++j) walk(0, j);
-  for (int i = 1; i < n; ++i) walk(i, 0);
+                            const std::vector<int>& col_starts, SequenceDirection direction,
+                            int threads) {
+  cv::Mat1f out = LargeMatrix(d.rows, d.cols);
+  d.copyTo(out);
+  SequenceDistancesInPlace(out, sequence_length, row_starts, col_starts, direction, threads);
   return out;
 }
 

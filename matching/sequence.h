@@ -2,20 +2,25 @@
 // frames): the distance between the place of frame i and the place of frame j is the sum of
 // the L single-frame distances along the diagonal that ends at (i, j):
 //
-//   S(i, j) = sum_{k = 0 .. L-1} D(i - k, j - k)
+//   forward:  S(i, j) = sum_{k = 0 .. L-1} D(i - k, j - k)   (both routes driven the same way)
+//   reverse:  S(i, j) = sum_{k = 0 .. L-1} D(i - k, j + k)   (anti-diagonals: the reference
+//                                                            route driven the other way)
 //
 // L = 1 gives single images back, as the paper says (the original summed L + 1 terms).
 //
 // Traversals: the frames of a run may be several traversals concatenated (a query route after
 // a reference route). A sum never crosses from one traversal into another: the terms that
-// would start before the first frame of the traversal of i, or of j, do not exist.
+// would leave the traversal of i, or of j, do not exist.
 //
 // Early frames: where only c < L terms exist (the first L - 1 frames of a traversal), the sum
 // of the c terms is scaled by L / c, i.e. the mean distance along the available part of the
 // diagonal times L. Leaving the short sums unscaled would make early frames look similar to
 // everything.
 //
-// The cost is one pass over the matrix whatever L is: a running sum per diagonal.
+// Cost: one pass over the matrix whatever L is. Row i is obtained from row i - 1 by the running
+// sum S(i, j) = S(i - 1, j -+ 1) + D(i, j) - D(i - L, j -+ L), kept in double precision, with
+// the last L rows of D kept aside so that the matrix can be overwritten in place. Columns are
+// split between threads, which meet once per row.
 #pragma once
 
 #include <vector>
@@ -24,12 +29,24 @@
 
 namespace openable {
 
-// D: N x M single-frame distances (rows: frames i, columns: frames j). `row_starts` and
-// `col_starts` are the first frame of each traversal along the rows and the columns, in
-// increasing order and starting with 0 (empty means {0}: one traversal). Returns S as above.
-// Throws std::logic_error when L < 1 or the starts are not increasing from 0.
+enum class SequenceDirection { kForward = 0, kReverse = 1, kBoth = 2 };  // kBoth: min of the two
+
+// D: N x M single-frame distances (rows: frames i, columns: frames j), replaced by S.
+// `row_starts` and `col_starts` are the first frame of each traversal along the rows and the
+// columns, in increasing order and starting with 0 (empty means {0}: one traversal).
+// `threads` = 0 uses all cores. Throws std::logic_error when L < 1 or the starts are not
+// increasing from 0. kBoth needs a second N x M matrix for the time of the call.
+void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length,
+                              const std::vector<int>& row_starts = {},
+                              const std::vector<int>& col_starts = {},
+                              SequenceDirection direction = SequenceDirection::kForward,
+                              int threads = 0);
+
+// The same, returning S in a new matrix and leaving D as it is.
 cv::Mat1f SequenceDistances(const cv::Mat1f& d, int sequence_length,
                             const std::vector<int>& row_starts = {},
-                            const std::vector<int>& col_starts = {});
+                            const std::vector<int>& col_starts = {},
+                            SequenceDirection direction = SequenceDirection::kForward,
+                            int threads = 0);
 
 }  // namespace openable

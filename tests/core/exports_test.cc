@@ -132,3 +132,49 @@ TEST(OutputBatch, FailureLeavesNoFile) {
 
 }  // namespace
 }  // namespace openable
+
+namespace openable {
+namespace {
+
+// The fast colouring (one affine function per channel, rows in parallel) against ColorOf,
+// pixel by pixel, for every map.
+TEST(ColorizeMatrix, EqualsColorOfForEveryPixelAndMap) {
+  cv::Mat1f m(37, 53);
+  cv::RNG rng(5);
+  rng.fill(m, cv::RNG::UNIFORM, -0.2, 1.2);  // out of [0, 1] is clamped
+  m(0, 0) = 0.f;
+  m(0, 1) = 1.f;
+  for (int map = 0; map < 12; ++map) {
+    const cv::Mat3b c = ColorizeMatrix(m, map);
+    for (int i = 0; i < m.rows; ++i)
+      for (int j = 0; j < m.cols; ++j) {
+        const cv::Vec3f e = ColorOf(std::min(1.f, std::max(0.f, m(i, j))), map);
+        for (int k = 0; k < 3; ++k)
+          ASSERT_EQ(c(i, j)[k], cv::saturate_cast<std::uint8_t>(e[k] * 255.f))
+              << "map " << map << " at " << i << "," << j;
+      }
+  }
+}
+
+// The text writer against printf's "%.6g" on values of every magnitude.
+TEST(EncodeText, MatchesPrintfOnRandomFloats) {
+  cv::Mat1f m(130, 7);  // more rows than one parallel block
+  cv::RNG rng(9);
+  for (int i = 0; i < m.rows; ++i)
+    for (int j = 0; j < m.cols; ++j)
+      m(i, j) = static_cast<float>(rng.uniform(0.0, 1.0) * std::pow(10.0, rng.uniform(-9, 4)));
+  std::string expected;
+  char buf[64];
+  for (int i = 0; i < m.rows; ++i) {
+    for (int j = 0; j < m.cols; ++j) {
+      std::snprintf(buf, sizeof buf, "%s%.6g", j ? " " : "", m(i, j));
+      expected += buf;
+    }
+    expected += "\n";
+  }
+  EXPECT_EQ(EncodeText(m), expected);
+}
+
+}  // namespace
+}  // namespace openable
+

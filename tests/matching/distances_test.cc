@@ -39,6 +39,10 @@ class HammingWidths : public ::testing::TestWithParam<int> {};
 TEST_P(HammingWidths, MatrixMatchesBruteForce) {
   const int width = GetParam();
   const cv::Mat a = RandomBytes(37, width, 1 + width), b = RandomBytes(23, width, 99 + width);
+  for (HammingKernel kernel : {HammingKernel::kPortable, HammingKernel::kPopcnt,
+                               HammingKernel::kAvx2, HammingKernel::kAuto}) {
+  if (!ForceHammingKernel(kernel)) continue;  // the CPU lacks it
+  SCOPED_TRACE(HammingKernelName());
   for (int threads : {1, 2, 3}) {
     const cv::Mat1f cross = HammingDistances(a, b, threads);
     ASSERT_EQ(cross.rows, 37);
@@ -52,9 +56,21 @@ TEST_P(HammingWidths, MatrixMatchesBruteForce) {
       EXPECT_EQ(HammingDistance(a.ptr<std::uint8_t>(i), b.ptr<std::uint8_t>(0), width),
                 BitCount(a, i, b, 0));
   }
+  }
+  ForceHammingKernel(HammingKernel::kAuto);
 }
 
-INSTANTIATE_TEST_SUITE_P(Widths, HammingWidths, ::testing::Values(1, 7, 8, 9, 32, 64, 174));
+// 256 and 300 bytes: more than 31 words, where the AVX2 kernel's byte counters are flushed.
+INSTANTIATE_TEST_SUITE_P(Widths, HammingWidths,
+                         ::testing::Values(1, 7, 8, 9, 32, 64, 174, 256, 300));
+
+TEST(HammingKernel, TheBestKernelOfTheCpuIsChosen) {
+  __builtin_cpu_init();
+  const std::string expected = __builtin_cpu_supports("avx2")     ? "avx2"
+                               : __builtin_cpu_supports("popcnt") ? "popcnt"
+                                                                  : "portable";
+  EXPECT_EQ(HammingKernelName(), expected);
+}
 
 TEST(HammingDistances, ReportsProgressUpToTheTotal) {
   const cv::Mat a = RandomBytes(50, 32, 5);
@@ -64,7 +80,7 @@ TEST(HammingDistances, ReportsProgressUpToTheTotal) {
     last = done;
     total_seen = total;
   });
-  EXPECT_EQ(total_seen, 50 * 49 / 2);
+  EXPECT_EQ(total_seen, 50 * 50);  // every cell is computed
   EXPECT_EQ(last, total_seen);
 }
 

@@ -1,5 +1,6 @@
 #include "matching/sequence.h"
 
+#include <algorithm>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -14,17 +15,25 @@ int StartOf(const std::vector<int>& starts, int x) {
   return s;
 }
 
-// Naive definition: sum over k of the terms that exist, scaled to L terms.
+int EndOf(const std::vector<int>& starts, int x, int n) {
+  for (int v : starts)
+    if (v > x) return v;  // first start after x: one past the last frame of x's traversal
+  return n;
+}
+
+// Naive definition: sum over k of the terms that exist, scaled to L terms. reverse: the
+// column runs forward (j + k) while the row runs back (i - k).
 cv::Mat1f NaiveSequence(const cv::Mat1f& d, int L, const std::vector<int>& rs,
-                        const std::vector<int>& cs) {
+                        const std::vector<int>& cs, bool reverse = false) {
   cv::Mat1f out(d.size());
   for (int i = 0; i < d.rows; ++i)
     for (int j = 0; j < d.cols; ++j) {
       double sum = 0;
       int count = 0;
       for (int k = 0; k < L; ++k) {
-        if (i - k < StartOf(rs, i) || j - k < StartOf(cs, j)) break;
-        sum += d(i - k, j - k);
+        const int jk = reverse ? j + k : j - k;
+        if (i - k < StartOf(rs, i) || jk < StartOf(cs, j) || jk >= EndOf(cs, j, d.cols)) break;
+        sum += d(i - k, jk);
         ++count;
       }
       out(i, j) = static_cast<float>(sum * L / count);
@@ -78,6 +87,47 @@ TEST(SequenceDistances, SumsNeverCrossTraversals) {
     for (int i = 0; i < d.rows; ++i)
       for (int j = 0; j < d.cols; ++j)
         ASSERT_NEAR(fast(i, j), slow(i, j), 1e-3) << "L=" << L << " at " << i << "," << j;
+  }
+}
+
+// Anti-diagonals (reference route driven the other way), with traversals, on 1-3 threads,
+// in place; and kBoth as the element-wise minimum of the two naive sums.
+TEST(SequenceDistances, ReverseAndBothMatchNaiveLoops) {
+  const cv::Mat1f d = Random(45, 300, 6);  // wide enough for several column chunks
+  const std::vector<int> rows = {0, 20}, cols = {0, 120, 250};
+  for (int L : {1, 3, 10, 25, 400}) {
+    const cv::Mat1f fwd = NaiveSequence(d, L, rows, cols);
+    const cv::Mat1f rev = NaiveSequence(d, L, rows, cols, true);
+    cv::Mat1f both(d.size());
+    for (int i = 0; i < d.rows; ++i)
+      for (int j = 0; j < d.cols; ++j) both(i, j) = std::min(fwd(i, j), rev(i, j));
+    for (int threads : {1, 2, 3}) {
+      cv::Mat1f in_place = d.clone();
+      SequenceDistancesInPlace(in_place, L, rows, cols, SequenceDirection::kReverse, threads);
+      EXPECT_LE(cv::norm(in_place, rev, cv::NORM_INF), 1e-3) << "L=" << L << " t=" << threads;
+      EXPECT_LE(cv::norm(SequenceDistances(d, L, rows, cols, SequenceDirection::kForward, threads),
+                         fwd, cv::NORM_INF),
+                1e-3)
+          << "L=" << L << " t=" << threads;
+      EXPECT_LE(cv::norm(SequenceDistances(d, L, rows, cols, SequenceDirection::kBoth, threads),
+                         both, cv::NORM_INF),
+                1e-3)
+          << "L=" << L << " t=" << threads;
+    }
+  }
+}
+
+// A long diagonal of a Hamming-like matrix (integers): the running sum in double stays exact.
+TEST(SequenceDistances, LongDiagonalsStayExactForIntegerDistances) {
+  cv::Mat1f d(2000, 2000);
+  cv::RNG rng(8);
+  for (auto& v : d) v = static_cast<float>(rng.uniform(0, 1387));
+  const cv::Mat1f s = SequenceDistances(d, 30);
+  for (int i : {29, 500, 1999}) {
+    const int j = i;
+    double sum = 0;
+    for (int k = 0; k < 30; ++k) sum += d(i - k, j - k);
+    EXPECT_EQ(s(i, j), static_cast<float>(sum)) << i;
   }
 }
 

@@ -1,0 +1,53 @@
+// Exports of a 3576 x 3576 matrix (Nordland trimmed, both seasons): colour map, PNG encoding,
+// .npy and text encoding. Items = matrix cells.
+#include <benchmark/benchmark.h>
+
+#include <opencv2/core.hpp>
+
+#include "OpenABLE/exports.h"
+
+namespace {
+
+// A smooth matrix with a dark diagonal, compressed by PNG like a real one (not like noise).
+cv::Mat1f Matrix(int n) {
+  cv::Mat1f m(n, n);
+  cv::RNG rng(3);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      m(i, j) = std::min(1.0f, 0.3f + 0.5f * std::abs(i - j) / n + 0.05f * rng.uniform(0.f, 1.f));
+  return m;
+}
+
+const cv::Mat1f& Shared() {
+  static const cv::Mat1f m = Matrix(3576);
+  return m;
+}
+
+void BM_Colorize(benchmark::State& state) {
+  for (auto _ : state) benchmark::DoNotOptimize(openable::ColorizeMatrix(Shared(), 4).data);
+  state.SetItemsProcessed(state.iterations() * Shared().total());
+}
+BENCHMARK(BM_Colorize)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_EncodePng(benchmark::State& state) {
+  const cv::Mat3b image = openable::ColorizeMatrix(Shared(), 4);
+  for (auto _ : state) benchmark::DoNotOptimize(openable::EncodePng(image).size());
+  state.SetItemsProcessed(state.iterations() * Shared().total());
+}
+BENCHMARK(BM_EncodePng)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_EncodeNpy(benchmark::State& state) {
+  for (auto _ : state) benchmark::DoNotOptimize(openable::EncodeNpy(Shared()).size());
+  state.SetItemsProcessed(state.iterations() * Shared().total());
+}
+BENCHMARK(BM_EncodeNpy)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_EncodeText(benchmark::State& state) {
+  for (auto _ : state) benchmark::DoNotOptimize(openable::EncodeText(Shared()).size());
+  state.SetItemsProcessed(state.iterations() * Shared().total());
+}
+BENCHMARK(BM_EncodeText)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+
+}  // namespace
+
+BENCHMARK_MAIN();
