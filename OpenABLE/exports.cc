@@ -57,12 +57,12 @@ cv::Mat3b ColorizeMatrix(const cv::Mat1f& normalized, int map) {
   return out;
 }
 
-std::string EncodeNpy(const cv::Mat1f& m) {
+std::string NpyHeader(int rows, int cols) {
   // The .npy format: magic, version 1.0, a little-endian uint16 header length, then a Python
   // dict literal padded with spaces and ended by '\n' so that the data starts at a multiple
   // of 64 bytes. Written by hand: none of our dependencies writes .npy.
   std::string dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (" +
-                     std::to_string(m.rows) + ", " + std::to_string(m.cols) + "), }";
+                     std::to_string(rows) + ", " + std::to_string(cols) + "), }";
   const size_t preamble = 10;  // magic (6) + version (2) + length (2)
   size_t total = preamble + dict.size() + 1;
   const size_t padded = (total + 63) / 64 * 64;
@@ -72,7 +72,11 @@ std::string EncodeNpy(const cv::Mat1f& m) {
   const auto len = static_cast<std::uint16_t>(dict.size());
   out.push_back(static_cast<char>(len & 0xFF));
   out.push_back(static_cast<char>(len >> 8));
-  out += dict;
+  return out + dict;
+}
+
+std::string EncodeNpy(const cv::Mat1f& m) {
+  std::string out = NpyHeader(m.rows, m.cols);
   static_assert(sizeof(float) == 4, "float32 expected");
   const size_t bytes = static_cast<size_t>(m.rows) * m.cols * sizeof(float);
   out.reserve(out.size() + bytes);
@@ -126,6 +130,11 @@ OutputBatch::~OutputBatch() {
 
 void OutputBatch::Stage(const std::string& key, const std::string& path,
                         const std::string& bytes) {
+  Stage(key, path, std::vector<std::string_view>{bytes});
+}
+
+void OutputBatch::Stage(const std::string& key, const std::string& path,
+                        const std::vector<std::string_view>& parts) {
   namespace fs = std::filesystem;
   const fs::path dest(path);
   const fs::path folder = dest.has_parent_path() ? dest.parent_path() : fs::path(".");
@@ -141,7 +150,8 @@ void OutputBatch::Stage(const std::string& key, const std::string& path,
                                .string();
   items_.push_back({key, temp, path});
   std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-  if (out) out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  for (const std::string_view part : parts)
+    if (out) out.write(part.data(), static_cast<std::streamsize>(part.size()));
   if (out) out.close();
   if (!out)
     throw InputError(key + ": cannot write \"" + path + "\": " + std::strerror(errno) +

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -21,6 +22,9 @@ cv::Mat3b ColorizeMatrix(const cv::Mat1f& normalized, int map);
 // Bytes of a NumPy .npy file (format version 1.0, little-endian float32, C order) holding
 // `m` (CV_32FC1).
 std::string EncodeNpy(const cv::Mat1f& m);
+// The header alone (magic, version, dictionary) of a rows x cols float32 .npy; the data
+// follows it in C order.
+std::string NpyHeader(int rows, int cols);
 
 // Text of the matrix: one row per line, values separated by one space. Floats are written
 // with 6 significant digits; CV_8U matrices (thresholded) as integers.
@@ -40,6 +44,10 @@ class OutputBatch {
   // Writes `bytes` to a temporary file beside `path`, creating its folder when missing.
   // Throws InputError naming `key` and the path when the file cannot be written.
   void Stage(const std::string& key, const std::string& path, const std::string& bytes);
+  // The same for a file made of several pieces written one after the other (no copy into
+  // one buffer: a matrix's rows can be written from where they are).
+  void Stage(const std::string& key, const std::string& path,
+             const std::vector<std::string_view>& parts);
   // Renames every staged file to its destination. Throws InputError if a rename fails (files
   // renamed before stay; the error names the one that failed).
   void Commit();

@@ -173,8 +173,6 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
       return EncodeText(result.thresholded.empty() ? cv::Mat(result.normalized)
                                                    : cv::Mat(result.thresholded));
     });
-  if (!config.npy_name.empty())
-    encode("Npy_name", config.npy_name, [&] { return EncodeNpy(result.normalized); });
   if (!config.png_name.empty())
     encode("Png_name", config.png_name,
            [&] { return EncodePng(ColorizeMatrix(result.normalized, config.matrix_color)); });
@@ -188,6 +186,15 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
            });
   }
   OutputBatch batch;
+  if (!config.npy_name.empty()) {
+    // Written from the matrix itself while the other outputs are being encoded.
+    const std::string header = NpyHeader(result.normalized.rows, result.normalized.cols);
+    std::vector<std::string_view> parts = {header};
+    for (int i = 0; i < result.normalized.rows; ++i)
+      parts.emplace_back(reinterpret_cast<const char*>(result.normalized.ptr<float>(i)),
+                         result.normalized.cols * sizeof(float));
+    batch.Stage("Npy_name", config.npy_name, parts);
+  }
   for (Pending& p : pending) batch.Stage(p.key, p.path, p.bytes.get());
   if (evaluation != nullptr && !config.evaluation_name.empty())
     StageEvaluation(batch, "Evaluation_name", config.evaluation_name, *evaluation,
