@@ -1,7 +1,9 @@
 #include "OpenABLE/pipeline.h"
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
+#include <unistd.h>
 #include <future>
 #include <filesystem>
 
@@ -51,6 +53,11 @@ std::vector<SourceSpec> Sources(const Config& c) {
     default:
       return {{"Video_path_1", c.video_path_1, true}, {"Video_path_2", c.video_path_2, true}};
   }
+}
+
+double PhysicalMemoryBytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? static_cast<double>(pages) * page : 8.0 * (1 << 30);
 }
 
 bool HasDisplay() {
@@ -117,9 +124,78 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   cv::Mat descriptors;
   cv::vconcat(blocks, descriptors);
 
-  // Match: every frame against every frame of the concatenated traversals, as the original.
-  t = Clock::now();
+  std::vector<int> starts;
+  for (const auto& tr : result.traversals) starts.push_back(tr.first_row);
   const std::int64_t n = descriptors.rows;
+  const MatchBlock block = BlockOf(starts, static_cast<int>(n));
+  KeepRules rules;
+  rules.best = config.best_matches;
+  rules.band = config.band_width;
+  rules.exclusion = config.exclusion;
+  rules.one_traversal = block.one_traversal;
+
+  // Dense or bounded (Matrix_mode), said in one line.
+  const auto direction = static_cast<SequenceDirection>(config.sequence_direction);
+  const double gib = 1024.0 * 1024.0 * 1024.0;
+  const double dense_bytes = static_cast<double>(n) * n * 4.0 *
+                             (direction == SequenceDirection::kBoth ? 2.0 : 1.0);
+  const double limit_bytes = config.memory_limit > 0 ? config.memory_limit * gib
+                                                     : 0.75 * PhysicalMemoryBytes();
+  char sizes[160];
+  std::snprintf(sizes, sizeof sizes, "the %lldx%lld matrix needs %.2f GiB, Memory_limit %.2f GiB%s",
+                static_cast<long long>(n), static_cast<long long>(n), dense_bytes / gib,
+                limit_bytes / gib, config.memory_limit > 0 ? "" : " (3/4 of the RAM)");
+  if (config.approximate_search == 1) {
+    result.bounded = true;
+    result.mode_reason = "bounded (Approximate_search 1)";
+  } else if (config.matrix_mode == 2) {
+    result.bounded = true;
+    result.mode_reason = "bounded (Matrix_mode 2)";
+  } else if (config.matrix_mode == 1) {
+    result.mode_reason = std::string("dense (Matrix_mode 1; ") + sizes + ")";
+  } else {
+    result.bounded = dense_bytes > limit_bytes;
+    result.mode_reason = std::string(result.bounded ? "bounded" : "dense") + " (Matrix_mode 0: " +
+                         sizes + ")";
+  }
+  if (result.bounded && config.matches_name.empty())
+    throw InputError("Matches_name: empty, but the run is " + result.mode_reason +
+                     " and keeps only matches; expected a .npy or .csv path (or a larger "
+                     "Memory_limit for the dense matrix)");
+
+  if (result.bounded) {
+    for (const char* key : {"Txt_name", "Npy_name", "Png_name", "Png_threshold_name"}) {
+      const std::string& v = std::string(key) == "Txt_name"  ? config.txt_name
+                             : std::string(key) == "Npy_name" ? config.npy_name
+                             : std::string(key) == "Png_name" ? config.png_name
+                                                              : config.png_threshold_name;
+      if (!v.empty())
+        result.notes.push_back(std::string(key) + ": not written: the run is bounded and "
+                               "keeps no dense matrix (see Matches_name)");
+    }
+    t = Clock::now();
+    result.timings.pairs =
+        static_cast<std::int64_t>(block.query_count) * block.reference_count;
+    progress.Begin("matching", block.query_count, "queries (bounded: tiles of rows)");
+    BoundedOptions options;
+    options.sequence_length = config.image_sequences;
+    options.direction = direction;
+    options.threads = config.threads;
+    if (config.approximate_search == 1) {
+      result.matches = ApproximateMatches(descriptors, block, rules, options,
+                                          config.approximate_checks, result.max_distance);
+    } else {
+      result.matches = BoundedMatches(descriptors, block, rules, options, result.max_distance,
+                                      [&](int done, int) { progress.Update(done); });
+    }
+    progress.End();
+    result.timings.match_seconds = SecondsSince(t);
+    result.timings.total_seconds = SecondsSince(run_start);
+    return result;
+  }
+
+  // Dense: every frame against every frame of the concatenated traversals, as the original.
+  t = Clock::now();
   result.timings.pairs = n * (n - 1) / 2;
   progress.Begin("matching", n * n, "cells");
   const PairProgress on_pairs = [&](std::int64_t done, std::int64_t) { progress.Update(done); };
@@ -131,16 +207,15 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
 
   // Sequences, Eq. 5, Eq. 9.
   t = Clock::now();
-  std::vector<int> starts;
-  for (const auto& tr : result.traversals) starts.push_back(tr.first_row);
-  SequenceDistancesInPlace(distances, config.image_sequences, starts, starts,
-                           static_cast<SequenceDirection>(config.sequence_direction),
+  SequenceDistancesInPlace(distances, config.image_sequences, starts, starts, direction,
                            config.threads);
   result.normalized = distances;
   distances.release();
   result.max_distance = NormalizeByMax(result.normalized);
   if (config.threshold >= 0.0)
     result.thresholded = ThresholdMatrix(result.normalized, static_cast<float>(config.threshold));
+  if (!config.matches_name.empty())
+    result.matches = MatchesFromMatrix(result.normalized, block, rules);
   result.timings.sequence_seconds = SecondsSince(t);
   result.timings.total_seconds = SecondsSince(run_start);
   return result;
@@ -168,16 +243,17 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
   auto encode = [&](const std::string& key, const std::string& path, auto make) {
     pending.push_back({key, path, std::async(std::launch::async, make)});
   };
-  if (!config.txt_name.empty())
+  const bool dense = !result.bounded;  // bounded runs keep no matrix: only Matches_name
+  if (dense && !config.txt_name.empty())
     encode("Txt_name", config.txt_name, [&] {
       return EncodeText(result.thresholded.empty() ? cv::Mat(result.normalized)
                                                    : cv::Mat(result.thresholded));
     });
-  if (!config.png_name.empty())
+  if (dense && !config.png_name.empty())
     encode("Png_name", config.png_name,
            [&] { return EncodePng(ColorizeMatrix(result.normalized, config.matrix_color)); });
   const std::string threshold_png = ThresholdPngPath(config);
-  if (!threshold_png.empty()) {
+  if (dense && !threshold_png.empty()) {
     encode(config.png_threshold_name.empty() ? "Png_name" : "Png_threshold_name", threshold_png,
            [&] {
              cv::Mat1f binary;
@@ -186,7 +262,7 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
            });
   }
   OutputBatch batch;
-  if (!config.npy_name.empty()) {
+  if (dense && !config.npy_name.empty()) {
     // Written from the matrix itself while the other outputs are being encoded.
     const std::string header = NpyHeader(result.normalized.rows, result.normalized.cols);
     std::vector<std::string_view> parts = {header};
@@ -196,6 +272,11 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
     batch.Stage("Npy_name", config.npy_name, parts);
   }
   for (Pending& p : pending) batch.Stage(p.key, p.path, p.bytes.get());
+  if (!config.matches_name.empty()) {
+    const bool csv = config.matches_name.size() >= 4 &&
+                     config.matches_name.compare(config.matches_name.size() - 4, 4, ".csv") == 0;
+    batch.Stage("Matches_name", config.matches_name, EncodeMatches(result.matches, csv));
+  }
   if (evaluation != nullptr && !config.evaluation_name.empty())
     StageEvaluation(batch, "Evaluation_name", config.evaluation_name, *evaluation,
                     {&result.normalized});

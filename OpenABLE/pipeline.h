@@ -8,6 +8,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "OpenABLE/bounded.h"
 #include "OpenABLE/progress.h"
 #include "config/config.h"
 
@@ -45,6 +46,10 @@ struct RunResult {
   cv::Mat1f normalized;               // M' of Eq. 5 (N x N over the concatenated traversals)
   float max_distance = 0;             // max(M), the divisor of Eq. 5
   cv::Mat1b thresholded;              // M'' of Eq. 9; empty when Threshold is -1
+  bool bounded = false;               // Matrix_mode: the bounded mode ran (no dense matrix)
+  std::string mode_reason;            // which mode and why, one line
+  std::vector<std::string> notes;     // outputs asked for but not possible in this mode
+  std::vector<Match> matches;         // kept matches (bounded mode, or Matches_name asked)
   RunTimings timings;
 };
 

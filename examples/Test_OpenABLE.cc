@@ -65,8 +65,15 @@ void PrintReport(const openable::Config& c, const openable::RunResult& r,
     for (const auto& s : t.skipped) std::cout << "    skipped: " << s << "\n";
   }
   const auto& tm = r.timings;
-  std::cout << "  matrix: " << r.normalized.rows << "x" << r.normalized.cols
-            << ", max distance " << r.max_distance << " (Eq. 5 divisor)";
+  std::cout << "  mode: " << r.mode_reason << "\n";
+  if (r.bounded) {
+    std::cout << "  bounded: " << r.matches.size() << " matches kept (Best_matches "
+              << c.best_matches << ", Band_width " << c.band_width << "), max distance "
+              << r.max_distance << " (Eq. 5 divisor over the cells computed)";
+  } else {
+    std::cout << "  matrix: " << r.normalized.rows << "x" << r.normalized.cols
+              << ", max distance " << r.max_distance << " (Eq. 5 divisor)";
+  }
   if (!r.thresholded.empty())
     std::cout << ", threshold " << c.threshold << ": "
               << r.thresholded.total() - static_cast<size_t>(cv::countNonZero(r.thresholded))
@@ -166,6 +173,13 @@ int main(int argc, char** argv) {
       evaluation->settings = openable::EvaluationSettingsFrom(config);
     }
     openable::RunResult result = openable::ComputeRun(config, progress);
+    for (const std::string& note : result.notes) std::cerr << "Test_OpenABLE: note: " << note << "\n";
+    if (evaluation && result.bounded) {
+      std::cerr << "Test_OpenABLE: note: Ground_truth_type: no evaluation in bounded mode (the "
+                   "protocols need the dense matrix); evaluate Matches_name yourself or use "
+                   "Matrix_mode 1\n";
+      evaluation.reset();
+    }
     if (evaluation) {
       const auto start = std::chrono::steady_clock::now();
       openable::EvaluateMatrix(*evaluation, result.normalized, openable::LayoutOf(result),

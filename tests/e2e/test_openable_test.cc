@@ -108,6 +108,55 @@ TEST(TestOpenABLE, OverridesRangeAndSingleSequence) {
   EXPECT_NE(o.out.find("40 frames"), std::string::npos) << o.out;
 }
 
+// Auto mode with a tiny Memory_limit: the run says it is bounded and why, writes the matches
+// and no matrix, and its best matches equal those the dense run writes from its matrix.
+TEST(TestOpenABLE, AutoModeSwitchesToBoundedAndAgreesWithDense) {
+  const std::string dir = testing::TempDir();
+  const std::vector<std::string> common = {SampleConfig(dir), "--set", "Ground_truth_type=",
+                                           "--set", "Evaluation_name=", "--set", "Best_matches=3"};
+  std::vector<std::string> bounded = common;
+  for (const char* a : {"--set", "Memory_limit=0.0001", "--set", "Matches_name=bounded.csv"})
+    bounded.push_back(a);
+  const Outcome b = RunProgram(testing::TestOpenableExe(), bounded, dir);
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_NE(b.out.find("mode: bounded (Matrix_mode 0: the 600x600 matrix needs"), std::string::npos)
+      << b.out;
+  EXPECT_NE(b.err.find("Png_name: not written: the run is bounded"), std::string::npos) << b.err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out/matrix.npy"));
+  std::vector<std::string> dense = common;
+  for (const char* a : {"--set", "Matrix_mode=1", "--set", "Matches_name=dense.csv"})
+    dense.push_back(a);
+  const Outcome d = RunProgram(testing::TestOpenableExe(), dense, dir);
+  ASSERT_EQ(d.status, 0) << d.err;
+  // Same queries, references and ranks; distances differ only by the Eq. 5 divisor (the
+  // bounded run computes the cross block only), so compare everything but that column.
+  auto columns = [](const std::string& csv) {
+    std::string out;
+    std::istringstream in(csv);
+    for (std::string line; std::getline(in, line);) {
+      const auto a = line.find(','), b = line.find(',', a + 1), c = line.rfind(',');
+      out += line.substr(0, b) + line.substr(c) + "\n";
+      (void)a;
+    }
+    return out;
+  };
+  const std::string bc = ReadAll(dir + "/bounded.csv"), dc = ReadAll(dir + "/dense.csv");
+  EXPECT_EQ(std::count(bc.begin(), bc.end(), '\n'), 1 + 300 * 3);
+  EXPECT_EQ(columns(bc), columns(dc));
+}
+
+TEST(TestOpenABLE, BoundedModeNeedsAMatchesFile) {
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunProgram(testing::TestOpenableExe(),
+                               {SampleConfig(dir), "--set", "Matrix_mode=2"}, dir);
+  EXPECT_EQ(o.status, 1);
+  EXPECT_TRUE(OneLine(o.err)) << o.err;
+  EXPECT_NE(o.err.find("Test_OpenABLE: error: Matches_name: empty, but Matrix_mode 2 (bounded) "
+                       "keeps only matches; expected a .npy or .csv path"),
+            std::string::npos)
+      << o.err;
+}
+
 TEST(TestOpenABLE, HelpListsEveryKey) {
   const std::string dir = testing::TempDir();
   const Outcome o = RunProgram(testing::TestOpenableExe(), {"--help"}, dir);

@@ -1,0 +1,116 @@
+// Approximate candidate search (Approximate_search 1): FLANN finds the candidates of each
+// query, LSH for binary descriptors and randomised k-d trees for vector ones; the candidates
+// are then scored by the exact sequence sum. Declared in OpenABLE/bounded.h.
+#include <flann/flann.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <thread>
+
+#include "OpenABLE/bounded.h"
+#include "matching/distances.h"
+
+namespace openable {
+namespace {
+
+float PairDistance(const cv::Mat& d, int a, int b) {
+  if (d.depth() == CV_8U)
+    return static_cast<float>(HammingDistance(d.ptr<std::uint8_t>(a), d.ptr<std::uint8_t>(b), d.cols));
+  const float* x = d.ptr<float>(a);
+  const float* y = d.ptr<float>(b);
+  double s = 0;
+  for (int k = 0; k < d.cols; ++k) s += (static_cast<double>(x[k]) - y[k]) * (x[k] - y[k]);
+  return static_cast<float>(std::sqrt(s));
+}
+
+// Candidate lists (reference numbers) of every query, k' per query.
+std::vector<std::vector<size_t>> Candidates(const cv::Mat& refs, const cv::Mat& queries, int k,
+                                            int checks, int threads) {
+  std::vector<std::vector<size_t>> indices;
+  flann::SearchParams params(checks);
+  params.cores = threads;
+  if (refs.depth() == CV_8U) {
+    cv::Mat r = refs.clone(), q = queries.clone();  // continuous rows for flann::Matrix
+    flann::Matrix<unsigned char> fr(r.data, static_cast<size_t>(r.rows), static_cast<size_t>(r.cols));
+    flann::Matrix<unsigned char> fq(q.data, static_cast<size_t>(q.rows), static_cast<size_t>(q.cols));
+    // 12 tables of 20-bit keys, multi-probe level 2: FLANN's usual setting for binary
+    // descriptors of 256 bits (docs/benchmarks.md has the recall it gives here).
+    flann::Index<flann::Hamming<unsigned char>> index(fr, flann::LshIndexParams(12, 20, 2));
+    index.buildIndex();
+    std::vector<std::vector<unsigned int>> dist;
+    index.knnSearch(fq, indices, dist, static_cast<size_t>(k), params);
+  } else {
+    cv::Mat r = refs.clone(), q = queries.clone();
+    flann::Matrix<float> fr(r.ptr<float>(), static_cast<size_t>(r.rows), static_cast<size_t>(r.cols));
+    flann::Matrix<float> fq(q.ptr<float>(), static_cast<size_t>(q.rows), static_cast<size_t>(q.cols));
+    flann::Index<flann::L2<float>> index(fr, flann::KDTreeIndexParams(4));
+    index.buildIndex();
+    std::vector<std::vector<float>> dist;
+    index.knnSearch(fq, indices, dist, static_cast<size_t>(k), params);
+  }
+  return indices;
+}
+
+}  // namespace
+
+std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlock& block,
+                                      const KeepRules& rules, const BoundedOptions& options,
+                                      int checks, float& max_distance) {
+  const int L = options.sequence_length;
+  const int threads = options.threads > 0
+                          ? options.threads
+                          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const bool reverse = options.direction == SequenceDirection::kReverse;
+  const bool both = options.direction == SequenceDirection::kBoth;
+  const int m = block.reference_count;
+  // One sequence: the candidates must lie Exclusion frames back; ask FLANN for that many more.
+  const int k = std::max(1, rules.best);
+  const int asked = std::min(m, block.one_traversal ? k + 2 * rules.exclusion : k);
+  const cv::Mat refs = descriptors.rowRange(block.reference_first, block.reference_first + m);
+  const cv::Mat queries =
+      descriptors.rowRange(block.query_first, block.query_first + block.query_count);
+  const std::vector<std::vector<size_t>> cand = Candidates(refs, queries, asked, checks, threads);
+
+  // The sequence sum of one cell, as SequenceDistances defines it (scaled to L terms).
+  auto score = [&](int q, int j, bool rev) {
+    const int tq = q;  // steps back within the query traversal
+    const int tj = rev ? m - 1 - j : j;
+    const int c = std::min(L, std::min(tq, tj) + 1);
+    double sum = 0;
+    for (int s = 0; s < c; ++s)
+      sum += PairDistance(descriptors, block.query_first + q - s,
+                          block.reference_first + (rev ? j + s : j - s));
+    return static_cast<float>(sum * L / c);
+  };
+  std::vector<std::vector<Match>> per_query(static_cast<size_t>(block.query_count));
+  cv::parallel_for_(cv::Range(0, block.query_count), [&](const cv::Range& range) {
+    for (int q = range.start; q < range.end; ++q) {
+      std::vector<std::pair<float, int>> scored;
+      for (size_t id : cand[static_cast<size_t>(q)]) {
+        const int j = static_cast<int>(id);
+        if (j < 0 || j >= m) continue;
+        if (block.one_traversal && j > q - rules.exclusion) continue;
+        float s = both ? std::min(score(q, j, false), score(q, j, true)) : score(q, j, reverse);
+        scored.emplace_back(s, j);
+      }
+      std::sort(scored.begin(), scored.end());
+      if (static_cast<int>(scored.size()) > k) scored.resize(static_cast<size_t>(k));
+      auto& out = per_query[static_cast<size_t>(q)];
+      for (size_t r = 0; r < scored.size(); ++r)
+        out.push_back({q, scored[r].second, scored[r].first, static_cast<int>(r + 1)});
+    }
+  });
+  std::vector<Match> kept;
+  float max_seen = 0.0f;
+  for (auto& v : per_query)
+    for (Match& x : v) {
+      max_seen = std::max(max_seen, x.distance);
+      kept.push_back(x);
+    }
+  max_distance = max_seen;
+  if (max_seen > 0.0f)
+    for (Match& x : kept) x.distance /= max_seen;
+  return kept;
+}
+
+}  // namespace openable

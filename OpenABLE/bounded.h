@@ -1,0 +1,86 @@
+// Memory-bounded matching (Matrix_mode 2, or auto when the dense matrix would not fit): the
+// matrix is computed in tiles of rows, sequence sums included, and only the matches the user
+// asked for are kept: the Best_matches smallest distances of every query and the cells of the
+// band |i - j| <= Band_width. Memory: one tile (about 256 MB) plus the kept matches, whatever N.
+//
+// Rows and columns: with two traversals, the queries are the frames of the second
+// (Images_path_2) and the references those of the first (Images_path), and only that block is
+// computed; with one traversal every frame is matched against every frame, and the k best of
+// frame q are taken among frames at least Exclusion frames earlier (as the evaluation does).
+//
+// Distances are normalised (Eq. 5) by the largest distance computed. Where every cell is
+// computed the same matches come from the dense matrix (MatchesFromMatrix), which the tests
+// use as the reference.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "matching/sequence.h"
+
+namespace openable {
+
+struct Match {
+  int query = 0;      // frame number in the query traversal
+  int reference = 0;  // frame number in the reference traversal
+  float distance = 0; // normalised (M')
+  int rank = 0;       // 1 = best of its query, ..., k; 0 = kept by the band only
+};
+
+struct KeepRules {
+  int best = 10;          // k
+  int band = -1;          // |i - j| <= band; -1 none
+  int exclusion = 100;    // one traversal: candidates at least this many frames earlier
+  bool one_traversal = true;
+};
+
+// Which rows and columns of the concatenated descriptors are matched.
+struct MatchBlock {
+  int query_first = 0, query_count = 0;          // rows of the queries
+  int reference_first = 0, reference_count = 0;  // rows of the references
+  bool one_traversal = true;
+};
+
+// The block of a run whose traversals start at `starts` (1 or 2 traversals) over `n` frames.
+MatchBlock BlockOf(const std::vector<int>& starts, int n);
+
+// The kept matches of one row of (unnormalised) distances `s` of query q; appended to `out`.
+void KeepRow(const float* s, int references, int q, const KeepRules& rules,
+             std::vector<Match>& out);
+
+// The matches kept from a dense normalised matrix (rows and columns of the whole run).
+std::vector<Match> MatchesFromMatrix(const cv::Mat1f& normalized, const MatchBlock& block,
+                                     const KeepRules& rules);
+
+struct BoundedOptions {
+  int sequence_length = 1;
+  SequenceDirection direction = SequenceDirection::kForward;
+  int threads = 0;
+  std::int64_t tile_bytes = std::int64_t{256} << 20;
+};
+
+// Computes the block tile by tile from the descriptors (CV_8U: Hamming, CV_32F: L2) and keeps
+// the matches; `max_distance` receives the Eq. 5 divisor. progress(done rows, rows).
+std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& block,
+                                  const KeepRules& rules, const BoundedOptions& options,
+                                  float& max_distance,
+                                  const std::function<void(int, int)>& progress = {});
+
+// Approximate_search: FLANN (LSH for CV_8U rows, 4 randomised k-d trees for CV_32F) gives
+// Best_matches candidates per query (with one traversal, Best_matches + 2 x Exclusion, of
+// which those Exclusion frames back are kept), each scored by its exact sequence sum; the
+// k best by that score are kept. Normalised by the largest score computed. `checks`: FLANN
+// leaves checked per query.
+std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlock& block,
+                                      const KeepRules& rules, const BoundedOptions& options,
+                                      int checks, float& max_distance);
+
+// Bytes of the matches file: .npy (structured array: query, reference int32; distance
+// float32; rank int32) or .csv (header "query,reference,distance,rank").
+std::string EncodeMatches(const std::vector<Match>& matches, bool csv);
+
+}  // namespace openable

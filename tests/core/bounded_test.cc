@@ -1,0 +1,174 @@
+#include "OpenABLE/bounded.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <numeric>
+#include <random>
+
+#include "matching/distances.h"
+#include "matching/normalize.h"
+#include "matching/sequence.h"
+
+namespace openable {
+namespace {
+
+cv::Mat RandomBinary(int rows, int cols, unsigned seed) {
+  cv::Mat m(rows, cols, CV_8U);
+  cv::RNG rng(seed);
+  rng.fill(m, cv::RNG::UNIFORM, 0, 256);
+  return m;
+}
+
+// Brute force: every cell, sorted by (distance, reference), the first k kept.
+std::vector<Match> SortedRow(const cv::Mat1f& s, int row, int q, int first, int count,
+                             const KeepRules& rules) {
+  std::vector<std::pair<float, int>> all;
+  for (int j = 0; j < count; ++j)
+    if (!rules.one_traversal || j <= q - rules.exclusion) all.emplace_back(s(row, first + j), j);
+  std::sort(all.begin(), all.end());
+  std::vector<Match> out;
+  for (int r = 0; r < std::min<int>(rules.best, static_cast<int>(all.size())); ++r)
+    out.push_back({q, all[r].second, all[r].first, r + 1});
+  for (int j = std::max(0, q - rules.band); rules.band >= 0 && j <= std::min(count - 1, q + rules.band); ++j)
+    if (std::none_of(out.begin(), out.end(), [&](const Match& m) { return m.rank > 0 && m.reference == j; }))
+      out.push_back({q, j, s(row, first + j), 0});
+  return out;
+}
+
+void ExpectSame(const std::vector<Match>& a, const std::vector<Match>& b, float scale_b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].query, b[k].query) << k;
+    EXPECT_EQ(a[k].reference, b[k].reference) << k;
+    EXPECT_EQ(a[k].rank, b[k].rank) << k;
+    EXPECT_NEAR(a[k].distance, b[k].distance * scale_b, 1e-5) << k;
+  }
+}
+
+// The tiled run against the dense matrix computed by the separate, tested pieces, then
+// selected by brute force: one traversal (exclusion) and two (cross block), several L and
+// both directions, with tiles of a few rows so that many tile borders are crossed.
+TEST(BoundedMatches, EqualsBruteForceSelectionOfTheDenseMatrix) {
+  const cv::Mat d = RandomBinary(150, 32, 3);
+  for (int traversals : {1, 2}) {
+    const std::vector<int> starts = traversals == 1 ? std::vector<int>{0} : std::vector<int>{0, 70};
+    const MatchBlock block = BlockOf(starts, d.rows);
+    KeepRules rules;
+    rules.best = 4;
+    rules.band = 2;
+    rules.exclusion = 10;
+    rules.one_traversal = block.one_traversal;
+    for (int L : {1, 3, 8}) {
+      for (auto dir : {SequenceDirection::kForward, SequenceDirection::kReverse}) {
+        SCOPED_TRACE("traversals " + std::to_string(traversals) + " L " + std::to_string(L));
+        // Dense: the block of the full matrix, with sums restricted to the block's traversals.
+        cv::Mat1f full = HammingDistances(d);
+        SequenceDistancesInPlace(full, L, starts, starts, dir);
+        std::vector<Match> expected;
+        float block_max = 0;
+        for (int q = 0; q < block.query_count; ++q) {
+          const int row = block.query_first + q;
+          for (int j = 0; j < block.reference_count; ++j)
+            block_max = std::max(block_max, full(row, block.reference_first + j));
+          for (const Match& m : SortedRow(full, row, q, block.reference_first,
+                                          block.reference_count, rules))
+            expected.push_back(m);
+        }
+        BoundedOptions options;
+        options.sequence_length = L;
+        options.direction = dir;
+        options.tile_bytes = 7 * block.reference_count * 4;  // a few rows per tile
+        float max_distance = 0;
+        const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
+        EXPECT_FLOAT_EQ(max_distance, block_max);
+        ExpectSame(got, expected, 1.0f / block_max);
+      }
+    }
+  }
+}
+
+TEST(MatchesFromMatrix, SameSelectionAsBoundedOnOneTraversal) {
+  const cv::Mat d = RandomBinary(90, 32, 4);
+  const MatchBlock block = BlockOf({0}, d.rows);
+  KeepRules rules;
+  rules.best = 3;
+  rules.exclusion = 5;
+  cv::Mat1f full = HammingDistances(d);
+  SequenceDistancesInPlace(full, 4, {0}, {0});
+  NormalizeByMax(full);  // one traversal: the block is the whole matrix, same divisor
+  BoundedOptions options;
+  options.sequence_length = 4;
+  options.tile_bytes = 5 * d.rows * 4;
+  float max_distance = 0;
+  ExpectSame(BoundedMatches(d, block, rules, options, max_distance),
+             MatchesFromMatrix(full, block, rules), 1.0f);
+}
+
+TEST(BoundedMatches, VectorDescriptorsUseL2) {
+  cv::Mat d(60, 16, CV_32F);
+  cv::RNG(5).fill(d, cv::RNG::UNIFORM, 0.0, 1.0);
+  const MatchBlock block = BlockOf({0, 30}, d.rows);
+  KeepRules rules;
+  rules.best = 2;
+  rules.one_traversal = false;
+  float max_distance = 0;
+  const std::vector<Match> got = BoundedMatches(d, block, rules, {}, max_distance);
+  ASSERT_EQ(got.size(), 60u);
+  for (const Match& m : got) {
+    const float direct = static_cast<float>(cv::norm(d.row(30 + m.query), d.row(m.reference)));
+    EXPECT_NEAR(m.distance * max_distance, direct, 1e-4);
+  }
+}
+
+TEST(EncodeMatches, NpyRecordsAndCsvText) {
+  const std::vector<Match> m = {{1, 2, 0.5f, 1}, {3, 4, 0.25f, 0}};
+  const std::string csv = EncodeMatches(m, true);
+  EXPECT_EQ(csv, "query,reference,distance,rank\n1,2,0.5,1\n3,4,0.25,0\n");
+  const std::string npy = EncodeMatches(m, false);
+  ASSERT_EQ(npy.size() % 16, 0u);  // 64-byte aligned header, 16-byte records
+  const size_t header = npy.size() - 32;
+  EXPECT_EQ(header % 64, 0u);
+  EXPECT_NE(npy.find("('distance', '<f4')"), std::string::npos);
+  EXPECT_NE(npy.find("'shape': (2,)"), std::string::npos);
+  int q = 0;
+  float dist = 0;
+  std::memcpy(&q, npy.data() + header + 16, 4);
+  std::memcpy(&dist, npy.data() + header + 16 + 8, 4);
+  EXPECT_EQ(q, 3);
+  EXPECT_EQ(dist, 0.25f);
+}
+
+// FLANN candidates on planted near-duplicates: every query's duplicate found first, and every
+// kept distance is the exact one of its pair.
+TEST(ApproximateMatches, FindsPlantedDuplicatesWithExactScores) {
+  const int n = 2000;
+  cv::Mat refs = RandomBinary(n, 32, 6);
+  cv::Mat queries = refs.clone();
+  std::mt19937 rng(7);
+  for (int i = 0; i < n; ++i)
+    for (int f = 0; f < 6; ++f) {
+      const int bit = static_cast<int>(rng() % 256);
+      queries.at<std::uint8_t>(i, bit / 8) ^= static_cast<std::uint8_t>(1 << (bit % 8));
+    }
+  cv::Mat d;
+  cv::vconcat(refs, queries, d);
+  const MatchBlock block = BlockOf({0, n}, d.rows);
+  KeepRules rules;
+  rules.best = 3;
+  rules.one_traversal = false;
+  float max_distance = 0;
+  const std::vector<Match> got = ApproximateMatches(d, block, rules, {}, 128, max_distance);
+  int found = 0;
+  for (const Match& m : got) {
+    const float exact = static_cast<float>(HammingDistance(d.ptr<std::uint8_t>(n + m.query),
+                                                           d.ptr<std::uint8_t>(m.reference), 32));
+    EXPECT_NEAR(m.distance * max_distance, exact, 1e-3);
+    if (m.rank == 1 && m.reference == m.query) ++found;
+  }
+  EXPECT_GE(found, 0.95 * n);
+}
+
+}  // namespace
+}  // namespace openable
