@@ -364,6 +364,22 @@ void HammingReferences::Distances(const std::uint8_t* query, float* out) const {
   Current().kernel(words, packed_->rows, 0, packed_->rows.blocks, out);
 }
 
+void HammingReferences::DistancesInto(const cv::Mat& queries, cv::Mat1f& out,
+                                      int threads) const {
+  if (queries.depth() != CV_8U || queries.cols != bytes_)
+    throw std::logic_error("HammingReferences::DistancesInto: queries of another width/type");
+  const int n = queries.rows, m = Size();
+  if (out.rows != n || out.cols != m) out = LargeMatrix(n, m);
+  if (n == 0 || m == 0) return;
+  const std::vector<std::uint64_t> qwords = RowWords(queries);
+  constexpr int kRowsPerTask = 16;
+  const int tasks = (n + kRowsPerTask - 1) / kRowsPerTask;
+  ParallelRows(tasks, threads, {}, [](int) -> std::int64_t { return 0; }, 0, [&](int t) {
+    const int r0 = t * kRowsPerTask, r1 = std::min(n, r0 + kRowsPerTask);
+    QueryRange(qwords, r0, r1, packed_->rows, out.ptr<float>(r0), out.step1());
+  });
+}
+
 const char* HammingKernelName() { return Current().name; }
 
 bool ForceHammingKernel(HammingKernel kernel) {

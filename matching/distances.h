@@ -46,6 +46,9 @@ class HammingReferences {
   int Size() const;
   // out[j] = bits differing between `query` and reference j, for j in [0, Size()).
   void Distances(const std::uint8_t* query, float* out) const;
+  // Every row of `queries` (CV_8U, same width) against every reference, into `out` (resized
+  // to queries.rows x Size(), reused when already that size). Blocks of rows in parallel.
+  void DistancesInto(const cv::Mat& queries, cv::Mat1f& out, int threads = 0) const;
 
  private:
   struct Packed;
