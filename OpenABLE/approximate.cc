@@ -1,13 +1,12 @@
-// Approximate candidate search (Approximate_search 1): FLANN finds the candidates of each
+// Approximate candidate search (Approximate_search 1): FLANN (OpenCV's copy) finds the candidates of each
 // query, LSH for binary descriptors and randomised k-d trees for vector ones; the candidates
 // are then scored by the exact sequence sum. Declared in OpenABLE/bounded.h.
-#include <flann/flann.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <thread>
 
 #include "OpenABLE/bounded.h"
+#include "matching/approximate.h"
 #include "matching/distances.h"
 
 namespace openable {
@@ -23,32 +22,20 @@ float PairDistance(const cv::Mat& d, int a, int b) {
   return static_cast<float>(std::sqrt(s));
 }
 
-// Candidate lists (reference numbers) of every query, k' per query.
-std::vector<std::vector<size_t>> Candidates(const cv::Mat& refs, const cv::Mat& queries, int k,
-                                            int checks, int threads) {
-  std::vector<std::vector<size_t>> indices;
-  flann::SearchParams params(checks);
-  params.cores = threads;
-  if (refs.depth() == CV_8U) {
-    cv::Mat r = refs.clone(), q = queries.clone();  // continuous rows for flann::Matrix
-    flann::Matrix<unsigned char> fr(r.data, static_cast<size_t>(r.rows), static_cast<size_t>(r.cols));
-    flann::Matrix<unsigned char> fq(q.data, static_cast<size_t>(q.rows), static_cast<size_t>(q.cols));
-    // 12 tables of 20-bit keys, multi-probe level 2: FLANN's usual setting for binary
-    // descriptors of 256 bits (docs/benchmarks.md has the recall it gives here).
-    flann::Index<flann::Hamming<unsigned char>> index(fr, flann::LshIndexParams(12, 20, 2));
-    index.buildIndex();
-    std::vector<std::vector<unsigned int>> dist;
-    index.knnSearch(fq, indices, dist, static_cast<size_t>(k), params);
-  } else {
-    cv::Mat r = refs.clone(), q = queries.clone();
-    flann::Matrix<float> fr(r.ptr<float>(), static_cast<size_t>(r.rows), static_cast<size_t>(r.cols));
-    flann::Matrix<float> fq(q.ptr<float>(), static_cast<size_t>(q.rows), static_cast<size_t>(q.cols));
-    flann::Index<flann::L2<float>> index(fr, flann::KDTreeIndexParams(4));
-    index.buildIndex();
-    std::vector<std::vector<float>> dist;
-    index.knnSearch(fq, indices, dist, static_cast<size_t>(k), params);
-  }
-  return indices;
+// Candidate lists (reference numbers) of every query, k per query: OpenCV's FLANN through
+// matching/approximate.h (seeded, so two runs give the same candidates; libflann cannot be).
+std::vector<std::vector<int>> Candidates(const cv::Mat& refs, const cv::Mat& queries, int k,
+                                         int checks, int threads) {
+  ApproximateOptions options;
+  options.k = k;
+  options.checks = checks;
+  options.threads = threads;
+  const ApproximateIndex index(refs, options);
+  const CandidateLists lists = index.Search(queries);
+  std::vector<std::vector<int>> out(lists.size());
+  for (size_t q = 0; q < lists.size(); ++q)
+    for (const Candidate& c : lists[q]) out[q].push_back(c.reference);
+  return out;
 }
 
 }  // namespace
@@ -69,7 +56,7 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
   const cv::Mat refs = descriptors.rowRange(block.reference_first, block.reference_first + m);
   const cv::Mat queries =
       descriptors.rowRange(block.query_first, block.query_first + block.query_count);
-  const std::vector<std::vector<size_t>> cand = Candidates(refs, queries, asked, checks, threads);
+  const std::vector<std::vector<int>> cand = Candidates(refs, queries, asked, checks, threads);
 
   // The sequence sum of one cell, as SequenceDistances defines it (scaled to L terms).
   auto score = [&](int q, int j, bool rev) {
@@ -86,8 +73,7 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
   cv::parallel_for_(cv::Range(0, block.query_count), [&](const cv::Range& range) {
     for (int q = range.start; q < range.end; ++q) {
       std::vector<std::pair<float, int>> scored;
-      for (size_t id : cand[static_cast<size_t>(q)]) {
-        const int j = static_cast<int>(id);
+      for (const int j : cand[static_cast<size_t>(q)]) {
         if (j < 0 || j >= m) continue;
         if (block.one_traversal && j > q - rules.exclusion) continue;
         float s = both ? std::min(score(q, j, false), score(q, j, true)) : score(q, j, reverse);

@@ -183,7 +183,8 @@ const std::vector<Binding>& Bindings() {
        "(docs/benchmarks.md). No band.",
        true},
       {"Approximate_checks", "Scale", &Config::approximate_checks, 1, 100000,
-       "FLANN leaves checked per query (more: better recall, slower).", true},
+       "FLANN k-d trees (vector descriptors): references examined per query (more: better "
+       "recall, slower; LSH for binary descriptors ignores it).", true},
       // Evaluation (docs/evaluation.md)
       {"Ground_truth_type", "Evaluation", &Config::ground_truth_type, 0, 0,
        "Empty: no evaluation. matrix (0/1 text, image, .npy), pairs (CSV or whitespace "

@@ -55,7 +55,7 @@ struct Config {
   int band_width = -1;                // also keep |i - j| <= this (frames); -1 none
   std::string matches_name;           // matches file (.npy or .csv); empty = not written
   int approximate_search = 0;         // 1: FLANN candidates instead of every pair (bounded)
-  int approximate_checks = 128;       // FLANN checks per query
+  int approximate_checks = 512;       // FLANN checks per query
   // --- Evaluation (new) ----------------------------------------------------------------------
   std::string ground_truth_type;      // "", matrix, pairs, aligned, kitti, tum, positions
   std::string ground_truth;           // ground-truth file (poses of the reference, for poses)

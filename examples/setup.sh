@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make pkg-config libopencv-dev libopencv-contrib-dev libeigen3-dev
-          libflann-dev libopenimageio-dev libgtest-dev libgmock-dev libbenchmark-dev
+          libopenimageio-dev openimageio-tools libgtest-dev libgmock-dev libbenchmark-dev
           python3-numpy)
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,443 @@
+#include "matching/approximate.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+namespace openable {
+namespace {
+
+cv::Mat RandomBytes(int rows, int cols, unsigned seed) {
+  std::mt19937 rng(seed);
+  cv::Mat m(rows, cols, CV_8U);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) m.at<std::uint8_t>(i, j) = static_cast<std::uint8_t>(rng());
+  return m;
+}
+
+cv::Mat RandomFloats(int rows, int cols, unsigned seed, float offset = 0, float sigma = 1) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> normal(0.0f, sigma);
+  cv::Mat m(rows, cols, CV_32F);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) m.at<float>(i, j) = offset + normal(rng);
+  return m;
+}
+
+// Row i of the result: row source[i] of `refs` with `bits` distinct bits flipped.
+cv::Mat FlipBits(const cv::Mat& refs, const std::vector<int>& source, int bits, unsigned seed) {
+  std::mt19937 rng(seed);
+  cv::Mat out(static_cast<int>(source.size()), refs.cols, CV_8U);
+  std::vector<int> positions(static_cast<size_t>(refs.cols) * 8);
+  for (size_t i = 0; i < positions.size(); ++i) positions[i] = static_cast<int>(i);
+  for (int i = 0; i < out.rows; ++i) {
+    refs.row(source[static_cast<size_t>(i)]).copyTo(out.row(i));
+    std::shuffle(positions.begin(), positions.end(), rng);
+    for (int b = 0; b < bits; ++b)
+      out.at<std::uint8_t>(i, positions[static_cast<size_t>(b)] / 8) ^=
+          static_cast<std::uint8_t>(1u << (positions[static_cast<size_t>(b)] % 8));
+  }
+  return out;
+}
+
+// Row i: row source[i] of `refs` plus Gaussian noise of deviation `sigma`.
+cv::Mat AddNoise(const cv::Mat& refs, const std::vector<int>& source, float sigma, unsigned seed) {
+  cv::Mat out(static_cast<int>(source.size()), refs.cols, CV_32F);
+  const cv::Mat noise = RandomFloats(out.rows, refs.cols, seed, 0, sigma);
+  for (int i = 0; i < out.rows; ++i)
+    out.row(i) = refs.row(source[static_cast<size_t>(i)]) + noise.row(i);
+  return out;
+}
+
+std::vector<int> EveryNth(int count, int step) {
+  std::vector<int> v;
+  for (int i = 0; i < count; i += step) v.push_back(i);
+  return v;
+}
+
+// Naive distances, written independently of the library: bit by bit, and a double sum.
+float NaiveDistance(const cv::Mat& refs, int r, const cv::Mat& queries, int q) {
+  if (refs.depth() == CV_8U) {
+    int bits = 0;
+    for (int k = 0; k < refs.cols; ++k)
+      for (int bit = 0; bit < 8; ++bit)
+        bits += ((refs.at<std::uint8_t>(r, k) >> bit) & 1) !=
+                ((queries.at<std::uint8_t>(q, k) >> bit) & 1);
+    return static_cast<float>(bits);
+  }
+  double s = 0;
+  for (int k = 0; k < refs.cols; ++k) {
+    const double t = static_cast<double>(refs.at<float>(r, k)) - queries.at<float>(q, k);
+    s += t * t;
+  }
+  return static_cast<float>(std::sqrt(s));
+}
+
+// The k nearest by a double loop: every pair, sorted by (distance, reference).
+CandidateLists NaiveNearest(const cv::Mat& refs, const cv::Mat& queries, int k) {
+  CandidateLists out(static_cast<size_t>(queries.rows));
+  for (int q = 0; q < queries.rows; ++q) {
+    std::vector<Candidate>& all = out[static_cast<size_t>(q)];
+    for (int r = 0; r < refs.rows; ++r) all.push_back({r, NaiveDistance(refs, r, queries, q)});
+    std::stable_sort(all.begin(), all.end(), [](const Candidate& a, const Candidate& b) {
+      return a.distance < b.distance;
+    });
+    all.resize(static_cast<size_t>(std::min(k, refs.rows)));
+  }
+  return out;
+}
+
+void ExpectSameLists(const CandidateLists& expected, const CandidateLists& actual) {
+  ASSERT_EQ(expected.size(), actual.size());
+  for (size_t q = 0; q < expected.size(); ++q) {
+    ASSERT_EQ(expected[q].size(), actual[q].size()) << "query " << q;
+    for (size_t i = 0; i < expected[q].size(); ++i) {
+      EXPECT_EQ(expected[q][i].reference, actual[q][i].reference) << "query " << q << " rank " << i;
+      EXPECT_EQ(expected[q][i].distance, actual[q][i].distance) << "query " << q << " rank " << i;
+    }
+  }
+}
+
+// Every candidate's distance is the naive distance of its pair; lists sorted by (distance,
+// reference), without repeats, at most k long.
+void ExpectExactDistances(const cv::Mat& refs, const cv::Mat& queries, const CandidateLists& lists,
+                          int k) {
+  ASSERT_EQ(lists.size(), static_cast<size_t>(queries.rows));
+  for (int q = 0; q < queries.rows; ++q) {
+    const std::vector<Candidate>& list = lists[static_cast<size_t>(q)];
+    ASSERT_LE(list.size(), static_cast<size_t>(k));
+    for (size_t i = 0; i < list.size(); ++i) {
+      ASSERT_GE(list[i].reference, 0);
+      ASSERT_LT(list[i].reference, refs.rows);
+      EXPECT_EQ(list[i].distance, NaiveDistance(refs, list[i].reference, queries, q))
+          << "query " << q << " reference " << list[i].reference;
+      if (i > 0) {
+        const bool ordered =
+            list[i - 1].distance < list[i].distance ||
+            (list[i - 1].distance == list[i].distance && list[i - 1].reference < list[i].reference);
+        EXPECT_TRUE(ordered) << "query " << q << " rank " << i;
+      }
+    }
+  }
+}
+
+bool SameLists(const CandidateLists& a, const CandidateLists& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t q = 0; q < a.size(); ++q) {
+    if (a[q].size() != b[q].size()) return false;
+    for (size_t i = 0; i < a[q].size(); ++i)
+      if (a[q][i].reference != b[q][i].reference || a[q][i].distance != b[q][i].distance)
+        return false;
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------- exact search
+
+TEST(ExactNearest, HammingMatchesDoubleLoop) {
+  // 2-byte descriptors over 300 references: many equal distances, so the tie order is tested.
+  for (int width : {2, 32, 13}) {
+    SCOPED_TRACE(width);
+    const cv::Mat refs = RandomBytes(300, width, 10 + width);
+    const cv::Mat queries = RandomBytes(40, width, 20 + width);
+    for (int k : {1, 7, 300}) {
+      SCOPED_TRACE(k);
+      for (int threads : {1, 3})
+        ExpectSameLists(NaiveNearest(refs, queries, k), ExactNearest(refs, queries, k, threads));
+    }
+  }
+}
+
+TEST(ExactNearest, L2MatchesDoubleLoop) {
+  // A large common offset makes |q|^2 + |r|^2 - 2 q.r cancel: the matrix product alone would
+  // misrank these; the exact recomputation must not. Also plain unit Gaussians, and exact
+  // duplicates of references (distance 0, ties by index).
+  for (float offset : {0.0f, 100.0f}) {
+    SCOPED_TRACE(offset);
+    for (int width : {1, 64, 300}) {
+      SCOPED_TRACE(width);
+      cv::Mat refs = RandomFloats(400, width, 30 + width, offset, 0.01f);
+      refs.row(5).copyTo(refs.row(17));
+      cv::Mat queries = RandomFloats(30, width, 40 + width, offset, 0.01f);
+      refs.row(17).copyTo(queries.row(3));
+      for (int k : {1, 10, 400}) {
+        SCOPED_TRACE(k);
+        ExpectSameLists(NaiveNearest(refs, queries, k), ExactNearest(refs, queries, k, 2));
+      }
+    }
+  }
+}
+
+TEST(ExactNearest, KLargerThanReferencesGivesThemAll) {
+  const cv::Mat refs = RandomBytes(5, 32, 1), queries = RandomBytes(3, 32, 2);
+  const CandidateLists exact = ExactNearest(refs, queries, 10);
+  for (const auto& list : exact) EXPECT_EQ(list.size(), 5u);
+  ExpectSameLists(NaiveNearest(refs, queries, 10), exact);
+}
+
+TEST(ExactNearest, ViewsAndEmptyQueries) {
+  const cv::Mat big = RandomFloats(60, 40, 3);
+  const cv::Mat refs = big(cv::Rect(5, 0, 30, 50)), queries = big(cv::Rect(5, 50, 30, 10));
+  ASSERT_FALSE(refs.isContinuous());
+  ExpectSameLists(NaiveNearest(refs, queries, 4), ExactNearest(refs, queries, 4));
+  EXPECT_TRUE(ExactNearest(refs, cv::Mat(0, 30, CV_32F), 4).empty());
+  EXPECT_TRUE(ExactNearest(refs, cv::Mat(), 4).empty());
+}
+
+// ---------------------------------------------------------------- approximate search
+
+// 2000 random 256-bit references; queries are every 4th reference with 8 bits flipped (a
+// planted near-duplicate at distance 8, while other references lie around 128).
+TEST(ApproximateIndex, LshFindsPlantedNearDuplicates) {
+  const cv::Mat refs = RandomBytes(2000, 32, 7);
+  const cv::Mat queries = FlipBits(refs, EveryNth(2000, 4), 8, 8);
+  ApproximateOptions options;
+  const ApproximateIndex index(refs, options);
+  EXPECT_EQ(index.Size(), 2000);
+  EXPECT_EQ(index.Width(), 32);
+  EXPECT_EQ(index.Type(), CV_8U);
+  const CandidateLists approximate = index.Search(queries);
+  ExpectExactDistances(refs, queries, approximate, options.k);
+  const CandidateLists exact = ExactNearest(refs, queries, options.k);
+  const SearchRecall recall = MeasureRecall(exact, approximate);
+  EXPECT_EQ(recall.queries, 500);
+  // Measured top1 1.000 with the default options: level-2 probing finds the planted row
+  // whenever a table's 20-bit key holds at most 2 of the 8 flipped bits (probability 0.98),
+  // so all 12 tables miss with probability ~1e-21.
+  EXPECT_GE(recall.top1, 0.99);
+  // Measured at_k 0.130: the other 9 exact neighbours are unrelated rows ~100 bits away, which
+  // rarely share a probed bucket with the query; the planted one alone gives 0.1.
+  EXPECT_GE(recall.at_k, 0.1);
+}
+
+// Without probing and with one table LSH misses planted neighbours at distance 40 often; with
+// the defaults far less. Guards against the LSH options being ignored.
+TEST(ApproximateIndex, LshOptionsChangeRecall) {
+  const cv::Mat refs = RandomBytes(2000, 32, 11);
+  const cv::Mat queries = FlipBits(refs, EveryNth(2000, 4), 40, 12);
+  const CandidateLists exact = ExactNearest(refs, queries, 10);
+  ApproximateOptions weak;
+  weak.lsh_tables = 1;
+  weak.lsh_probe_level = 0;
+  const SearchRecall low = MeasureRecall(exact, ApproximateIndex(refs, weak).Search(queries));
+  const SearchRecall high =
+      MeasureRecall(exact, ApproximateIndex(refs, ApproximateOptions()).Search(queries));
+  // One table, no probing: found only when the 20 key bits avoid all 40 flipped bits
+  // (probability 0.029; measured top1 0.032). Defaults, 12 tables probed at level 2: found
+  // unless every key holds 3 or more (1 - 0.634^12 = 0.996; measured 0.998).
+  EXPECT_LE(low.top1, 0.15);
+  EXPECT_GE(high.top1, 0.9);
+}
+
+// Float vectors: 2000 references of 64 unit Gaussians; queries every 4th reference plus noise of
+// deviation 0.1 (the planted neighbour at ~0.8, others at ~11).
+TEST(ApproximateIndex, KdTreesFindPlantedNearDuplicates) {
+  const cv::Mat refs = RandomFloats(2000, 64, 21);
+  const cv::Mat queries = AddNoise(refs, EveryNth(2000, 4), 0.1f, 22);
+  ApproximateOptions options;
+  options.checks = 128;
+  const ApproximateIndex index(refs, options);
+  EXPECT_EQ(index.Type(), CV_32F);
+  const CandidateLists approximate = index.Search(queries);
+  ExpectExactDistances(refs, queries, approximate, options.k);
+  for (const auto& list : approximate) EXPECT_EQ(list.size(), 10u);  // k-d trees fill k
+  const CandidateLists exact = ExactNearest(refs, queries, options.k);
+  const SearchRecall recall = MeasureRecall(exact, approximate);
+  // Measured top1 1.000, at_k 0.355 with 128 checks (the 9 other neighbours are unrelated
+  // rows at ~11, hard for k-d trees in 64 dimensions).
+  EXPECT_GE(recall.top1, 0.95);
+  EXPECT_GE(recall.at_k, 0.25);
+  // A budget of 2 x the references examines all of them: exact (measured 1.000 and 1.000).
+  options.checks = 4000;
+  const SearchRecall full = MeasureRecall(exact, ApproximateIndex(refs, options).Search(queries));
+  EXPECT_GE(full.top1, recall.top1);
+  EXPECT_GE(full.at_k, 0.99);
+}
+
+TEST(ApproximateIndex, DeterministicAcrossBuildsAndThreads) {
+  const cv::Mat bytes = RandomBytes(1000, 32, 31);
+  const cv::Mat byte_queries = FlipBits(bytes, EveryNth(1000, 3), 30, 32);
+  const cv::Mat floats = RandomFloats(1000, 32, 33);
+  const cv::Mat float_queries = AddNoise(floats, EveryNth(1000, 3), 0.5f, 34);
+  for (const auto& [refs, queries] :
+       {std::pair{bytes, byte_queries}, std::pair{floats, float_queries}}) {
+    ApproximateOptions one, two;
+    one.threads = 1;
+    two.threads = 2;
+    one.checks = two.checks = 32;
+    cv::theRNG() = cv::RNG(1);  // the caller's generator must not matter...
+    const CandidateLists a = ApproximateIndex(refs, one).Search(queries);
+    cv::theRNG() = cv::RNG(2);
+    const CandidateLists b = ApproximateIndex(refs, two).Search(queries);
+    EXPECT_TRUE(SameLists(a, b));
+    // ...and is given back unchanged.
+    cv::RNG before = cv::theRNG();
+    const ApproximateIndex index(refs, one);
+    EXPECT_EQ(before.state, cv::theRNG().state);
+    // Another seed builds another index (different candidates somewhere).
+    ApproximateOptions other = one;
+    other.seed = 12345;
+    EXPECT_FALSE(SameLists(a, ApproximateIndex(refs, other).Search(queries)));
+  }
+}
+
+TEST(ApproximateIndex, ConcurrentSearchesAgree) {
+  const cv::Mat floats = RandomFloats(1000, 32, 35);
+  const cv::Mat bytes = RandomBytes(1000, 32, 36);
+  for (const cv::Mat& refs : {floats, bytes}) {
+    ApproximateOptions options;
+    options.threads = 2;
+    const ApproximateIndex index(refs, options);
+    const CandidateLists alone = index.Search(refs);
+    CandidateLists results[3];
+    std::vector<std::thread> threads;
+    for (auto& r : results) threads.emplace_back([&index, &refs, &r] { r = index.Search(refs); });
+    for (auto& t : threads) t.join();
+    for (const auto& r : results) EXPECT_TRUE(SameLists(alone, r));
+  }
+}
+
+TEST(ApproximateIndex, KLargerThanReferences) {
+  const cv::Mat refs = RandomFloats(5, 8, 41), queries = RandomFloats(3, 8, 42);
+  ApproximateOptions options;
+  options.k = 10;
+  const CandidateLists kd = ApproximateIndex(refs, options).Search(queries);
+  ExpectSameLists(NaiveNearest(refs, queries, 10), kd);  // all 5, in order
+
+  const cv::Mat bytes = RandomBytes(5, 32, 43);
+  const CandidateLists lsh = ApproximateIndex(bytes, options).Search(bytes);
+  for (int q = 0; q < 5; ++q) {
+    ASSERT_GE(lsh[static_cast<size_t>(q)].size(), 1u);
+    ASSERT_LE(lsh[static_cast<size_t>(q)].size(), 5u);
+    EXPECT_EQ(lsh[static_cast<size_t>(q)][0].reference, q);  // itself, distance 0
+    EXPECT_EQ(lsh[static_cast<size_t>(q)][0].distance, 0.0f);
+  }
+}
+
+TEST(ApproximateIndex, NarrowDescriptorsCapTheKey) {
+  // 1-byte descriptors: a 20-bit key cannot be drawn from 8 bits; it is capped, not a crash.
+  const cv::Mat refs = RandomBytes(200, 1, 51), queries = RandomBytes(20, 1, 52);
+  const CandidateLists approximate = ApproximateIndex(refs, ApproximateOptions()).Search(queries);
+  ExpectExactDistances(refs, queries, approximate, 10);
+  // An 8-bit key over 8-bit descriptors: each table's bucket holds the equal references, and
+  // probing level 2 reaches every reference within 2 bits.
+  for (int q = 0; q < queries.rows; ++q)
+    for (const Candidate& c : approximate[static_cast<size_t>(q)]) EXPECT_LE(c.distance, 2.0f);
+}
+
+TEST(ApproximateIndex, ViewsAndEmptyQueries) {
+  const cv::Mat big = RandomFloats(60, 40, 61);
+  const cv::Mat refs = big(cv::Rect(5, 0, 30, 50)), queries = big(cv::Rect(5, 50, 30, 10));
+  ApproximateOptions options;
+  options.checks = 1000;  // more than the references: exact
+  const ApproximateIndex index(refs, options);
+  ExpectSameLists(NaiveNearest(refs, queries, 10), index.Search(queries));
+  EXPECT_TRUE(index.Search(cv::Mat(0, 30, CV_32F)).empty());
+  EXPECT_TRUE(index.Search(cv::Mat()).empty());
+}
+
+TEST(ApproximateIndex, MovesKeepTheIndex) {
+  const cv::Mat refs = RandomBytes(100, 32, 71);
+  ApproximateIndex a(refs, ApproximateOptions());
+  const CandidateLists before = a.Search(refs);
+  ApproximateIndex b(std::move(a));
+  EXPECT_TRUE(SameLists(before, b.Search(refs)));
+}
+
+// ---------------------------------------------------------------- invalid input
+
+TEST(ApproximateIndex, RejectsBadOptionsAndInputs) {
+  const cv::Mat bytes = RandomBytes(10, 32, 81), floats = RandomFloats(10, 32, 82);
+  auto with = [](auto change) {
+    ApproximateOptions o;
+    change(o);
+    return o;
+  };
+  const ApproximateOptions bad[] = {
+      with([](ApproximateOptions& o) { o.k = 0; }),
+      with([](ApproximateOptions& o) { o.checks = 0; }),
+      with([](ApproximateOptions& o) { o.lsh_tables = 0; }),
+      with([](ApproximateOptions& o) { o.lsh_key_bits = 0; }),
+      with([](ApproximateOptions& o) { o.lsh_key_bits = 33; }),
+      with([](ApproximateOptions& o) { o.lsh_probe_level = -1; }),
+      with([](ApproximateOptions& o) { o.lsh_probe_level = 4; }),
+      with([](ApproximateOptions& o) { o.kd_trees = 0; }),
+      with([](ApproximateOptions& o) { o.threads = -1; }),
+  };
+  for (const ApproximateOptions& o : bad) {
+    EXPECT_THROW(o.Check(), std::invalid_argument);
+    EXPECT_THROW(ApproximateIndex(bytes, o), std::invalid_argument);
+    EXPECT_THROW(ApproximateIndex(floats, o), std::invalid_argument);
+  }
+  try {
+    bad[0].Check();
+  } catch (const std::invalid_argument& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("k = 0"), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+
+  const ApproximateOptions ok;
+  EXPECT_THROW(ApproximateIndex(cv::Mat(), ok), std::invalid_argument);
+  EXPECT_THROW(ApproximateIndex(cv::Mat(0, 32, CV_8U), ok), std::invalid_argument);
+  EXPECT_THROW(ApproximateIndex(cv::Mat(10, 32, CV_16U, cv::Scalar(0)), ok), std::invalid_argument);
+  EXPECT_THROW(ApproximateIndex(cv::Mat(10, 32, CV_8UC3, cv::Scalar(0)), ok),
+               std::invalid_argument);
+  cv::Mat nan = floats.clone();
+  nan.at<float>(3, 4) = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(ApproximateIndex(nan, ok), std::invalid_argument);
+
+  const ApproximateIndex lsh(bytes, ok), kd(floats, ok);
+  EXPECT_THROW(lsh.Search(RandomBytes(3, 16, 83)), std::invalid_argument);  // width
+  EXPECT_THROW(lsh.Search(floats), std::invalid_argument);                  // type
+  EXPECT_THROW(kd.Search(bytes), std::invalid_argument);
+  EXPECT_THROW(kd.Search(nan), std::invalid_argument);
+  EXPECT_THROW(kd.Search(RandomFloats(3, 31, 84)), std::invalid_argument);
+}
+
+TEST(ExactNearest, RejectsBadInputs) {
+  const cv::Mat bytes = RandomBytes(10, 32, 91), floats = RandomFloats(10, 32, 92);
+  EXPECT_THROW(ExactNearest(bytes, bytes, 0), std::invalid_argument);
+  EXPECT_THROW(ExactNearest(bytes, bytes, 3, -1), std::invalid_argument);
+  EXPECT_THROW(ExactNearest(cv::Mat(), bytes, 3), std::invalid_argument);
+  EXPECT_THROW(ExactNearest(bytes, floats, 3), std::invalid_argument);
+  EXPECT_THROW(ExactNearest(bytes, RandomBytes(2, 31, 93), 3), std::invalid_argument);
+  EXPECT_THROW(ExactNearest(cv::Mat(4, 4, CV_64F, cv::Scalar(0)), cv::Mat(4, 4, CV_64F), 1),
+               std::invalid_argument);
+}
+
+// ---------------------------------------------------------------- recall
+
+TEST(MeasureRecall, TiesCountAndAtKCounts) {
+  const CandidateLists exact = {
+      {{0, 1}, {1, 2}, {2, 3}},
+      {{5, 0}, {6, 0}, {7, 4}},
+      {{3, 1}, {4, 5}, {8, 9}},
+      {{1, 2}, {2, 2}, {3, 2}},
+  };
+  const CandidateLists approximate = {
+      {{0, 1}, {1, 2}, {2, 3}},  // all found: top1, 3/3
+      {{6, 0}, {9, 4}, {2, 7}},  // another reference at the nearest distance counts; 9 ties
+                                 // the 3rd (4): 2/3
+      {{4, 5}},                  // nearest missed, one of 3 found: 1/3
+      {},                        // nothing: 0
+  };
+  const SearchRecall r = MeasureRecall(exact, approximate);
+  EXPECT_EQ(r.queries, 4);
+  EXPECT_DOUBLE_EQ(r.top1, 2.0 / 4);
+  EXPECT_DOUBLE_EQ(r.at_k, (1.0 + 2.0 / 3 + 1.0 / 3 + 0) / 4);
+  EXPECT_DOUBLE_EQ(MeasureRecall(exact, exact).top1, 1.0);
+  EXPECT_DOUBLE_EQ(MeasureRecall(exact, exact).at_k, 1.0);
+  EXPECT_EQ(MeasureRecall({}, {}).queries, 0);
+  EXPECT_THROW(MeasureRecall(exact, {}), std::invalid_argument);
+  EXPECT_THROW(MeasureRecall({{}}, {{}}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace openable
