@@ -22,14 +22,20 @@ enum class DescriptionType { kGlobal = 0, kGrid = 1 };
 //    the rows are concatenated in row-major cell order. (The original placed grid keypoints on
 //    the full-size frame; resizing each cell works for every descriptor at any frame size and
 //    keeps the patch the descriptor was designed for.)
+// With panoramas = n > 1 (Camera_type 2, ABLE-P Eq. 1) the frame is first cut into n
+// equal-width vertical strips (strip s spans [floor(s W / n), floor((s+1) W / n))), each strip
+// is described as above (global or grid) and the n rows are concatenated in strip order.
 class FrameDescriber {
  public:
   FrameDescriber(const Descriptor& descriptor, DescriptionType type, int grid_x = 1,
-                 int grid_y = 1);
-  // Elements per row (descriptor width x cells) and their CV type (CV_8U or CV_32F).
+                 int grid_y = 1, int panoramas = 1);
+  // Elements per row (descriptor width x cells x sub-panoramas) and their CV type (CV_8U or
+  // CV_32F).
   int RowWidth() const;
   int RowType() const;
-  // Describes `gray` (CV_8UC1, any size with at least grid_x x grid_y pixels) into `row`
+  // Smallest frame Describe accepts: (grid_x * panoramas) x grid_y pixels.
+  cv::Size MinimumFrame() const;
+  // Describes `gray` (CV_8UC1, at least grid_x * panoramas x grid_y pixels) into `row`
   // (1 x RowWidth(), RowType()). Thread-safe.
   void Describe(const cv::Mat1b& gray, cv::Mat row) const;
 
@@ -37,6 +43,7 @@ class FrameDescriber {
   const Descriptor& descriptor_;
   DescriptionType type_;
   int grid_x_, grid_y_;
+  int panoramas_;
 };
 
 // Descriptors of every frame of a source, and what was skipped.
@@ -51,6 +58,8 @@ struct DescribeOptions {
   int threads = 0;               // 0 = all cores
   bool skip_unreadable = false;  // false: the first unreadable frame is an InputError
   bool show_images = false;      // show each frame in a window (forces one thread)
+  bool illumination_invariance = false;  // describe IlluminationInvariant(frame, alpha), not grey
+  double alpha = 0.47;
   std::string key;               // config key naming the source, prefixed to errors
 };
 

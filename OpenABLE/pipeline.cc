@@ -12,9 +12,11 @@
 #include "OpenABLE/evaluate.h"
 #include "OpenABLE/exports.h"
 #include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/preprocess.h"
 #include "descriptors/registry.h"
 #include "matching/distances.h"
 #include "matching/normalize.h"
+#include "matching/panorama.h"
 #include "matching/sequence.h"
 
 namespace openable {
@@ -75,8 +77,29 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   dopt.patch_size = config.patch_size;
   dopt.ldb_bits = config.ldb_bits;
   const auto descriptor = CreateDescriptor(config.image_descriptor, dopt);
+  const bool panoramic = config.camera_type == 2;
+  const int strips = panoramic ? config.panoramas : 1;
+  const auto panorama_matching = static_cast<PanoramaMatching>(config.panorama_matching);
   const FrameDescriber describer(*descriptor, static_cast<DescriptionType>(config.description_type),
-                                 config.grid_x, config.grid_y);
+                                 config.grid_x, config.grid_y, strips);
+  // Eq. 7 replaces Alpha when the three peak responses are given.
+  const bool lambdas = config.lambda_red > 0;
+  const double alpha = lambdas ? AlphaFromPeakResponses(config.lambda_red, config.lambda_green,
+                                                         config.lambda_blue)
+                               : config.alpha;
+  {
+    char text[200];
+    result.camera = panoramic ? "panoramic, " + std::to_string(strips) + " sub-panoramas, " +
+                                    PanoramaMatchingName(panorama_matching) + " matching"
+                              : "monocular";
+    if (config.illumination_invariance == 1) {
+      std::snprintf(text, sizeof text, ", illumination invariant (Eq. 6, alpha %.4f%s)", alpha,
+                    lambdas ? " from Eq. 7" : "");
+      result.camera += text;
+    } else {
+      result.camera += ", grey";
+    }
+  }
   result.descriptor = descriptor->Name();
   result.row_width = describer.RowWidth();
   result.binary = descriptor->Kind() == DescriptorKind::kBinary;
@@ -92,10 +115,51 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
     }));
   }
 
+  // Dense or bounded (Matrix_mode), said in one line, decided before any work from the frame
+  // counts of the sources (skipped frames can only make the matrix smaller).
+  std::int64_t planned = 0;
+  for (const auto& source : sources) planned += source->Size();
+  const auto direction = static_cast<SequenceDirection>(config.sequence_direction);
+  const double gib = 1024.0 * 1024.0 * 1024.0;
+  const double dense_bytes = static_cast<double>(planned) * planned * 4.0 *
+                             (direction == SequenceDirection::kBoth ? 2.0 : 1.0);
+  const double limit_bytes = config.memory_limit > 0 ? config.memory_limit * gib
+                                                     : 0.75 * PhysicalMemoryBytes();
+  char sizes[160];
+  std::snprintf(sizes, sizeof sizes, "the %lldx%lld matrix needs %.2f GiB, Memory_limit %.2f GiB%s",
+                static_cast<long long>(planned), static_cast<long long>(planned), dense_bytes / gib,
+                limit_bytes / gib, config.memory_limit > 0 ? "" : " (3/4 of the RAM)");
+  if (config.approximate_search == 1) {
+    result.bounded = true;
+    result.mode_reason = "bounded (Approximate_search 1)";
+  } else if (config.matrix_mode == 2) {
+    result.bounded = true;
+    result.mode_reason = "bounded (Matrix_mode 2)";
+  } else if (config.matrix_mode == 1) {
+    result.mode_reason = std::string("dense (Matrix_mode 1; ") + sizes + ")";
+  } else {
+    result.bounded = dense_bytes > limit_bytes;
+    result.mode_reason = std::string(result.bounded ? "bounded" : "dense") + " (Matrix_mode 0: " +
+                         sizes + ")";
+  }
+  if (result.bounded && config.matches_name.empty())
+    throw InputError("Matches_name: empty, but the run is " + result.mode_reason +
+                     " and keeps only matches; expected a .npy or .csv path (or a larger "
+                     "Memory_limit for the dense matrix)");
+
+  if (result.bounded && panoramic && panorama_matching != PanoramaMatching::kAligned)
+    throw InputError(std::string("Panorama_matching: ") + std::to_string(config.panorama_matching) +
+                     " (" + PanoramaMatchingName(panorama_matching) + ") needs the dense "
+                     "matrix, but the run is " + result.mode_reason +
+                     "; expected Matrix_mode 1 (or 0 with a larger Memory_limit) or "
+                     "Panorama_matching 0");
+
   DescribeOptions options;
   options.threads = config.threads;
   options.skip_unreadable = config.skip_unreadable == 1;
   options.show_images = config.show_images == 1 && HasDisplay();
+  options.illumination_invariance = config.illumination_invariance == 1;
+  options.alpha = alpha;
 
   // Describe.
   auto t = Clock::now();
@@ -134,35 +198,6 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   rules.exclusion = config.exclusion;
   rules.one_traversal = block.one_traversal;
 
-  // Dense or bounded (Matrix_mode), said in one line.
-  const auto direction = static_cast<SequenceDirection>(config.sequence_direction);
-  const double gib = 1024.0 * 1024.0 * 1024.0;
-  const double dense_bytes = static_cast<double>(n) * n * 4.0 *
-                             (direction == SequenceDirection::kBoth ? 2.0 : 1.0);
-  const double limit_bytes = config.memory_limit > 0 ? config.memory_limit * gib
-                                                     : 0.75 * PhysicalMemoryBytes();
-  char sizes[160];
-  std::snprintf(sizes, sizeof sizes, "the %lldx%lld matrix needs %.2f GiB, Memory_limit %.2f GiB%s",
-                static_cast<long long>(n), static_cast<long long>(n), dense_bytes / gib,
-                limit_bytes / gib, config.memory_limit > 0 ? "" : " (3/4 of the RAM)");
-  if (config.approximate_search == 1) {
-    result.bounded = true;
-    result.mode_reason = "bounded (Approximate_search 1)";
-  } else if (config.matrix_mode == 2) {
-    result.bounded = true;
-    result.mode_reason = "bounded (Matrix_mode 2)";
-  } else if (config.matrix_mode == 1) {
-    result.mode_reason = std::string("dense (Matrix_mode 1; ") + sizes + ")";
-  } else {
-    result.bounded = dense_bytes > limit_bytes;
-    result.mode_reason = std::string(result.bounded ? "bounded" : "dense") + " (Matrix_mode 0: " +
-                         sizes + ")";
-  }
-  if (result.bounded && config.matches_name.empty())
-    throw InputError("Matches_name: empty, but the run is " + result.mode_reason +
-                     " and keeps only matches; expected a .npy or .csv path (or a larger "
-                     "Memory_limit for the dense matrix)");
-
   if (result.bounded) {
     for (const char* key : {"Txt_name", "Npy_name", "Png_name", "Png_threshold_name"}) {
       const std::string& v = std::string(key) == "Txt_name"  ? config.txt_name
@@ -197,11 +232,14 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   // Dense: every frame against every frame of the concatenated traversals, as the original.
   t = Clock::now();
   result.timings.pairs = n * (n - 1) / 2;
-  progress.Begin("matching", n * n, "cells");
+  const bool cross = panoramic && panorama_matching != PanoramaMatching::kAligned;
+  progress.Begin("matching", n * n * (cross ? strips * strips : 1),
+                 cross ? "cells of sub-panorama pairs" : "cells");
   const PairProgress on_pairs = [&](std::int64_t done, std::int64_t) { progress.Update(done); };
-  cv::Mat1f distances = result.binary
-                            ? HammingDistances(descriptors, cv::Mat(), config.threads, on_pairs)
-                            : L2Distances(descriptors, cv::Mat(), config.threads, on_pairs);
+  cv::Mat1f distances =
+      panoramic ? PanoramaDistances(descriptors, strips, panorama_matching, config.threads, on_pairs)
+      : result.binary ? HammingDistances(descriptors, cv::Mat(), config.threads, on_pairs)
+                      : L2Distances(descriptors, cv::Mat(), config.threads, on_pairs);
   progress.End();
   result.timings.match_seconds = SecondsSince(t);
 

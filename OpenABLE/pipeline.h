@@ -43,6 +43,7 @@ struct RunResult {
   std::string descriptor;             // registry name
   int row_width = 0;                  // elements per frame descriptor
   bool binary = true;                 // Hamming (true) or L2
+  std::string camera;                 // camera and preprocessing, one line ("monocular, grey")
   cv::Mat1f normalized;               // M' of Eq. 5 (N x N over the concatenated traversals)
   float max_distance = 0;             // max(M), the divisor of Eq. 5
   cv::Mat1b thresholded;              // M'' of Eq. 9; empty when Threshold is -1

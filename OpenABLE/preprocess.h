@@ -11,3 +11,25 @@ namespace openable {
 cv::Mat1b ToGray8(const cv::Mat& frame);
 
 }  // namespace openable
+
+namespace openable {
+
+// Illumination invariant image of Eq. 6 of the OpenABLE paper (after Maddern et al., "Illumination
+// invariant imaging", ICRA-W 2014): I = log(G) - alpha log(B) - (1 - alpha) log(R), per pixel of a
+// colour frame (CV_32FC3, BGR in [0, 1], as a FrameSource gives it).
+// Chosen here (the paper gives no 8-bit mapping): channel values are floored at 1/510 (half an
+// 8-bit step) so that log stays finite, and I is mapped to 8 bits as 255 (0.5 + I / 2), rounded
+// and saturated: 0.5 is Maddern's offset, and log-chromaticity ratios between e^-1 and e^1 fill
+// 0..255 (the range of real scenes: a pixel whose green is e times its weighted red-blue mean
+// is white). Throws InputError (without a file name: the caller adds it) on a frame that is not
+// colour, or whose three channels are equal everywhere (a grey image stored as colour: Eq. 6
+// gives a constant image).
+cv::Mat1b IlluminationInvariant(const cv::Mat& frame, double alpha);
+
+// Alpha of Eq. 7 from the peak spectral responses of the camera's red, green and blue channels
+// (nanometres): alpha = (lB / lG - lB / lR) / (1 - lB / lR). KITTI's PointGrey Flea2 (610, 535,
+// 470 nm) gives 0.4706. Throws InputError naming the keys Lambda_red, Lambda_green, Lambda_blue
+// unless 0 < blue < green < red (which puts alpha in (0, 1)).
+double AlphaFromPeakResponses(double red_nm, double green_nm, double blue_nm);
+
+}  // namespace openable

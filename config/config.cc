@@ -104,8 +104,9 @@ const std::vector<Binding>& Bindings() {
        false},
       // Description and matching
       {"Camera_type", "Description and matching", &Config::camera_type, 0, 2,
-       "0 monocular (ABLE-M); 1 stereo (ABLE-S) and 2 panoramic (ABLE-P) are not built yet "
-       "and are rejected.",
+       "0 monocular (ABLE-M); 2 panoramic (ABLE-P): each frame is a 360-degree panorama cut "
+       "into Panoramas sub-panoramas, compared as Panorama_matching says. 1 stereo (ABLE-S) "
+       "is not built yet and is rejected.",
        false},
       {"Description_type", "Description and matching", &Config::description_type, 0, 1,
        "0 global: the frame is resized to Patch_size x Patch_size and described at its centre; "
@@ -121,11 +122,35 @@ const std::vector<Binding>& Bindings() {
       {"Grid_y", "Description and matching", &Config::grid_y, 1, 64,
        "Grid cells down the frame (Description_type 1).", false},
       {"Panoramas", "Description and matching", &Config::panoramas, 1, 64,
-       "Sub-panoramas of a panoramic frame (Camera_type 2, not built yet).", false},
+       "Sub-panoramas (equal-width vertical strips) of a panoramic frame (Camera_type 2), each "
+       "described on its own (global or grid) and concatenated. An even number makes a "
+       "half-turn (the route driven the other way) a whole number of strips.",
+       false},
+      {"Panorama_matching", "Description and matching", &Config::panorama_matching, 0, 2,
+       "Camera_type 2: how two panoramas are compared. 0 aligned (ABLE-P Eq. 2: strip k "
+       "against strip k; same-direction revisits only); 1 cross-correlation (Eq. 3, 4: the "
+       "smallest distance over every pair of strips; finds revisits in the opposite "
+       "direction); 2 circular (the whole panorama turned by the best whole number of "
+       "strips).",
+       true},
       {"Illumination_invariance", "Description and matching", &Config::illumination_invariance,
-       0, 1, "1 applies the illumination invariant transform of Eq. 6 (not built yet).", false},
+       0, 1,
+       "1 describes the illumination invariant image of Eq. 6, I = log G - Alpha log B - "
+       "(1 - Alpha) log R, instead of the grey image. Needs colour frames (an error names the "
+       "first grey one).",
+       false},
       {"Alpha", "Description and matching", &Config::alpha, 0, 1,
-       "Alpha of Eq. 6 (0.47 for KITTI's PointGrey Flea2).", false},
+       "Alpha of Eq. 6 (0.47 for KITTI's PointGrey Flea2). Replaced by Eq. 7 when Lambda_red, "
+       "Lambda_green and Lambda_blue are given.",
+       false},
+      {"Lambda_red", "Description and matching", &Config::lambda_red, 0, 2000,
+       "Peak spectral response of the red channel, nm (camera data sheet); with Lambda_green "
+       "and Lambda_blue it sets Alpha by Eq. 7. 0 = not given (all three or none).",
+       true},
+      {"Lambda_green", "Description and matching", &Config::lambda_green, 0, 2000,
+       "Peak spectral response of the green channel, nm; see Lambda_red.", true},
+      {"Lambda_blue", "Description and matching", &Config::lambda_blue, 0, 2000,
+       "Peak spectral response of the blue channel, nm; see Lambda_red.", true},
       {"Image_descriptor", "Description and matching", &Config::image_descriptor, 0, 0,
        "LDB, ORB, BRISK (binary, Hamming distance) or SIFT, HOG (vector, L2 distance). "
        "D-LDB, BRIEF and FREAK are not built yet; SURF is not available (non-free, absent "
@@ -454,11 +479,13 @@ void CheckConfig(const Config& c) {
   if (c.camera_type == 1)
     throw InputError(
         "Camera_type: 1 (stereo, ABLE-S) is not built yet; expected 0 (monocular)");
-  if (c.camera_type == 2)
-    throw InputError(
-        "Camera_type: 2 (panoramic, ABLE-P) is not built yet; expected 0 (monocular)");
-  if (c.illumination_invariance == 1)
-    throw InputError("Illumination_invariance: 1 is not built yet; expected 0");
+  {
+    const int given = (c.lambda_red > 0) + (c.lambda_green > 0) + (c.lambda_blue > 0);
+    if (given != 0 && given != 3)
+      throw InputError("Lambda_red, Lambda_green, Lambda_blue: " + FormatNumber(c.lambda_red) +
+                       ", " + FormatNumber(c.lambda_green) + ", " + FormatNumber(c.lambda_blue) +
+                       "; expected all three peak responses (nm) or none (0)");
+  }
   switch (c.frame_mode) {
     case 0:
       need(c.images_path, "Images_path", "Frame_mode 0 reads an image folder");

@@ -42,6 +42,10 @@ struct Config {
   int panoramas = 4;                  // sub-panoramas (Camera_type 2)
   int illumination_invariance = 0;    // 1 applies Eq. 6
   double alpha = 0.47;                // alpha of Eq. 6
+  double lambda_red = 0.0;            // new: peak spectral responses (nm) for Eq. 7; 0 = not
+  double lambda_green = 0.0;          //   given
+  double lambda_blue = 0.0;
+  int panorama_matching = 1;          // new: 0 aligned, 1 cross-correlation, 2 circular
   std::string image_descriptor = "LDB";
   int image_sequences = 1;            // sequence length L; 1 = single images
   double threshold = -1.0;            // theta of Eq. 9 in [0, 1]; -1 disables

@@ -58,6 +58,7 @@ void PrintReport(const openable::Config& c, const openable::RunResult& r,
                     : std::to_string(c.grid_x) + "x" + std::to_string(c.grid_y) + " cells of " +
                           std::to_string(c.patch_size) + "x" + std::to_string(c.patch_size))
             << ", sequence length " << c.image_sequences << "\n";
+  if (!r.camera.empty()) std::cout << "  camera: " << r.camera << "\n";
   for (const auto& t : r.traversals) {
     std::cout << "  " << t.key << ": " << t.frames << " frames of " << t.frame_size.width << "x"
               << t.frame_size.height << " from \"" << t.path << "\" (rows " << t.first_row

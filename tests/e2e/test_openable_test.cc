@@ -1,5 +1,6 @@
 // End-to-end runs of the Test_OpenABLE program: the files it writes, the figures in them, and
 // every input error of the issue (one line, non-zero exit, no output left behind).
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -243,7 +244,18 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"StereoNotBuilt", {"Camera_type=1"}, "Camera_type: 1"},
         BadInput{"OutOfRange", {"Matrix_color=12"}, "Matrix_color"},
         BadInput{"UnknownKey", {"Patch_sise=3"}, "did you mean \"Patch_size\""},
-        BadInput{"RangeOutside", {"Initial_image=400", "Final_image=500"}, "Initial_image"}),
+        BadInput{"RangeOutside", {"Initial_image=400", "Final_image=500"}, "Initial_image"},
+        // The sample's frames are grey stored as RGB: Eq. 6 would give constant images.
+        BadInput{"IlluminationOnGreyFrames", {"Illumination_invariance=1"}, "is grey"},
+        BadInput{"OneLambdaOnly", {"Lambda_red=610"}, "Lambda_red"},
+        BadInput{"LambdasOutOfOrder",
+                 {"Lambda_red=470", "Lambda_green=535", "Lambda_blue=610"}, "Lambda_blue"},
+        BadInput{"PanoramasWiderThanTheFrame",
+                 {"Camera_type=2", "Panoramas=40", "Description_type=1", "Grid_x=2"},
+                 "Grid_x x Panoramas"},
+        BadInput{"CrossCorrelationNeedsTheDenseMatrix",
+                 {"Camera_type=2", "Matrix_mode=2", "Matches_name=out/m.csv"},
+                 "Panorama_matching: 1"}),
     [](const ::testing::TestParamInfo<BadInput>& info) { return std::string(info.param.name); });
 
 TEST(TestOpenABLE, MissingOrBrokenConfigFile) {
@@ -279,6 +291,79 @@ TEST(TestOpenABLE, NordlandWinterVsSummerBeatsTheOriginal) {
   std::cout << "[ nordland ] winter vs summer, LDB global 64x64, L=10: R@1 (+-2) = " << r1
             << "\n" << o.out;
   EXPECT_GE(r1, 0.355);
+}
+
+// Reverse traversal with a monocular camera (issue 5, item 5) and the matrix image (item 6):
+// 300 Nordland summer frames, then the same stretch in winter played backwards as the second
+// traversal. Summing sequences along anti-diagonals (Sequence_direction 1) finds query i at
+// reference 299 - i; the forward sums do not. In the image of the matrix (Matrix_color 0:
+// grey = normalised distance), the revisit is a dark left-side diagonal of the lower-left
+// block, as in the ABLE-P figures.
+TEST(TestOpenABLE, ReverseTraversalIsFoundAlongTheAntiDiagonal) {
+  const std::string data = testing::DatasetsDir() + "/nordland_trimmed";
+  OPENABLE_REQUIRE_PATH(data);
+  const std::string dir = testing::TempDir();
+  const int n = 300;
+  std::vector<std::string> winter;
+  for (const auto& e : fs::directory_iterator(data + "/winter")) winter.push_back(e.path().string());
+  std::sort(winter.begin(), winter.end());
+  fs::create_directories(dir + "/backwards");
+  char name[32];
+  for (int i = 0; i < n; ++i) {  // frame i of the folder is winter frame n - 1 - i
+    std::snprintf(name, sizeof name, "/f%04d.png", i);
+    fs::create_symlink(winter[static_cast<size_t>(n - 1 - i)], dir + "/backwards" + name);
+  }
+  auto run = [&](int direction) {
+    const Outcome o = RunProgram(
+        testing::TestOpenableExe(),
+        {SampleConfig(dir), "--set", "Images_path=" + data + "/summer", "--set",
+         "Final_image=" + std::to_string(n), "--set", "Images_path_2=" + dir + "/backwards",
+         "--set", "Txt_name=", "--set", "Threshold=-1", "--set", "Matrix_color=0", "--set",
+         "Sequence_direction=" + std::to_string(direction), "--quiet"},
+        dir);
+    EXPECT_EQ(o.status, 0) << o.err;
+    return ReadNpy(dir + "/out/matrix.npy");
+  };
+  // Share of queries whose best reference is within +-2 frames of the place they show.
+  auto recall = [&](const cv::Mat1f& m) {
+    int found = 0;
+    for (int q = 0; q < n; ++q) {
+      cv::Point best;
+      cv::minMaxLoc(m.row(n + q).colRange(0, n), nullptr, nullptr, &best);
+      found += std::abs(best.x - (n - 1 - q)) <= 2;
+    }
+    return static_cast<double>(found) / n;
+  };
+  const cv::Mat1f forward = run(0);
+  ASSERT_EQ(forward.rows, 2 * n);
+  const double r_forward = recall(forward);
+  const cv::Mat1f reverse = run(1);
+  ASSERT_EQ(reverse.rows, 2 * n);
+  const double r_reverse = recall(reverse);
+  std::cout << "[ reverse ] Nordland, 300 frames, winter backwards, L=10: R@1 (+-2) forward "
+            << r_forward << ", reverse " << r_reverse << "\n";
+  EXPECT_GE(r_reverse, 0.5);
+  EXPECT_GE(r_reverse, r_forward + 0.3);
+
+  // The image: pixel (row, column) = cell (row, column), grey = 255 x distance. The mean along
+  // the anti-diagonal (left-side diagonal) of the lower-left block is darker than the block and
+  // than its main-direction diagonal (row n + q, column q). Winter against summer stays far
+  // from 0: measured 121 against 154 and 152.
+  const cv::Mat png = cv::imread(dir + "/out/matrix.png", cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(png.rows, 2 * n);
+  ASSERT_EQ(png.cols, 2 * n);
+  double anti = 0, diagonal = 0;
+  for (int q = 0; q < n; ++q) {
+    anti += png.at<std::uint8_t>(n + q, n - 1 - q);
+    diagonal += png.at<std::uint8_t>(n + q, q);
+  }
+  anti /= n;
+  diagonal /= n;
+  const double block = cv::mean(png(cv::Rect(0, n, n, n)))[0];
+  EXPECT_LT(anti, 0.85 * block) << "anti-diagonal " << anti << ", block " << block;
+  EXPECT_LT(anti, 0.85 * diagonal) << "anti-diagonal " << anti << ", diagonal " << diagonal;
+  // And the pixels follow the matrix written beside them.
+  EXPECT_NEAR(png.at<std::uint8_t>(n + 10, 17), 255.0 * reverse(n + 10, 17), 1.0);
 }
 
 }  // namespace

@@ -1,0 +1,102 @@
+#include "matching/panorama.h"
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "matching/large_matrix.h"
+
+namespace openable {
+namespace {
+
+// out = min(out, d), cell by cell, in place.
+void MinInto(cv::Mat1f& out, const cv::Mat1f& d) {
+  cv::Mat o = out;
+  cv::min(o, cv::Mat(d), o);
+}
+
+}  // namespace
+
+const char* PanoramaMatchingName(PanoramaMatching mode) {
+  switch (mode) {
+    case PanoramaMatching::kAligned:
+      return "aligned";
+    case PanoramaMatching::kCrossCorrelation:
+      return "cross-correlation";
+    case PanoramaMatching::kCircular:
+      return "circular";
+  }
+  return "?";
+}
+
+cv::Mat1f PanoramaDistances(const cv::Mat& rows, int strips, PanoramaMatching mode, int threads,
+                            const PairProgress& progress) {
+  if (strips < 1)
+    throw std::invalid_argument("PanoramaDistances: " + std::to_string(strips) +
+                                " strips; expected >= 1");
+  if (rows.cols % strips != 0)
+    throw std::invalid_argument("PanoramaDistances: row width " + std::to_string(rows.cols) +
+                                " is not a multiple of " + std::to_string(strips) + " strips");
+  const bool binary = rows.depth() == CV_8U;
+  auto distances = [&](const cv::Mat& a, const cv::Mat& b, const PairProgress& p) {
+    return binary ? HammingDistances(a, b, threads, p) : L2Distances(a, b, threads, p);
+  };
+  if (mode == PanoramaMatching::kAligned || strips == 1) return distances(rows, cv::Mat(), progress);
+
+  const int n = rows.rows;
+  const int w = rows.cols / strips;
+  std::vector<cv::Mat> strip(static_cast<size_t>(strips));
+  for (int k = 0; k < strips; ++k) strip[static_cast<size_t>(k)] = rows.colRange(k * w, (k + 1) * w).clone();
+
+  // Progress over the strips^2 single-strip matrices.
+  const std::int64_t cells = static_cast<std::int64_t>(n) * n;
+  const std::int64_t total = cells * strips * strips;
+  std::int64_t offset = 0;
+  const PairProgress inner = [&](std::int64_t done, std::int64_t) {
+    if (progress) progress(offset + done, total);
+  };
+  auto strip_pair = [&](int k, int l) {
+    cv::Mat1f d = distances(strip[static_cast<size_t>(k)], strip[static_cast<size_t>(l)], inner);
+    offset += cells;
+    return d;
+  };
+
+  cv::Mat1f out = LargeMatrix(n, n);
+  if (mode == PanoramaMatching::kCrossCorrelation) {
+    // Eq. 3 and 4: the smallest distance over every pair of strips (k, l).
+    for (int k = 0; k < strips; ++k)
+      for (int l = 0; l < strips; ++l) {
+        const cv::Mat1f d = strip_pair(k, l);
+        if (k == 0 && l == 0) {
+          d.copyTo(out);
+        } else {
+          MinInto(out, d);
+        }
+      }
+    return out;
+  }
+
+  // Circular: for each shift s, the aligned distance against the strips of j turned by s.
+  cv::Mat1f sum = LargeMatrix(n, n);
+  for (int s = 0; s < strips; ++s) {
+    for (int k = 0; k < strips; ++k) {
+      cv::Mat1f d = strip_pair(k, (k + s) % strips);
+      if (!binary) cv::multiply(d, d, d);  // L2: squared strip distances add up
+      if (k == 0) {
+        d.copyTo(sum);
+      } else {
+        sum += d;
+      }
+    }
+    if (!binary) cv::sqrt(sum, sum);
+    if (s == 0) {
+      sum.copyTo(out);
+    } else {
+      MinInto(out, sum);
+    }
+  }
+  return out;
+}
+
+}  // namespace openable
