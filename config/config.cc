@@ -127,9 +127,9 @@ const std::vector<Binding>& Bindings() {
       {"Alpha", "Description and matching", &Config::alpha, 0, 1,
        "Alpha of Eq. 6 (0.47 for KITTI's PointGrey Flea2).", false},
       {"Image_descriptor", "Description and matching", &Config::image_descriptor, 0, 0,
-       "LDB, ORB, BRISK (binary, Hamming distance) or SIFT, HOG (vector, L2 distance). "
-       "D-LDB, BRIEF and FREAK are not built yet; SURF is not available (non-free, absent "
-       "from Debian's OpenCV).",
+       "LDB, ORB, BRISK, BRIEF, FREAK (binary, Hamming distance) or SIFT, HOG (vector, L2 "
+       "distance). D-LDB is not built yet; SURF is not available (non-free, absent from "
+       "Debian's OpenCV).",
        false},
       {"Image_sequences", "Description and matching", &Config::image_sequences, 1, 100000,
        "Sequence length L: the distance of two places sums L single-frame distances along "
