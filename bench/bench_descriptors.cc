@@ -42,5 +42,7 @@ BENCHMARK_CAPTURE(BM_Describe, ORB, std::string("ORB"), 256)->Arg(64);
 BENCHMARK_CAPTURE(BM_Describe, BRISK, std::string("BRISK"), 256)->Arg(64);
 BENCHMARK_CAPTURE(BM_Describe, SIFT, std::string("SIFT"), 256)->Arg(64);
 BENCHMARK_CAPTURE(BM_Describe, HOG, std::string("HOG"), 256)->Arg(64);
+BENCHMARK_CAPTURE(BM_Describe, BRIEF, std::string("BRIEF"), 256)->Arg(64);
+BENCHMARK_CAPTURE(BM_Describe, FREAK, std::string("FREAK"), 256)->Arg(64);
 
 BENCHMARK_MAIN();

@@ -2,7 +2,7 @@
 # The table of docs/benchmarks.md: every descriptor on KITTI 00 (frames 0-1699), Nordland
 # (winter vs summer) and Gardens Point (day_right vs day_left), with the protocols of
 # reference.md, evaluated by Test_OpenABLE itself. Prints one Markdown row per run.
-# Usage: bench/evaluation_table.sh [descriptor ...]   (default: LDB ORB BRISK SIFT HOG)
+# Usage: bench/evaluation_table.sh [descriptor ...]   (default: LDB ORB BRISK SIFT HOG BRIEF FREAK)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 data="$root/../shared/datasets"
@@ -12,7 +12,7 @@ exe="$root/build/examples/Test_OpenABLE"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 descriptors=("$@")
-[ ${#descriptors[@]} -gt 0 ] || descriptors=(LDB ORB BRISK SIFT HOG)
+[ ${#descriptors[@]} -gt 0 ] || descriptors=(LDB ORB BRISK SIFT HOG BRIEF FREAK)
 
 figure() {  # figure KEY FILE: the first number after "KEY": in a JSON file
   grep -o "\"$1\": [-0-9.e]*" "$2" | head -1 | awk '{print $2}'

@@ -152,9 +152,9 @@ const std::vector<Binding>& Bindings() {
       {"Lambda_blue", "Description and matching", &Config::lambda_blue, 0, 2000,
        "Peak spectral response of the blue channel, nm; see Lambda_red.", true},
       {"Image_descriptor", "Description and matching", &Config::image_descriptor, 0, 0,
-       "LDB, ORB, BRISK (binary, Hamming distance) or SIFT, HOG (vector, L2 distance). "
-       "D-LDB, BRIEF and FREAK are not built yet; SURF is not available (non-free, absent "
-       "from Debian's OpenCV).",
+       "LDB, ORB, BRISK, BRIEF, FREAK (binary, Hamming distance) or SIFT, HOG (vector, L2 "
+       "distance). D-LDB is not built yet; SURF is not available (non-free, absent from "
+       "Debian's OpenCV).",
        false},
       {"Image_sequences", "Description and matching", &Config::image_sequences, 1, 100000,
        "Sequence length L: the distance of two places sums L single-frame distances along "

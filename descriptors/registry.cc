@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "descriptors/brief.h"
+#include "descriptors/freak.h"
 #include "descriptors/hog.h"
 #include "descriptors/ldb.h"
 #include "descriptors/opencv_descriptors.h"
@@ -33,6 +35,8 @@ const Entry kDescriptors[] = {
     {"BRISK", &Make<BriskDescriptor>},  // descriptors/opencv_descriptors.h
     {"SIFT", &Make<SiftDescriptor>},    // descriptors/opencv_descriptors.h
     {"HOG", &Make<HogDescriptor>},      // descriptors/hog.h
+    {"BRIEF", &Make<BriefDescriptor>},  // descriptors/brief.h
+    {"FREAK", &Make<FreakDescriptor>},  // descriptors/freak.h
 };
 
 struct Unavailable {
@@ -45,8 +49,6 @@ const Unavailable kUnavailable[] = {
      "patented non-free code, absent from Debian's OpenCV build; use SIFT for a vector "
      "descriptor or LDB for a binary one"},
     {"D-LDB", "stereo; not built yet"},
-    {"BRIEF", "not built yet"},
-    {"FREAK", "not built yet"},
 };
 
 std::string Upper(const std::string& s) {

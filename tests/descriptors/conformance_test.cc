@@ -38,6 +38,8 @@ const std::map<std::string, Expected>& ExpectedFor64() {
       {"BRISK", {64, DescriptorKind::kBinary}},  // 512 bits
       {"SIFT", {128, DescriptorKind::kFloat}},   // 4 x 4 cells x 8 bins
       {"HOG", {1764, DescriptorKind::kFloat}},   // 7 x 7 blocks x 4 cells x 9 bins
+      {"BRIEF", {32, DescriptorKind::kBinary}},  // 256 tests
+      {"FREAK", {64, DescriptorKind::kBinary}},  // 512 pairs
   };
   return table;
 }
