@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "descriptors/dldb.h"
 #include "descriptors/hog.h"
 #include "descriptors/ldb.h"
 #include "descriptors/opencv_descriptors.h"
@@ -29,6 +30,7 @@ struct Entry {
 // The one table of descriptors, in the order shown to users.
 const Entry kDescriptors[] = {
     {"LDB", &Make<LdbDescriptor>},      // descriptors/ldb.h
+    {"D-LDB", &Make<DldbDescriptor>},   // descriptors/dldb.h (2-channel patch: grey, disparity)
     {"ORB", &Make<OrbDescriptor>},      // descriptors/opencv_descriptors.h
     {"BRISK", &Make<BriskDescriptor>},  // descriptors/opencv_descriptors.h
     {"SIFT", &Make<SiftDescriptor>},    // descriptors/opencv_descriptors.h
@@ -44,7 +46,6 @@ const Unavailable kUnavailable[] = {
     {"SURF",
      "patented non-free code, absent from Debian's OpenCV build; use SIFT for a vector "
      "descriptor or LDB for a binary one"},
-    {"D-LDB", "stereo; not built yet"},
     {"BRIEF", "not built yet"},
     {"FREAK", "not built yet"},
 };
