@@ -28,7 +28,13 @@ FrameDescriber::FrameDescriber(const Descriptor& descriptor, DescriptionType typ
 int FrameDescriber::RowWidth() const { return descriptor_.Width() * grid_x_ * grid_y_; }
 int FrameDescriber::RowType() const { return openable::RowType(descriptor_); }
 
-void FrameDescriber::Describe(const cv::Mat1b& gray, cv::Mat row) const {
+int FrameDescriber::Channels() const { return descriptor_.Channels(); }
+
+void FrameDescriber::Describe(const cv::Mat& gray, cv::Mat row) const {
+  if (gray.type() != CV_8UC(descriptor_.Channels()))
+    throw std::logic_error("FrameDescriber: expected a CV_8UC" +
+                           std::to_string(descriptor_.Channels()) + " image for " +
+                           descriptor_.Name() + ", got " + cv::typeToString(gray.type()));
   if (gray.cols < grid_x_ || gray.rows < grid_y_)
     throw std::logic_error("FrameDescriber: frame smaller than the grid");
   const int p = descriptor_.PatchSize();
@@ -94,8 +100,9 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
         return;
       }
     }
-    const cv::Mat1b gray = ToGray8(frame);
-    describer.Describe(gray, rows.row(i));
+    // Grey for every descriptor; grey + disparity (a stereo frame) for D-LDB.
+    describer.Describe(describer.Channels() == 2 ? ToGrayDisparity8(frame) : cv::Mat(ToGray8(frame)),
+                       rows.row(i));
     ok[i] = 1;
   };
   auto report = [&]() {
@@ -130,7 +137,10 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
       for (int i = start; i < std::min(n, start + batch); ++i) {
         if (auto f = read(i)) {
           if (options.show_images) {
-            reinterpret_cast<OpenableGuiShow>(ModuleSymbol("gui", "openable_gui_show"))(*f);
+            // A stereo frame shows its rectified left image (channel 0).
+            cv::Mat shown = *f;
+            if (shown.channels() == 2) cv::extractChannel(*f, shown, 0);
+            reinterpret_cast<OpenableGuiShow>(ModuleSymbol("gui", "openable_gui_show"))(shown);
           }
           frames.emplace_back(i, std::move(*f));
         } else {

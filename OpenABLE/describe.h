@@ -29,9 +29,13 @@ class FrameDescriber {
   // Elements per row (descriptor width x cells) and their CV type (CV_8U or CV_32F).
   int RowWidth() const;
   int RowType() const;
-  // Describes `gray` (CV_8UC1, any size with at least grid_x x grid_y pixels) into `row`
-  // (1 x RowWidth(), RowType()). Thread-safe.
-  void Describe(const cv::Mat1b& gray, cv::Mat row) const;
+  // Channels of the image Describe takes: the descriptor's (1 grey; 2 grey + disparity for
+  // D-LDB, whose cells are then 2-channel: LDB(grey cell) ++ LDB(disparity cell)).
+  int Channels() const;
+  // Describes `image` (CV_8UC(Channels()), any size with at least grid_x x grid_y pixels)
+  // into `row` (1 x RowWidth(), RowType()). Every channel of a cell is resized alike.
+  // Thread-safe. Throws std::logic_error on another type.
+  void Describe(const cv::Mat& image, cv::Mat row) const;
 
  private:
   const Descriptor& descriptor_;
