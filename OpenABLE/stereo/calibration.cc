@@ -154,14 +154,16 @@ void CheckCalibrationFits(const StereoCalibration& c, const cv::Size& size,
   } cameras[] = {{"ML", c.left_camera}, {"MR", c.right_camera}};
   for (const auto& cam : cameras) {
     const double cx = cam.k(0, 2), cy = cam.k(1, 2);
-    if (cx < 0.0 || cx >= size.width || cy < 0.0 || cy >= size.height)
+    const double w = size.width, h = size.height;
+    if (cx < w / 4 || cx > 3 * w / 4 || cy < h / 4 || cy > 3 * h / 4)
       throw InputError("calibration \"" + c.path + "\" does not fit the images: " + cam.key +
-                       " principal point (" + Num(cx) + ", " + Num(cy) + ") lies outside the " +
-                       std::to_string(size.width) + "x" + std::to_string(size.height) +
-                       " image \"" + first_image + "\" (it suits images of about " +
+                       " principal point (" + Num(cx) + ", " + Num(cy) +
+                       ") lies outside the middle half of the " + std::to_string(size.width) +
+                       "x" + std::to_string(size.height) + " image \"" + first_image +
+                       "\" (it suits images of about " +
                        std::to_string(static_cast<int>(std::lround(2 * cx))) + "x" +
                        std::to_string(static_cast<int>(std::lround(2 * cy))) +
-                       "); expected 0 <= cx < width and 0 <= cy < height");
+                       "); expected width/4 <= cx <= 3 width/4 and height/4 <= cy <= 3 height/4");
   }
 }
 

@@ -41,9 +41,12 @@ StereoCalibration LoadStereoCalibration(const std::string& path);
 
 // Checks that the calibration fits images of `image_size` (the size of the first left image,
 // named `first_image` in the message). Rule: the principal point (cx, cy) of each camera lies
-// inside the image, 0 <= cx < width and 0 <= cy < height; a calibration made for another
-// resolution (e.g. full-size KITTI intrinsics on half-size frames) usually breaks it. Throws
-// InputError "calibration does not fit the images" naming the file, both sizes and the point.
+// inside the image, and more strictly in its middle half: width/4 <= cx <= 3 width/4 and
+// height/4 <= cy <= 3 height/4. Real principal points sit near the centre; plain "inside"
+// misses a calibration made for another resolution, e.g. full-size KITTI intrinsics
+// (607, 185) on the half-size 620x188 frames, which this rule catches. Throws InputError
+// "calibration does not fit the images" naming the file, the image size, the size the
+// calibration suits (2 cx x 2 cy) and the point.
 void CheckCalibrationFits(const StereoCalibration& calibration, const cv::Size& image_size,
                           const std::string& first_image);
 

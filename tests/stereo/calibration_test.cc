@@ -145,15 +145,26 @@ TEST(StereoCalibration, OtherBadValues) {
   ExpectInputError([&] { LoadStereoCalibration(bottom); }, {"ML: rows 2-3", "0 0 1"});
 }
 
-TEST(StereoCalibration, PrincipalPointsMustLieInsideTheImages) {
+TEST(StereoCalibration, PrincipalPointsMustLieInTheMiddleOfTheImages) {
   const StereoCalibration c = LoadStereoCalibration(Write(CalibrationText()));
   EXPECT_NO_THROW(CheckCalibrationFits(c, cv::Size(752, 480), "left/0.png"));
-  // Half-size images: cx = 367.2 is inside 376 columns, cy = 248.4 is below 240 rows.
+  // Half-size images: (367.2, 248.4) is beyond 3/4 of 376 columns (282).
   ExpectInputError([&] { CheckCalibrationFits(c, cv::Size(376, 240), "left/0.png"); },
                    {"does not fit the images", "ML principal point (367.215, 248.375)",
                     "376x240 image \"left/0.png\"", "about 734x497", testing::Q(c.path)});
-  ExpectInputError([&] { CheckCalibrationFits(c, cv::Size(370, 600), "l.png"); },
-                   {"MR principal point (379.999, 255.238)", "370x600"});
+  // Full-size KITTI intrinsics on the half-size frames: inside the image, but not in its
+  // middle half (cx 607 > 465).
+  const StereoCalibration kitti = LoadStereoCalibration(Write(CalibrationText(
+      {{"ML", MatrixNode("ML", 3, 3, "718.856, 0., 607.1928, 0., 718.856, 185.2157, 0., 0., 1.")},
+       {"MR", MatrixNode("MR", 3, 3, "718.856, 0., 607.1928, 0., 718.856, 185.2157, 0., 0., 1.")}})));
+  EXPECT_NO_THROW(CheckCalibrationFits(kitti, cv::Size(1241, 376), "full.png"));
+  ExpectInputError([&] { CheckCalibrationFits(kitti, cv::Size(620, 188), "half.png"); },
+                   {"ML principal point (607.193, 185.216)", "620x188", "about 1214x370"});
+  // Only the right camera off.
+  const StereoCalibration right = LoadStereoCalibration(Write(CalibrationText(
+      {{"MR", MatrixNode("MR", 3, 3, "457.5, 0., 700., 0., 456.1, 255.2, 0., 0., 1.")}})));
+  ExpectInputError([&] { CheckCalibrationFits(right, cv::Size(752, 480), "l.png"); },
+                   {"MR principal point (700, 255.2)", "752x480"});
 }
 
 TEST(EurocConversion, GivesTheBaselineAlongXAndANearIdentityRotation) {
