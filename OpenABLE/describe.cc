@@ -36,7 +36,13 @@ cv::Size FrameDescriber::MinimumFrame() const {
 
 int FrameDescriber::RowType() const { return openable::RowType(descriptor_); }
 
-void FrameDescriber::Describe(const cv::Mat1b& gray, cv::Mat row) const {
+int FrameDescriber::Channels() const { return descriptor_.Channels(); }
+
+void FrameDescriber::Describe(const cv::Mat& gray, cv::Mat row) const {
+  if (gray.type() != CV_8UC(descriptor_.Channels()))
+    throw std::logic_error("FrameDescriber: expected a CV_8UC" +
+                           std::to_string(descriptor_.Channels()) + " image for " +
+                           descriptor_.Name() + ", got " + cv::typeToString(gray.type()));
   if (gray.cols < grid_x_ * panoramas_ || gray.rows < grid_y_)
     throw std::logic_error("FrameDescriber: frame smaller than the grid");
   const int p = descriptor_.PatchSize();
@@ -46,7 +52,7 @@ void FrameDescriber::Describe(const cv::Mat1b& gray, cv::Mat row) const {
   // Sub-panorama s spans columns [floor(s W / n), floor((s + 1) W / n)) (n = 1 for a
   // monocular frame: the whole frame).
   for (int s = 0; s < panoramas_; ++s) {
-    const cv::Mat1b strip =
+    const cv::Mat strip =
         gray.colRange(s * gray.cols / panoramas_, (s + 1) * gray.cols / panoramas_);
     for (int gy = 0; gy < grid_y_; ++gy)
       for (int gx = 0; gx < grid_x_; ++gx) {
@@ -109,22 +115,24 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
         return;
       }
     }
-    cv::Mat1b gray;
+    // Grey (or Eq. 6) for every descriptor; grey + disparity (a stereo frame) for D-LDB.
+    cv::Mat image;
     try {
-      gray = options.illumination_invariance ? IlluminationInvariant(frame, options.alpha)
-                                             : ToGray8(frame);
+      image = describer.Channels() == 2          ? ToGrayDisparity8(frame)
+              : options.illumination_invariance ? cv::Mat(IlluminationInvariant(frame, options.alpha))
+                                                : cv::Mat(ToGray8(frame));
     } catch (const InputError& e) {
       fail(i, "image " + Quoted(source.FrameName(i)) + ": " + e.what());
       return;
     }
     const cv::Size need = describer.MinimumFrame();
-    if (gray.cols < need.width || gray.rows < need.height) {
-      fail(i, "image " + Quoted(source.FrameName(i)) + " is " + SizeText(gray.size()) +
+    if (image.cols < need.width || image.rows < need.height) {
+      fail(i, "image " + Quoted(source.FrameName(i)) + " is " + SizeText(image.size()) +
                   "; the grid and sub-panoramas need at least " + SizeText(need) +
                   " (Grid_x x Panoramas by Grid_y pixels)");
       return;
     }
-    describer.Describe(gray, rows.row(i));
+    describer.Describe(image, rows.row(i));
     ok[i] = 1;
   };
   auto report = [&]() {
@@ -159,7 +167,10 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
       for (int i = start; i < std::min(n, start + batch); ++i) {
         if (auto f = read(i)) {
           if (options.show_images) {
-            reinterpret_cast<OpenableGuiShow>(ModuleSymbol("gui", "openable_gui_show"))(*f);
+            // A stereo frame shows its rectified left image (channel 0).
+            cv::Mat shown = *f;
+            if (shown.channels() == 2) cv::extractChannel(*f, shown, 0);
+            reinterpret_cast<OpenableGuiShow>(ModuleSymbol("gui", "openable_gui_show"))(shown);
           }
           frames.emplace_back(i, std::move(*f));
         } else {

@@ -35,9 +35,13 @@ class FrameDescriber {
   int RowType() const;
   // Smallest frame Describe accepts: (grid_x * panoramas) x grid_y pixels.
   cv::Size MinimumFrame() const;
-  // Describes `gray` (CV_8UC1, at least grid_x * panoramas x grid_y pixels) into `row`
-  // (1 x RowWidth(), RowType()). Thread-safe.
-  void Describe(const cv::Mat1b& gray, cv::Mat row) const;
+  // Channels of the image Describe takes: the descriptor's (1 grey; 2 grey + disparity for
+  // D-LDB, whose cells are then 2-channel: LDB(grey cell) ++ LDB(disparity cell)).
+  int Channels() const;
+  // Describes `image` (CV_8UC(Channels()), at least MinimumFrame() pixels) into `row`
+  // (1 x RowWidth(), RowType()). Every channel of a cell is resized alike. Thread-safe.
+  // Throws std::logic_error on another type or a smaller image.
+  void Describe(const cv::Mat& image, cv::Mat row) const;
 
  private:
   const Descriptor& descriptor_;

@@ -13,6 +13,8 @@
 #include "OpenABLE/exports.h"
 #include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/preprocess.h"
+#include "OpenABLE/stereo/calibration.h"
+#include "OpenABLE/stereo/stereo_source.h"
 #include "descriptors/registry.h"
 #include "matching/distances.h"
 #include "matching/normalize.h"
@@ -38,22 +40,28 @@ auto WithKey(const std::string& key, F open) {
   }
 }
 
+enum class SourceKind { kFolder, kVideo, kStereo };
+
 struct SourceSpec {
   std::string key, path;
-  bool video;
+  SourceKind kind;
 };
 
 std::vector<SourceSpec> Sources(const Config& c) {
+  // Stereo (Camera_type 1): one pair of folders; CheckConfig rejects videos and Images_path_2.
+  if (c.camera_type == 1) return {{"Images_path_left", c.images_path_left, SourceKind::kStereo}};
   switch (c.frame_mode) {
     case 0: {
-      std::vector<SourceSpec> s = {{"Images_path", c.images_path, false}};
-      if (!c.images_path_2.empty()) s.push_back({"Images_path_2", c.images_path_2, false});
+      std::vector<SourceSpec> s = {{"Images_path", c.images_path, SourceKind::kFolder}};
+      if (!c.images_path_2.empty())
+        s.push_back({"Images_path_2", c.images_path_2, SourceKind::kFolder});
       return s;
     }
     case 1:
-      return {{"Video_path_1", c.video_path_1, true}};
+      return {{"Video_path_1", c.video_path_1, SourceKind::kVideo}};
     default:
-      return {{"Video_path_1", c.video_path_1, true}, {"Video_path_2", c.video_path_2, true}};
+      return {{"Video_path_1", c.video_path_1, SourceKind::kVideo},
+              {"Video_path_2", c.video_path_2, SourceKind::kVideo}};
   }
 }
 
@@ -108,10 +116,23 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   std::vector<std::unique_ptr<FrameSource>> sources;
   const std::vector<SourceSpec> specs = Sources(config);
   for (const auto& spec : specs) {
+    if (spec.kind == SourceKind::kStereo) {
+      // The stereo source's messages name their keys (Images_path_left, Images_path_right,
+      // Calibration_path) themselves.
+      StereoSourceOptions stereo_options;
+      stereo_options.compute_disparity = describer.Channels() == 2;  // only D-LDB reads it
+      const StereoCalibration calibration = WithKey(
+          "Calibration_path", [&] { return LoadStereoCalibration(config.calibration_path); });
+      sources.push_back(OpenStereoFolders(config.images_path_left, config.images_path_right,
+                                          config.images_format, config.initial_image,
+                                          config.final_image, calibration, stereo_options));
+      continue;
+    }
     sources.push_back(WithKey(spec.key, [&] {
-      return spec.video ? OpenVideo(spec.path, config.initial_image, config.final_image)
-                        : OpenImageFolder(spec.path, config.images_format, config.initial_image,
-                                          config.final_image);
+      return spec.kind == SourceKind::kVideo
+                 ? OpenVideo(spec.path, config.initial_image, config.final_image)
+                 : OpenImageFolder(spec.path, config.images_format, config.initial_image,
+                                   config.final_image);
     }));
   }
 
@@ -166,8 +187,13 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   std::vector<cv::Mat> blocks;
   int row = 0;
   for (size_t s = 0; s < sources.size(); ++s) {
-    options.key = specs[s].key;
-    progress.Begin("describing", sources[s]->Size(), "frames of " + specs[s].key);
+    const bool stereo = specs[s].kind == SourceKind::kStereo;
+    options.key = stereo ? "" : specs[s].key;  // stereo read errors name their own key
+    progress.Begin("describing", sources[s]->Size(),
+                   stereo ? "stereo pairs (rectify" +
+                                std::string(describer.Channels() == 2 ? ", SGBM" : "") + ", " +
+                                result.descriptor + ")"
+                          : "frames of " + specs[s].key);
     DescribedSequence seq = DescribeSequence(*sources[s], describer, options,
                                              [&](int done, int) { progress.Update(done); });
     progress.End();

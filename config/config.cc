@@ -1,6 +1,7 @@
 #include "config/config.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -50,11 +51,18 @@ const std::vector<Binding>& Bindings() {
        "sequence.",
        true},
       {"Images_path_left", "Datasets", &Config::images_path_left, 0, 0,
-       "Left image folder of a stereo camera (Camera_type 1, not built yet).", false},
+       "Left image folder of a stereo camera (Camera_type 1; Images_path is then not used). "
+       "Same Images_format and Initial_image/Final_image range as Images_path; the frame "
+       "names of the run are the left file names.",
+       false},
       {"Images_path_right", "Datasets", &Config::images_path_right, 0, 0,
-       "Right image folder of a stereo camera (Camera_type 1, not built yet).", false},
+       "Right image folder of a stereo camera (Camera_type 1). Must hold as many images as "
+       "Images_path_left: pairs are matched by position in natural order.",
+       false},
       {"Calibration_path", "Datasets", &Config::calibration_path, 0, 0,
-       "Stereo calibration file (Camera_type 1, not built yet).", false},
+       "Stereo calibration file (Camera_type 1), OpenCV YAML as the original: ML, MR, DL, "
+       "DR, R, T, optional colormap and use_log (docs/cameras.md).",
+       false},
       {"Images_format", "Datasets", &Config::images_format, 0, 0,
        "Extension of the images to take from the folders (e.g. png); empty takes every "
        "supported image file. Unlike the original, names need not be %06d.<ext>.",
@@ -104,9 +112,11 @@ const std::vector<Binding>& Bindings() {
        false},
       // Description and matching
       {"Camera_type", "Description and matching", &Config::camera_type, 0, 2,
-       "0 monocular (ABLE-M); 2 panoramic (ABLE-P): each frame is a 360-degree panorama cut "
-       "into Panoramas sub-panoramas, compared as Panorama_matching says. 1 stereo (ABLE-S) "
-       "is not built yet and is rejected.",
+       "0 monocular (ABLE-M); 1 stereo (ABLE-S): pairs of Images_path_left and "
+       "Images_path_right are rectified with Calibration_path and matched (SGBM) for D-LDB; "
+       "other descriptors describe the rectified left image (docs/cameras.md). 2 panoramic "
+       "(ABLE-P): each frame is a 360-degree panorama cut into Panoramas sub-panoramas, "
+       "compared as Panorama_matching says.",
        false},
       {"Description_type", "Description and matching", &Config::description_type, 0, 1,
        "0 global: the frame is resized to Patch_size x Patch_size and described at its centre; "
@@ -152,9 +162,9 @@ const std::vector<Binding>& Bindings() {
       {"Lambda_blue", "Description and matching", &Config::lambda_blue, 0, 2000,
        "Peak spectral response of the blue channel, nm; see Lambda_red.", true},
       {"Image_descriptor", "Description and matching", &Config::image_descriptor, 0, 0,
-       "LDB, ORB, BRISK, BRIEF, FREAK (binary, Hamming distance) or SIFT, HOG (vector, L2 "
-       "distance). D-LDB is not built yet; SURF is not available (non-free, absent from "
-       "Debian's OpenCV).",
+       "LDB, D-LDB (LDB of the grey and of the disparity image; needs Camera_type 1), ORB, "
+       "BRISK, BRIEF, FREAK (binary, Hamming distance) or SIFT, HOG (vector, L2 distance). "
+       "SURF is not available (non-free, absent from Debian's OpenCV).",
        false},
       {"Image_sequences", "Description and matching", &Config::image_sequences, 1, 100000,
        "Sequence length L: the distance of two places sums L single-frame distances along "
@@ -476,9 +486,6 @@ void CheckConfig(const Config& c) {
   auto need = [](const std::string& value, const std::string& key, const std::string& why) {
     if (value.empty()) throw InputError(key + ": empty; expected a path (" + why + ")");
   };
-  if (c.camera_type == 1)
-    throw InputError(
-        "Camera_type: 1 (stereo, ABLE-S) is not built yet; expected 0 (monocular)");
   {
     const int given = (c.lambda_red > 0) + (c.lambda_green > 0) + (c.lambda_blue > 0);
     if (given != 0 && given != 3)
@@ -486,9 +493,31 @@ void CheckConfig(const Config& c) {
                        ", " + FormatNumber(c.lambda_green) + ", " + FormatNumber(c.lambda_blue) +
                        "; expected all three peak responses (nm) or none (0)");
   }
+  std::string descriptor = c.image_descriptor;
+  for (char& ch : descriptor) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  if (descriptor == "D-LDB" && c.camera_type != 1)
+    throw InputError("Image_descriptor: D-LDB needs Camera_type 1 (stereo); Camera_type is " +
+                     std::to_string(c.camera_type));
+  if (c.camera_type == 1) {
+    if (c.frame_mode != 0)
+      throw InputError("Frame_mode: " + std::to_string(c.frame_mode) +
+                       " with Camera_type 1 (stereo); expected 0: stereo reads the image "
+                       "folders Images_path_left and Images_path_right, not videos");
+    if (!c.images_path_2.empty())
+      throw InputError("Images_path_2: " + Quote(c.images_path_2) +
+                       " with Camera_type 1 (stereo); expected empty: a second stereo "
+                       "traversal is not supported");
+    need(c.images_path_left, "Images_path_left", "Camera_type 1 reads a left image folder");
+    need(c.images_path_right, "Images_path_right", "Camera_type 1 reads a right image folder");
+    need(c.calibration_path, "Calibration_path", "Camera_type 1 needs a stereo calibration");
+  }
+  if (c.camera_type == 1 && c.illumination_invariance == 1)
+    throw InputError("Illumination_invariance: 1 with Camera_type 1 (stereo); expected 0: the "
+                     "stereo pipeline describes grey rectified images, and Eq. 6 needs colour");
   switch (c.frame_mode) {
     case 0:
-      need(c.images_path, "Images_path", "Frame_mode 0 reads an image folder");
+      if (c.camera_type != 1)
+        need(c.images_path, "Images_path", "Frame_mode 0 reads an image folder");
       break;
     case 1:
       need(c.video_path_1, "Video_path_1", "Frame_mode 1 reads a video");

@@ -42,7 +42,10 @@ class Descriptor {
   }
   // Side of the square patch this descriptor expects.
   virtual int PatchSize() const = 0;
-  // Describes `patch` (CV_8UC1, PatchSize() x PatchSize()) into `row`, a 1 x Width() matrix of
+  // Channels of the patch: 1 (grey) for every descriptor but D-LDB, whose patch has 2
+  // (channel 0 grey, channel 1 disparity, both CV_8U; descriptors/dldb.h).
+  virtual int Channels() const { return 1; }
+  // Describes `patch` (CV_8UC(Channels()), PatchSize() x PatchSize()) into `row`, a 1 x Width() matrix of
   // CV_8U (binary) or CV_32F (float) that the caller allocated. Must be deterministic and safe
   // to call from several threads at once. Throws std::logic_error on a patch of the wrong size
   // or type.

@@ -9,6 +9,7 @@
 #include "OpenABLE/base/error.h"
 #include "descriptors/brief.h"
 #include "descriptors/freak.h"
+#include "descriptors/dldb.h"
 #include "descriptors/hog.h"
 #include "descriptors/ldb.h"
 #include "descriptors/opencv_descriptors.h"
@@ -31,12 +32,13 @@ struct Entry {
 // The one table of descriptors, in the order shown to users.
 const Entry kDescriptors[] = {
     {"LDB", &Make<LdbDescriptor>},      // descriptors/ldb.h
+    {"D-LDB", &Make<DldbDescriptor>},   // descriptors/dldb.h (2-channel patch: grey, disparity)
     {"ORB", &Make<OrbDescriptor>},      // descriptors/opencv_descriptors.h
     {"BRISK", &Make<BriskDescriptor>},  // descriptors/opencv_descriptors.h
-    {"SIFT", &Make<SiftDescriptor>},    // descriptors/opencv_descriptors.h
-    {"HOG", &Make<HogDescriptor>},      // descriptors/hog.h
     {"BRIEF", &Make<BriefDescriptor>},  // descriptors/brief.h
     {"FREAK", &Make<FreakDescriptor>},  // descriptors/freak.h
+    {"SIFT", &Make<SiftDescriptor>},    // descriptors/opencv_descriptors.h
+    {"HOG", &Make<HogDescriptor>},      // descriptors/hog.h
 };
 
 struct Unavailable {
@@ -48,7 +50,6 @@ const Unavailable kUnavailable[] = {
     {"SURF",
      "patented non-free code, absent from Debian's OpenCV build; use SIFT for a vector "
      "descriptor or LDB for a binary one"},
-    {"D-LDB", "stereo; not built yet"},
 };
 
 std::string Upper(const std::string& s) {

@@ -145,9 +145,50 @@ TEST(Config, CrossKeyChecks) {
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Images_path: empty"), std::string::npos);
   c.images_path = "x";
   CheckConfig(c);
+  c.camera_type = 2;
+  CheckConfig(c);  // panoramas read Images_path like a monocular run
+  // Peak responses: all three or none.
+  c.lambda_red = 610;
+  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Lambda_red, Lambda_green, Lambda_blue: 610, 0, 0"),
+            std::string::npos);
+  c.lambda_green = 535;
+  c.lambda_blue = 470;
+  CheckConfig(c);
+  c.lambda_red = c.lambda_green = c.lambda_blue = 0;
+  // Stereo: its folders and calibration are required, Images_path is not.
   c.camera_type = 1;
-  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Camera_type: 1"), std::string::npos);
+  c.images_path = "";
+  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Images_path_left: empty"), std::string::npos);
+  c.images_path_left = "l";
+  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Images_path_right: empty"), std::string::npos);
+  c.images_path_right = "r";
+  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Calibration_path: empty"), std::string::npos);
+  c.calibration_path = "cal.yaml";
+  c.image_descriptor = "D-LDB";
+  CheckConfig(c);
+  c.illumination_invariance = 1;  // stereo frames are grey
+  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Illumination_invariance: 1 with Camera_type 1"),
+            std::string::npos);
+  c.illumination_invariance = 0;
+  c.images_path_2 = "second";
+  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Images_path_2: \"second\" with Camera_type 1"),
+            std::string::npos);
+  c.images_path_2 = "";
+  c.frame_mode = 1;
+  c.video_path_1 = "a.avi";
+  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Frame_mode: 1 with Camera_type 1"),
+            std::string::npos);
+  c.frame_mode = 0;
+  c.video_path_1 = "";
+  // D-LDB needs the disparity of a stereo camera (any case of the name).
   c.camera_type = 0;
+  c.images_path = "x";
+  for (const char* name : {"D-LDB", "d-ldb"}) {
+    c.image_descriptor = name;
+    EXPECT_EQ(ErrorOf([&] { CheckConfig(c); }),
+              "Image_descriptor: D-LDB needs Camera_type 1 (stereo); Camera_type is 0");
+  }
+  c.image_descriptor = "LDB";
   c.frame_mode = 2;
   c.video_path_1 = "a.avi";
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Video_path_2"), std::string::npos);

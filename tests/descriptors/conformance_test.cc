@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -34,6 +35,7 @@ struct Expected {
 const std::map<std::string, Expected>& ExpectedFor64() {
   static const std::map<std::string, Expected> table = {
       {"LDB", {32, DescriptorKind::kBinary}},    // 256 bits
+      {"D-LDB", {64, DescriptorKind::kBinary}},  // 256 bits of grey ++ 256 bits of disparity
       {"ORB", {32, DescriptorKind::kBinary}},    // 256 bits
       {"BRISK", {64, DescriptorKind::kBinary}},  // 512 bits
       {"SIFT", {128, DescriptorKind::kFloat}},   // 4 x 4 cells x 8 bins
@@ -62,6 +64,16 @@ double Distance(const Descriptor& d, const cv::Mat& a, const cv::Mat& b) {
   return std::sqrt(sum);
 }
 
+// A patch of the descriptor's channel count: the textured grey patch, and for a 2-channel
+// descriptor (D-LDB: grey, disparity) a second, independent textured patch as channel 1.
+cv::Mat PatchFor(const Descriptor& d, int size, std::uint64_t seed) {
+  if (d.Channels() == 1) return TexturedPatch(size, seed);
+  const cv::Mat channels[2] = {TexturedPatch(size, seed), TexturedPatch(size, seed + 7919)};
+  cv::Mat out;
+  cv::merge(channels, 2, out);
+  return out;
+}
+
 bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
   return a.type() == b.type() && a.size() == b.size() &&
          std::memcmp(a.ptr(0), b.ptr(0), a.cols * a.elemSize()) == 0;
@@ -88,7 +100,7 @@ TEST_P(DescriptorConformance, DeclaresWidthAndRowType) {
                                                                       : DistanceKind::kL2);
   EXPECT_EQ(RowType(*d), it->second.kind == DescriptorKind::kBinary ? CV_8U : CV_32F);
 
-  const cv::Mat row = Describe(*d, TexturedPatch(64, 1));
+  const cv::Mat row = Describe(*d, PatchFor(*d, 64, 1));
   EXPECT_EQ(row.rows, 1);
   EXPECT_EQ(row.cols, it->second.width);
   EXPECT_EQ(row.type(), RowType(*d));
@@ -101,7 +113,7 @@ TEST_P(DescriptorConformance, DeclaresWidthAndRowType) {
 TEST_P(DescriptorConformance, WritesIntoARowOfALargerBlock) {
   // The pipeline describes straight into row i of an N x Width block.
   const auto d = Make();
-  const cv::Mat patch = TexturedPatch(64, 2);
+  const cv::Mat patch = PatchFor(*d, 64, 2);
   cv::Mat block(3, d->Width(), RowType(*d), cv::Scalar::all(7));
   d->Describe(patch, block.row(1));
   EXPECT_TRUE(SameBytes(block.row(1), Describe(*d, patch)));
@@ -111,8 +123,8 @@ TEST_P(DescriptorConformance, WritesIntoARowOfALargerBlock) {
 }
 
 TEST_P(DescriptorConformance, IsDeterministic) {
-  const cv::Mat patch = TexturedPatch(64, 3);
   const auto d = Make();
+  const cv::Mat patch = PatchFor(*d, 64, 3);
   const cv::Mat first = Describe(*d, patch);
   EXPECT_TRUE(SameBytes(first, Describe(*d, patch)));
   EXPECT_TRUE(SameBytes(first, Describe(*Make(), patch))) << "a second instance differs";
@@ -123,7 +135,7 @@ TEST_P(DescriptorConformance, IsDeterministicAcrossThreads) {
   std::vector<cv::Mat> patches;
   std::vector<cv::Mat> expected;
   for (int i = 0; i < 6; ++i) {
-    patches.push_back(TexturedPatch(64, 10 + i));
+    patches.push_back(PatchFor(*d, 64, 10 + i));
     expected.push_back(Describe(*d, patches.back()));
   }
   constexpr int kThreads = 4;
@@ -148,7 +160,7 @@ TEST_P(DescriptorConformance, IsDeterministicAcrossThreads) {
 
 TEST_P(DescriptorConformance, IdenticalImagesAreAtDistanceZero) {
   const auto d = Make();
-  const cv::Mat patch = TexturedPatch(64, 4);
+  const cv::Mat patch = PatchFor(*d, 64, 4);
   const cv::Mat copy = patch.clone();
   EXPECT_EQ(Distance(*d, Describe(*d, patch), Describe(*d, copy)), 0.0);
 }
@@ -157,7 +169,7 @@ TEST_P(DescriptorConformance, ViewIntoALargerImageIsDescribedFromItsOwnPixels) {
   // The same pixels as a 64 x 64 view inside a larger, different image and as a standalone
   // copy: the descriptor must not read pixels around the view.
   const auto d = Make();
-  cv::Mat big = TexturedPatch(128, 5);
+  cv::Mat big = PatchFor(*d, 128, 5);
   const cv::Mat view = big(cv::Rect(30, 40, 64, 64));
   ASSERT_TRUE(view.isSubmatrix());
   EXPECT_EQ(Distance(*d, Describe(*d, view), Describe(*d, view.clone())), 0.0);
@@ -166,7 +178,7 @@ TEST_P(DescriptorConformance, ViewIntoALargerImageIsDescribedFromItsOwnPixels) {
 TEST_P(DescriptorConformance, HandlesUniformPatches) {
   const auto d = Make();
   for (const int value : {0, 255}) {
-    const cv::Mat patch(64, 64, CV_8UC1, cv::Scalar(value));
+    const cv::Mat patch(64, 64, CV_8UC(d->Channels()), cv::Scalar::all(value));
     cv::Mat row;
     EXPECT_NO_THROW(row = Describe(*d, patch)) << "uniform patch " << value;
     if (d->Kind() == DescriptorKind::kFloat && !row.empty()) {
@@ -178,11 +190,13 @@ TEST_P(DescriptorConformance, HandlesUniformPatches) {
 TEST_P(DescriptorConformance, RejectsPatchOfWrongSizeOrType) {
   const auto d = Make();
   cv::Mat row(1, d->Width(), RowType(*d));
+  const int c = d->Channels();
   const std::vector<cv::Mat> wrong = {
       cv::Mat(),
-      cv::Mat(63, 64, CV_8UC1, cv::Scalar(9)),
-      cv::Mat(64, 65, CV_8UC1, cv::Scalar(9)),
-      cv::Mat(32, 32, CV_8UC1, cv::Scalar(9)),
+      cv::Mat(63, 64, CV_8UC(c), cv::Scalar::all(9)),
+      cv::Mat(64, 65, CV_8UC(c), cv::Scalar::all(9)),
+      cv::Mat(32, 32, CV_8UC(c), cv::Scalar::all(9)),
+      cv::Mat(64, 64, CV_8UC(c == 1 ? 2 : 1), cv::Scalar::all(9)),  // the other channel count
       cv::Mat(64, 64, CV_8UC3, cv::Scalar::all(9)),
       cv::Mat(64, 64, CV_32FC1, cv::Scalar(9)),
       cv::Mat(64, 64, CV_16UC1, cv::Scalar(9)),
@@ -191,7 +205,7 @@ TEST_P(DescriptorConformance, RejectsPatchOfWrongSizeOrType) {
     EXPECT_THROW(d->Describe(patch, row), std::logic_error)
         << patch.rows << " x " << patch.cols << " type " << patch.type();
   }
-  const cv::Mat patch = TexturedPatch(64, 6);
+  const cv::Mat patch = PatchFor(*d, 64, 6);
   const int other_type = RowType(*d) == CV_8U ? CV_32F : CV_8U;
   EXPECT_THROW(d->Describe(patch, cv::Mat(1, d->Width() - 1, RowType(*d))), std::logic_error);
   EXPECT_THROW(d->Describe(patch, cv::Mat(1, d->Width(), other_type)), std::logic_error);
@@ -201,7 +215,7 @@ TEST_P(DescriptorConformance, RejectsPatchOfWrongSizeOrType) {
 TEST_P(DescriptorConformance, DifferentImagesAreAtNonZeroDistance) {
   const auto d = Make();
   std::vector<cv::Mat> rows;
-  for (int i = 0; i < 5; ++i) rows.push_back(Describe(*d, TexturedPatch(64, 100 + i)));
+  for (int i = 0; i < 5; ++i) rows.push_back(Describe(*d, PatchFor(*d, 64, 100 + i)));
   for (std::size_t i = 0; i < rows.size(); ++i) {
     for (std::size_t j = i + 1; j < rows.size(); ++j) {
       EXPECT_GT(Distance(*d, rows[i], rows[j]), 0.0) << "images " << i << " and " << j;
@@ -213,8 +227,8 @@ TEST_P(DescriptorConformance, WorksAtOtherPatchSizes) {
   for (const int size : {16, 24, 32, 48, 96}) {
     const auto d = Make(size);
     EXPECT_EQ(d->PatchSize(), size);
-    const cv::Mat a = TexturedPatch(size, 200 + size);
-    const cv::Mat b = TexturedPatch(size, 300 + size);
+    const cv::Mat a = PatchFor(*d, size, 200 + size);
+    const cv::Mat b = PatchFor(*d, size, 300 + size);
     cv::Mat row_a, row_b;
     ASSERT_NO_THROW(row_a = Describe(*d, a)) << "patch size " << size;
     ASSERT_NO_THROW(row_b = Describe(*d, b)) << "patch size " << size;
@@ -226,7 +240,10 @@ TEST_P(DescriptorConformance, WorksAtOtherPatchSizes) {
 INSTANTIATE_TEST_SUITE_P(AllRegistered, DescriptorConformance,
                          ::testing::ValuesIn(RegisteredDescriptorNames()),
                          [](const ::testing::TestParamInfo<std::string>& info) {
-                           return info.param;  // registered names are alphanumeric
+                           std::string name = info.param;  // "D-LDB" -> "D_LDB"
+                           for (char& ch : name)
+                             if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+                           return name;
                          });
 
 // The table above covers exactly the registered names.
