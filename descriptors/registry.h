@@ -14,7 +14,7 @@ namespace openable {
 std::vector<std::string> RegisteredDescriptorNames();
 
 // Names the original OpenABLE knew that this build cannot provide, each with the reason
-// (SURF: patented, absent from Debian's OpenCV; others: not built yet).
+// (SURF: patented, absent from Debian's OpenCV).
 std::vector<std::pair<std::string, std::string>> UnavailableDescriptors();
 
 // Creates the descriptor `name` (case-insensitive). Throws InputError naming the value and
