@@ -99,7 +99,10 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
     char text[200];
     result.camera = panoramic ? "panoramic, " + std::to_string(strips) + " sub-panoramas, " +
                                     PanoramaMatchingName(panorama_matching) + " matching"
-                              : "monocular";
+                  : config.camera_type == 1
+                      ? std::string("stereo, rectified") +
+                            (descriptor->Channels() == 2 ? ", SGBM disparity" : ", left image")
+                      : "monocular";
     if (config.illumination_invariance == 1) {
       std::snprintf(text, sizeof text, ", illumination invariant (Eq. 6, alpha %.4f%s)", alpha,
                     lambdas ? " from Eq. 7" : "");
