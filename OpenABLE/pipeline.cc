@@ -30,15 +30,6 @@ double SecondsSince(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// Runs `open` and prefixes the key to any InputError it throws.
-template <typename F>
-auto WithKey(const std::string& key, F open) {
-  try {
-    return open();
-  } catch (const InputError& e) {
-    throw InputError(key + ": " + e.what());
-  }
-}
 
 enum class SourceKind { kFolder, kVideo, kStereo };
 

@@ -108,24 +108,10 @@ void SortCandidates(std::vector<Candidate>& c) {
 // Queries handed to one FLANN call (and one thread) at a time.
 constexpr int kQueryBlock = 32;
 
-// Bits differing between a and b, with the POPCNT instruction (x86-64 CPUs since 2008).
-__attribute__((target("popcnt"))) int PopcntHamming(const unsigned char* a, const unsigned char* b,
-                                                    size_t bytes) {
-  int bits = 0;
-  size_t k = 0;
-  for (; k + 8 <= bytes; k += 8) {
-    std::uint64_t x, y;
-    std::memcpy(&x, a + k, 8);
-    std::memcpy(&y, b + k, 8);
-    bits += __builtin_popcountll(x ^ y);
-  }
-  for (; k < bytes; ++k) bits += __builtin_popcount(static_cast<unsigned>(a[k] ^ b[k]));
-  return bits;
-}
-
-// FLANN's Hamming functor, with the popcount instruction when the CPU has it: FLANN's own
-// cvflann::Hamming is compiled for baseline x86-64 here, where __builtin_popcountll becomes a
-// bit-twiddling routine. The LSH index scores every candidate of every probed bucket with it.
+// FLANN's Hamming functor on HammingDistance, which uses the popcount instruction when the CPU
+// has it: FLANN's own cvflann::Hamming is compiled for baseline x86-64 here, where
+// __builtin_popcountll becomes a bit-twiddling routine. The LSH index scores every candidate of
+// every probed bucket with it.
 struct LshHamming {
   using ElementType = unsigned char;
   using ResultType = int;
@@ -133,10 +119,8 @@ struct LshHamming {
   using is_vector_space_distance = cvflann::False;
   template <typename A, typename B>
   ResultType operator()(A a, B b, size_t size, ResultType /*worst*/ = -1) const {
-    static const bool popcnt = __builtin_cpu_supports("popcnt");
-    const auto* x = reinterpret_cast<const unsigned char*>(a);
-    const auto* y = reinterpret_cast<const unsigned char*>(b);
-    return popcnt ? PopcntHamming(x, y, size) : HammingDistance(x, y, static_cast<int>(size));
+    return HammingDistance(reinterpret_cast<const std::uint8_t*>(a),
+                           reinterpret_cast<const std::uint8_t*>(b), static_cast<int>(size));
   }
 };
 

@@ -299,7 +299,12 @@ void CheckInputs(const cv::Mat& a, const cv::Mat& b, int depth, const char* what
 
 }  // namespace
 
-int HammingDistance(const std::uint8_t* a, const std::uint8_t* b, int bytes) {
+namespace {
+
+// One pair, compiled twice: for baseline x86-64 (where __builtin_popcountll is a bit-twiddling
+// routine) and with the POPCNT instruction.
+template <int kUnused>
+__attribute__((always_inline)) inline int PairBits(const std::uint8_t* a, const std::uint8_t* b, int bytes) {
   int bits = 0;
   int k = 0;
   for (; k + 8 <= bytes; k += 8) {
@@ -310,6 +315,22 @@ int HammingDistance(const std::uint8_t* a, const std::uint8_t* b, int bytes) {
   }
   for (; k < bytes; ++k) bits += __builtin_popcount(static_cast<unsigned>(a[k] ^ b[k]));
   return bits;
+}
+
+int PairBitsPortable(const std::uint8_t* a, const std::uint8_t* b, int bytes) {
+  return PairBits<0>(a, b, bytes);
+}
+
+__attribute__((target("popcnt"))) int PairBitsPopcnt(const std::uint8_t* a,
+                                                     const std::uint8_t* b, int bytes) {
+  return PairBits<1>(a, b, bytes);
+}
+
+}  // namespace
+
+int HammingDistance(const std::uint8_t* a, const std::uint8_t* b, int bytes) {
+  static const bool popcnt = __builtin_cpu_supports("popcnt");
+  return popcnt ? PairBitsPopcnt(a, b, bytes) : PairBitsPortable(a, b, bytes);
 }
 
 cv::Mat1f HammingDistances(const cv::Mat& a, const cv::Mat& b, int threads,

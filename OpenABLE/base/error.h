@@ -44,4 +44,14 @@ inline std::string Quoted(std::string_view s) {
   return out + "\"";
 }
 
+// Runs `f` and prefixes `key` (a config key naming the source) to any InputError it throws.
+template <typename F>
+auto WithKey(const std::string& key, F f) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    throw InputError(key + ": " + e.what());
+  }
+}
+
 }  // namespace openable

@@ -9,7 +9,6 @@
 namespace openable {
 namespace {
 
-std::string Quoted(const std::string& s) { return "\"" + s + "\""; }
 std::string SizeText(const cv::Size& s) {
   return std::to_string(s.width) + "x" + std::to_string(s.height);
 }
@@ -20,16 +19,6 @@ cv::Mat Gray8(const cv::Mat& frame) {
   if (frame.channels() == 3) cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
   gray.convertTo(out, CV_8U, 255.0);
   return out;
-}
-
-// Runs `open` and prefixes `key` to any InputError.
-template <typename F>
-auto WithKey(const std::string& key, F open) {
-  try {
-    return open();
-  } catch (const InputError& e) {
-    throw InputError(key + ": " + e.what());
-  }
 }
 
 class StereoFolderSource final : public FrameSource {
