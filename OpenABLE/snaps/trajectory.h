@@ -1,0 +1,83 @@
+// Trajectories for the SNAPS add-on (issue 6): poses of a camera over a run, their files, their
+// association with a ground truth, and the absolute trajectory error.
+//
+// Paper: "Similarity and Location-based Real-time Loop Closure: SNAPS for SLAM in Unexplored
+// Environments" (../shared/papers/000_589a4d56462291ec.txt), Sec. II-III.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+namespace openable::snaps {
+
+// File formats.
+//  - kKitti: one pose per line, 12 numbers, row-major 3x4 [R | t]; pose i is frame i.
+//  - kKittiWithId: a frame number, then the 12 numbers (keyframes of a VO system, e.g. the
+//    SO-DSO files of ../shared/datasets/kitti_trajectories); pose i is frame id_i.
+//  - kTum: `timestamp tx ty tz qx qy qz qw` per line ('#' comments); pose i is frame i.
+enum class TrajectoryFormat { kKitti, kKittiWithId, kTum };
+
+// "kitti", "kitti-id", "tum" (case-insensitive); throws InputError naming `key` otherwise.
+TrajectoryFormat ParseTrajectoryFormat(const std::string& name, const std::string& key);
+std::string TrajectoryFormatName(TrajectoryFormat format);
+
+struct Trajectory {
+  TrajectoryFormat format = TrajectoryFormat::kKitti;
+  // Camera-to-world poses (the camera's position is poses[i].translation()).
+  std::vector<Eigen::Isometry3d> poses;
+  // Frame number of each pose: the line index (kKitti, kTum) or the first column (kKittiWithId),
+  // strictly increasing.
+  std::vector<long> frame_ids;
+  // Seconds, kTum only (empty otherwise).
+  std::vector<double> timestamps;
+  // The file stored world-to-camera matrices (inverted on reading, re-inverted on writing).
+  bool world_to_camera = false;
+
+  int Size() const { return static_cast<int>(poses.size()); }
+};
+
+// Reads a trajectory. `world_to_camera`: the file's matrices map world points into the camera
+// (SO-DSO's poses_history_file.txt); they are inverted so that `poses` are camera-to-world.
+// Throws InputError naming the file and the line (wrong count of numbers, not a number,
+// non-finite value, a rotation that is not one within 1e-3, frame ids not increasing, empty
+// file).
+Trajectory ReadTrajectory(const std::string& path, TrajectoryFormat format,
+                          bool world_to_camera = false);
+
+// The trajectory in its own format (and orientation convention), full double precision, so that
+// ReadTrajectory(EncodeTrajectory(t)) gives t back.
+std::string EncodeTrajectory(const Trajectory& trajectory);
+
+// For each pose of `estimate`, the index of its pose in `truth`: by frame id (kKitti and
+// kKittiWithId against a per-frame ground truth), or by nearest timestamp within
+// `time_tolerance` seconds (both kTum). Throws InputError naming `key` when a pose has no
+// counterpart (the message gives the first such frame and the ground truth's range).
+std::vector<int> AssociateWithTruth(const Trajectory& estimate, const Trajectory& truth,
+                                    double time_tolerance, const std::string& key);
+
+// Absolute trajectory error of the positions of `estimate` against their counterparts in
+// `truth` (`association` as AssociateWithTruth gives it).
+struct TrajectoryError {
+  double rmse = 0;     // sqrt(mean of squared distances), metres
+  double mean = 0;     // mean distance: the paper's "mean deviation from the ground truth"
+  double median = 0;
+  double max = 0;
+  bool aligned = false;                      // a rigid alignment was applied first
+  Eigen::Isometry3d alignment = Eigen::Isometry3d::Identity();  // applied to the estimate
+};
+// `align` = true: first the rigid motion (rotation + translation, no scale) that best maps the
+// estimate's positions onto the truth's in the least-squares sense (Umeyama, Eigen::umeyama).
+TrajectoryError AbsoluteTrajectoryError(const Trajectory& estimate, const Trajectory& truth,
+                                        const std::vector<int>& association, bool align);
+
+// A loop: pose `query` (the later one) revisits the place of pose `reference` (indices into
+// the trajectory, reference < query). `similarity` in [0, 1] (Q of the paper; 1 when unknown).
+struct LoopPair {
+  int query = 0;
+  int reference = 0;
+  double similarity = 1.0;
+};
+
+}  // namespace openable::snaps
