@@ -1,0 +1,71 @@
+// Where SNAPS's loops come from: (a) a finished OpenABLE run (its normalised matrix), (b) a CSV
+// of frame pairs (ground truth or another detector), (c) SNAPS's own search on thumbnails of
+// the images (Sec. III-B), corrected online as the paper does.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "OpenABLE/snaps/loop_search.h"
+#include "OpenABLE/snaps/trajectory.h"
+
+namespace openable::snaps {
+
+// Frame id -> trajectory index: exactly, or the nearest pose's frame id within `tolerance`
+// frames (ties: the earlier pose). -1 when none.
+int IndexOfFrame(const Trajectory& trajectory, long frame_id, long tolerance);
+
+struct MatrixLoopOptions {
+  // A loop needs M'(q, j) < threshold (M' in [0, 1]; 0 = identical).
+  double threshold = 0.1;
+  // Only j <= q - exclusion (matrix rows, i.e. frames) are matches of q.
+  int exclusion = 100;
+  // Frame id of the matrix's row 0 (the run's Initial_image).
+  long initial = 0;
+  // Frames whose id is not a pose of the trajectory map to the nearest pose within this many
+  // frames; 0 keeps only frames that are poses (keyframes).
+  long tolerance = 0;
+};
+
+// (a) Loops from an OpenABLE matrix of one sequence (ReadMatrixFile: .npy, .txt, image). For
+// each row q, its best earlier match j (smallest M'(q, j) with j <= q - exclusion; the earliest
+// on ties) with M'(q, j) < threshold gives LoopPair{index(q), index(j), 1 - M'(q, j)}, frames
+// mapped to trajectory indices by frame id (row i is frame initial + i) through IndexOfFrame;
+// pairs with a frame that maps to no pose, or whose indices are not query > reference, are
+// dropped; when several rows map to one query index the most similar is kept. A matrix whose
+// maximum exceeds 1 (an image, 0-255) is first divided by its maximum. Throws InputError
+// naming the file when the matrix is not square.
+std::vector<LoopPair> LoopsFromMatrix(const std::string& path, const Trajectory& trajectory,
+                                      const MatrixLoopOptions& options);
+
+// (b) Loops from a CSV of pairs: one `row,col` per line (spaces allowed around the numbers,
+// '#' starts a comment, blank lines skipped), row = the later frame id, col the earlier.
+// Frame ids map to trajectory indices by IndexOfFrame(tolerance); a pair with a frame
+// inside the trajectory's frame range that maps to no pose (not a keyframe) is dropped
+// (counted in `dropped` when given); similarity 1. Throws InputError, one line naming
+// file:line and the value, when a line is not two non-negative integers, row <= col, or a
+// frame id is outside the trajectory's frame ids [first, last].
+std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& trajectory,
+                                   long tolerance = 0, int* dropped = nullptr);
+
+// (c) SNAPS's search on the images of a folder: frame id f of the trajectory is image
+// `f - initial` of ListImages(folder, extension); each pose in order is read (ReadImageFile,
+// ToGray8), reduced to its thumbnail (options.thumbnail_scale) and fed to OnlineSnaps with the
+// trajectory's pose as the odometry. Throws InputError when a frame id has no image.
+struct ImageSearchResult {
+  std::vector<LoopPair> loops;       // indices of the trajectory
+  Trajectory corrected;              // the trajectory as corrected online
+  std::vector<StepRecord> steps;     // one per pose (search latency and what happened)
+  std::vector<double> correction_seconds;  // one per loop
+  std::vector<double> thumbnail_seconds;   // one per pose: read + grey + thumbnail
+};
+ImageSearchResult SearchLoopsInImages(const std::string& folder, const std::string& extension,
+                                      long initial, const Trajectory& trajectory,
+                                      const SearchOptions& options);
+
+// The same on thumbnails already made (thumbnails[i] belongs to pose i).
+ImageSearchResult SearchLoopsInThumbnails(const std::vector<cv::Mat>& thumbnails,
+                                          const Trajectory& trajectory,
+                                          const SearchOptions& options);
+
+}  // namespace openable::snaps
