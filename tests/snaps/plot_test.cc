@@ -59,8 +59,8 @@ TEST(RenderTrajectories, EqualAspect) {
   TrajectoryPlot plot;
   plot.input = &input;
   const cv::Mat3b img = RenderTrajectories(plot);
-  // Extents within a band through the plot area's centre (1000 - 90 - 30 = 1000 - 50 - 70 = 880 px
-  // square from x = 90, y = 50): away from the legend's line samples.
+  // Extents within a band through the plot area's centre (an 880 px square from x = 90,
+  // y = 50): away from the legend's line samples.
   const int cx = 90 + 440, cy = 50 + 440;
   int left = img.cols, right = 0, top = img.rows, bottom = 0;
   const cv::Vec3b vermillion(0, 94, 213);
