@@ -14,6 +14,8 @@
 // The figure is max(k cols, 600) wide; a white legend strip (one or more 30 px lines) is below.
 #include "OpenABLE/evaluation/plots.h"
 
+#include "OpenABLE/evaluation/drawing.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -29,60 +31,18 @@
 namespace openable {
 namespace {
 
-// ---------------------------------------------------------------------------------------------
-// Shared drawing helpers.
-
-constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
-const cv::Scalar kBlack(0, 0, 0);
-const cv::Scalar kWhite(255, 255, 255);
-const cv::Scalar kGridGrey(225, 225, 225);
-const cv::Scalar kFrameGrey(160, 160, 160);
-
-// Okabe-Ito, BGR: blue, orange, bluish green, vermillion, reddish purple, sky blue, black,
-// yellow (yellow last: it is the weakest on white).
-const cv::Scalar kPalette[] = {
-    {178, 114, 0}, {0, 159, 230}, {115, 158, 0},  {0, 94, 213},
-    {167, 121, 204}, {233, 180, 86}, {0, 0, 0}, {66, 228, 240},
-};
-constexpr int kPaletteSize = static_cast<int>(sizeof(kPalette) / sizeof(kPalette[0]));
-
-cv::Size TextSize(const std::string& text, double scale, int thickness, int* baseline = nullptr) {
-  int b = 0;
-  const cv::Size s = cv::getTextSize(text, kFont, scale, thickness, &b);
-  if (baseline != nullptr) *baseline = b;
-  return s;
-}
-
-void PutText(cv::Mat3b& img, const std::string& text, cv::Point baseline_left, double scale,
-             int thickness, const cv::Scalar& colour) {
-  cv::putText(img, text, baseline_left, kFont, scale, colour, thickness, cv::LINE_AA);
-}
-
-// Largest scale <= `scale` (down to `min_scale`) at which `text` fits in `max_width`.
-double FitScale(const std::string& text, double scale, double min_scale, int thickness,
-                int max_width) {
-  while (scale > min_scale && TextSize(text, scale, thickness).width > max_width) scale -= 0.05;
-  return std::max(scale, min_scale);
-}
-
-// Bold (thickness 2) text at `scale` if it fits in `max_width` at a scale >= 0.6; else thin text
-// at a scale >= `min_scale` (thick Hershey strokes clog at small scales).
-void FitBold(const std::string& text, double scale, double min_scale, int max_width,
-             double* fitted_scale, int* thickness) {
-  *thickness = 2;
-  *fitted_scale = FitScale(text, scale, 0.6, 2, max_width);
-  if (TextSize(text, *fitted_scale, 2).width <= max_width) return;
-  *thickness = 1;
-  *fitted_scale = FitScale(text, 0.6, min_scale, 1, max_width);
-}
-
-// `text` shortened with "..." until it fits in `max_width` at `scale`.
-std::string Ellipsize(const std::string& text, double scale, int thickness, int max_width) {
-  if (TextSize(text, scale, thickness).width <= max_width) return text;
-  std::string t = text;
-  while (!t.empty() && TextSize(t + "...", scale, thickness).width > max_width) t.pop_back();
-  return t + "...";
-}
+using drawing::DrawLegend;
+using drawing::Ellipsize;
+using drawing::FitBold;
+using drawing::Format;
+using drawing::kBlack;
+using drawing::kPalette;
+using drawing::kPaletteSize;
+using drawing::kGridGrey;
+using drawing::LegendEntry;
+using drawing::PutText;
+using drawing::PutVerticalText;
+using drawing::TextSize;
 
 // ---------------------------------------------------------------------------------------------
 // Precision-recall figure.
@@ -96,12 +56,6 @@ constexpr int kMarginTop = 50;
 constexpr int kMarginBottom = 60;
 constexpr int kShift = 4;  // fixed-point bits of curve coordinates
 constexpr double kOne = 1 << kShift;
-
-std::string Format(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, value);
-  return buffer;
-}
 
 double Clamp01(double v) {
   if (!(v == v)) return 0;  // NaN
@@ -127,25 +81,6 @@ std::string TickLabel(int i) {
   if (i == 0) return "0";
   if (i == 10) return "1.0";
   return "0." + std::to_string(i);
-}
-
-// Text rotated by 90 degrees counter-clockwise (reads bottom to top), centred on `centre`.
-void PutVerticalText(cv::Mat3b& img, const std::string& text, cv::Point centre, double scale,
-                     int thickness) {
-  int baseline = 0;
-  const cv::Size s = TextSize(text, scale, thickness, &baseline);
-  cv::Mat3b label(s.height + baseline + 4, s.width + 4, cv::Vec3b(255, 255, 255));
-  PutText(label, text, {2, 2 + s.height}, scale, thickness, kBlack);
-  cv::Mat3b rotated;
-  cv::rotate(label, rotated, cv::ROTATE_90_COUNTERCLOCKWISE);
-  cv::Rect where(centre.x - rotated.cols / 2, centre.y - rotated.rows / 2, rotated.cols,
-                 rotated.rows);
-  const cv::Rect clipped = where & cv::Rect(0, 0, img.cols, img.rows);
-  if (clipped.empty()) return;
-  cv::Mat target = img(clipped);
-  const cv::Mat source = rotated(cv::Rect(clipped.x - where.x, clipped.y - where.y,
-                                            clipped.width, clipped.height));
-  cv::min(target, source, target);  // dark text over whatever is there (white)
 }
 
 void DrawAxes(cv::Mat3b& img, const Axes& axes, const std::string& panel_title) {
@@ -211,49 +146,6 @@ void DrawCurve(cv::Mat3b& img, const Axes& axes, const std::vector<CurvePoint>& 
   cv::polylines(img, path, false, colour, 2, cv::LINE_AA, kShift);
 }
 
-struct LegendEntry {
-  std::string label;   // shortened with "..." when the box would not fit in the plot area
-  std::string suffix;  // " (AUC 0.612)", kept whole
-  cv::Scalar colour;
-};
-
-// Legend box in the lower left of the plot area.
-void DrawLegend(cv::Mat3b& img, const Axes& axes, const std::vector<LegendEntry>& entries) {
-  if (entries.empty()) return;
-  const cv::Rect& r = axes.plot;
-  const int pad = 8, sample = 28, gap = 8;
-  const int max_text_width = r.width - 20 - 2 * pad - sample - gap;
-  // Smaller rows when there are many series, so the box stays inside the plot area.
-  double scale = 0.48;
-  int row = 22;
-  const int rows = static_cast<int>(entries.size());
-  if (rows * row + 2 * pad > r.height - 20) {
-    row = std::max(12, (r.height - 20 - 2 * pad) / rows);
-    scale = std::max(0.3, scale * row / 22.0);
-  }
-  std::vector<std::string> texts;
-  int text_width = 0;
-  for (const LegendEntry& e : entries) {
-    const int suffix_width = TextSize(e.suffix, scale, 1).width;
-    texts.push_back(Ellipsize(e.label, scale, 1, std::max(0, max_text_width - suffix_width)) +
-                    e.suffix);
-    text_width = std::max(text_width, TextSize(texts.back(), scale, 1).width);
-  }
-  const int width = 2 * pad + sample + gap + text_width;
-  const int height = 2 * pad + rows * row - (row - TextSize("Ag", scale, 1).height) + 4;
-  const cv::Rect box(r.x + 10, r.y + r.height - 10 - height, width, height);
-  cv::rectangle(img, box, kWhite, cv::FILLED);
-  cv::rectangle(img, box, kFrameGrey, 1);
-  const int text_height = TextSize("Ag", scale, 1).height;
-  for (int i = 0; i < rows; ++i) {
-    const int baseline_y = box.y + pad + i * row + text_height + 1;
-    const int mid_y = baseline_y - text_height / 2;
-    cv::line(img, {box.x + pad, mid_y}, {box.x + pad + sample, mid_y}, entries[i].colour, 2,
-             cv::LINE_AA);
-    PutText(img, texts[i], {box.x + pad + sample + gap, baseline_y}, scale, 1, kBlack);
-  }
-}
-
 }  // namespace
 
 cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& title,
@@ -297,7 +189,7 @@ cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& t
         suffix = " (AP " + Format("%.1f", 100.0 * CurveArea(curve)) + "%)";
       legend.push_back({series[i].label, suffix, colour});
     }
-    DrawLegend(img, axes, legend);
+    DrawLegend(img, axes.plot, legend);
   }
   return img;
 }
