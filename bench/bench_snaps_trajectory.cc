@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/snaps/plot.h"
+#include "OpenABLE/snaps/loops.h"
 #include "OpenABLE/snaps/pose_graph.h"
 #include "OpenABLE/snaps/trajectory.h"
 
@@ -27,9 +28,11 @@ int main(int argc, char** argv) {
                                            TrajectoryFormat::kKittiWithId, true);
       const Trajectory truth = ReadTrajectory(root + "/poses/" + s + ".txt", TrajectoryFormat::kKitti);
       const std::vector<int> association = AssociateWithTruth(vo, truth, 0, "truth");
-      const std::vector<FramePair> pairs = ReadFramePairs(root + "/loop_pairs/" + run.pairs);
+      int dropped = 0, outside = 0;
+      const std::vector<LoopPair> pairs =
+          LoopsFromCsv(root + "/loop_pairs/" + run.pairs, vo, 0, &dropped, &outside);
       for (const bool middle : {true, false}) {
-        const std::vector<LoopPair> loops = KeyframeLoopPairs(pairs, vo, middle);
+        const std::vector<LoopPair> loops = middle ? MiddleOfRuns(pairs, vo) : pairs;
         for (const RobustKernel kernel : {RobustKernel::kHuber, RobustKernel::kNone}) {
           PoseGraphOptions options;
           options.robust_kernel = kernel;
@@ -48,6 +51,25 @@ int main(int argc, char** argv) {
                       e(corrected, true).mean, e(vo, true).rmse, e(corrected, true).rmse,
                       report.iterations, report.seconds);
           if (middle && kernel == RobustKernel::kHuber) {
+            // Upper bound of any loop-based correction here: the same loops with their exact
+            // relative pose taken from the ground truth (what a perfect geometric verification
+            // would measure), as full 6-DoF loop edges.
+            std::vector<RelativeLoop> exact;
+            for (const LoopPair& l : loops)
+              exact.push_back({l.query, l.reference,
+                               truth.poses[association[l.reference]].inverse() *
+                                   truth.poses[association[l.query]]});
+            PoseGraphReport oracle_report;
+            const Trajectory oracle = CorrectPoseGraph(vo, {}, exact, options, &oracle_report);
+            std::printf("%s | exact relative poses from the ground truth (upper bound) | %s | %zu "
+                        "| %.2f -> %.2f (%+.0f %%) | %.2f -> %.2f | %.2f -> %.2f | %.2f -> %.2f "
+                        "| %d | %.3f s\n",
+                        s.c_str(), RobustKernelName(kernel).c_str(), exact.size(),
+                        e(vo, false).mean, e(oracle, false).mean,
+                        -100 * (1 - e(oracle, false).mean / e(vo, false).mean), e(vo, false).rmse,
+                        e(oracle, false).rmse, e(vo, true).mean, e(oracle, true).mean,
+                        e(vo, true).rmse, e(oracle, true).rmse, oracle_report.iterations,
+                        oracle_report.seconds);
             TrajectoryPlot plot;
             plot.truth = &truth;
             plot.input = &vo;

@@ -278,6 +278,124 @@ const std::vector<Binding>& Bindings() {
        "Name of this run in the figure's legend and the JSON; empty: descriptor and L, "
        "e.g. \"LDB L=10\".",
        true},
+      // SNAPS add-on (openable_snaps; docs/snaps.md)
+      {"Snaps_trajectory", "SNAPS", &Config::snaps_trajectory, 0, 0,
+       "openable_snaps: the drifting trajectory to correct (visual odometry), in "
+       "Snaps_trajectory_format.",
+       true},
+      {"Snaps_trajectory_format", "SNAPS", &Config::snaps_trajectory_format, 0, 0,
+       "kitti (12 numbers per line, pose i = frame i), kitti-id (frame number + 12 numbers: "
+       "keyframes) or tum (timestamp tx ty tz qx qy qz qw). The corrected trajectories are "
+       "written in the same format.",
+       true},
+      {"Snaps_world_to_camera", "SNAPS", &Config::snaps_world_to_camera, 0, 1,
+       "1: the trajectory file holds world-to-camera matrices (SO-DSO's "
+       "poses_history_file.txt); they are inverted on reading and again on writing.",
+       true},
+      {"Snaps_ground_truth", "SNAPS", &Config::snaps_ground_truth, 0, 0,
+       "Ground-truth trajectory (camera-to-world) for the error figures and the plot; empty: "
+       "no evaluation. Associated by frame number (kitti, kitti-id) or timestamp (tum).",
+       true},
+      {"Snaps_ground_truth_format", "SNAPS", &Config::snaps_ground_truth_format, 0, 0,
+       "Format of Snaps_ground_truth: kitti, kitti-id or tum.", true},
+      {"Snaps_time_tolerance", "SNAPS", &Config::snaps_time_tolerance, 0, kNoLimit,
+       "tum: a pose and its ground truth are associated when their timestamps differ by at "
+       "most this many seconds.",
+       true},
+      {"Snaps_loops", "SNAPS", &Config::snaps_loops, 0, 0,
+       "Where the loops come from: search (SNAPS's own search on thumbnails of Snaps_images, "
+       "run online with the discounted update, as the paper), pairs (Snaps_loops_file: "
+       "row,col frame numbers per line, row the later frame), matrix (Snaps_loops_file: the "
+       "normalised matrix of an OpenABLE run of one sequence, .npy/.txt/image: each frame's "
+       "best match at least Snaps_frame_distance frames back, kept below "
+       "Snaps_matrix_threshold).",
+       true},
+      {"Snaps_loops_file", "SNAPS", &Config::snaps_loops_file, 0, 0,
+       "Pairs file (Snaps_loops pairs) or saved matrix (Snaps_loops matrix).", true},
+      {"Snaps_keyframe_tolerance", "SNAPS", &Config::snaps_keyframe_tolerance, 0, kNoLimit,
+       "Snaps_loops pairs and matrix: a frame that is not a pose of the trajectory (keyframes) "
+       "takes the nearest pose within this many frames; 0 keeps only frames that are poses.",
+       true},
+      {"Snaps_drop_outside", "SNAPS", &Config::snaps_drop_outside, 0, 1,
+       "Snaps_loops pairs: 0 stops at a pair with a frame outside the trajectory's frames (an "
+       "error naming the line); 1 drops such pairs and says how many (a ground-truth list of a "
+       "whole sequence against a trajectory that stops a few frames early).",
+       true},
+      {"Snaps_middle_of_runs", "SNAPS", &Config::snaps_middle_of_runs, 0, 1,
+       "Snaps_loops pairs: 1 keeps, of each query's references, only the middle of each run of "
+       "consecutive frames (ground-truth lists pair a query with every frame within a radius; "
+       "the middle is the nearest place); 0 keeps every pair.",
+       true},
+      {"Snaps_matrix_threshold", "SNAPS", &Config::snaps_matrix_threshold, 0, 1,
+       "Snaps_loops matrix: a best match is a loop when its normalised distance M' is below "
+       "this; its similarity Q is 1 - M'.",
+       true},
+      {"Snaps_images", "SNAPS", &Config::snaps_images, 0, 0,
+       "Snaps_loops search: image folder of the trajectory's frames (image i in natural order "
+       "is frame i); empty: Images_path.",
+       true},
+      {"Snaps_thumbnail_scale", "SNAPS", &Config::snaps_thumbnail_scale, 0.01, 1,
+       "Thumbnails are the frames scaled by this (1/6 in the paper).", true},
+      {"Snaps_window", "SNAPS", &Config::snaps_window, 2, 64,
+       "B: side of the sliding window of the universal image quality index (Eq. 4, 5); the "
+       "paper gives none, 8 is Wang and Bovik's.",
+       true},
+      {"Snaps_min_similarity", "SNAPS", &Config::snaps_min_similarity, -1, 1,
+       "Minimum similarity Q of a loop (0.75 in the paper).", true},
+      {"Snaps_yaw_limit", "SNAPS", &Config::snaps_yaw_limit, 0, 180,
+       "Candidates whose heading differs from the current frame's by more than this many "
+       "degrees are ignored (10 in the paper).",
+       true},
+      {"Snaps_radius", "SNAPS", &Config::snaps_radius, 0, kNoLimit,
+       "Candidates lie within this many metres of the current (corrected) position (not "
+       "given in the paper).",
+       true},
+      {"Snaps_frame_distance", "SNAPS", &Config::snaps_frame_distance, 1, kNoLimit,
+       "M: the last M frames are never candidates (frame numbers of the trajectory's poses; "
+       "not given in the paper).",
+       true},
+      {"Snaps_attempts", "SNAPS", &Config::snaps_attempts, 1, kNoLimit,
+       "At most this many candidates, nearest first, are compared (not given in the paper).",
+       true},
+      {"Snaps_discount_length", "SNAPS", &Config::snaps_discount_length, 0, kNoLimit,
+       "K of Eq. 6: the last K poses move towards the reference (not given in the paper; "
+       "gamma is 0 beyond 300 poses for the first loop).",
+       true},
+      {"Snaps_pause", "SNAPS", &Config::snaps_pause, 0, kNoLimit,
+       "Inter-frame pause: no loop is closed within this many poses after the last one (not "
+       "given in the paper).",
+       true},
+      {"Snaps_corrector", "SNAPS", &Config::snaps_corrector, 0, 0,
+       "discounted (the paper's Eq. 6), pose-graph (least squares over odometry and loop "
+       "edges) or both.",
+       true},
+      {"Snaps_loop_weight", "SNAPS", &Config::snaps_loop_weight, 0, kNoLimit,
+       "Pose graph: information of a loop edge's position residual, 1/m^2 (1 = sigma 1 m).",
+       true},
+      {"Snaps_odometry_translation_weight", "SNAPS", &Config::snaps_odometry_translation_weight,
+       0, kNoLimit,
+       "Pose graph: information of an odometry edge's translation per pose step, 1/m^2 (2500 "
+       "= sigma 0.02 m).",
+       true},
+      {"Snaps_odometry_rotation_weight", "SNAPS", &Config::snaps_odometry_rotation_weight, 0,
+       kNoLimit,
+       "Pose graph: information of an odometry edge's rotation per pose step, 1/rad^2 (1e6 = "
+       "sigma 0.001 rad).",
+       true},
+      {"Snaps_robust_kernel", "SNAPS", &Config::snaps_robust_kernel, 0, 0,
+       "Pose graph: robust kernel on loop edges, none, huber or cauchy (a few wrong loops then "
+       "pull with a bounded force).",
+       true},
+      {"Snaps_robust_scale", "SNAPS", &Config::snaps_robust_scale, 0, kNoLimit,
+       "Pose graph: scale of the robust kernel in sigmas of a loop edge.", true},
+      {"Snaps_axes", "SNAPS", &Config::snaps_axes, 0, 0,
+       "Ground plane of the plot and of the yaw: xz (KITTI: y points down) or xy (z up).",
+       true},
+      {"Snaps_output_name", "SNAPS", &Config::snaps_output_name, 0, 0,
+       "Output prefix: <name>_discounted.txt and/or <name>_pose_graph.txt (the corrected "
+       "trajectories), <name>_loops.csv, <name>.json (figures), <name>.png (plot). Empty: "
+       "figures printed only.",
+       true},
   };
   return table;
 }
@@ -411,6 +529,42 @@ bool Config::operator==(const Config& o) const {
   for (const auto& b : Bindings())
     if (ValueText(*this, b) != ValueText(o, b)) return false;
   return true;
+}
+
+void CheckSnapsConfig(const Config& c) {
+  auto one_of = [](const std::string& key, const std::string& value,
+                   std::initializer_list<const char*> choices) {
+    std::string list;
+    for (const char* choice : choices) {
+      if (Lower(value) == choice) return;
+      list += (list.empty() ? "" : ", ") + std::string(choice);
+    }
+    throw InputError(key + ": " + Quote(value) + " is not valid; expected one of " + list);
+  };
+  if (c.snaps_trajectory.empty())
+    throw InputError("Snaps_trajectory: empty; expected the path of the trajectory to correct");
+  one_of("Snaps_trajectory_format", c.snaps_trajectory_format, {"kitti", "kitti-id", "tum"});
+  one_of("Snaps_ground_truth_format", c.snaps_ground_truth_format, {"kitti", "kitti-id", "tum"});
+  one_of("Snaps_loops", c.snaps_loops, {"search", "pairs", "matrix"});
+  one_of("Snaps_corrector", c.snaps_corrector, {"discounted", "pose-graph", "both"});
+  one_of("Snaps_robust_kernel", c.snaps_robust_kernel, {"none", "huber", "cauchy"});
+  one_of("Snaps_axes", c.snaps_axes, {"xz", "xy"});
+  const std::string loops = Lower(c.snaps_loops);
+  if (loops != "search" && c.snaps_loops_file.empty())
+    throw InputError("Snaps_loops_file: empty; expected the " +
+                     std::string(loops == "pairs" ? "pairs file" : "saved matrix") +
+                     " that Snaps_loops " + loops + " reads");
+  if (loops == "search" && c.snaps_images.empty() && c.images_path.empty())
+    throw InputError("Snaps_images: empty and Images_path empty; expected the image folder "
+                     "of the trajectory's frames for Snaps_loops search");
+  if (c.snaps_loop_weight <= 0 || c.snaps_odometry_translation_weight <= 0 ||
+      c.snaps_odometry_rotation_weight <= 0 || c.snaps_robust_scale <= 0)
+    throw InputError("Snaps_loop_weight, Snaps_odometry_translation_weight, "
+                     "Snaps_odometry_rotation_weight, Snaps_robust_scale: " +
+                     FormatNumber(c.snaps_loop_weight) + ", " +
+                     FormatNumber(c.snaps_odometry_translation_weight) + ", " +
+                     FormatNumber(c.snaps_odometry_rotation_weight) + ", " +
+                     FormatNumber(c.snaps_robust_scale) + "; expected every one > 0");
 }
 
 Config LoadConfig(const std::string& path) {

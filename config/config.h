@@ -74,6 +74,37 @@ struct Config {
   int vicinity = 7;                   // ABLE-P protocol: temporal vicinity, frames
   std::string evaluation_name;        // output prefix; empty = table only
   std::string evaluation_label;       // legend label; empty = "<descriptor> L=<L>"
+  // --- SNAPS add-on (new; openable_snaps, docs/snaps.md) ---------------------------------------
+  std::string snaps_trajectory;
+  std::string snaps_trajectory_format = "kitti";
+  int snaps_world_to_camera = 0;
+  std::string snaps_ground_truth;
+  std::string snaps_ground_truth_format = "kitti";
+  double snaps_time_tolerance = 0.02;
+  std::string snaps_loops = "search";     // search, pairs, matrix
+  std::string snaps_loops_file;
+  int snaps_keyframe_tolerance = 0;
+  int snaps_middle_of_runs = 1;
+  int snaps_drop_outside = 0;
+  double snaps_matrix_threshold = 0.15;
+  std::string snaps_images;               // empty: Images_path
+  double snaps_thumbnail_scale = 1.0 / 6.0;
+  int snaps_window = 8;
+  double snaps_min_similarity = 0.75;
+  double snaps_yaw_limit = 10.0;
+  double snaps_radius = 10.0;
+  int snaps_frame_distance = 100;
+  int snaps_attempts = 10;
+  int snaps_discount_length = 300;
+  int snaps_pause = 20;
+  std::string snaps_corrector = "both";   // discounted, pose-graph, both
+  double snaps_loop_weight = 1.0;
+  double snaps_odometry_translation_weight = 2500.0;
+  double snaps_odometry_rotation_weight = 1e6;
+  std::string snaps_robust_kernel = "huber";
+  double snaps_robust_scale = 3.0;
+  std::string snaps_axes = "xz";
+  std::string snaps_output_name;
 
   bool operator==(const Config& other) const;
   bool operator!=(const Config& other) const { return !(*this == other); }
@@ -98,6 +129,12 @@ void ApplyOverride(Config& config, const std::string& assignment);
 // Cross-key checks that no single value shows (the mode's inputs are given, the threshold is
 // -1 or in [0, 1], parts not built yet are asked for, ...). Throws InputError naming the key.
 void CheckConfig(const Config& config);
+
+// Cross-key checks of the SNAPS keys (openable_snaps): a trajectory is given, the format,
+// loop source, corrector, robust kernel and axes names are known, the file a loop source
+// reads is given, and Snaps_images or Images_path for the search. Throws InputError naming
+// the key, the value and what was expected.
+void CheckSnapsConfig(const Config& config);
 
 // The checks of CheckConfig on the Evaluation keys alone (Ground_truth_type known, its file
 // given, heading, radius and axes valid), for tools that only evaluate.

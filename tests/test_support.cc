@@ -69,6 +69,8 @@ std::string TestOpenableExe() { return OPENABLE_TEST_OPENABLE_EXE; }
 
 std::string OpenableEvaluateExe() { return OPENABLE_EVALUATE_EXE; }
 
+std::string OpenableSnapsExe() { return OPENABLE_SNAPS_EXE; }
+
 std::string TempDir() {
   static std::atomic<int> counter{0};
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();

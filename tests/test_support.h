@@ -33,6 +33,8 @@ std::string TempDir();
 std::string TestOpenableExe();
 // The openable_evaluate program built with the tests.
 std::string OpenableEvaluateExe();
+// The openable_snaps program built with the tests.
+std::string OpenableSnapsExe();
 
 }  // namespace openable::testing
 

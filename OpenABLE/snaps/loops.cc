@@ -87,14 +87,14 @@ std::vector<LoopPair> LoopsFromMatrix(const std::string& path, const Trajectory&
 }
 
 std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& trajectory,
-                                   long tolerance, int* dropped) {
+                                   long tolerance, int* dropped, int* outside) {
   std::ifstream in(path);
   if (!in) throw InputError("loop pairs file " + Quoted(path) + ": cannot be opened");
   if (trajectory.frame_ids.empty())
     throw InputError("loop pairs file " + Quoted(path) + ": the trajectory is empty");
   const long first = trajectory.frame_ids.front(), last = trajectory.frame_ids.back();
   std::vector<LoopPair> out;
-  int drop = 0;
+  int drop = 0, outside_count = 0;
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
     const std::string at = "loop pairs file " + Quoted(path) + ":" + std::to_string(number);
@@ -113,10 +113,19 @@ std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& tr
       throw InputError(at + ": col " + Quoted(b) + " is not a non-negative integer frame number");
     if (row <= col)
       throw InputError(at + ": row " + a + " <= col " + b + "; expected row = the later frame");
+    bool out_of_range = false;
     for (const long f : {row, col})
-      if (f < first || f > last)
-        throw InputError(at + ": frame " + std::to_string(f) + " outside the trajectory's frames " +
-                         std::to_string(first) + ".." + std::to_string(last));
+      if (f < first || f > last) {
+        if (!outside)
+          throw InputError(at + ": frame " + std::to_string(f) +
+                           " outside the trajectory's frames " + std::to_string(first) + ".." +
+                           std::to_string(last));
+        out_of_range = true;
+      }
+    if (out_of_range) {
+      ++outside_count;
+      continue;
+    }
     const int qi = IndexOfFrame(trajectory, row, tolerance);
     const int ri = IndexOfFrame(trajectory, col, tolerance);
     if (qi < 0 || ri < 0 || ri >= qi) {
@@ -126,6 +135,7 @@ std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& tr
     out.push_back(LoopPair{qi, ri, 1.0});
   }
   if (dropped) *dropped = drop;
+  if (outside) *outside = outside_count;
   return out;
 }
 
@@ -167,6 +177,32 @@ ImageSearchResult SearchLoopsInImages(const std::string& folder, const std::stri
   ImageSearchResult r = SearchLoopsInThumbnails(thumbnails, trajectory, options);
   r.thumbnail_seconds = std::move(seconds);
   return r;
+}
+
+std::vector<LoopPair> MiddleOfRuns(std::vector<LoopPair> loops, const Trajectory& trajectory,
+                                   long run_gap) {
+  std::sort(loops.begin(), loops.end(), [](const LoopPair& a, const LoopPair& b) {
+    return a.query != b.query ? a.query < b.query : a.reference < b.reference;
+  });
+  loops.erase(std::unique(loops.begin(), loops.end(),
+                          [](const LoopPair& a, const LoopPair& b) {
+                            return a.query == b.query && a.reference == b.reference;
+                          }),
+              loops.end());
+  std::vector<LoopPair> kept;
+  std::size_t begin = 0;
+  for (std::size_t k = 1; k <= loops.size(); ++k) {
+    const bool run_ends =
+        k == loops.size() || loops[k].query != loops[k - 1].query ||
+        trajectory.frame_ids[static_cast<std::size_t>(loops[k].reference)] -
+                trajectory.frame_ids[static_cast<std::size_t>(loops[k - 1].reference)] >=
+            run_gap;
+    if (run_ends) {
+      kept.push_back(loops[(begin + k - 1) / 2]);
+      begin = k;
+    }
+  }
+  return kept;
 }
 
 }  // namespace openable::snaps

@@ -45,8 +45,21 @@ std::vector<LoopPair> LoopsFromMatrix(const std::string& path, const Trajectory&
 // (counted in `dropped` when given); similarity 1. Throws InputError, one line naming
 // file:line and the value, when a line is not two non-negative integers, row <= col, or a
 // frame id is outside the trajectory's frame ids [first, last].
+// With `outside` given, pairs with a frame outside the trajectory's frame ids are dropped and
+// counted there instead (a ground-truth list of a whole sequence against a trajectory that
+// stops a few frames early).
 std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& trajectory,
-                                   long tolerance = 0, int* dropped = nullptr);
+                                   long tolerance = 0, int* dropped = nullptr,
+                                   int* outside = nullptr);
+
+// The nearest place of each loop run: ground-truth lists pair a query with every earlier frame
+// within some radius (up to 40 m in KITTI 00), so a query's references come in runs of
+// consecutive frames whose middle is the nearest place and whose ends are not "the same place".
+// The references of one query are split into runs (frame ids less than `run_gap` apart) and
+// only the middle reference of each run is kept (the earlier of two middles). Output sorted by
+// query then reference; similarity of the kept pair as given.
+std::vector<LoopPair> MiddleOfRuns(std::vector<LoopPair> loops, const Trajectory& trajectory,
+                                   long run_gap = 10);
 
 // (c) SNAPS's search on the images of a folder: frame id f of the trajectory is image
 // `f - initial` of ListImages(folder, extension); each pose in order is read (ReadImageFile,

@@ -105,27 +105,4 @@ Trajectory CorrectPoseGraph(const Trajectory& input, const std::vector<LoopPair>
                             const std::vector<RelativeLoop>& relative_loops,
                             const PoseGraphOptions& options, PoseGraphReport* report = nullptr);
 
-// A loop between two frames of a run (frame numbers, `query` the later one), as ground-truth
-// loop files list them.
-struct FramePair {
-  long query = 0;
-  long reference = 0;
-};
-
-// Reads `row,col` lines (0-based frame numbers, row the later frame; '#' comments, blank lines
-// skipped), e.g. ../shared/datasets/kitti_trajectories/loop_pairs/*.csv. InputError naming
-// file:line, the value and the expected form otherwise (or when the file holds no pair).
-std::vector<FramePair> ReadFramePairs(const std::string& path);
-
-// Frame pairs as loop pairs of `keyframes` (a kKittiWithId trajectory): a pair is kept when both
-// frames are keyframes (no nearest-keyframe substitution, which would add the distance between
-// the two frames to the loop's position error). With `middle_of_runs`, the references of one
-// query are split into runs (consecutive references less than `run_gap` frames apart) and only
-// the middle reference of each run is kept: a ground-truth list pairs a query with every earlier
-// frame within some radius (up to 40 m in KITTI 00), whose middle is the nearest place, while
-// the ends of a run are not "the same place". Sorted by query then reference.
-std::vector<LoopPair> KeyframeLoopPairs(const std::vector<FramePair>& pairs,
-                                        const Trajectory& keyframes, bool middle_of_runs,
-                                        long run_gap = 10);
-
 }  // namespace openable::snaps

@@ -1,5 +1,6 @@
 // Pose-graph correction: synthetic squares with injected drift, the robust kernel against a
 // wrong loop, and the SO-DSO trajectories of KITTI 00 and 06 with their ground-truth loops.
+#include "OpenABLE/snaps/loops.h"
 #include "OpenABLE/snaps/pose_graph.h"
 
 #include <cmath>
@@ -202,10 +203,13 @@ void CorrectSoDso(const std::string& sequence, const std::string& pairs_file) {
   const Trajectory truth =
       ReadTrajectory(root + "/poses/" + sequence + ".txt", TrajectoryFormat::kKitti);
   const std::vector<int> association = AssociateWithTruth(vo, truth, 0, "truth");
-  // Pairs on keyframes, the middle reference of each run (see KeyframeLoopPairs).
-  const std::vector<FramePair> pairs = ReadFramePairs(root + "/loop_pairs/" + pairs_file);
-  const std::vector<LoopPair> loops = KeyframeLoopPairs(pairs, vo, true);
-  const int total = static_cast<int>(pairs.size());
+  // Pairs on keyframes, the middle reference of each run (see MiddleOfRuns).
+  // Pairs beyond the last keyframe (the VO stops a few frames before the sequence) are dropped.
+  int dropped = 0, outside = 0;
+  const std::vector<LoopPair> pairs =
+      LoopsFromCsv(root + "/loop_pairs/" + pairs_file, vo, 0, &dropped, &outside);
+  const std::vector<LoopPair> loops = MiddleOfRuns(pairs, vo);
+  const int total = static_cast<int>(pairs.size()) + dropped + outside;
   PoseGraphReport report;
   const Trajectory corrected = CorrectPoseGraph(vo, loops, PoseGraphOptions(), &report);
   const TrajectoryError before = AbsoluteTrajectoryError(vo, truth, association, false);

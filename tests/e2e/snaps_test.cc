@@ -1,0 +1,182 @@
+// End-to-end runs of openable_snaps on the real KITTI trajectories
+// (../shared/datasets/kitti_trajectories): the files it writes, the figures in them recomputed
+// here from those files, and its input errors (one line, exit 1, nothing written).
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "tests/e2e/e2e_support.h"
+#include "tests/test_support.h"
+
+namespace openable {
+namespace {
+
+using namespace e2e;  // NOLINT: the e2e helpers are this file's vocabulary
+
+std::string Kitti() { return testing::DatasetsDir() + "/kitti_trajectories"; }
+
+struct Position {
+  double x, y, z;
+};
+
+// Camera positions by frame number, read here without the library: `with_id` lines start with
+// the frame number; `world_to_camera` matrices [R | t] put the camera at -R^T t.
+std::map<long, Position> ReadPositions(const std::string& path, bool with_id,
+                                       bool world_to_camera) {
+  std::map<long, Position> out;
+  std::ifstream in(path);
+  std::string line;
+  long index = 0;
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    long id = index++;
+    if (with_id) s >> id;
+    double m[12];
+    for (double& v : m) s >> v;
+    if (!s) continue;
+    if (world_to_camera) {
+      out[id] = {-(m[0] * m[3] + m[4] * m[7] + m[8] * m[11]),
+                 -(m[1] * m[3] + m[5] * m[7] + m[9] * m[11]),
+                 -(m[2] * m[3] + m[6] * m[7] + m[10] * m[11])};
+    } else {
+      out[id] = {m[3], m[7], m[11]};
+    }
+  }
+  return out;
+}
+
+double MeanDeviation(const std::map<long, Position>& a, const std::map<long, Position>& truth) {
+  double sum = 0;
+  for (const auto& [id, p] : a) {
+    const Position& g = truth.at(id);
+    sum += std::sqrt((p.x - g.x) * (p.x - g.x) + (p.y - g.y) * (p.y - g.y) + (p.z - g.z) * (p.z - g.z));
+  }
+  return sum / static_cast<double>(a.size());
+}
+
+// The first number after "key": in `json` from position `from`.
+double JsonNumber(const std::string& json, const std::string& key, size_t from = 0) {
+  const size_t k = json.find("\"" + key + "\":", from);
+  if (k == std::string::npos) return NAN;
+  return std::stod(json.substr(k + key.size() + 3));
+}
+
+std::vector<std::string> SoDsoArgs(const std::string& seq, const std::string& out) {
+  const std::string pairs = seq == "00" ? "groundTruth_KITTI00.pairs.csv" : "kitti06GroundTruth.pairs.csv";
+  return {"--quiet", "--set", "Snaps_trajectory=" + Kitti() + "/vo_so_dso/seq" + seq + "/poses_history_file.txt",
+          "--set", "Snaps_trajectory_format=kitti-id", "--set", "Snaps_world_to_camera=1",
+          "--set", "Snaps_ground_truth=" + Kitti() + "/poses/" + seq + ".txt",
+          "--set", "Snaps_loops=pairs", "--set", "Snaps_loops_file=" + Kitti() + "/loop_pairs/" + pairs,
+          "--set", "Snaps_drop_outside=1", "--set", "Snaps_output_name=" + out};
+}
+
+class SoDso : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SoDso, CorrectsWithGroundTruthPairsAndWritesWhatItReports) {
+  OPENABLE_REQUIRE_PATH(Kitti());
+  const std::string seq = GetParam();
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunProgram(testing::OpenableSnapsExe(), SoDsoArgs(seq, dir + "/out/run"), dir);
+  ASSERT_EQ(o.status, 0) << o.err << o.out;
+  std::cout << o.out;
+  for (const char* f : {"_discounted.txt", "_pose_graph.txt", "_loops.csv", ".json", ".png", "_discounted.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir + "/out/run" + f)) << f;
+
+  // The written trajectories keep the input's frames and convention; their mean deviation,
+  // recomputed here, is the one the report gives.
+  const auto input = ReadPositions(Kitti() + "/vo_so_dso/seq" + seq + "/poses_history_file.txt", true, true);
+  const auto truth = ReadPositions(Kitti() + "/poses/" + seq + ".txt", false, false);
+  const auto graph = ReadPositions(dir + "/out/run_pose_graph.txt", true, true);
+  const auto discounted = ReadPositions(dir + "/out/run_discounted.txt", true, true);
+  ASSERT_EQ(graph.size(), input.size());
+  ASSERT_EQ(discounted.size(), input.size());
+  EXPECT_EQ(graph.begin()->first, input.begin()->first);
+  EXPECT_EQ(graph.rbegin()->first, input.rbegin()->first);
+  const std::string json = ReadAll(dir + "/out/run.json");
+  const double in_mean = MeanDeviation(input, truth), graph_mean = MeanDeviation(graph, truth),
+               disc_mean = MeanDeviation(discounted, truth);
+  const size_t errors = json.find("\"errors\"");
+  ASSERT_NE(errors, std::string::npos) << json;
+  auto mean_of = [&](const std::string& name) {
+    return JsonNumber(json, "mean_m", json.find("\"" + name + "\"", errors));
+  };
+  EXPECT_NEAR(mean_of("input"), in_mean, 1e-3);
+  EXPECT_NEAR(mean_of("pose_graph"), graph_mean, 1e-3);
+  EXPECT_NEAR(mean_of("discounted"), disc_mean, 1e-3);
+  // SO-DSO's figures (docs/benchmarks.md): 9.59 m on 00, 4.83 m on 06.
+  EXPECT_NEAR(in_mean, seq == "00" ? 9.59 : 4.83, 0.01);
+  // The loops the graph was given are closed: the mean gap between the two positions of the
+  // written loop pairs shrinks at least by half.
+  std::ifstream loops(dir + "/out/run_loops.csv");
+  std::string line;
+  double gap_in = 0, gap_out = 0;
+  int n = 0;
+  while (std::getline(loops, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    long q = 0, r = 0;
+    char comma = 0;
+    std::istringstream(line) >> q >> comma >> r;
+    auto gap = [&](const std::map<long, Position>& t) {
+      const Position a = t.at(q), b = t.at(r);
+      return std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z));
+    };
+    gap_in += gap(input);
+    gap_out += gap(graph);
+    ++n;
+  }
+  ASSERT_GT(n, 100);
+  EXPECT_LT(gap_out, 0.5 * gap_in) << "mean loop gap " << gap_in / n << " -> " << gap_out / n;
+}
+
+INSTANTIATE_TEST_SUITE_P(Kitti, SoDso, ::testing::Values("00", "06"),
+                         [](const ::testing::TestParamInfo<const char*>& i) {
+                           return std::string("seq") + i.param;
+                         });
+
+// Every bad input: exit 1, one line naming the key or file, nothing written.
+TEST(SnapsErrors, OneLineNonZeroExitNothingWritten) {
+  OPENABLE_REQUIRE_PATH(Kitti());
+  const std::string dir = testing::TempDir();
+  std::ofstream(dir + "/short.txt") << "1 0 0 0 0 1 0 0 0 0 1\n";  // 11 numbers
+  {
+    std::ifstream in(Kitti() + "/poses/06.txt");
+    std::ofstream out(dir + "/truth100.txt");
+    std::string line;
+    for (int i = 0; i < 100 && std::getline(in, line); ++i) out << line << "\n";
+  }
+  struct Case {
+    std::vector<std::string> sets;
+    std::string expect;
+  };
+  const std::vector<Case> cases = {
+      {{"Snaps_trajectory=" + dir + "/short.txt", "Snaps_trajectory_format=kitti"}, "short.txt\":1"},
+      {{"Snaps_trajectory_format=kitty"}, "Snaps_trajectory_format"},
+      {{"Snaps_drop_outside=0"}, "outside the trajectory's frames"},
+      {{"Snaps_ground_truth=" + dir + "/truth100.txt"}, "Snaps_ground_truth"},
+      {{"Snaps_loops_file=" + dir + "/nope.csv"}, "nope.csv"},
+      {{"Snaps_loops=matrix", "Snaps_loops_file="}, "Snaps_loops_file"},
+      {{"Snaps_corrector=magic"}, "Snaps_corrector"},
+      {{"Snaps_trajectory=" + dir + "/missing.txt"}, "missing.txt"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = SoDsoArgs("06", dir + "/out/run");
+    for (const std::string& s : c.sets) {
+      args.push_back("--set");
+      args.push_back(s);
+    }
+    const Outcome o = RunProgram(testing::OpenableSnapsExe(), args, dir);
+    EXPECT_EQ(o.status, 1) << c.expect << ": " << o.err;
+    EXPECT_TRUE(OneLine(o.err)) << o.err;
+    EXPECT_NE(o.err.find(c.expect), std::string::npos) << o.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/out")) << c.expect << ": outputs left behind";
+  }
+}
+
+}  // namespace
+}  // namespace openable
