@@ -12,6 +12,7 @@
 #include <opencv2/core/utils/logger.hpp>
 
 #include "OpenABLE/OpenABLE.h"
+#include "config/command_line.h"
 
 namespace {
 
@@ -113,52 +114,28 @@ int main(int argc, char** argv) {
   // blocks up to 256 MB on the heap lets them be reused (Gardens Point 3.0 s -> 1.1 s).
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
-  std::string config_path;
-  std::vector<std::string> overrides;
-  bool quiet = false, print_config = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "-h" || a == "--help") {
-      std::cout << kUsage << openable::ConfigHelpText();
-      return 0;
-    } else if (a == "--help-markdown") {
-      std::cout << openable::ConfigMarkdownReference();
-      return 0;
-    } else if (a == "--version") {
-      std::cout << "OpenABLE " << openable::kVersion << "\n";
-      return 0;
-    } else if (a == "--set") {
-      if (i + 1 >= argc) {
-        std::cerr << "Test_OpenABLE: --set needs Key=Value (see --help)\n";
-        return kUsageError;
-      }
-      overrides.push_back(argv[++i]);
-    } else if (a.rfind("--set=", 0) == 0) {
-      overrides.push_back(a.substr(6));
-    } else if (a == "--quiet" || a == "-q") {
-      quiet = true;
-    } else if (a == "--print-config") {
-      print_config = true;
-    } else if (!a.empty() && a[0] == '-') {
-      std::cerr << "Test_OpenABLE: unknown option \"" << a << "\" (see --help)\n";
-      return kUsageError;
-    } else if (config_path.empty()) {
-      config_path = a;
-    } else {
-      std::cerr << "Test_OpenABLE: more than one configuration file (\"" << config_path
-                << "\" and \"" << a << "\"); expected one (see --help)\n";
-      return kUsageError;
-    }
+  openable::CommandLine cl;
+  const std::string usage_error = openable::ParseCommandLine(argc, argv, "Test_OpenABLE", cl);
+  if (cl.help) {
+    std::cout << kUsage << openable::ConfigHelpText();
+    return 0;
   }
-  if (config_path.empty() && overrides.empty()) {
-    std::cerr << "Test_OpenABLE: no configuration file given; expected Test_OpenABLE "
-                 "Config.txt (see --help)\n";
+  if (cl.help_markdown) {
+    std::cout << openable::ConfigMarkdownReference();
+    return 0;
+  }
+  if (cl.version) {
+    std::cout << "OpenABLE " << openable::kVersion << "\n";
+    return 0;
+  }
+  if (!usage_error.empty()) {
+    std::cerr << usage_error << "\n";
     return kUsageError;
   }
+  const bool quiet = cl.quiet;
   try {
-    openable::Config config = config_path.empty() ? openable::Config() : openable::LoadConfig(config_path);
-    for (const auto& o : overrides) openable::ApplyOverride(config, o);
-    if (print_config) {
+    openable::Config config = openable::ConfigOf(cl);
+    if (cl.print_config) {
       std::cout << openable::FormatConfig(config);
       return 0;
     }

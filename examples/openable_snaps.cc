@@ -22,6 +22,7 @@
 #include "OpenABLE/snaps/plot.h"
 #include "OpenABLE/snaps/pose_graph.h"
 #include "OpenABLE/snaps/trajectory.h"
+#include "config/command_line.h"
 #include "config/config.h"
 
 namespace {
@@ -346,51 +347,31 @@ int Run(const openable::Config& c, bool quiet) {
 
 int main(int argc, char** argv) {
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
-  std::string config_path;
-  std::vector<std::string> overrides;
-  bool quiet = false, print_config = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "-h" || a == "--help") {
-      std::cout << kUsage << openable::ConfigHelpText();
-      return 0;
-    } else if (a == "--set") {
-      if (i + 1 >= argc) {
-        std::cerr << "openable_snaps: --set needs Key=Value (see --help)\n";
-        return kUsageError;
-      }
-      overrides.push_back(argv[++i]);
-    } else if (a.rfind("--set=", 0) == 0) {
-      overrides.push_back(a.substr(6));
-    } else if (a == "--quiet" || a == "-q") {
-      quiet = true;
-    } else if (a == "--print-config") {
-      print_config = true;
-    } else if (!a.empty() && a[0] == '-') {
-      std::cerr << "openable_snaps: unknown option \"" << a << "\" (see --help)\n";
-      return kUsageError;
-    } else if (config_path.empty()) {
-      config_path = a;
-    } else {
-      std::cerr << "openable_snaps: more than one configuration file (\"" << config_path
-                << "\" and \"" << a << "\"); expected one (see --help)\n";
-      return kUsageError;
-    }
+  openable::CommandLine cl;
+  const std::string usage_error = openable::ParseCommandLine(argc, argv, "openable_snaps", cl);
+  if (cl.help) {
+    std::cout << kUsage << openable::ConfigHelpText();
+    return 0;
   }
-  if (config_path.empty() && overrides.empty()) {
-    std::cerr << "openable_snaps: no configuration given; expected openable_snaps Config.txt "
-                 "or --set Snaps_trajectory=... (see --help)\n";
+  if (cl.help_markdown) {
+    std::cout << openable::ConfigMarkdownReference();
+    return 0;
+  }
+  if (cl.version) {
+    std::cout << "openable_snaps " << openable::kVersion << "\n";
+    return 0;
+  }
+  if (!usage_error.empty()) {
+    std::cerr << usage_error << "\n";
     return kUsageError;
   }
   try {
-    openable::Config config =
-        config_path.empty() ? openable::Config() : openable::LoadConfig(config_path);
-    for (const auto& o : overrides) openable::ApplyOverride(config, o);
-    if (print_config) {
+    openable::Config config = openable::ConfigOf(cl);
+    if (cl.print_config) {
       std::cout << openable::FormatConfig(config);
       return 0;
     }
-    return Run(config, quiet);
+    return Run(config, cl.quiet);
   } catch (const openable::InputError& e) {
     std::cerr << "openable_snaps: error: " << e.what() << "\n";
     return kInputError;

@@ -1,0 +1,47 @@
+#include "config/command_line.h"
+
+namespace openable {
+
+std::string ParseCommandLine(int argc, const char* const* argv, const std::string& program,
+                             CommandLine& out) {
+  out = CommandLine();
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "-h" || a == "--help") {
+      out.help = true;
+    } else if (a == "--help-markdown") {
+      out.help_markdown = true;
+    } else if (a == "--version") {
+      out.version = true;
+    } else if (a == "--set") {
+      if (i + 1 >= argc) return program + ": --set needs Key=Value (see --help)";
+      out.overrides.push_back(argv[++i]);
+    } else if (a.rfind("--set=", 0) == 0) {
+      out.overrides.push_back(a.substr(6));
+    } else if (a == "--quiet" || a == "-q") {
+      out.quiet = true;
+    } else if (a == "--print-config") {
+      out.print_config = true;
+    } else if (!a.empty() && a[0] == '-') {
+      return program + ": unknown option \"" + a + "\" (see --help)";
+    } else if (out.config_path.empty()) {
+      out.config_path = a;
+    } else {
+      return program + ": more than one configuration file (\"" + out.config_path + "\" and \"" +
+             a + "\"); expected one (see --help)";
+    }
+  }
+  if (!out.help && !out.help_markdown && !out.version && out.config_path.empty() &&
+      out.overrides.empty())
+    return program + ": no configuration given; expected " + program +
+           " Config.txt or --set Key=Value (see --help)";
+  return "";
+}
+
+Config ConfigOf(const CommandLine& command_line) {
+  Config config = command_line.config_path.empty() ? Config() : LoadConfig(command_line.config_path);
+  for (const auto& o : command_line.overrides) ApplyOverride(config, o);
+  return config;
+}
+
+}  // namespace openable

@@ -1,0 +1,34 @@
+// The command line shared by the programs that read Config.txt (Test_OpenABLE,
+// openable_snaps): [Config.txt] [--set Key=Value ...] [--quiet] [--print-config] [--help]
+// [--help-markdown] [--version].
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "config/config.h"
+
+namespace openable {
+
+struct CommandLine {
+  std::string config_path;             // empty: defaults, then the overrides
+  std::vector<std::string> overrides;  // "Key=Value" from --set, in order
+  bool quiet = false;                  // --quiet, -q
+  bool print_config = false;           // --print-config
+  bool help = false;                   // -h, --help
+  bool help_markdown = false;          // --help-markdown
+  bool version = false;                // --version
+};
+
+// Parses argv. Returns an empty string on success, or one line (prefixed with `program`)
+// naming the bad argument and pointing at --help: an unknown option, --set without a value,
+// two configuration files, or neither a file nor an override (unless a help or version
+// option was given).
+std::string ParseCommandLine(int argc, const char* const* argv, const std::string& program,
+                             CommandLine& out);
+
+// The configuration a command line asks for: the file (or the defaults) with the overrides
+// applied in order. Throws InputError as LoadConfig and ApplyOverride do.
+Config ConfigOf(const CommandLine& command_line);
+
+}  // namespace openable
