@@ -58,6 +58,7 @@ const char* const kUsage =
     "    --set Snaps_trajectory_format=kitti-id --set Snaps_world_to_camera=1 \\\n"
     "    --set Snaps_ground_truth=poses/00.txt --set Snaps_loops=pairs \\\n"
     "    --set Snaps_loops_file=loop_pairs/groundTruth_KITTI00.pairs.csv \\\n"
+    "    --set Snaps_drop_outside=1 \\\n"
     "    --set Snaps_output_name=out/kitti00\n"
     "\n";
 
@@ -165,10 +166,16 @@ int Run(const openable::Config& c, bool quiet) {
   int dropped = 0, outside = 0;
   auto t = Clock::now();
   if (source == "pairs") {
-    loops = openable::WithKey("Snaps_loops_file", [&] {
-      return snaps::LoopsFromCsv(c.snaps_loops_file, input, c.snaps_keyframe_tolerance, &dropped,
-                                 c.snaps_drop_outside == 1 ? &outside : nullptr);
-    });
+    try {
+      loops = openable::WithKey("Snaps_loops_file", [&] {
+        return snaps::LoopsFromCsv(c.snaps_loops_file, input, c.snaps_keyframe_tolerance,
+                                   &dropped, c.snaps_drop_outside == 1 ? &outside : nullptr);
+      });
+    } catch (const openable::InputError& e) {
+      const std::string m = e.what();
+      if (m.find("outside the trajectory") == std::string::npos) throw;
+      throw openable::InputError(m + " (Snaps_drop_outside 1 drops such pairs)");
+    }
     if (c.snaps_middle_of_runs == 1) loops = snaps::MiddleOfRuns(loops, input);
   } else if (source == "matrix") {
     snaps::MatrixLoopOptions m;
