@@ -1,0 +1,44 @@
+// Keypoints and their matching between consecutive frames, shared by both odometries.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+
+namespace openable::odometry {
+
+// Keypoints of one frame and their descriptors (one row each).
+struct Features {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+};
+
+// Detector + descriptor by name: "ORB" (binary, Hamming distance; FAST corners with the
+// Harris score, 8 pyramid levels, scale 1.2 as OpenCV's defaults) or "SIFT" (float, L2; the
+// paper's choice, Lowe's defaults). Case-insensitive. `max_features` caps the keypoints kept
+// (strongest first). Throws InputError naming `key` and listing the valid names otherwise.
+class FeatureExtractor {
+ public:
+  FeatureExtractor(const std::string& name, int max_features, const std::string& key);
+  // Keypoints and descriptors of a CV_8UC1 image.
+  Features Extract(const cv::Mat& gray) const;
+  // The descriptor distance: cv::NORM_HAMMING (ORB) or cv::NORM_L2 (SIFT).
+  int Norm() const { return norm_; }
+
+ private:
+  cv::Ptr<cv::Feature2D> detector_;
+  int norm_ = cv::NORM_L2;
+};
+
+// Matches `from` to `to` by brute force (2 nearest neighbours in `to` per descriptor of
+// `from`) and keeps a match when its distance is below `ratio` x the second's (Lowe's ratio
+// test). queryIdx indexes `from`, trainIdx `to`. Deterministic. Empty when either is empty.
+std::vector<cv::DMatch> MatchWithRatioTest(const Features& from, const Features& to, int norm,
+                                           double ratio);
+
+// Upper-case copy of `s` (names of options are compared case-insensitively).
+std::string UpperCase(std::string s);
+
+}  // namespace openable::odometry
