@@ -39,6 +39,8 @@ void MonoOdometryOptions::Check() const {
   Require(ransac_confidence > 0 && ransac_confidence < 1, "ransac_confidence", ransac_confidence,
           "in (0, 1)");
   Require(min_inliers >= 5, "min_inliers", min_inliers, ">= 5");
+  Require(still_step_length >= 0 && std::isfinite(still_step_length), "still_step_length",
+          still_step_length, ">= 0");
 }
 
 MonoOdometry::MonoOdometry(const Intrinsics& intrinsics, const MonoOdometryOptions& options)
@@ -61,6 +63,8 @@ Eigen::Isometry3d MonoOdometry::Step(const cv::Mat& gray, double step_length) {
 
   if (frames_ == 0) {
     last_.note = "first frame";
+  } else if (step_length >= 0 && step_length < options_.still_step_length) {
+    last_.note = "standing still";  // pose unchanged; the velocity is kept for later
   } else {
     const std::vector<cv::DMatch> matches =
         MatchWithRatioTest(previous_, current, extractor_.Norm(), options_.ratio_test);
@@ -84,8 +88,10 @@ Eigen::Isometry3d MonoOdometry::Step(const cv::Mat& gray, double step_length) {
       if (E.rows == 3 && E.cols == 3) {
         cv::Mat R, t;
         // recoverPose: x_curr = R x_prev + t, |t| = 1; mask keeps the points in front of
-        // both cameras.
-        const int good = cv::recoverPose(E, p_prev, p_curr, K, R, t, mask);
+        // both cameras. Its default distance threshold (50 baselines) would drop the far
+        // points of short steps (at 0.17 m, everything beyond 8.5 m), hence 1e4.
+        cv::Mat triangulated;
+        const int good = cv::recoverPose(E, p_prev, p_curr, K, R, t, 1e4, mask, triangulated);
         last_.inliers = good;
         if (good >= options_.min_inliers) {
           Eigen::Matrix3d r;
