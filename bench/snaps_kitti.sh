@@ -41,4 +41,11 @@ echo "=== KITTI 00 frames 0-1699: SNAPS's own search on thumbnails"
   --set Snaps_ground_truth="$data/kitti00_first1700/poses/00_first1700.txt" \
   --set Snaps_loops=search --set Snaps_images="$images" \
   --set Snaps_output_name="$out/kitti00_first1700_search"
+
+echo "=== KITTI 00 frames 0-1699 from the images (issue 7): monocular odometry (scale from the"
+echo "    ground truth's step lengths), loops found by OpenABLE on the same frames"
+"$snaps" --quiet --set Snaps_odometry=mono --set Images_path="$images" \
+  --set Odometry_calibration="$data/kitti00_first1700/calib.txt" --set Odometry_calibration_scale=0.5 \
+  --set Snaps_ground_truth="$data/kitti00_first1700/poses/00_first1700.txt" \
+  --set Snaps_loops=openable --set Snaps_output_name="$out/kitti00_first1700_chain"
 echo "outputs in $out"

@@ -283,6 +283,13 @@ const std::vector<Binding>& Bindings() {
        "openable_snaps: the drifting trajectory to correct (visual odometry), in "
        "Snaps_trajectory_format.",
        true},
+      {"Snaps_odometry", "SNAPS", &Config::snaps_odometry, 0, 0,
+       "Empty: read Snaps_trajectory. mono: compute it from the images (Snaps_images or "
+       "Images_path) with the monocular odometry (docs/odometry.md; the scale comes from "
+       "Odometry_scale); stereo: from Images_path_left and Images_path_right (rectified with "
+       "Calibration_path, or already rectified with Odometry_calibration). The computed "
+       "trajectory is written as <Snaps_output_name>_odometry.txt (KITTI format).",
+       true},
       {"Snaps_trajectory_format", "SNAPS", &Config::snaps_trajectory_format, 0, 0,
        "kitti (12 numbers per line, pose i = frame i), kitti-id (frame number + 12 numbers: "
        "keyframes) or tum (timestamp tx ty tz qx qy qz qw). The corrected trajectories are "
@@ -304,7 +311,9 @@ const std::vector<Binding>& Bindings() {
        true},
       {"Snaps_loops", "SNAPS", &Config::snaps_loops, 0, 0,
        "Where the loops come from: search (SNAPS's own search on thumbnails of Snaps_images, "
-       "run online with the discounted update, as the paper), pairs (Snaps_loops_file: "
+       "run online with the discounted update, as the paper), openable (an OpenABLE run on "
+       "the same images with the description keys of this file: each frame's best match at "
+       "least Snaps_frame_distance frames back, kept below Snaps_matrix_threshold), pairs (Snaps_loops_file: "
        "row,col frame numbers per line, row the later frame), matrix (Snaps_loops_file: the "
        "normalised matrix of an OpenABLE run of one sequence, .npy/.txt/image: each frame's "
        "best match at least Snaps_frame_distance frames back, kept below "
@@ -391,6 +400,50 @@ const std::vector<Binding>& Bindings() {
       {"Snaps_axes", "SNAPS", &Config::snaps_axes, 0, 0,
        "Ground plane of the plot and of the yaw: xz (KITTI: y points down) or xy (z up).",
        true},
+      // Odometry (openable_snaps with Snaps_odometry; docs/odometry.md)
+      {"Odometry_calibration", "Odometry", &Config::odometry_calibration, 0, 0,
+       "KITTI calib.txt (P0, P1 lines) of rectified images: the intrinsics (P0) and, for "
+       "stereo, the baseline (P1). Stereo may use Calibration_path instead (raw pairs, "
+       "rectified here).",
+       true},
+      {"Odometry_calibration_scale", "Odometry", &Config::odometry_calibration_scale, 0.01, 10,
+       "Multiplies the focal lengths and principal point of Odometry_calibration (0.5 for "
+       "images at half the calibrated size, as the shared KITTI frames).",
+       true},
+      {"Odometry_scale", "Odometry", &Config::odometry_scale, 0, 0,
+       "mono: where the length of each step comes from, since one camera cannot measure it: "
+       "truth (the step lengths of Snaps_ground_truth), step (Odometry_step_length every "
+       "frame) or none (unit steps: the trajectory's scale is arbitrary).",
+       true},
+      {"Odometry_step_length", "Odometry", &Config::odometry_step_length, 0, kNoLimit,
+       "mono with Odometry_scale step: metres travelled between two frames (speed / frame "
+       "rate).",
+       true},
+      {"Odometry_features", "Odometry", &Config::odometry_features, 0, 0,
+       "ORB or SIFT; empty: SIFT (the paper's; also the better one for the monocular "
+       "odometry on KITTI, docs/odometry.md).",
+       true},
+      {"Odometry_max_features", "Odometry", &Config::odometry_max_features, 10, kNoLimit,
+       "Features detected per frame.", true},
+      {"Odometry_ratio_test", "Odometry", &Config::odometry_ratio_test, 0.1, 1,
+       "Lowe's ratio test on the two nearest descriptors.", true},
+      {"Odometry_ransac_threshold", "Odometry", &Config::odometry_ransac_threshold, 0, 100,
+       "RANSAC inlier threshold, pixels (mono: distance to the epipolar line, default 0.5; "
+       "stereo: PnP reprojection error, default 2); 0 keeps the default.",
+       true},
+      {"Odometry_min_inliers", "Odometry", &Config::odometry_min_inliers, 0, kNoLimit,
+       "Fewer inliers: the step keeps the previous motion (constant velocity) and is counted "
+       "as failed in the report (default 20 mono, 15 stereo; 0 keeps the default).",
+       true},
+      {"Odometry_matcher", "Odometry", &Config::odometry_matcher, 0, 0,
+       "stereo: disparity by sgbm or bm (block matching, as the paper).", true},
+      {"Odometry_wls_filter", "Odometry", &Config::odometry_wls_filter, 0, 1,
+       "stereo: 1 filters the disparity with the weighted-least-squares filter (the paper).",
+       true},
+      {"Odometry_num_disparities", "Odometry", &Config::odometry_num_disparities, 16, 1024,
+       "stereo: disparity search range, pixels (a multiple of 16).", true},
+      {"Odometry_max_depth", "Odometry", &Config::odometry_max_depth, 1, kNoLimit,
+       "stereo: points farther than this many metres are not used in PnP.", true},
       {"Snaps_output_name", "SNAPS", &Config::snaps_output_name, 0, 0,
        "Output prefix: <name>_discounted.txt and/or <name>_pose_graph.txt (the corrected "
        "trajectories), <name>_loops.csv, <name>.json (figures), <name>.png (plot). Empty: "
@@ -541,22 +594,52 @@ void CheckSnapsConfig(const Config& c) {
     }
     throw InputError(key + ": " + Quote(value) + " is not valid; expected one of " + list);
   };
-  if (c.snaps_trajectory.empty())
-    throw InputError("Snaps_trajectory: empty; expected the path of the trajectory to correct");
+  one_of("Snaps_odometry", c.snaps_odometry, {"", "mono", "stereo"});
+  const std::string odometry = Lower(c.snaps_odometry);
+  if (odometry.empty() && c.snaps_trajectory.empty())
+    throw InputError("Snaps_trajectory: empty; expected the path of the trajectory to correct "
+                     "(or Snaps_odometry mono or stereo to compute it from the images)");
+  if (!odometry.empty()) {
+    one_of("Odometry_scale", c.odometry_scale, {"truth", "step", "none"});
+    one_of("Odometry_features", c.odometry_features, {"", "orb", "sift"});
+    one_of("Odometry_matcher", c.odometry_matcher, {"sgbm", "bm"});
+    if (c.odometry_num_disparities % 16 != 0)
+      throw InputError("Odometry_num_disparities: " + std::to_string(c.odometry_num_disparities) +
+                       " is not valid; expected a multiple of 16");
+    if (odometry == "mono" && c.odometry_calibration.empty())
+      throw InputError("Odometry_calibration: empty; expected the camera's KITTI calib.txt "
+                       "for Snaps_odometry mono");
+    if (odometry == "mono" && Lower(c.odometry_scale) == "truth" && c.snaps_ground_truth.empty())
+      throw InputError("Odometry_scale: truth needs Snaps_ground_truth (its step lengths give "
+                       "the scale); expected a ground truth, or Odometry_scale step or none");
+    if (odometry == "mono" && c.snaps_images.empty() && c.images_path.empty())
+      throw InputError("Snaps_images: empty and Images_path empty; expected the image folder "
+                       "of the monocular odometry");
+    if (odometry == "stereo") {
+      if (c.images_path_left.empty() || c.images_path_right.empty())
+        throw InputError("Images_path_left, Images_path_right: expected both folders for "
+                         "Snaps_odometry stereo");
+      if (c.calibration_path.empty() && c.odometry_calibration.empty())
+        throw InputError("Calibration_path, Odometry_calibration: both empty; expected the "
+                         "stereo calibration (Calibration.txt for raw pairs, or KITTI calib.txt "
+                         "for rectified pairs)");
+    }
+  }
   one_of("Snaps_trajectory_format", c.snaps_trajectory_format, {"kitti", "kitti-id", "tum"});
   one_of("Snaps_ground_truth_format", c.snaps_ground_truth_format, {"kitti", "kitti-id", "tum"});
-  one_of("Snaps_loops", c.snaps_loops, {"search", "pairs", "matrix"});
+  one_of("Snaps_loops", c.snaps_loops, {"search", "pairs", "matrix", "openable"});
   one_of("Snaps_corrector", c.snaps_corrector, {"discounted", "pose-graph", "both"});
   one_of("Snaps_robust_kernel", c.snaps_robust_kernel, {"none", "huber", "cauchy"});
   one_of("Snaps_axes", c.snaps_axes, {"xz", "xy"});
   const std::string loops = Lower(c.snaps_loops);
-  if (loops != "search" && c.snaps_loops_file.empty())
+  if ((loops == "pairs" || loops == "matrix") && c.snaps_loops_file.empty())
     throw InputError("Snaps_loops_file: empty; expected the " +
                      std::string(loops == "pairs" ? "pairs file" : "saved matrix") +
                      " that Snaps_loops " + loops + " reads");
-  if (loops == "search" && c.snaps_images.empty() && c.images_path.empty())
+  if ((loops == "search" || loops == "openable") && c.snaps_images.empty() &&
+      c.images_path.empty() && !(odometry == "stereo" && !c.images_path_left.empty()))
     throw InputError("Snaps_images: empty and Images_path empty; expected the image folder "
-                     "of the trajectory's frames for Snaps_loops search");
+                     "of the trajectory's frames for Snaps_loops " + loops);
   if (c.snaps_loop_weight <= 0 || c.snaps_odometry_translation_weight <= 0 ||
       c.snaps_odometry_rotation_weight <= 0 || c.snaps_robust_scale <= 0)
     throw InputError("Snaps_loop_weight, Snaps_odometry_translation_weight, "

@@ -105,6 +105,21 @@ struct Config {
   double snaps_robust_scale = 3.0;
   std::string snaps_axes = "xz";
   std::string snaps_output_name;
+  std::string snaps_odometry;             // "", mono, stereo
+  // --- Odometry (new; openable_snaps with Snaps_odometry, docs/odometry.md) --------------------
+  std::string odometry_calibration;
+  double odometry_calibration_scale = 1.0;
+  std::string odometry_scale = "truth";   // truth, step, none
+  double odometry_step_length = 1.0;
+  std::string odometry_features;          // empty: the odometry's default (SIFT)
+  int odometry_max_features = 2000;
+  double odometry_ratio_test = 0.8;
+  double odometry_ransac_threshold = 0.0;  // 0: the odometry's default
+  int odometry_min_inliers = 0;           // 0: the odometry's default
+  std::string odometry_matcher = "sgbm";
+  int odometry_wls_filter = 1;
+  int odometry_num_disparities = 64;
+  double odometry_max_depth = 80.0;
 
   bool operator==(const Config& other) const;
   bool operator!=(const Config& other) const { return !(*this == other); }

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <map>
+#include <memory>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
@@ -16,6 +18,13 @@
 
 #include "OpenABLE/OpenABLE.h"
 #include "OpenABLE/exports.h"
+#include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/odometry/calibration.h"
+#include "OpenABLE/odometry/mono_odometry.h"
+#include "OpenABLE/odometry/stereo_odometry.h"
+#include "OpenABLE/preprocess.h"
+#include "OpenABLE/stereo/calibration.h"
+#include "OpenABLE/stereo/rectification.h"
 #include "OpenABLE/snaps/discounted.h"
 #include "OpenABLE/snaps/loop_search.h"
 #include "OpenABLE/snaps/loops.h"
@@ -120,6 +129,155 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
+// What the odometry did, for the report.
+struct OdometryReport {
+  std::string kind;                 // mono, stereo
+  std::string scale;                // where the scale came from
+  std::vector<double> seconds;      // per frame
+  int failed = 0;                   // steps that kept the previous motion
+  std::string first_failure;
+};
+
+// Frames [Initial_image, Final_image) of a folder, in natural order.
+std::vector<std::string> FramesOf(const openable::Config& c, const std::string& folder,
+                                  const std::string& key) {
+  return openable::WithKey(key, [&] {
+    const std::vector<std::string> all = openable::ListImages(folder, c.images_format);
+    const int first = c.initial_image;
+    const int last = c.final_image < 0 ? static_cast<int>(all.size())
+                                       : std::min(c.final_image, static_cast<int>(all.size()));
+    if (first >= last)
+      throw openable::InputError("folder " + openable::Quoted(folder) + " holds " +
+                                 std::to_string(all.size()) + " images; Initial_image " +
+                                 std::to_string(first) + " leaves none");
+    return std::vector<std::string>(all.begin() + first, all.begin() + last);
+  });
+}
+
+cv::Mat GrayOf(const std::string& path) { return openable::ToGray8(openable::ReadImageFile(path)); }
+
+// Snaps_odometry: the trajectory of the frames computed from the images (issue 7).
+snaps::Trajectory ComputeOdometry(const openable::Config& c, const snaps::Trajectory* truth,
+                                  openable::ProgressReporter& progress, OdometryReport& report) {
+  namespace odo = openable::odometry;
+  const std::string kind = Lower(c.snaps_odometry);
+  report.kind = kind;
+  snaps::Trajectory t;
+  t.format = c.initial_image == 0 ? snaps::TrajectoryFormat::kKitti
+                                  : snaps::TrajectoryFormat::kKittiWithId;
+  auto record = [&](const odo::StepStats& stats, int i, const Eigen::Isometry3d& pose) {
+    t.poses.push_back(pose);
+    t.frame_ids.push_back(c.initial_image + i);
+    report.seconds.push_back(stats.seconds);
+    if (!stats.ok) {
+      if (report.failed++ == 0)
+        report.first_failure = "frame " + std::to_string(c.initial_image + i) + ": " + stats.note;
+    }
+  };
+  if (kind == "mono") {
+    const std::string folder = c.snaps_images.empty() ? c.images_path : c.snaps_images;
+    const std::vector<std::string> frames =
+        FramesOf(c, folder, c.snaps_images.empty() ? "Images_path" : "Snaps_images");
+    const odo::KittiCalibration calib = openable::WithKey("Odometry_calibration", [&] {
+      return odo::ReadKittiCalibration(c.odometry_calibration, c.odometry_calibration_scale);
+    });
+    odo::MonoOdometryOptions o;  // 0 or empty keys keep the odometry's defaults
+    if (!c.odometry_features.empty()) o.features = c.odometry_features;
+    o.max_features = c.odometry_max_features;
+    o.ratio_test = c.odometry_ratio_test;
+    if (c.odometry_ransac_threshold > 0) o.ransac_threshold_px = c.odometry_ransac_threshold;
+    if (c.odometry_min_inliers > 0) o.min_inliers = c.odometry_min_inliers;
+    o.Check();
+    odo::MonoOdometry odometry(calib.left, o);
+    progress.Begin("odometry", static_cast<std::int64_t>(frames.size()), "frames (mono)");
+    const std::string scale = Lower(c.odometry_scale);
+    report.scale = scale == "truth" ? "step lengths of the ground truth (a single camera cannot measure scale)"
+                   : scale == "step" ? "Odometry_step_length " + Number(c.odometry_step_length) + " m per frame"
+                                     : "none: unit steps, arbitrary scale";
+    std::map<long, int> truth_index;
+    if (truth)
+      for (int k = 0; k < truth->Size(); ++k) truth_index[truth->frame_ids[static_cast<size_t>(k)]] = k;
+    for (int i = 0; i < static_cast<int>(frames.size()); ++i) {
+      double step = -1;
+      if (scale == "step") step = c.odometry_step_length;
+      if (scale == "truth" && i > 0) {
+        const long f = c.initial_image + i;
+        const auto a = truth_index.find(f - 1), b = truth_index.find(f);
+        if (a == truth_index.end() || b == truth_index.end())
+          throw openable::InputError("Odometry_scale: truth, but Snaps_ground_truth has no pose of frame " +
+                                     std::to_string(a == truth_index.end() ? f - 1 : f) +
+                                     "; expected the ground truth of every frame");
+        step = (truth->poses[static_cast<size_t>(b->second)].translation() -
+                truth->poses[static_cast<size_t>(a->second)].translation()).norm();
+      }
+      const cv::Mat gray = openable::WithKey("Snaps_images", [&] { return GrayOf(frames[static_cast<size_t>(i)]); });
+      const Eigen::Isometry3d pose = odometry.Step(gray, step);
+      record(odometry.last(), i, pose);
+      progress.Update(i + 1);
+    }
+    progress.End();
+    return t;
+  }
+  // Stereo.
+  const std::vector<std::string> left = FramesOf(c, c.images_path_left, "Images_path_left");
+  const std::vector<std::string> right = FramesOf(c, c.images_path_right, "Images_path_right");
+  if (left.size() != right.size())
+    throw openable::InputError("Images_path_right: " + openable::Quoted(c.images_path_right) + " holds " +
+                               std::to_string(right.size()) + " images in the range but Images_path_left " +
+                               std::to_string(left.size()) + "; expected one right image per left image");
+  odo::Intrinsics intrinsics;
+  double baseline = 0;
+  std::unique_ptr<openable::StereoRectifier> rectifier;
+  if (!c.calibration_path.empty()) {
+    const openable::StereoCalibration calibration = openable::WithKey(
+        "Calibration_path", [&] { return openable::LoadStereoCalibration(c.calibration_path); });
+    const cv::Size size = GrayOf(left.front()).size();
+    openable::CheckCalibrationFits(calibration, size, c.calibration_path);
+    rectifier = std::make_unique<openable::StereoRectifier>(calibration, size);
+    const cv::Matx34d& p = rectifier->ProjectionLeft();
+    intrinsics.fx = p(0, 0);
+    intrinsics.fy = p(1, 1);
+    intrinsics.cx = p(0, 2);
+    intrinsics.cy = p(1, 2);
+    baseline = rectifier->Baseline();
+  } else {
+    const odo::KittiCalibration calib = openable::WithKey("Odometry_calibration", [&] {
+      return odo::ReadKittiCalibration(c.odometry_calibration, c.odometry_calibration_scale);
+    });
+    intrinsics = calib.left;
+    baseline = calib.baseline;
+  }
+  odo::StereoOdometryOptions o;
+  o.matcher = Lower(c.odometry_matcher);
+  o.wls_filter = c.odometry_wls_filter == 1;
+  o.num_disparities = c.odometry_num_disparities;
+  if (!c.odometry_features.empty()) o.features = c.odometry_features;
+  o.max_features = c.odometry_max_features;
+  o.ratio_test = c.odometry_ratio_test;
+  o.max_depth = c.odometry_max_depth;
+  if (c.odometry_ransac_threshold > 0) o.pnp_reprojection_px = c.odometry_ransac_threshold;
+  if (c.odometry_min_inliers > 0) o.min_inliers = c.odometry_min_inliers;
+  o.Check();
+  odo::StereoOdometry odometry(intrinsics, baseline, o);
+  report.scale = "stereo baseline " + Number(baseline) + " (metric)";
+  progress.Begin("odometry", static_cast<std::int64_t>(left.size()), "stereo pairs");
+  for (size_t i = 0; i < left.size(); ++i) {
+    cv::Mat l = openable::WithKey("Images_path_left", [&] { return GrayOf(left[i]); });
+    cv::Mat r = openable::WithKey("Images_path_right", [&] { return GrayOf(right[i]); });
+    if (rectifier) {
+      cv::Mat lr, rr;
+      rectifier->Rectify(l, r, lr, rr);
+      l = lr;
+      r = rr;
+    }
+    const Eigen::Isometry3d pose = odometry.Step(l, r);
+    record(odometry.last(), static_cast<int>(i), pose);
+    progress.Update(static_cast<std::int64_t>(i) + 1);
+  }
+  progress.End();
+  return t;
+}
+
 int Run(const openable::Config& c, bool quiet) {
   openable::CheckSnapsConfig(c);
   using Clock = std::chrono::steady_clock;
@@ -127,25 +285,33 @@ int Run(const openable::Config& c, bool quiet) {
     if (!quiet) std::cerr << "  " << line << "\n";
   };
 
-  // Inputs.
-  const snaps::Trajectory input = openable::WithKey("Snaps_trajectory", [&] {
-    return snaps::ReadTrajectory(
-        c.snaps_trajectory,
-        snaps::ParseTrajectoryFormat(c.snaps_trajectory_format, "Snaps_trajectory_format"),
-        c.snaps_world_to_camera == 1);
-  });
+  // Inputs: the ground truth first (the monocular odometry may take its scale from it).
   snaps::Trajectory truth;
-  std::vector<int> association;
   const bool evaluate = !c.snaps_ground_truth.empty();
-  if (evaluate) {
+  if (evaluate)
     truth = openable::WithKey("Snaps_ground_truth", [&] {
       return snaps::ReadTrajectory(
           c.snaps_ground_truth,
           snaps::ParseTrajectoryFormat(c.snaps_ground_truth_format, "Snaps_ground_truth_format"));
     });
+  OdometryReport odometry_report;
+  snaps::Trajectory computed;
+  const bool odometry = !c.snaps_odometry.empty();
+  if (odometry) {
+    openable::ProgressReporter progress(std::cerr, !quiet, openable::IsTerminal(2));
+    computed = ComputeOdometry(c, evaluate ? &truth : nullptr, progress, odometry_report);
+  }
+  const snaps::Trajectory input = odometry ? computed : openable::WithKey("Snaps_trajectory", [&] {
+    return snaps::ReadTrajectory(
+        c.snaps_trajectory,
+        snaps::ParseTrajectoryFormat(c.snaps_trajectory_format, "Snaps_trajectory_format"),
+        c.snaps_world_to_camera == 1);
+  });
+  std::vector<int> association;
+  if (evaluate)
     association = snaps::AssociateWithTruth(input, truth, c.snaps_time_tolerance,
                                             "Snaps_ground_truth");
-  }
+  const std::string trajectory_name = odometry ? Lower(c.snaps_odometry) + " odometry" : c.snaps_trajectory;
 
   snaps::SearchOptions search;
   search.thumbnail_scale = c.snaps_thumbnail_scale;
@@ -185,6 +351,34 @@ int Run(const openable::Config& c, bool quiet) {
     m.tolerance = c.snaps_keyframe_tolerance;
     loops = openable::WithKey("Snaps_loops_file",
                               [&] { return snaps::LoopsFromMatrix(c.snaps_loops_file, input, m); });
+  } else if (source == "openable") {
+    // An OpenABLE run on the same images, with the description keys of the configuration.
+    openable::Config run = c;
+    run.frame_mode = 0;
+    run.camera_type = 0;
+    run.images_path = !c.snaps_images.empty() ? c.snaps_images
+                      : !c.images_path.empty() ? c.images_path
+                                               : c.images_path_left;
+    run.images_path_2.clear();
+    run.txt_name.clear();
+    run.npy_name.clear();
+    run.png_name.clear();
+    run.png_threshold_name.clear();
+    run.matches_name.clear();
+    run.threshold = -1;
+    run.matrix_mode = 1;
+    run.approximate_search = 0;
+    run.ground_truth_type.clear();
+    openable::ProgressReporter progress(std::cerr, !quiet, openable::IsTerminal(2));
+    const openable::RunResult result = openable::ComputeRun(run, progress);
+    snaps::MatrixLoopOptions m;
+    m.threshold = c.snaps_matrix_threshold;
+    m.exclusion = c.snaps_frame_distance;
+    m.initial = c.initial_image;
+    m.tolerance = c.snaps_keyframe_tolerance;
+    loops = snaps::LoopsFromMatrix(result.normalized, input, m);
+    say("OpenABLE: " + result.descriptor + ", L=" + std::to_string(c.image_sequences) + ", " +
+        std::to_string(result.normalized.rows) + " frames, " + Number(result.timings.total_seconds) + " s");
   } else {
     const std::string folder = c.snaps_images.empty() ? c.images_path : c.snaps_images;
     say("searching loops on thumbnails of " + folder + " (" + std::to_string(input.Size()) +
@@ -236,7 +430,16 @@ int Run(const openable::Config& c, bool quiet) {
   // Report.
   std::cout << "openable_snaps " << openable::kVersion << ": " << input.Size() << " poses ("
             << snaps::TrajectoryFormatName(input.format) << ", frames " << input.frame_ids.front()
-            << "-" << input.frame_ids.back() << ") from \"" << c.snaps_trajectory << "\"\n";
+            << "-" << input.frame_ids.back() << ") from " << (odometry ? trajectory_name : "\"" + trajectory_name + "\"") << "\n";
+  snaps::LatencyStats odometry_stats;
+  if (odometry) {
+    odometry_stats = snaps::Summarize(odometry_report.seconds);
+    std::cout << "  odometry: " << odometry_report.kind << ", scale from " << odometry_report.scale
+              << "; " << odometry_report.failed << " failed steps (kept the previous motion)"
+              << (odometry_report.failed ? ", first " + odometry_report.first_failure : std::string())
+              << "\n  odometry per frame " << StatsLine(odometry_stats)
+              << " (paper: 0.295 s per frame with loop closure)\n";
+  }
   std::cout << "  loops: " << loops.size() << " pairs from " << source << " ("
             << Number(loop_seconds) << " s";
   if (dropped > 0) std::cout << "; " << dropped << " pairs with a frame that is not a pose dropped";
@@ -253,7 +456,7 @@ int Run(const openable::Config& c, bool quiet) {
               << " s" << (graph_report.converged ? "" : " (not converged: max iterations)") << "\n";
 
   std::ostringstream json;
-  json << "{\n  \"trajectory\": \"" << c.snaps_trajectory << "\",\n  \"poses\": " << input.Size()
+  json << "{\n  \"trajectory\": \"" << trajectory_name << "\",\n  \"poses\": " << input.Size()
        << ",\n  \"loop_source\": \"" << source << "\",\n  \"loops\": " << loops.size()
        << ",\n  \"loops_closed_by_discounted_update\": " << closed.size()
        << ",\n  \"pose_graph\": {\"loop_edges\": " << graph_report.loop_edges
@@ -312,6 +515,9 @@ int Run(const openable::Config& c, bool quiet) {
     std::cout << "  discounted update: " << Number(discounted_seconds) << " s for "
               << closed.size() << " loops\n";
   }
+  if (odometry)
+    json << ",\n  \"odometry\": {\"kind\": \"" << odometry_report.kind << "\", \"failed_steps\": "
+         << odometry_report.failed << ", \"per_frame\": " << StatsJson(odometry_stats) << "}";
   json << "\n}\n";
 
   // Outputs, all or nothing.
@@ -322,6 +528,7 @@ int Run(const openable::Config& c, bool quiet) {
       batch.Stage("Snaps_output_name", p + "_discounted.txt", snaps::EncodeTrajectory(discounted));
     if (want_graph)
       batch.Stage("Snaps_output_name", p + "_pose_graph.txt", snaps::EncodeTrajectory(graph));
+    if (odometry) batch.Stage("Snaps_output_name", p + "_odometry.txt", snaps::EncodeTrajectory(input));
     batch.Stage("Snaps_output_name", p + "_loops.csv", CsvOfLoops(input, loops));
     batch.Stage("Snaps_output_name", p + ".json", json.str());
     // The plot: the pose graph's result (or the one corrector's), and the discounted update's
@@ -335,7 +542,8 @@ int Run(const openable::Config& c, bool quiet) {
       plot.loops = loops;
       plot.axes = Lower(c.snaps_axes);
       plot.title = "SNAPS, " + std::to_string(loops.size()) + " loops (" + source + "): " +
-                   std::filesystem::path(c.snaps_trajectory).filename().string();
+                   (odometry ? trajectory_name
+                             : std::filesystem::path(c.snaps_trajectory).filename().string());
       return openable::EncodePng(snaps::RenderTrajectories(plot));
     };
     if (want_graph) batch.Stage("Snaps_output_name", p + ".png", figure(graph, "pose graph"));

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <stdexcept>
 #include <sstream>
 #include <string>
 
@@ -55,11 +56,17 @@ int IndexOfFrame(const Trajectory& trajectory, long frame_id, long tolerance) {
 
 std::vector<LoopPair> LoopsFromMatrix(const std::string& path, const Trajectory& trajectory,
                                       const MatrixLoopOptions& options) {
-  cv::Mat1f m = ReadMatrixFile(path);
+  const cv::Mat1f m = ReadMatrixFile(path);
   if (m.rows != m.cols)
     throw InputError("matrix file " + Quoted(path) + ": " + std::to_string(m.rows) + "x" +
                      std::to_string(m.cols) +
                      " is not square; expected the matrix of one sequence");
+  return LoopsFromMatrix(m, trajectory, options);
+}
+
+std::vector<LoopPair> LoopsFromMatrix(cv::Mat1f m, const Trajectory& trajectory,
+                                      const MatrixLoopOptions& options) {
+  if (m.rows != m.cols) throw std::invalid_argument("LoopsFromMatrix: matrix not square");
   double max_value = 0;
   cv::minMaxLoc(m, nullptr, &max_value);
   if (max_value > 1) m = m / max_value;

@@ -37,6 +37,10 @@ struct MatrixLoopOptions {
 // naming the file when the matrix is not square.
 std::vector<LoopPair> LoopsFromMatrix(const std::string& path, const Trajectory& trajectory,
                                       const MatrixLoopOptions& options);
+// The same on a matrix in memory (e.g. RunResult::normalized of an OpenABLE run of the same
+// frames); std::invalid_argument when it is not square.
+std::vector<LoopPair> LoopsFromMatrix(cv::Mat1f matrix, const Trajectory& trajectory,
+                                      const MatrixLoopOptions& options);
 
 // (b) Loops from a CSV of pairs: one `row,col` per line (spaces allowed around the numbers,
 // '#' starts a comment, blank lines skipped), row = the later frame id, col the earlier.
