@@ -11,19 +11,9 @@
 #include <opencv2/core/eigen.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/odometry/features.h"
 
 namespace openable::odometry {
-namespace {
-
-template <typename T>
-void Require(bool ok, const char* field, T value, const char* expected) {
-  if (ok) return;
-  std::ostringstream s;
-  s << "MonoOdometryOptions." << field << " = " << value << ", expected " << expected;
-  throw InputError(s.str());
-}
-
-}  // namespace
 
 double RotationAngle(const Eigen::Matrix3d& r) {
   return Eigen::AngleAxisd(r).angle();
@@ -31,15 +21,15 @@ double RotationAngle(const Eigen::Matrix3d& r) {
 
 void MonoOdometryOptions::Check() const {
   const std::string upper = UpperCase(features);
-  Require(upper == "ORB" || upper == "SIFT", "features", Quoted(features), "ORB or SIFT");
-  Require(max_features >= 8, "max_features", max_features, ">= 8");
-  Require(ratio_test > 0 && ratio_test <= 1, "ratio_test", ratio_test, "in (0, 1]");
-  Require(ransac_threshold_px > 0 && std::isfinite(ransac_threshold_px), "ransac_threshold_px",
+  RequireOption("MonoOdometryOptions", upper == "ORB" || upper == "SIFT", "features", Quoted(features), "ORB or SIFT");
+  RequireOption("MonoOdometryOptions", max_features >= 8, "max_features", max_features, ">= 8");
+  RequireOption("MonoOdometryOptions", ratio_test > 0 && ratio_test <= 1, "ratio_test", ratio_test, "in (0, 1]");
+  RequireOption("MonoOdometryOptions", ransac_threshold_px > 0 && std::isfinite(ransac_threshold_px), "ransac_threshold_px",
           ransac_threshold_px, "> 0");
-  Require(ransac_confidence > 0 && ransac_confidence < 1, "ransac_confidence", ransac_confidence,
+  RequireOption("MonoOdometryOptions", ransac_confidence > 0 && ransac_confidence < 1, "ransac_confidence", ransac_confidence,
           "in (0, 1)");
-  Require(min_inliers >= 5, "min_inliers", min_inliers, ">= 5");
-  Require(still_step_length >= 0 && std::isfinite(still_step_length), "still_step_length",
+  RequireOption("MonoOdometryOptions", min_inliers >= 5, "min_inliers", min_inliers, ">= 5");
+  RequireOption("MonoOdometryOptions", still_step_length >= 0 && std::isfinite(still_step_length), "still_step_length",
           still_step_length, ">= 0");
 }
 

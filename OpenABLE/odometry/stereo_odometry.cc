@@ -11,18 +11,11 @@
 #include <opencv2/ximgproc/disparity_filter.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/odometry/features.h"
 #include "OpenABLE/stereo/disparity.h"
 
 namespace openable::odometry {
 namespace {
-
-template <typename T>
-void Require(bool ok, const char* field, T value, const char* expected) {
-  if (ok) return;
-  std::ostringstream s;
-  s << "StereoOdometryOptions." << field << " = " << value << ", expected " << expected;
-  throw InputError(s.str());
-}
 
 // The disparity options of OpenABLE/stereo with this odometry's range and block.
 DisparityOptions SgbmOptions(const StereoOdometryOptions& o) {
@@ -46,24 +39,24 @@ cv::Ptr<cv::StereoMatcher> LeftMatcher(const StereoOdometryOptions& o) {
 
 void StereoOdometryOptions::Check() const {
   const std::string m = UpperCase(matcher);
-  Require(m == "SGBM" || m == "BM", "matcher", Quoted(matcher), "sgbm or bm");
-  Require(wls_lambda > 0 && std::isfinite(wls_lambda), "wls_lambda", wls_lambda, "> 0");
-  Require(wls_sigma > 0 && std::isfinite(wls_sigma), "wls_sigma", wls_sigma, "> 0");
-  Require(num_disparities >= 16 && num_disparities <= 256 && num_disparities % 16 == 0,
+  RequireOption("StereoOdometryOptions", m == "SGBM" || m == "BM", "matcher", Quoted(matcher), "sgbm or bm");
+  RequireOption("StereoOdometryOptions", wls_lambda > 0 && std::isfinite(wls_lambda), "wls_lambda", wls_lambda, "> 0");
+  RequireOption("StereoOdometryOptions", wls_sigma > 0 && std::isfinite(wls_sigma), "wls_sigma", wls_sigma, "> 0");
+  RequireOption("StereoOdometryOptions", num_disparities >= 16 && num_disparities <= 256 && num_disparities % 16 == 0,
           "num_disparities", num_disparities, "a multiple of 16 in [16, 256]");
-  Require(block_size % 2 == 1 && block_size <= 11 && block_size >= (m == "BM" ? 5 : 1),
+  RequireOption("StereoOdometryOptions", block_size % 2 == 1 && block_size <= 11 && block_size >= (m == "BM" ? 5 : 1),
           "block_size", block_size, "odd, 1-11 (sgbm) or 5-11 (bm)");
   const std::string f = UpperCase(features);
-  Require(f == "ORB" || f == "SIFT", "features", Quoted(features), "ORB or SIFT");
-  Require(max_features >= 8, "max_features", max_features, ">= 8");
-  Require(ratio_test > 0 && ratio_test <= 1, "ratio_test", ratio_test, "in (0, 1]");
-  Require(max_depth > 0 && std::isfinite(max_depth), "max_depth", max_depth, "> 0");
-  Require(pnp_reprojection_px > 0 && std::isfinite(pnp_reprojection_px), "pnp_reprojection_px",
+  RequireOption("StereoOdometryOptions", f == "ORB" || f == "SIFT", "features", Quoted(features), "ORB or SIFT");
+  RequireOption("StereoOdometryOptions", max_features >= 8, "max_features", max_features, ">= 8");
+  RequireOption("StereoOdometryOptions", ratio_test > 0 && ratio_test <= 1, "ratio_test", ratio_test, "in (0, 1]");
+  RequireOption("StereoOdometryOptions", max_depth > 0 && std::isfinite(max_depth), "max_depth", max_depth, "> 0");
+  RequireOption("StereoOdometryOptions", pnp_reprojection_px > 0 && std::isfinite(pnp_reprojection_px), "pnp_reprojection_px",
           pnp_reprojection_px, "> 0");
-  Require(pnp_iterations >= 1, "pnp_iterations", pnp_iterations, ">= 1");
-  Require(pnp_confidence > 0 && pnp_confidence < 1, "pnp_confidence", pnp_confidence,
+  RequireOption("StereoOdometryOptions", pnp_iterations >= 1, "pnp_iterations", pnp_iterations, ">= 1");
+  RequireOption("StereoOdometryOptions", pnp_confidence > 0 && pnp_confidence < 1, "pnp_confidence", pnp_confidence,
           "in (0, 1)");
-  Require(min_inliers >= 4, "min_inliers", min_inliers, ">= 4");
+  RequireOption("StereoOdometryOptions", min_inliers >= 4, "min_inliers", min_inliers, ">= 4");
 }
 
 cv::Mat1f OdometryDisparity(const cv::Mat& left, const cv::Mat& right,
