@@ -11,6 +11,8 @@
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/evaluate.h"
 #include "OpenABLE/describe.h"
+#include "OpenABLE/descriptor_cache.h"
+#include "OpenABLE/interrupt.h"
 #include "OpenABLE/exports.h"
 #include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/pipeline.h"

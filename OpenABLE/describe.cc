@@ -102,19 +102,22 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
   };
 
   // Describes frame i once it is in memory; records a size mismatch as a failure.
-  auto describe = [&](int i, const cv::Mat& frame) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (!first_size) first_size = frame.size(), first_size_frame = source.FrameName(i);
-      if (frame.size() != *first_size) {
-        const std::string message = "image \"" + source.FrameName(i) + "\" is " +
-                                    SizeText(frame.size()) + " but \"" + first_size_frame +
-                                    "\" is " + SizeText(*first_size) +
-                                    " (expected the frames of one sequence to have one size)";
-        if (i < error_index) error_index = i, error_message = message;
-        return;
-      }
+  // Records the first frame size; a frame of another size is a failure (false).
+  auto check_size = [&](int i, cv::Size size) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!first_size) first_size = size, first_size_frame = source.FrameName(i);
+    if (size != *first_size) {
+      const std::string message = "image \"" + source.FrameName(i) + "\" is " +
+                                  SizeText(size) + " but \"" + first_size_frame +
+                                  "\" is " + SizeText(*first_size) +
+                                  " (expected the frames of one sequence to have one size)";
+      if (i < error_index) error_index = i, error_message = message;
+      return false;
     }
+    return true;
+  };
+  auto describe = [&](int i, const cv::Mat& frame) {
+    if (!check_size(i, frame.size())) return;
     // Grey (or Eq. 6) for every descriptor; grey + disparity (a stereo frame) for D-LDB.
     cv::Mat image;
     try {
@@ -134,6 +137,8 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
     }
     describer.Describe(image, rows.row(i));
     ok[i] = 1;
+    if (options.cache != nullptr && !options.show_images)
+      options.cache->Store(source, i, rows.row(i), frame.size());
   };
   auto report = [&]() {
     std::lock_guard<std::mutex> lock(mutex);
@@ -194,7 +199,12 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
     auto worker = [&]() {
       for (int i = next++; i < n; i = next++) {
         if (stopped()) return;
-        if (auto f = read(i)) describe(i, *f);
+        cv::Size cached_size;
+        if (options.cache != nullptr && options.cache->Lookup(source, i, rows.row(i), &cached_size)) {
+          if (check_size(i, cached_size)) ok[i] = 1;
+        } else if (auto f = read(i)) {
+          describe(i, *f);
+        }
         report();
       }
     };

@@ -58,6 +58,18 @@ struct DescribedSequence {
   cv::Size frame_size;                   // size of the frames of this source
 };
 
+// Rows kept from earlier runs (descriptor_cache.h). Both calls are made from several threads.
+class RowCache {
+ public:
+  virtual ~RowCache() = default;
+  // Fills `row` (1 x RowWidth(), RowType()) and the size of the frame as read when frame i of
+  // `source` is cached; false otherwise (also when the frame's file cannot be read).
+  virtual bool Lookup(const FrameSource& source, int i, cv::Mat row, cv::Size* frame_size) = 0;
+  // Keeps the row of frame i, described from a frame of `frame_size`.
+  virtual void Store(const FrameSource& source, int i, const cv::Mat& row,
+                     cv::Size frame_size) = 0;
+};
+
 struct DescribeOptions {
   int threads = 0;               // 0 = all cores
   bool skip_unreadable = false;  // false: the first unreadable frame is an InputError
@@ -65,6 +77,8 @@ struct DescribeOptions {
   bool illumination_invariance = false;  // describe IlluminationInvariant(frame, alpha), not grey
   double alpha = 0.47;
   std::string key;               // config key naming the source, prefixed to errors
+  RowCache* cache = nullptr;     // rows of frames described before; not used with show_images
+                                 // or sources without ParallelReads (videos)
 };
 
 // Reads and describes every frame of `source` (in parallel when the source allows it).

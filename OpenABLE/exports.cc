@@ -1,6 +1,7 @@
 #include "OpenABLE/exports.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -10,12 +11,16 @@
 #include <fstream>
 #include <stdexcept>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/interrupt.h"
 
 namespace openable {
 
@@ -124,8 +129,71 @@ std::string EncodePng(const cv::Mat& image) {
   return std::string(buf.begin(), buf.end());
 }
 
+namespace {
+
+std::atomic<long long> g_fail_after{-1};
+std::atomic<long long> g_written{0};
+std::atomic<int> g_fail_error{ENOSPC};
+
+// write(2) of every byte, retrying short writes and EINTR. Returns 0 or the errno.
+int WriteAll(int fd, const char* data, size_t size) {
+  while (size > 0) {
+    const long long limit = g_fail_after.load();
+    size_t chunk = std::min<size_t>(size, 1 << 30);
+    if (limit >= 0) {
+      const long long left = limit - g_written.load();
+      if (left <= 0) return g_fail_error.load();
+      chunk = std::min<size_t>(chunk, static_cast<size_t>(left));
+    }
+    const ssize_t n = ::write(fd, data, chunk);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    g_written += n;
+    data += n;
+    size -= static_cast<size_t>(n);
+  }
+  return 0;
+}
+
+// Removes ".<name>.tmp-<pid>-*" and ".<name>.old-<pid>-*" beside `dest` whose process is gone.
+void RemoveStaleTemporaries(const std::filesystem::path& folder, const std::string& name) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (const char* kind : {".tmp-", ".old-"}) {
+    const std::string prefix = "." + name + kind;
+    for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+      const std::string f = it->path().filename().string();
+      if (f.compare(0, prefix.size(), prefix) != 0) continue;
+      const std::string rest = f.substr(prefix.size());
+      const size_t dash = rest.find('-');
+      if (dash == 0 || dash == std::string::npos ||
+          rest.find_first_not_of("0123456789") != dash)
+        continue;
+      const long pid = std::strtol(rest.substr(0, dash).c_str(), nullptr, 10);
+      if (pid <= 0 || pid == ::getpid()) continue;
+      if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) {
+        std::error_code rm;
+        fs::remove(it->path(), rm);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void FailStagedWritesAfterForTesting(long long bytes, int error) {
+  g_fail_error = error;
+  g_written = 0;
+  g_fail_after = bytes;
+}
+
 OutputBatch::~OutputBatch() {
-  for (const auto& item : items_) std::remove(item.temp.c_str());
+  for (const auto& item : items_) {
+    ::unlink(item.temp.c_str());
+    UnregisterTemporary(item.slot);
+  }
 }
 
 void OutputBatch::Stage(const std::string& key, const std::string& path,
@@ -144,29 +212,72 @@ void OutputBatch::Stage(const std::string& key, const std::string& path,
                      "\" cannot be created (" + ec.message() + ")");
   if (fs::is_directory(dest, ec))
     throw InputError(key + ": cannot write \"" + path + "\": it is a folder (expected a file name)");
+  RemoveStaleTemporaries(folder, dest.filename().string());
   const std::string temp = (folder / ("." + dest.filename().string() + ".tmp-" +
                                       std::to_string(::getpid()) + "-" +
                                       std::to_string(items_.size())))
                                .string();
-  items_.push_back({key, temp, path});
-  std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+  // Registered before it exists, so that a signal between open and write removes it too.
+  items_.push_back({key, temp, path, RegisterTemporary(temp)});
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  int error = fd < 0 ? errno : 0;
   for (const std::string_view part : parts)
-    if (out) out.write(part.data(), static_cast<std::streamsize>(part.size()));
-  if (out) out.close();
-  if (!out)
-    throw InputError(key + ": cannot write \"" + path + "\": " + std::strerror(errno) +
-                     " (expected a writable location)");
+    if (error == 0) error = WriteAll(fd, part.data(), part.size());
+  // close() reports the errors of delayed writes on some file systems (NFS).
+  if (fd >= 0 && ::close(fd) != 0 && error == 0) error = errno;
+  if (error != 0) {
+    ::unlink(temp.c_str());
+    UnregisterTemporary(items_.back().slot);
+    items_.pop_back();
+    throw InputError(key + ": cannot write \"" + path + "\": " + std::strerror(error) +
+                     " (expected a writable location with free space)");
+  }
 }
 
 void OutputBatch::Commit() {
+  InterruptDeferral defer;  // a signal now acts after the renames (or their undoing)
+  struct Done {
+    std::string path, backup;  // backup empty: the destination did not exist (or no link)
+    bool existed;
+  };
+  std::vector<Done> done;
   for (size_t k = 0; k < items_.size(); ++k) {
     const Item& item = items_[k];
+    std::string backup;
+    struct stat st;
+    const bool existed = ::lstat(item.path.c_str(), &st) == 0;
+    if (existed) {
+      const std::filesystem::path dest(item.path);
+      const std::filesystem::path folder =
+          dest.has_parent_path() ? dest.parent_path() : std::filesystem::path(".");
+      backup = (folder / ("." + dest.filename().string() + ".old-" +
+                          std::to_string(::getpid()) + "-" + std::to_string(k)))
+                   .string();
+      ::unlink(backup.c_str());
+      if (::link(item.path.c_str(), backup.c_str()) != 0) backup.clear();
+    }
     if (std::rename(item.temp.c_str(), item.path.c_str()) != 0) {
       const std::string reason = std::strerror(errno);
-      items_.erase(items_.begin(), items_.begin() + static_cast<long>(k));  // renamed ones
-      throw InputError(item.key + ": cannot write \"" + item.path + "\": " + reason);
+      if (!backup.empty()) ::unlink(backup.c_str());
+      // Undo: every destination renamed so far goes back to its old state.
+      for (const Done& d : done) {
+        if (!d.backup.empty()) {
+          std::rename(d.backup.c_str(), d.path.c_str());
+        } else {
+          ::unlink(d.path.c_str());
+        }
+      }
+      // The destructor removes the temporaries not renamed.
+      const std::string key = item.key, path = item.path;
+      items_.erase(items_.begin(), items_.begin() + static_cast<long>(k));
+      throw InputError(key + ": cannot write \"" + path + "\": " + reason +
+                       " (no output of this run was kept)");
     }
+    UnregisterTemporary(item.slot);
+    done.push_back({item.path, backup, existed});
   }
+  for (const Done& d : done)
+    if (!d.backup.empty()) ::unlink(d.backup.c_str());
   items_.clear();
 }
 

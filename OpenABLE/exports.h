@@ -33,7 +33,19 @@ std::string EncodeText(const cv::Mat& m);
 // Bytes of a PNG image (OpenCV's encoder).
 std::string EncodePng(const cv::Mat& image);
 
-// Stages files and commits them together.
+// Stages files and commits them together (docs/output_formats.md, "Temporaries and
+// interrupted runs").
+//  - A file is staged as ".<name>.tmp-<pid>-<n>" beside its destination: hidden, and with a
+//    name no consumer takes for an output. It is registered for removal on SIGINT/SIGTERM/
+//    SIGHUP (interrupt.h) and removed by the destructor when not committed.
+//  - Staging a file first removes stale temporaries and backups of the same destination
+//    (".<name>.tmp-<pid>-*", ".<name>.old-<pid>-*") left by a process that no longer runs
+//    (a run killed with SIGKILL, or a power cut).
+//  - Commit renames every staged file into place. An existing destination is first
+//    hard-linked to ".<name>.old-<pid>-<n>"; if a rename fails part-way, the files already
+//    renamed are put back (the old file restored from its backup, or removed when there was
+//    none), so the destinations hold either the whole new batch or the whole old state.
+//    Signals are deferred during Commit (interrupt.h).
 class OutputBatch {
  public:
   OutputBatch() = default;
@@ -42,14 +54,15 @@ class OutputBatch {
   // Removes every staged temporary file not yet committed.
   ~OutputBatch();
   // Writes `bytes` to a temporary file beside `path`, creating its folder when missing.
-  // Throws InputError naming `key` and the path when the file cannot be written.
+  // Throws InputError naming `key`, the path and the system's reason (e.g. "No space left on
+  // device") when the file cannot be written; the partial temporary is removed.
   void Stage(const std::string& key, const std::string& path, const std::string& bytes);
   // The same for a file made of several pieces written one after the other (no copy into
   // one buffer: a matrix's rows can be written from where they are).
   void Stage(const std::string& key, const std::string& path,
              const std::vector<std::string_view>& parts);
-  // Renames every staged file to its destination. Throws InputError if a rename fails (files
-  // renamed before stay; the error names the one that failed).
+  // Renames every staged file to its destination, all or nothing (see above). Throws
+  // InputError naming the key and path whose rename failed.
   void Commit();
   // Destinations staged so far.
   std::vector<std::string> Paths() const;
@@ -57,8 +70,13 @@ class OutputBatch {
  private:
   struct Item {
     std::string key, temp, path;
+    int slot = -1;  // RegisterTemporary
   };
   std::vector<Item> items_;
 };
+
+// Test hook: once `bytes` bytes have been written by OutputBatch::Stage in this process,
+// further writes fail with `error` (e.g. ENOSPC). -1 turns it off (the default).
+void FailStagedWritesAfterForTesting(long long bytes, int error);
 
 }  // namespace openable

@@ -9,6 +9,7 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/describe.h"
+#include "OpenABLE/descriptor_cache.h"
 #include "OpenABLE/evaluate.h"
 #include "OpenABLE/exports.h"
 #include "OpenABLE/io/frame_source.h"
@@ -176,6 +177,25 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   options.illumination_invariance = config.illumination_invariance == 1;
   options.alpha = alpha;
 
+  // Descriptor cache: image folders only (a video frame or a stereo pair has no one file).
+  std::unique_ptr<DescriptorCache> cache;
+  if (!config.descriptor_cache.empty()) {
+    if (specs.front().kind != SourceKind::kFolder) {
+      result.notes.push_back("Descriptor_cache: not used: the cache keeps rows of image "
+                             "files (Frame_mode 0, Camera_type 0 or 2), not of videos or "
+                             "stereo pairs");
+    } else if (options.show_images) {
+      result.notes.push_back("Descriptor_cache: not used with Show_images 1");
+    } else {
+      cache = DescriptorCache::Open(
+          config.descriptor_cache,
+          DescriptionSettingsText(config, descriptor->Name(), describer.RowWidth(),
+                                  describer.RowType()),
+          describer.RowWidth(), describer.RowType(), result.warnings);
+      options.cache = cache.get();
+    }
+  }
+
   // Describe.
   auto t = Clock::now();
   std::vector<cv::Mat> blocks;
@@ -205,6 +225,13 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
     blocks.push_back(seq.rows);
   }
   result.timings.describe_seconds = SecondsSince(t);
+  if (cache) {
+    result.cache = std::to_string(cache->Hits()) + " of " +
+                   std::to_string(result.timings.frames) + " frames from the cache, " +
+                   std::to_string(cache->Stored()) + " added (\"" + cache->Path() + "\")";
+    const std::string problem = cache->WriteProblem();
+    if (!problem.empty()) result.warnings.push_back(problem);
+  }
   cv::Mat descriptors;
   cv::vconcat(blocks, descriptors);
 

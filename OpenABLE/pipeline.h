@@ -50,6 +50,8 @@ struct RunResult {
   bool bounded = false;               // Matrix_mode: the bounded mode ran (no dense matrix)
   std::string mode_reason;            // which mode and why, one line
   std::vector<std::string> notes;     // outputs asked for but not possible in this mode
+  std::vector<std::string> warnings;  // Descriptor_cache problems that only cost time
+  std::string cache;                  // Descriptor_cache: hits and file, one line; empty = off
   std::vector<Match> matches;         // kept matches (bounded mode, or Matches_name asked)
   RunTimings timings;
 };

@@ -9,6 +9,7 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <variant>
 
 #include "OpenABLE/base/error.h"
@@ -220,6 +221,13 @@ const std::vector<Binding>& Bindings() {
       {"Approximate_checks", "Scale", &Config::approximate_checks, 1, 100000,
        "FLANN k-d trees (vector descriptors): references examined per query (more: better "
        "recall, slower; LSH for binary descriptors ignores it).", true},
+      {"Descriptor_cache", "Scale", &Config::descriptor_cache, 0, 0,
+       "Folder of the descriptor cache; empty = off. Each frame's descriptor row is kept "
+       "under a hash of the image file's bytes and of every setting that changes the row "
+       "(docs/output_formats.md), so a run interrupted or repeated with the same description "
+       "settings describes only the frames not cached, and gives the same matrix bit for bit. "
+       "Image folders only (not videos or stereo pairs). Created when missing.",
+       true},
       // Evaluation (docs/evaluation.md)
       {"Ground_truth_type", "Evaluation", &Config::ground_truth_type, 0, 0,
        "Empty: no evaluation. matrix (0/1 text, image, .npy), pairs (CSV or whitespace "
@@ -843,6 +851,12 @@ std::string ConfigMarkdownReference() {
        << ValueText(defaults, b) << "` | " << meaning << " |\n";
   }
   return os.str();
+}
+
+std::string ConfigValueText(const Config& config, const std::string& key) {
+  for (const auto& b : Bindings())
+    if (key == b.key) return ValueText(config, b);
+  throw std::logic_error("ConfigValueText: unknown key " + key);
 }
 
 std::vector<std::string> ConfigKeyNames() {

@@ -60,6 +60,7 @@ struct Config {
   std::string matches_name;           // matches file (.npy or .csv); empty = not written
   int approximate_search = 0;         // 1: FLANN candidates instead of every pair (bounded)
   int approximate_checks = 512;       // FLANN checks per query
+  std::string descriptor_cache;       // descriptor cache folder; empty = off
   // --- Evaluation (new) ----------------------------------------------------------------------
   std::string ground_truth_type;      // "", matrix, pairs, aligned, kitti, tum, positions
   std::string ground_truth;           // ground-truth file (poses of the reference, for poses)
@@ -163,6 +164,10 @@ std::string ConfigHelpText();
 
 // The same information as a Markdown table, for docs/configuration.md.
 std::string ConfigMarkdownReference();
+
+// The value of `key` as FormatConfig writes it (strings quoted). Throws std::logic_error for
+// an unknown key.
+std::string ConfigValueText(const Config& config, const std::string& key);
 
 // Every key name, in table order.
 std::vector<std::string> ConfigKeyNames();

@@ -35,8 +35,9 @@ const char* kUsage =
     "  --version         print the version\n"
     "  -h, --help        this help\n"
     "\n"
-    "Exit status: 0 success, 1 bad configuration or input data, 2 bad command line,\n"
-    "3 internal error.\n"
+    "Exit status: 0 success, 1 bad configuration or input data (or an output that cannot be\n"
+    "written: no output of the run is kept), 2 bad command line, 3 internal error,\n"
+    "128 + signal when interrupted (130 SIGINT, 143 SIGTERM, 129 SIGHUP; temporaries removed).\n"
     "\n"
     "Example:\n"
     "  Test_OpenABLE config/Config.txt --set Image_sequences=20 --set Image_descriptor=HOG\n"
@@ -60,6 +61,7 @@ void PrintReport(const openable::Config& c, const openable::RunResult& r,
                           std::to_string(c.patch_size) + "x" + std::to_string(c.patch_size))
             << ", sequence length " << c.image_sequences << "\n";
   if (!r.camera.empty()) std::cout << "  camera: " << r.camera << "\n";
+  if (!r.cache.empty()) std::cout << "  descriptor cache: " << r.cache << "\n";
   for (const auto& t : r.traversals) {
     std::cout << "  " << t.key << ": " << t.frames << " frames of " << t.frame_size.width << "x"
               << t.frame_size.height << " from \"" << t.path << "\" (rows " << t.first_row
@@ -114,6 +116,8 @@ int main(int argc, char** argv) {
   // blocks up to 256 MB on the heap lets them be reused (Gardens Point 3.0 s -> 1.1 s).
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  // SIGINT/SIGTERM/SIGHUP remove the staged temporaries and exit with 128 + signal.
+  openable::InstallInterruptCleanup("Test_OpenABLE");
   openable::CommandLine cl;
   const std::string usage_error = openable::ParseCommandLine(argc, argv, "Test_OpenABLE", cl);
   if (cl.help) {
@@ -151,6 +155,7 @@ int main(int argc, char** argv) {
       evaluation->settings = openable::EvaluationSettingsFrom(config);
     }
     openable::RunResult result = openable::ComputeRun(config, progress);
+    for (const std::string& w : result.warnings) std::cerr << "Test_OpenABLE: warning: " << w << "\n";
     for (const std::string& note : result.notes) std::cerr << "Test_OpenABLE: note: " << note << "\n";
     if (evaluation && result.bounded) {
       std::cerr << "Test_OpenABLE: note: Ground_truth_type: no evaluation in bounded mode (the "

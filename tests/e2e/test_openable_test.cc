@@ -8,6 +8,12 @@
 #include <fstream>
 #include <sstream>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/mount.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -372,6 +378,119 @@ TEST(TestOpenABLE, ReverseTraversalIsFoundAlongTheAntiDiagonal) {
   EXPECT_LT(anti, 0.85 * diagonal) << "anti-diagonal " << anti << ", diagonal " << diagonal;
   // And the pixels follow the matrix written beside them.
   EXPECT_NEAR(png.at<std::uint8_t>(n + 10, 17), 255.0 * reverse(n + 10, 17), 1.0);
+}
+
+}  // namespace
+}  // namespace openable
+
+// --- Issue 8, item 6: interrupted runs, write errors, the descriptor cache --------------------
+namespace openable {
+namespace {
+
+using namespace e2e;  // NOLINT
+
+std::vector<std::string> FilesUnder(const std::string& dir) {
+  std::vector<std::string> files;
+  if (!fs::exists(dir)) return files;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) files.push_back(e.path().string());
+  return files;
+}
+
+// A run with Descriptor_cache gives the same .npy bytes as one without, cold, warm and after
+// the cache lost its last records and got a damaged tail (a run killed while appending).
+TEST(TestOpenABLE, DescriptorCacheResumeIsBitIdentical) {
+  const std::string dir = testing::TempDir();
+  const std::string config = SampleConfig(dir);
+  Outcome o = RunProgram(testing::TestOpenableExe(), {config}, dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const std::string clean = ReadAll(dir + "/out/matrix.npy");
+  const std::vector<std::string> cache = {"--set", "Descriptor_cache=cache"};
+  auto run = [&](const std::string& expect_cache_line) {
+    std::vector<std::string> args = {config};
+    args.insert(args.end(), cache.begin(), cache.end());
+    fs::remove(dir + "/out/matrix.npy");
+    const Outcome r = RunProgram(testing::TestOpenableExe(), args, dir);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find(expect_cache_line), std::string::npos) << r.out;
+    EXPECT_TRUE(ReadAll(dir + "/out/matrix.npy") == clean) << "matrix differs from a clean run";
+    return r;
+  };
+  // The sample holds frames whose files are byte-identical (dark frames): one record serves
+  // them all, so even a cold run has hits.
+  run(" of 600 frames from the cache, ");
+  run("descriptor cache: 600 of 600 frames from the cache, 0 added");
+  const std::vector<std::string> files = FilesUnder(dir + "/cache");
+  ASSERT_EQ(files.size(), 1u);
+  const std::string bytes = ReadAll(files[0]);
+  // Header: 32 bytes, the settings text's length (u32), the text, a u64 checksum. LDB 256
+  // bits: 32-byte rows, 64-byte records. Keep 400 records, then half a record and garbage.
+  std::uint32_t text = 0;
+  std::memcpy(&text, bytes.data() + 32, 4);
+  const size_t header = 44 + text, record = 64;
+  ASSERT_EQ((bytes.size() - header) % record, 0u);
+  ASSERT_GT(bytes.size(), header + 500 * record);
+  testing::WriteBytes(files[0], bytes.substr(0, header + 400 * record + 20) + "garbage");
+  const Outcome r = run(" of 600 frames from the cache, ");
+  EXPECT_NE(r.err.find("Test_OpenABLE: warning: Descriptor_cache: "), std::string::npos) << r.err;
+  EXPECT_EQ(ReadAll(files[0]).size(), bytes.size());
+}
+
+// SIGTERM while describing Nordland (3576 frames): exit status 143, one line, no file in the
+// output folder (no output, no temporary).
+TEST(TestOpenABLE, SigtermDuringARunLeavesNoOutput) {
+  const std::string data = testing::DatasetsDir() + "/nordland_trimmed";
+  OPENABLE_REQUIRE_PATH(data);
+  const std::string dir = testing::TempDir();
+  const std::string config = SampleConfig(dir);
+  const std::string err = dir + "/stderr.log";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    if (::chdir(dir.c_str()) != 0) ::_exit(99);
+    const int fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 2);
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, 1);
+    const std::string exe = testing::TestOpenableExe();
+    const std::string a = "Images_path=" + data + "/summer", b = "Images_path_2=" + data + "/winter";
+    ::execl(exe.c_str(), exe.c_str(), config.c_str(), "--set", a.c_str(), "--set", b.c_str(),
+            "--set", "Threads=1", static_cast<char*>(nullptr));
+    ::_exit(98);
+  }
+  // Wait until the run is describing, then a little more.
+  for (int k = 0; k < 400 && ReadAll(err).find("describing") == std::string::npos; ++k)
+    ::usleep(10000);
+  ::usleep(300000);
+  int status = 0;
+  if (::waitpid(child, &status, WNOHANG) == child)
+    GTEST_SKIP() << "the run finished before it could be interrupted";
+  ASSERT_EQ(::kill(child, SIGTERM), 0);
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 143);
+  const std::string e = ReadAll(err);
+  EXPECT_NE(e.find("Test_OpenABLE: interrupted by SIGTERM (temporary files removed)\n"),
+            std::string::npos) << e;
+  EXPECT_TRUE(FilesUnder(dir + "/out").empty()) << FilesUnder(dir + "/out").front();
+}
+
+// Outputs on a full file system: exit 1, one line naming the key, the path and the reason,
+// nothing left in the folder (a 64k tmpfs; skipped without the right to mount one).
+TEST(TestOpenABLE, FullDiskFailsWithOneLineAndLeavesNothing) {
+  const std::string dir = testing::TempDir();
+  const std::string out = dir + "/out";
+  fs::create_directories(out);
+  if (::mount("tmpfs", out.c_str(), "tmpfs", 0, "size=64k") != 0)
+    GTEST_SKIP() << "cannot mount a 64k tmpfs (" << std::strerror(errno) << ")";
+  const Outcome o = RunProgram(testing::TestOpenableExe(), {SampleConfig(dir)}, dir);
+  const std::vector<std::string> left = FilesUnder(out);
+  ::umount(out.c_str());
+  EXPECT_EQ(o.status, 1) << o.err;
+  EXPECT_TRUE(OneLine(o.err.substr(o.err.find("Test_OpenABLE: error"))) ) << o.err;
+  EXPECT_NE(o.err.find("No space left on device"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("_name: cannot write \"out/matrix."), std::string::npos) << o.err;
+  EXPECT_TRUE(left.empty()) << left.front();
 }
 
 }  // namespace

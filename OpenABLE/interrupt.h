@@ -1,0 +1,36 @@
+// Interrupted runs (issue 8): temporary files that must not outlive the process.
+//
+// A program calls InstallInterruptCleanup once. From then on SIGINT, SIGTERM and SIGHUP remove
+// every registered temporary file (unlink, from the handler: async-signal-safe calls only),
+// print one line "<program>: interrupted by SIGTERM (temporary files removed)" on stderr and end the
+// process with status 128 + signal number (130 for SIGINT, 143 for SIGTERM, 129 for SIGHUP).
+// SIGKILL cannot be caught: temporaries are named so that they cannot be taken for outputs
+// (OutputBatch: ".<name>.tmp-<pid>-<n>") and a later run removes stale ones (exports.h).
+#pragma once
+
+#include <string>
+
+namespace openable {
+
+// Installs the handlers for SIGINT, SIGTERM and SIGHUP. `program` (kept, not copied) prefixes
+// the message.
+void InstallInterruptCleanup(const char* program);
+
+// Registers a file to remove if the process is interrupted. Returns a slot for
+// UnregisterTemporary, or -1 when every slot is taken (the file is then only removed by the
+// owner or by a later run's stale-file sweep).
+int RegisterTemporary(const std::string& path);
+void UnregisterTemporary(int slot);
+
+// While an InterruptDeferral lives (OutputBatch::Commit), a signal is recorded instead of
+// acted on; when the last deferral ends, a recorded signal is acted on (cleanup, message,
+// exit). This keeps a commit from being cut between two renames.
+class InterruptDeferral {
+ public:
+  InterruptDeferral();
+  ~InterruptDeferral();
+  InterruptDeferral(const InterruptDeferral&) = delete;
+  InterruptDeferral& operator=(const InterruptDeferral&) = delete;
+};
+
+}  // namespace openable
