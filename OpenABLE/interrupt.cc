@@ -38,6 +38,7 @@ const char* SignalName(int sig) {
 [[noreturn]] void CleanUpAndExit(int sig) {
   for (int k = 0; k < kSlots; ++k)
     if (g_state[k].load(std::memory_order_acquire) == kFull) ::unlink(g_paths[k]);
+  if (::isatty(2)) Write("\n");  // after a progress line redrawn in place
   Write(g_program);
   Write(": interrupted by ");
   Write(SignalName(sig));
