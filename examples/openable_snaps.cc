@@ -18,6 +18,7 @@
 
 #include "OpenABLE/OpenABLE.h"
 #include "OpenABLE/exports.h"
+#include "OpenABLE/interrupt.h"
 #include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/odometry/calibration.h"
 #include "OpenABLE/odometry/mono_odometry.h"
@@ -60,7 +61,7 @@ const char* const kUsage =
     "  -h, --help        this help (the SNAPS keys are in the group SNAPS below)\n"
     "\n"
     "Exit status: 0 success, 1 bad configuration or input data, 2 bad command line,\n"
-    "3 internal error.\n"
+    "3 internal error, 128 + signal when interrupted (temporaries removed).\n"
     "\n"
     "Example (KITTI 00, SO-DSO keyframes, ground-truth loop pairs, pose graph):\n"
     "  openable_snaps --set Snaps_trajectory=seq00/poses_history_file.txt \\\n"
@@ -562,6 +563,7 @@ int Run(const openable::Config& c, bool quiet) {
 
 int main(int argc, char** argv) {
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+  openable::InstallInterruptCleanup("openable_snaps");
   openable::CommandLine cl;
   const std::string usage_error = openable::ParseCommandLine(argc, argv, "openable_snaps", cl);
   if (cl.help) {
