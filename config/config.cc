@@ -502,7 +502,9 @@ std::string Nearest(const std::string& key) {
   return best_d <= std::max<int>(3, static_cast<int>(key.size()) / 3) ? best : "";
 }
 
-std::string Quote(const std::string& v) { return "\"" + v + "\""; }
+// Quoted (error.h): quotes and control characters escaped, so that a message quoting a line
+// of a binary file stays one readable line.
+std::string Quote(const std::string& v) { return Quoted(v); }
 
 std::string FormatNumber(double v) {
   if (std::isinf(v)) return "inf";
@@ -522,7 +524,7 @@ std::string RangeText(const Binding& b) {
 std::string ValueText(const Config& c, const Binding& b) {
   if (auto p = std::get_if<int Config::*>(&b.field)) return std::to_string(c.**p);
   if (auto p = std::get_if<double Config::*>(&b.field)) return FormatNumber(c.**p);
-  return Quote(c.*std::get<std::string Config::*>(b.field));
+  return "\"" + c.*std::get<std::string Config::*>(b.field) + "\"";  // as FormatConfig writes it
 }
 
 // Strips the quotes of a YAML scalar ("..." or '...'); unquoted text is taken as is.
@@ -663,6 +665,23 @@ Config LoadConfig(const std::string& path) {
   if (!in)
     throw InputError("configuration file " + Quote(path) +
                      " cannot be opened (expected a readable Config.txt; see Test_OpenABLE --help)");
+  // A binary file (an image, random bytes) given as the configuration: say so in one line
+  // rather than quote its first "line" of bytes. Text has no control characters but tab, CR,
+  // LF and form feed.
+  {
+    char head[65536];
+    in.read(head, sizeof head);
+    const std::streamsize n = in.gcount();
+    for (std::streamsize i = 0; i < n; ++i) {
+      const auto u = static_cast<unsigned char>(head[i]);
+      if ((u < 0x20 && u != '\t' && u != '\n' && u != '\r' && u != '\f') || u == 0x7f)
+        throw InputError("configuration file " + Quote(path) + " is not text (byte " +
+                         std::to_string(i) + " is " + Quote(std::string(1, head[i])) +
+                         "); expected a Config.txt of lines Key: value");
+    }
+    in.clear();
+    in.seekg(0);
+  }
   Config config;
   std::map<std::string, int> seen;
   std::string line;
@@ -676,7 +695,7 @@ Config LoadConfig(const std::string& path) {
     if (text.empty() || text.rfind("%YAML", 0) == 0 || text == "---" || text == "...") continue;
     const auto colon = text.find(':');
     if (colon == std::string::npos || colon == 0)
-      throw InputError(where + ": line " + Quote(Trim(line)) +
+      throw InputError(where + ": line " + Quote(Trim(line).substr(0, 80)) +
                        " is not of the form Key: value");
     const std::string key = Trim(text.substr(0, colon));
     const std::string value = Trim(text.substr(colon + 1));

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <csetjmp>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -16,6 +18,8 @@
 #include <system_error>
 #include <utility>
 #include <vector>
+
+#include <jpeglib.h>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/io/io_common.h"
@@ -109,6 +113,92 @@ bool JpegHasEnd(const std::vector<unsigned char>& bytes) {
   return false;
 }
 
+// Frames are resized to Patch_size before they are described, so an image of hundreds of
+// megapixels only costs time and memory (4 bytes a pixel once converted to float; a 20000 x
+// 20000 PNG took 10 s and 2 GB per frame): such images are refused before decoding.
+constexpr std::uint64_t kMaxPixels = 100'000'000;
+
+void CheckPixelCount(std::uint64_t width, std::uint64_t height) {
+  if (width * height > kMaxPixels)
+    throw InputError("is " + std::to_string(width) + "x" + std::to_string(height) + " (" +
+                     std::to_string(width * height / 1'000'000) + " megapixels); expected at "
+                     "most " + std::to_string(kMaxPixels / 1'000'000) + " megapixels (frames are "
+                     "resized to Patch_size: scale the images down first)");
+}
+
+// The size in a JPEG's start-of-frame segment; false when the segments before it do not parse.
+bool JpegSize(const std::vector<unsigned char>& bytes, std::uint32_t& width,
+              std::uint32_t& height) {
+  std::size_t pos = 2;
+  while (pos + 9 <= bytes.size() && bytes[pos] == 0xFF) {
+    const unsigned char marker = bytes[pos + 1];
+    const std::size_t length = (std::size_t{bytes[pos + 2]} << 8) | bytes[pos + 3];
+    const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
+                     marker != 0xCC;
+    if (sof) {
+      height = (std::uint32_t{bytes[pos + 5]} << 8) | bytes[pos + 6];
+      width = (std::uint32_t{bytes[pos + 7]} << 8) | bytes[pos + 8];
+      return true;
+    }
+    if (marker == 0xDA || length < 2) return false;  // the scan starts before any frame header
+    pos += 2 + length;
+  }
+  return false;
+}
+
+// libjpeg's error manager for DecodeJpeg: the first warning or error ends the decoding with
+// libjpeg's own text, instead of a line on stderr (warnings) or exit() (errors).
+struct JpegErrors {
+  jpeg_error_mgr manager;
+  std::jmp_buf jump;
+  char message[JMSG_LENGTH_MAX];
+};
+
+[[noreturn]] void JpegStop(j_common_ptr cinfo) {
+  auto* errors = reinterpret_cast<JpegErrors*>(cinfo->err);
+  (*cinfo->err->format_message)(cinfo, errors->message);
+  std::longjmp(errors->jump, 1);
+}
+
+void JpegMessage(j_common_ptr cinfo, int level) {
+  if (level < 0) JpegStop(cinfo);  // a warning: "Corrupt JPEG data: ...", "Premature end ..."
+}
+
+// Decodes a JPEG of 1 or 3 components into CV_8UC1 or CV_8UC3 (BGR) with libjpeg, which
+// OpenCV uses too: OpenCV lets libjpeg print warnings about damaged data on stderr and returns
+// the image with the damage filled in. Returns false with libjpeg's message in `why` at the
+// first warning or error; leaves `image` empty for other colour spaces (CMYK: OpenCV's).
+bool DecodeJpeg(const std::vector<unsigned char>& bytes, cv::Mat& image, std::string& why) {
+  jpeg_decompress_struct cinfo;
+  JpegErrors errors;
+  cinfo.err = jpeg_std_error(&errors.manager);
+  errors.manager.error_exit = JpegStop;
+  errors.manager.emit_message = JpegMessage;
+  if (setjmp(errors.jump) != 0) {
+    jpeg_destroy_decompress(&cinfo);
+    image.release();
+    why = std::string("damaged JPEG: ") + errors.message;
+    return false;
+  }
+  jpeg_create_decompress(&cinfo);
+  jpeg_mem_src(&cinfo, const_cast<unsigned char*>(bytes.data()),
+               static_cast<unsigned long>(bytes.size()));
+  jpeg_read_header(&cinfo, TRUE);
+  if (cinfo.num_components == 1 || cinfo.num_components == 3) {
+    cinfo.out_color_space = cinfo.num_components == 1 ? JCS_GRAYSCALE : JCS_EXT_BGR;
+    jpeg_start_decompress(&cinfo);
+    image.create(static_cast<int>(cinfo.output_height), static_cast<int>(cinfo.output_width),
+                 cinfo.output_components == 1 ? CV_8UC1 : CV_8UC3);
+    while (cinfo.output_scanline < cinfo.output_height) {
+      JSAMPROW row = image.ptr<unsigned char>(static_cast<int>(cinfo.output_scanline));
+      jpeg_read_scanlines(&cinfo, &row, 1);
+    }
+    jpeg_finish_decompress(&cinfo);
+  }
+  jpeg_destroy_decompress(&cinfo);
+  return true;
+}
+
 // The maximum value of a binary or plain PGM/PPM header, or 0 when it cannot be read (or the
 // file is a bitmap, P1/P4, which has none).
 int PnmMaxValue(const std::vector<unsigned char>& bytes) {
@@ -138,15 +228,17 @@ int PnmMaxValue(const std::vector<unsigned char>& bytes) {
 // so that OpenImageIO decodes the file or says precisely what is wrong with it.
 cv::Mat DecodeWithOpenCV(const std::vector<unsigned char>& bytes, bool& grey_alpha) {
   grey_alpha = false;
-  if (bytes.size() < 16) return cv::Mat();
   std::string why;
-  const PngCheck png = CheckPng(bytes, why);
+  const PngCheck png = CheckPng(bytes, why);  // before the size check: a cut PNG is short
+  if (!why.empty()) throw InputError(why);
+  if (bytes.size() < 16) return cv::Mat();
   const bool jpeg = bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
   const bool pnm = bytes[0] == 'P' && (bytes[1] == '2' || bytes[1] == '3' || bytes[1] == '5' ||
                                        bytes[1] == '6');
   const bool bmp = bytes[0] == 'B' && bytes[1] == 'M';
   if (!why.empty()) throw InputError(why);
   if (png == PngCheck::kSound) {
+    CheckPixelCount(BigEndian32(&bytes[16]), BigEndian32(&bytes[20]));
     grey_alpha = bytes[25] == 4;  // IHDR colour type 4: grey + alpha
   } else if (png == PngCheck::kDamaged || (jpeg && !JpegHasEnd(bytes))) {
     return cv::Mat();
@@ -155,6 +247,13 @@ cv::Mat DecodeWithOpenCV(const std::vector<unsigned char>& bytes, bool& grey_alp
     if (max_value != 255 && max_value != 65535) return cv::Mat();
   } else if (!jpeg && !bmp) {
     return cv::Mat();
+  }
+  if (jpeg) {
+    std::uint32_t width = 0, height = 0;
+    if (JpegSize(bytes, width, height)) CheckPixelCount(width, height);
+    cv::Mat image;
+    if (!DecodeJpeg(bytes, image, why)) throw InputError(why);
+    if (!image.empty()) return image;
   }
   try {
     return cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
@@ -260,9 +359,13 @@ std::vector<std::string> ListImages(const std::string& folder, const std::string
     const std::string name = it->path().filename().string();
     if (name.empty() || name.front() == '.') continue;
     std::error_code file_ec;
-    if (!it->is_regular_file(file_ec) || file_ec) continue;  // follows symlinks
-    ++file_count;
     const std::string ext = ExtensionOf(name);
+    // A symbolic link that leads nowhere (dangling, or a loop) under an image name is a frame
+    // the user meant: it is listed so that reading it names it. Folders are passed over.
+    const bool broken_link = it->is_symlink(file_ec) && !fs::exists(it->path(), file_ec);
+    if (!broken_link && (!it->is_regular_file(file_ec) || file_ec)) continue;  // follows links
+    if (broken_link && !accepted(ext)) continue;
+    ++file_count;
     if (accepted(ext)) {
       names.push_back(name);
     } else {
@@ -306,7 +409,15 @@ cv::Mat ReadImageFile(const std::string& path) {
 
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
-  if (!fs::exists(status)) throw fail("does not exist");
+  if (!fs::exists(status)) {
+    std::error_code link_ec;
+    if (fs::is_symlink(fs::symlink_status(path, link_ec))) {
+      const std::string target = fs::read_symlink(path, link_ec).string();
+      throw fail("is a symbolic link to " + Quoted(target) + " that leads nowhere (" +
+                 (ec ? FirstLine(ec.message()) : std::string("dangling: no such file")) + ")");
+    }
+    throw fail("does not exist");
+  }
   if (!fs::is_regular_file(status)) throw fail("is not a regular file");
   if (fs::file_size(path, ec) == 0 && !ec) throw fail("is an empty file (0 bytes)");
 
@@ -329,7 +440,8 @@ cv::Mat ReadImageFile(const std::string& path) {
   try {
     image = DecodeWithOpenCV(bytes, grey_alpha);
   } catch (const InputError& e) {
-    throw fail(std::string("cannot be decoded: ") + e.what());
+    const std::string what = e.what();
+    throw fail(what.rfind("is ", 0) == 0 ? what : "cannot be decoded: " + what);  // size or damage
   }
   const int depth = image.depth();
   if (image.empty() || (depth != CV_8U && depth != CV_16U) || image.channels() == 2) {

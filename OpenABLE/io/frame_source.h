@@ -24,14 +24,17 @@ const std::vector<std::string>& SupportedImageExtensions();
 
 // Lists the image files of `folder` in natural order of their file names (not recursive).
 // `extension` (e.g. "png", case-insensitive, with or without a dot) keeps only those files;
-// empty keeps every supported image extension. Throws InputError when the folder is missing,
-// is not a folder, or holds no matching image.
+// empty keeps every supported image extension. Subfolders are passed over; a symbolic link
+// that leads nowhere (dangling or a loop) under an image name is listed, so that reading it
+// names it. Throws InputError when the folder is missing, is not a folder, or holds no
+// matching image.
 std::vector<std::string> ListImages(const std::string& folder, const std::string& extension);
 
 // Reads one image file through OpenImageIO (PNG, JPEG, TIFF, PGM/PPM, BMP, ...; 8 or 16 bit;
 // 1, 2, 3 or 4 channels; alpha is dropped, grey+alpha becomes grey). Returns CV_32FC1 or
 // CV_32FC3 (BGR) in [0, 1]. Throws InputError naming the file when it cannot be opened or
-// decoded (missing, corrupt, truncated, not an image).
+// decoded (missing, a broken symbolic link, corrupt, truncated, a JPEG libjpeg warns about,
+// not an image) or is a PNG or JPEG of more than 100 megapixels (docs/robustness.md).
 cv::Mat ReadImageFile(const std::string& path);
 
 // A sequence of frames with random access by index.

@@ -1,5 +1,7 @@
 // Module libopenable_video.so (see module_loader.h): video files through OpenCV's videoio.
 #include <algorithm>
+#include <cstdlib>
+#include <filesystem>
 #include <mutex>
 
 #include <opencv2/imgproc.hpp>
@@ -148,6 +150,13 @@ extern "C" void openable_video_open(const std::string& path, int first, int last
   using namespace openable::io_internal;
   int count = 0;
   int api = -1;
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(path, ec) && std::filesystem::file_size(path, ec) == 0 && !ec)
+    throw InputError("video " + Quoted(path) + " is an empty file (0 bytes; " + kExpectedVideo + ")");
+  // FFmpeg logs its complaints about a damaged file ("moov atom not found") on stderr before
+  // OpenCV reports failure; our message says it in one line, so FFmpeg is kept quiet (unless
+  // the user asked for its log level).
+  setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);
   try {
     cv::VideoCapture capture;
     api = OpenCapture(capture, path);

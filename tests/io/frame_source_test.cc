@@ -198,8 +198,9 @@ class ListImagesTest : public ::testing::Test {
 
 TEST_F(ListImagesTest, ExtensionFilterInNaturalOrder) {
   // Case-sensitive natural order: 'I' (0x49) comes before 'i' (0x69).
-  const std::vector<std::string> pngs = {P("IMG3.PNG"), P("img1.png"), P("img2.png"),
-                                         P("img10.png"), P("link5.png")};
+  // The dangling link broken.png is listed: a frame the user meant, named when read.
+  const std::vector<std::string> pngs = {P("IMG3.PNG"),  P("broken.png"), P("img1.png"),
+                                         P("img2.png"),  P("img10.png"),  P("link5.png")};
   EXPECT_EQ(ListImages(dir_, "png"), pngs);
   EXPECT_EQ(ListImages(dir_, ".png"), pngs);
   EXPECT_EQ(ListImages(dir_, "PNG"), pngs);
@@ -209,9 +210,16 @@ TEST_F(ListImagesTest, ExtensionFilterInNaturalOrder) {
 }
 
 TEST_F(ListImagesTest, EmptyExtensionKeepsEverySupportedImage) {
-  const std::vector<std::string> all = {P("IMG3.PNG"),  P("img1.png"),  P("img2.png"),
-                                        P("img10.png"), P("link5.png"), P("photo.jpg")};
+  const std::vector<std::string> all = {P("IMG3.PNG"),  P("broken.png"), P("img1.png"),
+                                        P("img2.png"),  P("img10.png"),  P("link5.png"),
+                                        P("photo.jpg")};
   EXPECT_EQ(ListImages(dir_, ""), all);
+}
+
+TEST_F(ListImagesTest, ReadingADanglingLinkNamesIt) {
+  ExpectInputError([&] { ReadImageFile(P("broken.png")); },
+                   {"image " + Q(P("broken.png")), "is a symbolic link to " + Q(P("missing.png")),
+                    "leads nowhere"});
 }
 
 TEST_F(ListImagesTest, NoMatchingExtensionNamesFolderAndWhatItHolds) {
