@@ -165,7 +165,7 @@ std::unique_ptr<DescriptorCache> DescriptorCache::Open(const std::string& folder
       if (Fnv1a64(r, record - 8) != sum) break;
       size_t at = valid;
       Key key;
-      std::int32_t w, h;
+      std::int32_t w = 0, h = 0;
       Get(bytes, at, &key.hash);
       Get(bytes, at, &key.size);
       Get(bytes, at, &w);

@@ -381,8 +381,9 @@ TEST(BadInputCorpus, GarbageAsConfiguration) {
     const Outcome o = RunBounded(dir, {dir + "/" + name});
     SCOPED_TRACE(name);
     ExpectRefused(o, dir, name);
-    if (bytes.find('\0') != std::string::npos || name == std::string("random.txt"))
+    if (bytes.find('\0') != std::string::npos || name == std::string("random.txt")) {
       EXPECT_NE(o.err.find("is not text"), std::string::npos) << o.err;
+    }
     for (char c : o.err.substr(0, o.err.size() - 1))
       EXPECT_TRUE(static_cast<unsigned char>(c) >= 0x20 || c == '\t')
           << "control character " << static_cast<int>(c) << " in: " << o.err;
