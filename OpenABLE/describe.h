@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/robustness.h"
 #include "descriptors/descriptor.h"
 
 namespace openable {
@@ -65,6 +66,12 @@ struct DescribeOptions {
   bool illumination_invariance = false;  // describe IlluminationInvariant(frame, alpha), not grey
   double alpha = 0.47;
   std::string key;               // config key naming the source, prefixed to errors
+  // Robustness (OpenABLE/robustness.h): noise added to each frame before grey conversion
+  // (off unless options set), seeded from noise.seed, noise_stream and the frame's index;
+  // side-window fusion of the grey image with these radii (empty = off) before description.
+  NoiseOptions noise;
+  int noise_stream = 0;          // traversal index: 0 Images_path, 1 Images_path_2
+  std::vector<int> side_window_radii;
 };
 
 // Reads and describes every frame of `source` (in parallel when the source allows it).
