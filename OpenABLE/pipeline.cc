@@ -175,6 +175,12 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   options.show_images = config.show_images == 1 && HasDisplay();
   options.illumination_invariance = config.illumination_invariance == 1;
   options.alpha = alpha;
+  options.noise.gaussian = config.noise_gaussian;
+  options.noise.salt_pepper = config.noise_salt_pepper;
+  options.noise.overexposure = config.noise_overexposure;
+  options.noise.seed = config.noise_seed;
+  if (config.side_window == 1)
+    options.side_window_radii = ParseSideWindowRadii(config.side_window_radii);
 
   // Describe.
   auto t = Clock::now();
@@ -183,6 +189,7 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   for (size_t s = 0; s < sources.size(); ++s) {
     const bool stereo = specs[s].kind == SourceKind::kStereo;
     options.key = stereo ? "" : specs[s].key;  // stereo read errors name their own key
+    options.noise_stream = static_cast<int>(s);  // each traversal its own noise
     progress.Begin("describing", sources[s]->Size(),
                    stereo ? "stereo pairs (rectify" +
                                 std::string(describer.Channels() == 2 ? ", SGBM" : "") + ", " +
