@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/robustness.h"
 #include "descriptors/descriptor.h"
 
 namespace openable {
@@ -79,6 +80,12 @@ struct DescribeOptions {
   std::string key;               // config key naming the source, prefixed to errors
   RowCache* cache = nullptr;     // rows of frames described before; not used with show_images
                                  // or sources without ParallelReads (videos)
+  // Robustness (OpenABLE/robustness.h): noise added to each frame before grey conversion
+  // (off unless options set), seeded from noise.seed, noise_stream and the frame's index;
+  // side-window fusion of the grey image with these radii (empty = off) before description.
+  NoiseOptions noise;
+  int noise_stream = 0;          // traversal index: 0 Images_path, 1 Images_path_2
+  std::vector<int> side_window_radii;
 };
 
 // Reads and describes every frame of `source` (in parallel when the source allows it).

@@ -176,6 +176,12 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   options.show_images = config.show_images == 1 && HasDisplay();
   options.illumination_invariance = config.illumination_invariance == 1;
   options.alpha = alpha;
+  options.noise.gaussian = config.noise_gaussian;
+  options.noise.salt_pepper = config.noise_salt_pepper;
+  options.noise.overexposure = config.noise_overexposure;
+  options.noise.seed = config.noise_seed;
+  if (config.side_window == 1)
+    options.side_window_radii = ParseSideWindowRadii(config.side_window_radii);
 
   // Descriptor cache: image folders only (a video frame or a stereo pair has no one file).
   std::unique_ptr<DescriptorCache> cache;
@@ -186,6 +192,11 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
                              "stereo pairs");
     } else if (options.show_images) {
       result.notes.push_back("Descriptor_cache: not used with Show_images 1");
+    } else if (options.noise.gaussian > 0 || options.noise.salt_pepper > 0 ||
+               options.noise.overexposure > 0) {
+      // The noise of a frame depends on its position in the run, not only on its bytes.
+      result.notes.push_back("Descriptor_cache: not used with Noise_* (a frame's noise depends "
+                             "on its position in the run, not only on the image)");
     } else {
       cache = DescriptorCache::Open(
           config.descriptor_cache,
@@ -203,6 +214,7 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   for (size_t s = 0; s < sources.size(); ++s) {
     const bool stereo = specs[s].kind == SourceKind::kStereo;
     options.key = stereo ? "" : specs[s].key;  // stereo read errors name their own key
+    options.noise_stream = static_cast<int>(s);  // each traversal its own noise
     progress.Begin("describing", sources[s]->Size(),
                    stereo ? "stereo pairs (rectify" +
                                 std::string(describer.Channels() == 2 ? ", SGBM" : "") + ", " +

@@ -187,6 +187,36 @@ const std::vector<Binding>& Bindings() {
        "anti-diagonals (the reference route driven the opposite way); 2 the smaller of the "
        "two for every cell (needs a second matrix in dense mode).",
        true},
+      // Robustness
+      {"Side_window", "Robustness", &Config::side_window, 0, 1,
+       "1 applies side-window multilayer pixel fusion to the grey image before description "
+       "(Algorithm 1 of the side-window direct SLAM paper): in every layer each pixel becomes "
+       "the mean of the one of its eight side windows (U, D, L, R, NW, NE, SW, SE) closest to "
+       "it, which smooths noise but keeps edges. 0 = off. See docs/descriptors.md.",
+       true},
+      {"Side_window_radii", "Robustness", &Config::side_window_radii, 0, 0,
+       "Radius of each side-window layer, in order, comma-separated (\"1,2,3\": three layers, "
+       "windows of 2x3 to 4x7 pixels); integers in [1, 50], 1 to 16 layers. Used when "
+       "Side_window is 1.",
+       true},
+      {"Noise_gaussian", "Robustness", &Config::noise_gaussian, 0, 1,
+       "Robustness studies: variance of the Gaussian noise added to every frame's intensities "
+       "in [0, 1] (per channel, then clipped to [0, 1]) before grey conversion; the "
+       "side-window paper uses 0.003. 0 = off.",
+       true},
+      {"Noise_salt_pepper", "Robustness", &Config::noise_salt_pepper, 0, 1,
+       "Robustness studies: fraction of the pixels of every frame set to black or white (even "
+       "odds), after the Gaussian noise; the side-window paper uses 0.1. 0 = off.",
+       true},
+      {"Noise_overexposure", "Robustness", &Config::noise_overexposure, 0, kNoLimit,
+       "Robustness studies: overexposure of every frame, intensities v in [0, 1] multiplied "
+       "by 1 + this value and saturated at 1 (1 doubles the exposure: everything above 0.5 "
+       "becomes white). Applied first. 0 = off.",
+       true},
+      {"Noise_seed", "Robustness", &Config::noise_seed, 0, 2147483647,
+       "Seed of the noise: each frame's noise depends only on this seed, its traversal and "
+       "its index, so a run is repeatable whatever the number of Threads.",
+       true},
       // Scale
       {"Matrix_mode", "Scale", &Config::matrix_mode, 0, 2,
        "0 auto: dense when the N x N matrix fits in Memory_limit, bounded otherwise (the run "
@@ -795,6 +825,7 @@ void CheckConfig(const Config& c) {
                      " is not after Initial_image " + std::to_string(c.initial_image) +
                      "; expected -1 (to the end) or a position > Initial_image");
   CheckEvaluationConfig(c);
+  if (c.side_window == 1) ParseSideWindowRadii(c.side_window_radii);
   if (c.approximate_search == 1 && c.matrix_mode == 1)
     throw InputError("Approximate_search: 1 needs Matrix_mode 2 (bounded) or 0 (auto); "
                      "Matrix_mode is 1 (dense), which compares every pair");
@@ -812,6 +843,31 @@ void CheckConfig(const Config& c) {
   if (c.threshold != -1.0 && (c.threshold < 0.0 || c.threshold > 1.0))
     throw InputError("Threshold: " + FormatNumber(c.threshold) +
                      " is not valid; expected -1 (disabled) or a number in [0, 1]");
+}
+
+std::vector<int> ParseSideWindowRadii(const std::string& text) {
+  auto fail = [&](const std::string& why) {
+    throw InputError("Side_window_radii: " + Quote(text) + " is not valid (" + why +
+                     "); expected radii in [1, 50] separated by commas, 1 to 16 layers, "
+                     "e.g. \"1,2,3\"");
+  };
+  std::vector<int> radii;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    item = Trim(item);
+    if (item.empty()) fail("empty item");
+    char* end = nullptr;
+    errno = 0;
+    const long v = std::strtol(item.c_str(), &end, 10);
+    if (end != item.c_str() + item.size() || errno == ERANGE) fail(Quote(item) + " is not an integer");
+    if (v < 1 || v > 50) fail(item + " is out of range");
+    radii.push_back(static_cast<int>(v));
+  }
+  if (!text.empty() && text.back() == ',') fail("empty item");
+  if (radii.empty()) fail("no radius");
+  if (radii.size() > 16) fail(std::to_string(radii.size()) + " layers");
+  return radii;
 }
 
 std::string FormatConfig(const Config& c) {

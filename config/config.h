@@ -52,6 +52,13 @@ struct Config {
   int ldb_bits = 256;                 // new: LDB bits kept, 1-1386
   int threads = 0;                    // new: worker threads, 0 = all cores
   int sequence_direction = 0;         // new: 0 diagonals, 1 anti-diagonals, 2 min of both
+  // --- Robustness (issue 8) ------------------------------------------------------------------
+  int side_window = 0;                // new: 1 applies side-window multilayer fusion
+  std::string side_window_radii = "1,2,3";  // new: radius of each layer, comma-separated
+  double noise_gaussian = 0.0;        // new: variance of Gaussian noise on [0, 1]; 0 off
+  double noise_salt_pepper = 0.0;     // new: fraction of salt-and-pepper pixels; 0 off
+  double noise_overexposure = 0.0;    // new: exposure gain v (1 + g), saturating; 0 off
+  int noise_seed = 0;                 // new: seed of the noise
   // --- Scale (new; docs/configuration.md) ----------------------------------------------------
   int matrix_mode = 0;                // 0 auto, 1 dense N x N, 2 bounded (tiles, kept matches)
   double memory_limit = 0.0;          // GiB the dense matrix may use; 0 = 3/4 of the RAM
@@ -145,6 +152,10 @@ void ApplyOverride(Config& config, const std::string& assignment);
 // Cross-key checks that no single value shows (the mode's inputs are given, the threshold is
 // -1 or in [0, 1], parts not built yet are asked for, ...). Throws InputError naming the key.
 void CheckConfig(const Config& config);
+
+// The layer radii of Side_window_radii ("1,2,3": integers in [1, 50], 1 to 16 layers, spaces
+// allowed). Throws a one-line InputError naming the key otherwise.
+std::vector<int> ParseSideWindowRadii(const std::string& text);
 
 // Cross-key checks of the SNAPS keys (openable_snaps): a trajectory is given, the format,
 // loop source, corrector, robust kernel and axes names are known, the file a loop source

@@ -1,0 +1,110 @@
+#include "OpenABLE/robustness.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+namespace openable {
+
+cv::Mat1d SideWindowLayer(const cv::Mat1d& image, int r) {
+  if (r < 1) throw std::logic_error("SideWindowLayer: radius below 1");
+  const int h = image.rows, w = image.cols;
+  cv::Mat1d sum;
+  cv::integral(image, sum, CV_64F);  // (h + 1) x (w + 1)
+  cv::Mat1d out(h, w);
+  // Sum and count of rows [y0, y1], columns [x0, x1] clipped to the image.
+  auto box = [&](int y0, int y1, int x0, int x1) {
+    y0 = std::max(y0, 0), x0 = std::max(x0, 0);
+    y1 = std::min(y1, h - 1), x1 = std::min(x1, w - 1);
+    const double s = sum(y1 + 1, x1 + 1) - sum(y0, x1 + 1) - sum(y1 + 1, x0) + sum(y0, x0);
+    return s / ((y1 - y0 + 1) * (x1 - x0 + 1));
+  };
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double p = image(y, x);
+      // Order of Eq. 6: U, D, L, R, NW, NE, SW, SE.
+      const double q[8] = {box(y - r, y, x - r, x + r), box(y, y + r, x - r, x + r),
+                           box(y - r, y + r, x - r, x), box(y - r, y + r, x, x + r),
+                           box(y - r, y, x - r, x),     box(y - r, y, x, x + r),
+                           box(y, y + r, x - r, x),     box(y, y + r, x, x + r)};
+      int s = 0;
+      double best = std::abs(q[0] - p);
+      for (int n = 1; n < 8; ++n) {
+        const double d = std::abs(q[n] - p);
+        if (d < best - 1e-9) best = d, s = n;
+      }
+      out(y, x) = q[s];
+    }
+  return out;
+}
+
+cv::Mat SideWindowFusion(const cv::Mat& image, const std::vector<int>& radii) {
+  if (image.type() != CV_8UC1 && image.type() != CV_8UC2)
+    throw std::logic_error("SideWindowFusion: expected CV_8UC1 or CV_8UC2, got " +
+                           cv::typeToString(image.type()));
+  if (radii.empty()) return image.clone();
+  cv::Mat grey;
+  if (image.channels() == 2) {
+    cv::extractChannel(image, grey, 0);
+  } else {
+    grey = image;
+  }
+  cv::Mat1d cur;
+  grey.convertTo(cur, CV_64F);
+  for (int r : radii) cur = SideWindowLayer(cur, r);
+  cv::Mat1b fused(cur.size());
+  for (int y = 0; y < cur.rows; ++y)
+    for (int x = 0; x < cur.cols; ++x)
+      fused(y, x) = cv::saturate_cast<uchar>(std::floor(cur(y, x) + 0.5));
+  if (image.channels() == 1) return fused;
+  cv::Mat out = image.clone();
+  cv::insertChannel(fused, out, 0);
+  return out;
+}
+
+uint64_t NoiseState(int seed, int stream, int frame) {
+  auto mix = [](uint64_t z) {  // splitmix64's finaliser
+    z += 0x9E3779B97F4A7C15ull;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  };
+  uint64_t z = mix(static_cast<uint64_t>(static_cast<uint32_t>(seed)));
+  z = mix(z ^ static_cast<uint64_t>(static_cast<uint32_t>(stream)));
+  z = mix(z ^ static_cast<uint64_t>(static_cast<uint32_t>(frame)));
+  return z == 0 ? 1 : z;  // cv::RNG replaces a zero state
+}
+
+cv::Mat AddNoise(const cv::Mat& frame, const NoiseOptions& o, uint64_t state) {
+  const int type = frame.type();
+  if (type != CV_32FC1 && type != CV_32FC2 && type != CV_32FC3)
+    throw std::logic_error("AddNoise: expected CV_32FC1, C2 or C3, got " +
+                           cv::typeToString(type));
+  cv::Mat out = frame.clone();
+  // Channels that are intensities: all but a stereo frame's disparity (channel 1).
+  const int cn = frame.channels(), noisy = cn == 2 ? 1 : cn;
+  cv::RNG rng(state);
+  const double sd = std::sqrt(std::max(0.0, o.gaussian));
+  const float gain = static_cast<float>(1.0 + o.overexposure);
+  for (int y = 0; y < out.rows; ++y) {
+    float* row = out.ptr<float>(y);
+    for (int x = 0; x < out.cols; ++x) {
+      float* px = row + x * cn;
+      for (int c = 0; c < noisy; ++c) {
+        float v = px[c];
+        if (o.overexposure > 0) v *= gain;
+        if (sd > 0) v += static_cast<float>(rng.gaussian(sd));
+        px[c] = std::min(1.f, std::max(0.f, v));
+      }
+      if (o.salt_pepper > 0 && rng.uniform(0.0, 1.0) < o.salt_pepper) {
+        const float v = rng.uniform(0, 2) == 0 ? 0.f : 1.f;
+        for (int c = 0; c < noisy; ++c) px[c] = v;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace openable
