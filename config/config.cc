@@ -213,7 +213,7 @@ const std::vector<Binding>& Bindings() {
        "by 1 + this value and saturated at 1 (1 doubles the exposure: everything above 0.5 "
        "becomes white). Applied first. 0 = off.",
        true},
-      {"Noise_seed", "Robustness", &Config::noise_seed, 0, 2147483647,
+      {"Noise_seed", "Robustness", &Config::noise_seed, 0, 1000000000,
        "Seed of the noise: each frame's noise depends only on this seed, its traversal and "
        "its index, so a run is repeatable whatever the number of Threads.",
        true},
