@@ -8,6 +8,7 @@
 #include <thread>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <random>
 #include <sstream>
 #include <string>
@@ -312,15 +313,15 @@ TEST(BadInputCorpus, EveryNumericKeyWrongInTurn) {
     if (cases.size() % 3 == 0) bad.push_back(k.values.rfind("integer", 0) == 0 ? "2.5" : "nan");
     double lo = 0, hi = 0;
     if (std::sscanf(k.values.c_str(), "%*s in [%lf, %lf]", &lo, &hi) == 2) {
-      std::ostringstream a, b;
-      a << lo - 1;
-      b << hi + 1;
+      std::ostringstream a, b;  // full precision: "1e+09" would round 1000000001 back in range
+      a << std::setprecision(15) << lo - 1;
+      b << std::setprecision(15) << hi + 1;
       bad.push_back(a.str());
       bad.push_back(b.str());
     } else {
       ASSERT_EQ(std::sscanf(k.values.c_str(), "%*s >= %lf", &lo), 1) << k.values;
       std::ostringstream a;
-      a << lo - 1;
+      a << std::setprecision(15) << lo - 1;
       bad.push_back(a.str());
     }
     for (const std::string& value : bad) cases.push_back({k.key, value, k.values, {}});
