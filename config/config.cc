@@ -650,11 +650,8 @@ void CheckSnapsConfig(const Config& c) {
                      FormatNumber(c.snaps_robust_scale) + "; expected every one > 0");
 }
 
-Config LoadConfig(const std::string& path) {
-  std::ifstream in(path);
-  if (!in)
-    throw InputError("configuration file " + Quote(path) +
-                     " cannot be opened (expected a readable Config.txt; see Test_OpenABLE --help)");
+Config ParseConfigText(const std::string& contents, const std::string& name) {
+  std::istringstream in(contents);
   Config config;
   std::map<std::string, int> seen;
   std::string line;
@@ -662,7 +659,7 @@ Config LoadConfig(const std::string& path) {
   bool any_key = false;
   while (std::getline(in, line)) {
     ++number;
-    const std::string where = path + ":" + std::to_string(number);
+    const std::string where = name + ":" + std::to_string(number);
     std::string text = Trim(StripComment(line));
     if (number == 1 && !text.empty() && text[0] == '\xEF') text = Trim(text.substr(3));  // BOM
     if (text.empty() || text.rfind("%YAML", 0) == 0 || text == "---" || text == "...") continue;
@@ -680,11 +677,21 @@ Config LoadConfig(const std::string& path) {
     Assign(config, b, value, where);
     any_key = true;
   }
-  if (in.bad()) throw InputError("configuration file " + Quote(path) + " could not be read");
   if (!any_key)
-    throw InputError("configuration file " + Quote(path) +
+    throw InputError("configuration file " + Quote(name) +
                      " holds no key (expected lines of the form Key: value)");
   return config;
+}
+
+Config LoadConfig(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw InputError("configuration file " + Quote(path) +
+                     " cannot be opened (expected a readable Config.txt; see Test_OpenABLE --help)");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw InputError("configuration file " + Quote(path) + " could not be read");
+  return ParseConfigText(text.str(), path);
 }
 
 void ApplyOverride(Config& config, const std::string& assignment) {
