@@ -163,6 +163,38 @@ cv::Mat DecodeWithOpenCV(const std::vector<unsigned char>& bytes, bool& grey_alp
   }
 }
 
+// The decoding shared by ReadImageFile and DecodeImageBytes: OpenCV's codecs for the common
+// formats, else `oiio_fallback` (OpenImageIO on the file or on the bytes). `name` names the
+// image in messages.
+template <typename Fallback>
+cv::Mat DecodeBytes(const std::vector<unsigned char>& bytes, const std::string& name,
+                    const Fallback& oiio_fallback) {
+  bool grey_alpha = false;
+  cv::Mat image;
+  try {
+    image = DecodeWithOpenCV(bytes, grey_alpha);
+  } catch (const InputError& e) {
+    throw InputError("image " + Quoted(name) + " cannot be decoded: " + e.what() + " (" +
+                     kExpectedImage + ")");
+  }
+  const int depth = image.depth();
+  if (image.empty() || (depth != CV_8U && depth != CV_16U) || image.channels() == 2) {
+    // Everything else (TIFF, damaged files, unusual depths) goes to OpenImageIO.
+    return oiio_fallback();
+  }
+  if (image.channels() == 4) {
+    if (grey_alpha) {
+      cv::extractChannel(image, image, 0);
+    } else {
+      cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
+    }
+  }
+  cv::Mat frame;
+  image.convertTo(frame, CV_MAKETYPE(CV_32F, image.channels()),
+                  depth == CV_8U ? 1.0 / 255.0 : 1.0 / 65535.0);
+  return frame;
+}
+
 // Frames of an image folder; each Read opens its own file, so reads may run in parallel.
 class ImageFolderSource final : public FrameSource {
  public:
@@ -324,31 +356,24 @@ cv::Mat ReadImageFile(const std::string& path) {
     }
     if (!f) throw fail("cannot be read (permission denied or I/O error)");
   }
-  bool grey_alpha = false;
-  cv::Mat image;
-  try {
-    image = DecodeWithOpenCV(bytes, grey_alpha);
-  } catch (const InputError& e) {
-    throw fail(std::string("cannot be decoded: ") + e.what());
-  }
-  const int depth = image.depth();
-  if (image.empty() || (depth != CV_8U && depth != CV_16U) || image.channels() == 2) {
-    // Everything else (TIFF, damaged files, unusual depths) goes to OpenImageIO.
+  return DecodeBytes(bytes, path, [&] {
     cv::Mat frame;
     reinterpret_cast<OpenableOiioRead>(ModuleSymbol("oiio", "openable_oiio_read"))(path, frame);
     return frame;
+  });
+}
+
+cv::Mat DecodeImageBytes(const std::string& bytes, const std::string& name) {
+  if (bytes.empty()) {
+    throw InputError("image " + Quoted(name) + " is empty (0 bytes) (" + kExpectedImage + ")");
   }
-  if (image.channels() == 4) {
-    if (grey_alpha) {
-      cv::extractChannel(image, image, 0);
-    } else {
-      cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
-    }
-  }
-  cv::Mat frame;
-  image.convertTo(frame, CV_MAKETYPE(CV_32F, image.channels()),
-                  depth == CV_8U ? 1.0 / 255.0 : 1.0 / 65535.0);
-  return frame;
+  const std::vector<unsigned char> data(bytes.begin(), bytes.end());
+  return DecodeBytes(data, name, [&] {
+    cv::Mat frame;
+    reinterpret_cast<OpenableOiioReadMemory>(
+        ModuleSymbol("oiio", "openable_oiio_read_memory"))(bytes, name, frame);
+    return frame;
+  });
 }
 
 std::unique_ptr<FrameSource> OpenImageFolder(const std::string& folder,

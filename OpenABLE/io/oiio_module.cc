@@ -1,5 +1,6 @@
 // Module libopenable_oiio.so (see module_loader.h): image decoding through OpenImageIO, for
 // TIFF and for the files OpenCV's decoders refuse (so that the error names the real problem).
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/typedesc.h>
 
@@ -12,7 +13,10 @@
 using namespace openable;
 using namespace openable::io_internal;
 
-extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame) {
+namespace {
+
+// Decodes the image `path` (read from `ioproxy` when it is not null).
+void Read(const std::string& path, OIIO::Filesystem::IOProxy* ioproxy, cv::Mat& frame) {
   auto fail = [&](const std::string& what) -> InputError {
     return InputError("image " + Quoted(path) + " " + what + " (" + kExpectedImage + ")");
   };
@@ -20,7 +24,7 @@ extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame) {
   // premultiply them by alpha), since the alpha channel is dropped below.
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = OIIO::ImageInput::open(path, &config);
+  auto in = OIIO::ImageInput::open(path, &config, ioproxy);
   if (!in) throw fail("cannot be decoded: " + FirstLine(OIIO::geterror()));
   // Callers read many files in parallel; one thread per file avoids OIIO's own fan-out.
   in->threads(1);
@@ -97,3 +101,14 @@ extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame) {
   frame = image;
 }
 
+}  // namespace
+
+extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame) {
+  Read(path, nullptr, frame);
+}
+
+extern "C" void openable_oiio_read_memory(const std::string& bytes, const std::string& name,
+                                          cv::Mat& frame) {
+  OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
+  Read(name, &reader, frame);
+}
