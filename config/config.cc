@@ -661,7 +661,7 @@ Config ParseConfigText(const std::string& contents, const std::string& name) {
     ++number;
     const std::string where = name + ":" + std::to_string(number);
     std::string text = Trim(StripComment(line));
-    if (number == 1 && !text.empty() && text[0] == '\xEF') text = Trim(text.substr(3));  // BOM
+    if (number == 1 && text.rfind("\xEF\xBB\xBF", 0) == 0) text = Trim(text.substr(3));  // BOM
     if (text.empty() || text.rfind("%YAML", 0) == 0 || text == "---" || text == "...") continue;
     const auto colon = text.find(':');
     if (colon == std::string::npos || colon == 0)

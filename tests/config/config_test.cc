@@ -138,6 +138,16 @@ TEST(Config, ParsesTextInMemoryLikeAFile) {
   EXPECT_EQ(msg.rfind("mem:2: Patch_size:", 0), 0u) << msg;
 }
 
+// Found by tests/fuzz/config_fuzzer.cc: a first line starting with 0xEF but shorter than a
+// UTF-8 byte-order mark threw std::out_of_range instead of InputError.
+TEST(Config, ByteOrderMarkOnlyWhenComplete) {
+  EXPECT_EQ(ParseConfigText("\xEF\xBB\xBFPatch_size: 16\n", "bom").patch_size, 16);
+  for (const std::string text : {"\xEF", "\xEFT", "\xEF\xBB", "\xEF\xBBPatch_size: 16\n"}) {
+    const std::string msg = ErrorOf([&] { ParseConfigText(text, "bom"); });
+    EXPECT_EQ(msg.rfind("bom:1: ", 0), 0u) << msg;
+  }
+}
+
 TEST(Config, OverridesUseTheSameBinding) {
   Config c;
   ApplyOverride(c, "Image_sequences=12");
