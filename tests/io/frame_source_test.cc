@@ -542,6 +542,24 @@ TEST(ReadImageFile, PngWithBadCrcIsRefusedQuietly) {
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
 }
 
+TEST(DecodeImageBytes, DecodesLikeReadImageFileThroughBothLibraries) {
+  const std::string png = TempDir() + "/bytes.png";
+  ASSERT_TRUE(cv::imwrite(png, Noise(7, 5, CV_8UC3, 3)));
+  const std::string tif = TempDir() + "/bytes.tif";
+  const std::vector<std::uint16_t> pixels = {65535, 0, 32768, 1, 2, 3};
+  ASSERT_NO_FATAL_FAILURE(WriteOiio(tif, 2, 1, 3, OIIO::TypeDesc::UINT16, pixels));
+  for (const std::string& path : {png, tif}) {  // OpenCV's codecs, OpenImageIO from memory
+    const cv::Mat from_file = ReadImageFile(path);
+    const cv::Mat from_bytes = DecodeImageBytes(ReadBytes(path), "memory");
+    ASSERT_EQ(from_bytes.type(), from_file.type()) << path;
+    ASSERT_EQ(from_bytes.size(), from_file.size()) << path;
+    EXPECT_EQ(cv::norm(from_bytes, from_file, cv::NORM_INF), 0.0) << path;
+  }
+  ExpectInputError([] { DecodeImageBytes("", "empty"); }, {"empty", "0 bytes"});
+  ExpectInputError([] { DecodeImageBytes(std::string(100, 'x'), "junk.bin"); },
+                   {"junk.bin", "cannot be decoded"});
+}
+
 TEST(ModuleSymbol, MissingModuleIsNamed) {
   ExpectInputError([] { ModuleSymbol("no_such_module", "f"); },
                    {"libopenable_no_such_module.so", "cannot be loaded", "OPENABLE_MODULE_PATH"});
