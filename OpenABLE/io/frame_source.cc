@@ -147,7 +147,11 @@ cv::Mat DecodeWithOpenCV(const std::vector<unsigned char>& bytes, bool& grey_alp
   const bool bmp = bytes[0] == 'B' && bytes[1] == 'M';
   if (!why.empty()) throw InputError(why);
   if (png == PngCheck::kSound) {
-    grey_alpha = bytes[25] == 4;  // IHDR colour type 4: grey + alpha
+    // IHDR colour type 4: grey + alpha. A sound chunk walk does not mean that IHDR comes first
+    // (or at all: a signature and IEND are 20 bytes), and the decoders refuse such a file.
+    static const unsigned char kIhdr[4] = {'I', 'H', 'D', 'R'};
+    grey_alpha = bytes.size() > 25 && std::equal(kIhdr, kIhdr + 4, bytes.begin() + 12) &&
+                 bytes[25] == 4;
   } else if (png == PngCheck::kDamaged || (jpeg && !JpegHasEnd(bytes))) {
     return cv::Mat();
   } else if (pnm) {

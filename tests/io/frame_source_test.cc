@@ -560,6 +560,17 @@ TEST(DecodeImageBytes, DecodesLikeReadImageFileThroughBothLibraries) {
                    {"junk.bin", "cannot be decoded"});
 }
 
+// A PNG whose chunks are sound but hold no IHDR (signature + IEND, 20 bytes): the colour type
+// was read at byte 25, past the end (heap-buffer-overflow under AddressSanitizer).
+TEST(ReadImageFile, PngWithoutHeaderChunk) {
+  const std::string iend("\x89PNG\r\n\x1a\n\0\0\0\0IEND\xae\x42\x60\x82", 20);
+  const std::string path = TempDir() + "/iend_only.png";
+  WriteBytes(path, iend);
+  ExpectInputError([&] { ReadImageFile(path); }, {Q(path), "cannot be decoded"});
+  ExpectInputError([&] { DecodeImageBytes(iend, "iend_only.png"); },
+                   {"iend_only.png", "cannot be decoded"});
+}
+
 TEST(ModuleSymbol, MissingModuleIsNamed) {
   ExpectInputError([] { ModuleSymbol("no_such_module", "f"); },
                    {"libopenable_no_such_module.so", "cannot be loaded", "OPENABLE_MODULE_PATH"});
