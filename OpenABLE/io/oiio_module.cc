@@ -4,6 +4,9 @@
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/typedesc.h>
 
+#include <cstddef>
+#include <string>
+
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
@@ -15,8 +18,10 @@ using namespace openable::io_internal;
 
 namespace {
 
-// Decodes the image `path` (read from `ioproxy` when it is not null).
-void Read(const std::string& path, OIIO::Filesystem::IOProxy* ioproxy, cv::Mat& frame) {
+// Decodes the image `path` (named so in messages); with an `ioproxy`, OpenImageIO reads the
+// bytes from it and takes the format from the extension of `oiio_name`.
+void Read(const std::string& path, const std::string& oiio_name,
+          OIIO::Filesystem::IOProxy* ioproxy, cv::Mat& frame) {
   auto fail = [&](const std::string& what) -> InputError {
     return InputError("image " + Quoted(path) + " " + what + " (" + kExpectedImage + ")");
   };
@@ -24,7 +29,7 @@ void Read(const std::string& path, OIIO::Filesystem::IOProxy* ioproxy, cv::Mat& 
   // premultiply them by alpha), since the alpha channel is dropped below.
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = OIIO::ImageInput::open(path, &config, ioproxy);
+  auto in = OIIO::ImageInput::open(oiio_name, &config, ioproxy);
   if (!in) throw fail("cannot be decoded: " + FirstLine(OIIO::geterror()));
   // Callers read many files in parallel; one thread per file avoids OIIO's own fan-out.
   in->threads(1);
@@ -104,11 +109,35 @@ void Read(const std::string& path, OIIO::Filesystem::IOProxy* ioproxy, cv::Mat& 
 }  // namespace
 
 extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame) {
-  Read(path, nullptr, frame);
+  Read(path, path, nullptr, frame);
 }
 
 extern "C" void openable_oiio_read_memory(const std::string& bytes, const std::string& name,
                                           cv::Mat& frame) {
+  // OpenImageIO picks its reader by the extension of the name it is given, and without a
+  // known one it probes every format on the file of that name, which does not exist here. So
+  // the format is told by the signature of the bytes; unknown bytes keep the name as given.
+  auto starts = [&](const char* signature, std::size_t n) {
+    return bytes.size() >= n && bytes.compare(0, n, signature, n) == 0;
+  };
+  std::string extension;
+  if (starts("\x89PNG", 4)) {
+    extension = "png";
+  } else if (starts("\xFF\xD8\xFF", 3)) {
+    extension = "jpg";
+  } else if (starts("II*\0", 4) || starts("MM\0*", 4)) {
+    extension = "tif";
+  } else if (starts("BM", 2)) {
+    extension = "bmp";
+  } else if (bytes.size() >= 2 && bytes[0] == 'P' && bytes[1] >= '1' && bytes[1] <= '6') {
+    extension = "pnm";
+  } else if (starts("GIF8", 4)) {
+    extension = "gif";
+  } else if (starts("RIFF", 4) && bytes.size() >= 12 && bytes.compare(8, 4, "WEBP") == 0) {
+    extension = "webp";
+  } else if (starts("v/1\x01", 4)) {
+    extension = "exr";
+  }
   OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
-  Read(name, &reader, frame);
+  Read(name, extension.empty() ? name : "memory." + extension, &reader, frame);
 }
