@@ -17,7 +17,9 @@ bash examples/setup.sh
 
 # Sanitized suite: any ASan or UBSan report fails the test that triggered it. The
 # suppressions (tests/sanitizers/) cover third-party code only; each one says why.
-export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1"
+# fast_unwind_on_malloc=0: full allocation stacks through the (frame-pointer-less) Debian
+# libraries, so that the LSan suppressions, which name third-party frames, match.
+export ASAN_OPTIONS="detect_leaks=1:fast_unwind_on_malloc=0:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/tests/sanitizers/ubsan.supp"
 export LSAN_OPTIONS="suppressions=$root/tests/sanitizers/lsan.supp:print_suppressions=0"
 echo "== Sanitized suite (ASan + UBSan) in build_asan"
@@ -46,8 +48,6 @@ for target in config image; do
   cp -r "tests/fuzz/corpus/$target" "$corpus"  # new inputs go to the copy, never the committed corpus
   echo "-- ${target}_fuzzer"
   status=0
-  # Full stacks of allocations, so that the LSan suppressions (third-party frames) match.
-  ASAN_OPTIONS="$ASAN_OPTIONS:fast_unwind_on_malloc=0" \
   "build_fuzz/tests/fuzz/${target}_fuzzer" -max_total_time="$fuzz_seconds" -max_len=65536 \
     -timeout=30 -rss_limit_mb=3072 -print_final_stats=1 -artifact_prefix="$probe/${target}-" \
     "$corpus" > "$probe/${target}.log" 2>&1 || status=$?
