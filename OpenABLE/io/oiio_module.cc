@@ -1,10 +1,15 @@
 // Module libopenable_oiio.so (see module_loader.h): image decoding through OpenImageIO, for
 // TIFF and for the files OpenCV's decoders refuse (so that the error names the real problem).
-#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/typedesc.h>
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -18,10 +23,8 @@ using namespace openable::io_internal;
 
 namespace {
 
-// Decodes the image `path` (named so in messages); with an `ioproxy`, OpenImageIO reads the
-// bytes from it and takes the format from the extension of `oiio_name`.
-void Read(const std::string& path, const std::string& oiio_name,
-          OIIO::Filesystem::IOProxy* ioproxy, cv::Mat& frame) {
+// Decodes the file `oiio_name`, named `path` in messages.
+void Read(const std::string& path, const std::string& oiio_name, cv::Mat& frame) {
   auto fail = [&](const std::string& what) -> InputError {
     return InputError("image " + Quoted(path) + " " + what + " (" + kExpectedImage + ")");
   };
@@ -29,7 +32,7 @@ void Read(const std::string& path, const std::string& oiio_name,
   // premultiply them by alpha), since the alpha channel is dropped below.
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = OIIO::ImageInput::open(oiio_name, &config, ioproxy);
+  auto in = OIIO::ImageInput::open(oiio_name, &config);
   if (!in) throw fail("cannot be decoded: " + FirstLine(OIIO::geterror()));
   // Callers read many files in parallel; one thread per file avoids OIIO's own fan-out.
   in->threads(1);
@@ -109,14 +112,14 @@ void Read(const std::string& path, const std::string& oiio_name,
 }  // namespace
 
 extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame) {
-  Read(path, path, nullptr, frame);
+  Read(path, path, frame);
 }
 
 extern "C" void openable_oiio_read_memory(const std::string& bytes, const std::string& name,
                                           cv::Mat& frame) {
-  // OpenImageIO picks its reader by the extension of the name it is given, and without a
-  // known one it probes every format on the file of that name, which does not exist here. So
-  // the format is told by the signature of the bytes; unknown bytes keep the name as given.
+  // OpenImageIO 2.4's readers do not all read from memory (an IOMemReader proxy: its TIFF
+  // reader still opens the file by name), so the bytes go through a temporary file, whose
+  // extension, told by the bytes' signature, is OpenImageIO's first guess of the format.
   auto starts = [&](const char* signature, std::size_t n) {
     return bytes.size() >= n && bytes.compare(0, n, signature, n) == 0;
   };
@@ -138,6 +141,29 @@ extern "C" void openable_oiio_read_memory(const std::string& bytes, const std::s
   } else if (starts("v/1\x01", 4)) {
     extension = "exr";
   }
-  OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
-  Read(name, extension.empty() ? name : "memory." + extension, &reader, frame);
+  extension = extension.empty() ? "" : "." + extension;
+  const char* tmp = std::getenv("TMPDIR");
+  std::string file = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") +
+                     "/openable_image_XXXXXX" + extension;
+  const int fd = mkstemps(file.data(), static_cast<int>(extension.size()));
+  if (fd < 0) {
+    throw InputError("image " + Quoted(name) + " cannot be decoded: no temporary file for " +
+                     "OpenImageIO (" + FirstLine(std::strerror(errno)) + ")");
+  }
+  struct Remove {
+    std::string path;
+    ~Remove() { std::remove(path.c_str()); }
+  } remove{file};
+  std::size_t written = 0;
+  while (written < bytes.size()) {
+    const ssize_t n = write(fd, bytes.data() + written, bytes.size() - written);
+    if (n <= 0) break;
+    written += static_cast<std::size_t>(n);
+  }
+  close(fd);
+  if (written != bytes.size()) {
+    throw InputError("image " + Quoted(name) + " cannot be decoded: the temporary file for " +
+                     "OpenImageIO could not be written");
+  }
+  Read(name, file, frame);
 }
