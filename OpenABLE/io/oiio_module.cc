@@ -5,7 +5,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstddef>
 #include <cstdio>
 #include <cstdlib>
@@ -75,6 +77,18 @@ void Read(const std::string& path, const std::string& oiio_name, cv::Mat& frame)
     stored_depth = CV_16U;
     read_as = OIIO::TypeDesc::UINT16;
     scale = 1.0 / 65535.0;
+  }
+  // A corrupt header can announce terabytes (the image fuzzer found a 5.4e11-pixel PGM header),
+  // so the size is checked before allocating, with the limit OpenCV's own decoders use:
+  // OPENCV_IO_MAX_IMAGE_PIXELS, 2^30 pixels by default.
+  std::int64_t max_pixels = std::int64_t{1} << 30;
+  if (const char* env = std::getenv("OPENCV_IO_MAX_IMAGE_PIXELS"); env != nullptr && *env != '\0') {
+    max_pixels = std::max<std::int64_t>(1, std::atoll(env));
+  }
+  if (std::int64_t{spec.width} * spec.height > max_pixels) {
+    throw fail("is too large to read: its header announces " + std::to_string(spec.width) +
+               " x " + std::to_string(spec.height) + " pixels, more than " +
+               std::to_string(max_pixels) + " (OPENCV_IO_MAX_IMAGE_PIXELS)");
   }
   cv::Mat image;
   try {

@@ -571,6 +571,16 @@ TEST(ReadImageFile, PngWithoutHeaderChunk) {
                    {"iend_only.png", "cannot be decoded"});
 }
 
+// Found by tests/fuzz/image_fuzzer.cc: a PGM header announcing 10^12 pixels made the
+// OpenImageIO module allocate them (an abort under AddressSanitizer) before reading anything.
+TEST(ReadImageFile, HugeAnnouncedSizeIsRefusedBeforeAllocating) {
+  const std::string bytes = "P5\n1000000 1000000\n255\nabc";
+  const std::string path = TempDir() + "/huge.pgm";
+  WriteBytes(path, bytes);
+  ExpectInputError([&] { ReadImageFile(path); }, {Q(path), "too large", "1000000 x 1000000"});
+  ExpectInputError([&] { DecodeImageBytes(bytes, "huge.pgm"); }, {"huge.pgm", "too large"});
+}
+
 TEST(ModuleSymbol, MissingModuleIsNamed) {
   ExpectInputError([] { ModuleSymbol("no_such_module", "f"); },
                    {"libopenable_no_such_module.so", "cannot be loaded", "OPENABLE_MODULE_PATH"});
