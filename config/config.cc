@@ -690,28 +690,18 @@ void CheckSnapsConfig(const Config& c) {
                      FormatNumber(c.snaps_robust_scale) + "; expected every one > 0");
 }
 
-Config LoadConfig(const std::string& path) {
-  std::ifstream in(path);
-  if (!in)
-    throw InputError("configuration file " + Quote(path) +
-                     " cannot be opened (expected a readable Config.txt; see Test_OpenABLE --help)");
+Config ParseConfigText(const std::string& contents, const std::string& name) {
   // A binary file (an image, random bytes) given as the configuration: say so in one line
   // rather than quote its first "line" of bytes. Text has no control characters but tab, CR,
   // LF and form feed.
-  {
-    char head[65536];
-    in.read(head, sizeof head);
-    const std::streamsize n = in.gcount();
-    for (std::streamsize i = 0; i < n; ++i) {
-      const auto u = static_cast<unsigned char>(head[i]);
-      if ((u < 0x20 && u != '\t' && u != '\n' && u != '\r' && u != '\f') || u == 0x7f)
-        throw InputError("configuration file " + Quote(path) + " is not text (byte " +
-                         std::to_string(i) + " is " + Quote(std::string(1, head[i])) +
-                         "); expected a Config.txt of lines Key: value");
-    }
-    in.clear();
-    in.seekg(0);
+  for (std::size_t i = 0; i < contents.size() && i < 65536; ++i) {
+    const auto u = static_cast<unsigned char>(contents[i]);
+    if ((u < 0x20 && u != '\t' && u != '\n' && u != '\r' && u != '\f') || u == 0x7f)
+      throw InputError("configuration file " + Quote(name) + " is not text (byte " +
+                       std::to_string(i) + " is " + Quote(std::string(1, contents[i])) +
+                       "); expected a Config.txt of lines Key: value");
   }
+  std::istringstream in(contents);
   Config config;
   std::map<std::string, int> seen;
   std::string line;
@@ -719,9 +709,9 @@ Config LoadConfig(const std::string& path) {
   bool any_key = false;
   while (std::getline(in, line)) {
     ++number;
-    const std::string where = path + ":" + std::to_string(number);
+    const std::string where = name + ":" + std::to_string(number);
     std::string text = Trim(StripComment(line));
-    if (number == 1 && !text.empty() && text[0] == '\xEF') text = Trim(text.substr(3));  // BOM
+    if (number == 1 && text.rfind("\xEF\xBB\xBF", 0) == 0) text = Trim(text.substr(3));  // BOM
     if (text.empty() || text.rfind("%YAML", 0) == 0 || text == "---" || text == "...") continue;
     const auto colon = text.find(':');
     if (colon == std::string::npos || colon == 0)
@@ -737,11 +727,21 @@ Config LoadConfig(const std::string& path) {
     Assign(config, b, value, where);
     any_key = true;
   }
-  if (in.bad()) throw InputError("configuration file " + Quote(path) + " could not be read");
   if (!any_key)
-    throw InputError("configuration file " + Quote(path) +
+    throw InputError("configuration file " + Quote(name) +
                      " holds no key (expected lines of the form Key: value)");
   return config;
+}
+
+Config LoadConfig(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw InputError("configuration file " + Quote(path) +
+                     " cannot be opened (expected a readable Config.txt; see Test_OpenABLE --help)");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw InputError("configuration file " + Quote(path) + " could not be read");
+  return ParseConfigText(text.str(), path);
 }
 
 void ApplyOverride(Config& config, const std::string& assignment) {

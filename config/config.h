@@ -146,6 +146,10 @@ struct ConfigSource {
 // of the wrong type or out of range.
 Config LoadConfig(const std::string& path);
 
+// The parser of LoadConfig on the text of a configuration already in memory; `name` stands
+// for the file in messages ("<name>:<line>: ..."). Same checks, same InputError messages.
+Config ParseConfigText(const std::string& text, const std::string& name);
+
 // Applies one "Key=Value" override (from --set). Same checks and messages as LoadConfig.
 void ApplyOverride(Config& config, const std::string& assignment);
 

@@ -1,9 +1,63 @@
 #!/usr/bin/env bash
 # The README's second command (and the whole of .ci/run): install what is missing, build,
 # and run every test with CTest. Tests that need ../shared/datasets skip with a message when
-# it is absent.
+# it is absent. Then the same suite under AddressSanitizer + UndefinedBehaviorSanitizer
+# (build_asan), and each libFuzzer target of tests/fuzz/ for a bounded time on a copy of its
+# committed corpus when clang's libFuzzer is available (docs/robustness.md).
+# OPENABLE_SANITIZE_STEP=0 skips the sanitizer step, OPENABLE_FUZZ_SECONDS sets the time of
+# each fuzzer (60 s; 0 skips them).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+root=$(pwd)
+jobs=${OPENABLE_JOBS:-$(nproc)}
 bash examples/setup.sh
-cd build
-ctest --output-on-failure -j"${OPENABLE_JOBS:-$(nproc)}" --timeout 1200
+(cd build && ctest --output-on-failure -j"$jobs" --timeout 1200)
+
+[ "${OPENABLE_SANITIZE_STEP:-1}" = 0 ] && exit 0
+
+# Sanitized suite: any ASan or UBSan report fails the test that triggered it. The
+# suppressions (tests/sanitizers/) cover third-party code only; each one says why.
+# fast_unwind_on_malloc=0: full allocation stacks through the (frame-pointer-less) Debian
+# libraries, so that the LSan suppressions, which name third-party frames, match.
+export ASAN_OPTIONS="detect_leaks=1:fast_unwind_on_malloc=0:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/tests/sanitizers/ubsan.supp"
+export LSAN_OPTIONS="suppressions=$root/tests/sanitizers/lsan.supp:print_suppressions=0"
+echo "== Sanitized suite (ASan + UBSan) in build_asan"
+cmake -S . -B build_asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOPENABLE_SANITIZE=address \
+      -DOPENABLE_BUILD_BENCHMARKS=OFF
+cmake --build build_asan -j"$jobs"
+(cd build_asan && ctest --output-on-failure -j"$jobs" --timeout 2400)
+
+fuzz_seconds=${OPENABLE_FUZZ_SECONDS:-60}
+[ "$fuzz_seconds" = 0 ] && exit 0
+probe=$(mktemp -d)
+trap 'rm -rf "$probe"' EXIT
+echo 'extern "C" int LLVMFuzzerTestOneInput(const char*, unsigned long) { return 0; }' \
+  > "$probe/probe.cc"
+if ! command -v clang++ > /dev/null ||
+   ! clang++ -fsanitize=fuzzer "$probe/probe.cc" -o "$probe/probe" 2> /dev/null; then
+  echo "== Fuzzers skipped: clang++ with libFuzzer is not available (examples/setup.sh installs it)"
+  exit 0
+fi
+echo "== Fuzzers (${fuzz_seconds} s each) in build_fuzz"
+CXX=clang++ cmake -S . -B build_fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOPENABLE_BUILD_FUZZERS=ON \
+      -DOPENABLE_BUILD_TESTS=OFF -DOPENABLE_BUILD_BENCHMARKS=OFF
+cmake --build build_fuzz -j"$jobs" --target config_fuzzer image_fuzzer
+for target in config image; do
+  corpus="$probe/$target"
+  cp -r "tests/fuzz/corpus/$target" "$corpus"  # new inputs go to the copy, never the committed corpus
+  echo "-- ${target}_fuzzer"
+  status=0
+  "build_fuzz/tests/fuzz/${target}_fuzzer" -max_total_time="$fuzz_seconds" -max_len=65536 \
+    -timeout=30 -rss_limit_mb=3072 -print_final_stats=1 -artifact_prefix="$probe/${target}-" \
+    "$corpus" > "$probe/${target}.log" 2>&1 || status=$?
+  # The decoders' own complaints (libpng, libjpeg, OpenImageIO) and progress lines are noise.
+  grep -v -e '^#[0-9]' -e '^libpng' -e 'JPEG' -e '^INFO: ' -e '^imdecode_' -e '^$' "$probe/${target}.log" | tail -n 40 || true
+  if [ "$status" -ne 0 ] || ls "$probe/${target}-"* > /dev/null 2>&1; then
+    mkdir -p build_fuzz/artifacts
+    cp "$probe/${target}.log" "$probe/${target}-"* build_fuzz/artifacts/ 2> /dev/null || true
+    echo "${target}_fuzzer failed (exit $status); log and failing input in build_fuzz/artifacts" \
+         "(reproduce: build_fuzz/tests/fuzz/${target}_fuzzer FILE)"
+    exit 1
+  fi
+done

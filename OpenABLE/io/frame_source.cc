@@ -238,8 +238,13 @@ cv::Mat DecodeWithOpenCV(const std::vector<unsigned char>& bytes, bool& grey_alp
   const bool bmp = bytes[0] == 'B' && bytes[1] == 'M';
   if (!why.empty()) throw InputError(why);
   if (png == PngCheck::kSound) {
-    CheckPixelCount(BigEndian32(&bytes[16]), BigEndian32(&bytes[20]));
-    grey_alpha = bytes[25] == 4;  // IHDR colour type 4: grey + alpha
+    // IHDR colour type 4: grey + alpha. A sound chunk walk does not mean that IHDR comes first
+    // (or at all: a signature and IEND are 20 bytes), and the decoders refuse such a file.
+    static const unsigned char kIhdr[4] = {'I', 'H', 'D', 'R'};
+    const bool ihdr_first =
+        bytes.size() > 25 && std::equal(kIhdr, kIhdr + 4, bytes.begin() + 12);
+    if (ihdr_first) CheckPixelCount(BigEndian32(&bytes[16]), BigEndian32(&bytes[20]));
+    grey_alpha = ihdr_first && bytes[25] == 4;
   } else if (png == PngCheck::kDamaged || (jpeg && !JpegHasEnd(bytes))) {
     return cv::Mat();
   } else if (pnm) {
@@ -260,6 +265,40 @@ cv::Mat DecodeWithOpenCV(const std::vector<unsigned char>& bytes, bool& grey_alp
   } catch (const cv::Exception&) {
     return cv::Mat();
   }
+}
+
+// The decoding shared by ReadImageFile and DecodeImageBytes: OpenCV's codecs for the common
+// formats, else `oiio_fallback` (OpenImageIO on the file or on the bytes). `name` names the
+// image in messages.
+template <typename Fallback>
+cv::Mat DecodeBytes(const std::vector<unsigned char>& bytes, const std::string& name,
+                    const Fallback& oiio_fallback) {
+  bool grey_alpha = false;
+  cv::Mat image;
+  try {
+    image = DecodeWithOpenCV(bytes, grey_alpha);
+  } catch (const InputError& e) {
+    const std::string what = e.what();  // "is ..." (too large) or the damage found
+    throw InputError("image " + Quoted(name) + " " +
+                     (what.rfind("is ", 0) == 0 ? what : "cannot be decoded: " + what) + " (" +
+                     kExpectedImage + ")");
+  }
+  const int depth = image.depth();
+  if (image.empty() || (depth != CV_8U && depth != CV_16U) || image.channels() == 2) {
+    // Everything else (TIFF, damaged files, unusual depths) goes to OpenImageIO.
+    return oiio_fallback();
+  }
+  if (image.channels() == 4) {
+    if (grey_alpha) {
+      cv::extractChannel(image, image, 0);
+    } else {
+      cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
+    }
+  }
+  cv::Mat frame;
+  image.convertTo(frame, CV_MAKETYPE(CV_32F, image.channels()),
+                  depth == CV_8U ? 1.0 / 255.0 : 1.0 / 65535.0);
+  return frame;
 }
 
 // Frames of an image folder; each Read opens its own file, so reads may run in parallel.
@@ -435,32 +474,24 @@ cv::Mat ReadImageFile(const std::string& path) {
     }
     if (!f) throw fail("cannot be read (permission denied or I/O error)");
   }
-  bool grey_alpha = false;
-  cv::Mat image;
-  try {
-    image = DecodeWithOpenCV(bytes, grey_alpha);
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    throw fail(what.rfind("is ", 0) == 0 ? what : "cannot be decoded: " + what);  // size or damage
-  }
-  const int depth = image.depth();
-  if (image.empty() || (depth != CV_8U && depth != CV_16U) || image.channels() == 2) {
-    // Everything else (TIFF, damaged files, unusual depths) goes to OpenImageIO.
+  return DecodeBytes(bytes, path, [&] {
     cv::Mat frame;
     reinterpret_cast<OpenableOiioRead>(ModuleSymbol("oiio", "openable_oiio_read"))(path, frame);
     return frame;
+  });
+}
+
+cv::Mat DecodeImageBytes(const std::string& bytes, const std::string& name) {
+  if (bytes.empty()) {
+    throw InputError("image " + Quoted(name) + " is empty (0 bytes) (" + kExpectedImage + ")");
   }
-  if (image.channels() == 4) {
-    if (grey_alpha) {
-      cv::extractChannel(image, image, 0);
-    } else {
-      cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
-    }
-  }
-  cv::Mat frame;
-  image.convertTo(frame, CV_MAKETYPE(CV_32F, image.channels()),
-                  depth == CV_8U ? 1.0 / 255.0 : 1.0 / 65535.0);
-  return frame;
+  const std::vector<unsigned char> data(bytes.begin(), bytes.end());
+  return DecodeBytes(data, name, [&] {
+    cv::Mat frame;
+    reinterpret_cast<OpenableOiioReadMemory>(
+        ModuleSymbol("oiio", "openable_oiio_read_memory"))(bytes, name, frame);
+    return frame;
+  });
 }
 
 std::unique_ptr<FrameSource> OpenImageFolder(const std::string& folder,

@@ -37,6 +37,12 @@ std::vector<std::string> ListImages(const std::string& folder, const std::string
 // not an image) or is a PNG or JPEG of more than 100 megapixels (docs/robustness.md).
 cv::Mat ReadImageFile(const std::string& path);
 
+// Decodes the bytes of an image file held in memory exactly as ReadImageFile decodes a file
+// (OpenCV's codecs first, OpenImageIO from memory for the rest); `name` names the image in
+// messages. Throws InputError when the bytes are not a readable image. Used by the image
+// fuzzer (tests/fuzz/image_fuzzer.cc).
+cv::Mat DecodeImageBytes(const std::string& bytes, const std::string& name);
+
 // A sequence of frames with random access by index.
 class FrameSource {
  public:

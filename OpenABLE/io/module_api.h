@@ -13,6 +13,11 @@
 // frame_source.h. Throws InputError naming the file.
 extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame);
 using OpenableOiioRead = void (*)(const std::string&, cv::Mat&);
+// The same on the bytes of an image file held in memory; `name` names it in messages and its
+// extension, if any, is OpenImageIO's first guess of the format.
+extern "C" void openable_oiio_read_memory(const std::string& bytes, const std::string& name,
+                                          cv::Mat& frame);
+using OpenableOiioReadMemory = void (*)(const std::string&, const std::string&, cv::Mat&);
 
 // libopenable_video.so: the frames [first, last) of a video (see OpenVideo).
 extern "C" void openable_video_open(const std::string& path, int first, int last,

@@ -3,6 +3,17 @@
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/typedesc.h>
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdint>
+#include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
@@ -12,7 +23,10 @@
 using namespace openable;
 using namespace openable::io_internal;
 
-extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame) {
+namespace {
+
+// Decodes the file `oiio_name`, named `path` in messages.
+void Read(const std::string& path, const std::string& oiio_name, cv::Mat& frame) {
   auto fail = [&](const std::string& what) -> InputError {
     return InputError("image " + Quoted(path) + " " + what + " (" + kExpectedImage + ")");
   };
@@ -20,7 +34,7 @@ extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame) {
   // premultiply them by alpha), since the alpha channel is dropped below.
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = OIIO::ImageInput::open(path, &config);
+  auto in = OIIO::ImageInput::open(oiio_name, &config);
   if (!in) throw fail("cannot be decoded: " + FirstLine(OIIO::geterror()));
   // Callers read many files in parallel; one thread per file avoids OIIO's own fan-out.
   in->threads(1);
@@ -64,6 +78,18 @@ extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame) {
     read_as = OIIO::TypeDesc::UINT16;
     scale = 1.0 / 65535.0;
   }
+  // A corrupt header can announce terabytes (the image fuzzer found a 5.4e11-pixel PGM header),
+  // so the size is checked before allocating, with the limit OpenCV's own decoders use:
+  // OPENCV_IO_MAX_IMAGE_PIXELS, 2^30 pixels by default.
+  std::int64_t max_pixels = std::int64_t{1} << 30;
+  if (const char* env = std::getenv("OPENCV_IO_MAX_IMAGE_PIXELS"); env != nullptr && *env != '\0') {
+    max_pixels = std::max<std::int64_t>(1, std::atoll(env));
+  }
+  if (std::int64_t{spec.width} * spec.height > max_pixels) {
+    throw fail("is too large to read: its header announces " + std::to_string(spec.width) +
+               " x " + std::to_string(spec.height) + " pixels, more than " +
+               std::to_string(max_pixels) + " (OPENCV_IO_MAX_IMAGE_PIXELS)");
+  }
   cv::Mat image;
   try {
     image.create(spec.height, spec.width, CV_MAKETYPE(stored_depth, channels));
@@ -97,3 +123,61 @@ extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame) {
   frame = image;
 }
 
+}  // namespace
+
+extern "C" void openable_oiio_read(const std::string& path, cv::Mat& frame) {
+  Read(path, path, frame);
+}
+
+extern "C" void openable_oiio_read_memory(const std::string& bytes, const std::string& name,
+                                          cv::Mat& frame) {
+  // OpenImageIO 2.4's readers do not all read from memory (an IOMemReader proxy: its TIFF
+  // reader still opens the file by name), so the bytes go through a temporary file, whose
+  // extension, told by the bytes' signature, is OpenImageIO's first guess of the format.
+  auto starts = [&](const char* signature, std::size_t n) {
+    return bytes.size() >= n && bytes.compare(0, n, signature, n) == 0;
+  };
+  std::string extension;
+  if (starts("\x89PNG", 4)) {
+    extension = "png";
+  } else if (starts("\xFF\xD8\xFF", 3)) {
+    extension = "jpg";
+  } else if (starts("II*\0", 4) || starts("MM\0*", 4)) {
+    extension = "tif";
+  } else if (starts("BM", 2)) {
+    extension = "bmp";
+  } else if (bytes.size() >= 2 && bytes[0] == 'P' && bytes[1] >= '1' && bytes[1] <= '6') {
+    extension = "pnm";
+  } else if (starts("GIF8", 4)) {
+    extension = "gif";
+  } else if (starts("RIFF", 4) && bytes.size() >= 12 && bytes.compare(8, 4, "WEBP") == 0) {
+    extension = "webp";
+  } else if (starts("v/1\x01", 4)) {
+    extension = "exr";
+  }
+  extension = extension.empty() ? "" : "." + extension;
+  const char* tmp = std::getenv("TMPDIR");
+  std::string file = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") +
+                     "/openable_image_XXXXXX" + extension;
+  const int fd = mkstemps(file.data(), static_cast<int>(extension.size()));
+  if (fd < 0) {
+    throw InputError("image " + Quoted(name) + " cannot be decoded: no temporary file for " +
+                     "OpenImageIO (" + FirstLine(std::strerror(errno)) + ")");
+  }
+  struct Remove {
+    std::string path;
+    ~Remove() { std::remove(path.c_str()); }
+  } remove{file};
+  std::size_t written = 0;
+  while (written < bytes.size()) {
+    const ssize_t n = write(fd, bytes.data() + written, bytes.size() - written);
+    if (n <= 0) break;
+    written += static_cast<std::size_t>(n);
+  }
+  close(fd);
+  if (written != bytes.size()) {
+    throw InputError("image " + Quoted(name) + " cannot be decoded: the temporary file for " +
+                     "OpenImageIO could not be written");
+  }
+  Read(name, file, frame);
+}

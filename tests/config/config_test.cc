@@ -128,6 +128,26 @@ TEST(Config, MalformedLinesDuplicatesAndEmptyFiles) {
             std::string::npos);
 }
 
+TEST(Config, ParsesTextInMemoryLikeAFile) {
+  const std::string text = "%YAML:1.0\nPatch_size: 32\nImage_descriptor: \"HOG\"\n";
+  const Config from_text = ParseConfigText(text, "memory");
+  EXPECT_EQ(from_text.patch_size, 32);
+  EXPECT_EQ(from_text.image_descriptor, "HOG");
+  EXPECT_EQ(from_text, LoadConfig(WriteFile(text)));
+  const std::string msg = ErrorOf([] { ParseConfigText("Patch_size: 32\nPatch_size: x\n", "mem"); });
+  EXPECT_EQ(msg.rfind("mem:2: Patch_size:", 0), 0u) << msg;
+}
+
+// Found by tests/fuzz/config_fuzzer.cc: a first line starting with 0xEF but shorter than a
+// UTF-8 byte-order mark threw std::out_of_range instead of InputError.
+TEST(Config, ByteOrderMarkOnlyWhenComplete) {
+  EXPECT_EQ(ParseConfigText("\xEF\xBB\xBFPatch_size: 16\n", "bom").patch_size, 16);
+  for (const std::string text : {"\xEF", "\xEFT", "\xEF\xBB", "\xEF\xBBPatch_size: 16\n"}) {
+    const std::string msg = ErrorOf([&] { ParseConfigText(text, "bom"); });
+    EXPECT_EQ(msg.rfind("bom:1: ", 0), 0u) << msg;
+  }
+}
+
 TEST(Config, OverridesUseTheSameBinding) {
   Config c;
   ApplyOverride(c, "Image_sequences=12");

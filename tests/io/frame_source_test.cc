@@ -550,6 +550,45 @@ TEST(ReadImageFile, PngWithBadCrcIsRefusedQuietly) {
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
 }
 
+TEST(DecodeImageBytes, DecodesLikeReadImageFileThroughBothLibraries) {
+  const std::string png = TempDir() + "/bytes.png";
+  ASSERT_TRUE(cv::imwrite(png, Noise(7, 5, CV_8UC3, 3)));
+  const std::string tif = TempDir() + "/bytes.tif";
+  const std::vector<std::uint16_t> pixels = {65535, 0, 32768, 1, 2, 3};
+  ASSERT_NO_FATAL_FAILURE(WriteOiio(tif, 2, 1, 3, OIIO::TypeDesc::UINT16, pixels));
+  for (const std::string& path : {png, tif}) {  // OpenCV's codecs, OpenImageIO from memory
+    const cv::Mat from_file = ReadImageFile(path);
+    const cv::Mat from_bytes = DecodeImageBytes(ReadBytes(path), "memory");
+    ASSERT_EQ(from_bytes.type(), from_file.type()) << path;
+    ASSERT_EQ(from_bytes.size(), from_file.size()) << path;
+    EXPECT_EQ(cv::norm(from_bytes, from_file, cv::NORM_INF), 0.0) << path;
+  }
+  ExpectInputError([] { DecodeImageBytes("", "empty"); }, {"empty", "0 bytes"});
+  ExpectInputError([] { DecodeImageBytes(std::string(100, 'x'), "junk.bin"); },
+                   {"junk.bin", "cannot be decoded"});
+}
+
+// A PNG whose chunks are sound but hold no IHDR (signature + IEND, 20 bytes): the colour type
+// was read at byte 25, past the end (heap-buffer-overflow under AddressSanitizer).
+TEST(ReadImageFile, PngWithoutHeaderChunk) {
+  const std::string iend("\x89PNG\r\n\x1a\n\0\0\0\0IEND\xae\x42\x60\x82", 20);
+  const std::string path = TempDir() + "/iend_only.png";
+  WriteBytes(path, iend);
+  ExpectInputError([&] { ReadImageFile(path); }, {Q(path), "cannot be decoded"});
+  ExpectInputError([&] { DecodeImageBytes(iend, "iend_only.png"); },
+                   {"iend_only.png", "cannot be decoded"});
+}
+
+// Found by tests/fuzz/image_fuzzer.cc: a PGM header announcing 10^12 pixels made the
+// OpenImageIO module allocate them (an abort under AddressSanitizer) before reading anything.
+TEST(ReadImageFile, HugeAnnouncedSizeIsRefusedBeforeAllocating) {
+  const std::string bytes = "P5\n1000000 1000000\n255\nabc";
+  const std::string path = TempDir() + "/huge.pgm";
+  WriteBytes(path, bytes);
+  ExpectInputError([&] { ReadImageFile(path); }, {Q(path), "too large", "1000000 x 1000000"});
+  ExpectInputError([&] { DecodeImageBytes(bytes, "huge.pgm"); }, {"huge.pgm", "too large"});
+}
+
 TEST(ModuleSymbol, MissingModuleIsNamed) {
   ExpectInputError([] { ModuleSymbol("no_such_module", "f"); },
                    {"libopenable_no_such_module.so", "cannot be loaded", "OPENABLE_MODULE_PATH"});
