@@ -12,6 +12,8 @@ namespace openable::testing {
 
 // Writes `bytes` to `path` as they are (fails the test when the file cannot be written).
 void WriteBytes(const std::string& path, const std::string& bytes);
+// The bytes of `path` (empty when it cannot be read).
+std::string ReadBytes(const std::string& path);
 
 // Runs `f` and expects an InputError whose message is one line (no '\n' or '\r') holding every
 // one of `parts`.

@@ -16,10 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+std::string ReadAll(const std::string& path) { return testing::ReadBytes(path); }
 
 TEST(ColorMaps, MatchTheOriginalTable) {
   // (b, g, r) of s = 0.25 for each of the 12 maps, worked out by hand from reference.md.

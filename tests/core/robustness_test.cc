@@ -30,10 +30,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+std::string ReadAll(const std::string& path) { return testing::ReadBytes(path); }
 
 std::vector<std::string> Entries(const std::string& dir) {
   std::vector<std::string> names;

@@ -13,6 +13,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "tests/test_support.h"
+
 namespace openable {
 namespace e2e {
 
@@ -23,10 +25,7 @@ struct Outcome {
   std::string out, err;
 };
 
-inline std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+inline std::string ReadAll(const std::string& path) { return testing::ReadBytes(path); }
 
 inline std::string ShellQuote(const std::string& s) {
   std::string q = "'";
