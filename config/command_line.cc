@@ -1,5 +1,7 @@
 #include "config/command_line.h"
 
+#include <iostream>
+
 namespace openable {
 
 std::string ParseCommandLine(int argc, const char* const* argv, const std::string& program,
@@ -36,6 +38,27 @@ std::string ParseCommandLine(int argc, const char* const* argv, const std::strin
     return program + ": no configuration given; expected " + program +
            " Config.txt or --set Key=Value (see --help)";
   return "";
+}
+
+int AnswerWithoutRunning(const CommandLine& command_line, const std::string& usage_error,
+                         const std::string& usage, const std::string& version_line) {
+  if (command_line.help) {
+    std::cout << usage << ConfigHelpText();
+    return 0;
+  }
+  if (command_line.help_markdown) {
+    std::cout << ConfigMarkdownReference();
+    return 0;
+  }
+  if (command_line.version) {
+    std::cout << version_line << "\n";
+    return 0;
+  }
+  if (!usage_error.empty()) {
+    std::cerr << usage_error << "\n";
+    return 2;
+  }
+  return -1;
 }
 
 Config ConfigOf(const CommandLine& command_line) {

@@ -27,6 +27,12 @@ struct CommandLine {
 std::string ParseCommandLine(int argc, const char* const* argv, const std::string& program,
                              CommandLine& out);
 
+// Answers what needs no run: --help (`usage` then every key), --help-markdown (the key
+// reference), --version (`version_line`), or a usage error (on stderr). Returns the exit status
+// (0, or 2 for a usage error), or -1 when the program should go on and run.
+int AnswerWithoutRunning(const CommandLine& command_line, const std::string& usage_error,
+                         const std::string& usage, const std::string& version_line);
+
 // The configuration a command line asks for: the file (or the defaults) with the overrides
 // applied in order. Throws InputError as LoadConfig and ApplyOverride do.
 Config ConfigOf(const CommandLine& command_line);

@@ -17,7 +17,6 @@
 namespace {
 
 constexpr int kInputError = 1;   // bad configuration or data: one line on stderr
-constexpr int kUsageError = 2;   // bad command line
 constexpr int kInternalError = 3;
 
 const char* kUsage =
@@ -120,22 +119,8 @@ int main(int argc, char** argv) {
   openable::InstallInterruptCleanup("Test_OpenABLE");
   openable::CommandLine cl;
   const std::string usage_error = openable::ParseCommandLine(argc, argv, "Test_OpenABLE", cl);
-  if (cl.help) {
-    std::cout << kUsage << openable::ConfigHelpText();
-    return 0;
-  }
-  if (cl.help_markdown) {
-    std::cout << openable::ConfigMarkdownReference();
-    return 0;
-  }
-  if (cl.version) {
-    std::cout << "OpenABLE " << openable::kVersion << "\n";
-    return 0;
-  }
-  if (!usage_error.empty()) {
-    std::cerr << usage_error << "\n";
-    return kUsageError;
-  }
+  const int answered = openable::AnswerWithoutRunning(cl, usage_error, kUsage, "OpenABLE " + std::string(openable::kVersion));
+  if (answered >= 0) return answered;
   const bool quiet = cl.quiet;
   try {
     openable::Config config = openable::ConfigOf(cl);

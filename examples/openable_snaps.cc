@@ -40,7 +40,6 @@ namespace {
 namespace snaps = openable::snaps;
 
 constexpr int kInputError = 1;
-constexpr int kUsageError = 2;
 constexpr int kInternalError = 3;
 
 const char* const kUsage =
@@ -566,22 +565,8 @@ int main(int argc, char** argv) {
   openable::InstallInterruptCleanup("openable_snaps");
   openable::CommandLine cl;
   const std::string usage_error = openable::ParseCommandLine(argc, argv, "openable_snaps", cl);
-  if (cl.help) {
-    std::cout << kUsage << openable::ConfigHelpText();
-    return 0;
-  }
-  if (cl.help_markdown) {
-    std::cout << openable::ConfigMarkdownReference();
-    return 0;
-  }
-  if (cl.version) {
-    std::cout << "openable_snaps " << openable::kVersion << "\n";
-    return 0;
-  }
-  if (!usage_error.empty()) {
-    std::cerr << usage_error << "\n";
-    return kUsageError;
-  }
+  const int answered = openable::AnswerWithoutRunning(cl, usage_error, kUsage, "openable_snaps " + std::string(openable::kVersion));
+  if (answered >= 0) return answered;
   try {
     openable::Config config = openable::ConfigOf(cl);
     if (cl.print_config) {
