@@ -76,6 +76,30 @@ std::vector<std::string> SoDsoArgs(const std::string& seq, const std::string& ou
           "--set", "Snaps_drop_outside=1", "--set", "Snaps_output_name=" + out};
 }
 
+// A bad input for openable_snaps: the overrides added to a good command line, and the text its
+// one error line must hold.
+struct RefusedCase {
+  std::vector<std::string> sets;
+  std::string expect;
+};
+
+// Each case: exit 1, one line on stderr holding `expect`, nothing written under <dir>/out.
+void ExpectEveryCaseRefused(const std::vector<std::string>& base,
+                            const std::vector<RefusedCase>& cases, const std::string& dir) {
+  for (const RefusedCase& c : cases) {
+    std::vector<std::string> args = base;
+    for (const std::string& s : c.sets) {
+      args.push_back("--set");
+      args.push_back(s);
+    }
+    const Outcome o = RunProgram(testing::OpenableSnapsExe(), args, dir);
+    EXPECT_EQ(o.status, 1) << c.expect << ": " << o.err;
+    EXPECT_TRUE(OneLine(o.err)) << o.err;
+    EXPECT_NE(o.err.find(c.expect), std::string::npos) << o.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/out")) << c.expect << ": outputs left behind";
+  }
+}
+
 class SoDso : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SoDso, CorrectsWithGroundTruthPairsAndWritesWhatItReports) {
@@ -150,11 +174,7 @@ TEST(SnapsErrors, OneLineNonZeroExitNothingWritten) {
     std::string line;
     for (int i = 0; i < 100 && std::getline(in, line); ++i) out << line << "\n";
   }
-  struct Case {
-    std::vector<std::string> sets;
-    std::string expect;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<RefusedCase> cases = {
       {{"Snaps_trajectory=" + dir + "/short.txt", "Snaps_trajectory_format=kitti"}, "short.txt\":1"},
       {{"Snaps_trajectory_format=kitty"}, "Snaps_trajectory_format"},
       {{"Snaps_drop_outside=0"}, "outside the trajectory's frames"},
@@ -164,18 +184,7 @@ TEST(SnapsErrors, OneLineNonZeroExitNothingWritten) {
       {{"Snaps_corrector=magic"}, "Snaps_corrector"},
       {{"Snaps_trajectory=" + dir + "/missing.txt"}, "missing.txt"},
   };
-  for (const Case& c : cases) {
-    std::vector<std::string> args = SoDsoArgs("06", dir + "/out/run");
-    for (const std::string& s : c.sets) {
-      args.push_back("--set");
-      args.push_back(s);
-    }
-    const Outcome o = RunProgram(testing::OpenableSnapsExe(), args, dir);
-    EXPECT_EQ(o.status, 1) << c.expect << ": " << o.err;
-    EXPECT_TRUE(OneLine(o.err)) << o.err;
-    EXPECT_NE(o.err.find(c.expect), std::string::npos) << o.err;
-    EXPECT_FALSE(std::filesystem::exists(dir + "/out")) << c.expect << ": outputs left behind";
-  }
+  ExpectEveryCaseRefused(SoDsoArgs("06", dir + "/out/run"), cases, dir);
 }
 
 }  // namespace
@@ -262,11 +271,7 @@ TEST(SnapsChainErrors, OneLineNonZeroExitNothingWritten) {
       "--quiet", "--set", "Images_path=" + kitti + "/image_0", "--set", "Snaps_loops=openable",
       "--set", "Snaps_ground_truth=" + kitti + "/poses/00_first1700.txt", "--set",
       "Snaps_output_name=" + dir + "/out/run"};
-  struct Case {
-    std::vector<std::string> sets;
-    std::string expect;
-  };
-  const std::vector<Case> cases = {
+  const std::vector<RefusedCase> cases = {
       {{"Snaps_odometry=mono"}, "Odometry_calibration: empty"},
       {{"Snaps_odometry=mono", "Odometry_calibration=" + kitti + "/calib.txt",
         "Snaps_ground_truth="},
@@ -278,18 +283,7 @@ TEST(SnapsChainErrors, OneLineNonZeroExitNothingWritten) {
        "Images_path_right"},
       {{"Snaps_odometry=stereo", "Odometry_num_disparities=40"}, "Odometry_num_disparities"},
   };
-  for (const Case& c : cases) {
-    std::vector<std::string> args = base;
-    for (const std::string& s : c.sets) {
-      args.push_back("--set");
-      args.push_back(s);
-    }
-    const Outcome o = RunProgram(testing::OpenableSnapsExe(), args, dir);
-    EXPECT_EQ(o.status, 1) << c.expect << ": " << o.err;
-    EXPECT_TRUE(OneLine(o.err)) << o.err;
-    EXPECT_NE(o.err.find(c.expect), std::string::npos) << o.err;
-    EXPECT_FALSE(std::filesystem::exists(dir + "/out")) << c.expect << ": outputs left behind";
-  }
+  ExpectEveryCaseRefused(base, cases, dir);
 }
 
 }  // namespace
