@@ -19,6 +19,11 @@ bash examples/setup.sh
 # suppressions (tests/sanitizers/) cover third-party code only; each one says why.
 # fast_unwind_on_malloc=0: full allocation stacks through the (frame-pointer-less) Debian
 # libraries, so that the LSan suppressions, which name third-party frames, match.
+# Leak checking: on in the fuzzers below, off for the suite (detect_leaks=0 for ctest only):
+# in CI, GCC 12's LeakSanitizer crashed in its own thread-suspending tracer ("Tracer caught
+# signal 11 ... LeakSanitizer has encountered a fatal error") at the exit of a test that had
+# passed (StereoOdometry.RecoversItWithBlockMatchingAndOrbToo, OpenCV worker threads alive),
+# which fails the test for a fault of the tool, not of the code (docs/robustness.md).
 export ASAN_OPTIONS="detect_leaks=1:fast_unwind_on_malloc=0:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/tests/sanitizers/ubsan.supp"
 export LSAN_OPTIONS="suppressions=$root/tests/sanitizers/lsan.supp:print_suppressions=0"
@@ -26,7 +31,8 @@ echo "== Sanitized suite (ASan + UBSan) in build_asan"
 cmake -S . -B build_asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOPENABLE_SANITIZE=address \
       -DOPENABLE_BUILD_BENCHMARKS=OFF
 cmake --build build_asan -j"$jobs"
-(cd build_asan && ctest --output-on-failure -j"$jobs" --timeout 2400)
+(cd build_asan && ASAN_OPTIONS="${ASAN_OPTIONS/detect_leaks=1/detect_leaks=0}" \
+   ctest --output-on-failure -j"$jobs" --timeout 2400)
 
 fuzz_seconds=${OPENABLE_FUZZ_SECONDS:-60}
 [ "$fuzz_seconds" = 0 ] && exit 0
