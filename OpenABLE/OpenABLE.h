@@ -13,6 +13,7 @@
 #include "OpenABLE/describe.h"
 #include "OpenABLE/descriptor_cache.h"
 #include "OpenABLE/interrupt.h"
+#include "OpenABLE/online.h"
 #include "OpenABLE/exports.h"
 #include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/pipeline.h"

@@ -1,0 +1,135 @@
+// The library's two ways in for programs that do not go through Config.txt (issue 9):
+//
+//  - OnlineDetector: a SLAM system feeds frames one by one and gets, for each, its loop
+//    candidates among earlier frames.
+//  - Batch helpers: describe a set of images, compute the normalised distance matrix (with
+//    sequences), as Test_OpenABLE does from a configuration.
+//
+//   #include <OpenABLE/OpenABLE.h>
+//   openable::OnlineOptions options;               // LDB, global, L = 1, exclusion 100
+//   options.sequence_length = 5;
+//   openable::OnlineDetector detector(options);
+//   for (const cv::Mat& image : camera) {
+//     openable::OnlineResult r = detector.AddFrame(image);
+//     for (const openable::LoopCandidate& c : r.candidates)
+//       if (c.accepted) CloseLoop(r.frame, c.frame);
+//   }
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "OpenABLE/describe.h"
+#include "matching/approximate.h"
+#include "matching/sequence.h"
+
+namespace openable {
+
+struct OnlineOptions {
+  // Description (as the keys Description_type, Patch_size, Ldb_bits, Grid_x, Grid_y).
+  std::string descriptor = "LDB";
+  DescriptionType description = DescriptionType::kGlobal;
+  int patch_size = 64;
+  int ldb_bits = 256;
+  int grid_x = 1, grid_y = 1;
+  // Matching.
+  int sequence_length = 1;  // L (Image_sequence_length): frames summed along the diagonal
+  int exclusion = 100;      // frame q's candidates are frames j <= q - exclusion (>= 1)
+  int candidates = 5;       // candidates returned per frame (the k best), >= 1
+  // A candidate is accepted when its normalised distance is <= threshold (see LoopCandidate).
+  // Default from KITTI 00 frames 0-1699 with LDB (docs/library.md).
+  double threshold = 0.10;
+  // Search: exact (every earlier frame) while the searchable map holds at most exact_limit
+  // frames; beyond, frames are indexed by FLANN (LSH for binary rows, k-d trees for float
+  // rows) in blocks of block_frames merged as they grow (sizes block_frames x 2^m, at most one
+  // of each), and only the newest unindexed frames (< block_frames) are scanned exactly.
+  int exact_limit = 20000;
+  int block_frames = 4096;
+  ApproximateOptions approximate;  // its k is the per-block candidate count (>= candidates)
+  // Throws InputError naming the field, the value and what was expected.
+  void Check() const;
+};
+
+// One loop candidate of a frame.
+struct LoopCandidate {
+  int frame = -1;         // the earlier frame
+  double distance = 0;    // raw sequence distance S(q, j) (Hamming bits or L2, summed over L
+                          // frames; early frames scaled as in matching/sequence.h)
+  // distance / (L x unit): unit = the descriptor's bit count for binary descriptors (so it is
+  // the mean fraction of differing bits, in [0, 1]), and for float descriptors the largest
+  // single-frame distance the detector has computed so far. Not the scale of Config.txt's
+  // Threshold (which divides by the largest distance of the finished matrix, Eq. 5).
+  double normalized = 0;
+  bool accepted = false;  // normalized <= OnlineOptions::threshold
+};
+
+struct OnlineResult {
+  int frame = -1;                            // index of the frame just added (0, 1, ...)
+  std::vector<LoopCandidate> candidates;     // best first (ties: earlier frame first); empty
+                                             // while no frame is old enough
+  bool approximate = false;                  // the search used the FLANN blocks
+  double describe_seconds = 0;               // AddFrame: describing the image
+  double search_seconds = 0;                 // searching and bookkeeping (index builds too)
+};
+
+// Loop candidates frame by frame. Memory: the descriptor rows of every frame (row bytes x
+// frames: 32 B a frame for LDB 256 bits, 3.2 MB per 100,000 frames) plus, beyond exact_limit,
+// the FLANN indices (see MemoryBytes). Latency per frame: description, plus L distances per
+// searchable frame while exact (linear in the map up to exact_limit), then one FLANN query per
+// block (at most log2(frames / block_frames) + 1 blocks) plus an exact scan of fewer than
+// block_frames frames, plus L distances per candidate. Not thread-safe for AddFrame; the const
+// members may be called while no AddFrame runs.
+class OnlineDetector {
+ public:
+  explicit OnlineDetector(const OnlineOptions& options);  // throws InputError on bad options
+  ~OnlineDetector();
+  OnlineDetector(const OnlineDetector&) = delete;
+  OnlineDetector& operator=(const OnlineDetector&) = delete;
+
+  // Describes `image` (CV_8UC1/CV_8UC3 BGR, or CV_32FC1/CV_32FC3 in [0, 1], as a FrameSource
+  // gives it; converted to grey as Test_OpenABLE does) and adds it. Throws InputError on an
+  // empty image, another type, or an image smaller than the description needs.
+  OnlineResult AddFrame(const cv::Mat& image);
+  // Adds an already computed row (1 x RowWidth(), RowType()).
+  OnlineResult AddDescriptor(const cv::Mat& row);
+
+  const OnlineOptions& Options() const;
+  int Size() const;                 // frames added
+  int RowWidth() const;             // elements per row
+  int RowType() const;              // CV_8U (Hamming) or CV_32F (L2)
+  cv::Mat Descriptors() const;      // Size() x RowWidth(), a view of the stored rows
+  std::int64_t MemoryBytes() const; // rows + indices held now
+  int Blocks() const;               // FLANN blocks in use (0 while exact)
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// ---- Batch helpers -------------------------------------------------------------------------
+
+// The describer of `options` (descriptor, description, grid) and the descriptor it uses.
+struct Describer {
+  std::unique_ptr<Descriptor> descriptor;
+  std::unique_ptr<FrameDescriber> frame;
+};
+Describer MakeDescriber(const OnlineOptions& options);
+
+// One row per image (images as OnlineDetector::AddFrame takes them), in parallel on `threads`
+// threads (0 = all cores). Throws InputError naming the image index.
+cv::Mat DescribeImages(const std::vector<cv::Mat>& images, const OnlineOptions& options,
+                       int threads = 0);
+
+// Distances between all rows of `rows` (Hamming for CV_8U, L2 for CV_32F), summed along
+// sequences of L frames (matching/sequence.h; `traversal_starts` as there), normalised by their
+// largest value (Eq. 5). `max_distance` receives that divisor (0 leaves the matrix as is).
+cv::Mat1f DistanceMatrix(const cv::Mat& rows, int sequence_length = 1,
+                         SequenceDirection direction = SequenceDirection::kForward,
+                         const std::vector<int>& traversal_starts = {}, int threads = 0,
+                         float* max_distance = nullptr);
+
+}  // namespace openable
