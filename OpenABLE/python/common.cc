@@ -1,0 +1,206 @@
+#include "OpenABLE/python/common.h"
+
+#include <cctype>
+#include <cstdint>
+#include <string>
+
+namespace openable::python {
+namespace {
+
+std::string DtypeName(const py::array& a) { return py::str(a.dtype()).cast<std::string>(); }
+
+std::string ShapeText(const py::array& a) {
+  std::string s = "(";
+  for (py::ssize_t d = 0; d < a.ndim(); ++d) {
+    s += (d ? ", " : "") + std::to_string(a.shape(d));
+  }
+  return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+bool IsUint8(const py::array& a) { return py::isinstance<py::array_t<std::uint8_t>>(a); }
+bool IsFloat32(const py::array& a) { return py::isinstance<py::array_t<float>>(a); }
+
+template <typename T>
+py::array ContiguousCopy(const py::array& a) {
+  return py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
+}
+
+// True when the memory of `a` (2-D or 3-D, elements of `item` bytes) can be described by a
+// cv::Mat header: the last axes packed, rows at a positive multiple of the element size, the
+// data aligned.
+bool Viewable(const py::array& a, py::ssize_t item) {
+  if (reinterpret_cast<std::uintptr_t>(a.data()) % static_cast<std::uintptr_t>(item) != 0)
+    return false;
+  py::ssize_t packed = item;  // bytes of one row's packed inner part
+  const py::ssize_t first_inner = a.ndim() == 1 ? 0 : 1;  // a 1-D array is one row
+  for (py::ssize_t d = a.ndim() - 1; d >= first_inner; --d) {
+    if (a.shape(d) > 1 && a.strides(d) != packed) return false;
+    packed *= a.shape(d);
+  }
+  if (a.ndim() >= 2 && a.shape(0) > 1) {
+    const py::ssize_t s0 = a.strides(0);
+    if (s0 < packed || s0 % item != 0) return false;
+  }
+  return true;
+}
+
+// The row step of a viewable array.
+std::size_t RowStep(const py::array& a, py::ssize_t packed) {
+  if (a.ndim() >= 2 && a.shape(0) > 1) return static_cast<std::size_t>(a.strides(0));
+  return static_cast<std::size_t>(packed);
+}
+
+MatView Wrap(py::array a, int depth, int channels, bool copied) {
+  MatView v;
+  v.copied = copied;
+  const int rows = a.ndim() == 1 ? 1 : static_cast<int>(a.shape(0));
+  const int cols = static_cast<int>(a.ndim() == 1 ? a.shape(0) : a.shape(1));
+  const int type = CV_MAKETYPE(depth, channels);
+  const py::ssize_t item = depth == CV_8U ? 1 : 4;
+  if (rows == 0 || cols == 0) {
+    v.mat = cv::Mat(rows, cols, type);
+  } else {
+    const std::size_t step = RowStep(a, item * cols * channels);
+    v.mat = cv::Mat(rows, cols, type, const_cast<void*>(a.data()), step);
+  }
+  v.owner = std::move(a);
+  return v;
+}
+
+}  // namespace
+
+MatView Matrix2D(const py::handle& object, Elements elements, const char* what) {
+  py::array a = py::array::ensure(object);
+  if (!a) {
+    throw py::value_error(std::string(what) + ": expected a NumPy array (or a nested list of numbers)");
+  }
+  if (a.ndim() != 1 && a.ndim() != 2) {
+    throw py::value_error(std::string(what) + ": array of shape " + ShapeText(a) +
+                          "; expected a 2-D array (one row per item) or a 1-D row");
+  }
+  const char kind = a.dtype().kind();
+  int depth = -1;
+  if (IsUint8(a) && elements != Elements::kFloat32) {
+    depth = CV_8U;
+  } else if (elements == Elements::kUint8) {
+    throw py::value_error(std::string(what) + ": dtype " + DtypeName(a) +
+                          "; expected uint8 (the bytes of binary descriptor rows)");
+  } else if (IsFloat32(a)) {
+    depth = CV_32F;
+  } else if (kind == 'f' || (elements == Elements::kFloat32 &&
+                             (kind == 'i' || kind == 'u' || kind == 'b'))) {
+    return Wrap(ContiguousCopy<float>(a), CV_32F, 1, true);
+  } else {
+    throw py::value_error(std::string(what) + ": dtype " + DtypeName(a) +
+                          "; expected uint8 (binary descriptors) or float32 (vector descriptors)");
+  }
+  const py::ssize_t item = depth == CV_8U ? 1 : 4;
+  if (!Viewable(a, item)) {
+    a = depth == CV_8U ? ContiguousCopy<std::uint8_t>(a) : ContiguousCopy<float>(a);
+    return Wrap(std::move(a), depth, 1, true);
+  }
+  return Wrap(std::move(a), depth, 1, false);
+}
+
+MatView Image(const py::handle& object, const char* what) {
+  py::array a = py::array::ensure(object);
+  if (!a) throw py::value_error(std::string(what) + ": expected an image as a NumPy array");
+  const bool shape_ok =
+      a.ndim() == 2 || (a.ndim() == 3 && (a.shape(2) == 1 || a.shape(2) == 3));
+  if (!shape_ok) {
+    throw py::value_error(std::string(what) + ": array of shape " + ShapeText(a) +
+                          "; expected (H, W) grey or (H, W, 3) BGR");
+  }
+  const int channels = a.ndim() == 3 ? static_cast<int>(a.shape(2)) : 1;
+  int depth = -1;
+  if (IsUint8(a)) {
+    depth = CV_8U;
+  } else if (IsFloat32(a)) {
+    depth = CV_32F;
+  } else if (a.dtype().kind() == 'f') {
+    return Wrap(ContiguousCopy<float>(a), CV_32F, channels, true);
+  } else {
+    throw py::value_error(std::string(what) + ": dtype " + DtypeName(a) +
+                          "; expected uint8 (0-255) or float32 (0-1); scale other types first, "
+                          "e.g. image / 65535.0 for 16-bit");
+  }
+  if (!Viewable(a, depth == CV_8U ? 1 : 4)) {
+    a = depth == CV_8U ? ContiguousCopy<std::uint8_t>(a) : ContiguousCopy<float>(a);
+    return Wrap(std::move(a), depth, channels, true);
+  }
+  return Wrap(std::move(a), depth, channels, false);
+}
+
+std::vector<MatView> Images(const py::handle& sequence, const char* what) {
+  std::vector<MatView> out;
+  if (py::isinstance<py::array>(sequence)) {
+    const py::array a = py::reinterpret_borrow<py::array>(sequence);
+    if (a.ndim() != 3 && a.ndim() != 4) {
+      throw py::value_error(std::string(what) + ": array of shape " + ShapeText(a) +
+                            "; expected a stack of images (N, H, W) or (N, H, W, 3), or a list");
+    }
+  } else if (!py::isinstance<py::sequence>(sequence) || py::isinstance<py::str>(sequence)) {
+    throw py::value_error(std::string(what) + ": expected a list of images (NumPy arrays)");
+  }
+  const py::sequence items = py::reinterpret_borrow<py::sequence>(sequence);
+  out.reserve(items.size());
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const std::string name = std::string(what) + "[" + std::to_string(i) + "]";
+    out.push_back(Image(items[i], name.c_str()));
+  }
+  return out;
+}
+
+py::array ToNumpy(const cv::Mat& input, bool one_dimensional) {
+  cv::Mat m = input;
+  if (!m.empty() && m.u == nullptr) m = m.clone();
+  py::dtype dtype;
+  switch (m.depth()) {
+    case CV_8U: dtype = py::dtype::of<std::uint8_t>(); break;
+    case CV_32F: dtype = py::dtype::of<float>(); break;
+    case CV_64F: dtype = py::dtype::of<double>(); break;
+    case CV_32S: dtype = py::dtype::of<std::int32_t>(); break;
+    default: throw std::logic_error("ToNumpy: unsupported depth " + std::to_string(m.depth()));
+  }
+  const py::ssize_t item = static_cast<py::ssize_t>(m.elemSize1());
+  const py::ssize_t channels = m.channels();
+  std::vector<py::ssize_t> shape, strides;
+  if (one_dimensional) {
+    if (m.rows > 1 || channels != 1) throw std::logic_error("ToNumpy: not a row");
+    shape = {m.cols};
+    strides = {item};
+  } else {
+    shape = {m.rows, m.cols};
+    strides = {static_cast<py::ssize_t>(m.empty() ? m.cols * item * channels : m.step[0]),
+               item * channels};
+    if (channels > 1) {
+      shape.push_back(channels);
+      strides.push_back(item);
+    }
+  }
+  if (m.empty()) return py::array(dtype, shape);
+  auto* keep = new cv::Mat(m);
+  py::capsule base(keep, [](void* p) { delete static_cast<cv::Mat*>(p); });
+  return py::array(dtype, shape, strides, keep->data, base);
+}
+
+py::array_t<double> DoubleArray(const std::vector<double>& values) {
+  py::array_t<double> a(static_cast<py::ssize_t>(values.size()));
+  std::copy(values.begin(), values.end(), a.mutable_data());
+  return a;
+}
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+int ParseDirection(const std::string& name) {
+  const std::string n = Lower(name);
+  if (n == "forward") return 0;
+  if (n == "reverse") return 1;
+  if (n == "both") return 2;
+  throw py::value_error("direction: \"" + name + "\"; expected \"forward\", \"reverse\" or \"both\"");
+}
+
+}  // namespace openable::python

@@ -1,0 +1,66 @@
+// Shared pieces of the Python module `openable` (docs/python.md): NumPy arrays viewed as
+// cv::Mat headers, cv::Mat results handed to NumPy without copies, and the parsing of the
+// string options that the bindings take instead of C++ enums.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+namespace openable::python {
+
+namespace py = pybind11;
+
+// A NumPy array seen as a cv::Mat. `mat` points into `owner`'s memory when the array's layout
+// allows it (elements of a row adjacent, rows at a positive stride, aligned, native byte
+// order), else into a contiguous converted copy that `owner` holds. `owner` must outlive every
+// use of `mat`.
+struct MatView {
+  cv::Mat mat;
+  py::array owner;
+  bool copied = false;
+};
+
+// Element types a view may take.
+enum class Elements {
+  kUint8,           // uint8 only (binary descriptor rows: any other type is refused)
+  kFloat32,         // any real or integer type, converted to float32 when it is not
+  kUint8OrFloat32,  // uint8 kept, float32 kept, any other real type converted to float32
+};
+
+// A 2-D matrix (a 1-D array is one row). `what` names the argument in errors (ValueError).
+MatView Matrix2D(const py::handle& object, Elements elements, const char* what);
+
+// An image: (H, W) or (H, W, C) with C in {1, 3} (BGR), uint8 or float32 in [0, 1]; other real
+// types are converted to float32. A 3-D array becomes a multi-channel cv::Mat (CV_8UC3, ...).
+MatView Image(const py::handle& object, const char* what);
+
+// Images of a Python sequence (list, tuple, or a 3-D/4-D array whose first axis is the image).
+std::vector<MatView> Images(const py::handle& sequence, const char* what);
+
+// The cv::Mat `m` (CV_8U or CV_32F, any channel count) as a NumPy array over the same memory:
+// a capsule holds a cv::Mat header, so the buffer lives as long as the array. A matrix that
+// does not own its memory (no cv::UMatData) is cloned first. `one_dimensional` gives a row
+// vector the shape (cols,) instead of (1, cols).
+py::array ToNumpy(const cv::Mat& m, bool one_dimensional = false);
+
+// A NumPy array of doubles with the given shape, filled from `values` (copied).
+py::array_t<double> DoubleArray(const std::vector<double>& values);
+
+// Lower-case copy of `s`.
+std::string Lower(std::string s);
+
+// "forward", "reverse", "both" -> 0, 1, 2 (SequenceDirection); ValueError otherwise.
+int ParseDirection(const std::string& name);
+
+// Registration of each part of the module (one source file each).
+void RegisterImages(py::module_& m);
+void RegisterMatching(py::module_& m);
+void RegisterEvaluation(py::module_& m);
+void RegisterOnline(py::module_& m);
+void RegisterSnaps(py::module_& m);
+
+}  // namespace openable::python

@@ -1,0 +1,583 @@
+// Evaluation against ground truth (docs/evaluation.md): evaluate() and its result.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <utility>
+
+#include <pybind11/stl.h>
+
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/base/version.h"
+#include "OpenABLE/evaluation/ground_truth.h"
+#include "OpenABLE/evaluation/layout.h"
+#include "OpenABLE/evaluation/metrics.h"
+#include "OpenABLE/evaluation/report.h"
+#include "OpenABLE/python/common.h"
+#include "matching/normalize.h"
+
+namespace openable::python {
+namespace {
+
+// A precision-recall curve.
+struct Curve {
+  std::vector<CurvePoint> points;
+};
+
+// The result of evaluate().
+struct Result {
+  EvaluationSettings settings;
+  EvaluatedRun run;
+  GroundTruth truth;
+};
+
+// Runs `f`; an InputError whose message starts with a Config.txt key is re-thrown naming the
+// Python argument instead ("Ground_truth_radius: 0 ..." -> "radius: 0 ...").
+template <typename F>
+auto WithArgumentNames(F f) {
+  static const std::pair<const char*, const char*> kNames[] = {
+      {"Ground_truth_radius:", "radius:"},   {"Ground_truth_heading:", "heading_limit:"},
+      {"Ground_truth_min_gap:", "min_frame_gap:"}, {"Ground_truth_axes:", "axes:"},
+      {"Ground_truth_base:", "base:"},        {"Initial_image:", "first_frame:"},
+      {"Tolerance:", "tolerance:"},          {"Exclusion:", "exclusion:"},
+      {"Vicinity:", "vicinity:"},            {"Ground_truth_2:", "truth_file_2:"},
+      {"Ground_truth:", "truth_file:"},      {"Ground_truth_type:", "truth_type:"}};
+  try {
+    return f();
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    for (const auto& [key, name] : kNames) {
+      const std::string k = key;
+      if (message.compare(0, k.size(), k) == 0) throw InputError(name + message.substr(k.size()));
+    }
+    throw;
+  }
+}
+
+// Poses as FramePose: (N, 3, 4) or (N, 4, 4) camera-to-world matrices (forward = third column
+// of R), or (N, 3) / (N, 2) positions (no orientation).
+std::vector<FramePose> PosesOf(const py::handle& object, const char* what) {
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(object);
+  if (!a) throw py::value_error(std::string(what) + ": expected a NumPy array of poses");
+  std::vector<FramePose> poses;
+  const double* v = a.data();
+  if (a.ndim() == 3 && (a.shape(1) == 3 || a.shape(1) == 4) && a.shape(2) == 4) {
+    const py::ssize_t n = a.shape(0), stride = a.shape(1) * 4;
+    for (py::ssize_t i = 0; i < n; ++i) {
+      const double* p = v + i * stride;
+      FramePose pose;
+      pose.position = Eigen::Vector3d(p[3], p[7], p[11]);
+      pose.forward = Eigen::Vector3d(p[2], p[6], p[10]);
+      const double norm = pose.forward.norm();
+      if (!(norm > 0) || !pose.position.allFinite()) {
+        throw py::value_error(std::string(what) + "[" + std::to_string(i) +
+                              "]: not a finite pose with a rotation (third column of R is zero)");
+      }
+      pose.forward /= norm;
+      pose.has_forward = true;
+      poses.push_back(pose);
+    }
+    return poses;
+  }
+  if (a.ndim() == 2 && (a.shape(1) == 2 || a.shape(1) == 3)) {
+    const py::ssize_t n = a.shape(0), k = a.shape(1);
+    for (py::ssize_t i = 0; i < n; ++i) {
+      FramePose pose;
+      pose.position = Eigen::Vector3d(v[i * k], v[i * k + 1], k == 3 ? v[i * k + 2] : 0.0);
+      if (!pose.position.allFinite())
+        throw py::value_error(std::string(what) + "[" + std::to_string(i) + "]: not finite");
+      poses.push_back(pose);
+    }
+    return poses;
+  }
+  throw py::value_error(std::string(what) +
+                        ": expected poses of shape (N, 3, 4) or (N, 4, 4) (camera-to-world) or "
+                        "positions of shape (N, 3) or (N, 2)");
+}
+
+bool HaveOrientations(const std::vector<FramePose>& poses) {
+  return std::all_of(poses.begin(), poses.end(), [](const FramePose& p) { return p.has_forward; });
+}
+
+// The layout of `layout` ("loop_closure", "query_reference" or None) on a rows x cols matrix.
+EvaluationLayout LayoutOf(const py::object& layout, const py::object& reference_frames, int rows,
+                          int cols) {
+  std::string kind = layout.is_none() ? "" : Lower(layout.cast<std::string>());
+  if (kind.empty()) {
+    kind = (!reference_frames.is_none() || rows != cols) ? "query_reference" : "loop_closure";
+  }
+  if (kind == "loop_closure") {
+    if (rows != cols) {
+      throw py::value_error("layout: loop_closure needs a square matrix; got " +
+                            std::to_string(rows) + "x" + std::to_string(cols));
+    }
+    if (!reference_frames.is_none())
+      throw py::value_error("reference_frames: only with layout=\"query_reference\"");
+    return EvaluationLayout::LoopClosure(rows);
+  }
+  if (kind != "query_reference") {
+    throw py::value_error("layout: \"" + layout.cast<std::string>() +
+                          "\"; expected \"loop_closure\" or \"query_reference\"");
+  }
+  if (reference_frames.is_none()) return EvaluationLayout::QueryReference(rows, cols);
+  const int r = reference_frames.cast<int>();
+  if (rows != cols || r < 1 || r >= rows) {
+    throw py::value_error("reference_frames: " + std::to_string(r) +
+                          " needs a square matrix over both traversals with more frames than "
+                          "that (reference first, then queries); got " +
+                          std::to_string(rows) + "x" + std::to_string(cols));
+  }
+  return EvaluationLayout::TwoTraversals(r, rows - r);
+}
+
+// Pairs (query, reference) in the block's indices; loop closure stores (later, earlier).
+void AddPair(GroundTruth& gt, const EvaluationLayout& layout, std::int64_t a, std::int64_t b,
+             py::ssize_t index) {
+  const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
+  const std::int64_t rows = layout.queries, cols = loop ? layout.queries : layout.references;
+  if (a < 0 || b < 0 || a >= rows || b >= cols) {
+    throw py::value_error("pairs[" + std::to_string(index) + "]: (" + std::to_string(a) + ", " +
+                          std::to_string(b) + ") is outside the " + std::to_string(rows) + "x" +
+                          std::to_string(cols) + " evaluated block");
+  }
+  if (loop && a == b) {
+    ++gt.dropped;
+  } else if (loop) {
+    gt.matches[static_cast<std::size_t>(std::max(a, b))].push_back(static_cast<int>(std::min(a, b)));
+  } else {
+    gt.matches[static_cast<std::size_t>(a)].push_back(static_cast<int>(b));
+  }
+}
+
+GroundTruth FromMatrix(const py::handle& object, const EvaluationLayout& layout, int full_rows,
+                       int full_cols) {
+  const MatView v = Matrix2D(object, Elements::kFloat32, "truth_matrix");
+  const int rows = layout.queries, cols = layout.references;
+  cv::Mat1f block(v.mat);
+  if (block.rows == full_rows && block.cols == full_cols && (rows != full_rows || cols != full_cols)) {
+    block = block(cv::Rect(layout.col_offset, layout.row_offset, cols, rows));
+  } else if (block.rows != rows || block.cols != cols) {
+    throw py::value_error("truth_matrix: shape (" + std::to_string(block.rows) + ", " +
+                          std::to_string(block.cols) + "); expected (" + std::to_string(rows) +
+                          ", " + std::to_string(cols) + ") (the evaluated block) or (" +
+                          std::to_string(full_rows) + ", " + std::to_string(full_cols) +
+                          ") (the whole matrix)");
+  }
+  GroundTruth gt;
+  gt.references = cols;
+  gt.matches.assign(static_cast<std::size_t>(rows), {});
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const float x = block(r, c);
+      if (!std::isfinite(x)) {
+        throw py::value_error("truth_matrix: cell (" + std::to_string(r) + ", " +
+                              std::to_string(c) + ") is not finite");
+      }
+      if (x != 0.f) AddPair(gt, layout, r, c, 0);
+    }
+  return gt;
+}
+
+GroundTruth FromPairs(const py::handle& object, const EvaluationLayout& layout) {
+  py::array raw = py::array::ensure(object);
+  if (!raw || raw.ndim() != 2 || raw.shape(1) < 2 ||
+      (raw.size() > 0 && raw.dtype().kind() != 'i' && raw.dtype().kind() != 'u')) {
+    throw py::value_error(
+        "pairs: expected integer pairs of shape (P, 2): (query, reference) frame indices of the "
+        "evaluated block");
+  }
+  const auto a = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(raw);
+  GroundTruth gt;
+  gt.references = layout.references;
+  gt.matches.assign(static_cast<std::size_t>(layout.queries), {});
+  const py::ssize_t width = a.shape(1);
+  for (py::ssize_t i = 0; i < a.shape(0); ++i)
+    AddPair(gt, layout, a.data()[i * width], a.data()[i * width + 1], i);
+  return gt;
+}
+
+py::array_t<std::int64_t> TruthPairs(const GroundTruth& truth) {
+  py::array_t<std::int64_t> out({static_cast<py::ssize_t>(truth.PairCount()), py::ssize_t{2}});
+  std::int64_t* p = out.mutable_data();
+  for (std::size_t q = 0; q < truth.matches.size(); ++q)
+    for (const int r : truth.matches[q]) {
+      *p++ = static_cast<std::int64_t>(q);
+      *p++ = r;
+    }
+  return out;
+}
+
+template <typename T>
+py::array_t<T> ArrayOf(const std::vector<T>& v) {
+  py::array_t<T> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), a.mutable_data());
+  return a;
+}
+
+template <typename F>
+py::array_t<double> Column(const Curve& c, F f) {
+  std::vector<double> v;
+  v.reserve(c.points.size());
+  for (const CurvePoint& p : c.points) v.push_back(static_cast<double>(f(p)));
+  return DoubleArray(v);
+}
+
+py::dict CurveDict(const Curve& c) {
+  py::dict d;
+  d["threshold"] = Column(c, [](const CurvePoint& p) { return p.threshold; });
+  d["precision"] = Column(c, [](const CurvePoint& p) { return p.precision; });
+  d["recall"] = Column(c, [](const CurvePoint& p) { return p.recall; });
+  d["f1"] = Column(c, [](const CurvePoint& p) { return p.f1; });
+  d["tp"] = Column(c, [](const CurvePoint& p) { return p.tp; });
+  d["fp"] = Column(c, [](const CurvePoint& p) { return p.fp; });
+  return d;
+}
+
+std::string LayoutName(const EvaluationLayout& l) {
+  return l.kind == EvaluationLayout::Kind::kLoopClosure ? "loop_closure" : "query_reference";
+}
+
+}  // namespace
+
+void RegisterEvaluation(py::module_& m) {
+  py::class_<Curve>(m, "Curve", R"doc(A precision-recall curve: one point per threshold, in
+increasing order of threshold. Each property is a float64 NumPy array with one value per point.)doc")
+      .def_property_readonly(
+          "threshold", [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.threshold; }); },
+          "Thresholds: per-query protocol, answers with distance <= threshold are accepted; "
+          "ABLE-P, cells with M' < threshold are detections.")
+      .def_property_readonly(
+          "precision", [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.precision; }); },
+          "Precision at each threshold (ABLE-P: 1 where nothing is detected).")
+      .def_property_readonly(
+          "recall", [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.recall; }); },
+          "Recall at each threshold.")
+      .def_property_readonly(
+          "f1", [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.f1; }); },
+          "F1 = 2PR / (P + R) at each threshold.")
+      .def_property_readonly(
+          "tp", [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.tp; }); },
+          "True positives at each threshold (as float64).")
+      .def_property_readonly(
+          "fp", [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.fp; }); },
+          "False positives at each threshold (as float64).")
+      .def("area", [](const Curve& c) { return CurveArea(c.points); },
+           "area() -> float\n\nStep-wise area: the sum of precision x (recall - previous recall) "
+           "over the points (AUC of the per-query curve; ABLE-P's average precision / 100).")
+      .def("to_dict", &CurveDict,
+           "to_dict() -> dict[str, numpy.ndarray]\n\nThe columns threshold, precision, recall, "
+           "f1, tp, fp (as the CSV files openable writes).")
+      .def("__len__", [](const Curve& c) { return c.points.size(); }, "Number of points.")
+      .def("__repr__", [](const Curve& c) {
+        return "<openable.Curve of " + std::to_string(c.points.size()) + " points>";
+      });
+
+  py::class_<Result>(m, "EvaluationResult", R"doc(The figures and curves of evaluate(): the
+per-query best-match protocol (auc, recall_at_100p, max_f1, recall_at_1/5/10, curve) and the
+ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md defines each.)doc")
+      .def_property_readonly("label", [](const Result& r) { return r.run.label; },
+                             "The label given to evaluate().")
+      .def_property_readonly("layout", [](const Result& r) { return LayoutName(r.run.layout); },
+                             "\"loop_closure\" or \"query_reference\".")
+      .def_property_readonly(
+          "block", [](const Result& r) {
+            const EvaluationLayout& l = r.run.layout;
+            return py::make_tuple(l.row_offset, l.col_offset, l.queries, l.references);
+          },
+          "(first row, first column, rows, columns) of the evaluated block in the matrix.")
+      .def_property_readonly("auc", [](const Result& r) { return r.run.per_query.auc; },
+                             "Per-query protocol: step-wise area under the precision-recall curve.")
+      .def_property_readonly("recall_at_100p", [](const Result& r) { return r.run.per_query.recall_at_100p; },
+                             "Per-query protocol: highest recall with precision 1 (0 if none).")
+      .def_property_readonly("max_f1", [](const Result& r) { return r.run.per_query.max_f1; },
+                             "Per-query protocol: the largest F1 along the curve.")
+      .def_property_readonly("max_f1_threshold", [](const Result& r) { return r.run.per_query.max_f1_threshold; },
+                             "Distance threshold of max_f1 (the first on ties).")
+      .def_property_readonly("max_f1_precision", [](const Result& r) { return r.run.per_query.max_f1_precision; },
+                             "Precision at max_f1.")
+      .def_property_readonly("max_f1_recall", [](const Result& r) { return r.run.per_query.max_f1_recall; },
+                             "Recall at max_f1.")
+      .def_property_readonly("recall_at_1", [](const Result& r) { return r.run.per_query.recall_at_1; },
+                             "Share of positive queries whose best candidate is correct (within tolerance of a true match).")
+      .def_property_readonly("recall_at_5", [](const Result& r) { return r.run.per_query.recall_at_5; },
+                             "Share of positive queries with a correct match among their 5 best candidates.")
+      .def_property_readonly("recall_at_10", [](const Result& r) { return r.run.per_query.recall_at_10; },
+                             "Share of positive queries with a correct match among their 10 best candidates.")
+      .def_property_readonly("queries", [](const Result& r) { return r.run.per_query.queries; },
+                             "Queries with at least one candidate.")
+      .def_property_readonly("positive_queries", [](const Result& r) { return r.run.per_query.positive_queries; },
+                             "Queries with a true match among their candidates.")
+      .def_property_readonly("truth_pairs", [](const Result& r) { return r.run.truth_pairs; },
+                             "Ground-truth pairs over the evaluated block.")
+      .def_property_readonly("truth_dropped", [](const Result& r) { return r.run.truth_dropped; },
+                             "Pairs dropped while building the ground truth (the diagonal of a loop-closure block, pairs outside a selected frame range).")
+      .def_property_readonly("truth_pairs_outside_candidates",
+                             [](const Result& r) { return r.run.per_query.truth_pairs_outside_candidates; },
+                             "True pairs that no candidate set contains (inside the exclusion window); they do not count.")
+      .def_property_readonly("curve", [](const Result& r) { return Curve{r.run.per_query.curve}; },
+                             "Per-query precision-recall curve (openable.Curve), one point per distinct best-match distance.")
+      .def_property_readonly("best", [](const Result& r) { return ArrayOf(r.run.per_query.best); },
+                             "int32 array, per query row of the block: its best candidate column (-1 without candidates).")
+      .def_property_readonly("best_distance", [](const Result& r) { return ArrayOf(r.run.per_query.best_distance); },
+                             "float32 array: the distance of each query's best candidate (inf without candidates).")
+      .def_property_readonly(
+          "positive", [](const Result& r) { return ArrayOf(r.run.per_query.positive).attr("astype")("bool"); },
+          "bool array: the query has a true match among its candidates.")
+      .def_property_readonly(
+          "correct", [](const Result& r) { return ArrayOf(r.run.per_query.correct).attr("astype")("bool"); },
+          "bool array: the query's best candidate is within tolerance of a true match.")
+      .def_property_readonly("average_precision", [](const Result& r) { return r.run.able_p.average_precision; },
+                             "ABLE-P protocol: area under its 100-threshold curve, in percent.")
+      .def_property_readonly("able_p_curve", [](const Result& r) { return Curve{r.run.able_p.curve}; },
+                             "ABLE-P precision-recall curve (openable.Curve), thresholds k / (n - 1).")
+      .def_property_readonly("candidate_cells", [](const Result& r) { return r.run.able_p.candidate_cells; },
+                             "ABLE-P: cells of the block that are candidates.")
+      .def_property_readonly("truth_cells", [](const Result& r) { return r.run.able_p.truth_cells; },
+                             "ABLE-P: ground-truth pairs among the candidate cells.")
+      .def("truth_matches", [](const Result& r) { return TruthPairs(r.truth); },
+           "truth_matches() -> numpy.ndarray\n\nThe ground truth used: int64 (P, 2) pairs "
+           "(query row, reference column) in the block's indices (loop closure: later frame "
+           "first).")
+      .def("to_json",
+           [](const Result& r) {
+             return EncodeEvaluationJson(r.settings, {r.run}, kVersion);
+           },
+           "to_json() -> str\n\nThe evaluation as the JSON file Test_OpenABLE and "
+           "openable_evaluate write (Evaluation_name.json), with this one run.")
+      .def(
+          "to_dict",
+          [](const Result& r) {
+            py::dict d;
+            const PerQueryResult& p = r.run.per_query;
+            d["label"] = r.run.label;
+            d["layout"] = LayoutName(r.run.layout);
+            d["auc"] = p.auc;
+            d["recall_at_100p"] = p.recall_at_100p;
+            d["max_f1"] = p.max_f1;
+            d["max_f1_threshold"] = p.max_f1_threshold;
+            d["max_f1_precision"] = p.max_f1_precision;
+            d["max_f1_recall"] = p.max_f1_recall;
+            d["recall_at_1"] = p.recall_at_1;
+            d["recall_at_5"] = p.recall_at_5;
+            d["recall_at_10"] = p.recall_at_10;
+            d["queries"] = p.queries;
+            d["positive_queries"] = p.positive_queries;
+            d["truth_pairs"] = r.run.truth_pairs;
+            d["truth_dropped"] = r.run.truth_dropped;
+            d["truth_pairs_outside_candidates"] = p.truth_pairs_outside_candidates;
+            d["average_precision"] = r.run.able_p.average_precision;
+            d["candidate_cells"] = r.run.able_p.candidate_cells;
+            d["truth_cells"] = r.run.able_p.truth_cells;
+            d["curve"] = CurveDict(Curve{p.curve});
+            d["able_p_curve"] = CurveDict(Curve{r.run.able_p.curve});
+            return d;
+          },
+          "to_dict() -> dict\n\nEvery figure, and both curves as dicts of NumPy arrays.")
+      .def("__repr__", [](const Result& r) {
+        const PerQueryResult& p = r.run.per_query;
+        char b[320];
+        std::snprintf(b, sizeof b,
+                      "<openable.EvaluationResult %s: AUC %.4f, R@100P %.4f, max F1 %.4f, "
+                      "R@1/5/10 %.4f/%.4f/%.4f, ABLE-P AP %.2f %%>",
+                      LayoutName(r.run.layout).c_str(), p.auc, p.recall_at_100p, p.max_f1,
+                      p.recall_at_1, p.recall_at_5, p.recall_at_10,
+                      r.run.able_p.average_precision);
+        return std::string(b);
+      });
+
+  m.def(
+      "evaluate",
+      [](const py::object& matrix, const py::object& truth_matrix, const py::object& pairs,
+         const py::object& poses, const py::object& reference_poses, bool aligned,
+         const py::object& truth_file, const py::object& truth_type,
+         const std::string& truth_file_2, int base, int first_frame, bool range_selected,
+         const py::object& layout_name, const py::object& reference_frames, int tolerance,
+         int exclusion, int vicinity, int able_thresholds, double radius, double heading_limit,
+         const py::object& min_frame_gap, const std::string& axes, bool normalize,
+         const std::string& label) {
+        const MatView view = Matrix2D(matrix, Elements::kFloat32, "matrix");
+        const int full_rows = view.mat.rows, full_cols = view.mat.cols;
+        Result result;
+        EvaluationSettings& s = result.settings;
+        s.options.tolerance = tolerance;
+        s.options.exclusion = exclusion;
+        s.options.vicinity = vicinity;
+        s.options.able_thresholds = able_thresholds;
+        if (able_thresholds < 2) throw py::value_error("able_thresholds: expected >= 2");
+        WithArgumentNames([&] { s.options.Check(); });
+        const EvaluationLayout layout = LayoutOf(layout_name, reference_frames, full_rows, full_cols);
+        const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
+
+        const int given = (truth_matrix.is_none() ? 0 : 1) + (pairs.is_none() ? 0 : 1) +
+                          (poses.is_none() ? 0 : 1) + (aligned ? 1 : 0) +
+                          (truth_file.is_none() ? 0 : 1);
+        if (given != 1) {
+          throw py::value_error(
+              "evaluate: give exactly one ground truth: truth_matrix, pairs, poses, aligned=True "
+              "or truth_file (got " + std::to_string(given) + ")");
+        }
+        GroundTruthOptions& t = s.truth;
+        t.radius = radius;
+        t.heading_limit = heading_limit;
+        t.min_frame_gap = min_frame_gap.is_none() ? exclusion : min_frame_gap.cast<int>();
+        t.axes = axes;
+        t.base = base;
+        t.first_frame = first_frame;
+        t.range_selected = range_selected;
+        GroundTruth& gt = result.truth;
+        if (!truth_file.is_none()) {
+          t.path = truth_file.cast<std::string>();
+          t.path_2 = truth_file_2;
+          if (truth_type.is_none())
+            throw py::value_error("truth_type: expected with truth_file (matrix, pairs, kitti, tum or positions)");
+          gt = WithArgumentNames([&] {
+            t.type = ParseGroundTruthType(truth_type.cast<std::string>());
+            return LoadGroundTruth(t, layout, full_rows, full_cols);
+          });
+        } else if (aligned) {
+          t.type = GroundTruthType::kAligned;
+          if (loop) {
+            throw py::value_error(
+                "aligned: needs a query-reference layout (two traversals: reference_frames, or "
+                "a queries x references matrix)");
+          }
+          gt = LoadGroundTruth(t, layout, full_rows, full_cols);
+        } else if (!truth_matrix.is_none()) {
+          t.type = GroundTruthType::kMatrix;
+          t.path = "<truth_matrix>";
+          gt = FromMatrix(truth_matrix, layout, full_rows, full_cols);
+        } else if (!pairs.is_none()) {
+          t.type = GroundTruthType::kPairs;
+          t.path = "<pairs>";
+          gt = FromPairs(pairs, layout);
+        } else {
+          const std::vector<FramePose> queries = PosesOf(poses, "poses");
+          std::vector<FramePose> reference;
+          if (!loop) {
+            if (reference_poses.is_none()) {
+              throw py::value_error(
+                  "reference_poses: expected with a query-reference layout (poses are then the "
+                  "poses of the queries)");
+            }
+            reference = PosesOf(reference_poses, "reference_poses");
+          }
+          const bool oriented = HaveOrientations(queries) && HaveOrientations(reference);
+          t.type = oriented ? GroundTruthType::kKitti : GroundTruthType::kPositions;
+          t.path = "<poses>";
+          WithArgumentNames([&] { t.Check(); });
+          if (static_cast<int>(queries.size()) < layout.queries) {
+            throw py::value_error("poses: " + std::to_string(queries.size()) +
+                                  " poses; expected one per query frame (" +
+                                  std::to_string(layout.queries) + ")");
+          }
+          if (!loop && static_cast<int>(reference.size()) < layout.references) {
+            throw py::value_error("reference_poses: " + std::to_string(reference.size()) +
+                                  " poses; expected one per reference frame (" +
+                                  std::to_string(layout.references) + ")");
+          }
+          std::vector<FramePose> q(queries.begin(), queries.begin() + layout.queries);
+          if (!loop) reference.resize(static_cast<std::size_t>(layout.references));
+          gt.references = layout.references;
+          {
+            py::gil_scoped_release release;
+            gt.matches = PairsFromPoses(q, reference, t);
+          }
+          if (loop) {
+            for (std::size_t i = 0; i < gt.matches.size(); ++i) {
+              auto& mm = gt.matches[i];
+              const auto self = std::find(mm.begin(), mm.end(), static_cast<int>(i));
+              if (self != mm.end()) {
+                mm.erase(self);
+                ++gt.dropped;
+              }
+            }
+          }
+        }
+        for (auto& mm : gt.matches) {
+          std::sort(mm.begin(), mm.end());
+          mm.erase(std::unique(mm.begin(), mm.end()), mm.end());
+        }
+
+        EvaluatedRun& run = result.run;
+        run.label = label;
+        run.source = "Python";
+        run.layout = layout;
+        run.truth_pairs = gt.PairCount();
+        run.truth_dropped = gt.dropped;
+        {
+          py::gil_scoped_release release;
+          cv::Mat1f m(view.mat);
+          if (normalize) {
+            double lo = 0, hi = 0;
+            cv::minMaxLoc(m, &lo, &hi);
+            if (hi != 1.0) {  // M' of Test_OpenABLE is left as it is, without a copy
+              cv::Mat1f scaled = m.clone();
+              NormalizeByMax(scaled);
+              m = scaled;
+            }
+          }
+          run.per_query = EvaluatePerQuery(m, layout, gt, s.options);
+          run.able_p = EvaluateAbleP(m, layout, gt, s.options);
+        }
+        return result;
+      },
+      py::arg("matrix"), py::kw_only(), py::arg("truth_matrix") = py::none(),
+      py::arg("pairs") = py::none(), py::arg("poses") = py::none(),
+      py::arg("reference_poses") = py::none(), py::arg("aligned") = false,
+      py::arg("truth_file") = py::none(), py::arg("truth_type") = py::none(),
+      py::arg("truth_file_2") = "", py::arg("base") = -1, py::arg("first_frame") = 0,
+      py::arg("range_selected") = false, py::arg("layout") = py::none(),
+      py::arg("reference_frames") = py::none(), py::arg("tolerance") = 2,
+      py::arg("exclusion") = 100, py::arg("vicinity") = 7, py::arg("able_thresholds") = 100,
+      py::arg("radius") = 5.0, py::arg("heading_limit") = -1.0,
+      py::arg("min_frame_gap") = py::none(), py::arg("axes") = "xyz", py::arg("normalize") = true,
+      py::arg("label") = "python",
+      R"doc(evaluate(matrix, *, truth_matrix=None, pairs=None, poses=None, reference_poses=None, aligned=False, truth_file=None, truth_type=None, truth_file_2="", base=-1, first_frame=0, range_selected=False, layout=None, reference_frames=None, tolerance=2, exclusion=100, vicinity=7, able_thresholds=100, radius=5.0, heading_limit=-1.0, min_frame_gap=None, axes="xyz", normalize=True, label="python") -> EvaluationResult
+
+Evaluates a distance matrix against ground truth with both protocols of docs/evaluation.md,
+exactly as Test_OpenABLE (Ground_truth_type) and openable_evaluate do.
+
+Args:
+    matrix (numpy.ndarray): distances (small = similar), shape (N, N) or (Q, R); float32 is
+        read in place.
+    truth_matrix (numpy.ndarray): ground truth as a matrix, non-zero = same place, of the
+        evaluated block's shape or of the whole matrix's (the block is then taken from it).
+        Loop closure: cell (a, b) is the pair (max, min); the diagonal is dropped.
+    pairs (array-like): integer (P, 2) pairs (query, reference) in the block's 0-based
+        indices (loop closure: two frame indices, either order).
+    poses (numpy.ndarray): poses of the frames (loop closure) or of the query frames:
+        (N, 3, 4) / (N, 4, 4) camera-to-world matrices, or (N, 3) / (N, 2) positions. A pair
+        is a loop when the positions over `axes` are closer than `radius` and, with
+        heading_limit >= 0, the viewing directions (third column of R) differ by less than
+        heading_limit degrees; loop closure also needs the frames min_frame_gap apart.
+    reference_poses (numpy.ndarray): poses of the reference frames (query-reference with poses).
+    aligned (bool): two frame-aligned traversals: query i is reference i.
+    truth_file (str): a ground-truth file read as Test_OpenABLE reads Ground_truth, with
+        truth_type "matrix", "pairs", "aligned", "kitti", "tum" or "positions";
+        truth_file_2 holds the query poses of two traversals; base (-1, 0, 1) is the index
+        base of a pairs file; first_frame (Initial_image) and range_selected say which part
+        of the source the matrix covers.
+    layout (str | None): "loop_closure" (one sequence, square matrix: the candidates of query
+        q are frames j <= q - exclusion) or "query_reference" (rows are queries, columns
+        references, every reference a candidate). None: query_reference when the matrix is
+        not square or reference_frames is given, else loop_closure.
+    reference_frames (int | None): a square matrix over two concatenated traversals, the
+        reference's frames first: the lower-left block (queries x reference) is evaluated.
+    tolerance (int): frames; an answer within this many frames of a true match is correct.
+    exclusion (int): loop closure: candidates are frames at least this far back (>= 1).
+    vicinity (int): ABLE-P protocol: temporal vicinity in frames.
+    able_thresholds (int): ABLE-P protocol: thresholds evenly spaced in [0, 1].
+    radius, heading_limit, min_frame_gap, axes: the loop rule of poses (metres, degrees or
+        -1 for no limit, frames or None for `exclusion`, "xyz", "xz" or "xy").
+    normalize (bool): divide the matrix by its maximum first (Eq. 5), as openable_evaluate
+        does; Test_OpenABLE's M' is unchanged by it.
+    label (str): the run's label in to_json().
+
+Returns:
+    EvaluationResult: figures (auc, recall_at_100p, max_f1, recall_at_1/5/10,
+    average_precision, ...) and curves (curve, able_p_curve).
+
+Raises:
+    ValueError (openable.InputError for files and options): one line naming the argument.)doc");
+}
+
+}  // namespace openable::python

@@ -1,0 +1,110 @@
+// Images and descriptor names: read_image, list_images, to_gray8, descriptor_names.
+#include <pybind11/stl.h>
+
+#include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/preprocess.h"
+#include "OpenABLE/python/common.h"
+#include "descriptors/registry.h"
+
+namespace openable::python {
+
+void RegisterImages(py::module_& m) {
+  m.def("descriptor_names", &RegisteredDescriptorNames,
+        R"doc(descriptor_names() -> list[str]
+
+Names of the descriptors this build provides, in the order shown to users:
+LDB, D-LDB, ORB, BRISK, BRIEF, FREAK (binary rows, uint8, matched with the Hamming
+distance) and SIFT, HOG (vector rows, float32, matched with the L2 distance). D-LDB needs a
+grey + disparity image (stereo) and is not usable through describe(). Names are
+case-insensitive wherever a descriptor is asked for.)doc");
+
+  m.def(
+      "unavailable_descriptors",
+      [] {
+        py::dict d;
+        for (const auto& [name, reason] : UnavailableDescriptors()) d[py::str(name)] = reason;
+        return d;
+      },
+      R"doc(unavailable_descriptors() -> dict[str, str]
+
+Descriptors of the original OpenABLE that this build cannot provide, each with the reason
+(SURF: patented, absent from Debian's OpenCV).)doc");
+
+  m.def(
+      "read_image",
+      [](const std::string& path) {
+        cv::Mat image;
+        {
+          py::gil_scoped_release release;
+          image = ReadImageFile(path);
+        }
+        return ToNumpy(image);
+      },
+      py::arg("path"),
+      R"doc(read_image(path) -> numpy.ndarray
+
+Reads one image file exactly as Test_OpenABLE reads the frames of a folder (PNG, JPEG, PNM
+and BMP by OpenCV's codecs after OpenABLE's own integrity checks; TIFF and the rest by
+OpenImageIO).
+
+Args:
+    path (str): the image file.
+
+Returns:
+    numpy.ndarray: float32 in [0, 1] whatever the bit depth of the file, shape (H, W) for a
+    grey image or (H, W, 3) in BGR order for a colour one (alpha dropped). This is the form
+    describe(), describe_images() and OnlineDetector.add_frame() take.
+
+Raises:
+    openable.InputError: one line naming the file when it is missing, corrupt, truncated or
+    not an image.)doc");
+
+  m.def(
+      "list_images",
+      [](const std::string& folder, const std::string& extension) {
+        return ListImages(folder, extension);
+      },
+      py::arg("folder"), py::arg("extension") = "",
+      R"doc(list_images(folder, extension="") -> list[str]
+
+The image files of a folder in natural order of their names (img2 before img10), as a run of
+Test_OpenABLE takes them (not recursive).
+
+Args:
+    folder (str): the folder.
+    extension (str): keep only files with this extension ("png", case-insensitive, with or
+        without the dot); empty keeps every supported image type.
+
+Returns:
+    list[str]: full paths.
+
+Raises:
+    openable.InputError: the folder is missing, not a folder, or holds no matching image.)doc");
+
+  m.def(
+      "to_gray8",
+      [](const py::object& image) {
+        MatView v = Image(image, "image");
+        cv::Mat1b gray;
+        {
+          py::gil_scoped_release release;
+          cv::Mat frame = v.mat;
+          if (frame.depth() == CV_8U) frame.convertTo(frame, CV_32F, 1.0 / 255.0);
+          gray = ToGray8(frame);
+        }
+        return ToNumpy(gray);
+      },
+      py::arg("image"),
+      R"doc(to_gray8(image) -> numpy.ndarray
+
+The grey 8-bit image every monocular descriptor describes: OpenCV's luma weights
+(0.299 R + 0.587 G + 0.114 B) on the [0, 1] image, times 255, rounded.
+
+Args:
+    image (numpy.ndarray): (H, W) grey or (H, W, 3) BGR; uint8 (0-255) or float32 (0-1).
+
+Returns:
+    numpy.ndarray: uint8, shape (H, W).)doc");
+}
+
+}  // namespace openable::python

@@ -1,0 +1,52 @@
+// The Python module `openable` (docs/python.md).
+#include <stdexcept>
+
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/base/version.h"
+#include "OpenABLE/python/common.h"
+
+PYBIND11_MODULE(openable, m) {
+  namespace py = pybind11;
+  m.doc() = R"doc(OpenABLE: visual place recognition and loop-closure detection (docs/python.md).
+
+Images are NumPy arrays: (H, W) grey or (H, W, 3) BGR, uint8 (0-255) or float32 (0-1), as
+read_image() gives them. Descriptor rows are uint8 (binary descriptors, Hamming distance) or
+float32 (vector descriptors, L2). Distance matrices are float32 NumPy arrays that own the C++
+result (no copy); contiguous input arrays are read in place. Long computations release the GIL.
+
+Parts:
+  descriptors   descriptor_names, describe, describe_images, read_image, list_images, to_gray8
+  matching      hamming_distances, l2_distances, sequence_distances, distance_matrix,
+                normalize_by_max, threshold_matrix, read_matrix
+  evaluation    evaluate -> EvaluationResult (figures and Curve objects)
+  online        OnlineDetector (loop candidates frame by frame)
+  snaps         openable.snaps: trajectories, loops, discounted update, pose graph, errors
+
+Errors: bad input raises openable.InputError (a ValueError) with the same one-line message as
+the command-line programs; other invalid arguments raise ValueError.)doc";
+  m.attr("__version__") = openable::kVersion;
+
+  py::register_exception<openable::InputError>(m, "InputError", PyExc_ValueError);
+  m.attr("InputError").attr("__doc__") =
+      "Bad input (a file, an option, a value): one line naming it, the value and what was "
+      "expected. A subclass of ValueError.";
+  // A broken precondition of the C++ library on arguments given from Python (a wrong shape, a
+  // bad index) is an invalid value here.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const std::logic_error& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    }
+  });
+
+  openable::python::RegisterImages(m);
+  openable::python::RegisterMatching(m);
+  openable::python::RegisterEvaluation(m);
+#ifdef OPENABLE_PYTHON_ONLINE
+  openable::python::RegisterOnline(m);
+#endif
+  openable::python::RegisterSnaps(m);
+  // `import openable.snaps` and `from openable.snaps import ...` work like the attribute.
+  py::module_::import("sys").attr("modules")["openable.snaps"] = m.attr("snaps");
+}

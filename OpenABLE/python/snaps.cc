@@ -1,0 +1,560 @@
+// The SNAPS add-on (docs/snaps.md) as openable.snaps: trajectories, loops, the discounted
+// update (Eq. 6), the pose graph, the absolute trajectory error.
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <pybind11/stl.h>
+
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/exports.h"
+#include "OpenABLE/python/common.h"
+#include "OpenABLE/snaps/discounted.h"
+#include "OpenABLE/snaps/loops.h"
+#include "OpenABLE/snaps/pose_graph.h"
+#include "OpenABLE/snaps/trajectory.h"
+
+namespace openable::python {
+namespace {
+
+using snaps::LoopPair;
+using snaps::Trajectory;
+
+// Poses (N, 3, 4) or (N, 4, 4), camera-to-world, as isometries; ValueError when a 3x3 part
+// is not a rotation within 1e-3 (the tolerance of trajectory files).
+std::vector<Eigen::Isometry3d> IsometriesOf(const py::handle& object, const char* what) {
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(object);
+  if (!a || a.ndim() != 3 || (a.shape(1) != 3 && a.shape(1) != 4) || a.shape(2) != 4) {
+    throw py::value_error(std::string(what) +
+                          ": expected poses of shape (N, 3, 4) or (N, 4, 4): camera-to-world "
+                          "matrices [R | t]");
+  }
+  std::vector<Eigen::Isometry3d> poses;
+  const py::ssize_t n = a.shape(0), stride = a.shape(1) * 4;
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const double* p = a.data() + i * stride;
+    Eigen::Matrix3d r;
+    Eigen::Vector3d t;
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 3; ++col) r(row, col) = p[row * 4 + col];
+      t(row) = p[row * 4 + 3];
+    }
+    const double deviation = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    if (!(deviation <= 1e-3) || !(r.determinant() > 0) || !t.allFinite()) {
+      throw py::value_error(std::string(what) + "[" + std::to_string(i) +
+                            "]: the 3x3 part is not a rotation (orthonormal, determinant +1, "
+                            "within 1e-3) or the translation is not finite");
+    }
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = r;
+    pose.translation() = t;
+    poses.push_back(pose);
+  }
+  return poses;
+}
+
+py::array_t<double> PosesArray(const Trajectory& t, int rows) {
+  py::array_t<double> a({static_cast<py::ssize_t>(t.Size()), static_cast<py::ssize_t>(rows),
+                         py::ssize_t{4}});
+  double* out = a.mutable_data();
+  for (const Eigen::Isometry3d& pose : t.poses) {
+    const Eigen::Matrix4d& m = pose.matrix();
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < 4; ++c) *out++ = m(r, c);
+  }
+  return a;
+}
+
+snaps::TrajectoryFormat FormatOf(const std::string& name) {
+  return snaps::ParseTrajectoryFormat(name, "format");
+}
+
+Trajectory MakeTrajectory(const py::object& poses, const py::object& frame_ids,
+                          const py::object& timestamps, const std::string& format,
+                          bool world_to_camera) {
+  Trajectory t;
+  t.format = FormatOf(format);
+  t.poses = IsometriesOf(poses, "poses");
+  t.world_to_camera = world_to_camera;
+  const std::size_t n = t.poses.size();
+  if (frame_ids.is_none()) {
+    for (std::size_t i = 0; i < n; ++i) t.frame_ids.push_back(static_cast<long>(i));
+  } else {
+    t.frame_ids = frame_ids.cast<std::vector<long>>();
+    if (t.frame_ids.size() != n)
+      throw py::value_error("frame_ids: " + std::to_string(t.frame_ids.size()) +
+                            " ids; expected one per pose (" + std::to_string(n) + ")");
+    for (std::size_t i = 1; i < n; ++i)
+      if (t.frame_ids[i] <= t.frame_ids[i - 1])
+        throw py::value_error("frame_ids: " + std::to_string(t.frame_ids[i]) + " after " +
+                              std::to_string(t.frame_ids[i - 1]) + "; expected strictly increasing ids");
+  }
+  if (!timestamps.is_none()) {
+    t.timestamps = timestamps.cast<std::vector<double>>();
+    if (t.timestamps.size() != n)
+      throw py::value_error("timestamps: " + std::to_string(t.timestamps.size()) +
+                            " values; expected one per pose (" + std::to_string(n) + ")");
+  } else if (t.format == snaps::TrajectoryFormat::kTum) {
+    throw py::value_error("timestamps: expected one per pose for format \"tum\"");
+  }
+  return t;
+}
+
+std::vector<LoopPair> LoopsOf(const py::handle& loops, const Trajectory* t) {
+  std::vector<LoopPair> out;
+  if (loops.is_none()) return out;
+  const py::sequence items = py::reinterpret_borrow<py::sequence>(
+      py::isinstance<py::array>(loops) ? loops.attr("tolist")() : loops);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const py::sequence item = items[i].cast<py::sequence>();
+    if (item.size() != 2 && item.size() != 3)
+      throw py::value_error("loops[" + std::to_string(i) +
+                            "]: expected (query, reference) or (query, reference, similarity)");
+    LoopPair p;
+    p.query = item[0].cast<int>();
+    p.reference = item[1].cast<int>();
+    p.similarity = item.size() == 3 ? item[2].cast<double>() : 1.0;
+    if (t && (p.query < 0 || p.query >= t->Size() || p.reference < 0 || p.reference >= p.query))
+      throw py::value_error("loops[" + std::to_string(i) + "]: (" + std::to_string(p.query) + ", " +
+                            std::to_string(p.reference) +
+                            ") are not pose indices with 0 <= reference < query < " +
+                            std::to_string(t->Size()));
+    out.push_back(p);
+  }
+  return out;
+}
+
+py::list LoopsList(const std::vector<LoopPair>& loops) {
+  py::list out;
+  for (const LoopPair& p : loops) out.append(py::make_tuple(p.query, p.reference, p.similarity));
+  return out;
+}
+
+py::array_t<double> Matrix4(const Eigen::Isometry3d& pose) {
+  py::array_t<double> a({py::ssize_t{4}, py::ssize_t{4}});
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) a.mutable_at(r, c) = pose.matrix()(r, c);
+  return a;
+}
+
+}  // namespace
+
+void RegisterSnaps(py::module_& parent) {
+  py::module_ m = parent.def_submodule("snaps", R"doc(The SNAPS add-on (docs/snaps.md).
+
+Trajectories (camera-to-world poses per frame), their files (KITTI, KITTI with frame ids,
+TUM), loop pairs (from a pairs file or an OpenABLE matrix), the paper's discounted update
+(Eq. 6), a least-squares pose graph, and the absolute trajectory error against a ground truth.
+Loops are lists of (query, reference, similarity) tuples of pose indices (query > reference).)doc");
+
+  py::class_<Trajectory>(m, "Trajectory", R"doc(Trajectory(poses, frame_ids=None, timestamps=None, format="kitti", world_to_camera=False)
+
+Camera-to-world poses of a camera over a run.
+
+Args:
+    poses (numpy.ndarray): (N, 3, 4) or (N, 4, 4) camera-to-world matrices [R | t]
+        (R a rotation within 1e-3).
+    frame_ids (list[int] | None): frame number of each pose, strictly increasing; None:
+        0 .. N-1.
+    timestamps (list[float] | None): seconds per pose (needed for format "tum").
+    format (str): the file format it is saved in: "kitti" (12 numbers a line, pose i is
+        frame i), "kitti-id" (a frame number then 12 numbers), "tum" (timestamp tx ty tz qx qy
+        qz qw).
+    world_to_camera (bool): save() writes the inverse matrices (as SO-DSO's files are).)doc")
+      .def(py::init(&MakeTrajectory), py::arg("poses"), py::arg("frame_ids") = py::none(),
+           py::arg("timestamps") = py::none(), py::arg("format") = "kitti",
+           py::arg("world_to_camera") = false)
+      .def_property_readonly("poses", [](const Trajectory& t) { return PosesArray(t, 4); },
+                             "float64 (N, 4, 4) camera-to-world matrices (a copy).")
+      .def_property_readonly("poses_3x4", [](const Trajectory& t) { return PosesArray(t, 3); },
+                             "float64 (N, 3, 4) camera-to-world matrices [R | t] (a copy), the KITTI layout.")
+      .def_property_readonly(
+          "positions",
+          [](const Trajectory& t) {
+            py::array_t<double> a({static_cast<py::ssize_t>(t.Size()), py::ssize_t{3}});
+            for (int i = 0; i < t.Size(); ++i)
+              for (int k = 0; k < 3; ++k) a.mutable_at(i, k) = t.poses[i].translation()(k);
+            return a;
+          },
+          "float64 (N, 3) camera positions (the translations).")
+      .def_property_readonly(
+          "frame_ids",
+          [](const Trajectory& t) {
+            py::array_t<std::int64_t> a(static_cast<py::ssize_t>(t.frame_ids.size()));
+            std::copy(t.frame_ids.begin(), t.frame_ids.end(), a.mutable_data());
+            return a;
+          },
+          "int64 (N,) frame number of each pose.")
+      .def_property_readonly("timestamps", [](const Trajectory& t) { return DoubleArray(t.timestamps); },
+                             "float64 (N,) seconds (empty unless the format is tum).")
+      .def_property_readonly("format", [](const Trajectory& t) { return snaps::TrajectoryFormatName(t.format); },
+                             "\"kitti\", \"kitti-id\" or \"tum\".")
+      .def_property_readonly("world_to_camera", [](const Trajectory& t) { return t.world_to_camera; },
+                             "The file stores world-to-camera matrices (inverted on reading and writing).")
+      .def("encode", &snaps::EncodeTrajectory,
+           "encode() -> str\n\nThe trajectory as the text of its file (its format and "
+           "convention, 17 significant digits: read_trajectory gives it back).")
+      .def(
+          "save",
+          [](const Trajectory& t, const std::string& path) {
+            const std::string text = snaps::EncodeTrajectory(t);
+            OutputBatch batch;
+            batch.Stage("path", path, text);
+            batch.Commit();
+          },
+          py::arg("path"),
+          "save(path)\n\nWrites encode() to `path` (through a temporary file renamed when "
+          "complete; folders created). Raises openable.InputError when it cannot be written.")
+      .def("__len__", &Trajectory::Size, "Number of poses.")
+      .def("__repr__", [](const Trajectory& t) {
+        std::string s = "<openable.snaps.Trajectory " + std::to_string(t.Size()) + " poses, " +
+                        snaps::TrajectoryFormatName(t.format);
+        if (!t.frame_ids.empty())
+          s += ", frames " + std::to_string(t.frame_ids.front()) + "-" + std::to_string(t.frame_ids.back());
+        return s + ">";
+      });
+
+  m.def(
+      "read_trajectory",
+      [](const std::string& path, const std::string& format, bool world_to_camera) {
+        const snaps::TrajectoryFormat f = FormatOf(format);
+        py::gil_scoped_release release;
+        return snaps::ReadTrajectory(path, f, world_to_camera);
+      },
+      py::arg("path"), py::arg("format") = "kitti", py::arg("world_to_camera") = false,
+      R"doc(read_trajectory(path, format="kitti", world_to_camera=False) -> Trajectory
+
+Reads a trajectory file.
+
+Args:
+    path (str): the file.
+    format (str): "kitti" (12 numbers a line: row-major [R | t], pose i = frame i),
+        "kitti-id" (a frame number, then the 12 numbers; e.g. SO-DSO keyframes) or "tum"
+        ("timestamp tx ty tz qx qy qz qw", '#' comments).
+    world_to_camera (bool): the file's matrices map world points into the camera (SO-DSO's
+        poses_history_file.txt); they are inverted so that poses are camera-to-world.
+
+Raises:
+    openable.InputError: one line naming the file and line (wrong count of numbers, not a
+    number, a matrix that is not a rotation, frame ids not increasing, empty file).)doc");
+
+  m.def(
+      "associate",
+      [](const Trajectory& estimate, const Trajectory& truth, double time_tolerance) {
+        const std::vector<int> a =
+            snaps::AssociateWithTruth(estimate, truth, time_tolerance, "truth");
+        py::array_t<std::int32_t> out(static_cast<py::ssize_t>(a.size()));
+        std::copy(a.begin(), a.end(), out.mutable_data());
+        return out;
+      },
+      py::arg("estimate"), py::arg("truth"), py::arg("time_tolerance") = 0.02,
+      R"doc(associate(estimate, truth, time_tolerance=0.02) -> numpy.ndarray
+
+For each pose of `estimate`, the index of its pose in `truth`: by frame id (kitti and
+kitti-id), or by nearest timestamp within time_tolerance seconds (both tum).
+
+Returns:
+    numpy.ndarray: int32 (N,).
+
+Raises:
+    openable.InputError: a pose without counterpart (naming the first such frame).)doc");
+
+  py::class_<snaps::TrajectoryError>(m, "TrajectoryError",
+                                     "Absolute trajectory error of the positions (metres).")
+      .def_readonly("rmse", &snaps::TrajectoryError::rmse, "Root of the mean squared distance.")
+      .def_readonly("mean", &snaps::TrajectoryError::mean,
+                    "Mean distance: the paper's \"mean deviation from the ground truth\".")
+      .def_readonly("median", &snaps::TrajectoryError::median, "Median distance.")
+      .def_readonly("max", &snaps::TrajectoryError::max, "Largest distance.")
+      .def_readonly("aligned", &snaps::TrajectoryError::aligned,
+                    "A rigid alignment (rotation + translation, Umeyama) was applied first.")
+      .def_property_readonly(
+          "alignment", [](const snaps::TrajectoryError& e) { return Matrix4(e.alignment); },
+          "float64 (4, 4): the rigid motion applied to the estimate (identity when not aligned).")
+      .def("__repr__", [](const snaps::TrajectoryError& e) {
+        char b[200];
+        std::snprintf(b, sizeof b,
+                      "<openable.snaps.TrajectoryError%s: RMSE %.4f m, mean %.4f m, median %.4f m, max %.4f m>",
+                      e.aligned ? " (aligned)" : "", e.rmse, e.mean, e.median, e.max);
+        return std::string(b);
+      });
+
+  m.def(
+      "trajectory_error",
+      [](const Trajectory& estimate, const Trajectory& truth, const py::object& association,
+         bool align, double time_tolerance) {
+        std::vector<int> a;
+        if (association.is_none()) {
+          a = snaps::AssociateWithTruth(estimate, truth, time_tolerance, "truth");
+        } else {
+          a = association.cast<std::vector<int>>();
+          if (a.size() != estimate.poses.size())
+            throw py::value_error("association: " + std::to_string(a.size()) +
+                                  " indices; expected one per pose of the estimate");
+          for (const int i : a)
+            if (i < 0 || i >= truth.Size())
+              throw py::value_error("association: index " + std::to_string(i) +
+                                    " is not a pose of the truth");
+        }
+        py::gil_scoped_release release;
+        return snaps::AbsoluteTrajectoryError(estimate, truth, a, align);
+      },
+      py::arg("estimate"), py::arg("truth"), py::arg("association") = py::none(),
+      py::arg("align") = false, py::arg("time_tolerance") = 0.02,
+      R"doc(trajectory_error(estimate, truth, association=None, align=False, time_tolerance=0.02) -> TrajectoryError
+
+Absolute trajectory error of the estimate's positions against their ground-truth
+counterparts, as openable_snaps reports it.
+
+Args:
+    estimate (Trajectory): the trajectory evaluated.
+    truth (Trajectory): the ground truth.
+    association (array-like | None): index in `truth` of each estimate pose; None:
+        associate(estimate, truth, time_tolerance).
+    align (bool): first apply the rigid motion (no scale) that best maps the estimate onto
+        the truth (Umeyama); False measures the trajectory as it is.
+
+Returns:
+    TrajectoryError: rmse, mean, median, max (metres), aligned, alignment.)doc");
+
+  m.def(
+      "loops_from_csv",
+      [](const std::string& path, const Trajectory& t, long tolerance, bool drop_outside,
+         bool middle_of_runs, bool counts) -> py::object {
+        int dropped = 0, outside = 0;
+        std::vector<LoopPair> loops;
+        {
+          py::gil_scoped_release release;
+          loops = snaps::LoopsFromCsv(path, t, tolerance, &dropped, drop_outside ? &outside : nullptr);
+          if (middle_of_runs) loops = snaps::MiddleOfRuns(loops, t);
+        }
+        if (!counts) return LoopsList(loops);
+        py::dict c;
+        c["dropped"] = dropped;
+        c["outside"] = outside;
+        return py::make_tuple(LoopsList(loops), c);
+      },
+      py::arg("path"), py::arg("trajectory"), py::arg("tolerance") = 0,
+      py::arg("drop_outside") = false, py::arg("middle_of_runs") = false,
+      py::arg("counts") = false,
+      R"doc(loops_from_csv(path, trajectory, tolerance=0, drop_outside=False, middle_of_runs=False, counts=False) -> list
+
+Loop pairs from a CSV of frame pairs ("row,col" a line, row the later frame; '#' comments),
+as openable_snaps reads Snaps_loops_file with Snaps_loops = pairs.
+
+Args:
+    path (str): the pairs file.
+    trajectory (Trajectory): frames are mapped to its poses by frame id.
+    tolerance (int): a frame that is not a pose maps to the nearest pose within this many
+        frames (Snaps_keyframe_tolerance); 0 drops such pairs.
+    drop_outside (bool): drop pairs with a frame outside the trajectory's frames instead of
+        raising (Snaps_drop_outside).
+    middle_of_runs (bool): keep only the middle reference of each run of consecutive
+        references of a query (Snaps_middle_of_runs; ground-truth lists pair a query with
+        every frame within some radius).
+    counts (bool): also return {"dropped": pairs whose frame is not a pose, "outside":
+        pairs outside the trajectory}.
+
+Returns:
+    list[tuple[int, int, float]]: (query, reference, similarity 1.0) pose indices
+    (or (list, dict) with counts=True).)doc");
+
+  m.def(
+      "middle_of_runs",
+      [](const py::object& loops, const Trajectory& t, long run_gap) {
+        std::vector<LoopPair> l = LoopsOf(loops, &t);
+        {
+          py::gil_scoped_release release;
+          l = snaps::MiddleOfRuns(l, t, run_gap);
+        }
+        return LoopsList(l);
+      },
+      py::arg("loops"), py::arg("trajectory"), py::arg("run_gap") = 10,
+      R"doc(middle_of_runs(loops, trajectory, run_gap=10) -> list
+
+The references of each query split into runs (frame ids less than run_gap apart); only the
+middle reference of each run is kept (the earlier of two middles). Sorted by query, then
+reference.)doc");
+
+  m.def(
+      "loops_from_matrix",
+      [](const py::object& matrix, const Trajectory& t, double threshold, int exclusion,
+         long initial, long tolerance) {
+        snaps::MatrixLoopOptions o;
+        o.threshold = threshold;
+        o.exclusion = exclusion;
+        o.initial = initial;
+        o.tolerance = tolerance;
+        std::vector<LoopPair> loops;
+        if (py::isinstance<py::str>(matrix)) {
+          const std::string path = matrix.cast<std::string>();
+          py::gil_scoped_release release;
+          loops = snaps::LoopsFromMatrix(path, t, o);
+        } else {
+          const MatView v = Matrix2D(matrix, Elements::kFloat32, "matrix");
+          if (v.mat.rows != v.mat.cols)
+            throw py::value_error("matrix: " + std::to_string(v.mat.rows) + "x" +
+                                  std::to_string(v.mat.cols) + "; expected a square matrix of one sequence");
+          py::gil_scoped_release release;
+          loops = snaps::LoopsFromMatrix(cv::Mat1f(v.mat), t, o);
+        }
+        return LoopsList(loops);
+      },
+      py::arg("matrix"), py::arg("trajectory"), py::arg("threshold") = 0.1,
+      py::arg("exclusion") = 100, py::arg("initial") = 0, py::arg("tolerance") = 0,
+      R"doc(loops_from_matrix(matrix, trajectory, threshold=0.1, exclusion=100, initial=0, tolerance=0) -> list
+
+Loops from an OpenABLE matrix of one sequence (Snaps_loops = matrix): for each row q its best
+earlier match j (smallest M'(q, j) with j <= q - exclusion) with M'(q, j) < threshold gives
+(pose of q, pose of j, 1 - M'(q, j)); row i is frame initial + i, mapped to a pose by frame id
+(nearest within `tolerance` frames). A matrix whose maximum exceeds 1 is first divided by it.
+
+Args:
+    matrix (numpy.ndarray | str): the square normalised matrix, or a file (.npy, .txt, image).
+    trajectory (Trajectory): the poses.
+    threshold (float): Snaps_matrix_threshold.
+    exclusion (int): Snaps_frame_distance.
+    initial (int): frame id of row 0 (Initial_image).
+    tolerance (int): Snaps_keyframe_tolerance.)doc");
+
+  m.def("closed_loops",
+        [](const py::object& loops, int pause) {
+          return LoopsList(snaps::ClosedLoops(LoopsOf(loops, nullptr), pause));
+        },
+        py::arg("loops"), py::arg("pause") = 20,
+        R"doc(closed_loops(loops, pause=20) -> list
+
+The loops correct_discounted() closes, in order: taken by query, a loop is skipped when its
+query is not more than `pause` poses after the last closed loop's query.)doc");
+
+  m.def("discount_gamma", &snaps::DiscountGamma, py::arg("s_prime"), py::arg("alpha"),
+        R"doc(discount_gamma(s_prime, alpha) -> float
+
+gamma of Eq. 6: 1 - 1 / exp(3 - alpha * 0.01 * s_prime), clamped at 0; s_prime = N - s >= 0
+frames before the loop's frame N, alpha >= 1 the number of loops closed so far.)doc");
+
+  m.def(
+      "apply_discounted_update",
+      [](const Trajectory& t, int n, int reference, double similarity, int alpha,
+         int discount_length) {
+        if (n < 0 || n >= t.Size() || reference < 0 || reference >= n)
+          throw py::value_error("n, reference: expected 0 <= reference < n < " + std::to_string(t.Size()));
+        Trajectory out = t;
+        const Eigen::Vector3d shift =
+            snaps::ApplyDiscountedUpdate(out, n, reference, similarity, alpha, discount_length);
+        return py::make_tuple(out, DoubleArray({shift.x(), shift.y(), shift.z()}));
+      },
+      py::arg("trajectory"), py::arg("n"), py::arg("reference"), py::arg("similarity") = 1.0,
+      py::arg("alpha") = 1, py::arg("discount_length") = 300,
+      R"doc(apply_discounted_update(trajectory, n, reference, similarity=1.0, alpha=1, discount_length=300) -> tuple[Trajectory, numpy.ndarray]
+
+One loop of Eq. 6: pose n closes a loop with pose `reference`; positions of poses
+max(0, n-K)..n move by similarity * gamma(n - s) * (p_reference - p_n), later poses with pose
+n; rotations are kept. Returns the corrected copy and the shift of pose n.)doc");
+
+  m.def(
+      "correct_discounted",
+      [](const Trajectory& t, const py::object& loops, int discount_length, int pause) {
+        const std::vector<LoopPair> l = LoopsOf(loops, &t);
+        snaps::DiscountOptions o;
+        o.discount_length = discount_length;
+        o.pause = pause;
+        if (discount_length < 0 || pause < 0)
+          throw py::value_error("discount_length, pause: expected >= 0");
+        py::gil_scoped_release release;
+        return snaps::CorrectDiscounted(t, l, o);
+      },
+      py::arg("trajectory"), py::arg("loops"), py::arg("discount_length") = 300,
+      py::arg("pause") = 20,
+      R"doc(correct_discounted(trajectory, loops, discount_length=300, pause=20) -> Trajectory
+
+The paper's correction (Eq. 6) of a whole trajectory, offline, as openable_snaps does with
+Snaps_corrector = discounted: loops taken in the order of their query, a loop skipped while its
+query is not more than `pause` poses after the last closed one (Snaps_pause), each closed loop
+applying apply_discounted_update with alpha = loops closed so far and K = discount_length
+(Snaps_discount_length).
+
+Args:
+    trajectory (Trajectory): the drifting input.
+    loops (list): (query, reference[, similarity]) pose indices.
+
+Returns:
+    Trajectory: the corrected copy (frame ids, format and convention kept).)doc");
+
+  py::class_<snaps::PoseGraphReport>(m, "PoseGraphReport", "What correct_pose_graph() did.")
+      .def_readonly("iterations", &snaps::PoseGraphReport::iterations, "Steps tried.")
+      .def_readonly("loop_edges", &snaps::PoseGraphReport::loop_edges, "Loop edges in the graph.")
+      .def_readonly("initial_cost", &snaps::PoseGraphReport::initial_cost, "Robustified cost of the input.")
+      .def_readonly("final_cost", &snaps::PoseGraphReport::final_cost, "Cost of the output.")
+      .def_readonly("seconds", &snaps::PoseGraphReport::seconds, "Wall time of the correction.")
+      .def_readonly("converged", &snaps::PoseGraphReport::converged,
+                    "Stopped by relative_tolerance (not max_iterations).")
+      .def("__repr__", [](const snaps::PoseGraphReport& r) {
+        char b[200];
+        std::snprintf(b, sizeof b,
+                      "<openable.snaps.PoseGraphReport %d loop edges, %d iterations, cost %.6g -> %.6g%s>",
+                      r.loop_edges, r.iterations, r.initial_cost, r.final_cost,
+                      r.converged ? "" : " (not converged)");
+        return std::string(b);
+      });
+
+  m.def(
+      "correct_pose_graph",
+      [](const Trajectory& t, const py::object& loops, double odometry_translation_weight,
+         double odometry_rotation_weight, double loop_weight, bool use_similarity,
+         const std::string& robust_kernel, double robust_scale, double relative_tolerance,
+         int max_iterations, double initial_lambda, bool report) -> py::object {
+        const std::vector<LoopPair> l = LoopsOf(loops, &t);
+        snaps::PoseGraphOptions o;
+        o.odometry_translation_weight = odometry_translation_weight;
+        o.odometry_rotation_weight = odometry_rotation_weight;
+        o.loop_weight = loop_weight;
+        o.use_similarity = use_similarity;
+        o.robust_kernel = snaps::ParseRobustKernel(robust_kernel, "robust_kernel");
+        o.robust_scale = robust_scale;
+        o.relative_tolerance = relative_tolerance;
+        o.max_iterations = max_iterations;
+        o.initial_lambda = initial_lambda;
+        o.Check();
+        snaps::PoseGraphReport r;
+        Trajectory out;
+        {
+          py::gil_scoped_release release;
+          out = snaps::CorrectPoseGraph(t, l, o, &r);
+        }
+        if (report) return py::make_tuple(out, r);
+        return py::cast(out);
+      },
+      py::arg("trajectory"), py::arg("loops"), py::arg("odometry_translation_weight") = 2500.0,
+      py::arg("odometry_rotation_weight") = 1e6, py::arg("loop_weight") = 1.0,
+      py::arg("use_similarity") = false, py::arg("robust_kernel") = "huber",
+      py::arg("robust_scale") = 3.0, py::arg("relative_tolerance") = 1e-9,
+      py::arg("max_iterations") = 100, py::arg("initial_lambda") = 1e-6,
+      py::arg("report") = false,
+      R"doc(correct_pose_graph(trajectory, loops, odometry_translation_weight=2500.0, odometry_rotation_weight=1e6, loop_weight=1.0, use_similarity=False, robust_kernel="huber", robust_scale=3.0, relative_tolerance=1e-9, max_iterations=100, initial_lambda=1e-6, report=False) -> Trajectory
+
+Least-squares pose-graph correction (docs/snaps.md): odometry edges between consecutive poses
+(relative pose of the input; information diag(w_t I, w_R I)), loop edges pulling the two
+positions of each loop together (information loop_weight, times the similarity when
+use_similarity; robust kernel "none", "huber" or "cauchy" of scale robust_scale), pose 0
+fixed; iteratively reweighted Levenberg-Marquardt on SE(3), sparse LDLT. The same solver and
+defaults as openable_snaps (Snaps_corrector pose-graph).
+
+Args:
+    trajectory (Trajectory): the drifting input.
+    loops (list): (query, reference[, similarity]) pose indices.
+    odometry_translation_weight (float): 1/m^2 (Snaps_odometry_translation_weight).
+    odometry_rotation_weight (float): 1/rad^2 (Snaps_odometry_rotation_weight).
+    loop_weight (float): 1/m^2 (Snaps_loop_weight).
+    use_similarity (bool): multiply each loop's weight by its similarity.
+    robust_kernel (str), robust_scale (float): Snaps_robust_kernel, Snaps_robust_scale.
+    relative_tolerance (float), max_iterations (int), initial_lambda (float): the solver's
+        stopping rule and initial damping.
+    report (bool): also return a PoseGraphReport.
+
+Returns:
+    Trajectory (or (Trajectory, PoseGraphReport) with report=True).)doc");
+}
+
+}  // namespace openable::python
