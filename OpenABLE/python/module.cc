@@ -7,6 +7,10 @@
 
 PYBIND11_MODULE(openable, m) {
   namespace py = pybind11;
+  // Every docstring starts with its own signature, written for readers (numpy.ndarray rather
+  // than pybind11's "object"); pybind11's generated one would repeat it.
+  py::options options;
+  options.disable_function_signatures();
   m.doc() = R"doc(OpenABLE: visual place recognition and loop-closure detection (docs/python.md).
 
 Images are NumPy arrays: (H, W) grey or (H, W, 3) BGR, uint8 (0-255) or float32 (0-1), as

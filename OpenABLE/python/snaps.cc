@@ -164,7 +164,9 @@ Args:
     world_to_camera (bool): save() writes the inverse matrices (as SO-DSO's files are).)doc")
       .def(py::init(&MakeTrajectory), py::arg("poses"), py::arg("frame_ids") = py::none(),
            py::arg("timestamps") = py::none(), py::arg("format") = "kitti",
-           py::arg("world_to_camera") = false)
+           py::arg("world_to_camera") = false,
+           "__init__(poses, frame_ids=None, timestamps=None, format=\"kitti\", "
+           "world_to_camera=False)\n\nSee help(openable.snaps.Trajectory).")
       .def_property_readonly("poses", [](const Trajectory& t) { return PosesArray(t, 4); },
                              "float64 (N, 4, 4) camera-to-world matrices (a copy).")
       .def_property_readonly("poses_3x4", [](const Trajectory& t) { return PosesArray(t, 3); },

@@ -1,0 +1,165 @@
+"""Distance matrices from Python against values computed here with NumPy alone."""
+import unittest
+
+import numpy as np
+
+import openable
+
+
+def hamming_reference(a, b):
+    """Bits differing between every row of a and every row of b (NumPy only)."""
+    out = np.empty((len(a), len(b)), dtype=np.int64)
+    for i in range(len(a)):
+        out[i] = np.unpackbits(a[i][None, :] ^ b, axis=1).sum(axis=1)
+    return out
+
+
+def sequence_reference(d, length, direction, row_starts=(0,), col_starts=(0,)):
+    """S of matching/sequence.h written out term by term in float64."""
+    n, m = d.shape
+    row_starts, col_starts = list(row_starts), list(col_starts)
+    row_bounds = [(s, e) for s, e in zip(row_starts, row_starts[1:] + [n])]
+    col_bounds = [(s, e) for s, e in zip(col_starts, col_starts[1:] + [m])]
+
+    def bounds(bounds_list, x):
+        return next(b for b in bounds_list if b[0] <= x < b[1])
+
+    def one(step):
+        s = np.zeros((n, m))
+        for i in range(n):
+            r0, _ = bounds(row_bounds, i)
+            for j in range(m):
+                c0, c1 = bounds(col_bounds, j)
+                total, count = 0.0, 0
+                for k in range(length):
+                    ii, jj = i - k, j + step * k
+                    if ii < r0 or jj < c0 or jj >= c1:
+                        break
+                    total += d[ii, jj]
+                    count += 1
+                s[i, j] = total * length / count
+        return s
+
+    if direction == "forward":
+        return one(-1)
+    if direction == "reverse":
+        return one(+1)
+    return np.minimum(one(-1), one(+1))
+
+
+class HammingTest(unittest.TestCase):
+    def setUp(self):
+        rng = np.random.default_rng(7)
+        self.a = rng.integers(0, 256, (37, 32), dtype=np.uint8)
+        self.b = rng.integers(0, 256, (23, 32), dtype=np.uint8)
+
+    def test_against_unpackbits(self):
+        np.testing.assert_array_equal(openable.hamming_distances(self.a, self.b),
+                                      hamming_reference(self.a, self.b))
+        square = openable.hamming_distances(self.a)
+        np.testing.assert_array_equal(square, hamming_reference(self.a, self.a))
+        self.assertEqual(square.shape, (37, 37))
+        np.testing.assert_array_equal(np.diag(square), 0)
+
+    def test_result_is_the_cpp_buffer(self):
+        d = openable.hamming_distances(self.a, self.b)
+        self.assertEqual(d.dtype, np.float32)
+        self.assertFalse(d.flags.owndata)  # memory held by the capsule of the cv::Mat
+        self.assertEqual(type(d.base).__name__, "PyCapsule")
+        self.assertTrue(d.flags.c_contiguous and d.flags.writeable)
+
+    def test_strided_and_converted_inputs(self):
+        # Rows at a stride (a view of every other row, the first 16 bytes of each row), a
+        # Fortran-ordered copy, one 1-D row: each gives the brute-force values.
+        for a in (self.a[::2], self.a[:, :16], np.asfortranarray(self.a), self.a[5]):
+            a_np = np.atleast_2d(np.asarray(a, dtype=np.uint8))
+            np.testing.assert_array_equal(openable.hamming_distances(a, a_np),
+                                          hamming_reference(a_np, a_np))
+
+    def test_refuses_other_types_and_widths(self):
+        with self.assertRaisesRegex(ValueError, "uint8"):
+            openable.hamming_distances(self.a.astype(np.float32))
+        with self.assertRaisesRegex(ValueError, "16 elements; expected 32"):
+            openable.hamming_distances(self.a, self.b[:, :16])
+        with self.assertRaisesRegex(ValueError, "2-D"):
+            openable.hamming_distances(np.zeros((2, 2, 2), np.uint8))
+
+
+class L2Test(unittest.TestCase):
+    def test_against_numpy(self):
+        rng = np.random.default_rng(3)
+        a = rng.random((40, 128), dtype=np.float32)
+        b = rng.random((31, 128), dtype=np.float32)
+        ref = np.sqrt(((a[:, None, :].astype(np.float64) - b[None, :, :]) ** 2).sum(axis=2))
+        np.testing.assert_allclose(openable.l2_distances(a, b), ref, rtol=1e-5, atol=1e-5)
+        # float64 input is converted to float32.
+        np.testing.assert_allclose(openable.l2_distances(a.astype(np.float64), b), ref,
+                                   rtol=1e-5, atol=1e-5)
+        square = openable.l2_distances(a)
+        np.testing.assert_allclose(np.diag(square), 0, atol=1e-6)
+
+
+class SequenceTest(unittest.TestCase):
+    def test_against_the_sums_written_out(self):
+        rng = np.random.default_rng(11)
+        d = rng.random((30, 26), dtype=np.float32) * 100
+        cases = [
+            (1, "forward", None, None),
+            (4, "forward", None, None),
+            (4, "reverse", None, None),
+            (3, "both", None, None),
+            (5, "forward", [0, 12], [0, 10]),
+            (5, "reverse", [0, 12], [0, 10]),
+        ]
+        for length, direction, rows, cols in cases:
+            with self.subTest(L=length, direction=direction, starts=rows):
+                got = openable.sequence_distances(d, length, direction, rows, cols)
+                ref = sequence_reference(d.astype(np.float64), length, direction,
+                                         rows or [0], cols or [0])
+                np.testing.assert_allclose(got, ref, rtol=2e-6, atol=1e-4)
+
+    def test_in_place_writes_into_the_given_array(self):
+        rng = np.random.default_rng(5)
+        d = rng.random((20, 20), dtype=np.float32)
+        expected = openable.sequence_distances(d, 3)
+        out = openable.sequence_distances(d, 3, in_place=True)
+        self.assertTrue(np.shares_memory(out, d))
+        np.testing.assert_array_equal(d, expected)
+        with self.assertRaisesRegex(ValueError, "in_place"):
+            openable.sequence_distances(d.astype(np.float64), 3, in_place=True)
+
+    def test_bad_arguments(self):
+        d = np.ones((4, 4), np.float32)
+        with self.assertRaisesRegex(ValueError, "sequence length"):
+            openable.sequence_distances(d, 0)
+        with self.assertRaisesRegex(ValueError, "direction"):
+            openable.sequence_distances(d, 2, "sideways")
+        with self.assertRaises(ValueError):
+            openable.sequence_distances(d, 2, row_starts=[1, 2])
+
+
+class NormalizeThresholdTest(unittest.TestCase):
+    def test_eq5_and_eq9(self):
+        rng = np.random.default_rng(2)
+        m = rng.random((9, 7), dtype=np.float32) * 40
+        normalized, peak = openable.normalize_by_max(m)
+        self.assertAlmostEqual(peak, float(m.max()), places=4)
+        np.testing.assert_allclose(normalized, m / m.max(), rtol=1e-6)
+        np.testing.assert_array_equal(openable.threshold_matrix(normalized, 0.3),
+                                      (normalized >= 0.3).astype(np.uint8))
+        with self.assertRaisesRegex(ValueError, "negative or non-finite"):
+            openable.normalize_by_max(-m)
+
+    def test_read_matrix_reads_numpy_files(self):
+        import tempfile, os
+        m = np.arange(12, dtype=np.float64).reshape(3, 4) / 11
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "m.npy")
+            np.save(path, m)
+            np.testing.assert_allclose(openable.read_matrix(path), m, rtol=1e-7)
+            with self.assertRaises(openable.InputError):
+                openable.read_matrix(os.path.join(tmp, "missing.npy"))
+
+
+if __name__ == "__main__":
+    unittest.main()
