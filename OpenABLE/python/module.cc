@@ -47,9 +47,7 @@ the command-line programs; other invalid arguments raise ValueError.)doc";
   openable::python::RegisterImages(m);
   openable::python::RegisterMatching(m);
   openable::python::RegisterEvaluation(m);
-#ifdef OPENABLE_PYTHON_ONLINE
   openable::python::RegisterOnline(m);
-#endif
   openable::python::RegisterSnaps(m);
   // `import openable.snaps` and `from openable.snaps import ...` work like the attribute.
   py::module_::import("sys").attr("modules")["openable.snaps"] = m.attr("snaps");

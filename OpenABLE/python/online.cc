@@ -1,5 +1,6 @@
 // The batch helpers and the online detector of OpenABLE/online.h: describe, describe_images,
 // distance_matrix, OnlineDetector.
+#include <cstdio>
 #include <memory>
 #include <mutex>
 #include <utility>
@@ -60,6 +61,13 @@ py::tuple ResultTuple(const OnlineResult& r) {
   timings["search_seconds"] = r.search_seconds;
   timings["approximate"] = r.approximate;
   return py::make_tuple(r.frame, candidates, timings);
+}
+
+template <typename... Args>
+std::string Format(const char* format, Args... args) {
+  char buffer[1024];
+  std::snprintf(buffer, sizeof buffer, format, args...);
+  return buffer;
 }
 
 const char* const kDescriptionArgs = R"doc(    descriptor (str): a name of descriptor_names() but D-LDB (case-insensitive).
@@ -169,7 +177,20 @@ Returns:
     numpy.ndarray: float32 (N, N) in [0, 1], owning the C++ result (no copy); or (matrix,
     max) with return_max=True.)doc");
 
-  py::class_<Detector>(m, "OnlineDetector", R"doc(OnlineDetector(descriptor="LDB", description="global", patch_size=64, ldb_bits=256, grid=(1, 1), sequence_length=1, exclusion=100, candidates=5, threshold=0.1, exact_limit=20000, block_frames=4096, approximate_k=10, checks=512, lsh_tables=12, lsh_key_bits=20, lsh_probe_level=2, kd_trees=4, threads=0, seed=0x464C414E)
+  const OnlineOptions defaults;  // the defaults of the keyword arguments
+  const ApproximateOptions& fl = defaults.approximate;
+  const std::string signature = Format(
+      "OnlineDetector(*, descriptor=\"%s\", description=\"%s\", patch_size=%d, ldb_bits=%d, "
+      "grid=(%d, %d), sequence_length=%d, exclusion=%d, candidates=%d, threshold=%g, "
+      "exact_limit=%d, block_frames=%d, approximate_k=%d, checks=%d, lsh_tables=%d, "
+      "lsh_key_bits=%d, lsh_probe_level=%d, kd_trees=%d, threads=%d, seed=%llu)",
+      defaults.descriptor.c_str(), DescriptionName(defaults.description).c_str(),
+      defaults.patch_size, defaults.ldb_bits, defaults.grid_x, defaults.grid_y,
+      defaults.sequence_length, defaults.exclusion, defaults.candidates, defaults.threshold,
+      defaults.exact_limit, defaults.block_frames, fl.k, fl.checks, fl.lsh_tables,
+      fl.lsh_key_bits, fl.lsh_probe_level, fl.kd_trees, fl.threads,
+      static_cast<unsigned long long>(fl.seed));
+  const std::string class_doc = signature + R"doc(
 
 Loop candidates frame by frame, for a SLAM system: each frame added is described, searched
 among the earlier frames (exactly while the map holds at most exact_limit frames, then through
@@ -193,7 +214,8 @@ Args:
 Raises:
     openable.InputError (or ValueError): an option out of range, naming it.
 
-Not for several threads at once: calls are serialised by a lock.)doc")
+Calls from several threads are serialised by a lock.)doc";
+  py::class_<Detector>(m, "OnlineDetector", class_doc.c_str())
       .def(py::init([](const std::string& descriptor, const std::string& description,
                        int patch_size, int ldb_bits, std::pair<int, int> grid,
                        int sequence_length, int exclusion, int candidates, double threshold,
@@ -219,15 +241,33 @@ Not for several threads at once: calls are serialised by a lock.)doc")
              d->detector = std::make_unique<OnlineDetector>(o);
              return d;
            }),
-           py::kw_only(), py::arg("descriptor") = "LDB", py::arg("description") = "global",
-           py::arg("patch_size") = 64, py::arg("ldb_bits") = 256,
-           py::arg("grid") = std::make_pair(1, 1), py::arg("sequence_length") = 1,
-           py::arg("exclusion") = 100, py::arg("candidates") = 5, py::arg("threshold") = 0.10,
-           py::arg("exact_limit") = 20000, py::arg("block_frames") = 4096,
-           py::arg("approximate_k") = 10, py::arg("checks") = 512, py::arg("lsh_tables") = 12,
-           py::arg("lsh_key_bits") = 20, py::arg("lsh_probe_level") = 2, py::arg("kd_trees") = 4,
-           py::arg("threads") = 0, py::arg("seed") = std::uint64_t{0x464C414EULL},
+           py::kw_only(), py::arg("descriptor") = defaults.descriptor,
+           py::arg("description") = DescriptionName(defaults.description),
+           py::arg("patch_size") = defaults.patch_size, py::arg("ldb_bits") = defaults.ldb_bits,
+           py::arg("grid") = std::make_pair(defaults.grid_x, defaults.grid_y),
+           py::arg("sequence_length") = defaults.sequence_length,
+           py::arg("exclusion") = defaults.exclusion, py::arg("candidates") = defaults.candidates,
+           py::arg("threshold") = defaults.threshold, py::arg("exact_limit") = defaults.exact_limit,
+           py::arg("block_frames") = defaults.block_frames, py::arg("approximate_k") = fl.k,
+           py::arg("checks") = fl.checks, py::arg("lsh_tables") = fl.lsh_tables,
+           py::arg("lsh_key_bits") = fl.lsh_key_bits,
+           py::arg("lsh_probe_level") = fl.lsh_probe_level, py::arg("kd_trees") = fl.kd_trees,
+           py::arg("threads") = fl.threads, py::arg("seed") = fl.seed,
            "__init__(**options)\n\nSee help(openable.OnlineDetector) for the options.")
+      .def(
+          "add_to_map",
+          [](Detector& det, const py::object& rows) {
+            const MatView v = Matrix2D(rows, Elements::kUint8OrFloat32, "rows");
+            py::gil_scoped_release release;
+            std::lock_guard<std::mutex> lock(det.mutex);
+            det.detector->AddToMap(v.mat);
+          },
+          py::arg("rows"),
+          R"doc(add_to_map(rows)
+
+Appends descriptor rows (n x row_width, row_dtype; e.g. the `descriptors` of an earlier
+detector, saved with numpy.save) as the next n frames without searching for them: a map from an
+earlier run, which later frames find as candidates like any other frame.)doc")
       .def(
           "add_frame",
           [](Detector& d, const py::object& image) {
