@@ -114,6 +114,27 @@ class Kitti00LoopClosureTest(ParityMixin, TempDirTestCase):
                                       truth_type="kitti", radius=5, axes="xz", heading_limit=45)
         self.check_evaluation(from_file)
         np.testing.assert_array_equal(from_file.truth_matches(), r.truth_matches())
+        # The same pairs given as pairs (either order: loop closure takes the later frame as
+        # the query), and as a symmetric 0/1 matrix.
+        pairs = r.truth_matches()
+        self.check_evaluation(openable.evaluate(self.cli, pairs=pairs[:, ::-1]))
+        truth = np.zeros(self.cli.shape, np.uint8)
+        truth[pairs[:, 0], pairs[:, 1]] = truth[pairs[:, 1], pairs[:, 0]] = 1
+        self.check_evaluation(openable.evaluate(self.cli, truth_matrix=truth))
+
+    def test_positions_without_headings(self):
+        positions = openable.evaluate(self.cli, poses=self.poses[:, :, 3], radius=5, axes="xz")
+        kitti = openable.evaluate(self.cli, truth_file=str(self.poses_file), truth_type="kitti",
+                                  radius=5, axes="xz")
+        self.assertEqual(positions.to_dict().keys(), kitti.to_dict().keys())
+        for key, value in kitti.to_dict().items():
+            if not isinstance(value, dict):
+                self.assertEqual(getattr(positions, key), value, key)
+        with_headings = openable.evaluate(self.cli, poses=self.poses, radius=5, axes="xz",
+                                          heading_limit=45)
+        self.assertGreater(kitti.truth_pairs, with_headings.truth_pairs)
+        with self.assertRaisesRegex(ValueError, "heading_limit"):
+            openable.evaluate(self.cli, poses=self.poses[:, :, 3], heading_limit=45)
 
     def test_recall_at_1_from_numpy(self):
         # Ground truth and R@1 written out with NumPy: loops are frames 100 apart or more,

@@ -84,6 +84,9 @@ class OnlineAgainstBatchTest(unittest.TestCase):
             self.assertEqual(candidates, self.results[q][1])
             self.assertGreaterEqual(timings["describe_seconds"], 0)
         np.testing.assert_array_equal(d.descriptors, self.rows[:len(self.images)])
+        # A stack of images is a list of images.
+        np.testing.assert_array_equal(openable.describe_images(np.stack(self.images[:6])),
+                                      self.rows[:6])
         # uint8 images give the same rows as float32 ones.
         as_bytes = np.round(self.images[3] * 255).astype(np.uint8)
         np.testing.assert_array_equal(openable.describe(as_bytes), self.rows[3])
@@ -100,6 +103,25 @@ class OnlineAgainstBatchTest(unittest.TestCase):
                 self.assertAlmostEqual(distance, self.sums[q, j], delta=1e-3 * max(1, distance))
         self.assertTrue(used)
         self.assertGreater(d.blocks, 0)
+
+    def test_threads_share_a_detector(self):
+        # add_descriptor releases the GIL; the detector's lock keeps frames whole.
+        import threading
+        d = openable.OnlineDetector(sequence_length=L, exclusion=EXCLUSION)
+        frames = []
+
+        def feed(rows):
+            for row in rows:
+                frames.append(d.add_descriptor(row)[0])
+
+        threads = [threading.Thread(target=feed, args=(self.rows[k::2],)) for k in range(2)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        self.assertEqual(sorted(frames), list(range(len(self.rows))))
+        self.assertEqual(d.size, len(self.rows))
+        self.assertEqual(sorted(map(bytes, d.descriptors)), sorted(map(bytes, self.rows)))
 
     def test_bad_options_and_rows(self):
         with self.assertRaises(ValueError):
