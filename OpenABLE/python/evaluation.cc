@@ -1,6 +1,7 @@
 // Evaluation against ground truth (docs/evaluation.md): evaluate() and its result.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <utility>
 

@@ -39,6 +39,8 @@ the command-line programs; other invalid arguments raise ValueError.)doc";
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
+    } catch (const std::out_of_range&) {
+      throw;  // pybind11's own translation: IndexError
     } catch (const std::logic_error& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
     }

@@ -1,6 +1,7 @@
 // The SNAPS add-on (docs/snaps.md) as openable.snaps: trajectories, loops, the discounted
 // update (Eq. 6), the pose graph, the absolute trajectory error.
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <string>
 #include <vector>

@@ -58,7 +58,8 @@ class ParityMixin:
 
 class Kitti00LoopClosureTest(ParityMixin, TempDirTestCase):
     """KITTI 00 frames 0-1699 (the loop at frames 1559-1641 revisits 108-180): LDB, L = 5,
-    loops from the poses (5 m in the ground plane, headings within 45 degrees)."""
+    loops from the poses (5 m in the ground plane, headings within 45 degrees, 120 frames
+    apart), tolerance 3, vicinity 5."""
 
     L = 5
 
@@ -73,8 +74,8 @@ class Kitti00LoopClosureTest(ParityMixin, TempDirTestCase):
              "--set", "Png_name=", "--set", "Threshold=-1", "--set", "Npy_name=m.npy",
              "--set", "Ground_truth_type=kitti", "--set", "Ground_truth=%s" % cls.poses_file,
              "--set", "Ground_truth_axes=xz", "--set", "Ground_truth_radius=5", "--set",
-             "Ground_truth_heading=45", "--set", "Exclusion=100", "--set", "Tolerance=2",
-             "--set", "Evaluation_name=eval"], cls.tmp)
+             "Ground_truth_heading=45", "--set", "Exclusion=120", "--set", "Tolerance=3",
+             "--set", "Vicinity=5", "--set", "Evaluation_name=eval"], cls.tmp)
         cls.cli = np.load(cls.tmp / "m.npy")
         cls.rows = describe_folder(KITTI00 / "image_0")
         cls.matrix, cls.peak = openable.distance_matrix(cls.rows, cls.L, return_max=True)
@@ -104,23 +105,25 @@ class Kitti00LoopClosureTest(ParityMixin, TempDirTestCase):
         self.assertAlmostEqual(self.peak, float(s.max()), places=2)
 
     def test_evaluation_equals_the_programs(self):
+        protocol = dict(exclusion=120, tolerance=3, vicinity=5)  # not the defaults
         r = openable.evaluate(self.cli, poses=self.poses, radius=5, axes="xz", heading_limit=45,
-                              exclusion=100, tolerance=2)
+                              **protocol)
         self.assertEqual(r.layout, "loop_closure")
         self.assertGreater(r.positive_queries, 50)  # the loop is there
         self.check_evaluation(r)
         # The same ground truth read from the file, as the program read it.
         from_file = openable.evaluate(self.matrix, truth_file=str(self.poses_file),
-                                      truth_type="kitti", radius=5, axes="xz", heading_limit=45)
+                                      truth_type="kitti", radius=5, axes="xz", heading_limit=45,
+                                      **protocol)
         self.check_evaluation(from_file)
         np.testing.assert_array_equal(from_file.truth_matches(), r.truth_matches())
         # The same pairs given as pairs (either order: loop closure takes the later frame as
         # the query), and as a symmetric 0/1 matrix.
         pairs = r.truth_matches()
-        self.check_evaluation(openable.evaluate(self.cli, pairs=pairs[:, ::-1]))
+        self.check_evaluation(openable.evaluate(self.cli, pairs=pairs[:, ::-1], **protocol))
         truth = np.zeros(self.cli.shape, np.uint8)
         truth[pairs[:, 0], pairs[:, 1]] = truth[pairs[:, 1], pairs[:, 0]] = 1
-        self.check_evaluation(openable.evaluate(self.cli, truth_matrix=truth))
+        self.check_evaluation(openable.evaluate(self.cli, truth_matrix=truth, **protocol))
 
     def test_positions_without_headings(self):
         positions = openable.evaluate(self.cli, poses=self.poses[:, :, 3], radius=5, axes="xz")
@@ -161,7 +164,8 @@ class Kitti00LoopClosureTest(ParityMixin, TempDirTestCase):
 
 
 class NordlandTwoTraversalsTest(ParityMixin, TempDirTestCase):
-    """Nordland, 500 summer (reference) and 500 winter (query) frames, frame-aligned."""
+    """Nordland, 500 summer (reference) and 500 winter (query) frames, frame-aligned;
+    tolerance 1, vicinity 3."""
 
     FRAMES = 500
 
@@ -172,7 +176,7 @@ class NordlandTwoTraversalsTest(ParityMixin, TempDirTestCase):
                 "--set", "Description_type=%d" % (description == "grid"), "--set",
                 "Image_sequences=10", "--set", "Txt_name=", "--set", "Png_name=", "--set",
                 "Threshold=-1", "--set", "Npy_name=m.npy", "--set", "Ground_truth_type=aligned",
-                "--set", "Tolerance=2", "--set", "Evaluation_name=eval"] + extra_sets
+                "--set", "Tolerance=1", "--set", "Vicinity=3", "--set", "Evaluation_name=eval"] + extra_sets
         run("Test_OpenABLE", sets, self.tmp)
         cli = np.load(self.tmp / "m.npy")
         rows = np.vstack([describe_folder(NORDLAND / season, 0, self.FRAMES,
@@ -181,14 +185,15 @@ class NordlandTwoTraversalsTest(ParityMixin, TempDirTestCase):
                           for season in ("summer", "winter")])
         matrix = openable.distance_matrix(rows, 10, traversal_starts=[0, self.FRAMES])
         np.testing.assert_allclose(matrix, cli, rtol=1e-5, atol=1e-6)
-        r = openable.evaluate(matrix, aligned=True, reference_frames=self.FRAMES)
+        r = openable.evaluate(matrix, aligned=True, reference_frames=self.FRAMES, tolerance=1,
+                              vicinity=3)
         self.assertEqual(r.layout, "query_reference")
         self.assertEqual(r.block, (self.FRAMES, 0, self.FRAMES, self.FRAMES))
         self.check_evaluation(r)
         # The block alone, as a queries x references matrix, with the ground truth as a matrix.
         block = np.ascontiguousarray(cli[self.FRAMES:, :self.FRAMES])
         r2 = openable.evaluate(block, truth_matrix=np.eye(self.FRAMES, dtype=bool),
-                               layout="query_reference")
+                               layout="query_reference", tolerance=1, vicinity=3)
         self.check_evaluation(r2)
         return rows, r
 
