@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# CTest Install.FindPackageExample (tests/CMakeLists.txt; docs/install.md): installs the build
+# CTest install.find_package_example (tests/CMakeLists.txt; docs/install.md): installs the build
 # tree into a fresh prefix, builds examples/find_package against it as a user would, runs it
 # on real frames, and runs the installed Test_OpenABLE with the build tree out of its reach.
 #
