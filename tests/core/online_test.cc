@@ -152,11 +152,20 @@ TEST(OnlineDetector, SearchesFlannBlocksBeyondTheExactLimit) {
   OnlineOptions options = exact_options;
   options.exact_limit = 100;
   options.block_frames = 64;
+  options.background_merges = false;  // repeatable block counts
   OnlineDetector exact(exact_options), approximate(options);
+  OnlineOptions background_options = options;
+  background_options.background_merges = true;
+  OnlineDetector background(background_options);
   int same = 0, queries = 0, loops = 0, loops_found = 0;
   for (int q = 0; q < static_cast<int>(frames.size()); ++q) {
     const OnlineResult e = exact.AddFrame(frames[q]);
     const OnlineResult a = approximate.AddFrame(frames[q]);
+    const OnlineResult b = background.AddFrame(frames[q]);
+    for (const LoopCandidate& c : b.candidates) {  // merges in flight: still valid candidates
+      EXPECT_LE(c.frame, q - 50);
+      EXPECT_DOUBLE_EQ(c.distance, Single(background.Descriptors(), q, c.frame));
+    }
     const int searchable = q - 50 + 1;
     EXPECT_EQ(a.approximate, searchable > 100) << "frame " << q;
     if (searchable > 100) {
@@ -188,6 +197,8 @@ TEST(OnlineDetector, SearchesFlannBlocksBeyondTheExactLimit) {
   EXPECT_GT(loops, 20);
   EXPECT_GE(loops_found, 0.95 * loops);
   EXPECT_GT(approximate.MemoryBytes(), exact.MemoryBytes());
+  background.FinishMerges();
+  EXPECT_EQ(background.Blocks(), approximate.Blocks());
 }
 
 TEST(OnlineDetector, DistanceMatrixIsTheNormalisedBruteForce) {
