@@ -4,6 +4,8 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <future>
+#include <optional>
 #include <mutex>
 #include <thread>
 #include <utility>
@@ -222,26 +224,78 @@ struct OnlineDetector::State {
     return static_cast<float>(s);
   }
 
+  // A merge of blocks[block] and blocks[block + 1] being built (one at a time).
+  struct Merge {
+    size_t block = 0;
+    int first = 0, count = 0;
+    std::future<std::unique_ptr<ApproximateIndex>> index;
+  };
+  std::optional<Merge> merge;
+  std::future<void> disposal;  // freeing the indices a merge replaced
+
   // Builds an index over frames [first, first + count).
   std::unique_ptr<ApproximateIndex> Index(int first, int count) const {
     return std::make_unique<ApproximateIndex>(buffer.rowRange(first, first + count),
                                               options.approximate);
   }
 
+  // Installs a finished merge (waiting for it when `wait`), then starts the next one.
+  void FinishMerge(bool wait, bool background = true) {
+    if (merge && (wait || merge->index.wait_for(std::chrono::seconds(0)) ==
+                              std::future_status::ready)) {
+      Block merged{merge->first, merge->count, merge->index.get()};
+      // The two old indices are freed on another thread: freeing the tables of a large LSH
+      // index takes a good part of a second.
+      std::vector<std::unique_ptr<ApproximateIndex>> old;
+      old.push_back(std::move(blocks[merge->block].index));
+      old.push_back(std::move(blocks[merge->block + 1].index));
+      if (disposal.valid()) disposal.wait();
+      disposal = std::async(std::launch::async, [old = std::move(old)]() mutable { old.clear(); });
+      blocks[merge->block] = std::move(merged);
+      blocks.erase(blocks.begin() + static_cast<std::ptrdiff_t>(merge->block) + 1);
+      merge.reset();
+    }
+    StartMerges(background);
+  }
+
+  // Merges neighbouring blocks of equal size (a binary counter of block sizes): on a
+  // background thread, one at a time; or here, all of them, without background_merges.
+  void StartMerges(bool background) {
+    while (!merge) {
+      size_t i = blocks.size();
+      for (size_t b = blocks.size(); b-- > 1;)
+        if (blocks[b - 1].count == blocks[b].count) {
+          i = b - 1;
+          break;
+        }
+      if (i == blocks.size()) return;
+      const int first = blocks[i].first, count = 2 * blocks[i].count;
+      if (!options.background_merges || !background) {
+        blocks[i] = Block{first, count, Index(first, count)};
+        blocks.erase(blocks.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+        continue;
+      }
+      // The rows are copied: the buffer may grow (and move) while the index is built.
+      cv::Mat rows = buffer.rowRange(first, first + count).clone();
+      const ApproximateOptions approximate = options.approximate;
+      merge = Merge{i, first, count, std::async(std::launch::async, [rows, approximate]() {
+                      return std::make_unique<ApproximateIndex>(rows, approximate);
+                    })};
+    }
+  }
+
   // Indexes full blocks of the searchable frames [0, searchable) once the map is past
-  // exact_limit, merging equal neighbours (a binary counter of block sizes).
-  void UpdateBlocks(int searchable) {
+  // exact_limit.
+  // `background` false: every merge is built here (a map loaded by AddToMap).
+  void UpdateBlocks(int searchable, bool background = true) {
     if (searchable <= options.exact_limit) return;
+    if (!background) FinishMerge(true, false);
     while (searchable - indexed >= options.block_frames) {
       blocks.push_back({indexed, options.block_frames, Index(indexed, options.block_frames)});
       indexed += options.block_frames;
-      while (blocks.size() >= 2 && blocks[blocks.size() - 2].count == blocks.back().count) {
-        Block& a = blocks[blocks.size() - 2];
-        a.count *= 2;
-        a.index = Index(a.first, a.count);
-        blocks.pop_back();
-      }
+      if (!background) StartMerges(false);
     }
+    FinishMerge(false, background);
   }
 };
 
@@ -262,6 +316,9 @@ int OnlineDetector::RowWidth() const { return state_->width; }
 int OnlineDetector::RowType() const { return state_->type; }
 cv::Mat OnlineDetector::Descriptors() const { return state_->Rows(); }
 int OnlineDetector::Blocks() const { return static_cast<int>(state_->blocks.size()); }
+void OnlineDetector::FinishMerges() {
+  while (state_->merge) state_->FinishMerge(true);
+}
 
 std::int64_t OnlineDetector::MemoryBytes() const {
   const State& s = *state_;
@@ -270,6 +327,7 @@ std::int64_t OnlineDetector::MemoryBytes() const {
   // tables of one 4-byte id per row is less; k-d trees: 4 trees of nodes per row).
   for (const auto& b : s.blocks)
     bytes += 2 * static_cast<std::int64_t>(b.count) * s.width * s.buffer.elemSize();
+  if (s.merge) bytes += 3 * static_cast<std::int64_t>(s.merge->count) * s.width * s.buffer.elemSize();
   return bytes;
 }
 
@@ -294,7 +352,7 @@ void OnlineDetector::AddToMap(const cv::Mat& rows) {
   if (s.type == CV_32F && !cv::checkRange(rows))
     throw InputError("map rows hold a value that is not finite");
   for (int i = 0; i < rows.rows; ++i) s.Append(rows.row(i));
-  s.UpdateBlocks(s.size - s.options.exclusion);
+  s.UpdateBlocks(s.size - s.options.exclusion, false);
 }
 
 OnlineResult OnlineDetector::AddDescriptor(const cv::Mat& row) {

@@ -50,6 +50,11 @@ struct OnlineOptions {
   // of each), and only the newest unindexed frames (< block_frames) are scanned exactly.
   int exact_limit = 20000;
   int block_frames = 4096;
+  // Merges of two blocks into one are built on a background thread while the frames go on
+  // being searched in the two old blocks, so no frame waits for a large index build (a merge
+  // to 500,000 rows takes seconds). The candidates then depend on when a merge finishes: false
+  // builds merges in AddFrame instead, for repeatable results (at the cost of those waits).
+  bool background_merges = true;
   ApproximateOptions approximate;  // its k is the per-block candidate count (>= candidates)
   // Throws InputError naming the field, the value and what was expected.
   void Check() const;
@@ -81,8 +86,9 @@ struct OnlineResult {
 // frames: 32 B a frame for LDB 256 bits, 3.2 MB per 100,000 frames) plus, beyond exact_limit,
 // the FLANN indices (see MemoryBytes). Latency per frame: description, plus L distances per
 // searchable frame while exact (linear in the map up to exact_limit), then one FLANN query per
-// block (at most log2(frames / block_frames) + 1 blocks) plus an exact scan of fewer than
-// block_frames frames, plus L distances per candidate. Not thread-safe for AddFrame; the const
+// block (about log2(frames / block_frames) + 1 blocks; one more while a merge is built) plus
+// an exact scan of fewer than block_frames frames, plus L distances per candidate; every
+// block_frames frames one block of block_frames rows is indexed in AddFrame (milliseconds). Not thread-safe for AddFrame; the const
 // members may be called while no AddFrame runs.
 class OnlineDetector {
  public:
@@ -109,6 +115,8 @@ class OnlineDetector {
   cv::Mat Descriptors() const;      // Size() x RowWidth(), a view of the stored rows
   std::int64_t MemoryBytes() const; // rows + indices held now
   int Blocks() const;               // FLANN blocks in use (0 while exact)
+  // Waits for a background merge (background_merges) to finish and installs its index.
+  void FinishMerges();
 
  private:
   struct State;

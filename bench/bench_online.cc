@@ -5,7 +5,7 @@
 //
 // Usage: bench_online [--datasets DIR] [--descriptor LDB] [--sequence L] [--exclusion E]
 //                     [--threshold T] [--heading-limit DEG] [--prefill N] [--exact-limit N]
-//                     [--block-frames N] [--csv FILE]
+//                     [--block-frames N] [--foreground-merges] [--csv FILE]
 // --prefill N adds N random rows before the frames (a map of N + 1700 frames, for the latency
 // of large maps only: random rows are never loop candidates of real frames in practice).
 #include <algorithm>
@@ -77,6 +77,7 @@ int main(int argc, char** argv) {
     else if (a == "--prefill") prefill = std::stoi(next());
     else if (a == "--exact-limit") options.exact_limit = std::stoi(next());
     else if (a == "--block-frames") options.block_frames = std::stoi(next());
+    else if (a == "--foreground-merges") options.background_merges = false;
     else if (a == "--csv") csv = next();
     else {
       std::fprintf(stderr, "bench_online: unknown argument %s (see the comment at the top of "
@@ -155,10 +156,13 @@ int main(int argc, char** argv) {
     const int positives = std::count(positive.begin(), positive.end(), 1);
     std::printf("OnlineDetector on KITTI 00 frames 0-1699: %s, L=%d, exclusion %d, threshold "
                 "%.3f, %d random rows before (map %d frames at the end), exact limit %d, %d "
-                "frames searched with FLANN blocks (%d blocks at the end), memory %.1f MB\n",
+                "frames searched with FLANN blocks (%d blocks at the end, merges %s), memory "
+                "%.1f MB\n",
                 options.descriptor.c_str(), options.sequence_length, options.exclusion,
                 options.threshold, prefill, detector.Size(), options.exact_limit,
-                approximate_frames, detector.Blocks(), detector.MemoryBytes() / 1e6);
+                approximate_frames, detector.Blocks(),
+                options.background_merges ? "in the background" : "in AddFrame",
+                detector.MemoryBytes() / 1e6);
     Print("describe", Summarise(describe));
     Print("search", Summarise(search));
     Print("describe + search", Summarise(total));

@@ -10,7 +10,10 @@
 // 0.3 s of every run before main(), more than the whole computation on Nordland.
 //
 // Modules are searched in the folders of the environment variable OPENABLE_MODULE_PATH
-// (colon-separated), then in the build tree, then in the install tree.
+// (colon-separated), then beside the program (or shared library) holding this code as
+// installed (<prefix>/lib/openable, whatever prefix it was installed to), then in the build
+// tree's modules/ for a program of the build tree, or in the configured prefix's lib/openable
+// for any other program (docs/install.md).
 #pragma once
 
 #include <string>

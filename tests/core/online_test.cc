@@ -1,5 +1,5 @@
-// The online detector (OpenABLE/online.h) against an independent brute force on real KITTI
-// frames: single-frame distances counted bit by bit here, sequence sums written from their
+// The online detector (OpenABLE/online.h) against the batch matrix and against an independent
+// brute force on real KITTI frames: single-frame distances counted bit by bit here, sequence sums written from their
 // definition (matching/sequence.h), candidates as the k smallest with ties to the earlier frame.
 #include "OpenABLE/online.h"
 
@@ -15,6 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/bounded.h"
 #include "tests/test_support.h"
 
 namespace openable {
@@ -83,6 +84,18 @@ TEST(OnlineDetector, GivesTheBruteForceCandidatesOnRealKittiFrames) {
   options.candidates = 4;
   OnlineDetector detector(options);
   const cv::Mat batch_rows = DescribeImages(frames, options);
+  // The batch path of Test_OpenABLE: the normalised sequence matrix and its kept matches (the
+  // k best of each query among frames at least `exclusion` earlier).
+  float max_distance = 0;
+  const cv::Mat1f matrix = DistanceMatrix(batch_rows, 5, SequenceDirection::kForward, {}, 0,
+                                          &max_distance);
+  const int n = static_cast<int>(frames.size());
+  KeepRules rules;
+  rules.best = 4;
+  rules.exclusion = 25;
+  const std::vector<Match> batch = MatchesFromMatrix(matrix, MatchBlock{0, n, 0, n, true}, rules);
+  std::vector<std::vector<Match>> batch_of(frames.size());
+  for (const Match& m : batch) batch_of[m.query].push_back(m);
   int accepted_loops = 0, compared = 0;
   for (int q = 0; q < static_cast<int>(frames.size()); ++q) {
     const OnlineResult r = detector.AddFrame(frames[q]);
@@ -100,6 +113,10 @@ TEST(OnlineDetector, GivesTheBruteForceCandidatesOnRealKittiFrames) {
       // Hamming: normalised = mean fraction of differing bits over the L frames.
       EXPECT_DOUBLE_EQ(r.candidates[i].normalized, distance / (5.0 * 256));
       EXPECT_EQ(r.candidates[i].accepted, r.candidates[i].normalized <= options.threshold);
+      // The same candidates as the batch matrix, whose cells are S / max(S).
+      ASSERT_EQ(batch_of[q].size(), want.size()) << "frame " << q;
+      EXPECT_EQ(batch_of[q][i].reference, r.candidates[i].frame) << "frame " << q;
+      EXPECT_NEAR(batch_of[q][i].distance * max_distance, r.candidates[i].distance, 1e-3);
       ++compared;
     }
     // Accepted candidates in the loop: KITTI frames 1559-1641 revisit frames ~0-200.
@@ -152,11 +169,20 @@ TEST(OnlineDetector, SearchesFlannBlocksBeyondTheExactLimit) {
   OnlineOptions options = exact_options;
   options.exact_limit = 100;
   options.block_frames = 64;
+  options.background_merges = false;  // repeatable block counts
   OnlineDetector exact(exact_options), approximate(options);
+  OnlineOptions background_options = options;
+  background_options.background_merges = true;
+  OnlineDetector background(background_options);
   int same = 0, queries = 0, loops = 0, loops_found = 0;
   for (int q = 0; q < static_cast<int>(frames.size()); ++q) {
     const OnlineResult e = exact.AddFrame(frames[q]);
     const OnlineResult a = approximate.AddFrame(frames[q]);
+    const OnlineResult b = background.AddFrame(frames[q]);
+    for (const LoopCandidate& c : b.candidates) {  // merges in flight: still valid candidates
+      EXPECT_LE(c.frame, q - 50);
+      EXPECT_DOUBLE_EQ(c.distance, Single(background.Descriptors(), q, c.frame));
+    }
     const int searchable = q - 50 + 1;
     EXPECT_EQ(a.approximate, searchable > 100) << "frame " << q;
     if (searchable > 100) {
@@ -188,6 +214,8 @@ TEST(OnlineDetector, SearchesFlannBlocksBeyondTheExactLimit) {
   EXPECT_GT(loops, 20);
   EXPECT_GE(loops_found, 0.95 * loops);
   EXPECT_GT(approximate.MemoryBytes(), exact.MemoryBytes());
+  background.FinishMerges();
+  EXPECT_EQ(background.Blocks(), approximate.Blocks());
 }
 
 TEST(OnlineDetector, DistanceMatrixIsTheNormalisedBruteForce) {
