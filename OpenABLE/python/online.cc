@@ -182,12 +182,14 @@ Returns:
   const std::string signature = Format(
       "OnlineDetector(*, descriptor=\"%s\", description=\"%s\", patch_size=%d, ldb_bits=%d, "
       "grid=(%d, %d), sequence_length=%d, exclusion=%d, candidates=%d, threshold=%g, "
-      "exact_limit=%d, block_frames=%d, approximate_k=%d, checks=%d, lsh_tables=%d, "
+      "exact_limit=%d, block_frames=%d, background_merges=%s, approximate_k=%d, checks=%d, "
+      "lsh_tables=%d, "
       "lsh_key_bits=%d, lsh_probe_level=%d, kd_trees=%d, threads=%d, seed=%llu)",
       defaults.descriptor.c_str(), DescriptionName(defaults.description).c_str(),
       defaults.patch_size, defaults.ldb_bits, defaults.grid_x, defaults.grid_y,
       defaults.sequence_length, defaults.exclusion, defaults.candidates, defaults.threshold,
-      defaults.exact_limit, defaults.block_frames, fl.k, fl.checks, fl.lsh_tables,
+      defaults.exact_limit, defaults.block_frames, defaults.background_merges ? "True" : "False",
+      fl.k, fl.checks, fl.lsh_tables,
       fl.lsh_key_bits, fl.lsh_probe_level, fl.kd_trees, fl.threads,
       static_cast<unsigned long long>(fl.seed));
   const std::string class_doc = signature + R"doc(
@@ -207,6 +209,9 @@ Args:
         distance seen so far for float descriptors. Not the scale of Config.txt's Threshold.
     exact_limit (int): exact search while the searchable map holds at most this many frames.
     block_frames (int): frames per FLANN block beyond it.
+    background_merges (bool): build merges of two blocks on a background thread (no frame
+        waits for a large index build; candidates then depend on when a merge finishes);
+        False builds them inside add_frame, for repeatable results.
     approximate_k, checks, lsh_tables, lsh_key_bits, lsh_probe_level, kd_trees, threads, seed:
         the FLANN search (candidates per block, k-d tree checks, LSH tables, key bits and
         multi-probe level, k-d trees, threads, seed of the index build).
@@ -219,7 +224,8 @@ Calls from several threads are serialised by a lock.)doc";
       .def(py::init([](const std::string& descriptor, const std::string& description,
                        int patch_size, int ldb_bits, std::pair<int, int> grid,
                        int sequence_length, int exclusion, int candidates, double threshold,
-                       int exact_limit, int block_frames, int approximate_k, int checks,
+                       int exact_limit, int block_frames, bool background_merges,
+                       int approximate_k, int checks,
                        int lsh_tables, int lsh_key_bits, int lsh_probe_level, int kd_trees,
                        int threads, std::uint64_t seed) {
              OnlineOptions o = DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid);
@@ -229,6 +235,7 @@ Calls from several threads are serialised by a lock.)doc";
              o.threshold = threshold;
              o.exact_limit = exact_limit;
              o.block_frames = block_frames;
+             o.background_merges = background_merges;
              o.approximate.k = approximate_k;
              o.approximate.checks = checks;
              o.approximate.lsh_tables = lsh_tables;
@@ -248,7 +255,9 @@ Calls from several threads are serialised by a lock.)doc";
            py::arg("sequence_length") = defaults.sequence_length,
            py::arg("exclusion") = defaults.exclusion, py::arg("candidates") = defaults.candidates,
            py::arg("threshold") = defaults.threshold, py::arg("exact_limit") = defaults.exact_limit,
-           py::arg("block_frames") = defaults.block_frames, py::arg("approximate_k") = fl.k,
+           py::arg("block_frames") = defaults.block_frames,
+           py::arg("background_merges") = defaults.background_merges,
+           py::arg("approximate_k") = fl.k,
            py::arg("checks") = fl.checks, py::arg("lsh_tables") = fl.lsh_tables,
            py::arg("lsh_key_bits") = fl.lsh_key_bits,
            py::arg("lsh_probe_level") = fl.lsh_probe_level, py::arg("kd_trees") = fl.kd_trees,
@@ -314,6 +323,17 @@ Raises:
 
 Adds an already computed descriptor row (1-D, row_width elements of row_dtype, e.g. a row of
 describe_images()) as the next frame; returns what add_frame() returns.)doc")
+      .def(
+          "finish_merges",
+          [](Detector& det) {
+            py::gil_scoped_release release;
+            std::lock_guard<std::mutex> lock(det.mutex);
+            det.detector->FinishMerges();
+          },
+          R"doc(finish_merges()
+
+Waits for a merge of FLANN blocks being built in the background (background_merges) and
+installs its index.)doc")
       .def_property_readonly(
           "size",
           [](Detector& d) {
@@ -380,6 +400,7 @@ describe_images()) as the next frame; returns what add_frame() returns.)doc")
             r["threshold"] = o.threshold;
             r["exact_limit"] = o.exact_limit;
             r["block_frames"] = o.block_frames;
+            r["background_merges"] = o.background_merges;
             r["approximate_k"] = o.approximate.k;
             r["checks"] = o.approximate.checks;
             r["lsh_tables"] = o.approximate.lsh_tables;

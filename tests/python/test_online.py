@@ -93,7 +93,8 @@ class OnlineAgainstBatchTest(unittest.TestCase):
 
     def test_approximate_search_distances_are_exact(self):
         d = openable.OnlineDetector(sequence_length=L, exclusion=EXCLUSION, candidates=K,
-                                    threshold=THRESHOLD, exact_limit=100, block_frames=64)
+                                    threshold=THRESHOLD, exact_limit=100, block_frames=64,
+                                    background_merges=False)
         used = False
         for q, row in enumerate(self.rows):
             _, candidates, timings = d.add_descriptor(row)
@@ -102,7 +103,9 @@ class OnlineAgainstBatchTest(unittest.TestCase):
                 self.assertLessEqual(j, q - EXCLUSION)
                 self.assertAlmostEqual(distance, self.sums[q, j], delta=1e-3 * max(1, distance))
         self.assertTrue(used)
+        d.finish_merges()
         self.assertGreater(d.blocks, 0)
+        self.assertFalse(d.options["background_merges"])
 
     def test_threads_share_a_detector(self):
         # add_descriptor releases the GIL; the detector's lock keeps frames whole.
