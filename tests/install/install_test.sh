@@ -155,6 +155,24 @@ run_installed "$tmp/tiff" tiff LD_DEBUG=files || {
 loaded=$(grep -o "file=[^ ]*libopenable_oiio\.so" "$tmp/out/tiff.log" | head -n 1 | cut -d= -f2)
 [ "$loaded" = "$prefix/$libdir/openable/libopenable_oiio.so" ] ||
   fail "installed Test_OpenABLE loaded the OpenImageIO module from '$loaded', expected $prefix/$libdir/openable"
+# The installed Python module (when the build made one) imports from the prefix and reads a
+# TIFF through the prefix's OpenImageIO module, found two folders above its own file.
+python_dir=$(find "$prefix" -name 'openable.cpython-*.so' -printf '%h\n' 2> /dev/null | head -n 1)
+if [ -n "$python_dir" ]; then
+  tiff=$(ls "$tmp/tiff"/* | head -n 1)
+  (cd "$tmp" && LD_DEBUG=files PYTHONPATH="$python_dir" /usr/bin/python3 -c \
+     "import openable, sys; a = openable.read_image(sys.argv[1]); assert a.ndim >= 2; print(openable.__file__)" \
+     "$tiff" > "$tmp/out/python.log" 2>&1) || {
+    grep -v "^ *[0-9]*:" "$tmp/out/python.log"
+    fail "the installed Python module could not read a TIFF"
+  }
+  grep -q "^$python_dir/openable" "$tmp/out/python.log" ||
+    fail "python imported openable from elsewhere than $python_dir"
+  loaded=$(grep -o "file=[^ ]*libopenable_oiio\.so" "$tmp/out/python.log" | head -n 1 | cut -d= -f2)
+  [ "$loaded" = "$prefix/$libdir/openable/libopenable_oiio.so" ] ||
+    fail "the installed Python module loaded the OpenImageIO module from '$loaded', expected $prefix/$libdir/openable"
+  echo "-- installed Python module: imports and reads TIFF with the prefix's module"
+fi
 # A copy of the program in a prefix without modules must fail and say where it looked: a
 # program outside the build tree never falls back on the build's modules.
 configured=$(sed -n 's/^CMAKE_INSTALL_PREFIX:PATH=//p' "$build/CMakeCache.txt")
