@@ -12,16 +12,6 @@
 namespace openable {
 namespace {
 
-float PairDistance(const cv::Mat& d, int a, int b) {
-  if (d.depth() == CV_8U)
-    return static_cast<float>(HammingDistance(d.ptr<std::uint8_t>(a), d.ptr<std::uint8_t>(b), d.cols));
-  const float* x = d.ptr<float>(a);
-  const float* y = d.ptr<float>(b);
-  double s = 0;
-  for (int k = 0; k < d.cols; ++k) s += (static_cast<double>(x[k]) - y[k]) * (x[k] - y[k]);
-  return static_cast<float>(std::sqrt(s));
-}
-
 // Candidate lists (reference numbers) of every query, k per query: OpenCV's FLANN through
 // matching/approximate.h (seeded, so two runs give the same candidates; libflann cannot be).
 std::vector<std::vector<int>> Candidates(const cv::Mat& refs, const cv::Mat& queries, int k,
@@ -65,8 +55,8 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
     const int c = std::min(L, std::min(tq, tj) + 1);
     double sum = 0;
     for (int s = 0; s < c; ++s)
-      sum += PairDistance(descriptors, block.query_first + q - s,
-                          block.reference_first + (rev ? j + s : j - s));
+      sum += ExactRowDistance(descriptors, block.query_first + q - s, descriptors,
+                              block.reference_first + (rev ? j + s : j - s));
     return static_cast<float>(sum * L / c);
   };
   std::vector<std::vector<Match>> per_query(static_cast<size_t>(block.query_count));

@@ -52,31 +52,9 @@ cv::Mat1b GreyOf(const cv::Mat& image, const std::string& what) {
   return ToGray8(scaled);
 }
 
-// Single-frame distance between rows a and b (Hamming bit count or Euclidean, the latter
-// summed in double as matching/approximate.h does).
-double RowDistance(const cv::Mat& rows, int a, int b) {
-  if (rows.type() == CV_8UC1)
-    return HammingDistance(rows.ptr<std::uint8_t>(a), rows.ptr<std::uint8_t>(b), rows.cols);
-  const float* x = rows.ptr<float>(a);
-  const float* y = rows.ptr<float>(b);
-  double s = 0;
-  for (int k = 0; k < rows.cols; ++k) {
-    const double d = static_cast<double>(x[k]) - y[k];
-    s += d * d;
-  }
-  return static_cast<float>(std::sqrt(s));
-}
-
 }  // namespace
 
 void OnlineOptions::Check() const {
-  const auto names = RegisteredDescriptorNames();
-  std::string upper = descriptor;
-  std::transform(upper.begin(), upper.end(), upper.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
-  Require(upper != "D-LDB" && upper != "DLDB", "descriptor", descriptor,
-          "a single-camera descriptor (D-LDB needs stereo pairs: use Test_OpenABLE with "
-          "Camera_type 1)");
   Require(description == DescriptionType::kGlobal || description == DescriptionType::kGrid,
           "description", std::to_string(static_cast<int>(description)), "global or grid");
   Require(grid_x >= 1 && grid_x <= 64, "grid_x", std::to_string(grid_x), "1..64");
@@ -107,6 +85,11 @@ Describer MakeDescriber(const OnlineOptions& options) {
   d.ldb_bits = options.ldb_bits;
   Describer out;
   out.descriptor = CreateDescriptor(options.descriptor, d);
+  // A grey image per frame: descriptors of several channels (D-LDB: grey + disparity) need
+  // stereo pairs.
+  Require(out.descriptor->Channels() == 1, "descriptor", options.descriptor,
+          "a single-camera descriptor (" + out.descriptor->Name() +
+              " needs stereo pairs: use Test_OpenABLE with Camera_type 1)");
   out.frame = std::make_unique<FrameDescriber>(*out.descriptor, options.description,
                                                options.grid_x, options.grid_y, 1);
   return out;
@@ -215,7 +198,7 @@ struct OnlineDetector::State {
     const int terms = std::min({options.sequence_length, q + 1, j + 1});
     double s = 0;
     for (int k = 0; k < terms; ++k) {
-      const double d = RowDistance(rows, q - k, j - k);
+      const double d = ExactRowDistance(rows, q - k, rows, j - k);
       if (type == CV_32F) unit = std::max(unit, d);
       s += d;
     }

@@ -92,13 +92,6 @@ float L2Exact(const float* a, const float* b, int width) {
   return static_cast<float>(std::sqrt(s));
 }
 
-float PairDistance(const cv::Mat& references, int r, const cv::Mat& queries, int q) {
-  if (references.depth() == CV_8U)
-    return static_cast<float>(HammingDistance(references.ptr<std::uint8_t>(r),
-                                              queries.ptr<std::uint8_t>(q), references.cols));
-  return L2Exact(references.ptr<float>(r), queries.ptr<float>(q), references.cols);
-}
-
 void SortCandidates(std::vector<Candidate>& c) {
   std::sort(c.begin(), c.end(), [](const Candidate& a, const Candidate& b) {
     return a.distance < b.distance || (a.distance == b.distance && a.reference < b.reference);
@@ -171,6 +164,12 @@ class KnnUnique final : public cvflann::ResultSet<Distance> {
 };
 
 }  // namespace
+
+float ExactRowDistance(const cv::Mat& a, int i, const cv::Mat& b, int j) {
+  if (a.depth() == CV_8U)
+    return static_cast<float>(HammingDistance(a.ptr<std::uint8_t>(i), b.ptr<std::uint8_t>(j), a.cols));
+  return L2Exact(a.ptr<float>(i), b.ptr<float>(j), a.cols);
+}
 
 void ApproximateOptions::Check() const {
   CheckField("k", k, 1, std::numeric_limits<int>::max());
@@ -266,7 +265,7 @@ CandidateLists ApproximateIndex::Search(const cv::Mat& queries_in) const {
     // FLANN's distances are squared (L2): recompute the exact ones and sort.
     for (int q = q0; q < q1; ++q) {
       std::vector<Candidate>& list = out[static_cast<size_t>(q)];
-      for (Candidate& c : list) c.distance = PairDistance(refs, c.reference, queries, q);
+      for (Candidate& c : list) c.distance = ExactRowDistance(refs, c.reference, queries, q);
       SortCandidates(list);
     }
   });

@@ -56,6 +56,11 @@ struct ApproximateOptions {
   void Check() const;
 };
 
+// The exact distance between row i of `a` and row j of `b` (same type and width, CV_8U or
+// CV_32F), as every distance returned here is computed: differing bits, or the Euclidean
+// distance with differences and squares summed in double and rounded once to float.
+float ExactRowDistance(const cv::Mat& a, int i, const cv::Mat& b, int j);
+
 // An index over a fixed set of references (rows of one CV_8UC1 or CV_32FC1 matrix).
 class ApproximateIndex {
  public:
