@@ -185,22 +185,10 @@ TEST(BriefTest, UniformPatchGivesZeros) {
 
 TEST(BriefTest, SmallNoiseChangesFewBitsAndOtherImagesAboutHalf) {
   const BriefDescriptor d(Options(64));
-  cv::RNG rng(99);
-  int noise_total = 0, other_total = 0;
-  constexpr int kPatches = 8;
-  for (int i = 0; i < kPatches; ++i) {
-    const cv::Mat patch = TexturedPatch(64, 800 + i);
-    cv::Mat noise(64, 64, CV_32F), noisy;
-    rng.fill(noise, cv::RNG::NORMAL, 0.0, 3.0);
-    cv::Mat f;
-    patch.convertTo(f, CV_32F);
-    cv::Mat(f + noise).convertTo(noisy, CV_8U);
-    noise_total += Hamming(Describe(d, patch), Describe(d, noisy));
-    other_total += Hamming(Describe(d, patch), Describe(d, TexturedPatch(64, 900 + i)));
-  }
-  EXPECT_LT(noise_total / kPatches, 26);  // < 10% of 256 bits
-  EXPECT_GT(other_total / kPatches, 90);  // about half of 256
-  EXPECT_LT(other_total / kPatches, 166);
+  const auto mean = testing_util::MeanDistancesToNoisyAndOther(d, 99, 800, 900);
+  EXPECT_LT(mean.noise, 26);  // < 10% of 256 bits
+  EXPECT_GT(mean.other, 90);  // about half of 256
+  EXPECT_LT(mean.other, 166);
 }
 
 }  // namespace

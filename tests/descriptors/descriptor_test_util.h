@@ -52,5 +52,31 @@ inline int Hamming(const cv::Mat& a, const cv::Mat& b) {
   return bits;
 }
 
+// Mean Hamming distances over 8 textured patches (seeds patch_seed + i) between each patch and
+// (a) itself with Gaussian noise of sigma 3 grey levels (drawn from noise_seed) and (b) an
+// unrelated patch (seeds other_seed + i). A descriptor should change few bits for (a) and
+// about half for (b).
+struct NoiseAndOther {
+  int noise = 0, other = 0;
+};
+inline NoiseAndOther MeanDistancesToNoisyAndOther(const Descriptor& d, std::uint64_t noise_seed,
+                                                  std::uint64_t patch_seed,
+                                                  std::uint64_t other_seed) {
+  cv::RNG rng(noise_seed);
+  constexpr int kPatches = 8;
+  const int size = d.PatchSize();
+  NoiseAndOther total;
+  for (int i = 0; i < kPatches; ++i) {
+    const cv::Mat patch = TexturedPatch(size, patch_seed + i);
+    cv::Mat noise(size, size, CV_32F), f, noisy;
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, 3.0);
+    patch.convertTo(f, CV_32F);
+    cv::Mat(f + noise).convertTo(noisy, CV_8U);
+    total.noise += Hamming(Describe(d, patch), Describe(d, noisy));
+    total.other += Hamming(Describe(d, patch), Describe(d, TexturedPatch(size, other_seed + i)));
+  }
+  return {total.noise / kPatches, total.other / kPatches};
+}
+
 }  // namespace testing_util
 }  // namespace openable

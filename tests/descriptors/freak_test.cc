@@ -196,21 +196,10 @@ TEST(FreakTest, UniformPatchGivesZeros) {
 
 TEST(FreakTest, SmallNoiseChangesFewBitsAndOtherImagesAboutHalf) {
   const FreakDescriptor d(Options(64));
-  cv::RNG rng(77);
-  int noise_total = 0, other_total = 0;
-  constexpr int kPatches = 8;
-  for (int i = 0; i < kPatches; ++i) {
-    const cv::Mat patch = TexturedPatch(64, 810 + i);
-    cv::Mat noise(64, 64, CV_32F), f, noisy;
-    rng.fill(noise, cv::RNG::NORMAL, 0.0, 3.0);
-    patch.convertTo(f, CV_32F);
-    cv::Mat(f + noise).convertTo(noisy, CV_8U);
-    noise_total += Hamming(Describe(d, patch), Describe(d, noisy));
-    other_total += Hamming(Describe(d, patch), Describe(d, TexturedPatch(64, 910 + i)));
-  }
-  EXPECT_LT(noise_total / kPatches, 51);   // < 10% of 512 bits
-  EXPECT_GT(other_total / kPatches, 180);  // about half of 512
-  EXPECT_LT(other_total / kPatches, 332);
+  const auto mean = testing_util::MeanDistancesToNoisyAndOther(d, 77, 810, 910);
+  EXPECT_LT(mean.noise, 51);   // < 10% of 512 bits
+  EXPECT_GT(mean.other, 180);  // about half of 512
+  EXPECT_LT(mean.other, 332);
 }
 
 }  // namespace
