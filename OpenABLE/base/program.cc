@@ -1,0 +1,22 @@
+#include "OpenABLE/base/program.h"
+
+#include <exception>
+#include <iostream>
+
+#include "OpenABLE/base/error.h"
+
+namespace openable {
+
+int RunProgram(const std::string& program, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const InputError& e) {
+    std::cerr << program << ": error: " << e.what() << "\n";
+    return kExitInputError;
+  } catch (const std::exception& e) {
+    std::cerr << program << ": internal error (please report): " << e.what() << "\n";
+    return kExitInternalError;
+  }
+}
+
+}  // namespace openable
