@@ -4,7 +4,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "OpenABLE/exports.h"
+#include "OpenABLE/run/exports.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// The online detector (OpenABLE/online.h) frame by frame on KITTI 00 frames 0-1699
+// The online detector (OpenABLE/online/online.h) frame by frame on KITTI 00 frames 0-1699
 // (../shared/datasets/kitti00_first1700): per-frame latency of description and search (mean,
 // median, 99th percentile, maximum; image decoding is not counted), and the loops it accepts
 // against loop_gt_5m.txt, with a threshold sweep of its top-1 candidates.
@@ -24,7 +24,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/online.h"
+#include "OpenABLE/online/online.h"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/io/frame_source.h"
-#include "OpenABLE/preprocess.h"
+#include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/snaps/loops.h"
 
 using namespace openable::snaps;

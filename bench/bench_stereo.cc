@@ -12,8 +12,8 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "OpenABLE/describe.h"
-#include "OpenABLE/preprocess.h"
+#include "OpenABLE/run/describe.h"
+#include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/stereo/stereo_source.h"
 #include "descriptors/registry.h"
 #include "tests/tools/euroc_calibration.h"

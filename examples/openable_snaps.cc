@@ -17,13 +17,13 @@
 #include <opencv2/core/utils/logger.hpp>
 
 #include "OpenABLE/OpenABLE.h"
-#include "OpenABLE/exports.h"
-#include "OpenABLE/interrupt.h"
+#include "OpenABLE/run/exports.h"
+#include "OpenABLE/run/interrupt.h"
 #include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/odometry/calibration.h"
 #include "OpenABLE/odometry/mono_odometry.h"
 #include "OpenABLE/odometry/stereo_odometry.h"
-#include "OpenABLE/preprocess.h"
+#include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/stereo/calibration.h"
 #include "OpenABLE/stereo/rectification.h"
 #include "OpenABLE/snaps/discounted.h"

@@ -1,11 +1,11 @@
 // Approximate candidate search (Approximate_search 1): FLANN (OpenCV's copy) finds the candidates of each
 // query, LSH for binary descriptors and randomised k-d trees for vector ones; the candidates
-// are then scored by the exact sequence sum. Declared in OpenABLE/bounded.h.
+// are then scored by the exact sequence sum. Declared in matching/bounded.h.
 #include <algorithm>
 #include <cmath>
 #include <thread>
 
-#include "OpenABLE/bounded.h"
+#include "matching/bounded.h"
 #include "matching/approximate.h"
 #include "matching/distances.h"
 

@@ -1,13 +1,10 @@
-#include "OpenABLE/bounded.h"
+#include "matching/bounded.h"
 
 #include <algorithm>
-#include <charconv>
-#include <cstring>
 #include <functional>
 #include <queue>
 #include <stdexcept>
 
-#include "OpenABLE/exports.h"
 #include "matching/distances.h"
 #include "matching/large_matrix.h"
 
@@ -115,47 +112,6 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
   if (max_seen > 0.0f)
     for (Match& k : kept) k.distance /= max_seen;
   return kept;
-}
-
-std::string EncodeMatches(const std::vector<Match>& matches, bool csv) {
-  if (csv) {
-    std::string out = "query,reference,distance,rank\n";
-    char buf[96];
-    for (const Match& k : matches) {
-      char* p = buf;
-      p = std::to_chars(p, buf + sizeof buf, k.query).ptr;
-      *p++ = ',';
-      p = std::to_chars(p, buf + sizeof buf, k.reference).ptr;
-      *p++ = ',';
-      p = std::to_chars(p, buf + sizeof buf, k.distance, std::chars_format::general, 7).ptr;
-      *p++ = ',';
-      p = std::to_chars(p, buf + sizeof buf, k.rank).ptr;
-      *p++ = '\n';
-      out.append(buf, p);
-    }
-    return out;
-  }
-  // A structured .npy: one record of 16 bytes per match (written by hand, as NpyHeader).
-  std::string dict = "{'descr': [('query', '<i4'), ('reference', '<i4'), ('distance', '<f4'), "
-                     "('rank', '<i4')], 'fortran_order': False, 'shape': (" +
-                     std::to_string(matches.size()) + ",), }";
-  const size_t total = 10 + dict.size() + 1;
-  dict.append((total + 63) / 64 * 64 - total, ' ');
-  dict.push_back('\n');
-  std::string out("\x93NUMPY\x01\x00", 8);
-  out.push_back(static_cast<char>(dict.size() & 0xFF));
-  out.push_back(static_cast<char>(dict.size() >> 8));
-  out += dict;
-  out.reserve(out.size() + matches.size() * 16);
-  for (const Match& k : matches) {
-    char rec[16];
-    std::memcpy(rec, &k.query, 4);
-    std::memcpy(rec + 4, &k.reference, 4);
-    std::memcpy(rec + 8, &k.distance, 4);
-    std::memcpy(rec + 12, &k.rank, 4);
-    out.append(rec, 16);
-  }
-  return out;
 }
 
 }  // namespace openable

@@ -79,8 +79,4 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
                                       const KeepRules& rules, const BoundedOptions& options,
                                       int checks, float& max_distance);
 
-// Bytes of the matches file: .npy (structured array: query, reference int32; distance
-// float32; rank int32) or .csv (header "query,reference,distance,rank").
-std::string EncodeMatches(const std::vector<Match>& matches, bool csv);
-
 }  // namespace openable

@@ -19,7 +19,8 @@ set(OPENABLE_INSTALL_MODULEDIR "${CMAKE_INSTALL_LIBDIR}/openable")
 # ($<LINK_ONLY:...> in the export), so all of them are in the export set.
 set(OPENABLE_EXPORTED_LIBRARIES
   openable_base openable_io openable_descriptors openable_matching openable_config
-  openable_evaluation openable_stereo OpenABLE openable_snaps_core openable_odometry)
+  openable_evaluation openable_stereo openable_image openable_run OpenABLE
+  openable_snaps_core openable_odometry)
 install(TARGETS ${OPENABLE_EXPORTED_LIBRARIES}
   EXPORT OpenABLETargets
   ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}"

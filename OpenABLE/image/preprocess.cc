@@ -1,4 +1,4 @@
-#include "OpenABLE/preprocess.h"
+#include "OpenABLE/image/preprocess.h"
 
 #include <cmath>
 #include <sstream>

@@ -1,4 +1,4 @@
-#include "OpenABLE/robustness.h"
+#include "OpenABLE/image/robustness.h"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 // A frame is returned as the image was stored, converted to floating point: CV_32FC1 (grey) or
 // CV_32FC3 (colour, BGR order as everywhere in OpenCV), values in [0, 1] whatever the bit depth
 // of the file (8- or 16-bit). Preprocessing (grey conversion, illumination invariance) happens
-// later, in OpenABLE/preprocess.h.
+// later, in OpenABLE/image/preprocess.h.
 #pragma once
 
 #include <memory>

@@ -1,4 +1,4 @@
-#include "OpenABLE/online.h"
+#include "OpenABLE/online/online.h"
 
 #include <algorithm>
 #include <atomic>
@@ -13,7 +13,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/preprocess.h"
+#include "OpenABLE/image/preprocess.h"
 #include "descriptors/registry.h"
 #include "matching/distances.h"
 #include "matching/normalize.h"

@@ -23,7 +23,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "OpenABLE/describe.h"
+#include "OpenABLE/run/describe.h"
 #include "matching/approximate.h"
 #include "matching/sequence.h"
 

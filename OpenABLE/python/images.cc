@@ -2,7 +2,7 @@
 #include <pybind11/stl.h>
 
 #include "OpenABLE/io/frame_source.h"
-#include "OpenABLE/preprocess.h"
+#include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/python/common.h"
 #include "descriptors/registry.h"
 

@@ -1,4 +1,4 @@
-// The batch helpers and the online detector of OpenABLE/online.h: describe, describe_images,
+// The batch helpers and the online detector of OpenABLE/online/online.h: describe, describe_images,
 // distance_matrix, OnlineDetector.
 #include <cstdio>
 #include <memory>
@@ -7,7 +7,7 @@
 
 #include <pybind11/stl.h>
 
-#include "OpenABLE/online.h"
+#include "OpenABLE/online/online.h"
 #include "OpenABLE/python/common.h"
 
 namespace openable::python {

@@ -9,7 +9,7 @@
 #include <pybind11/stl.h>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/exports.h"
+#include "OpenABLE/run/exports.h"
 #include "OpenABLE/python/common.h"
 #include "OpenABLE/snaps/discounted.h"
 #include "OpenABLE/snaps/loops.h"

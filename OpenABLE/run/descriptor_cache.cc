@@ -1,4 +1,4 @@
-#include "OpenABLE/descriptor_cache.h"
+#include "OpenABLE/run/descriptor_cache.h"
 
 #include <cerrno>
 #include <cstdio>

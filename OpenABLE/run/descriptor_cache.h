@@ -12,7 +12,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "OpenABLE/describe.h"
+#include "OpenABLE/run/describe.h"
 #include "config/config.h"
 
 namespace openable {

@@ -1,4 +1,4 @@
-#include "OpenABLE/evaluate.h"
+#include "OpenABLE/run/evaluate.h"
 
 #include <cctype>
 #include <set>
@@ -50,14 +50,6 @@ std::string RunLabel(const Config& config) {
   if (config.description_type == 1)
     label += " " + std::to_string(config.grid_x) + "x" + std::to_string(config.grid_y);
   return label + " L=" + std::to_string(config.image_sequences);
-}
-
-EvaluationLayout LayoutOf(const RunResult& result) {
-  if (result.traversals.size() == 2)
-    return EvaluationLayout::TwoTraversals(result.traversals[0].frames, result.traversals[1].frames);
-  if (result.traversals.size() != 1)
-    throw std::logic_error("LayoutOf: a run has one or two traversals");
-  return EvaluationLayout::LoopClosure(result.normalized.rows);
 }
 
 void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,

@@ -12,8 +12,7 @@
 #include "OpenABLE/evaluation/layout.h"
 #include "OpenABLE/evaluation/metrics.h"
 #include "OpenABLE/evaluation/report.h"
-#include "OpenABLE/exports.h"
-#include "OpenABLE/pipeline.h"
+#include "OpenABLE/run/exports.h"
 #include "config/config.h"
 
 namespace openable {
@@ -34,10 +33,6 @@ EvaluationSettings EvaluationSettingsFrom(const Config& config);
 
 // "LDB L=10", or Evaluation_label when set.
 std::string RunLabel(const Config& config);
-
-// The block a run's matrix is evaluated on: the query-reference block of two traversals, or
-// the whole matrix of one sequence as loop closure.
-EvaluationLayout LayoutOf(const RunResult& result);
 
 // Loads the ground truth for `layout` (a block of `normalized`) and evaluates `normalized` with
 // both protocols; appends the result to `evaluation`. Throws InputError on bad ground truth.

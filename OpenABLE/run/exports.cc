@@ -1,4 +1,4 @@
-#include "OpenABLE/exports.h"
+#include "OpenABLE/run/exports.h"
 
 #include <algorithm>
 #include <atomic>
@@ -20,7 +20,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/interrupt.h"
+#include "OpenABLE/run/interrupt.h"
 
 namespace openable {
 
@@ -285,6 +285,47 @@ std::vector<std::string> OutputBatch::Paths() const {
   std::vector<std::string> paths;
   for (const auto& item : items_) paths.push_back(item.path);
   return paths;
+}
+
+std::string EncodeMatches(const std::vector<Match>& matches, bool csv) {
+  if (csv) {
+    std::string out = "query,reference,distance,rank\n";
+    char buf[96];
+    for (const Match& k : matches) {
+      char* p = buf;
+      p = std::to_chars(p, buf + sizeof buf, k.query).ptr;
+      *p++ = ',';
+      p = std::to_chars(p, buf + sizeof buf, k.reference).ptr;
+      *p++ = ',';
+      p = std::to_chars(p, buf + sizeof buf, k.distance, std::chars_format::general, 7).ptr;
+      *p++ = ',';
+      p = std::to_chars(p, buf + sizeof buf, k.rank).ptr;
+      *p++ = '\n';
+      out.append(buf, p);
+    }
+    return out;
+  }
+  // A structured .npy: one record of 16 bytes per match (written by hand, as NpyHeader).
+  std::string dict = "{'descr': [('query', '<i4'), ('reference', '<i4'), ('distance', '<f4'), "
+                     "('rank', '<i4')], 'fortran_order': False, 'shape': (" +
+                     std::to_string(matches.size()) + ",), }";
+  const size_t total = 10 + dict.size() + 1;
+  dict.append((total + 63) / 64 * 64 - total, ' ');
+  dict.push_back('\n');
+  std::string out("\x93NUMPY\x01\x00", 8);
+  out.push_back(static_cast<char>(dict.size() & 0xFF));
+  out.push_back(static_cast<char>(dict.size() >> 8));
+  out += dict;
+  out.reserve(out.size() + matches.size() * 16);
+  for (const Match& k : matches) {
+    char rec[16];
+    std::memcpy(rec, &k.query, 4);
+    std::memcpy(rec + 4, &k.reference, 4);
+    std::memcpy(rec + 8, &k.distance, 4);
+    std::memcpy(rec + 12, &k.rank, 4);
+    out.append(rec, 16);
+  }
+  return out;
 }
 
 }  // namespace openable

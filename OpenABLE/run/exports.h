@@ -11,6 +11,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "matching/bounded.h"
+
 namespace openable {
 
 // The 12 colour maps of the original OpenABLE (docs/output_formats.md). Pixel of a
@@ -32,6 +34,11 @@ std::string EncodeText(const cv::Mat& m);
 
 // Bytes of a PNG image (OpenCV's encoder).
 std::string EncodePng(const cv::Mat& image);
+
+// Bytes of the matches file: .npy (structured array: query, reference int32; distance
+// float32; rank int32) or .csv (header "query,reference,distance,rank").
+std::string EncodeMatches(const std::vector<Match>& matches, bool csv);
+
 
 // Stages files and commits them together (docs/output_formats.md, "Temporaries and
 // interrupted runs").

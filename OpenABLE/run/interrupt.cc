@@ -1,4 +1,4 @@
-#include "OpenABLE/interrupt.h"
+#include "OpenABLE/run/interrupt.h"
 
 #include <atomic>
 #include <csignal>

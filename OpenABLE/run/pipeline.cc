@@ -1,19 +1,20 @@
-#include "OpenABLE/pipeline.h"
+#include "OpenABLE/run/pipeline.h"
 
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <unistd.h>
 #include <future>
+#include <stdexcept>
 #include <filesystem>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/describe.h"
-#include "OpenABLE/descriptor_cache.h"
-#include "OpenABLE/evaluate.h"
-#include "OpenABLE/exports.h"
+#include "OpenABLE/run/describe.h"
+#include "OpenABLE/run/descriptor_cache.h"
+#include "OpenABLE/run/evaluate.h"
+#include "OpenABLE/run/exports.h"
 #include "OpenABLE/io/frame_source.h"
-#include "OpenABLE/preprocess.h"
+#include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/stereo/calibration.h"
 #include "OpenABLE/stereo/stereo_source.h"
 #include "descriptors/registry.h"
@@ -316,6 +317,14 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   result.timings.sequence_seconds = SecondsSince(t);
   result.timings.total_seconds = SecondsSince(run_start);
   return result;
+}
+
+EvaluationLayout LayoutOf(const RunResult& result) {
+  if (result.traversals.size() == 2)
+    return EvaluationLayout::TwoTraversals(result.traversals[0].frames, result.traversals[1].frames);
+  if (result.traversals.size() != 1)
+    throw std::logic_error("LayoutOf: a run has one or two traversals");
+  return EvaluationLayout::LoopClosure(result.normalized.rows);
 }
 
 std::string ThresholdPngPath(const Config& config) {

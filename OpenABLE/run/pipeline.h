@@ -8,13 +8,14 @@
 
 #include <opencv2/core.hpp>
 
-#include "OpenABLE/bounded.h"
-#include "OpenABLE/progress.h"
+#include "OpenABLE/evaluation/layout.h"
+#include "matching/bounded.h"
+#include "OpenABLE/run/progress.h"
 #include "config/config.h"
 
 namespace openable {
 
-struct Evaluation;  // OpenABLE/evaluate.h
+struct Evaluation;  // OpenABLE/run/evaluate.h
 
 // One traversal of the run (a folder or a video) and the rows it holds in the matrix.
 struct Traversal {
@@ -59,6 +60,10 @@ struct RunResult {
 // Computes the matrices of a run. Throws InputError (one line naming the key, file or value)
 // on any problem with the configuration or the input data. Progress goes to `progress`.
 RunResult ComputeRun(const Config& config, ProgressReporter& progress);
+
+// The block a run's matrix is evaluated on: the query-reference block of two traversals, or
+// the whole matrix of one sequence as loop closure.
+EvaluationLayout LayoutOf(const RunResult& result);
 
 // Writes the outputs the configuration asks for (Txt_name, Npy_name, Png_name,
 // Png_threshold_name, and the files of Evaluation_name when `evaluation` is given)

@@ -1,4 +1,4 @@
-#include "OpenABLE/progress.h"
+#include "OpenABLE/run/progress.h"
 
 #include <cstdio>
 #include <ostream>

@@ -12,7 +12,7 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/io/frame_source.h"
-#include "OpenABLE/preprocess.h"
+#include "OpenABLE/image/preprocess.h"
 
 namespace openable::snaps {
 namespace {

@@ -1,4 +1,4 @@
-// The library's batch path (OpenABLE/online.h, OpenABLE/evaluation/) gives what Test_OpenABLE
+// The library's batch path (OpenABLE/online/online.h, OpenABLE/evaluation/) gives what Test_OpenABLE
 // gives from a configuration, on real KITTI 00 frames 0-1699: the same normalised sequence
 // matrix and the same evaluation figures. docs/library.md quotes this code.
 #include <cstdio>

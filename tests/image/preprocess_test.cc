@@ -1,5 +1,5 @@
 // Illumination invariance (Eq. 6, 7 of the OpenABLE paper).
-#include "OpenABLE/preprocess.h"
+#include "OpenABLE/image/preprocess.h"
 
 #include <cmath>
 #include <filesystem>

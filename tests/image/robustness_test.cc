@@ -1,5 +1,5 @@
-// Side-window multilayer fusion and noise injection (issue 8, OpenABLE/robustness.h).
-#include "OpenABLE/robustness.h"
+// Side-window multilayer fusion and noise injection (issue 8, OpenABLE/image/robustness.h).
+#include "OpenABLE/image/robustness.h"
 
 #include <cmath>
 
@@ -7,8 +7,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/describe.h"
-#include "OpenABLE/preprocess.h"
+#include "OpenABLE/run/describe.h"
+#include "OpenABLE/image/preprocess.h"
 #include "config/config.h"
 #include "tests/test_support.h"
 

@@ -46,7 +46,7 @@ for f in "$bindir/Test_OpenABLE" "$bindir/openable_evaluate" "$bindir/openable_s
          "$libdir/cmake/OpenABLE/OpenABLEConfig.cmake" \
          "$libdir/cmake/OpenABLE/OpenABLEConfigVersion.cmake" \
          "$libdir/cmake/OpenABLE/OpenABLETargets.cmake" \
-         include/openable/OpenABLE/OpenABLE.h include/openable/OpenABLE/online.h \
+         include/openable/OpenABLE/OpenABLE.h include/openable/OpenABLE/online/online.h \
          include/openable/descriptors/descriptor.h include/openable/config/config.h; do
   [ -e "$prefix/$f" ] || fail "not installed: $f"
 done

@@ -1,4 +1,4 @@
-#include "OpenABLE/bounded.h"
+#include "matching/bounded.h"
 
 #include <gtest/gtest.h>
 
@@ -120,24 +120,6 @@ TEST(BoundedMatches, VectorDescriptorsUseL2) {
     const float direct = static_cast<float>(cv::norm(d.row(30 + m.query), d.row(m.reference)));
     EXPECT_NEAR(m.distance * max_distance, direct, 1e-4);
   }
-}
-
-TEST(EncodeMatches, NpyRecordsAndCsvText) {
-  const std::vector<Match> m = {{1, 2, 0.5f, 1}, {3, 4, 0.25f, 0}};
-  const std::string csv = EncodeMatches(m, true);
-  EXPECT_EQ(csv, "query,reference,distance,rank\n1,2,0.5,1\n3,4,0.25,0\n");
-  const std::string npy = EncodeMatches(m, false);
-  ASSERT_EQ(npy.size() % 16, 0u);  // 64-byte aligned header, 16-byte records
-  const size_t header = npy.size() - 32;
-  EXPECT_EQ(header % 64, 0u);
-  EXPECT_NE(npy.find("('distance', '<f4')"), std::string::npos);
-  EXPECT_NE(npy.find("'shape': (2,)"), std::string::npos);
-  int q = 0;
-  float dist = 0;
-  std::memcpy(&q, npy.data() + header + 16, 4);
-  std::memcpy(&dist, npy.data() + header + 16 + 8, 4);
-  EXPECT_EQ(q, 3);
-  EXPECT_EQ(dist, 0.25f);
 }
 
 // FLANN candidates on planted near-duplicates: every query's duplicate found first, and every

@@ -4,9 +4,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
-#include "OpenABLE/describe.h"
+#include "OpenABLE/run/describe.h"
 #include "OpenABLE/io/frame_source.h"
-#include "OpenABLE/preprocess.h"
+#include "OpenABLE/image/preprocess.h"
 #include "descriptors/registry.h"
 #include "matching/distances.h"
 #include "matching/panorama.h"

@@ -1,7 +1,7 @@
-// The online detector (OpenABLE/online.h) against the batch matrix and against an independent
+// The online detector (OpenABLE/online/online.h) against the batch matrix and against an independent
 // brute force on real KITTI frames: single-frame distances counted bit by bit here, sequence sums written from their
 // definition (matching/sequence.h), candidates as the k smallest with ties to the earlier frame.
-#include "OpenABLE/online.h"
+#include "OpenABLE/online/online.h"
 
 #include <bitset>
 #include <cmath>
@@ -15,7 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/bounded.h"
+#include "matching/bounded.h"
 #include "tests/test_support.h"
 
 namespace openable {

@@ -1,4 +1,4 @@
-#include "OpenABLE/describe.h"
+#include "OpenABLE/run/describe.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "OpenABLE/exports.h"
+#include "OpenABLE/run/exports.h"
 
 #include <cstdio>
 #include <cstring>
@@ -170,6 +170,24 @@ TEST(EncodeText, MatchesPrintfOnRandomFloats) {
     expected += "\n";
   }
   EXPECT_EQ(EncodeText(m), expected);
+}
+
+TEST(EncodeMatches, NpyRecordsAndCsvText) {
+  const std::vector<Match> m = {{1, 2, 0.5f, 1}, {3, 4, 0.25f, 0}};
+  const std::string csv = EncodeMatches(m, true);
+  EXPECT_EQ(csv, "query,reference,distance,rank\n1,2,0.5,1\n3,4,0.25,0\n");
+  const std::string npy = EncodeMatches(m, false);
+  ASSERT_EQ(npy.size() % 16, 0u);  // 64-byte aligned header, 16-byte records
+  const size_t header = npy.size() - 32;
+  EXPECT_EQ(header % 64, 0u);
+  EXPECT_NE(npy.find("('distance', '<f4')"), std::string::npos);
+  EXPECT_NE(npy.find("'shape': (2,)"), std::string::npos);
+  int q = 0;
+  float dist = 0;
+  std::memcpy(&q, npy.data() + header + 16, 4);
+  std::memcpy(&dist, npy.data() + header + 16 + 8, 4);
+  EXPECT_EQ(q, 3);
+  EXPECT_EQ(dist, 0.25f);
 }
 
 }  // namespace

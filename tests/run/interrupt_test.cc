@@ -1,5 +1,6 @@
-// Issue 8, item 6: interrupted runs and write errors leave no output that looks complete; the
-// descriptor cache (hash, key sensitivity, hit/miss, damaged files, bit-identical rows).
+// Interrupted runs (OpenABLE/run/interrupt.h) and write errors leave no output that looks
+// complete: temporaries removed on signals, commits deferred until a batch is whole, write
+// errors named, old sets restored, stale temporaries swept (OutputBatch, OpenABLE/run/exports.h).
 #include <sys/mount.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -16,10 +17,10 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/describe.h"
-#include "OpenABLE/descriptor_cache.h"
-#include "OpenABLE/exports.h"
-#include "OpenABLE/interrupt.h"
+#include "OpenABLE/run/describe.h"
+#include "OpenABLE/run/descriptor_cache.h"
+#include "OpenABLE/run/exports.h"
+#include "OpenABLE/run/interrupt.h"
 #include "OpenABLE/io/frame_source.h"
 #include "config/config.h"
 #include "descriptors/registry.h"
@@ -159,211 +160,6 @@ TEST(OutputBatch, StaleTemporariesOfDeadRunsAreRemoved) {
   }
   EXPECT_EQ(Entries(dir), (std::vector<std::string>{alive.substr(1), ".other.npy.tmp-99999999-0",
                                                     "m.npy"}));
-}
-
-// --- The descriptor cache --------------------------------------------------------------------
-
-TEST(Fnv1a64, SpecificationVectors) {
-  // From the FNV reference (Fowler, Noll, Vo) test suite.
-  EXPECT_EQ(Fnv1a64("", 0), 0xcbf29ce484222325ull);
-  EXPECT_EQ(Fnv1a64("a", 1), 0xaf63dc4c8601ec8cull);
-  EXPECT_EQ(Fnv1a64("foobar", 6), 0x85944171f73967e8ull);
-  // Continuation equals one pass.
-  EXPECT_EQ(Fnv1a64("bar", 3, Fnv1a64("foo", 3)), Fnv1a64("foobar", 6));
-}
-
-// Keys that do not change a frame's row (inputs, outputs, matching, evaluation, tools). A key
-// added to the configuration table must be put here or in DescriptionKeys(): otherwise this
-// test fails, so a setting that changes rows cannot be left out of the cache key silently.
-const std::set<std::string> kNotDescription = {
-    "Frame_mode", "Images_path", "Images_path_2", "Images_path_left", "Images_path_right",
-    "Calibration_path", "Images_format", "Video_path_1", "Video_path_2", "Initial_image",
-    "Final_image", "Skip_unreadable", "Txt_name", "Npy_name", "Png_name", "Png_threshold_name",
-    "Matrix_color", "Show_images", "Panorama_matching", "Image_sequences", "Threshold",
-    "Threads", "Sequence_direction", "Matrix_mode", "Memory_limit", "Best_matches",
-    "Band_width", "Matches_name", "Approximate_search", "Approximate_checks",
-    "Descriptor_cache"};
-
-bool Perturb(Config& c, const std::string& key) {
-  const std::string v = ConfigValueText(c, key);
-  std::vector<std::string> candidates;
-  if (!v.empty() && v.front() == '"') {
-    candidates = {"HOG", "LDB", "other"};
-  } else {
-    const double x = std::stod(v);
-    candidates = {std::to_string(x + 1), std::to_string(x - 1), std::to_string(x + 0.25),
-                  std::to_string(x / 2)};
-  }
-  for (const std::string& cand : candidates) {
-    Config copy = c;
-    try {
-      ApplyOverride(copy, key + "=" + cand);
-    } catch (const InputError&) {
-      continue;
-    }
-    if (ConfigValueText(copy, key) != v) {
-      c = copy;
-      return true;
-    }
-  }
-  return false;
-}
-
-TEST(DescriptorCacheKey, EveryKeyIsClassifiedAndEveryDescriptionKeyChangesTheKey) {
-  const std::set<std::string> described(DescriptionKeys().begin(), DescriptionKeys().end());
-  const Config base;
-  const std::string base_text = DescriptionSettingsText(base, "LDB", 32, CV_8U);
-  for (const std::string& key : ConfigKeyNames()) {
-    if (key.rfind("Snaps_", 0) == 0 || key.rfind("Odometry_", 0) == 0 ||
-        key.rfind("Ground_truth", 0) == 0 || kNotDescription.count(key))
-      continue;
-    if (key == "Tolerance" || key == "Exclusion" || key == "Vicinity" ||
-        key.rfind("Evaluation_", 0) == 0)
-      continue;  // evaluation keys
-    ASSERT_TRUE(described.count(key))
-        << key << " is new: add it to DescriptionKeys() (descriptor_cache.cc) if it changes "
-                  "descriptor rows, else to kNotDescription here";
-    Config changed = base;
-    ASSERT_TRUE(Perturb(changed, key)) << key;
-    EXPECT_NE(DescriptionSettingsText(changed, "LDB", 32, CV_8U), base_text) << key;
-  }
-  for (const std::string& key : DescriptionKeys())
-    EXPECT_NE(std::find(ConfigKeyNames().begin(), ConfigKeyNames().end(), key),
-              ConfigKeyNames().end())
-        << key;
-  // The descriptor's own name and row shape are part of the key too.
-  EXPECT_NE(DescriptionSettingsText(base, "LDB", 64, CV_8U), base_text);
-  EXPECT_NE(DescriptionSettingsText(base, "HOG", 32, CV_8U), base_text);
-  EXPECT_NE(DescriptionSettingsText(base, "LDB", 32, CV_32F), base_text);
-}
-
-struct Fixture {
-  std::string images, cache;
-  std::unique_ptr<Descriptor> descriptor;
-  std::unique_ptr<FrameDescriber> describer;
-};
-
-Fixture MakeFixture(int frames) {
-  Fixture f;
-  const std::string dir = testing::TempDir();
-  f.images = dir + "/images";
-  f.cache = dir + "/cache";
-  fs::create_directories(f.images);
-  cv::RNG rng(7);
-  for (int i = 0; i < frames; ++i) {
-    cv::Mat1b img(48, 64);
-    rng.fill(img, cv::RNG::UNIFORM, 0, 256);
-    cv::imwrite(f.images + "/f" + std::to_string(i) + ".png", img);
-  }
-  DescriptorOptions o;
-  f.descriptor = CreateDescriptor("LDB", o);
-  f.describer = std::make_unique<FrameDescriber>(*f.descriptor, DescriptionType::kGrid, 2, 2);
-  return f;
-}
-
-DescribedSequence Describe(const Fixture& f, DescriptorCache* cache) {
-  const auto source = OpenImageFolder(f.images, "", 0, -1);
-  DescribeOptions o;
-  o.cache = cache;
-  return DescribeSequence(*source, *f.describer, o);
-}
-
-std::unique_ptr<DescriptorCache> OpenCache(const Fixture& f, std::vector<std::string>& w) {
-  return DescriptorCache::Open(f.cache, "settings", f.describer->RowWidth(),
-                               f.describer->RowType(), w);
-}
-
-bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
-  return a.size() == b.size() && a.type() == b.type() &&
-         std::equal(a.datastart, a.dataend, b.datastart);
-}
-
-TEST(DescriptorCache, MissThenHitGivesTheSameRows) {
-  const Fixture f = MakeFixture(12);
-  const DescribedSequence clean = Describe(f, nullptr);
-  std::vector<std::string> w;
-  {
-    auto c = OpenCache(f, w);
-    const DescribedSequence cold = Describe(f, c.get());
-    EXPECT_EQ(c->Hits(), 0);
-    EXPECT_EQ(c->Stored(), 12);
-    EXPECT_TRUE(SameBytes(cold.rows, clean.rows));
-  }
-  {
-    auto c = OpenCache(f, w);
-    const DescribedSequence warm = Describe(f, c.get());
-    EXPECT_EQ(c->Hits(), 12);
-    EXPECT_EQ(c->Stored(), 0);
-    EXPECT_TRUE(SameBytes(warm.rows, clean.rows));
-    EXPECT_EQ(warm.frame_size, clean.frame_size);
-  }
-  EXPECT_TRUE(w.empty()) << w.front();
-  // Other settings: another file, all misses.
-  {
-    auto c = DescriptorCache::Open(f.cache, "other settings", f.describer->RowWidth(),
-                                   f.describer->RowType(), w);
-    Describe(f, c.get());
-    EXPECT_EQ(c->Hits(), 0);
-  }
-  // A changed image is a miss (content, not name, is the key).
-  cv::Mat1b changed(48, 64, static_cast<std::uint8_t>(90));
-  cv::imwrite(f.images + "/f3.png", changed);
-  auto c = OpenCache(f, w);
-  const DescribedSequence after = Describe(f, c.get());
-  EXPECT_EQ(c->Hits(), 11);
-  EXPECT_EQ(c->Stored(), 1);
-  EXPECT_TRUE(SameBytes(after.rows, Describe(f, nullptr).rows));
-}
-
-TEST(DescriptorCache, TruncatedOrDamagedFileIsRepairedWithAWarningNeverAWrongRow) {
-  const Fixture f = MakeFixture(10);
-  const DescribedSequence clean = Describe(f, nullptr);
-  std::vector<std::string> w;
-  std::string path;
-  {
-    auto c = OpenCache(f, w);
-    Describe(f, c.get());
-    path = c->Path();
-  }
-  const std::string full = ReadAll(path);
-  // A run killed while writing: half a record at the end.
-  const size_t record = 24 + static_cast<size_t>(f.describer->RowWidth()) + 8;
-  fs::resize_file(path, full.size() - 3 * record - record / 2);
-  {
-    w.clear();
-    auto c = OpenCache(f, w);
-    const DescribedSequence r = Describe(f, c.get());
-    ASSERT_EQ(w.size(), 1u);
-    EXPECT_NE(w[0].find("Descriptor_cache"), std::string::npos) << w[0];
-    EXPECT_EQ(c->Hits(), 6);
-    EXPECT_EQ(c->Stored(), 4);
-    EXPECT_TRUE(SameBytes(r.rows, clean.rows));
-  }
-  EXPECT_EQ(ReadAll(path).size(), full.size());  // repaired: whole records only
-  // A flipped bit inside a row: that record and the ones after it are dropped, not used.
-  std::string bytes = ReadAll(path);
-  bytes[bytes.size() - 5 * record + 30] ^= 0x10;
-  testing::WriteBytes(path, bytes);
-  {
-    w.clear();
-    auto c = OpenCache(f, w);
-    const DescribedSequence r = Describe(f, c.get());
-    EXPECT_EQ(w.size(), 1u);
-    EXPECT_EQ(c->Hits(), 5);
-    EXPECT_TRUE(SameBytes(r.rows, clean.rows));
-  }
-  // Garbage instead of a header: started afresh.
-  testing::WriteBytes(path, "not a cache file at all");
-  {
-    w.clear();
-    auto c = OpenCache(f, w);
-    const DescribedSequence r = Describe(f, c.get());
-    ASSERT_EQ(w.size(), 1u);
-    EXPECT_NE(w[0].find("bad header"), std::string::npos) << w[0];
-    EXPECT_EQ(c->Hits(), 0);
-    EXPECT_EQ(c->Stored(), 10);
-    EXPECT_TRUE(SameBytes(r.rows, clean.rows));
-  }
 }
 
 }  // namespace

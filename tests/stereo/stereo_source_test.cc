@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "OpenABLE/describe.h"
-#include "OpenABLE/preprocess.h"
+#include "OpenABLE/run/describe.h"
+#include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/stereo/rectification.h"
 #include "descriptors/registry.h"
 #include "tests/stereo/stereo_test_util.h"
