@@ -2,20 +2,17 @@
 
 #include <Eigen/Core>
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstring>
-#include <exception>
 #include <limits>
-#include <mutex>
 #include <stdexcept>
 #include <string>
-#include <thread>
 // OpenCV's FLANN (namespace cvflann): its index templates are used directly, not through the
 // type-erased cv::flann::Index, for const searches from several threads. See approximate.h for
 // why not Debian's libflann. (opencv2/flann.hpp: the cvflann headers need its includes first.)
 #include <opencv2/flann.hpp>
 
+#include "OpenABLE/base/threading.h"
 #include "matching/distances.h"
 
 namespace openable {
@@ -29,36 +26,13 @@ void CheckField(const char* field, long long value, long long lo, long long hi) 
          ", expected " + std::to_string(lo) + ".." + std::to_string(hi));
 }
 
-int ResolveThreads(int threads) {
-  return threads > 0 ? threads
-                     : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-}
-
 // Runs body(first, last) over [0, count) in blocks of `block` items on `threads` threads. The
 // first exception thrown by a block is rethrown on the calling thread once all have stopped.
 template <typename Body>
 void ParallelBlocks(int count, int block, int threads, Body body) {
   const int blocks = (count + block - 1) / block;
-  std::atomic<int> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto worker = [&]() {
-    for (int b = next++; b < blocks; b = next++) {
-      try {
-        body(b * block, std::min(count, (b + 1) * block));
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-        next = blocks;
-      }
-    }
-  };
-  const int n = std::min(ResolveThreads(threads), std::max(blocks, 1));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < n; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
+  ParallelFor(blocks, threads,
+              [&](int b) { body(b * block, std::min(count, (b + 1) * block)); });
 }
 
 // `m` must be a single-channel CV_8U or CV_32F matrix (finite values for CV_32F).
@@ -81,16 +55,6 @@ void CheckQueries(const cv::Mat& queries, int type, int width, const char* what)
 }
 
 cv::Mat Continuous(const cv::Mat& m) { return m.isContinuous() ? m : m.clone(); }
-
-// The exact L2 distance: differences and their squares summed in double, rounded once.
-float L2Exact(const float* a, const float* b, int width) {
-  double s = 0;
-  for (int i = 0; i < width; ++i) {
-    const double t = static_cast<double>(a[i]) - static_cast<double>(b[i]);
-    s += t * t;
-  }
-  return static_cast<float>(std::sqrt(s));
-}
 
 void SortCandidates(std::vector<Candidate>& c) {
   std::sort(c.begin(), c.end(), [](const Candidate& a, const Candidate& b) {
@@ -164,12 +128,6 @@ class KnnUnique final : public cvflann::ResultSet<Distance> {
 };
 
 }  // namespace
-
-float ExactRowDistance(const cv::Mat& a, int i, const cv::Mat& b, int j) {
-  if (a.depth() == CV_8U)
-    return static_cast<float>(HammingDistance(a.ptr<std::uint8_t>(i), b.ptr<std::uint8_t>(j), a.cols));
-  return L2Exact(a.ptr<float>(i), b.ptr<float>(j), a.cols);
-}
 
 void ApproximateOptions::Check() const {
   CheckField("k", k, 1, std::numeric_limits<int>::max());
@@ -265,7 +223,7 @@ CandidateLists ApproximateIndex::Search(const cv::Mat& queries_in) const {
     // FLANN's distances are squared (L2): recompute the exact ones and sort.
     for (int q = q0; q < q1; ++q) {
       std::vector<Candidate>& list = out[static_cast<size_t>(q)];
-      for (Candidate& c : list) c.distance = ExactRowDistance(refs, c.reference, queries, q);
+      for (Candidate& c : list) c.distance = RowDistance(refs, c.reference, queries, q);
       SortCandidates(list);
     }
   });
@@ -334,7 +292,7 @@ void ExactL2(const cv::Mat& refs, const cv::Mat& queries, int k, int threads, Ca
       std::vector<Candidate>& list = out[static_cast<size_t>(q0 + i)];
       for (int j = 0; j < n; ++j)
         if (lower[static_cast<size_t>(j)] <= bound)
-          list.push_back(Candidate{j, L2Exact(queries.ptr<float>(q0 + i), refs.ptr<float>(j), d)});
+          list.push_back(Candidate{j, L2Distance(queries.ptr<float>(q0 + i), refs.ptr<float>(j), d)});
       SortCandidates(list);
       list.resize(static_cast<size_t>(k));
     }

@@ -1,4 +1,4 @@
-// Approximate candidate search for very large reference sets (issue 4, item 5): the k nearest
+// Approximate candidate search for very large reference sets: the k nearest
 // references of each query found by FLANN, with LSH for binary descriptors (Hamming) and
 // randomised k-d trees for vector descriptors (L2), and the exact search it is measured against.
 //
@@ -12,9 +12,9 @@
 // std::random_device, so two runs on the same data give different candidates, and it cannot
 // be made deterministic; OpenCV's copy draws from cv::theRNG(), which is seeded here.
 //
-// Every distance returned is exact, recomputed for the pair after the search: the number of
-// differing bits (as HammingDistance), or the Euclidean (not squared) distance summed in double
-// precision and rounded to float. Exact and approximate results therefore give equal distances
+// Every distance returned is exact, recomputed for the pair after the search by RowDistance
+// (matching/distances.h): the number of differing bits, or the Euclidean (not squared) distance
+// summed in double precision and rounded to float. Exact and approximate results therefore give equal distances
 // for equal pairs, and recall can compare them with ==.
 #pragma once
 
@@ -55,11 +55,6 @@ struct ApproximateOptions {
   // Throws std::invalid_argument naming the field, the value and the valid range.
   void Check() const;
 };
-
-// The exact distance between row i of `a` and row j of `b` (same type and width, CV_8U or
-// CV_32F), as every distance returned here is computed: differing bits, or the Euclidean
-// distance with differences and squares summed in double and rounded once to float.
-float ExactRowDistance(const cv::Mat& a, int i, const cv::Mat& b, int j);
 
 // An index over a fixed set of references (rows of one CV_8UC1 or CV_32FC1 matrix).
 class ApproximateIndex {

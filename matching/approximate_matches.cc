@@ -1,13 +1,13 @@
-// Approximate candidate search (Approximate_search 1): FLANN (OpenCV's copy) finds the candidates of each
-// query, LSH for binary descriptors and randomised k-d trees for vector ones; the candidates
-// are then scored by the exact sequence sum. Declared in matching/bounded.h.
+// The bounded mode with approximate candidates (Approximate_search 1): FLANN (OpenCV's copy,
+// matching/approximate.h) finds the candidates of each query, LSH for binary descriptors and
+// randomised k-d trees for vector ones; each candidate is then scored by its exact sequence sum
+// (SequenceCellDistance). Declared in matching/bounded.h.
 #include <algorithm>
-#include <cmath>
-#include <thread>
 
-#include "matching/bounded.h"
+#include "OpenABLE/base/threading.h"
 #include "matching/approximate.h"
-#include "matching/distances.h"
+#include "matching/bounded.h"
+#include "matching/sequence.h"
 
 namespace openable {
 namespace {
@@ -34,9 +34,6 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
                                       const KeepRules& rules, const BoundedOptions& options,
                                       int checks, float& max_distance) {
   const int L = options.sequence_length;
-  const int threads = options.threads > 0
-                          ? options.threads
-                          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const bool reverse = options.direction == SequenceDirection::kReverse;
   const bool both = options.direction == SequenceDirection::kBoth;
   const int m = block.reference_count;
@@ -46,35 +43,26 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
   const cv::Mat refs = descriptors.rowRange(block.reference_first, block.reference_first + m);
   const cv::Mat queries =
       descriptors.rowRange(block.query_first, block.query_first + block.query_count);
-  const std::vector<std::vector<int>> cand = Candidates(refs, queries, asked, checks, threads);
+  const std::vector<std::vector<int>> cand =
+      Candidates(refs, queries, asked, checks, options.threads);
 
-  // The sequence sum of one cell, as SequenceDistances defines it (scaled to L terms).
   auto score = [&](int q, int j, bool rev) {
-    const int tq = q;  // steps back within the query traversal
-    const int tj = rev ? m - 1 - j : j;
-    const int c = std::min(L, std::min(tq, tj) + 1);
-    double sum = 0;
-    for (int s = 0; s < c; ++s)
-      sum += ExactRowDistance(descriptors, block.query_first + q - s, descriptors,
-                              block.reference_first + (rev ? j + s : j - s));
-    return static_cast<float>(sum * L / c);
+    return SequenceCellDistance(queries, q, refs, j, L, rev);
   };
   std::vector<std::vector<Match>> per_query(static_cast<size_t>(block.query_count));
-  cv::parallel_for_(cv::Range(0, block.query_count), [&](const cv::Range& range) {
-    for (int q = range.start; q < range.end; ++q) {
-      std::vector<std::pair<float, int>> scored;
-      for (const int j : cand[static_cast<size_t>(q)]) {
-        if (j < 0 || j >= m) continue;
-        if (block.one_traversal && j > q - rules.exclusion) continue;
-        float s = both ? std::min(score(q, j, false), score(q, j, true)) : score(q, j, reverse);
-        scored.emplace_back(s, j);
-      }
-      std::sort(scored.begin(), scored.end());
-      if (static_cast<int>(scored.size()) > k) scored.resize(static_cast<size_t>(k));
-      auto& out = per_query[static_cast<size_t>(q)];
-      for (size_t r = 0; r < scored.size(); ++r)
-        out.push_back({q, scored[r].second, scored[r].first, static_cast<int>(r + 1)});
+  ParallelFor(block.query_count, options.threads, [&](int q) {
+    std::vector<std::pair<float, int>> scored;
+    for (const int j : cand[static_cast<size_t>(q)]) {
+      if (j < 0 || j >= m) continue;
+      if (block.one_traversal && j > q - rules.exclusion) continue;
+      float s = both ? std::min(score(q, j, false), score(q, j, true)) : score(q, j, reverse);
+      scored.emplace_back(s, j);
     }
+    std::sort(scored.begin(), scored.end());
+    if (static_cast<int>(scored.size()) > k) scored.resize(static_cast<size_t>(k));
+    auto& out = per_query[static_cast<size_t>(q)];
+    for (size_t r = 0; r < scored.size(); ++r)
+      out.push_back({q, scored[r].second, scored[r].first, static_cast<int>(r + 1)});
   });
   std::vector<Match> kept;
   float max_seen = 0.0f;

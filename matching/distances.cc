@@ -2,13 +2,14 @@
 
 #include "matching/large_matrix.h"
 
+#include "OpenABLE/base/threading.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
-#include <thread>
 #include <vector>
 
 #include <Eigen/Core>
@@ -253,40 +254,26 @@ std::vector<std::uint64_t> RowWords(const cv::Mat& m) {
   return w;
 }
 
-int ResolveThreads(int threads) {
-  if (threads > 0) return threads;
-  return std::max(1u, std::thread::hardware_concurrency());
-}
-
-// Runs body(row) for every row in [0, rows) on `threads` threads, handing rows out one at a
-// time (rows of a triangle differ in cost). Reports progress in pairs from the calling thread
-// of the first worker only, to keep the callback single-threaded.
+// Runs body(row) for every row in [0, rows) on `threads` threads (ParallelFor: rows of a
+// triangle differ in cost), reporting progress in pairs, one caller at a time.
 template <typename Body, typename PairsOfRow>
 void ParallelRows(int rows, int threads, const PairProgress& progress, PairsOfRow pairs_of_row,
                   std::int64_t total_pairs, Body body) {
-  std::atomic<int> next{0};
   std::atomic<std::int64_t> done{0};
   std::mutex report_mutex;
   std::int64_t last_report = 0;
   const std::int64_t report_step = std::max<std::int64_t>(1, total_pairs / 100);
-  auto worker = [&]() {
-    for (int i = next++; i < rows; i = next++) {
-      body(i);
-      const std::int64_t now = done += pairs_of_row(i);
-      if (progress && now - last_report >= report_step) {
-        std::lock_guard<std::mutex> lock(report_mutex);
-        if (now - last_report >= report_step) {
-          last_report = now;
-          progress(now, total_pairs);
-        }
+  ParallelFor(rows, threads, [&](int i) {
+    body(i);
+    const std::int64_t now = done += pairs_of_row(i);
+    if (progress && now - last_report >= report_step) {
+      std::lock_guard<std::mutex> lock(report_mutex);
+      if (now - last_report >= report_step) {
+        last_report = now;
+        progress(now, total_pairs);
       }
     }
-  };
-  const int n = std::min(ResolveThreads(threads), std::max(rows, 1));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < n; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+  });
   if (progress) progress(done.load(), total_pairs);
 }
 
@@ -331,6 +318,22 @@ __attribute__((target("popcnt"))) int PairBitsPopcnt(const std::uint8_t* a,
 int HammingDistance(const std::uint8_t* a, const std::uint8_t* b, int bytes) {
   static const bool popcnt = __builtin_cpu_supports("popcnt");
   return popcnt ? PairBitsPopcnt(a, b, bytes) : PairBitsPortable(a, b, bytes);
+}
+
+float L2Distance(const float* a, const float* b, int width) {
+  double s = 0;
+  for (int i = 0; i < width; ++i) {
+    const double t = static_cast<double>(a[i]) - static_cast<double>(b[i]);
+    s += t * t;
+  }
+  return static_cast<float>(std::sqrt(s));
+}
+
+float RowDistance(const cv::Mat& a, int i, const cv::Mat& b, int j) {
+  if (a.depth() == CV_8U)
+    return static_cast<float>(
+        HammingDistance(a.ptr<std::uint8_t>(i), b.ptr<std::uint8_t>(j), a.cols));
+  return L2Distance(a.ptr<float>(i), b.ptr<float>(j), a.cols);
 }
 
 cv::Mat1f HammingDistances(const cv::Mat& a, const cv::Mat& b, int threads,

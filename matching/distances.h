@@ -18,6 +18,16 @@ using PairProgress = std::function<void(std::int64_t done, std::int64_t total)>;
 // Number of bits that differ between the byte strings a and b of `bytes` bytes.
 int HammingDistance(const std::uint8_t* a, const std::uint8_t* b, int bytes);
 
+// Euclidean distance between two rows of `width` floats, with the differences and their squares
+// summed in double precision and rounded once to float: the exact distance of a pair.
+float L2Distance(const float* a, const float* b, int width);
+
+// The distance of one pair of rows: row i of `a` and row j of `b` (same type and width):
+// HammingDistance for CV_8U rows, L2Distance for CV_32F rows. Every distance of single pairs
+// (candidates rescored after an approximate search, sequence cells computed one by one)
+// comes from here; the matrices below agree with it (L2: within float rounding).
+float RowDistance(const cv::Mat& a, int i, const cv::Mat& b, int j);
+
 // Distances between every row of `a` (N x W, CV_8U) and every row of `b` (M x W, CV_8U):
 // an N x M matrix of bit counts, stored as float. When `b` is empty, b = a and the result
 // is symmetric with a zero diagonal. Every cell is computed (for a symmetric matrix too: rows

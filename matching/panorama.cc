@@ -18,18 +18,6 @@ void MinInto(cv::Mat1f& out, const cv::Mat1f& d) {
 
 }  // namespace
 
-const char* PanoramaMatchingName(PanoramaMatching mode) {
-  switch (mode) {
-    case PanoramaMatching::kAligned:
-      return "aligned";
-    case PanoramaMatching::kCrossCorrelation:
-      return "cross-correlation";
-    case PanoramaMatching::kCircular:
-      return "circular";
-  }
-  return "?";
-}
-
 cv::Mat1f PanoramaDistances(const cv::Mat& rows, int strips, PanoramaMatching mode, int threads,
                             const PairProgress& progress) {
   if (strips < 1)

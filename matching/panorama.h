@@ -24,14 +24,14 @@
 
 #include <opencv2/core.hpp>
 
+#include "OpenABLE/base/enum_names.h"
+
 #include "matching/distances.h"
 
 namespace openable {
 
 enum class PanoramaMatching { kAligned = 0, kCrossCorrelation = 1, kCircular = 2 };
-
-// Name for reports: "aligned", "cross-correlation", "circular".
-const char* PanoramaMatchingName(PanoramaMatching mode);
+OPENABLE_ENUM_NAMES(PanoramaMatching, "aligned", "cross-correlation", "circular")
 
 // The N x N distance matrix of the rows of `rows` (N x (n * w): CV_8U compared with Hamming,
 // CV_32F with L2), each row made of `strips` = n descriptors of w elements. `threads` as in

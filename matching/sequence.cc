@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "OpenABLE/base/threading.h"
+#include "matching/distances.h"
 #include "matching/large_matrix.h"
 
 namespace openable {
@@ -73,6 +75,7 @@ void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, 
   std::vector<double> prev(static_cast<size_t>(m)), cur(static_cast<size_t>(m));
   threads = std::max(1, std::min(threads, m / 256 + 1));
   SpinBarrier barrier(threads);
+  // Columns are split evenly between the threads, which meet at the barrier once per row.
   auto work = [&](int c0, int c1) {
     for (int i = 0; i < n; ++i) {
       float* row = d.ptr<float>(i);
@@ -92,20 +95,17 @@ void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, 
           if (t >= L) w -= old[reverse ? j + L : j - L];
         }
         cur[static_cast<size_t>(j)] = w;
-        const int c = std::min(L, t + 1);
-        row[j] = static_cast<float>(c == L ? w : w * L / c);
+        row[j] = ScaleSequenceSum(w, SequenceTerms(L, t), L);
       }
       barrier.Wait();  // every column of row i done before anyone reads it as row i - 1
       if (c0 == 0) std::swap(prev, cur);
       barrier.Wait();
     }
   };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t)
-    pool.emplace_back(work, static_cast<int>(static_cast<long>(m) * t / threads),
-                      static_cast<int>(static_cast<long>(m) * (t + 1) / threads));
-  work(0, m / threads);
-  for (auto& t : pool) t.join();
+  RunOnThreads(threads, [&](int t) {
+    work(static_cast<int>(static_cast<long>(m) * t / threads),
+         static_cast<int>(static_cast<long>(m) * (t + 1) / threads));
+  });
 }
 
 }  // namespace
@@ -118,7 +118,7 @@ void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length,
   const Traversals rows = Bounds(row_starts, d.rows, "row");
   const Traversals cols = Bounds(col_starts, d.cols, "column");
   if (sequence_length == 1 || d.empty()) return;
-  if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  threads = EffectiveThreads(threads);
   if (direction == SequenceDirection::kBoth) {
     cv::Mat1f reverse = LargeMatrix(d.rows, d.cols);
     d.copyTo(reverse);
@@ -138,6 +138,19 @@ cv::Mat1f SequenceDistances(const cv::Mat1f& d, int sequence_length,
   d.copyTo(out);
   SequenceDistancesInPlace(out, sequence_length, row_starts, col_starts, direction, threads);
   return out;
+}
+
+float SequenceCellDistance(const cv::Mat& queries, int q, const cv::Mat& references, int j,
+                           int sequence_length, bool reverse, double* largest_term) {
+  const int steps_back = std::min(q, reverse ? references.rows - 1 - j : j);
+  const int terms = SequenceTerms(sequence_length, steps_back);
+  double sum = 0;
+  for (int k = 0; k < terms; ++k) {
+    const double d = RowDistance(queries, q - k, references, reverse ? j + k : j - k);
+    if (largest_term != nullptr && d > *largest_term) *largest_term = d;
+    sum += d;
+  }
+  return ScaleSequenceSum(sum, terms, sequence_length);
 }
 
 }  // namespace openable

@@ -27,9 +27,36 @@
 
 #include <opencv2/core.hpp>
 
+#include "OpenABLE/base/enum_names.h"
+
 namespace openable {
 
 enum class SequenceDirection { kForward = 0, kReverse = 1, kBoth = 2 };  // kBoth: min of the two
+OPENABLE_ENUM_NAMES(SequenceDirection, "forward", "reverse", "both")
+
+// The terms of S(i, j) that exist: min(L, t + 1), t being the steps the diagonal can go back
+// from (i, j) without leaving the traversal of i or that of j.
+inline int SequenceTerms(int sequence_length, int steps_back) {
+  return steps_back + 1 < sequence_length ? steps_back + 1 : sequence_length;
+}
+
+// The sum of `terms` single-frame distances scaled to L terms (L / terms, when terms < L) and
+// rounded to float: how every sequence distance is finished, in the matrix sweep below and in
+// SequenceCellDistance.
+inline float ScaleSequenceSum(double sum, int terms, int sequence_length) {
+  return static_cast<float>(terms == sequence_length ? sum : sum * sequence_length / terms);
+}
+
+// S(q, j) of one cell, straight from descriptor rows, for searches that score a few cells
+// (approximate candidates, the online detector): `queries` holds the query traversal from its
+// first frame (row q is frame q) and `references` the reference traversal (row j is frame j);
+// the terms are RowDistance (matching/distances.h) of (q - k, j - k), or (q - k, j + k) when
+// `reverse`, for as many k < L as both traversals hold, summed in double and scaled by
+// ScaleSequenceSum. Equal to the cell of SequenceDistances up to float rounding (exactly for
+// Hamming rows). `largest_term`, when given, is raised to the largest single-frame distance
+// summed.
+float SequenceCellDistance(const cv::Mat& queries, int q, const cv::Mat& references, int j,
+                           int sequence_length, bool reverse, double* largest_term = nullptr);
 
 // D: N x M single-frame distances (rows: frames i, columns: frames j), replaced by S.
 // `row_starts` and `col_starts` are the first frame of each traversal along the rows and the

@@ -1,15 +1,14 @@
 #include "OpenABLE/run/describe.h"
 
 #include <algorithm>
-#include <atomic>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
-#include <thread>
 
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/threading.h"
 #include "OpenABLE/io/module_api.h"
 #include "OpenABLE/io/module_loader.h"
 #include "OpenABLE/image/preprocess.h"
@@ -17,10 +16,6 @@
 namespace openable {
 
 namespace {
-
-int ResolveThreads(int threads) {
-  return threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-}
 
 std::string SizeText(const cv::Size& s) {
   return std::to_string(s.width) + "x" + std::to_string(s.height);
@@ -116,7 +111,7 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
     return error_index < n;
   };
 
-  const int threads = options.show_images ? 1 : ResolveThreads(options.threads);
+  const int threads = options.show_images ? 1 : EffectiveThreads(options.threads);
   if (options.show_images || !source.ParallelReads()) {
     // One reader in order; description of a batch in parallel.
     const int batch = std::max(1, threads * 8);
@@ -136,36 +131,22 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
           report();
         }
       }
-      std::atomic<size_t> next{0};
-      auto worker = [&]() {
-        for (size_t k = next++; k < frames.size(); k = next++) {
-          describe(frames[k].first, frames[k].second);
-          report();
-        }
-      };
-      std::vector<std::thread> pool;
-      for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-      worker();
-      for (auto& t : pool) t.join();
+      ParallelFor(static_cast<int>(frames.size()), threads, [&](int k) {
+        describe(frames[k].first, frames[k].second);
+        report();
+      });
     }
   } else {
-    std::atomic<int> next{0};
-    auto worker = [&]() {
-      for (int i = next++; i < n; i = next++) {
-        if (stopped()) return;
-        cv::Size cached_size;
-        if (options.cache != nullptr && options.cache->Lookup(source, i, rows.row(i), &cached_size)) {
-          if (check_size(i, cached_size)) ok[i] = 1;
-        } else if (auto f = read(i)) {
-          describe(i, *f);
-        }
-        report();
+    ParallelFor(n, threads, [&](int i) {
+      if (stopped()) return;
+      cv::Size cached_size;
+      if (options.cache != nullptr && options.cache->Lookup(source, i, rows.row(i), &cached_size)) {
+        if (check_size(i, cached_size)) ok[i] = 1;
+      } else if (auto f = read(i)) {
+        describe(i, *f);
       }
-    };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
-    worker();
-    for (auto& t : pool) t.join();
+      report();
+    });
   }
 
   if (error_index < n) throw InputError(prefix + error_message);

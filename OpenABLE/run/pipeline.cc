@@ -18,7 +18,7 @@
 #include "OpenABLE/stereo/calibration.h"
 #include "OpenABLE/stereo/stereo_source.h"
 #include "descriptors/registry.h"
-#include "matching/distances.h"
+#include "matching/matrix.h"
 #include "matching/normalize.h"
 #include "matching/panorama.h"
 #include "matching/sequence.h"
@@ -91,7 +91,7 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   {
     char text[200];
     result.camera = panoramic ? "panoramic, " + std::to_string(strips) + " sub-panoramas, " +
-                                    PanoramaMatchingName(panorama_matching) + " matching"
+                                    EnumName(panorama_matching) + " matching"
                   : config.camera_type == 1
                       ? std::string("stereo, rectified") +
                             (descriptor->Channels() == 2 ? ", SGBM disparity" : ", left image")
@@ -166,7 +166,7 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
 
   if (result.bounded && panoramic && panorama_matching != PanoramaMatching::kAligned)
     throw InputError(std::string("Panorama_matching: ") + std::to_string(config.panorama_matching) +
-                     " (" + PanoramaMatchingName(panorama_matching) + ") needs the dense "
+                     " (" + EnumName(panorama_matching) + ") needs the dense "
                      "matrix, but the run is " + result.mode_reason +
                      "; expected Matrix_mode 1 (or 0 with a larger Memory_limit) or "
                      "Panorama_matching 0");
@@ -297,9 +297,7 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
                  cross ? "cells of sub-panorama pairs" : "cells");
   const PairProgress on_pairs = [&](std::int64_t done, std::int64_t) { progress.Update(done); };
   cv::Mat1f distances =
-      panoramic ? PanoramaDistances(descriptors, strips, panorama_matching, config.threads, on_pairs)
-      : result.binary ? HammingDistances(descriptors, cv::Mat(), config.threads, on_pairs)
-                      : L2Distances(descriptors, cv::Mat(), config.threads, on_pairs);
+      PairwiseDistances(descriptors, strips, panorama_matching, config.threads, on_pairs);
   progress.End();
   result.timings.match_seconds = SecondsSince(t);
 

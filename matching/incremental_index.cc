@@ -1,0 +1,160 @@
+#include "matching/incremental_index.h"
+
+#include <algorithm>
+#include <chrono>
+#include <future>
+#include <optional>
+#include <utility>
+
+namespace openable {
+
+struct IncrementalIndex::State {
+  IncrementalIndexOptions options;
+  int width = 0, type = CV_8U;
+
+  // Rows of every frame, in a buffer that doubles when full (amortised O(1) per row).
+  cv::Mat buffer;
+  int size = 0;
+
+  // FLANN blocks over rows [first, first + count), contiguous and in order from row 0; counts
+  // are block_frames x 2^m, non-increasing along the vector.
+  struct Block {
+    int first = 0, count = 0;
+    std::unique_ptr<ApproximateIndex> index;
+  };
+  std::vector<Block> blocks;
+  int indexed = 0;  // rows covered by blocks
+
+  // A merge of blocks[block] and blocks[block + 1] being built (one at a time).
+  struct Merge {
+    size_t block = 0;
+    int first = 0, count = 0;
+    std::future<std::unique_ptr<ApproximateIndex>> index;
+  };
+  std::optional<Merge> merge;
+  std::future<void> disposal;  // freeing the indices a merge replaced
+
+  // Builds an index over rows [first, first + count).
+  std::unique_ptr<ApproximateIndex> Index(int first, int count) const {
+    return std::make_unique<ApproximateIndex>(buffer.rowRange(first, first + count),
+                                              options.approximate);
+  }
+
+  // Installs a finished merge (waiting for it when `wait`), then starts the next one.
+  void FinishMerge(bool wait, bool background = true) {
+    if (merge && (wait || merge->index.wait_for(std::chrono::seconds(0)) ==
+                              std::future_status::ready)) {
+      Block merged{merge->first, merge->count, merge->index.get()};
+      // The two old indices are freed on another thread: freeing the tables of a large LSH
+      // index takes a good part of a second.
+      std::vector<std::unique_ptr<ApproximateIndex>> old;
+      old.push_back(std::move(blocks[merge->block].index));
+      old.push_back(std::move(blocks[merge->block + 1].index));
+      if (disposal.valid()) disposal.wait();
+      disposal = std::async(std::launch::async, [old = std::move(old)]() mutable { old.clear(); });
+      blocks[merge->block] = std::move(merged);
+      blocks.erase(blocks.begin() + static_cast<std::ptrdiff_t>(merge->block) + 1);
+      merge.reset();
+    }
+    StartMerges(background);
+  }
+
+  // Merges neighbouring blocks of equal size (a binary counter of block sizes): on a
+  // background thread, one at a time; or here, all of them, without background_merges.
+  void StartMerges(bool background) {
+    while (!merge) {
+      size_t i = blocks.size();
+      for (size_t b = blocks.size(); b-- > 1;)
+        if (blocks[b - 1].count == blocks[b].count) {
+          i = b - 1;
+          break;
+        }
+      if (i == blocks.size()) return;
+      const int first = blocks[i].first, count = 2 * blocks[i].count;
+      if (!options.background_merges || !background) {
+        blocks[i] = Block{first, count, Index(first, count)};
+        blocks.erase(blocks.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+        continue;
+      }
+      // The rows are copied: the buffer may grow (and move) while the index is built.
+      cv::Mat rows = buffer.rowRange(first, first + count).clone();
+      const ApproximateOptions approximate = options.approximate;
+      merge = Merge{i, first, count, std::async(std::launch::async, [rows, approximate]() {
+                      return std::make_unique<ApproximateIndex>(rows, approximate);
+                    })};
+    }
+  }
+};
+
+IncrementalIndex::IncrementalIndex(int width, int type, const IncrementalIndexOptions& options)
+    : state_(std::make_unique<State>()) {
+  state_->options = options;
+  state_->width = width;
+  state_->type = type;
+}
+
+IncrementalIndex::~IncrementalIndex() = default;
+
+void IncrementalIndex::Append(const cv::Mat& row) {
+  State& s = *state_;
+  if (s.size == s.buffer.rows) {
+    cv::Mat bigger(std::max(64, 2 * s.buffer.rows), s.width, s.type);
+    if (s.size > 0) s.buffer.rowRange(0, s.size).copyTo(bigger.rowRange(0, s.size));
+    s.buffer = bigger;
+  }
+  row.copyTo(s.buffer.row(s.size));
+  ++s.size;
+}
+
+void IncrementalIndex::Update(int searchable, bool background) {
+  State& s = *state_;
+  if (searchable <= s.options.exact_limit) return;
+  if (!background) s.FinishMerge(true, false);
+  while (searchable - s.indexed >= s.options.block_frames) {
+    s.blocks.push_back(
+        {s.indexed, s.options.block_frames, s.Index(s.indexed, s.options.block_frames)});
+    s.indexed += s.options.block_frames;
+    if (!background) s.StartMerges(false);
+  }
+  s.FinishMerge(false, background);
+}
+
+std::vector<int> IncrementalIndex::Candidates(const cv::Mat& row, int searchable,
+                                              bool* approximate) const {
+  const State& s = *state_;
+  std::vector<int> out;
+  *approximate = !s.blocks.empty();
+  if (s.blocks.empty()) {
+    out.reserve(static_cast<size_t>(std::max(0, searchable)));
+    for (int j = 0; j < searchable; ++j) out.push_back(j);
+    return out;
+  }
+  for (const auto& b : s.blocks) {
+    const CandidateLists found = b.index->Search(row);
+    for (const Candidate& c : found[0]) out.push_back(b.first + c.reference);
+  }
+  for (int j = s.indexed; j < searchable; ++j) out.push_back(j);
+  return out;
+}
+
+void IncrementalIndex::FinishMerges() {
+  while (state_->merge) state_->FinishMerge(true);
+}
+
+cv::Mat IncrementalIndex::Rows() const { return state_->buffer.rowRange(0, state_->size); }
+int IncrementalIndex::Size() const { return state_->size; }
+int IncrementalIndex::Blocks() const { return static_cast<int>(state_->blocks.size()); }
+
+std::int64_t IncrementalIndex::MemoryBytes() const {
+  const State& s = *state_;
+  std::int64_t bytes = static_cast<std::int64_t>(s.buffer.total()) * s.buffer.elemSize();
+  // Each index holds a copy of its rows plus its tables; counted as twice the rows (LSH: 12
+  // tables of one 4-byte id per row is less; k-d trees: 4 trees of nodes per row).
+  for (const auto& b : s.blocks)
+    bytes += 2 * static_cast<std::int64_t>(b.count) * s.width * s.buffer.elemSize();
+  if (s.merge)
+    bytes += 3 * static_cast<std::int64_t>(s.merge->count) * s.width * s.buffer.elemSize();
+  return bytes;
+}
+
+}  // namespace openable

@@ -1,0 +1,60 @@
+// A growing set of descriptor rows searched for the candidates of each new row: the map of the
+// online loop detector (OpenABLE/online/online.h).
+//
+// Rows are appended one by one. While the searchable rows number at most exact_limit, every
+// one is a candidate (an exact scan); beyond, rows are indexed by FLANN
+// (matching/approximate.h: LSH for binary rows, k-d trees for float rows) in blocks of
+// block_frames rows merged as they grow (sizes block_frames x 2^m, at most one of each, like a
+// binary counter), and only the newest unindexed rows (fewer than block_frames) are scanned
+// exactly. Merges of two blocks are built on a background thread while the two old blocks go
+// on being searched, so that no row waits for a large index build.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "matching/approximate.h"
+
+namespace openable {
+
+struct IncrementalIndexOptions {
+  int exact_limit = 20000;         // searchable rows scanned exactly before FLANN blocks, >= 0
+  int block_frames = 4096;         // rows of the smallest FLANN block, >= 16
+  bool background_merges = true;   // build merges on a background thread (see above)
+  ApproximateOptions approximate;  // its k is the candidate count of each block
+};
+
+class IncrementalIndex {
+ public:
+  // Rows of `width` elements of `type` (CV_8U or CV_32F).
+  IncrementalIndex(int width, int type, const IncrementalIndexOptions& options);
+  ~IncrementalIndex();
+  IncrementalIndex(const IncrementalIndex&) = delete;
+  IncrementalIndex& operator=(const IncrementalIndex&) = delete;
+
+  // Appends one row (1 x width, type) as row Size(); the buffer doubles when full.
+  void Append(const cv::Mat& row);
+  // Indexes full blocks of the rows [0, searchable) once `searchable` exceeds exact_limit.
+  // `background` false builds every merge here (a map loaded all at once).
+  void Update(int searchable, bool background = true);
+  // The candidate rows for `row` among [0, searchable) (after Update(searchable)): every row
+  // while exact; else the FLANN candidates of each block plus the unindexed rows. `approximate`
+  // receives whether FLANN was used.
+  std::vector<int> Candidates(const cv::Mat& row, int searchable, bool* approximate) const;
+  // Waits for a background merge to finish and installs its index.
+  void FinishMerges();
+
+  cv::Mat Rows() const;              // Size() x width, a view of the stored rows
+  int Size() const;                  // rows appended
+  int Blocks() const;                // FLANN blocks in use (0 while exact)
+  std::int64_t MemoryBytes() const;  // rows + indices held now (estimate, see the .cc)
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace openable
