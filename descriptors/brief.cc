@@ -13,11 +13,6 @@
 namespace openable {
 namespace {
 
-constexpr int kMinPatchSize = 16;
-
-std::string MatDescription(const cv::Mat& m) {
-  return std::to_string(m.rows) + " x " + std::to_string(m.cols) + " " + cv::typeToString(m.type());
-}
 
 // Two standard normal deviates from two raw 32-bit outputs (Box-Muller, in double).
 void NormalPair(std::mt19937& generator, double* z0, double* z1) {
@@ -53,34 +48,20 @@ const std::array<BriefUnitTest, kBriefTests>& BriefUnitPattern() {
 }
 
 BriefDescriptor::BriefDescriptor(const DescriptorOptions& options)
-    : patch_size_(options.patch_size) {
-  if (patch_size_ < kMinPatchSize) {
-    throw InputError("Patch_size: " + std::to_string(patch_size_) +
-                     " is too small; expected an integer >= 16");
-  }
-  half_ = std::max(1, static_cast<int>(std::lround(4.0 * patch_size_ / 48.0)));
+    : Descriptor(options) {
+  half_ = std::max(1, static_cast<int>(std::lround(4.0 * PatchSize() / 48.0)));
   tests_.reserve(kBriefTests);
   for (const BriefUnitTest& t : BriefUnitPattern()) {
-    tests_.push_back({ToPixel(t.x_col, patch_size_), ToPixel(t.x_row, patch_size_),
-                      ToPixel(t.y_col, patch_size_), ToPixel(t.y_row, patch_size_)});
+    tests_.push_back({ToPixel(t.x_col, PatchSize()), ToPixel(t.x_row, PatchSize()),
+                      ToPixel(t.y_col, PatchSize()), ToPixel(t.y_row, PatchSize())});
   }
 }
 
-void BriefDescriptor::Describe(const cv::Mat& patch, cv::Mat row) const {
-  if (patch.type() != CV_8UC1 || patch.rows != patch_size_ || patch.cols != patch_size_) {
-    throw std::logic_error("BRIEF: expected a " + std::to_string(patch_size_) + " x " +
-                           std::to_string(patch_size_) + " CV_8UC1 patch, got " +
-                           MatDescription(patch));
-  }
-  if (row.type() != CV_8UC1 || row.rows != 1 || row.cols != Width()) {
-    throw std::logic_error("BRIEF: expected a 1 x " + std::to_string(Width()) +
-                           " CV_8UC1 row, got " + MatDescription(row));
-  }
-
+void BriefDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
   // Sums up to 255 * S^2 fit in 32 bits for any S below 2900.
   cv::Mat integral;
   cv::integral(patch, integral, CV_32S);
-  const int s = patch_size_;
+  const int s = PatchSize();
   const int h = half_;
   // Sum and pixel count of the box around (col, row) clipped to the patch.
   const auto box = [&](int col, int r, std::int64_t* count) {

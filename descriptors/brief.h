@@ -75,8 +75,6 @@ class BriefDescriptor final : public Descriptor {
   std::string Name() const override { return "BRIEF"; }
   int Width() const override { return kBriefTests / 8; }
   DescriptorKind Kind() const override { return DescriptorKind::kBinary; }
-  int PatchSize() const override { return patch_size_; }
-  void Describe(const cv::Mat& patch, cv::Mat row) const override;
 
   // Half-side h of the smoothing box (side 2h + 1) at this patch size.
   int BoxHalfSide() const { return half_; }
@@ -84,7 +82,7 @@ class BriefDescriptor final : public Descriptor {
   const std::vector<BriefPixelTest>& PixelTests() const { return tests_; }
 
  private:
-  int patch_size_;
+  void DescribePatch(const cv::Mat& patch, cv::Mat row) const override;
   int half_;
   std::vector<BriefPixelTest> tests_;
 };

@@ -20,12 +20,14 @@ enum class DistanceKind { kHamming, kL2 };
 
 // Options every descriptor may read; defaults are those of the ABLE papers.
 struct DescriptorOptions {
-  int patch_size = 64;  // side of the square patch, pixels, >= 16
-  int ldb_bits = 256;   // LDB bits kept after selection, 1..1386 (32 bytes = 256 in ABLE-P)
+  std::string name = "LDB";  // registry name (descriptors/registry.h), any case
+  int patch_size = 64;       // side of the square patch, pixels, 16..1024
+  int ldb_bits = 256;        // LDB bits kept after selection, 1..1386 (32 bytes = 256 in ABLE-P)
 
   // Throws InputError naming the key (Patch_size, Ldb_bits), the value and the valid range.
-  // CreateDescriptor calls it before building anything; descriptors add their own limits
-  // (HOG: a multiple of 8).
+  // Every descriptor's constructor calls it (through the base class) before building
+  // anything; descriptors add their own limits (HOG: a multiple of 8). The name is checked by
+  // CreateDescriptor.
   void Check() const;
 };
 
@@ -41,15 +43,29 @@ class Descriptor {
     return Kind() == DescriptorKind::kBinary ? DistanceKind::kHamming : DistanceKind::kL2;
   }
   // Side of the square patch this descriptor expects.
-  virtual int PatchSize() const = 0;
+  int PatchSize() const { return patch_size_; }
   // Channels of the patch: 1 (grey) for every descriptor but D-LDB, whose patch has 2
   // (channel 0 grey, channel 1 disparity, both CV_8U; descriptors/dldb.h).
   virtual int Channels() const { return 1; }
-  // Describes `patch` (CV_8UC(Channels()), PatchSize() x PatchSize()) into `row`, a 1 x Width() matrix of
-  // CV_8U (binary) or CV_32F (float) that the caller allocated. Must be deterministic and safe
-  // to call from several threads at once. Throws std::logic_error on a patch of the wrong size
-  // or type.
-  virtual void Describe(const cv::Mat& patch, cv::Mat row) const = 0;
+  // Describes `patch` (CV_8UC(Channels()), PatchSize() x PatchSize()) into `row`, a 1 x Width()
+  // matrix of CV_8U (binary) or CV_32F (float) that the caller allocated. Deterministic and
+  // safe to call from several threads at once. Checks both once for every descriptor (after
+  // OpenCV's Feature2D::compute around its virtual part) and throws std::logic_error naming
+  // the descriptor on a patch or row of the wrong size or type; then DescribePatch does the
+  // work.
+  void Describe(const cv::Mat& patch, cv::Mat row) const;
+
+ protected:
+  // Checks `options` (DescriptorOptions::Check: InputError naming the key).
+  explicit Descriptor(const DescriptorOptions& options);
+  // std::logic_error naming the descriptor unless `patch` is CV_8UC(Channels()) of
+  // PatchSize() x PatchSize().
+  void CheckPatch(const cv::Mat& patch) const;
+  // The descriptor proper, on a patch and a row that Describe has checked.
+  virtual void DescribePatch(const cv::Mat& patch, cv::Mat row) const = 0;
+
+ private:
+  int patch_size_;
 };
 
 // CV type of one row element of a descriptor: CV_8U or CV_32F.

@@ -31,21 +31,21 @@ namespace openable {
 class DldbDescriptor final : public Descriptor {
  public:
   // Same options and limits as LDB (Patch_size >= 16, Ldb_bits in [1, 1386]).
-  explicit DldbDescriptor(const DescriptorOptions& options) : ldb_(options) {}
+  explicit DldbDescriptor(const DescriptorOptions& options)
+      : Descriptor(options), ldb_(options) {}
 
   std::string Name() const override { return "D-LDB"; }
   int Width() const override { return 2 * ldb_.Width(); }
   DescriptorKind Kind() const override { return DescriptorKind::kBinary; }
-  int PatchSize() const override { return ldb_.PatchSize(); }
   int Channels() const override { return 2; }
   // `patch`: PatchSize() x PatchSize() CV_8UC2 (grey, disparity); `row`: 1 x Width() CV_8U.
   // Throws std::logic_error on anything else.
-  void Describe(const cv::Mat& patch, cv::Mat row) const override;
 
   // The LDB used for both halves.
   const LdbDescriptor& Ldb() const { return ldb_; }
 
  private:
+  void DescribePatch(const cv::Mat& patch, cv::Mat row) const override;
   LdbDescriptor ldb_;
 };
 

@@ -12,13 +12,8 @@
 namespace openable {
 namespace {
 
-constexpr int kMinPatchSize = 16;
 constexpr double kRingRatio = 1.4;   // r_{k+1} / r_k
 constexpr double kFieldRatio = 0.6;  // rho_k / r_k
-
-std::string MatDescription(const cv::Mat& m) {
-  return std::to_string(m.rows) + " x " + std::to_string(m.cols) + " " + cv::typeToString(m.type());
-}
 
 // The 512 pairs, selected once offline by bench/freak_pairs.cc (rerun it with --check to
 // compare): the paper's greedy decorrelation on the 903 tests of 5676 whole frames of
@@ -128,12 +123,8 @@ const std::array<std::array<std::uint8_t, 2>, kFreakBits>& FreakPairs() {
 }
 
 FreakDescriptor::FreakDescriptor(const DescriptorOptions& options)
-    : patch_size_(options.patch_size) {
-  if (patch_size_ < kMinPatchSize) {
-    throw InputError("Patch_size: " + std::to_string(patch_size_) +
-                     " is too small; expected an integer >= 16");
-  }
-  const int s = patch_size_;
+    : Descriptor(options) {
+  const int s = PatchSize();
   for (const FreakField& f : FreakFields(s)) {
     std::vector<Span> spans;
     int count = 0;
@@ -163,14 +154,6 @@ FreakDescriptor::FreakDescriptor(const DescriptorOptions& options)
   }
 }
 
-void FreakDescriptor::CheckPatch(const cv::Mat& patch) const {
-  if (patch.type() != CV_8UC1 || patch.rows != patch_size_ || patch.cols != patch_size_) {
-    throw std::logic_error("FREAK: expected a " + std::to_string(patch_size_) + " x " +
-                           std::to_string(patch_size_) + " CV_8UC1 patch, got " +
-                           MatDescription(patch));
-  }
-}
-
 void FreakDescriptor::FieldSums(const cv::Mat& patch, std::int64_t* sums) const {
   // Sums up to 255 * S^2 fit in 32 bits for any S below 2900.
   cv::Mat integral;
@@ -186,12 +169,7 @@ void FreakDescriptor::FieldSums(const cv::Mat& patch, std::int64_t* sums) const 
   }
 }
 
-void FreakDescriptor::Describe(const cv::Mat& patch, cv::Mat row) const {
-  CheckPatch(patch);
-  if (row.type() != CV_8UC1 || row.rows != 1 || row.cols != Width()) {
-    throw std::logic_error("FREAK: expected a 1 x " + std::to_string(Width()) +
-                           " CV_8UC1 row, got " + MatDescription(row));
-  }
+void FreakDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
   std::int64_t sums[kFreakFields];
   FieldSums(patch, sums);
   auto* out = row.ptr<std::uint8_t>(0);

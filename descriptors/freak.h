@@ -73,8 +73,6 @@ class FreakDescriptor final : public Descriptor {
   std::string Name() const override { return "FREAK"; }
   int Width() const override { return kFreakBits / 8; }
   DescriptorKind Kind() const override { return DescriptorKind::kBinary; }
-  int PatchSize() const override { return patch_size_; }
-  void Describe(const cv::Mat& patch, cv::Mat row) const override;
 
   // All 903 tests of `patch` (same checks as Describe), one 0/1 value each, pairs (i, j),
   // i < j, in lexicographic order. Used to select the pairs (bench/freak_pairs.cc).
@@ -83,14 +81,13 @@ class FreakDescriptor final : public Descriptor {
   const std::vector<int>& FieldPixelCounts() const { return counts_; }
 
  private:
+  void DescribePatch(const cv::Mat& patch, cv::Mat row) const override;
   struct Span {
     int row, x0, x1;  // pixels [x0, x1) of row `row`
   };
   // Sum of each field's pixels.
   void FieldSums(const cv::Mat& patch, std::int64_t* sums) const;
-  void CheckPatch(const cv::Mat& patch) const;
 
-  int patch_size_;
   std::vector<std::vector<Span>> spans_;  // per field
   std::vector<int> counts_;               // per field
 };

@@ -23,32 +23,20 @@ cv::HOGDescriptor MakeHog(int patch_size) {
                            /*_gammaCorrection=*/false);
 }
 
-std::string Shape(const cv::Mat& m) {
-  return std::to_string(m.rows) + " x " + std::to_string(m.cols) + " " + cv::typeToString(m.type());
-}
-
 }  // namespace
 
 HogDescriptor::HogDescriptor(const DescriptorOptions& options)
-    : patch_size_(options.patch_size), width_(0) {
-  if (patch_size_ < kBlock || patch_size_ % kCell != 0) {
-    throw InputError("Patch_size: " + std::to_string(patch_size_) +
+    : Descriptor(options), width_(0) {
+  if (PatchSize() < kBlock || PatchSize() % kCell != 0) {
+    throw InputError("Patch_size: " + std::to_string(PatchSize()) +
                      " does not suit HOG; expected a multiple of 8 that is at least 16");
   }
-  width_ = static_cast<int>(MakeHog(patch_size_).getDescriptorSize());
+  width_ = static_cast<int>(MakeHog(PatchSize()).getDescriptorSize());
 }
 
-void HogDescriptor::Describe(const cv::Mat& patch, cv::Mat row) const {
-  if (patch.type() != CV_8UC1 || patch.rows != patch_size_ || patch.cols != patch_size_) {
-    throw std::logic_error("HOG: expected a " + std::to_string(patch_size_) + " x " +
-                           std::to_string(patch_size_) + " CV_8UC1 patch, got " + Shape(patch));
-  }
-  if (row.type() != CV_32FC1 || row.rows != 1 || row.cols != width_) {
-    throw std::logic_error("HOG: expected a 1 x " + std::to_string(width_) + " CV_32FC1 row, got " +
-                           Shape(row));
-  }
+void HogDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
   // cv::HOGDescriptor is a small parameter object; one per call keeps Describe thread-safe.
-  const cv::HOGDescriptor hog = MakeHog(patch_size_);
+  const cv::HOGDescriptor hog = MakeHog(PatchSize());
   std::vector<float> values;
   // HOG reads pixels beyond a view's edges when the view is part of a larger image: compute on
   // a copy so the descriptor depends only on the patch.

@@ -26,11 +26,9 @@ class HogDescriptor final : public Descriptor {
   std::string Name() const override { return "HOG"; }
   int Width() const override { return width_; }
   DescriptorKind Kind() const override { return DescriptorKind::kFloat; }
-  int PatchSize() const override { return patch_size_; }
-  void Describe(const cv::Mat& patch, cv::Mat row) const override;
 
  private:
-  int patch_size_;
+  void DescribePatch(const cv::Mat& patch, cv::Mat row) const override;
   int width_;
 };
 

@@ -20,11 +20,6 @@ constexpr int kLevels[] = {2, 3, 4, 5};
 constexpr int kCellCount = 4 + 9 + 16 + 25;
 constexpr int kFeaturesPerCell = 3;  // I_avg, G_x, G_y
 constexpr std::size_t kFeatureCount = std::size_t{kFeaturesPerCell} * kCellCount;
-constexpr int kMinPatchSize = 16;
-
-std::string PatchDescription(const cv::Mat& m) {
-  return std::to_string(m.rows) + " x " + std::to_string(m.cols) + " " + cv::typeToString(m.type());
-}
 
 }  // namespace
 
@@ -50,17 +45,9 @@ std::vector<int> LdbSelectedTests(int bits, LdbSelection selection) {
 }
 
 LdbDescriptor::LdbDescriptor(const DescriptorOptions& options, LdbSelection selection)
-    : patch_size_(options.patch_size), bits_(options.ldb_bits), selection_(selection) {
-  if (patch_size_ < kMinPatchSize) {
-    throw InputError("Patch_size: " + std::to_string(patch_size_) +
-                     " is too small; expected an integer >= 16");
-  }
-  if (bits_ < 1 || bits_ > kLdbTotalTests) {
-    throw InputError("Ldb_bits: " + std::to_string(bits_) +
-                     " is out of range; expected an integer in [1, 1386]");
-  }
+    : Descriptor(options), bits_(options.ldb_bits), selection_(selection) {
 
-  const long long s = patch_size_;
+  const long long s = PatchSize();
   cells_.reserve(kCellCount);
   for (const int n : kLevels) {
     for (int r = 0; r < n; ++r) {
@@ -105,17 +92,7 @@ LdbDescriptor::LdbDescriptor(const DescriptorOptions& options, LdbSelection sele
   }
 }
 
-void LdbDescriptor::Describe(const cv::Mat& patch, cv::Mat row) const {
-  if (patch.type() != CV_8UC1 || patch.rows != patch_size_ || patch.cols != patch_size_) {
-    throw std::logic_error("LDB: expected a " + std::to_string(patch_size_) + " x " +
-                           std::to_string(patch_size_) + " CV_8UC1 patch, got " +
-                           PatchDescription(patch));
-  }
-  if (row.type() != CV_8UC1 || row.rows != 1 || row.cols != Width()) {
-    throw std::logic_error("LDB: expected a 1 x " + std::to_string(Width()) + " CV_8UC1 row, got " +
-                           PatchDescription(row));
-  }
-
+void LdbDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
   // Sums of up to 255 * S^2 are exact in double for any practical S.
   cv::Mat integral;
   cv::integral(patch, integral, CV_64F);

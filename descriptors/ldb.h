@@ -76,8 +76,6 @@ class LdbDescriptor final : public Descriptor {
   std::string Name() const override { return "LDB"; }
   int Width() const override { return (bits_ + 7) / 8; }
   DescriptorKind Kind() const override { return DescriptorKind::kBinary; }
-  int PatchSize() const override { return patch_size_; }
-  void Describe(const cv::Mat& patch, cv::Mat row) const override;
 
   // Bits kept (options.ldb_bits).
   int Bits() const { return bits_; }
@@ -86,6 +84,7 @@ class LdbDescriptor final : public Descriptor {
   const std::vector<int>& SelectedTests() const { return selected_; }
 
  private:
+  void DescribePatch(const cv::Mat& patch, cv::Mat row) const override;
   // A cell, in patch pixels: rows [y0, y1), columns [x0, x1); halves split at xm and ym.
   struct Cell {
     int y0, y1, x0, x1, xm, ym;
@@ -96,7 +95,6 @@ class LdbDescriptor final : public Descriptor {
     std::uint16_t a, b;
   };
 
-  int patch_size_;
   int bits_;
   LdbSelection selection_;
   std::vector<int> selected_;

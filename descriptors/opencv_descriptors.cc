@@ -14,29 +14,8 @@
 namespace openable {
 namespace {
 
-constexpr int kMinPatchSize = 16;
-
-void CheckPatchSize(int patch_size) {
-  if (patch_size < kMinPatchSize) {
-    throw InputError("Patch_size: " + std::to_string(patch_size) +
-                     " is too small; expected an integer >= 16");
-  }
-}
-
 std::string Shape(const cv::Mat& m) {
   return std::to_string(m.rows) + " x " + std::to_string(m.cols) + " " + cv::typeToString(m.type());
-}
-
-void CheckInputs(const std::string& name, int patch_size, int width, int row_type,
-                 const cv::Mat& patch, const cv::Mat& row) {
-  if (patch.type() != CV_8UC1 || patch.rows != patch_size || patch.cols != patch_size) {
-    throw std::logic_error(name + ": expected a " + std::to_string(patch_size) + " x " +
-                           std::to_string(patch_size) + " CV_8UC1 patch, got " + Shape(patch));
-  }
-  if (row.type() != row_type || row.rows != 1 || row.cols != width) {
-    throw std::logic_error(name + ": expected a 1 x " + std::to_string(width) + " " +
-                           cv::typeToString(row_type) + " row, got " + Shape(row));
-  }
 }
 
 // Pixels added on each side of the patch; see the header.
@@ -110,18 +89,16 @@ cv::Ptr<cv::BRISK> MakeBrisk() {
 // ---------------------------------------------------------------------------------------------
 // ORB
 
-OrbDescriptor::OrbDescriptor(const DescriptorOptions& options) : patch_size_(options.patch_size) {
-  CheckPatchSize(patch_size_);
+OrbDescriptor::OrbDescriptor(const DescriptorOptions& options) : Descriptor(options) {
 }
 
-void OrbDescriptor::Describe(const cv::Mat& patch, cv::Mat row) const {
-  CheckInputs("ORB", patch_size_, Width(), CV_8UC1, patch, row);
+void OrbDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
   // cv::ORB is cheap to build (its pattern is made in compute()); one per call is thread-safe.
   cv::Ptr<cv::ORB> orb = cv::ORB::create(/*nfeatures=*/500, /*scaleFactor=*/1.2f, /*nlevels=*/1,
-                                         /*edgeThreshold=*/patch_size_, /*firstLevel=*/0,
+                                         /*edgeThreshold=*/PatchSize(), /*firstLevel=*/0,
                                          /*WTA_K=*/2, cv::ORB::HARRIS_SCORE,
-                                         /*patchSize=*/patch_size_);
-  const cv::KeyPoint keypoint(Centre(patch_size_), static_cast<float>(patch_size_),
+                                         /*patchSize=*/PatchSize());
+  const cv::KeyPoint keypoint(Centre(PatchSize()), static_cast<float>(PatchSize()),
                               /*angle=*/0.0f, /*response=*/0.0f, /*octave=*/0);
   ComputeOne("ORB", *orb, PadPatch(patch), keypoint, row);
 }
@@ -135,16 +112,14 @@ struct BriskDescriptor::Pool {
 };
 
 BriskDescriptor::BriskDescriptor(const DescriptorOptions& options)
-    : patch_size_(options.patch_size), pool_(std::make_unique<Pool>()) {
-  CheckPatchSize(patch_size_);
-  keypoint_size_ = BriskKeypointSize(patch_size_);
+    : Descriptor(options), pool_(std::make_unique<Pool>()) {
+  keypoint_size_ = BriskKeypointSize(PatchSize());
   pool_->idle.push_back(MakeBrisk());
 }
 
 BriskDescriptor::~BriskDescriptor() = default;
 
-void BriskDescriptor::Describe(const cv::Mat& patch, cv::Mat row) const {
-  CheckInputs("BRISK", patch_size_, Width(), CV_8UC1, patch, row);
+void BriskDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
 
   cv::Ptr<cv::BRISK> brisk;
   {
@@ -168,7 +143,7 @@ void BriskDescriptor::Describe(const cv::Mat& patch, cv::Mat row) const {
   } release{*pool_, brisk};
 
   std::vector<cv::KeyPoint> keypoints{
-      cv::KeyPoint(Centre(patch_size_), keypoint_size_, /*angle=*/0.0f)};
+      cv::KeyPoint(Centre(PatchSize()), keypoint_size_, /*angle=*/0.0f)};
   cv::Mat descriptors;
   brisk->compute(PadPatch(patch), keypoints, descriptors);
   if (keypoints.size() != 1 || keypoints[0].angle != 0.0f || descriptors.rows != 1 ||
@@ -185,15 +160,13 @@ void BriskDescriptor::Describe(const cv::Mat& patch, cv::Mat row) const {
 // ---------------------------------------------------------------------------------------------
 // SIFT
 
-SiftDescriptor::SiftDescriptor(const DescriptorOptions& options) : patch_size_(options.patch_size) {
-  CheckPatchSize(patch_size_);
+SiftDescriptor::SiftDescriptor(const DescriptorOptions& options) : Descriptor(options) {
 }
 
-void SiftDescriptor::Describe(const cv::Mat& patch, cv::Mat row) const {
-  CheckInputs("SIFT", patch_size_, Width(), CV_32FC1, patch, row);
+void SiftDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
   // cv::SIFT is cheap to build; one per call is thread-safe.
   cv::Ptr<cv::SIFT> sift = cv::SIFT::create();
-  const cv::KeyPoint keypoint(Centre(patch_size_), static_cast<float>(patch_size_) / 6.0f,
+  const cv::KeyPoint keypoint(Centre(PatchSize()), static_cast<float>(PatchSize()) / 6.0f,
                               /*angle=*/0.0f, /*response=*/0.0f, /*octave=*/0);
   ComputeOne("SIFT", *sift, PadPatch(patch), keypoint, row);
 }

@@ -36,11 +36,9 @@ class OrbDescriptor final : public Descriptor {
   std::string Name() const override { return "ORB"; }
   int Width() const override { return 32; }
   DescriptorKind Kind() const override { return DescriptorKind::kBinary; }
-  int PatchSize() const override { return patch_size_; }
-  void Describe(const cv::Mat& patch, cv::Mat row) const override;
 
  private:
-  int patch_size_;
+  void DescribePatch(const cv::Mat& patch, cv::Mat row) const override;
 };
 
 // BRISK with its standard sampling pattern (60 points on rings of radius 0, 2.9, 4.9, 7.4 and
@@ -73,15 +71,13 @@ class BriskDescriptor final : public Descriptor {
   std::string Name() const override { return "BRISK"; }
   int Width() const override { return 64; }
   DescriptorKind Kind() const override { return DescriptorKind::kBinary; }
-  int PatchSize() const override { return patch_size_; }
-  void Describe(const cv::Mat& patch, cv::Mat row) const override;
 
   // Keypoint size passed to OpenCV for this patch size (see the class comment).
   float KeypointSize() const { return keypoint_size_; }
 
  private:
+  void DescribePatch(const cv::Mat& patch, cv::Mat row) const override;
   struct Pool;
-  int patch_size_;
   float keypoint_size_;
   std::unique_ptr<Pool> pool_;
 };
@@ -103,11 +99,9 @@ class SiftDescriptor final : public Descriptor {
   std::string Name() const override { return "SIFT"; }
   int Width() const override { return 128; }
   DescriptorKind Kind() const override { return DescriptorKind::kFloat; }
-  int PatchSize() const override { return patch_size_; }
-  void Describe(const cv::Mat& patch, cv::Mat row) const override;
 
  private:
-  int patch_size_;
+  void DescribePatch(const cv::Mat& patch, cv::Mat row) const override;
 };
 
 }  // namespace openable

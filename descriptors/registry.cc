@@ -1,12 +1,12 @@
 #include "descriptors/registry.h"
 
-#include <cctype>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 #include "descriptors/brief.h"
 #include "descriptors/freak.h"
 #include "descriptors/dldb.h"
@@ -52,14 +52,6 @@ const Unavailable kUnavailable[] = {
      "descriptor or LDB for a binary one"},
 };
 
-std::string Upper(const std::string& s) {
-  std::string out = s;
-  for (char& c : out) {
-    c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  }
-  return out;
-}
-
 }  // namespace
 
 std::vector<std::string> RegisteredDescriptorNames() {
@@ -83,7 +75,6 @@ std::unique_ptr<Descriptor> CreateDescriptor(const std::string& name,
   const std::string key = Upper(name);
   for (const Entry& e : kDescriptors) {
     if (key == e.name) {
-      options.Check();
       return e.create(options);
     }
   }
@@ -103,15 +94,8 @@ std::unique_ptr<Descriptor> CreateDescriptor(const std::string& name,
                    valid);
 }
 
-void DescriptorOptions::Check() const {
-  if (patch_size < 16) {
-    throw InputError("Patch_size: " + std::to_string(patch_size) +
-                     " is too small; expected an integer >= 16");
-  }
-  if (ldb_bits < 1 || ldb_bits > 1386) {
-    throw InputError("Ldb_bits: " + std::to_string(ldb_bits) +
-                     " is out of range; expected an integer in [1, 1386]");
-  }
+std::unique_ptr<Descriptor> CreateDescriptor(const DescriptorOptions& options) {
+  return CreateDescriptor(options.name, options);
 }
 
 }  // namespace openable

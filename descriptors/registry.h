@@ -22,5 +22,7 @@ std::vector<std::pair<std::string, std::string>> UnavailableDescriptors();
 // suit the descriptor (e.g. a HOG patch that is not a multiple of 8).
 std::unique_ptr<Descriptor> CreateDescriptor(const std::string& name,
                                              const DescriptorOptions& options);
+// The same with the name of `options` (the key Image_descriptor).
+std::unique_ptr<Descriptor> CreateDescriptor(const DescriptorOptions& options);
 
 }  // namespace openable

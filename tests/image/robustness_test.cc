@@ -225,11 +225,18 @@ TEST(Noise, StereoFrameKeepsItsDisparity) {
 // A descriptor that copies its 16x16 patch: rows then show the image that was described.
 class RawDescriptor : public Descriptor {
  public:
+  RawDescriptor() : Descriptor(Options16()) {}
   std::string Name() const override { return "RAW"; }
   int Width() const override { return 256; }
   DescriptorKind Kind() const override { return DescriptorKind::kFloat; }
-  int PatchSize() const override { return 16; }
-  void Describe(const cv::Mat& patch, cv::Mat row) const override {
+
+ private:
+  static DescriptorOptions Options16() {
+    DescriptorOptions o;
+    o.patch_size = 16;
+    return o;
+  }
+  void DescribePatch(const cv::Mat& patch, cv::Mat row) const override {
     patch.reshape(1, 1).convertTo(row, CV_32F);
   }
 };

@@ -11,19 +11,22 @@ namespace {
 // grid geometry checkable by hand.
 class MeanDescriptor : public Descriptor {
  public:
-  explicit MeanDescriptor(int patch) : patch_(patch) {}
+  explicit MeanDescriptor(int patch) : Descriptor(OptionsOf(patch)) {}
   std::string Name() const override { return "MEAN"; }
   int Width() const override { return 1; }
   DescriptorKind Kind() const override { return DescriptorKind::kFloat; }
-  int PatchSize() const override { return patch_; }
-  void Describe(const cv::Mat& patch, cv::Mat row) const override {
-    if (patch.rows != patch_ || patch.cols != patch_ || patch.type() != CV_8UC1)
+
+ private:
+  static DescriptorOptions OptionsOf(int patch) {
+    DescriptorOptions o;
+    o.patch_size = patch;
+    return o;
+  }
+  void DescribePatch(const cv::Mat& patch, cv::Mat row) const override {
+    if (patch.rows != PatchSize() || patch.cols != PatchSize() || patch.type() != CV_8UC1)
       throw std::logic_error("bad patch");
     row.at<float>(0, 0) = static_cast<float>(cv::mean(patch)[0]);
   }
-
- private:
-  int patch_;
 };
 
 // Frames in memory; frames listed in `broken` throw InputError like an unreadable file.

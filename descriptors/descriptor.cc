@@ -1,0 +1,52 @@
+#include "descriptors/descriptor.h"
+
+#include <stdexcept>
+#include <string>
+
+#include "OpenABLE/base/error.h"
+
+namespace openable {
+namespace {
+
+std::string Shape(const cv::Mat& m) {
+  return std::to_string(m.rows) + " x " + std::to_string(m.cols) + " " +
+         cv::typeToString(m.type());
+}
+
+}  // namespace
+
+void DescriptorOptions::Check() const {
+  if (patch_size < 16 || patch_size > 1024) {
+    throw InputError("Patch_size: " + std::to_string(patch_size) +
+                     " is out of range; expected an integer in [16, 1024]");
+  }
+  if (ldb_bits < 1 || ldb_bits > 1386) {
+    throw InputError("Ldb_bits: " + std::to_string(ldb_bits) +
+                     " is out of range; expected an integer in [1, 1386]");
+  }
+}
+
+Descriptor::Descriptor(const DescriptorOptions& options) : patch_size_(options.patch_size) {
+  options.Check();
+}
+
+void Descriptor::CheckPatch(const cv::Mat& patch) const {
+  if (patch.type() != CV_8UC(Channels()) || patch.rows != patch_size_ ||
+      patch.cols != patch_size_) {
+    throw std::logic_error(Name() + ": expected a " + std::to_string(patch_size_) + " x " +
+                           std::to_string(patch_size_) + " " +
+                           cv::typeToString(CV_8UC(Channels())) + " patch, got " + Shape(patch));
+  }
+}
+
+void Descriptor::Describe(const cv::Mat& patch, cv::Mat row) const {
+  CheckPatch(patch);
+  const int row_type = Kind() == DescriptorKind::kBinary ? CV_8UC1 : CV_32FC1;
+  if (row.type() != row_type || row.rows != 1 || row.cols != Width()) {
+    throw std::logic_error(Name() + ": expected a 1 x " + std::to_string(Width()) + " " +
+                           cv::typeToString(row_type) + " row, got " + Shape(row));
+  }
+  DescribePatch(patch, row);
+}
+
+}  // namespace openable
