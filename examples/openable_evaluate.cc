@@ -1,21 +1,15 @@
 // openable_evaluate: evaluates saved distance matrices against ground truth, with the same
 // protocols, keys and outputs as Test_OpenABLE's evaluation (docs/evaluation.md). A thin layer
 // over the library.
-#include <cmath>
+#include <algorithm>
 #include <iostream>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "OpenABLE/OpenABLE.h"
-#include "OpenABLE/evaluation/matrix_file.h"
-#include "matching/normalize.h"
 
 namespace {
-
-constexpr int kInputError = 1;
-constexpr int kUsageError = 2;
-constexpr int kInternalError = 3;
 
 // Command-line flags that stand for a Config.txt key.
 const std::pair<const char*, const char*> kFlagKeys[] = {
@@ -74,21 +68,10 @@ const char* kUsage =
     "\n"
     "Exit status: 0 success, 1 bad input (one line on stderr), 2 bad command line, 3 bug.\n";
 
-struct MatrixArg {
-  std::string path, label;
-};
-
-std::string FileLabel(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
-  const auto dot = name.find_last_of('.');
-  return dot == std::string::npos || dot == 0 ? name : name.substr(0, dot);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<MatrixArg> matrices;
+  std::vector<openable::MatrixFile> matrices;
   std::vector<std::string> overrides;
   std::string config_path;
   int reference_frames = 0;
@@ -100,15 +83,11 @@ int main(int argc, char** argv) {
   try {
     for (int i = 1; i < argc; ++i) {
       const std::string a = argv[i];
-      bool mapped = false;
-      for (const auto& [flag, key] : kFlagKeys) {
-        if (a == flag) {
-          overrides.push_back(std::string(key) + "=" + value_of(i, a));
-          mapped = true;
-        }
-      }
-      if (mapped) continue;
-      if (a == "--help" || a == "-h") {
+      const auto flag = std::find_if(std::begin(kFlagKeys), std::end(kFlagKeys),
+                                     [&](const auto& f) { return a == f.first; });
+      if (flag != std::end(kFlagKeys)) {
+        overrides.push_back(std::string(flag->second) + "=" + value_of(i, a));
+      } else if (a == "--help" || a == "-h") {
         std::cout << kUsage;
         return 0;
       } else if (a == "--version") {
@@ -143,11 +122,12 @@ int main(int argc, char** argv) {
     if (matrices.empty()) throw std::invalid_argument("no --matrix given");
   } catch (const std::invalid_argument& e) {
     std::cerr << "openable_evaluate: " << e.what() << " (see --help)\n";
-    return kUsageError;
+    return openable::kExitUsageError;
   }
 
-  try {
-    openable::Config config = config_path.empty() ? openable::Config() : openable::LoadConfig(config_path);
+  return openable::RunProgram("openable_evaluate", [&] {
+    openable::Config config =
+        config_path.empty() ? openable::Config() : openable::LoadConfig(config_path);
     for (const auto& o : overrides) openable::ApplyOverride(config, o);
     if (!openable::EvaluationRequested(config))
       throw openable::InputError(
@@ -156,52 +136,14 @@ int main(int argc, char** argv) {
     openable::CheckEvaluationConfig(config);
     openable::Evaluation evaluation;
     evaluation.settings = openable::EvaluationSettingsFrom(config);
-    std::vector<cv::Mat1f> loaded;
-    loaded.reserve(matrices.size());
-    for (const MatrixArg& m : matrices) {
-      cv::Mat1f matrix = openable::ReadMatrixFile(m.path);
-      if (!cv::checkRange(matrix, true, nullptr, 0.0, 3.0e38))
-        throw openable::InputError("matrix \"" + m.path +
-                                   "\" holds a negative, infinite or NaN value; expected "
-                                   "distances >= 0");
-      openable::NormalizeByMax(matrix);
-      openable::EvaluationLayout layout;
-      if (matrix.rows != matrix.cols) {
-        layout = openable::EvaluationLayout::QueryReference(matrix.rows, matrix.cols);
-      } else if (reference_frames > 0) {
-        if (reference_frames >= matrix.rows)
-          throw openable::InputError("--reference-frames: " + std::to_string(reference_frames) +
-                                     " leaves no query frame in the " +
-                                     std::to_string(matrix.rows) + "x" +
-                                     std::to_string(matrix.cols) + " matrix \"" + m.path +
-                                     "\"; expected fewer frames than its rows");
-        layout = openable::EvaluationLayout::TwoTraversals(reference_frames,
-                                                           matrix.rows - reference_frames);
-      } else {
-        layout = openable::EvaluationLayout::LoopClosure(matrix.rows);
-      }
-      openable::EvaluateMatrix(evaluation, matrix, layout,
-                               m.label.empty() ? FileLabel(m.path) : m.label, m.path);
-      loaded.push_back(std::move(matrix));
-    }
+    const std::vector<cv::Mat1f> loaded =
+        openable::EvaluateMatrixFiles(evaluation, matrices, reference_frames);
     if (!quiet) std::cout << openable::FormatEvaluationTable(evaluation.settings, evaluation.runs);
-    if (!config.evaluation_name.empty()) {
-      openable::OutputBatch batch;
-      std::vector<const cv::Mat1f*> pointers;
-      for (const auto& m : loaded) pointers.push_back(&m);
-      openable::StageEvaluation(batch, "Evaluation_name", config.evaluation_name, evaluation,
-                                pointers);
-      const std::vector<std::string> paths = batch.Paths();
-      batch.Commit();
-      std::cout << "Wrote:\n";
-      for (const auto& p : paths) std::cout << "  " << p << "\n";
-    }
+    if (config.evaluation.name.empty()) return 0;
+    const std::vector<std::string> paths = openable::WriteEvaluation(
+        "Evaluation_name", config.evaluation.name, evaluation, loaded);
+    std::cout << "Wrote:\n";
+    for (const auto& p : paths) std::cout << "  " << p << "\n";
     return 0;
-  } catch (const openable::InputError& e) {
-    std::cerr << "openable_evaluate: error: " << e.what() << "\n";
-    return kInputError;
-  } catch (const std::exception& e) {
-    std::cerr << "openable_evaluate: internal error (please report): " << e.what() << "\n";
-    return kInternalError;
-  }
+  });
 }

@@ -5,10 +5,17 @@
 #include <queue>
 #include <stdexcept>
 
+#include "OpenABLE/base/option_checks.h"
 #include "matching/distances.h"
 #include "matching/large_matrix.h"
 
 namespace openable {
+
+void KeepRules::Check() const {
+  CheckIntRange("Best_matches", best, 0, 100000);
+  CheckIntAtLeast("Band_width", band, -1);
+  CheckIntAtLeast("Exclusion", exclusion, 1);
+}
 
 MatchBlock BlockOf(const std::vector<int>& starts, int n) {
   MatchBlock b;

@@ -32,10 +32,13 @@ struct Match {
 };
 
 struct KeepRules {
-  int best = 10;          // k
-  int band = -1;          // |i - j| <= band; -1 none
-  int exclusion = 100;    // one traversal: candidates at least this many frames earlier
+  int best = 10;          // k (Best_matches), 0..100000
+  int band = -1;          // |i - j| <= band (Band_width); -1 none
+  int exclusion = 100;    // one traversal: candidates at least this many frames earlier, >= 1
   bool one_traversal = true;
+
+  // Throws InputError naming the key (Best_matches, Band_width, Exclusion) of a bad value.
+  void Check() const;
 };
 
 // Which rows and columns of the concatenated descriptors are matched.

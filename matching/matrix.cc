@@ -1,8 +1,19 @@
 #include "matching/matrix.h"
 
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/base/option_checks.h"
+#include "OpenABLE/base/strings.h"
 #include "matching/normalize.h"
 
 namespace openable {
+
+void MatchingOptions::Check() const {
+  CheckIntRange("Image_sequences", sequence_length, 1, 100000);
+  if (threshold != -1.0 && !(threshold >= 0.0 && threshold <= 1.0))
+    throw InputError("Threshold: " + FormatNumber(threshold) +
+                     " is not valid; expected -1 (disabled) or a number in [0, 1]");
+  CheckIntRange("Threads", threads, 0, 1024);
+}
 
 cv::Mat1f PairwiseDistances(const cv::Mat& rows, int strips, PanoramaMatching mode, int threads,
                             const PairProgress& progress) {

@@ -1,12 +1,16 @@
 #include "OpenABLE/image/preprocess.h"
 
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/option_checks.h"
+#include "OpenABLE/base/strings.h"
 
 namespace openable {
 
@@ -71,6 +75,57 @@ cv::Mat ToGrayDisparity8(const cv::Mat& frame) {
   cv::Mat out;
   frame.convertTo(out, CV_8U, 255.0);  // saturating and rounding, per channel
   return out;
+}
+
+std::vector<int> ParseSideWindowRadii(const std::string& text) {
+  auto fail = [&](const std::string& why) {
+    throw InputError("Side_window_radii: " + Quoted(text) + " is not valid (" + why +
+                     "); expected radii in [1, 50] separated by commas, 1 to 16 layers, "
+                     "e.g. \"1,2,3\"");
+  };
+  std::vector<int> radii;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    item = Trim(item);
+    if (item.empty()) fail("empty item");
+    char* end = nullptr;
+    errno = 0;
+    const long v = std::strtol(item.c_str(), &end, 10);
+    if (end != item.c_str() + item.size() || errno == ERANGE)
+      fail(Quoted(item) + " is not an integer");
+    if (v < 1 || v > 50) fail(item + " is out of range");
+    radii.push_back(static_cast<int>(v));
+  }
+  if (!text.empty() && text.back() == ',') fail("empty item");
+  if (radii.empty()) fail("no radius");
+  if (radii.size() > 16) fail(std::to_string(radii.size()) + " layers");
+  return radii;
+}
+
+double PreprocessOptions::Alpha() const {
+  return lambda_red > 0 ? AlphaFromPeakResponses(lambda_red, lambda_green, lambda_blue) : alpha;
+}
+
+std::vector<int> PreprocessOptions::SideWindowRadii() const {
+  return side_window ? ParseSideWindowRadii(side_window_radii) : std::vector<int>{};
+}
+
+void PreprocessOptions::Check() const {
+  CheckNumberRange("Alpha", alpha, 0, 1);
+  CheckNumberRange("Lambda_red", lambda_red, 0, 2000);
+  CheckNumberRange("Lambda_green", lambda_green, 0, 2000);
+  CheckNumberRange("Lambda_blue", lambda_blue, 0, 2000);
+  const int given = (lambda_red > 0) + (lambda_green > 0) + (lambda_blue > 0);
+  if (given != 0 && given != 3)
+    throw InputError("Lambda_red, Lambda_green, Lambda_blue: " + FormatNumber(lambda_red) +
+                     ", " + FormatNumber(lambda_green) + ", " + FormatNumber(lambda_blue) +
+                     "; expected all three peak responses (nm) or none (0)");
+  CheckNumberRange("Noise_gaussian", noise.gaussian, 0, 1);
+  CheckNumberRange("Noise_salt_pepper", noise.salt_pepper, 0, 1);
+  CheckNumberAtLeast("Noise_overexposure", noise.overexposure, 0);
+  CheckIntRange("Noise_seed", noise.seed, 0, 1000000000);
+  SideWindowRadii();
 }
 
 }  // namespace openable

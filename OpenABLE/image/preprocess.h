@@ -1,7 +1,12 @@
 // Preprocessing of a frame before description.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include <opencv2/core.hpp>
+
+#include "OpenABLE/image/robustness.h"
 
 namespace openable {
 
@@ -37,5 +42,30 @@ cv::Mat1b IlluminationInvariant(const cv::Mat& frame, double alpha);
 // 470 nm) gives 0.4706. Throws InputError naming the keys Lambda_red, Lambda_green, Lambda_blue
 // unless 0 < blue < green < red (which puts alpha in (0, 1)).
 double AlphaFromPeakResponses(double red_nm, double green_nm, double blue_nm);
+
+// The layer radii of a side-window fusion written as text ("1,2,3": integers in [1, 50],
+// 1 to 16 layers, spaces allowed). Throws a one-line InputError naming Side_window_radii.
+std::vector<int> ParseSideWindowRadii(const std::string& text);
+
+// How each frame is prepared before description (the keys Illumination_invariance, Alpha,
+// Lambda_*, Side_window, Side_window_radii and Noise_*; docs/descriptors.md).
+struct PreprocessOptions {
+  bool illumination_invariance = false;  // describe Eq. 6's image instead of the grey one
+  double alpha = 0.47;                   // alpha of Eq. 6, [0, 1] (KITTI's PointGrey Flea2)
+  // Peak spectral responses of the red, green and blue channels, nm, [0, 2000]: all three
+  // (then Eq. 7 gives alpha) or none (0).
+  double lambda_red = 0, lambda_green = 0, lambda_blue = 0;
+  bool side_window = false;               // side-window multilayer fusion (robustness.h)
+  std::string side_window_radii = "1,2,3";  // its layer radii, ParseSideWindowRadii
+  NoiseOptions noise;                     // noise for robustness studies (robustness.h)
+
+  // Alpha of Eq. 6: by Eq. 7 from the peak responses when they are given, else `alpha`.
+  double Alpha() const;
+  // The radii of the side-window layers; empty when side_window is off.
+  std::vector<int> SideWindowRadii() const;
+  // Throws InputError naming the key of a value out of range, peak responses given in part or
+  // out of order, or radii that do not parse (when side_window is on).
+  void Check() const;
+};
 
 }  // namespace openable

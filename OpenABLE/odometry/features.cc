@@ -1,20 +1,15 @@
 #include "OpenABLE/odometry/features.h"
 
 #include <algorithm>
-#include <cctype>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 
 namespace openable::odometry {
 
-std::string UpperCase(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return s;
-}
-
 FeatureExtractor::FeatureExtractor(const std::string& name, int max_features,
                                    const std::string& key) {
-  const std::string upper = UpperCase(name);
+  const std::string upper = Upper(name);
   if (upper == "ORB") {
     detector_ = cv::ORB::create(max_features);
     norm_ = cv::NORM_HAMMING;

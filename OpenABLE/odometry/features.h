@@ -1,14 +1,12 @@
 // Keypoints and their matching between consecutive frames, shared by both odometries.
 #pragma once
 
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 
-#include "OpenABLE/base/error.h"
 
 namespace openable::odometry {
 
@@ -40,17 +38,5 @@ class FeatureExtractor {
 // test). queryIdx indexes `from`, trainIdx `to`. Deterministic. Empty when either is empty.
 std::vector<cv::DMatch> MatchWithRatioTest(const Features& from, const Features& to, int norm,
                                            double ratio);
-
-// Upper-case copy of `s` (names of options are compared case-insensitively).
-std::string UpperCase(std::string s);
-
-// Options checks: throws InputError "<owner>.<field> = <value>, expected <expected>" unless ok.
-template <typename T>
-void RequireOption(const char* owner, bool ok, const char* field, T value, const char* expected) {
-  if (ok) return;
-  std::ostringstream s;
-  s << owner << "." << field << " = " << value << ", expected " << expected;
-  throw InputError(s.str());
-}
 
 }  // namespace openable::odometry

@@ -11,26 +11,13 @@
 #include <opencv2/core/eigen.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/odometry/features.h"
 
 namespace openable::odometry {
 
 double RotationAngle(const Eigen::Matrix3d& r) {
   return Eigen::AngleAxisd(r).angle();
-}
-
-void MonoOdometryOptions::Check() const {
-  const std::string upper = UpperCase(features);
-  RequireOption("MonoOdometryOptions", upper == "ORB" || upper == "SIFT", "features", Quoted(features), "ORB or SIFT");
-  RequireOption("MonoOdometryOptions", max_features >= 8, "max_features", max_features, ">= 8");
-  RequireOption("MonoOdometryOptions", ratio_test > 0 && ratio_test <= 1, "ratio_test", ratio_test, "in (0, 1]");
-  RequireOption("MonoOdometryOptions", ransac_threshold_px > 0 && std::isfinite(ransac_threshold_px), "ransac_threshold_px",
-          ransac_threshold_px, "> 0");
-  RequireOption("MonoOdometryOptions", ransac_confidence > 0 && ransac_confidence < 1, "ransac_confidence", ransac_confidence,
-          "in (0, 1)");
-  RequireOption("MonoOdometryOptions", min_inliers >= 5, "min_inliers", min_inliers, ">= 5");
-  RequireOption("MonoOdometryOptions", still_step_length >= 0 && std::isfinite(still_step_length), "still_step_length",
-          still_step_length, ">= 0");
 }
 
 MonoOdometry::MonoOdometry(const Intrinsics& intrinsics, const MonoOdometryOptions& options)

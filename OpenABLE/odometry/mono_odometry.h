@@ -29,9 +29,9 @@ struct MonoOdometryOptions {
   // (half size) SIFT gives 0.11 degree of rotation error per step against ORB's 0.24-0.5, and
   // is faster there (fewer keypoints found on the small frames). See docs/odometry.md.
   std::string features = "SIFT";
-  // Keypoints kept per frame (strongest), >= 8. 2000 leaves several hundred inliers on KITTI.
+  // Keypoints kept per frame (strongest), >= 10. 2000 leaves several hundred inliers on KITTI.
   int max_features = 2000;
-  // Lowe's ratio test, in (0, 1]: a match is kept when its distance is below ratio x the
+  // Lowe's ratio test, in [0.1, 1]: a match is kept when its distance is below ratio x the
   // second nearest's. 0.8 is Lowe's value.
   double ratio_test = 0.8;
   // RANSAC inlier threshold of the essential matrix (distance to the epipolar line), pixels,
@@ -48,7 +48,9 @@ struct MonoOdometryOptions {
   // StepStats::note "standing still"): a stopped camera gives no parallax, so the essential
   // matrix is undefined and RANSAC would fit noise. 0.02 m is 0.2 m/s at KITTI's 10 Hz.
   double still_step_length = 0.02;
-  // Throws InputError naming the field (MonoOdometryOptions.<field>), its value and the range.
+  // Throws InputError naming the Config.txt key and the field ("Odometry_max_features
+  // (MonoOdometryOptions.max_features)"; the field alone when no key sets it), the value and
+  // the range. Defined in options.cc.
   void Check() const;
 };
 

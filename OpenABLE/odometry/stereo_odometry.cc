@@ -11,6 +11,7 @@
 #include <opencv2/ximgproc/disparity_filter.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/odometry/features.h"
 #include "OpenABLE/stereo/disparity.h"
 
@@ -26,7 +27,7 @@ DisparityOptions SgbmOptions(const StereoOdometryOptions& o) {
 }
 
 cv::Ptr<cv::StereoMatcher> LeftMatcher(const StereoOdometryOptions& o) {
-  if (UpperCase(o.matcher) == "BM") return cv::StereoBM::create(o.num_disparities, o.block_size);
+  if (Upper(o.matcher) == "BM") return cv::StereoBM::create(o.num_disparities, o.block_size);
   const DisparityOptions d = SgbmOptions(o);
   const int area = d.block_size * d.block_size;
   return cv::StereoSGBM::create(0, d.num_disparities, d.block_size, 8 * area, 32 * area,
@@ -37,35 +38,13 @@ cv::Ptr<cv::StereoMatcher> LeftMatcher(const StereoOdometryOptions& o) {
 
 }  // namespace
 
-void StereoOdometryOptions::Check() const {
-  const std::string m = UpperCase(matcher);
-  RequireOption("StereoOdometryOptions", m == "SGBM" || m == "BM", "matcher", Quoted(matcher), "sgbm or bm");
-  RequireOption("StereoOdometryOptions", wls_lambda > 0 && std::isfinite(wls_lambda), "wls_lambda", wls_lambda, "> 0");
-  RequireOption("StereoOdometryOptions", wls_sigma > 0 && std::isfinite(wls_sigma), "wls_sigma", wls_sigma, "> 0");
-  RequireOption("StereoOdometryOptions", num_disparities >= 16 && num_disparities <= 256 && num_disparities % 16 == 0,
-          "num_disparities", num_disparities, "a multiple of 16 in [16, 256]");
-  RequireOption("StereoOdometryOptions", block_size % 2 == 1 && block_size <= 11 && block_size >= (m == "BM" ? 5 : 1),
-          "block_size", block_size, "odd, 1-11 (sgbm) or 5-11 (bm)");
-  const std::string f = UpperCase(features);
-  RequireOption("StereoOdometryOptions", f == "ORB" || f == "SIFT", "features", Quoted(features), "ORB or SIFT");
-  RequireOption("StereoOdometryOptions", max_features >= 8, "max_features", max_features, ">= 8");
-  RequireOption("StereoOdometryOptions", ratio_test > 0 && ratio_test <= 1, "ratio_test", ratio_test, "in (0, 1]");
-  RequireOption("StereoOdometryOptions", max_depth > 0 && std::isfinite(max_depth), "max_depth", max_depth, "> 0");
-  RequireOption("StereoOdometryOptions", pnp_reprojection_px > 0 && std::isfinite(pnp_reprojection_px), "pnp_reprojection_px",
-          pnp_reprojection_px, "> 0");
-  RequireOption("StereoOdometryOptions", pnp_iterations >= 1, "pnp_iterations", pnp_iterations, ">= 1");
-  RequireOption("StereoOdometryOptions", pnp_confidence > 0 && pnp_confidence < 1, "pnp_confidence", pnp_confidence,
-          "in (0, 1)");
-  RequireOption("StereoOdometryOptions", min_inliers >= 4, "min_inliers", min_inliers, ">= 4");
-}
-
 cv::Mat1f OdometryDisparity(const cv::Mat& left, const cv::Mat& right,
                             const StereoOdometryOptions& o) {
   o.Check();
   if (left.type() != CV_8UC1 || right.type() != CV_8UC1 || left.size() != right.size() ||
       left.empty())
     throw std::logic_error("OdometryDisparity: expected two CV_8UC1 images of one size");
-  const bool bm = UpperCase(o.matcher) == "BM";
+  const bool bm = Upper(o.matcher) == "BM";
   if (!bm && !o.wls_filter) return ComputeDisparity(left, right, SgbmOptions(o));
 
   const cv::Ptr<cv::StereoMatcher> left_matcher = LeftMatcher(o);

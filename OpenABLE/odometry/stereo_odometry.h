@@ -41,11 +41,11 @@ struct StereoOdometryOptions {
   int block_size = 5;
   // "SIFT" (the paper) or "ORB".
   std::string features = "SIFT";
-  // Keypoints kept per frame, >= 8.
+  // Keypoints kept per frame, >= 10.
   int max_features = 2000;
-  // Lowe's ratio test, in (0, 1].
+  // Lowe's ratio test, in [0.1, 1].
   double ratio_test = 0.8;
-  // Metres, > 0: points farther than this (in the previous frame) are not used in PnP.
+  // Metres, >= 1: points farther than this (in the previous frame) are not used in PnP.
   double max_depth = 80;
   // RANSAC of PnP: inlier reprojection error, pixels (> 0); iterations (>= 1); confidence (0, 1).
   double pnp_reprojection_px = 2.0;
@@ -53,7 +53,9 @@ struct StereoOdometryOptions {
   double pnp_confidence = 0.999;
   // Fewest PnP inliers to accept a step, >= 4; below, constant velocity.
   int min_inliers = 15;
-  // Throws InputError naming the field (StereoOdometryOptions.<field>), its value and the range.
+  // Throws InputError naming the Config.txt key and the field ("Odometry_max_depth
+  // (StereoOdometryOptions.max_depth)"; the field alone when no key sets it), the value and
+  // the range. Defined in options.cc.
   void Check() const;
 };
 

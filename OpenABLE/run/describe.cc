@@ -58,18 +58,21 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
     }
     return true;
   };
+  const NoiseOptions& noise = options.preprocess.noise;
+  const bool illumination_invariance = options.preprocess.illumination_invariance;
+  const double alpha = options.preprocess.Alpha();
+  const std::vector<int> side_window_radii = options.preprocess.SideWindowRadii();
   auto describe = [&](int i, const cv::Mat& frame) {
     if (!check_size(i, frame.size())) return;
     // Grey (or Eq. 6) for every descriptor; grey + disparity (a stereo frame) for D-LDB.
     // Noise (robustness studies) on the frame as read, before any conversion.
-    const cv::Mat input = options.noise.Any()
-                              ? AddNoise(frame, options.noise,
-                                         NoiseState(options.noise.seed, options.noise_stream, i))
-                              : frame;
+    const cv::Mat input =
+        noise.Any() ? AddNoise(frame, noise, NoiseState(noise.seed, options.noise_stream, i))
+                    : frame;
     cv::Mat image;
     try {
       image = describer.Channels() == 2          ? ToGrayDisparity8(input)
-              : options.illumination_invariance ? cv::Mat(IlluminationInvariant(input, options.alpha))
+              : illumination_invariance ? cv::Mat(IlluminationInvariant(input, alpha))
                                                 : cv::Mat(ToGray8(input));
     } catch (const InputError& e) {
       fail(i, "image " + Quoted(source.FrameName(i)) + ": " + e.what());
@@ -82,8 +85,7 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
                   " (Grid_x x Panoramas by Grid_y pixels)");
       return;
     }
-    if (!options.side_window_radii.empty())
-      image = SideWindowFusion(image, options.side_window_radii);
+    if (!side_window_radii.empty()) image = SideWindowFusion(image, side_window_radii);
     describer.Describe(image, rows.row(i));
     ok[i] = 1;
     if (options.cache != nullptr && !options.show_images)

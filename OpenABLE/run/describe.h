@@ -9,7 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/io/frame_source.h"
-#include "OpenABLE/image/robustness.h"
+#include "OpenABLE/image/preprocess.h"
 #include "descriptors/descriptor.h"
 #include "descriptors/frame_describer.h"
 
@@ -39,17 +39,14 @@ struct DescribeOptions {
   int threads = 0;               // 0 = all cores
   bool skip_unreadable = false;  // false: the first unreadable frame is an InputError
   bool show_images = false;      // show each frame in a window (forces one thread)
-  bool illumination_invariance = false;  // describe IlluminationInvariant(frame, alpha), not grey
-  double alpha = 0.47;
   std::string key;               // config key naming the source, prefixed to errors
   RowCache* cache = nullptr;     // rows of frames described before; not used with show_images
                                  // or sources without ParallelReads (videos)
-  // Robustness (OpenABLE/image/robustness.h): noise added to each frame before grey conversion
-  // (off unless options set), seeded from noise.seed, noise_stream and the frame's index;
-  // side-window fusion of the grey image with these radii (empty = off) before description.
-  NoiseOptions noise;
+  // How each frame is prepared (OpenABLE/image/preprocess.h): noise added before grey
+  // conversion (seeded from noise.seed, noise_stream and the frame's index), the grey image or
+  // Eq. 6's, side-window fusion of it.
+  PreprocessOptions preprocess;
   int noise_stream = 0;          // traversal index: 0 Images_path, 1 Images_path_2
-  std::vector<int> side_window_radii;
 };
 
 // Reads and describes every frame of `source` (in parallel when the source allows it).

@@ -1,4 +1,4 @@
-// The descriptor cache (Descriptor_cache, issue 8): descriptor rows kept on disk under a hash
+// The descriptor cache (Descriptor_cache): descriptor rows kept on disk under a hash
 // of the image file's bytes and of every setting that changes the row, so that an interrupted
 // or repeated run describes only the frames not cached. Format: docs/output_formats.md.
 #pragma once
@@ -26,7 +26,7 @@ std::uint64_t Fnv1a64(const void* data, size_t size, std::uint64_t h = kFnv1a64O
 inline constexpr int kDescriptorCacheVersion = 1;
 
 // The Config keys whose values change a frame's descriptor row: the one place to list them.
-// tests/core/descriptor_cache_test.cc fails when a key of the table is neither here nor in
+// tests/run/descriptor_cache_test.cc fails when a key of the table is neither here nor in
 // its list of keys known not to change rows.
 const std::vector<std::string>& DescriptionKeys();
 

@@ -1,11 +1,14 @@
 #include "OpenABLE/run/evaluate.h"
 
 #include <cctype>
+#include <filesystem>
 #include <set>
 #include <stdexcept>
 
 #include "OpenABLE/base/version.h"
+#include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/evaluation/plots.h"
+#include "matching/normalize.h"
 
 namespace openable {
 namespace {
@@ -22,34 +25,30 @@ std::string FileSafe(const std::string& label) {
 
 }  // namespace
 
-bool EvaluationRequested(const Config& config) { return !config.ground_truth_type.empty(); }
+bool EvaluationRequested(const Config& config) { return config.evaluation.Requested(); }
 
 EvaluationSettings EvaluationSettingsFrom(const Config& c) {
   EvaluationSettings s;
-  s.truth.type = ParseGroundTruthType(c.ground_truth_type);
-  s.truth.path = c.ground_truth;
-  s.truth.path_2 = c.ground_truth_2;
-  s.truth.base = c.ground_truth_base;
-  s.truth.first_frame = c.initial_image;
-  s.truth.range_selected = c.initial_image > 0 || c.final_image != -1;
-  s.truth.radius = c.ground_truth_radius;
-  s.truth.heading_limit = c.ground_truth_heading;
-  s.truth.min_frame_gap = c.ground_truth_min_gap >= 0 ? c.ground_truth_min_gap : c.exclusion;
-  s.truth.axes = c.ground_truth_axes;
-  s.options.tolerance = c.tolerance;
-  s.options.exclusion = c.exclusion;
-  s.options.vicinity = c.vicinity;
+  s.truth = c.evaluation.truth;
+  s.options = c.evaluation.protocol;
+  // What the evaluation takes from the rest of the run: the frame number of row 0, whether
+  // part of the source was selected, and the frame gap of loops (-1: the exclusion).
+  s.truth.first_frame = c.input.initial_image;
+  s.truth.range_selected = c.input.initial_image > 0 || c.input.final_image != -1;
+  s.truth.min_frame_gap =
+      c.evaluation.min_frame_gap >= 0 ? c.evaluation.min_frame_gap : s.options.exclusion;
   s.truth.Check();
   s.options.Check();
   return s;
 }
 
 std::string RunLabel(const Config& config) {
-  if (!config.evaluation_label.empty()) return config.evaluation_label;
-  std::string label = config.image_descriptor;
-  if (config.description_type == 1)
-    label += " " + std::to_string(config.grid_x) + "x" + std::to_string(config.grid_y);
-  return label + " L=" + std::to_string(config.image_sequences);
+  if (!config.evaluation.label.empty()) return config.evaluation.label;
+  std::string label = config.descriptor.name;
+  if (config.description.type == DescriptionType::kGrid)
+    label += " " + std::to_string(config.description.grid_x) + "x" +
+             std::to_string(config.description.grid_y);
+  return label + " L=" + std::to_string(config.matching.sequence_length);
 }
 
 void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
@@ -100,6 +99,50 @@ void StageEvaluation(OutputBatch& batch, const std::string& key, const std::stri
       evaluation.runs[0].layout.kind == EvaluationLayout::Kind::kLoopClosure)
     title += ", exclusion " + std::to_string(s.options.exclusion);
   batch.Stage(key, prefix + "_pr.png", EncodePng(RenderPrPlot(series, title, s.options.vicinity)));
+}
+
+std::vector<cv::Mat1f> EvaluateMatrixFiles(Evaluation& evaluation,
+                                           const std::vector<MatrixFile>& files,
+                                           int reference_frames) {
+  std::vector<cv::Mat1f> loaded;
+  loaded.reserve(files.size());
+  for (const MatrixFile& m : files) {
+    cv::Mat1f matrix = ReadMatrixFile(m.path);
+    if (!cv::checkRange(matrix, true, nullptr, 0.0, 3.0e38))
+      throw InputError("matrix " + Quoted(m.path) +
+                       " holds a negative, infinite or NaN value; expected distances >= 0");
+    NormalizeByMax(matrix);
+    EvaluationLayout layout;
+    if (matrix.rows != matrix.cols) {
+      layout = EvaluationLayout::QueryReference(matrix.rows, matrix.cols);
+    } else if (reference_frames > 0) {
+      if (reference_frames >= matrix.rows)
+        throw InputError("--reference-frames: " + std::to_string(reference_frames) +
+                         " leaves no query frame in the " + std::to_string(matrix.rows) + "x" +
+                         std::to_string(matrix.cols) + " matrix " + Quoted(m.path) +
+                         "; expected fewer frames than its rows");
+      layout = EvaluationLayout::TwoTraversals(reference_frames, matrix.rows - reference_frames);
+    } else {
+      layout = EvaluationLayout::LoopClosure(matrix.rows);
+    }
+    const std::string label =
+        m.label.empty() ? std::filesystem::path(m.path).stem().string() : m.label;
+    EvaluateMatrix(evaluation, matrix, layout, label, m.path);
+    loaded.push_back(std::move(matrix));
+  }
+  return loaded;
+}
+
+std::vector<std::string> WriteEvaluation(const std::string& key, const std::string& prefix,
+                                         const Evaluation& evaluation,
+                                         const std::vector<cv::Mat1f>& matrices) {
+  OutputBatch batch;
+  std::vector<const cv::Mat1f*> pointers;
+  for (const auto& m : matrices) pointers.push_back(&m);
+  StageEvaluation(batch, key, prefix, evaluation, pointers);
+  const std::vector<std::string> paths = batch.Paths();
+  batch.Commit();
+  return paths;
 }
 
 }  // namespace openable

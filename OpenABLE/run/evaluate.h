@@ -47,4 +47,26 @@ void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
 void StageEvaluation(OutputBatch& batch, const std::string& key, const std::string& prefix,
                      const Evaluation& evaluation, const std::vector<const cv::Mat1f*>& matrices);
 
+// A saved matrix to evaluate (openable_evaluate's --matrix and --label).
+struct MatrixFile {
+  std::string path;
+  std::string label;  // legend label; empty: the file name without its extension
+};
+
+// Reads each matrix (ReadMatrixFile: .npy, text or image), refuses negative, infinite or NaN
+// values, normalises it by its maximum (Eq. 5; no change for Test_OpenABLE's M'), takes its
+// layout (not square: queries x references; square: two traversals of which the first
+// `reference_frames` frames are the reference when reference_frames > 0, else one sequence)
+// and evaluates it into `evaluation` (EvaluateMatrix). Returns the normalised matrices in the
+// order of `files`. Throws InputError naming the file.
+std::vector<cv::Mat1f> EvaluateMatrixFiles(Evaluation& evaluation,
+                                           const std::vector<MatrixFile>& files,
+                                           int reference_frames);
+
+// Writes the files of `evaluation` under `prefix` (StageEvaluation), all or nothing; returns
+// the paths written. `key` names the prefix in errors.
+std::vector<std::string> WriteEvaluation(const std::string& key, const std::string& prefix,
+                                         const Evaluation& evaluation,
+                                         const std::vector<cv::Mat1f>& matrices);
+
 }  // namespace openable

@@ -40,22 +40,24 @@ struct SourceSpec {
   SourceKind kind;
 };
 
-std::vector<SourceSpec> Sources(const Config& c) {
+std::vector<SourceSpec> Sources(const InputOptions& c) {
   // Stereo (Camera_type 1): one pair of folders; CheckConfig rejects videos and Images_path_2.
-  if (c.camera_type == 1) return {{"Images_path_left", c.images_path_left, SourceKind::kStereo}};
+  if (c.camera_type == CameraType::kStereo)
+    return {{"Images_path_left", c.images_path_left, SourceKind::kStereo}};
   switch (c.frame_mode) {
-    case 0: {
+    case FrameMode::kImageFolders: {
       std::vector<SourceSpec> s = {{"Images_path", c.images_path, SourceKind::kFolder}};
       if (!c.images_path_2.empty())
         s.push_back({"Images_path_2", c.images_path_2, SourceKind::kFolder});
       return s;
     }
-    case 1:
+    case FrameMode::kVideo:
       return {{"Video_path_1", c.video_path_1, SourceKind::kVideo}};
-    default:
-      return {{"Video_path_1", c.video_path_1, SourceKind::kVideo},
-              {"Video_path_2", c.video_path_2, SourceKind::kVideo}};
+    case FrameMode::kTwoVideos:
+      break;
   }
+  return {{"Video_path_1", c.video_path_1, SourceKind::kVideo},
+          {"Video_path_2", c.video_path_2, SourceKind::kVideo}};
 }
 
 double PhysicalMemoryBytes() {
@@ -74,29 +76,26 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   const auto run_start = Clock::now();
   RunResult result;
 
-  DescriptorOptions dopt;
-  dopt.patch_size = config.patch_size;
-  dopt.ldb_bits = config.ldb_bits;
-  const auto descriptor = CreateDescriptor(config.image_descriptor, dopt);
-  const bool panoramic = config.camera_type == 2;
-  const int strips = panoramic ? config.panoramas : 1;
-  const auto panorama_matching = static_cast<PanoramaMatching>(config.panorama_matching);
-  const FrameDescriber describer(*descriptor, static_cast<DescriptionType>(config.description_type),
-                                 config.grid_x, config.grid_y, strips);
+  const InputOptions& input = config.input;
+  const MatchingOptions& matching = config.matching;
+  const auto descriptor = CreateDescriptor(config.descriptor);
+  const bool panoramic = input.camera_type == CameraType::kPanoramic;
+  const int strips = panoramic ? config.description.panoramas : 1;
+  const PanoramaMatching panorama_matching = matching.panorama_matching;
+  const FrameDescriber describer(*descriptor, config.description.type, config.description.grid_x,
+                                 config.description.grid_y, strips);
   // Eq. 7 replaces Alpha when the three peak responses are given.
-  const bool lambdas = config.lambda_red > 0;
-  const double alpha = lambdas ? AlphaFromPeakResponses(config.lambda_red, config.lambda_green,
-                                                         config.lambda_blue)
-                               : config.alpha;
+  const bool lambdas = config.preprocess.lambda_red > 0;
+  const double alpha = config.preprocess.Alpha();
   {
     char text[200];
     result.camera = panoramic ? "panoramic, " + std::to_string(strips) + " sub-panoramas, " +
                                     EnumName(panorama_matching) + " matching"
-                  : config.camera_type == 1
+                  : input.camera_type == CameraType::kStereo
                       ? std::string("stereo, rectified") +
                             (descriptor->Channels() == 2 ? ", SGBM disparity" : ", left image")
                       : "monocular";
-    if (config.illumination_invariance == 1) {
+    if (config.preprocess.illumination_invariance) {
       std::snprintf(text, sizeof text, ", illumination invariant (Eq. 6, alpha %.4f%s)", alpha,
                     lambdas ? " from Eq. 7" : "");
       result.camera += text;
@@ -110,7 +109,7 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
 
   // Open every source first, so that a bad second folder is reported before any work.
   std::vector<std::unique_ptr<FrameSource>> sources;
-  const std::vector<SourceSpec> specs = Sources(config);
+  const std::vector<SourceSpec> specs = Sources(input);
   for (const auto& spec : specs) {
     if (spec.kind == SourceKind::kStereo) {
       // The stereo source's messages name their keys (Images_path_left, Images_path_right,
@@ -118,17 +117,17 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
       StereoSourceOptions stereo_options;
       stereo_options.compute_disparity = describer.Channels() == 2;  // only D-LDB reads it
       const StereoCalibration calibration = WithKey(
-          "Calibration_path", [&] { return LoadStereoCalibration(config.calibration_path); });
-      sources.push_back(OpenStereoFolders(config.images_path_left, config.images_path_right,
-                                          config.images_format, config.initial_image,
-                                          config.final_image, calibration, stereo_options));
+          "Calibration_path", [&] { return LoadStereoCalibration(input.calibration_path); });
+      sources.push_back(OpenStereoFolders(input.images_path_left, input.images_path_right,
+                                          input.images_format, input.initial_image,
+                                          input.final_image, calibration, stereo_options));
       continue;
     }
     sources.push_back(WithKey(spec.key, [&] {
       return spec.kind == SourceKind::kVideo
-                 ? OpenVideo(spec.path, config.initial_image, config.final_image)
-                 : OpenImageFolder(spec.path, config.images_format, config.initial_image,
-                                   config.final_image);
+                 ? OpenVideo(spec.path, input.initial_image, input.final_image)
+                 : OpenImageFolder(spec.path, input.images_format, input.initial_image,
+                                   input.final_image);
     }));
   }
 
@@ -136,71 +135,65 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   // counts of the sources (skipped frames can only make the matrix smaller).
   std::int64_t planned = 0;
   for (const auto& source : sources) planned += source->Size();
-  const auto direction = static_cast<SequenceDirection>(config.sequence_direction);
+  const ScaleOptions& scale = config.scale;
+  const SequenceDirection direction = matching.direction;
   const double gib = 1024.0 * 1024.0 * 1024.0;
   const double dense_bytes = static_cast<double>(planned) * planned * 4.0 *
                              (direction == SequenceDirection::kBoth ? 2.0 : 1.0);
-  const double limit_bytes = config.memory_limit > 0 ? config.memory_limit * gib
+  const double limit_bytes = scale.memory_limit > 0 ? scale.memory_limit * gib
                                                      : 0.75 * PhysicalMemoryBytes();
   char sizes[160];
   std::snprintf(sizes, sizeof sizes, "the %lldx%lld matrix needs %.2f GiB, Memory_limit %.2f GiB%s",
                 static_cast<long long>(planned), static_cast<long long>(planned), dense_bytes / gib,
-                limit_bytes / gib, config.memory_limit > 0 ? "" : " (3/4 of the RAM)");
-  if (config.approximate_search == 1) {
+                limit_bytes / gib, scale.memory_limit > 0 ? "" : " (3/4 of the RAM)");
+  if (scale.approximate_search) {
     result.bounded = true;
     result.mode_reason = "bounded (Approximate_search 1)";
-  } else if (config.matrix_mode == 2) {
+  } else if (scale.matrix_mode == MatrixMode::kBounded) {
     result.bounded = true;
     result.mode_reason = "bounded (Matrix_mode 2)";
-  } else if (config.matrix_mode == 1) {
+  } else if (scale.matrix_mode == MatrixMode::kDense) {
     result.mode_reason = std::string("dense (Matrix_mode 1; ") + sizes + ")";
   } else {
     result.bounded = dense_bytes > limit_bytes;
     result.mode_reason = std::string(result.bounded ? "bounded" : "dense") + " (Matrix_mode 0: " +
                          sizes + ")";
   }
-  if (result.bounded && config.matches_name.empty())
+  if (result.bounded && scale.matches_name.empty())
     throw InputError("Matches_name: empty, but the run is " + result.mode_reason +
                      " and keeps only matches; expected a .npy or .csv path (or a larger "
                      "Memory_limit for the dense matrix)");
 
   if (result.bounded && panoramic && panorama_matching != PanoramaMatching::kAligned)
-    throw InputError(std::string("Panorama_matching: ") + std::to_string(config.panorama_matching) +
+    throw InputError(std::string("Panorama_matching: ") +
+                     std::to_string(static_cast<int>(panorama_matching)) +
                      " (" + EnumName(panorama_matching) + ") needs the dense "
                      "matrix, but the run is " + result.mode_reason +
                      "; expected Matrix_mode 1 (or 0 with a larger Memory_limit) or "
                      "Panorama_matching 0");
 
   DescribeOptions options;
-  options.threads = config.threads;
-  options.skip_unreadable = config.skip_unreadable == 1;
-  options.show_images = config.show_images == 1 && HasDisplay();
-  options.illumination_invariance = config.illumination_invariance == 1;
-  options.alpha = alpha;
-  options.noise.gaussian = config.noise_gaussian;
-  options.noise.salt_pepper = config.noise_salt_pepper;
-  options.noise.overexposure = config.noise_overexposure;
-  options.noise.seed = config.noise_seed;
-  if (config.side_window == 1)
-    options.side_window_radii = ParseSideWindowRadii(config.side_window_radii);
+  options.threads = matching.threads;
+  options.skip_unreadable = input.skip_unreadable;
+  options.show_images = config.output.show_images && HasDisplay();
+  options.preprocess = config.preprocess;
 
   // Descriptor cache: image folders only (a video frame or a stereo pair has no one file).
   std::unique_ptr<DescriptorCache> cache;
-  if (!config.descriptor_cache.empty()) {
+  if (!scale.descriptor_cache.empty()) {
     if (specs.front().kind != SourceKind::kFolder) {
       result.notes.push_back("Descriptor_cache: not used: the cache keeps rows of image "
                              "files (Frame_mode 0, Camera_type 0 or 2), not of videos or "
                              "stereo pairs");
     } else if (options.show_images) {
       result.notes.push_back("Descriptor_cache: not used with Show_images 1");
-    } else if (options.noise.gaussian > 0 || options.noise.salt_pepper > 0 ||
-               options.noise.overexposure > 0) {
+    } else if (options.preprocess.noise.Any()) {
       // The noise of a frame depends on its position in the run, not only on its bytes.
       result.notes.push_back("Descriptor_cache: not used with Noise_* (a frame's noise depends "
                              "on its position in the run, not only on the image)");
     } else {
       cache = DescriptorCache::Open(
-          config.descriptor_cache,
+          scale.descriptor_cache,
           DescriptionSettingsText(config, descriptor->Name(), describer.RowWidth(),
                                   describer.RowType()),
           describer.RowWidth(), describer.RowType(), result.warnings);
@@ -252,18 +245,17 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
   for (const auto& tr : result.traversals) starts.push_back(tr.first_row);
   const std::int64_t n = descriptors.rows;
   const MatchBlock block = BlockOf(starts, static_cast<int>(n));
-  KeepRules rules;
-  rules.best = config.best_matches;
-  rules.band = config.band_width;
-  rules.exclusion = config.exclusion;
+  KeepRules rules = scale.keep;
+  rules.exclusion = config.evaluation.protocol.exclusion;
   rules.one_traversal = block.one_traversal;
 
   if (result.bounded) {
     for (const char* key : {"Txt_name", "Npy_name", "Png_name", "Png_threshold_name"}) {
-      const std::string& v = std::string(key) == "Txt_name"  ? config.txt_name
-                             : std::string(key) == "Npy_name" ? config.npy_name
-                             : std::string(key) == "Png_name" ? config.png_name
-                                                              : config.png_threshold_name;
+      const OutputOptions& o = config.output;
+      const std::string& v = std::string(key) == "Txt_name"  ? o.txt_name
+                             : std::string(key) == "Npy_name" ? o.npy_name
+                             : std::string(key) == "Png_name" ? o.png_name
+                                                              : o.png_threshold_name;
       if (!v.empty())
         result.notes.push_back(std::string(key) + ": not written: the run is bounded and "
                                "keeps no dense matrix (see Matches_name)");
@@ -273,12 +265,12 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
         static_cast<std::int64_t>(block.query_count) * block.reference_count;
     progress.Begin("matching", block.query_count, "queries (bounded: tiles of rows)");
     BoundedOptions options;
-    options.sequence_length = config.image_sequences;
+    options.sequence_length = matching.sequence_length;
     options.direction = direction;
-    options.threads = config.threads;
-    if (config.approximate_search == 1) {
+    options.threads = matching.threads;
+    if (scale.approximate_search) {
       result.matches = ApproximateMatches(descriptors, block, rules, options,
-                                          config.approximate_checks, result.max_distance);
+                                          scale.approximate_checks, result.max_distance);
     } else {
       result.matches = BoundedMatches(descriptors, block, rules, options, result.max_distance,
                                       [&](int done, int) { progress.Update(done); });
@@ -297,20 +289,21 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
                  cross ? "cells of sub-panorama pairs" : "cells");
   const PairProgress on_pairs = [&](std::int64_t done, std::int64_t) { progress.Update(done); };
   cv::Mat1f distances =
-      PairwiseDistances(descriptors, strips, panorama_matching, config.threads, on_pairs);
+      PairwiseDistances(descriptors, strips, panorama_matching, matching.threads, on_pairs);
   progress.End();
   result.timings.match_seconds = SecondsSince(t);
 
   // Sequences, Eq. 5, Eq. 9.
   t = Clock::now();
-  SequenceDistancesInPlace(distances, config.image_sequences, starts, starts, direction,
-                           config.threads);
+  SequenceDistancesInPlace(distances, matching.sequence_length, starts, starts, direction,
+                           matching.threads);
   result.normalized = distances;
   distances.release();
   result.max_distance = NormalizeByMax(result.normalized);
-  if (config.threshold >= 0.0)
-    result.thresholded = ThresholdMatrix(result.normalized, static_cast<float>(config.threshold));
-  if (!config.matches_name.empty())
+  if (matching.threshold >= 0.0)
+    result.thresholded =
+        ThresholdMatrix(result.normalized, static_cast<float>(matching.threshold));
+  if (!scale.matches_name.empty())
     result.matches = MatchesFromMatrix(result.normalized, block, rules);
   result.timings.sequence_seconds = SecondsSince(t);
   result.timings.total_seconds = SecondsSince(run_start);
@@ -326,12 +319,7 @@ EvaluationLayout LayoutOf(const RunResult& result) {
 }
 
 std::string ThresholdPngPath(const Config& config) {
-  if (config.threshold < 0.0) return "";
-  if (!config.png_threshold_name.empty()) return config.png_threshold_name;
-  if (config.png_name.empty()) return "";
-  const std::filesystem::path p(config.png_name);
-  return (p.parent_path() / (p.stem().string() + "_thresholded" + p.extension().string()))
-      .string();
+  return config.output.ThresholdPngPath(config.matching.threshold >= 0.0);
 }
 
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
@@ -347,42 +335,44 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
   auto encode = [&](const std::string& key, const std::string& path, auto make) {
     pending.push_back({key, path, std::async(std::launch::async, make)});
   };
+  const OutputOptions& out = config.output;
   const bool dense = !result.bounded;  // bounded runs keep no matrix: only Matches_name
-  if (dense && !config.txt_name.empty())
-    encode("Txt_name", config.txt_name, [&] {
+  if (dense && !out.txt_name.empty())
+    encode("Txt_name", out.txt_name, [&] {
       return EncodeText(result.thresholded.empty() ? cv::Mat(result.normalized)
                                                    : cv::Mat(result.thresholded));
     });
-  if (dense && !config.png_name.empty())
-    encode("Png_name", config.png_name,
-           [&] { return EncodePng(ColorizeMatrix(result.normalized, config.matrix_color)); });
+  if (dense && !out.png_name.empty())
+    encode("Png_name", out.png_name,
+           [&] { return EncodePng(ColorizeMatrix(result.normalized, out.matrix_color)); });
   const std::string threshold_png = ThresholdPngPath(config);
   if (dense && !threshold_png.empty()) {
-    encode(config.png_threshold_name.empty() ? "Png_name" : "Png_threshold_name", threshold_png,
+    encode(out.png_threshold_name.empty() ? "Png_name" : "Png_threshold_name", threshold_png,
            [&] {
              cv::Mat1f binary;
              result.thresholded.convertTo(binary, CV_32F);
-             return EncodePng(ColorizeMatrix(binary, config.matrix_color));
+             return EncodePng(ColorizeMatrix(binary, out.matrix_color));
            });
   }
   OutputBatch batch;
-  if (dense && !config.npy_name.empty()) {
+  if (dense && !out.npy_name.empty()) {
     // Written from the matrix itself while the other outputs are being encoded.
     const std::string header = NpyHeader(result.normalized.rows, result.normalized.cols);
     std::vector<std::string_view> parts = {header};
     for (int i = 0; i < result.normalized.rows; ++i)
       parts.emplace_back(reinterpret_cast<const char*>(result.normalized.ptr<float>(i)),
                          result.normalized.cols * sizeof(float));
-    batch.Stage("Npy_name", config.npy_name, parts);
+    batch.Stage("Npy_name", out.npy_name, parts);
   }
   for (Pending& p : pending) batch.Stage(p.key, p.path, p.bytes.get());
-  if (!config.matches_name.empty()) {
-    const bool csv = config.matches_name.size() >= 4 &&
-                     config.matches_name.compare(config.matches_name.size() - 4, 4, ".csv") == 0;
-    batch.Stage("Matches_name", config.matches_name, EncodeMatches(result.matches, csv));
+  const std::string& matches = config.scale.matches_name;
+  if (!matches.empty()) {
+    const bool csv =
+        matches.size() >= 4 && matches.compare(matches.size() - 4, 4, ".csv") == 0;
+    batch.Stage("Matches_name", matches, EncodeMatches(result.matches, csv));
   }
-  if (evaluation != nullptr && !config.evaluation_name.empty())
-    StageEvaluation(batch, "Evaluation_name", config.evaluation_name, *evaluation,
+  if (evaluation != nullptr && !config.evaluation.name.empty())
+    StageEvaluation(batch, "Evaluation_name", config.evaluation.name, *evaluation,
                     {&result.normalized});
   const std::vector<std::string> paths = batch.Paths();
   batch.Commit();

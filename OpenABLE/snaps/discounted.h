@@ -32,6 +32,10 @@ struct DiscountOptions {
   // frames (trajectory indices) after the last pinned frame. Not given in the paper; 20 frames
   // = 2 s of KITTI at 10 Hz.
   int pause = 20;
+
+  // Throws InputError naming the key (Snaps_discount_length, Snaps_pause) of a negative value.
+  // Defined in options.cc.
+  void Check() const;
 };
 
 // gamma of Eq. 6 for s' = N - s >= 0 and alpha >= 1, clamped at 0.

@@ -42,6 +42,10 @@ struct SearchOptions {
   // whose y axis points down; (0, 0, 1) for a z-up world (TUM). The heading of a pose is its
   // optical axis (camera z) projected on the plane normal to this axis.
   Eigen::Vector3d vertical = Eigen::Vector3d::UnitY();
+
+  // Throws InputError naming the key (Snaps_window, Snaps_radius, ...) of a value out of range.
+  // Defined in options.cc.
+  void Check() const;
 };
 
 // Yaw difference in degrees, in [0, 180], between two camera-to-world poses (see

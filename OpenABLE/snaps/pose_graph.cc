@@ -260,54 +260,6 @@ void CheckIndex(int index, int size, const char* what) {
 
 }  // namespace
 
-RobustKernel ParseRobustKernel(const std::string& name, const std::string& key) {
-  std::string lower = name;
-  std::transform(lower.begin(), lower.end(), lower.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (lower == "none") return RobustKernel::kNone;
-  if (lower == "huber") return RobustKernel::kHuber;
-  if (lower == "cauchy") return RobustKernel::kCauchy;
-  throw InputError(key + ": " + Quoted(name) +
-                   " is not a robust kernel; expected none, huber or cauchy");
-}
-
-std::string RobustKernelName(RobustKernel kernel) {
-  switch (kernel) {
-    case RobustKernel::kNone:
-      return "none";
-    case RobustKernel::kHuber:
-      return "huber";
-    case RobustKernel::kCauchy:
-      return "cauchy";
-  }
-  return "?";
-}
-
-void PoseGraphOptions::Check() const {
-  const auto positive = [](double v, const char* name) {
-    if (!(v > 0) || !std::isfinite(v)) {
-      throw InputError(std::string("PoseGraphOptions.") + name + ": " + std::to_string(v) +
-                       "; expected a finite number > 0");
-    }
-  };
-  positive(odometry_translation_weight, "odometry_translation_weight");
-  positive(odometry_rotation_weight, "odometry_rotation_weight");
-  positive(loop_weight, "loop_weight");
-  positive(robust_scale, "robust_scale");
-  if (!(relative_tolerance >= 0) || !std::isfinite(relative_tolerance)) {
-    throw InputError("PoseGraphOptions.relative_tolerance: " + std::to_string(relative_tolerance) +
-                     "; expected a finite number >= 0");
-  }
-  if (max_iterations < 1) {
-    throw InputError("PoseGraphOptions.max_iterations: " + std::to_string(max_iterations) +
-                     "; expected >= 1");
-  }
-  if (!(initial_lambda >= 0) || !std::isfinite(initial_lambda)) {
-    throw InputError("PoseGraphOptions.initial_lambda: " + std::to_string(initial_lambda) +
-                     "; expected a finite number >= 0");
-  }
-}
-
 Trajectory CorrectPoseGraph(const Trajectory& input, const std::vector<LoopPair>& loops,
                             const PoseGraphOptions& options, PoseGraphReport* report) {
   return CorrectPoseGraph(input, loops, {}, options, report);

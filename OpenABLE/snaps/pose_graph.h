@@ -1,4 +1,4 @@
-// Pose-graph correction of a drifting trajectory with loop pairs (SNAPS add-on, issue 6).
+// Pose-graph correction of a drifting trajectory with loop pairs (the SNAPS add-on).
 //
 // The paper (../shared/papers/000_589a4d56462291ec.txt, Sec. II-C, Eq. 6) corrects the
 // trajectory with a discounted update; this is the classical alternative it is compared with:
@@ -49,10 +49,13 @@
 namespace openable::snaps {
 
 enum class RobustKernel { kNone, kHuber, kCauchy };
+OPENABLE_ENUM_NAMES(RobustKernel, "none", "huber", "cauchy")
 
 // "none", "huber", "cauchy" (case-insensitive); InputError naming `key` otherwise.
-RobustKernel ParseRobustKernel(const std::string& name, const std::string& key);
-std::string RobustKernelName(RobustKernel kernel);
+inline RobustKernel ParseRobustKernel(const std::string& name, const std::string& key) {
+  return ParseEnum<RobustKernel>(name, key);
+}
+inline std::string RobustKernelName(RobustKernel kernel) { return EnumName(kernel); }
 
 struct PoseGraphOptions {
   // Information of an odometry edge's translation residual, 1/m^2 (> 0). 2500 = sigma 0.02 m.
@@ -74,7 +77,9 @@ struct PoseGraphOptions {
   // Initial Levenberg-Marquardt damping (>= 0; 0 = start as Gauss-Newton).
   double initial_lambda = 1e-6;
 
-  // InputError naming the field when a value is out of range.
+  // InputError naming the key and the field ("Snaps_loop_weight
+  // (PoseGraphOptions.loop_weight)"; the field alone when no key sets it) of a value out of
+  // range. Defined in options.cc.
   void Check() const;
 };
 

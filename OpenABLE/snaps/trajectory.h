@@ -1,4 +1,4 @@
-// Trajectories for the SNAPS add-on (issue 6): poses of a camera over a run, their files, their
+// Trajectories for the SNAPS add-on: poses of a camera over a run, their files, their
 // association with a ground truth, and the absolute trajectory error.
 //
 // Paper: "Similarity and Location-based Real-time Loop Closure: SNAPS for SLAM in Unexplored
@@ -10,6 +10,8 @@
 
 #include <Eigen/Geometry>
 
+#include "OpenABLE/base/enum_names.h"
+
 namespace openable::snaps {
 
 // File formats.
@@ -18,10 +20,13 @@ namespace openable::snaps {
 //    SO-DSO files of ../shared/datasets/kitti_trajectories); pose i is frame id_i.
 //  - kTum: `timestamp tx ty tz qx qy qz qw` per line ('#' comments); pose i is frame i.
 enum class TrajectoryFormat { kKitti, kKittiWithId, kTum };
+OPENABLE_ENUM_NAMES(TrajectoryFormat, "kitti", "kitti-id", "tum")
 
 // "kitti", "kitti-id", "tum" (case-insensitive); throws InputError naming `key` otherwise.
-TrajectoryFormat ParseTrajectoryFormat(const std::string& name, const std::string& key);
-std::string TrajectoryFormatName(TrajectoryFormat format);
+inline TrajectoryFormat ParseTrajectoryFormat(const std::string& name, const std::string& key) {
+  return ParseEnum<TrajectoryFormat>(name, key);
+}
+inline std::string TrajectoryFormatName(TrajectoryFormat format) { return EnumName(format); }
 
 struct Trajectory {
   TrajectoryFormat format = TrajectoryFormat::kKitti;

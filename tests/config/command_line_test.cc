@@ -43,8 +43,8 @@ TEST(CommandLine, ConfigOfAppliesOverridesInOrder) {
   CommandLine cl;
   cl.overrides = {"Threads=3", "Threads=5", "Snaps_corrector=pose-graph"};
   const Config c = ConfigOf(cl);
-  EXPECT_EQ(c.threads, 5);
-  EXPECT_EQ(c.snaps_corrector, "pose-graph");
+  EXPECT_EQ(c.matching.threads, 5);
+  EXPECT_EQ(EnumName(c.snaps.corrector), "pose-graph");
 }
 
 }  // namespace

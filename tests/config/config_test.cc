@@ -45,38 +45,38 @@ TEST(Config, ReadsTheOriginalFormat) {
       "Threshold: 0.25\n"
       "Show_images: 0\n");
   const Config c = LoadConfig(path);
-  EXPECT_EQ(c.images_path, "/data/seq # not a comment");
-  EXPECT_EQ(c.images_format, "png");
-  EXPECT_EQ(c.initial_image, 10);
-  EXPECT_EQ(c.final_image, 200);
-  EXPECT_EQ(c.txt_name, "out.txt");
-  EXPECT_EQ(c.image_descriptor, "ORB");
-  EXPECT_EQ(c.patch_size, 48);
-  EXPECT_EQ(c.image_sequences, 7);
-  EXPECT_DOUBLE_EQ(c.threshold, 0.25);
+  EXPECT_EQ(c.input.images_path, "/data/seq # not a comment");
+  EXPECT_EQ(c.input.images_format, "png");
+  EXPECT_EQ(c.input.initial_image, 10);
+  EXPECT_EQ(c.input.final_image, 200);
+  EXPECT_EQ(c.output.txt_name, "out.txt");
+  EXPECT_EQ(c.descriptor.name, "ORB");
+  EXPECT_EQ(c.descriptor.patch_size, 48);
+  EXPECT_EQ(c.matching.sequence_length, 7);
+  EXPECT_DOUBLE_EQ(c.matching.threshold, 0.25);
   // Keys not given keep their defaults.
-  EXPECT_EQ(c.matrix_color, 0);
-  EXPECT_EQ(c.ldb_bits, 256);
+  EXPECT_EQ(c.output.matrix_color, 0);
+  EXPECT_EQ(c.descriptor.ldb_bits, 256);
 }
 
 TEST(Config, RoundTripsEveryKey) {
   Config c;
-  c.frame_mode = 2;
-  c.video_path_1 = "a b.avi";
-  c.video_path_2 = "/x/y.mp4";
-  c.images_path_2 = "winter";
-  c.matrix_color = 11;
-  c.alpha = 0.123;
-  c.threshold = 0.5;
-  c.image_descriptor = "HOG";
-  c.ldb_bits = 1386;
-  c.threads = 3;
-  c.final_image = 77;
+  c.input.frame_mode = FrameMode::kTwoVideos;
+  c.input.video_path_1 = "a b.avi";
+  c.input.video_path_2 = "/x/y.mp4";
+  c.input.images_path_2 = "winter";
+  c.output.matrix_color = 11;
+  c.preprocess.alpha = 0.123;
+  c.matching.threshold = 0.5;
+  c.descriptor.name = "HOG";
+  c.descriptor.ldb_bits = 1386;
+  c.matching.threads = 3;
+  c.input.final_image = 77;
   const Config back = LoadConfig(WriteFile(FormatConfig(c)));
   EXPECT_EQ(back, c);
   EXPECT_NE(back, Config());
-  EXPECT_EQ(back.video_path_1, "a b.avi");
-  EXPECT_DOUBLE_EQ(back.alpha, 0.123);
+  EXPECT_EQ(back.input.video_path_1, "a b.avi");
+  EXPECT_DOUBLE_EQ(back.preprocess.alpha, 0.123);
 }
 
 TEST(Config, MissingFileNamesIt) {
@@ -131,8 +131,8 @@ TEST(Config, MalformedLinesDuplicatesAndEmptyFiles) {
 TEST(Config, ParsesTextInMemoryLikeAFile) {
   const std::string text = "%YAML:1.0\nPatch_size: 32\nImage_descriptor: \"HOG\"\n";
   const Config from_text = ParseConfigText(text, "memory");
-  EXPECT_EQ(from_text.patch_size, 32);
-  EXPECT_EQ(from_text.image_descriptor, "HOG");
+  EXPECT_EQ(from_text.descriptor.patch_size, 32);
+  EXPECT_EQ(from_text.descriptor.name, "HOG");
   EXPECT_EQ(from_text, LoadConfig(WriteFile(text)));
   const std::string msg = ErrorOf([] { ParseConfigText("Patch_size: 32\nPatch_size: x\n", "mem"); });
   EXPECT_EQ(msg.rfind("mem:2: Patch_size:", 0), 0u) << msg;
@@ -141,7 +141,7 @@ TEST(Config, ParsesTextInMemoryLikeAFile) {
 // Found by tests/fuzz/config_fuzzer.cc: a first line starting with 0xEF but shorter than a
 // UTF-8 byte-order mark threw std::out_of_range instead of InputError.
 TEST(Config, ByteOrderMarkOnlyWhenComplete) {
-  EXPECT_EQ(ParseConfigText("\xEF\xBB\xBFPatch_size: 16\n", "bom").patch_size, 16);
+  EXPECT_EQ(ParseConfigText("\xEF\xBB\xBFPatch_size: 16\n", "bom").descriptor.patch_size, 16);
   for (const std::string text : {"\xEF", "\xEFT", "\xEF\xBB", "\xEF\xBBPatch_size: 16\n"}) {
     const std::string msg = ErrorOf([&] { ParseConfigText(text, "bom"); });
     EXPECT_EQ(msg.rfind("bom:1: ", 0), 0u) << msg;
@@ -152,8 +152,8 @@ TEST(Config, OverridesUseTheSameBinding) {
   Config c;
   ApplyOverride(c, "Image_sequences=12");
   ApplyOverride(c, "Images_path = /tmp/x");
-  EXPECT_EQ(c.image_sequences, 12);
-  EXPECT_EQ(c.images_path, "/tmp/x");
+  EXPECT_EQ(c.matching.sequence_length, 12);
+  EXPECT_EQ(c.input.images_path, "/tmp/x");
   EXPECT_NE(ErrorOf([&] { ApplyOverride(c, "Image_sequence=3"); }).find("did you mean \"Image_sequences\""),
             std::string::npos);
   EXPECT_NE(ErrorOf([&] { ApplyOverride(c, "Patch_size"); }).find("Key=Value"), std::string::npos);
@@ -163,61 +163,61 @@ TEST(Config, OverridesUseTheSameBinding) {
 TEST(Config, CrossKeyChecks) {
   Config c;
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Images_path: empty"), std::string::npos);
-  c.images_path = "x";
+  c.input.images_path = "x";
   CheckConfig(c);
-  c.camera_type = 2;
+  c.input.camera_type = CameraType::kPanoramic;
   CheckConfig(c);  // panoramas read Images_path like a monocular run
   // Peak responses: all three or none.
-  c.lambda_red = 610;
+  c.preprocess.lambda_red = 610;
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Lambda_red, Lambda_green, Lambda_blue: 610, 0, 0"),
             std::string::npos);
-  c.lambda_green = 535;
-  c.lambda_blue = 470;
+  c.preprocess.lambda_green = 535;
+  c.preprocess.lambda_blue = 470;
   CheckConfig(c);
-  c.lambda_red = c.lambda_green = c.lambda_blue = 0;
+  c.preprocess.lambda_red = c.preprocess.lambda_green = c.preprocess.lambda_blue = 0;
   // Stereo: its folders and calibration are required, Images_path is not.
-  c.camera_type = 1;
-  c.images_path = "";
+  c.input.camera_type = CameraType::kStereo;
+  c.input.images_path = "";
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Images_path_left: empty"), std::string::npos);
-  c.images_path_left = "l";
+  c.input.images_path_left = "l";
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Images_path_right: empty"), std::string::npos);
-  c.images_path_right = "r";
+  c.input.images_path_right = "r";
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Calibration_path: empty"), std::string::npos);
-  c.calibration_path = "cal.yaml";
-  c.image_descriptor = "D-LDB";
+  c.input.calibration_path = "cal.yaml";
+  c.descriptor.name = "D-LDB";
   CheckConfig(c);
-  c.illumination_invariance = 1;  // stereo frames are grey
+  c.preprocess.illumination_invariance = true;  // stereo frames are grey
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Illumination_invariance: 1 with Camera_type 1"),
             std::string::npos);
-  c.illumination_invariance = 0;
-  c.images_path_2 = "second";
+  c.preprocess.illumination_invariance = false;
+  c.input.images_path_2 = "second";
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Images_path_2: \"second\" with Camera_type 1"),
             std::string::npos);
-  c.images_path_2 = "";
-  c.frame_mode = 1;
-  c.video_path_1 = "a.avi";
+  c.input.images_path_2 = "";
+  c.input.frame_mode = FrameMode::kVideo;
+  c.input.video_path_1 = "a.avi";
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Frame_mode: 1 with Camera_type 1"),
             std::string::npos);
-  c.frame_mode = 0;
-  c.video_path_1 = "";
+  c.input.frame_mode = FrameMode::kImageFolders;
+  c.input.video_path_1 = "";
   // D-LDB needs the disparity of a stereo camera (any case of the name).
-  c.camera_type = 0;
-  c.images_path = "x";
+  c.input.camera_type = CameraType::kMonocular;
+  c.input.images_path = "x";
   for (const char* name : {"D-LDB", "d-ldb"}) {
-    c.image_descriptor = name;
+    c.descriptor.name = name;
     EXPECT_EQ(ErrorOf([&] { CheckConfig(c); }),
               "Image_descriptor: D-LDB needs Camera_type 1 (stereo); Camera_type is 0");
   }
-  c.image_descriptor = "LDB";
-  c.frame_mode = 2;
-  c.video_path_1 = "a.avi";
+  c.descriptor.name = "LDB";
+  c.input.frame_mode = FrameMode::kTwoVideos;
+  c.input.video_path_1 = "a.avi";
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Video_path_2"), std::string::npos);
-  c.frame_mode = 0;
-  c.initial_image = 5;
-  c.final_image = 5;
+  c.input.frame_mode = FrameMode::kImageFolders;
+  c.input.initial_image = 5;
+  c.input.final_image = 5;
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Final_image: 5"), std::string::npos);
-  c.final_image = -1;
-  c.threshold = -0.5;
+  c.input.final_image = -1;
+  c.matching.threshold = -0.5;
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Threshold: -0.5"), std::string::npos);
 }
 
@@ -245,7 +245,7 @@ TEST(Config, DocsReferenceIsUpToDate) {
 TEST(Config, ShippedConfigFilesLoad) {
   const Config c = LoadConfig(testing::SourceDir() + "/config/Config.txt");
   CheckConfig(c);
-  EXPECT_EQ(c.image_descriptor, "LDB");
+  EXPECT_EQ(c.descriptor.name, "LDB");
 }
 
 }  // namespace

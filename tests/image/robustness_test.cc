@@ -258,10 +258,11 @@ TEST(Noise, DescribeSequenceIsIndependentOfThreadsAndDiffersByFrame) {
   const FrameDescriber d(raw, DescriptionType::kGlobal);
   const Frames src(24);
   DescribeOptions opt;
-  opt.noise.gaussian = 0.003;
-  opt.noise.salt_pepper = 0.1;
-  opt.noise.seed = 5;
-  opt.side_window_radii = {1, 2};
+  opt.preprocess.noise.gaussian = 0.003;
+  opt.preprocess.noise.salt_pepper = 0.1;
+  opt.preprocess.noise.seed = 5;
+  opt.preprocess.side_window = true;
+  opt.preprocess.side_window_radii = "1,2";
   opt.threads = 1;
   const cv::Mat one = DescribeSequence(src, d, opt).rows;
   opt.threads = 4;
@@ -269,7 +270,8 @@ TEST(Noise, DescribeSequenceIsIndependentOfThreadsAndDiffersByFrame) {
   EXPECT_EQ(cv::norm(one, four, cv::NORM_INF), 0);
   // Frame i equals AddNoise with its own state, then grey, then fusion.
   for (int i : {0, 17}) {
-    const cv::Mat grey = ToGray8(AddNoise(src.Read(i), opt.noise, NoiseState(5, 0, i)));
+    const cv::Mat grey =
+        ToGray8(AddNoise(src.Read(i), opt.preprocess.noise, NoiseState(5, 0, i)));
     const cv::Mat fused = SideWindowFusion(grey, {1, 2});
     cv::Mat expect;
     fused.reshape(1, 1).convertTo(expect, CV_32F);
@@ -294,11 +296,11 @@ TEST(RobustnessKeys, RadiiParseAndErrorsAreOneLineNamingTheKey) {
     testing::ExpectInputError([&] { ParseSideWindowRadii(bad); },
                               {"Side_window_radii", "expected radii in [1, 50]"});
   Config c;
-  c.images_path = "x";
-  c.side_window = 1;
-  c.side_window_radii = "1,x";
+  c.input.images_path = "x";
+  c.preprocess.side_window = true;
+  c.preprocess.side_window_radii = "1,x";
   testing::ExpectInputError([&] { CheckConfig(c); }, {"Side_window_radii", "\"x\""});
-  c.side_window = 0;
+  c.preprocess.side_window = false;
   CheckConfig(c);  // not used when off
 }
 
@@ -314,8 +316,8 @@ TEST(RobustnessKeys, NoiseKeysAreBoundedWithOneLineErrors) {
   testing::ExpectInputError([&] { ApplyOverride(c, "Side_window=2"); }, {"Side_window"});
   ApplyOverride(c, "Noise_gaussian=0.003");
   ApplyOverride(c, "Side_window_radii=\"2,2\"");
-  EXPECT_DOUBLE_EQ(c.noise_gaussian, 0.003);
-  EXPECT_EQ(c.side_window_radii, "2,2");
+  EXPECT_DOUBLE_EQ(c.preprocess.noise.gaussian, 0.003);
+  EXPECT_EQ(c.preprocess.side_window_radii, "2,2");
 }
 
 }  // namespace

@@ -1,0 +1,113 @@
+#include "OpenABLE/run/run.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "OpenABLE/base/version.h"
+
+namespace openable {
+namespace {
+
+std::string Fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+}  // namespace
+
+RunOutcome Run(const Config& config, ProgressReporter& progress,
+               const std::function<void(const std::string&)>& log) {
+  if (config.output.show_images && std::getenv("DISPLAY") == nullptr &&
+      std::getenv("WAYLAND_DISPLAY") == nullptr)
+    log("warning: Show_images is 1 but there is no display (DISPLAY is not set); frames are "
+        "not shown");
+  RunOutcome out;
+  // Evaluation settings are checked before the long part of the run.
+  if (EvaluationRequested(config)) {
+    out.evaluation = std::make_unique<Evaluation>();
+    out.evaluation->settings = EvaluationSettingsFrom(config);
+  }
+  out.result = ComputeRun(config, progress);
+  RunResult& result = out.result;
+  for (const std::string& w : result.warnings) log("warning: " + w);
+  for (const std::string& note : result.notes) log("note: " + note);
+  if (out.evaluation && result.bounded) {
+    log("note: Ground_truth_type: no evaluation in bounded mode (the protocols need the dense "
+        "matrix); evaluate Matches_name yourself or use Matrix_mode 1");
+    out.evaluation.reset();
+  }
+  if (out.evaluation) {
+    const auto start = std::chrono::steady_clock::now();
+    EvaluateMatrix(*out.evaluation, result.normalized, LayoutOf(result), RunLabel(config),
+                   "Test_OpenABLE run");
+    result.timings.evaluate_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.timings.total_seconds += result.timings.evaluate_seconds;
+  }
+  out.written = WriteOutputs(config, result, out.evaluation.get());
+  return out;
+}
+
+std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
+  const RunResult& r = outcome.result;
+  const Evaluation* evaluation = outcome.evaluation.get();
+  const int patch = c.descriptor.patch_size;
+  const DescriptionOptions& d = c.description;
+  std::ostringstream out;
+  out << "OpenABLE " << kVersion << ": " << r.descriptor << " (" << r.row_width
+      << (r.binary ? " bytes, Hamming" : " floats, L2") << "), "
+      << (d.type == DescriptionType::kGlobal ? "global " : "grid ")
+      << (d.type == DescriptionType::kGlobal
+              ? std::to_string(patch) + "x" + std::to_string(patch)
+              : std::to_string(d.grid_x) + "x" + std::to_string(d.grid_y) + " cells of " +
+                    std::to_string(patch) + "x" + std::to_string(patch))
+      << ", sequence length " << c.matching.sequence_length << "\n";
+  if (!r.camera.empty()) out << "  camera: " << r.camera << "\n";
+  if (!r.cache.empty()) out << "  descriptor cache: " << r.cache << "\n";
+  for (const auto& t : r.traversals) {
+    out << "  " << t.key << ": " << t.frames << " frames of " << t.frame_size.width << "x"
+        << t.frame_size.height << " from \"" << t.path << "\" (rows " << t.first_row << "-"
+        << t.first_row + t.frames - 1 << ")\n";
+    for (const auto& s : t.skipped) out << "    skipped: " << s << "\n";
+  }
+  const auto& tm = r.timings;
+  out << "  mode: " << r.mode_reason << "\n";
+  if (r.bounded) {
+    out << "  bounded: " << r.matches.size() << " matches kept (Best_matches "
+        << c.scale.keep.best << ", Band_width " << c.scale.keep.band << "), max distance "
+        << r.max_distance << " (Eq. 5 divisor over the cells computed)";
+  } else {
+    out << "  matrix: " << r.normalized.rows << "x" << r.normalized.cols << ", max distance "
+        << r.max_distance << " (Eq. 5 divisor)";
+  }
+  if (!r.thresholded.empty())
+    out << ", threshold " << c.matching.threshold << ": "
+        << r.thresholded.total() - static_cast<size_t>(cv::countNonZero(r.thresholded))
+        << " cells below";
+  out << "\nTimings (wall clock):\n"
+      << "  total            " << Fixed(tm.total_seconds, 3) << " s\n"
+      << "  description      " << Fixed(tm.describe_seconds, 3) << " s  ("
+      << Fixed(tm.frames ? 1e3 * tm.describe_seconds / tm.frames : 0, 3) << " ms per image, "
+      << tm.frames << " images, reading included)\n"
+      << "  matching         " << Fixed(tm.match_seconds, 3) << " s  ("
+      << Fixed(tm.pairs ? 1e9 * tm.match_seconds / static_cast<double>(tm.pairs) : 0, 1)
+      << " ns per pair, " << tm.pairs << " pairs)\n"
+      << "  sequences+norm.  " << Fixed(tm.sequence_seconds, 3) << " s\n";
+  if (evaluation != nullptr)
+    out << "  evaluation       " << Fixed(tm.evaluate_seconds, 3) << " s\n";
+  out << "  export           " << Fixed(tm.export_seconds, 3) << " s\n";
+  if (evaluation != nullptr)
+    out << FormatEvaluationTable(evaluation->settings, evaluation->runs);
+  if (outcome.written.empty()) {
+    out << "No output file was asked for (set Txt_name, Npy_name or Png_name).\n";
+  } else {
+    out << "Wrote:\n";
+    for (const auto& p : outcome.written) out << "  " << p << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace openable

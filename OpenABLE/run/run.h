@@ -1,0 +1,35 @@
+// A run of Test_OpenABLE from its configuration to its files, as one call: the program is a
+// thin layer over Run and FormatRunReport.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "OpenABLE/run/evaluate.h"
+#include "OpenABLE/run/pipeline.h"
+#include "OpenABLE/run/progress.h"
+#include "config/config.h"
+
+namespace openable {
+
+struct RunOutcome {
+  RunResult result;
+  std::unique_ptr<Evaluation> evaluation;  // when Ground_truth_type is set (not bounded)
+  std::vector<std::string> written;        // the paths of the outputs
+};
+
+// Checks the evaluation settings, computes the run (ComputeRun), evaluates its matrix when
+// Ground_truth_type is set, and writes the outputs (WriteOutputs). `log` receives, as they
+// arise, lines "warning: ..." (a problem that only costs time or a feature unavailable here)
+// and "note: ..." (an output or evaluation this mode cannot give). Throws InputError naming
+// the key, file or value.
+RunOutcome Run(const Config& config, ProgressReporter& progress,
+               const std::function<void(const std::string&)>& log);
+
+// The report Test_OpenABLE prints at the end: descriptor and camera, traversals, mode and
+// matrix, timings, the evaluation table, the files written.
+std::string FormatRunReport(const Config& config, const RunOutcome& outcome);
+
+}  // namespace openable

@@ -1,0 +1,94 @@
+// The option structs of a run of Test_OpenABLE that belong to no single module: its inputs,
+// its output files, its scale (dense or bounded) and its evaluation. The modules' own option
+// structs (descriptors, matching, preprocessing, SNAPS, odometry) live with their modules;
+// config.h gathers all of them into Config.
+#pragma once
+
+#include <string>
+
+#include "OpenABLE/base/enum_names.h"
+#include "OpenABLE/evaluation/ground_truth.h"
+#include "OpenABLE/evaluation/metrics.h"
+#include "matching/bounded.h"
+
+namespace openable {
+
+// Frame_mode: image folders (Images_path, optionally Images_path_2), one video, two videos.
+enum class FrameMode { kImageFolders = 0, kVideo = 1, kTwoVideos = 2 };
+OPENABLE_ENUM_NAMES(FrameMode, "image folders", "video", "two videos")
+
+// Camera_type: monocular (ABLE-M), stereo (ABLE-S), panoramic (ABLE-P).
+enum class CameraType { kMonocular = 0, kStereo = 1, kPanoramic = 2 };
+OPENABLE_ENUM_NAMES(CameraType, "monocular", "stereo", "panoramic")
+
+// Matrix_mode: dense when it fits Memory_limit (auto), always dense, or bounded.
+enum class MatrixMode { kAuto = 0, kDense = 1, kBounded = 2 };
+OPENABLE_ENUM_NAMES(MatrixMode, "auto", "dense", "bounded")
+
+// Where the frames of a run come from (the Datasets keys and Camera_type).
+struct InputOptions {
+  FrameMode frame_mode = FrameMode::kImageFolders;
+  std::string images_path;        // folder of the (first) traversal
+  std::string images_path_2;      // folder of a second traversal, matched against the first
+  std::string images_path_left;   // stereo: left folder
+  std::string images_path_right;  // stereo: right folder
+  std::string calibration_path;   // stereo: calibration of the pair
+  std::string images_format;      // extension of the images taken; empty: every image type
+  std::string video_path_1;       // video of Frame_mode 1 and 2
+  std::string video_path_2;       // second video of Frame_mode 2
+  int initial_image = 0;          // first position (natural order) processed, >= 0
+  int final_image = -1;           // one past the last position; -1: to the end
+  bool skip_unreadable = false;   // skip unreadable frames with a warning instead of stopping
+  CameraType camera_type = CameraType::kMonocular;
+
+  // Throws InputError naming the key: a range that selects nothing, the inputs the frame mode
+  // and camera read not given, a stereo camera with videos or a second traversal.
+  void Check() const;
+};
+
+// The files of the matrix (the Representation keys).
+struct OutputOptions {
+  std::string txt_name;            // M' (or M'' with a threshold) as text; empty: not written
+  std::string npy_name;            // M' as float32 .npy; empty: not written
+  std::string png_name;            // M' as a colour image; empty: not written
+  std::string png_threshold_name;  // M'' as an image; empty: Png_name + "_thresholded"
+  int matrix_color = 0;            // colour map, 0..11 (docs/output_formats.md)
+  bool show_images = false;        // show each frame while it is described
+
+  // The thresholded image's path: Png_threshold_name, or Png_name with "_thresholded" before
+  // its extension; empty when `thresholded` is false or no PNG is asked for.
+  std::string ThresholdPngPath(bool thresholded) const;
+  // Throws InputError naming Matrix_color out of range.
+  void Check() const;
+};
+
+// Dense or bounded matrices, and what the bounded mode keeps (the Scale keys).
+struct ScaleOptions {
+  MatrixMode matrix_mode = MatrixMode::kAuto;
+  double memory_limit = 0.0;      // GiB the dense matrices may take, >= 0; 0: 3/4 of the RAM
+  KeepRules keep;                 // Best_matches and Band_width (its exclusion: Exclusion)
+  std::string matches_name;       // kept matches, .npy or .csv
+  bool approximate_search = false;  // FLANN candidates instead of every pair (bounded)
+  int approximate_checks = 512;   // FLANN k-d trees: references examined per query, 1..100000
+  std::string descriptor_cache;   // folder of the descriptor cache; empty: off
+
+  // Throws InputError naming the key: a value out of range, approximate search with the dense
+  // mode, the bounded mode without Matches_name, a matches file that is not .npy or .csv.
+  void Check() const;
+};
+
+// The evaluation of a run (the Evaluation keys).
+struct EvaluationConfig {
+  GroundTruthOptions truth;  // the ground truth (its frame gap, first frame and range: below)
+  int min_frame_gap = -1;    // Ground_truth_min_gap: poses, one sequence; -1: Exclusion
+  EvaluationOptions protocol;  // Tolerance, Exclusion, Vicinity
+  std::string name;          // output prefix (Evaluation_name); empty: the table only
+  std::string label;         // legend label (Evaluation_label); empty: descriptor and L
+
+  bool Requested() const { return truth.type != GroundTruthType::kNone; }
+  // Throws InputError naming the key of a bad value (GroundTruthOptions::Check,
+  // EvaluationOptions::Check, Ground_truth_min_gap below -1).
+  void Check() const;
+};
+
+}  // namespace openable
