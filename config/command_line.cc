@@ -2,6 +2,8 @@
 
 #include <iostream>
 
+#include "OpenABLE/base/program.h"
+
 namespace openable {
 
 std::string ParseCommandLine(int argc, const char* const* argv, const std::string& program,
@@ -65,6 +67,23 @@ Config ConfigOf(const CommandLine& command_line) {
   Config config = command_line.config_path.empty() ? Config() : LoadConfig(command_line.config_path);
   for (const auto& o : command_line.overrides) ApplyOverride(config, o);
   return config;
+}
+
+int RunConfigProgram(int argc, const char* const* argv, const std::string& program,
+                     const std::string& usage, const std::string& version_line,
+                     const std::function<int(const Config&, const CommandLine&)>& body) {
+  CommandLine cl;
+  const std::string usage_error = ParseCommandLine(argc, argv, program, cl);
+  const int answered = AnswerWithoutRunning(cl, usage_error, usage, version_line);
+  if (answered >= 0) return answered;
+  return RunProgram(program, [&] {
+    const Config config = ConfigOf(cl);
+    if (cl.print_config) {
+      std::cout << FormatConfig(config);
+      return 0;
+    }
+    return body(config, cl);
+  });
 }
 
 }  // namespace openable

@@ -3,6 +3,7 @@
 // [--help-markdown] [--version].
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -36,5 +37,13 @@ int AnswerWithoutRunning(const CommandLine& command_line, const std::string& usa
 // The configuration a command line asks for: the file (or the defaults) with the overrides
 // applied in order. Throws InputError as LoadConfig and ApplyOverride do.
 Config ConfigOf(const CommandLine& command_line);
+
+// The main of a program that reads Config.txt, around its work: parses the command line,
+// answers --help, --help-markdown, --version and usage errors (AnswerWithoutRunning), reads the
+// configuration (ConfigOf), prints it for --print-config, and otherwise returns `body`'s status;
+// errors become exit statuses through RunProgram (OpenABLE/base/program.h).
+int RunConfigProgram(int argc, const char* const* argv, const std::string& program,
+                     const std::string& usage, const std::string& version_line,
+                     const std::function<int(const Config&, const CommandLine&)>& body);
 
 }  // namespace openable

@@ -50,23 +50,15 @@ int main(int argc, char** argv) {
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
   // SIGINT/SIGTERM/SIGHUP remove the staged temporaries and exit with 128 + signal.
   openable::InstallInterruptCleanup("Test_OpenABLE");
-  openable::CommandLine cl;
-  const std::string usage_error = openable::ParseCommandLine(argc, argv, "Test_OpenABLE", cl);
-  const int answered = openable::AnswerWithoutRunning(
-      cl, usage_error, kUsage, "OpenABLE " + std::string(openable::kVersion));
-  if (answered >= 0) return answered;
-  return openable::RunProgram("Test_OpenABLE", [&] {
-    const openable::Config config = openable::ConfigOf(cl);
-    if (cl.print_config) {
-      std::cout << openable::FormatConfig(config);
-      return 0;
-    }
-    openable::ProgressReporter progress(std::cerr, !cl.quiet, openable::IsTerminal(2));
-    const openable::RunOutcome outcome =
-        openable::Run(config, progress, [](const std::string& line) {
-          std::cerr << "Test_OpenABLE: " << line << "\n";
-        });
-    std::cout << openable::FormatRunReport(config, outcome);
-    return 0;
-  });
+  return openable::RunConfigProgram(
+      argc, argv, "Test_OpenABLE", kUsage, "OpenABLE " + std::string(openable::kVersion),
+      [](const openable::Config& config, const openable::CommandLine& cl) {
+        openable::ProgressReporter progress(std::cerr, !cl.quiet, openable::IsTerminal(2));
+        const openable::RunOutcome outcome =
+            openable::Run(config, progress, [](const std::string& line) {
+              std::cerr << "Test_OpenABLE: " << line << "\n";
+            });
+        std::cout << openable::FormatRunReport(config, outcome);
+        return 0;
+      });
 }

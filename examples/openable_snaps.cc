@@ -10,7 +10,6 @@
 
 #include <opencv2/core/utils/logger.hpp>
 
-#include "OpenABLE/base/program.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/run/interrupt.h"
 #include "OpenABLE/snaps/chain.h"
@@ -52,28 +51,20 @@ const char* const kUsage =
 int main(int argc, char** argv) {
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   openable::InstallInterruptCleanup("openable_snaps");
-  openable::CommandLine cl;
-  const std::string usage_error = openable::ParseCommandLine(argc, argv, "openable_snaps", cl);
-  const int answered = openable::AnswerWithoutRunning(
-      cl, usage_error, kUsage, "openable_snaps " + std::string(openable::kVersion));
-  if (answered >= 0) return answered;
-  return openable::RunProgram("openable_snaps", [&] {
-    const openable::Config config = openable::ConfigOf(cl);
-    if (cl.print_config) {
-      std::cout << openable::FormatConfig(config);
-      return 0;
-    }
-    openable::ProgressReporter progress(std::cerr, !cl.quiet, openable::IsTerminal(2));
-    const openable::snaps::ChainResult result =
-        openable::snaps::RunChain(config, progress, [&](const std::string& line) {
-          if (!cl.quiet) std::cerr << "  " << line << "\n";
-        });
-    std::cout << openable::snaps::FormatChainReport(config, result);
-    const std::vector<std::string> paths = openable::snaps::WriteChainOutputs(config, result);
-    if (!paths.empty()) {
-      std::cout << "Wrote:\n";
-      for (const auto& path : paths) std::cout << "  " << path << "\n";
-    }
-    return 0;
-  });
+  return openable::RunConfigProgram(
+      argc, argv, "openable_snaps", kUsage, "openable_snaps " + std::string(openable::kVersion),
+      [](const openable::Config& config, const openable::CommandLine& cl) {
+        openable::ProgressReporter progress(std::cerr, !cl.quiet, openable::IsTerminal(2));
+        const openable::snaps::ChainResult result =
+            openable::snaps::RunChain(config, progress, [&](const std::string& line) {
+              if (!cl.quiet) std::cerr << "  " << line << "\n";
+            });
+        std::cout << openable::snaps::FormatChainReport(config, result);
+        const std::vector<std::string> paths = openable::snaps::WriteChainOutputs(config, result);
+        if (!paths.empty()) {
+          std::cout << "Wrote:\n";
+          for (const auto& path : paths) std::cout << "  " << path << "\n";
+        }
+        return 0;
+      });
 }

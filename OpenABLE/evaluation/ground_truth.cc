@@ -29,15 +29,8 @@ namespace {
 using evaluation_internal::IsBlank;
 using evaluation_internal::ParseNumber;
 using evaluation_internal::ReadWholeFile;
-using evaluation_internal::ToLower;
 
 namespace fs = std::filesystem;
-
-std::string FormatNumber(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
 
 // ---------------------------------------------------------------------------------------------
 // Text files of pairs and poses
@@ -107,16 +100,6 @@ bool ParseIndex(std::string_view field, std::int64_t* value) {
 
 // ---------------------------------------------------------------------------------------------
 // Options
-
-const struct {
-  GroundTruthType type;
-  const char* name;
-} kTypeNames[] = {
-    {GroundTruthType::kNone, "none"},           {GroundTruthType::kMatrix, "matrix"},
-    {GroundTruthType::kPairs, "pairs"},         {GroundTruthType::kAligned, "aligned"},
-    {GroundTruthType::kKitti, "kitti"},         {GroundTruthType::kTum, "tum"},
-    {GroundTruthType::kPositions, "positions"},
-};
 
 bool IsPoseType(GroundTruthType t) {
   return t == GroundTruthType::kKitti || t == GroundTruthType::kTum ||
@@ -263,7 +246,7 @@ void LoadPairs(const GroundTruthOptions& o, const EvaluationLayout& layout, Grou
   if (base == -1) {
     bool says_1 = false, says_0 = false;
     ForEachLine(data, [&](const Line& line) {
-      const std::string c = ToLower(std::string(line.comment));
+      const std::string c = Lower(line.comment);
       says_1 = says_1 || c.find("1-based") != std::string::npos;
       says_0 = says_0 || c.find("0-based") != std::string::npos;
     });
@@ -364,22 +347,11 @@ void LoadPoses(const GroundTruthOptions& o, const EvaluationLayout& layout, Grou
 }  // namespace
 
 GroundTruthType ParseGroundTruthType(const std::string& name) {
-  const std::string lower = ToLower(name);
-  if (lower.empty()) return GroundTruthType::kNone;
-  for (const auto& t : kTypeNames) {
-    if (lower == t.name) return t.type;
-  }
-  throw InputError("Ground_truth_type: " + Quoted(name) +
-                   " is not valid; expected matrix, pairs, aligned, kitti, tum, positions or "
-                   "empty (none)");
+  if (name.empty()) return GroundTruthType::kNone;
+  return ParseEnum<GroundTruthType>(name, "Ground_truth_type");
 }
 
-std::string GroundTruthTypeName(GroundTruthType type) {
-  for (const auto& t : kTypeNames) {
-    if (t.type == type) return t.name;
-  }
-  return "unknown";
-}
+std::string GroundTruthTypeName(GroundTruthType type) { return EnumName(type); }
 
 void GroundTruthOptions::Check() const {
   if (type != GroundTruthType::kNone && type != GroundTruthType::kAligned && path.empty()) {

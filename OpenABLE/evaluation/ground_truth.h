@@ -9,6 +9,8 @@
 
 #include <Eigen/Core>
 
+#include "OpenABLE/base/enum_names.h"
+
 #include "OpenABLE/evaluation/layout.h"
 
 namespace openable {
@@ -46,6 +48,8 @@ enum class GroundTruthType {
   kTum,        // TUM trajectory: "timestamp tx ty tz qx qy qz qw" per line, '#' comments
   kPositions,  // CSV/whitespace "x,y[,z]" per line (no orientation), '#' comments
 };
+OPENABLE_ENUM_NAMES(GroundTruthType, "none", "matrix", "pairs", "aligned", "kitti", "tum",
+                    "positions")
 
 // Parses "matrix", "pairs", "aligned", "kitti", "tum", "positions" (and "" = kNone). Throws
 // InputError naming Ground_truth_type otherwise.

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/text_parsing.h"
 
 namespace openable {
@@ -27,13 +28,12 @@ using evaluation_internal::IsBlank;
 using evaluation_internal::ParseNumber;
 using evaluation_internal::ReadWholeFile;
 using evaluation_internal::RequireFile;
-using evaluation_internal::ToLower;
 
 namespace fs = std::filesystem;
 
 // Lower-case extension without the dot ("" when none).
 std::string ExtensionOf(const std::string& path) {
-  std::string e = ToLower(fs::path(path).extension().string());
+  std::string e = Lower(fs::path(path).extension().string());
   if (!e.empty() && e.front() == '.') e.erase(0, 1);
   return e;
 }

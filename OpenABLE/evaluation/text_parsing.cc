@@ -37,9 +37,5 @@ bool ParseNumber(std::string_view token, double* value) {
   return r.ec == std::errc() && r.ptr == end;
 }
 
-std::string ToLower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 }  // namespace openable::evaluation_internal

@@ -22,6 +22,4 @@ inline bool IsBlank(char c) {
 // A whole token as a number ("1", "-2.5e3", "+4", "nan", "inf"); false on anything else.
 bool ParseNumber(std::string_view token, double* value);
 
-std::string ToLower(std::string s);
-
 }  // namespace openable::evaluation_internal

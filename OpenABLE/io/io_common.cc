@@ -1,5 +1,7 @@
 #include "OpenABLE/io/io_common.h"
 
+#include "OpenABLE/base/strings.h"
+
 #include <cctype>
 #include <filesystem>
 #include <stdexcept>
@@ -29,8 +31,7 @@ std::string FirstLine(const std::string& text) {
 }
 
 std::string NormalizeExtension(const std::string& extension) {
-  std::string e = extension;
-  for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  std::string e = Lower(extension);
   if (!e.empty() && e.front() == '.') e.erase(0, 1);
   return e;
 }

@@ -1,6 +1,5 @@
 #include "OpenABLE/python/common.h"
 
-#include <cctype>
 #include <cstdint>
 #include <string>
 
@@ -190,17 +189,28 @@ py::array_t<double> DoubleArray(const std::vector<double>& values) {
   return a;
 }
 
-std::string Lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
+std::vector<std::string> PropertyNames(const py::handle& cls) {
+  std::vector<std::string> names;
+  const py::object property = py::module_::import("builtins").attr("property");
+  for (const auto item : py::dict(cls.attr("__dict__")))
+    if (py::isinstance(item.second, property)) names.push_back(item.first.cast<std::string>());
+  return names;
 }
 
-int ParseDirection(const std::string& name) {
-  const std::string n = Lower(name);
-  if (n == "forward") return 0;
-  if (n == "reverse") return 1;
-  if (n == "both") return 2;
-  throw py::value_error("direction: \"" + name + "\"; expected \"forward\", \"reverse\" or \"both\"");
+py::dict PropertiesAsDict(const py::handle& object, bool arrays) {
+  py::dict out;
+  for (const std::string& name : PropertyNames(py::type::of(object))) {
+    const py::object value = object.attr(name.c_str());
+    if (py::hasattr(value, "to_dict")) {
+      out[name.c_str()] = value.attr("to_dict")();
+    } else if (value.is_none() || py::isinstance<py::bool_>(value) ||
+               py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value) ||
+               py::isinstance<py::str>(value) || py::isinstance<py::tuple>(value) ||
+               (arrays && py::isinstance<py::array>(value))) {
+      out[name.c_str()] = value;
+    }
+  }
+  return out;
 }
 
 }  // namespace openable::python

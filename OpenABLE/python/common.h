@@ -10,6 +10,9 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include "OpenABLE/base/enum_names.h"
+#include "OpenABLE/base/strings.h"
+
 namespace openable::python {
 
 namespace py = pybind11;
@@ -50,11 +53,15 @@ py::array ToNumpy(const cv::Mat& m, bool one_dimensional = false);
 // A NumPy array of doubles with the given shape, filled from `values` (copied).
 py::array_t<double> DoubleArray(const std::vector<double>& values);
 
-// Lower-case copy of `s`.
-std::string Lower(std::string s);
+// The names of the properties of the bound class `cls` (def_readwrite, def_property,
+// def_property_readonly), in the order they were bound.
+std::vector<std::string> PropertyNames(const py::handle& cls);
 
-// "forward", "reverse", "both" -> 0, 1, 2 (SequenceDirection); ValueError otherwise.
-int ParseDirection(const std::string& name);
+// The properties of `object` as a dict, after COLMAP's MakeDataclass todict(): every property
+// of its class (PropertyNames) whose value is a number, a string, a bool, None or a tuple, an
+// object with its own to_dict() (converted), and, with `arrays`, a NumPy array (without, the
+// per-query arrays of a result are left out).
+py::dict PropertiesAsDict(const py::handle& object, bool arrays = false);
 
 // Registration of each part of the module (one source file each).
 void RegisterImages(py::module_& m);

@@ -102,7 +102,7 @@ bool HaveOrientations(const std::vector<FramePose>& poses) {
 // The layout of `layout` ("loop_closure", "query_reference" or None) on a rows x cols matrix.
 EvaluationLayout LayoutOf(const py::object& layout, const py::object& reference_frames, int rows,
                           int cols) {
-  std::string kind = layout.is_none() ? "" : Lower(layout.cast<std::string>());
+  std::string kind = layout.is_none() ? "" : openable::Lower(layout.cast<std::string>());
   if (kind.empty()) {
     kind = (!reference_frames.is_none() || rows != cols) ? "query_reference" : "loop_closure";
   }
@@ -222,17 +222,6 @@ py::array_t<double> Column(const Curve& c, F f) {
   return DoubleArray(v);
 }
 
-py::dict CurveDict(const Curve& c) {
-  py::dict d;
-  d["threshold"] = Column(c, [](const CurvePoint& p) { return p.threshold; });
-  d["precision"] = Column(c, [](const CurvePoint& p) { return p.precision; });
-  d["recall"] = Column(c, [](const CurvePoint& p) { return p.recall; });
-  d["f1"] = Column(c, [](const CurvePoint& p) { return p.f1; });
-  d["tp"] = Column(c, [](const CurvePoint& p) { return p.tp; });
-  d["fp"] = Column(c, [](const CurvePoint& p) { return p.fp; });
-  return d;
-}
-
 std::string LayoutName(const EvaluationLayout& l) {
   return l.kind == EvaluationLayout::Kind::kLoopClosure ? "loop_closure" : "query_reference";
 }
@@ -264,7 +253,7 @@ increasing order of threshold. Each property is a float64 NumPy array with one v
       .def("area", [](const Curve& c) { return CurveArea(c.points); },
            "area() -> float\n\nStep-wise area: the sum of precision x (recall - previous recall) "
            "over the points (AUC of the per-query curve; ABLE-P's average precision / 100).")
-      .def("to_dict", &CurveDict,
+      .def("to_dict", [](const py::object& self) { return PropertiesAsDict(self, true); },
            "to_dict() -> dict[str, numpy.ndarray]\n\nThe columns threshold, precision, recall, "
            "f1, tp, fp (as the CSV files openable writes).")
       .def("__len__", [](const Curve& c) { return c.points.size(); }, "Number of points.")
@@ -345,33 +334,7 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
            "to_json() -> str\n\nThe evaluation as the JSON file Test_OpenABLE and "
            "openable_evaluate write (Evaluation_name.json), with this one run.")
       .def(
-          "to_dict",
-          [](const Result& r) {
-            py::dict d;
-            const PerQueryResult& p = r.run.per_query;
-            d["label"] = r.run.label;
-            d["layout"] = LayoutName(r.run.layout);
-            d["auc"] = p.auc;
-            d["recall_at_100p"] = p.recall_at_100p;
-            d["max_f1"] = p.max_f1;
-            d["max_f1_threshold"] = p.max_f1_threshold;
-            d["max_f1_precision"] = p.max_f1_precision;
-            d["max_f1_recall"] = p.max_f1_recall;
-            d["recall_at_1"] = p.recall_at_1;
-            d["recall_at_5"] = p.recall_at_5;
-            d["recall_at_10"] = p.recall_at_10;
-            d["queries"] = p.queries;
-            d["positive_queries"] = p.positive_queries;
-            d["truth_pairs"] = r.run.truth_pairs;
-            d["truth_dropped"] = r.run.truth_dropped;
-            d["truth_pairs_outside_candidates"] = p.truth_pairs_outside_candidates;
-            d["average_precision"] = r.run.able_p.average_precision;
-            d["candidate_cells"] = r.run.able_p.candidate_cells;
-            d["truth_cells"] = r.run.able_p.truth_cells;
-            d["curve"] = CurveDict(Curve{p.curve});
-            d["able_p_curve"] = CurveDict(Curve{r.run.able_p.curve});
-            return d;
-          },
+          "to_dict", [](const py::object& self) { return PropertiesAsDict(self); },
           "to_dict() -> dict\n\nEvery figure, and both curves as dicts of NumPy arrays.")
       .def("__repr__", [](const Result& r) {
         const PerQueryResult& p = r.run.per_query;

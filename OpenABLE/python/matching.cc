@@ -110,7 +110,7 @@ Returns:
       [](const py::object& d, int sequence_length, const std::string& direction,
          const py::object& row_starts, const py::object& col_starts, int threads,
          bool in_place) -> py::object {
-        const auto dir = static_cast<SequenceDirection>(ParseDirection(direction));
+        const auto dir = ParseEnum<SequenceDirection>(direction, "direction");
         const std::vector<int> rows = Starts(row_starts, "row_starts");
         const std::vector<int> cols = Starts(col_starts, "col_starts");
         if (in_place) {

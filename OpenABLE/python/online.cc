@@ -1,8 +1,11 @@
 // The batch helpers and the online detector of OpenABLE/online/online.h: describe, describe_images,
 // distance_matrix, OnlineDetector.
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <mutex>
+#include <tuple>
+#include <type_traits>
 #include <utility>
 
 #include <pybind11/stl.h>
@@ -13,23 +16,12 @@
 namespace openable::python {
 namespace {
 
-DescriptionType DescriptionOf(const std::string& name) {
-  const std::string n = Lower(name);
-  if (n == "global") return DescriptionType::kGlobal;
-  if (n == "grid") return DescriptionType::kGrid;
-  throw py::value_error("description: \"" + name + "\"; expected \"global\" or \"grid\"");
-}
-
-std::string DescriptionName(DescriptionType t) {
-  return t == DescriptionType::kGrid ? "grid" : "global";
-}
-
 // The description part of OnlineOptions.
 OnlineOptions DescriptionOptions(const std::string& descriptor, const std::string& description,
                                  int patch_size, int ldb_bits, std::pair<int, int> grid) {
   OnlineOptions o;
   o.descriptor = descriptor;
-  o.description = DescriptionOf(description);
+  o.description = ParseEnum<DescriptionType>(description, "description");
   o.patch_size = patch_size;
   o.ldb_bits = ldb_bits;
   o.grid_x = grid.first;
@@ -63,11 +55,101 @@ py::tuple ResultTuple(const OnlineResult& r) {
   return py::make_tuple(r.frame, candidates, timings);
 }
 
-template <typename... Args>
-std::string Format(const char* format, Args... args) {
-  char buffer[1024];
-  std::snprintf(buffer, sizeof buffer, format, args...);
-  return buffer;
+OnlineOptions OnlineOptionsOf(const py::kwargs& kwargs);
+
+// openable.OnlineOptions: OnlineOptions with one property per keyword argument of
+// OnlineDetector, in the flat names of the Python API (grid as a pair, description by name,
+// the FLANN search's fields at the top level). The properties are the one list of options:
+// the constructor's keywords, its signature, options["name"], keys() and to_dict() read it.
+void BindOnlineOptions(py::module_& m) {
+  using O = OnlineOptions;
+  py::class_<O> c(m, "OnlineOptions", R"doc(OnlineOptions(**options)
+
+The options of OnlineDetector (OpenABLE/online/online.h), with their defaults. Read like a
+dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
+  c.def(py::init([](const py::kwargs& kwargs) { return OnlineOptionsOf(kwargs); }),
+        "__init__(**options)\n\nThe defaults, with the options given by keyword.")
+      .def_readwrite("descriptor", &O::descriptor,
+                     "A name of descriptor_names() but D-LDB (case-insensitive).")
+      .def_property(
+          "description", [](const O& o) { return EnumName(o.description); },
+          [](O& o, const std::string& n) {
+            o.description = ParseEnum<DescriptionType>(n, "description");
+          },
+          "\"global\" (the frame resized to the patch) or \"grid\" (grid cells).")
+      .def_readwrite("patch_size", &O::patch_size, "Side of the square patch, pixels.")
+      .def_readwrite("ldb_bits", &O::ldb_bits, "Bits of LDB rows (1..1386).")
+      .def_property(
+          "grid", [](const O& o) { return std::make_pair(o.grid_x, o.grid_y); },
+          [](O& o, std::pair<int, int> g) { std::tie(o.grid_x, o.grid_y) = g; },
+          "(cells across, cells down) for description=\"grid\".")
+      .def_readwrite("sequence_length", &O::sequence_length,
+                     "L, frames summed along the diagonal (Image_sequences).")
+      .def_readwrite("exclusion", &O::exclusion,
+                     "Frame q's candidates are frames j <= q - exclusion (>= 1).")
+      .def_readwrite("candidates", &O::candidates, "Candidates returned per frame (>= 1).")
+      .def_readwrite("threshold", &O::threshold,
+                     "A candidate is accepted when its normalised distance is <= threshold: "
+                     "the distance divided by L x the descriptor's bit count for binary "
+                     "descriptors (the mean fraction of differing bits), by L x the largest "
+                     "single-frame distance seen so far for float descriptors. Not the scale "
+                     "of Config.txt's Threshold.")
+      .def_readwrite("exact_limit", &O::exact_limit,
+                     "Exact search while the searchable map holds at most this many frames.")
+      .def_readwrite("block_frames", &O::block_frames, "Frames per FLANN block beyond it.")
+      .def_readwrite("background_merges", &O::background_merges,
+                     "Build merges of two blocks on a background thread (no frame waits for a "
+                     "large index build; candidates then depend on when a merge finishes); "
+                     "False builds them inside add_frame, for repeatable results.");
+  // The FLANN search (matching/approximate.h), at the top level.
+  const auto flann = [&c](const char* name, auto member, const char* doc) {
+    using T = std::remove_reference_t<decltype(std::declval<ApproximateOptions&>().*member)>;
+    c.def_property(
+        name, [member](const O& o) { return o.approximate.*member; },
+        [member](O& o, T v) { o.approximate.*member = v; }, doc);
+  };
+  flann("approximate_k", &ApproximateOptions::k, "FLANN candidates per block (>= candidates).");
+  flann("checks", &ApproximateOptions::checks, "k-d trees: references examined per query.");
+  flann("lsh_tables", &ApproximateOptions::lsh_tables, "LSH hash tables.");
+  flann("lsh_key_bits", &ApproximateOptions::lsh_key_bits, "Bits of an LSH key.");
+  flann("lsh_probe_level", &ApproximateOptions::lsh_probe_level, "LSH multi-probe level.");
+  flann("kd_trees", &ApproximateOptions::kd_trees, "Randomised k-d trees.");
+  flann("threads", &ApproximateOptions::threads, "Threads of a search; 0 = all cores.");
+  flann("seed", &ApproximateOptions::seed, "Seed of the index build.");
+  c.def(
+       "__getitem__",
+       [](const py::object& self, const std::string& name) -> py::object {
+         const auto names = PropertyNames(py::type::of(self));
+         if (std::find(names.begin(), names.end(), name) == names.end())
+           throw py::key_error(name);
+         return self.attr(name.c_str());
+       },
+       "options[\"name\"]: the option `name`.")
+      .def(
+          "keys", [](const py::object& self) { return PropertyNames(py::type::of(self)); },
+          "keys() -> list[str]\n\nThe names of the options.")
+      .def(
+          "to_dict", [](const py::object& self) { return PropertiesAsDict(self); },
+          "to_dict() -> dict\n\nEvery option by name.")
+      .def("__repr__", [](const py::object& self) {
+        return "openable.OnlineOptions(**" + py::repr(PropertiesAsDict(self)).cast<std::string>() +
+               ")";
+      });
+}
+
+// OnlineOptions from the keyword arguments of OnlineDetector or OnlineOptions: the defaults,
+// then each keyword set as the property of its name.
+OnlineOptions OnlineOptionsOf(const py::kwargs& kwargs) {
+  const std::vector<std::string> names = PropertyNames(py::type::of<OnlineOptions>());
+  py::object options = py::cast(OnlineOptions());
+  for (const auto item : kwargs) {
+    const std::string name = item.first.cast<std::string>();
+    if (std::find(names.begin(), names.end(), name) == names.end())
+      throw py::type_error("unexpected keyword argument \"" + name + "\"; expected one of " +
+                           py::str(py::cast(names)).cast<std::string>());
+    options.attr(name.c_str()) = item.second;
+  }
+  return options.cast<OnlineOptions>();
 }
 
 const char* const kDescriptionArgs = R"doc(    descriptor (str): a name of descriptor_names() but D-LDB (case-insensitive).
@@ -141,7 +223,7 @@ Raises:
       [](const py::object& rows, int sequence_length, const std::string& direction,
          const py::object& traversal_starts, int threads, bool return_max) -> py::object {
         const MatView v = Matrix2D(rows, Elements::kUint8OrFloat32, "rows");
-        const auto dir = static_cast<SequenceDirection>(ParseDirection(direction));
+        const auto dir = ParseEnum<SequenceDirection>(direction, "direction");
         std::vector<int> starts;
         if (!traversal_starts.is_none()) starts = traversal_starts.cast<std::vector<int>>();
         float max = 0;
@@ -177,21 +259,13 @@ Returns:
     numpy.ndarray: float32 (N, N) in [0, 1], owning the C++ result (no copy); or (matrix,
     max) with return_max=True.)doc");
 
-  const OnlineOptions defaults;  // the defaults of the keyword arguments
-  const ApproximateOptions& fl = defaults.approximate;
-  const std::string signature = Format(
-      "OnlineDetector(*, descriptor=\"%s\", description=\"%s\", patch_size=%d, ldb_bits=%d, "
-      "grid=(%d, %d), sequence_length=%d, exclusion=%d, candidates=%d, threshold=%g, "
-      "exact_limit=%d, block_frames=%d, background_merges=%s, approximate_k=%d, checks=%d, "
-      "lsh_tables=%d, "
-      "lsh_key_bits=%d, lsh_probe_level=%d, kd_trees=%d, threads=%d, seed=%llu)",
-      defaults.descriptor.c_str(), DescriptionName(defaults.description).c_str(),
-      defaults.patch_size, defaults.ldb_bits, defaults.grid_x, defaults.grid_y,
-      defaults.sequence_length, defaults.exclusion, defaults.candidates, defaults.threshold,
-      defaults.exact_limit, defaults.block_frames, defaults.background_merges ? "True" : "False",
-      fl.k, fl.checks, fl.lsh_tables,
-      fl.lsh_key_bits, fl.lsh_probe_level, fl.kd_trees, fl.threads,
-      static_cast<unsigned long long>(fl.seed));
+  BindOnlineOptions(m);
+  // The signature of the constructor, from the defaults of the options' properties.
+  const py::object defaults = py::cast(OnlineOptions());
+  std::string signature = "OnlineDetector(*";
+  for (const std::string& name : PropertyNames(m.attr("OnlineOptions")))
+    signature += ", " + name + "=" + py::repr(defaults.attr(name.c_str())).cast<std::string>();
+  signature += ")";
   const std::string class_doc = signature + R"doc(
 
 Loop candidates frame by frame, for a SLAM system: each frame added is described, searched
@@ -199,69 +273,20 @@ among the earlier frames (exactly while the map holds at most exact_limit frames
 FLANN blocks), and its best candidates are returned.
 
 Args:
-)doc" R"doc(    descriptor, description, patch_size, ldb_bits, grid: the description, as describe().
-    sequence_length (int): L, frames summed along the diagonal (Image_sequences).
-    exclusion (int): frame q's candidates are frames j <= q - exclusion (>= 1).
-    candidates (int): candidates returned per frame (the k best, >= 1).
-    threshold (float): a candidate is accepted when its normalised distance is <= threshold.
-        Normalised: the distance divided by L x the descriptor's bit count for binary
-        descriptors (the mean fraction of differing bits), by L x the largest single-frame
-        distance seen so far for float descriptors. Not the scale of Config.txt's Threshold.
-    exact_limit (int): exact search while the searchable map holds at most this many frames.
-    block_frames (int): frames per FLANN block beyond it.
-    background_merges (bool): build merges of two blocks on a background thread (no frame
-        waits for a large index build; candidates then depend on when a merge finishes);
-        False builds them inside add_frame, for repeatable results.
-    approximate_k, checks, lsh_tables, lsh_key_bits, lsh_probe_level, kd_trees, threads, seed:
-        the FLANN search (candidates per block, k-d tree checks, LSH tables, key bits and
-        multi-probe level, k-d trees, threads, seed of the index build).
+    **options: the properties of openable.OnlineOptions (help(openable.OnlineOptions) says
+        what each means), by keyword.
 
 Raises:
-    openable.InputError (or ValueError): an option out of range, naming it.
+    openable.InputError (or ValueError): an option out of range, naming it; TypeError: an
+    unknown option.
 
 Calls from several threads are serialised by a lock.)doc";
   py::class_<Detector>(m, "OnlineDetector", class_doc.c_str())
-      .def(py::init([](const std::string& descriptor, const std::string& description,
-                       int patch_size, int ldb_bits, std::pair<int, int> grid,
-                       int sequence_length, int exclusion, int candidates, double threshold,
-                       int exact_limit, int block_frames, bool background_merges,
-                       int approximate_k, int checks,
-                       int lsh_tables, int lsh_key_bits, int lsh_probe_level, int kd_trees,
-                       int threads, std::uint64_t seed) {
-             OnlineOptions o = DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid);
-             o.sequence_length = sequence_length;
-             o.exclusion = exclusion;
-             o.candidates = candidates;
-             o.threshold = threshold;
-             o.exact_limit = exact_limit;
-             o.block_frames = block_frames;
-             o.background_merges = background_merges;
-             o.approximate.k = approximate_k;
-             o.approximate.checks = checks;
-             o.approximate.lsh_tables = lsh_tables;
-             o.approximate.lsh_key_bits = lsh_key_bits;
-             o.approximate.lsh_probe_level = lsh_probe_level;
-             o.approximate.kd_trees = kd_trees;
-             o.approximate.threads = threads;
-             o.approximate.seed = seed;
+      .def(py::init([](const py::kwargs& kwargs) {
              auto d = std::make_unique<Detector>();
-             d->detector = std::make_unique<OnlineDetector>(o);
+             d->detector = std::make_unique<OnlineDetector>(OnlineOptionsOf(kwargs));
              return d;
            }),
-           py::kw_only(), py::arg("descriptor") = defaults.descriptor,
-           py::arg("description") = DescriptionName(defaults.description),
-           py::arg("patch_size") = defaults.patch_size, py::arg("ldb_bits") = defaults.ldb_bits,
-           py::arg("grid") = std::make_pair(defaults.grid_x, defaults.grid_y),
-           py::arg("sequence_length") = defaults.sequence_length,
-           py::arg("exclusion") = defaults.exclusion, py::arg("candidates") = defaults.candidates,
-           py::arg("threshold") = defaults.threshold, py::arg("exact_limit") = defaults.exact_limit,
-           py::arg("block_frames") = defaults.block_frames,
-           py::arg("background_merges") = defaults.background_merges,
-           py::arg("approximate_k") = fl.k,
-           py::arg("checks") = fl.checks, py::arg("lsh_tables") = fl.lsh_tables,
-           py::arg("lsh_key_bits") = fl.lsh_key_bits,
-           py::arg("lsh_probe_level") = fl.lsh_probe_level, py::arg("kd_trees") = fl.kd_trees,
-           py::arg("threads") = fl.threads, py::arg("seed") = fl.seed,
            "__init__(**options)\n\nSee help(openable.OnlineDetector) for the options.")
       .def(
           "add_to_map",
@@ -385,37 +410,13 @@ installs its index.)doc")
           },
           "FLANN blocks in use (0 while the search is exact).")
       .def_property_readonly(
-          "options",
-          [](Detector& d) {
-            const OnlineOptions& o = d.detector->Options();
-            py::dict r;
-            r["descriptor"] = o.descriptor;
-            r["description"] = DescriptionName(o.description);
-            r["patch_size"] = o.patch_size;
-            r["ldb_bits"] = o.ldb_bits;
-            r["grid"] = py::make_tuple(o.grid_x, o.grid_y);
-            r["sequence_length"] = o.sequence_length;
-            r["exclusion"] = o.exclusion;
-            r["candidates"] = o.candidates;
-            r["threshold"] = o.threshold;
-            r["exact_limit"] = o.exact_limit;
-            r["block_frames"] = o.block_frames;
-            r["background_merges"] = o.background_merges;
-            r["approximate_k"] = o.approximate.k;
-            r["checks"] = o.approximate.checks;
-            r["lsh_tables"] = o.approximate.lsh_tables;
-            r["lsh_key_bits"] = o.approximate.lsh_key_bits;
-            r["lsh_probe_level"] = o.approximate.lsh_probe_level;
-            r["kd_trees"] = o.approximate.kd_trees;
-            r["threads"] = o.approximate.threads;
-            r["seed"] = o.approximate.seed;
-            return r;
-          },
-          "The options in effect, as a dict of the constructor's keyword arguments.")
+          "options", [](Detector& d) { return d.detector->Options(); },
+          "The options in effect (an openable.OnlineOptions; options[\"name\"] and "
+          "to_dict() read them like a dict of the constructor's keyword arguments).")
       .def("__repr__", [](Detector& d) {
         std::lock_guard<std::mutex> lock(d.mutex);
         const OnlineOptions& o = d.detector->Options();
-        return "<openable.OnlineDetector " + o.descriptor + " " + DescriptionName(o.description) +
+        return "<openable.OnlineDetector " + o.descriptor + " " + EnumName(o.description) +
                ", L=" + std::to_string(o.sequence_length) + ", " +
                std::to_string(d.detector->Size()) + " frames>";
       });

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdint>
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/run/exports.h"
 #include "OpenABLE/python/common.h"
+#include "OpenABLE/snaps/chain.h"
 #include "OpenABLE/snaps/discounted.h"
 #include "OpenABLE/snaps/loops.h"
 #include "OpenABLE/snaps/pose_graph.h"
@@ -19,11 +21,14 @@
 namespace openable::python {
 namespace {
 
+using snaps::ChainErrors;
+using snaps::ChainResult;
+using snaps::CheckedPose;
 using snaps::LoopPair;
 using snaps::Trajectory;
 
-// Poses (N, 3, 4) or (N, 4, 4), camera-to-world, as isometries; ValueError when a 3x3 part
-// is not a rotation within 1e-3 (the tolerance of trajectory files).
+// Poses (N, 3, 4) or (N, 4, 4), camera-to-world, as isometries: each passes the check of
+// trajectory files (CheckedPose: a rotation within kRotationTolerance, a finite translation).
 std::vector<Eigen::Isometry3d> IsometriesOf(const py::handle& object, const char* what) {
   const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(object);
   if (!a || a.ndim() != 3 || (a.shape(1) != 3 && a.shape(1) != 4) || a.shape(2) != 4) {
@@ -41,16 +46,7 @@ std::vector<Eigen::Isometry3d> IsometriesOf(const py::handle& object, const char
       for (int col = 0; col < 3; ++col) r(row, col) = p[row * 4 + col];
       t(row) = p[row * 4 + 3];
     }
-    const double deviation = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-    if (!(deviation <= 1e-3) || !(r.determinant() > 0) || !t.allFinite()) {
-      throw py::value_error(std::string(what) + "[" + std::to_string(i) +
-                            "]: the 3x3 part is not a rotation (orthonormal, determinant +1, "
-                            "within 1e-3) or the translation is not finite");
-    }
-    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    pose.linear() = r;
-    pose.translation() = t;
-    poses.push_back(pose);
+    poses.push_back(CheckedPose(r, t, std::string(what) + "[" + std::to_string(i) + "]"));
   }
   return poses;
 }
@@ -138,6 +134,13 @@ py::array_t<double> Matrix4(const Eigen::Isometry3d& pose) {
     for (int c = 0; c < 4; ++c) a.mutable_at(r, c) = pose.matrix()(r, c);
   return a;
 }
+
+// One run of the chain with the configuration it ran (the report needs both).
+struct ChainRun {
+  Config config;
+  ChainResult result;
+  std::vector<std::string> written;
+};
 
 }  // namespace
 
@@ -558,6 +561,102 @@ Args:
 
 Returns:
     Trajectory (or (Trajectory, PoseGraphReport) with report=True).)doc");
+
+  py::class_<ChainRun>(m, "ChainResult", R"doc(What run() did: the trajectories, the loops, the
+corrections and their errors, as openable_snaps reports them.)doc")
+      .def_property_readonly("input", [](const ChainRun& c) { return c.result.input; },
+                             "Trajectory: the one corrected (read, or computed by the odometry).")
+      .def_property_readonly(
+          "discounted",
+          [](const ChainRun& c) -> py::object {
+            return c.result.discounted_ran ? py::cast(c.result.discounted) : py::none();
+          },
+          "Trajectory corrected by the discounted update (Eq. 6); None when it did not run.")
+      .def_property_readonly(
+          "pose_graph",
+          [](const ChainRun& c) -> py::object {
+            return c.result.graph_ran ? py::cast(c.result.graph) : py::none();
+          },
+          "Trajectory corrected by the pose graph; None when it did not run.")
+      .def_property_readonly(
+          "pose_graph_report",
+          [](const ChainRun& c) -> py::object {
+            return c.result.graph_ran ? py::cast(c.result.graph_report) : py::none();
+          },
+          "PoseGraphReport of the pose graph; None when it did not run.")
+      .def_property_readonly(
+          "truth",
+          [](const ChainRun& c) -> py::object {
+            return c.result.evaluated ? py::cast(c.result.truth) : py::none();
+          },
+          "Trajectory of Snaps_ground_truth; None without one.")
+      .def_property_readonly("loops", [](const ChainRun& c) { return LoopsList(c.result.loops); },
+                             "Loop pairs (query, reference, similarity) of `input`'s poses.")
+      .def_property_readonly(
+          "closed", [](const ChainRun& c) { return LoopsList(c.result.closed); },
+          "The loops the discounted update closed.")
+      .def_property_readonly(
+          "errors",
+          [](const ChainRun& c) {
+            py::dict out;
+            for (const ChainErrors& e : c.result.errors)
+              out[e.name.c_str()] = py::make_tuple(e.raw, e.aligned);
+            return out;
+          },
+          "With a ground truth: {\"input\" | \"discounted\" | \"pose_graph\": (unaligned, "
+          "aligned)} TrajectoryError pairs; empty without one.")
+      .def_property_readonly("written", [](const ChainRun& c) { return c.written; },
+                             "Paths of the files written (write=True).")
+      .def("report", [](const ChainRun& c) { return snaps::FormatChainReport(c.config, c.result); },
+           "report() -> str\n\nThe report openable_snaps prints.")
+      .def("to_json", [](const ChainRun& c) { return snaps::ChainJson(c.config, c.result); },
+           "to_json() -> str\n\nThe figures, as <Snaps_output_name>.json.")
+      .def("__repr__", [](const ChainRun& c) {
+        return "<openable.snaps.ChainResult " + std::to_string(c.result.input.Size()) +
+               " poses, " + std::to_string(c.result.loops.size()) + " loops>";
+      });
+
+  m.def(
+      "run",
+      [](const py::object& config, const py::object& settings, bool write, bool quiet) {
+        auto c = std::make_unique<ChainRun>();
+        if (!config.is_none())
+          c->config = LoadConfig(py::str(config).cast<std::string>());
+        if (!settings.is_none())
+          for (const auto item : settings.cast<py::dict>()) {
+            const py::handle v = item.second;
+            const std::string text = py::isinstance<py::bool_>(v)
+                                         ? (v.cast<bool>() ? "1" : "0")
+                                         : py::str(v).cast<std::string>();
+            ApplyOverride(c->config, item.first.cast<std::string>() + "=" + text);
+          }
+        py::gil_scoped_release release;
+        ProgressReporter progress(std::cerr, !quiet, IsTerminal(2));
+        c->result = snaps::RunChain(c->config, progress);
+        if (write) c->written = snaps::WriteChainOutputs(c->config, c->result);
+        return c;
+      },
+      py::arg("config") = py::none(), py::kw_only(), py::arg("settings") = py::none(),
+      py::arg("write") = false, py::arg("quiet") = true,
+      R"doc(run(config=None, *, settings=None, write=False, quiet=True) -> ChainResult
+
+The whole SNAPS chain, as openable_snaps runs it (the same library call): the trajectory (a
+file, or the odometry on the images), the loops (Snaps_loops), the corrections
+(Snaps_corrector) and, with Snaps_ground_truth, their errors.
+
+Args:
+    config (str | os.PathLike | None): a Config.txt; None: the defaults.
+    settings (dict | None): keys set over it, {"Snaps_loops": "pairs", ...}, as --set does
+        (values as text; True and False as 1 and 0).
+    write (bool): also write the files of Snaps_output_name (all or nothing).
+    quiet (bool): no progress lines on stderr.
+
+Returns:
+    ChainResult: input, discounted, pose_graph, truth, loops, closed, errors, written,
+    report(), to_json().
+
+Raises:
+    openable.InputError: one line naming the key, file or value (as openable_snaps).)doc");
 }
 
 }  // namespace openable::python

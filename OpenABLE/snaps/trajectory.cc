@@ -23,7 +23,6 @@ namespace {
 
 // Largest |R^T R - I| entry accepted as a rotation, and the one below which a rotation is kept
 // as it is (so that a file written by EncodeTrajectory reads back to the same bits).
-constexpr double kRotationTolerance = 1e-3;
 constexpr double kExactEnough = 1e-12;
 
 std::string G17(double v) {
@@ -108,6 +107,15 @@ Eigen::Isometry3d Inverse(const Eigen::Isometry3d& t) {
 }
 
 }  // namespace
+
+Eigen::Isometry3d CheckedPose(const Eigen::Matrix3d& r, const Eigen::Vector3d& t,
+                              const std::string& where) {
+  if (!t.allFinite()) throw InputError(where + ": the translation is not finite");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = CheckedRotation(r, where);
+  pose.translation() = t;
+  return pose;
+}
 
 Trajectory ReadTrajectory(const std::string& path, TrajectoryFormat format,
                           bool world_to_camera) {

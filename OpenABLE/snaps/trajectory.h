@@ -43,6 +43,18 @@ struct Trajectory {
   int Size() const { return static_cast<int>(poses.size()); }
 };
 
+// The largest |R^T R - I| of a 3x3 matrix taken for a rotation (files and programs round their
+// numbers; a larger deviation is not a rotation).
+inline constexpr double kRotationTolerance = 1e-3;
+
+// The camera-to-world pose [r | t]: `r` must be a rotation within kRotationTolerance
+// (orthonormal, determinant +1), made exactly orthonormal (the nearest rotation) when it is not
+// one to 1e-12, and `t` finite. Throws InputError "<where>: the 3x3 part is not a rotation
+// (...)" or "<where>: the translation is not finite" otherwise. Every pose that enters a
+// trajectory (files, the Python module) passes here.
+Eigen::Isometry3d CheckedPose(const Eigen::Matrix3d& r, const Eigen::Vector3d& t,
+                              const std::string& where);
+
 // Reads a trajectory. `world_to_camera`: the file's matrices map world points into the camera
 // (SO-DSO's poses_history_file.txt); they are inverted so that `poses` are camera-to-world.
 // Throws InputError naming the file and the line (wrong count of numbers, not a number,

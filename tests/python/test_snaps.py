@@ -97,6 +97,33 @@ class KittiCorrectionTest(TempDirTestCase):
     def test_input_error_matches_the_program_and_numpy(self):
         self.check_errors(self.input, self.report["errors"]["input"])
 
+    def test_run_is_the_program(self):
+        # openable.snaps.run is the library call openable_snaps makes: with the same keys it
+        # writes the same files, byte for byte but the times in the JSON.
+        settings = {"Snaps_trajectory": self.trajectory_file,
+                    "Snaps_trajectory_format": "kitti-id", "Snaps_world_to_camera": True,
+                    "Snaps_ground_truth": self.truth_file, "Snaps_loops": "pairs",
+                    "Snaps_loops_file": self.pairs_file, "Snaps_drop_outside": 1,
+                    "Snaps_middle_of_runs": 1, "Snaps_corrector": "both",
+                    "Snaps_discount_length": 300, "Snaps_pause": 20,
+                    "Snaps_output_name": self.tmp / "py" / "k00"}
+        result = snaps.run(settings=settings, write=True)
+        self.assertEqual(len(result.loops), self.report["loops"])
+        self.assertEqual(result.input.encode(), self.input.encode())
+        for name in ("k00_discounted.txt", "k00_pose_graph.txt", "k00_loops.csv"):
+            self.assertEqual((self.tmp / "py" / name).read_bytes(),
+                             (self.tmp / "out" / name).read_bytes(), name)
+        mine = read_json(self.tmp / "py" / "k00.json")
+        del mine["pose_graph"]["seconds"]
+        theirs = dict(self.report, pose_graph=dict(self.report["pose_graph"]))
+        del theirs["pose_graph"]["seconds"]
+        self.assertEqual(mine, theirs)
+        unaligned, aligned = result.errors["pose_graph"]
+        self.assertTrue(close(aligned.mean, self.report["errors"]["pose_graph"]["aligned"]["mean_m"]))
+        self.assertIn("loops: %d pairs from pairs" % len(result.loops), result.report())
+        with self.assertRaisesRegex(openable.InputError, "Snaps_loops_file: empty"):
+            snaps.run(settings={"Snaps_trajectory": self.trajectory_file, "Snaps_loops": "pairs"})
+
     def check_errors(self, trajectory, expected):
         association = snaps.associate(trajectory, self.truth)
         np.testing.assert_array_equal(association, trajectory.frame_ids)  # KITTI: id = line
