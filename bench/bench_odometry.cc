@@ -1,4 +1,4 @@
-// Monocular odometry (issue 7) on KITTI 00 frames 0-1699 (../shared/datasets/kitti00_first1700,
+// Monocular odometry on KITTI 00 frames 0-1699 (../shared/datasets/kitti00_first1700,
 // half-size left frames), the scale of each step taken from the ground truth's step lengths (a
 // single camera cannot know it). Prints the per-frame time (mean, quartiles), the absolute
 // trajectory error (mean deviation, unaligned and rigidly aligned), the final drift, and writes
@@ -35,7 +35,8 @@ double Quantile(std::vector<double> v, double q) {
 int main(int argc, char** argv) {
   using namespace openable;
   if (argc < 2) {
-    std::cerr << "usage: bench_odometry OUTPUT_POSES.txt [FIRST LAST [ORB|SIFT [RANSAC_PX [MAX_FEATURES]]]]\n";
+    std::cerr << "usage: bench_odometry OUTPUT_POSES.txt [FIRST LAST [ORB|SIFT [RANSAC_PX "
+                 "[MAX_FEATURES]]]]\n";
     return 2;
   }
   const std::string dir = std::string(OPENABLE_DATASETS_DIR) + "/kitti00_first1700";
@@ -96,7 +97,8 @@ int main(int argc, char** argv) {
     double rotation_error = 0, direction_error = 0;
     int directions = 0;
     for (int i = first + 1; i <= last; ++i) {
-      const Eigen::Isometry3d e = estimate.poses[i - first - 1].inverse() * estimate.poses[i - first];
+      const Eigen::Isometry3d e =
+          estimate.poses[i - first - 1].inverse() * estimate.poses[i - first];
       const Eigen::Isometry3d g = truth.poses[i - 1].inverse() * truth.poses[i];
       rotation_error += odometry::RotationAngle(g.linear().transpose() * e.linear());
       if (g.translation().norm() > 0.1 && e.translation().norm() > 0) {
@@ -115,9 +117,10 @@ int main(int argc, char** argv) {
                 Quantile(seconds, 0.25), Quantile(seconds, 0.5), Quantile(seconds, 0.75));
     std::printf("mean inliers %.0f, fallback steps %d of %zu\n",
                 inliers / std::max(1.0, double(seconds.size())), failed, seconds.size());
-    std::printf("per-step errors: rotation %.3f deg (mean), translation direction %.2f deg (mean)\n",
-                kDegrees * rotation_error / std::max(1, last - first),
-                kDegrees * direction_error / std::max(1, directions));
+    std::printf(
+        "per-step errors: rotation %.3f deg (mean), translation direction %.2f deg (mean)\n",
+        kDegrees * rotation_error / std::max(1, last - first),
+        kDegrees * direction_error / std::max(1, directions));
     std::printf("ATE unaligned: mean %.2f m, rmse %.2f m, max %.2f m\n", unaligned.mean,
                 unaligned.rmse, unaligned.max);
     std::printf("ATE aligned:   mean %.2f m, rmse %.2f m, max %.2f m\n", aligned.mean,

@@ -167,8 +167,9 @@ int main(int argc, char** argv) {
     Print("search", Summarise(search));
     Print("describe + search", Summarise(total));
     std::printf("  ground truth: %d frames with a loop (5 m%s)\n", positives,
-                heading_limit >= 0 ? (", heading <= " + std::to_string(heading_limit) + " deg").c_str()
-                                   : ", any heading");
+                heading_limit >= 0
+                    ? (", heading <= " + std::to_string(heading_limit) + " deg").c_str()
+                    : ", any heading");
     std::printf("  accepted at %.3f: %d frames, %d right (precision %.3f), recall %.3f\n",
                 options.threshold, accepted, accepted_correct,
                 accepted ? double(accepted_correct) / accepted : 1.0,

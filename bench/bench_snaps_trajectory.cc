@@ -1,5 +1,5 @@
 // Pose-graph correction of the SO-DSO trajectories of KITTI 00 and 06 with the ground-truth loop
-// pairs: prints the figures of docs/benchmarks.md ("SNAPS (issue 6)") and writes the top views.
+// pairs: prints the figures of docs/benchmarks.md ("SNAPS and odometry") and writes the top views.
 // Usage: bench_snaps_trajectory [output folder, default .]
 #include <cstdio>
 #include <string>
@@ -26,7 +26,8 @@ int main(int argc, char** argv) {
       const std::string s = run.sequence;
       const Trajectory vo = ReadTrajectory(root + "/vo_so_dso/seq" + s + "/poses_history_file.txt",
                                            TrajectoryFormat::kKittiWithId, true);
-      const Trajectory truth = ReadTrajectory(root + "/poses/" + s + ".txt", TrajectoryFormat::kKitti);
+      const Trajectory truth =
+          ReadTrajectory(root + "/poses/" + s + ".txt", TrajectoryFormat::kKitti);
       const std::vector<int> association = AssociateWithTruth(vo, truth, 0, "truth");
       int dropped = 0, outside = 0;
       const std::vector<LoopPair> pairs =

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The table of docs/benchmarks.md: every descriptor on KITTI 00 (frames 0-1699), Nordland
 # (winter vs summer) and Gardens Point (day_right vs day_left), with the protocols of
-# reference.md, evaluated by Test_OpenABLE itself. Prints one Markdown row per run.
+# docs/benchmarks.md ("Accuracy"), evaluated by Test_OpenABLE itself. Prints one Markdown row per run.
 # Usage: bench/evaluation_table.sh [descriptor ...]   (default: LDB ORB BRISK SIFT HOG BRIEF FREAK)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"

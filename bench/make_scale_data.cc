@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
   if (argc != 4) {
-    std::fprintf(stderr, "usage: make_scale_data <nordland_trimmed> <output> <frames per traversal>\n");
+    std::fprintf(stderr,
+                 "usage: make_scale_data <nordland_trimmed> <output> <frames per traversal>\n");
     return 2;
   }
   const fs::path in = argv[1], out = argv[2];

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The bar of issue 2: Nordland trimmed, winter against summer (1788 + 1788 frames), LDB, global
+# The Nordland benchmark: Nordland trimmed, winter against summer (1788 + 1788 frames), LDB, global
 # 64x64, L = 10 by default. Prints R@1 (share of winter frames whose best summer match lies within
 # +-2 frames), wall time and peak memory of Test_OpenABLE (GNU time), for docs/benchmarks.md.
 # Usage: bench/nordland_bar.sh [--set Key=Value ...]   (from anywhere; needs ../shared/datasets)

@@ -26,7 +26,8 @@ int main(int argc, char** argv) {
   try {
     const double t1 = std::stod(argv[3]), t2 = std::stod(argv[4]), k = std::stod(argv[5]);
     double nm[3] = {470, 535, 610};  // B, G, R: KITTI's PointGrey Flea2 (OpenABLE paper)
-    if (argc == 9) nm[2] = std::stod(argv[6]), nm[1] = std::stod(argv[7]), nm[0] = std::stod(argv[8]);
+    if (argc == 9)
+      nm[2] = std::stod(argv[6]), nm[1] = std::stod(argv[7]), nm[0] = std::stod(argv[8]);
     const double c2 = 1.4388e-2;
     cv::Scalar gain;
     for (int c = 0; c < 3; ++c)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Robustness table of docs/benchmarks.md (issue 8, noise and light): a descriptor on KITTI 00
+# Robustness table of docs/benchmarks.md (sensor noise and light): a descriptor on KITTI 00
 # (frames 0-1699) and Nordland (winter vs summer, L=10) with the protocols of
 # bench/evaluation_table.sh, clean and with the side-window paper's disturbances (Gaussian
 # variance 0.003, salt-and-pepper 10 %, overexposure: exposure doubled), each noisy run also

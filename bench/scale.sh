@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end scale benchmark of issue 4: N query frames against N reference frames (real
+# End-to-end scale benchmark: N query frames against N reference frames (real
 # Nordland frames repeated and perturbed, bench/make_scale_data.cc), LDB 256 bits, L = 10,
 # Best_matches 10, for N in the arguments (default 1000 10000 50000 100000). Dense mode where
 # the (2N)^2 matrix fits in 16 GiB, bounded mode always. Prints wall time, pairs per second and

@@ -16,7 +16,8 @@
 
 int main(int argc, char** argv) {
   if (argc != 4 && argc != 5) {
-    std::fprintf(stderr, "usage: shift_panoramas <input folder> <output folder> <fraction> [count]\n");
+    std::fprintf(stderr,
+                 "usage: shift_panoramas <input folder> <output folder> <fraction> [count]\n");
     return 2;
   }
   try {

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The SNAPS figures of docs/benchmarks.md (issue 6) on real KITTI trajectories
+# The SNAPS figures of docs/benchmarks.md on real KITTI trajectories
 # (../shared/datasets/kitti_trajectories): SO-DSO keyframe trajectories of sequences 00 and 06
 # corrected with the ground-truth loop pairs, and KITTI 00 frames 0-1699 corrected with loops
 # found by OpenABLE itself (LDB, L=1 matrix of kitti00_first1700) and by SNAPS's own search on
@@ -42,7 +42,7 @@ echo "=== KITTI 00 frames 0-1699: SNAPS's own search on thumbnails"
   --set Snaps_loops=search --set Snaps_images="$images" \
   --set Snaps_output_name="$out/kitti00_first1700_search"
 
-echo "=== KITTI 00 frames 0-1699 from the images (issue 7): monocular odometry (scale from the"
+echo "=== KITTI 00 frames 0-1699 from the images: monocular odometry (scale from the"
 echo "    ground truth's step lengths), loops found by OpenABLE on the same frames"
 "$snaps" --quiet --set Snaps_odometry=mono --set Images_path="$images" \
   --set Odometry_calibration="$data/kitti00_first1700/calib.txt" --set Odometry_calibration_scale=0.5 \

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The panorama bar of issue 5 on the real Sussex panoramas (../shared/datasets/sussex_panoramas):
+# The panorama benchmark on the real Sussex panoramas (../shared/datasets/sussex_panoramas):
 # the 96 tracked frames of the re-run (test_infomax_binary, same direction) as queries against
 # the 455 frames of the training route; a query's true places are the training frames within
 # 30 cm of it (tracked positions, Ground_truth_type positions, Tolerance 0). R@1 = share of

@@ -64,7 +64,8 @@ int AnswerWithoutRunning(const CommandLine& command_line, const std::string& usa
 }
 
 Config ConfigOf(const CommandLine& command_line) {
-  Config config = command_line.config_path.empty() ? Config() : LoadConfig(command_line.config_path);
+  Config config =
+      command_line.config_path.empty() ? Config() : LoadConfig(command_line.config_path);
   for (const auto& o : command_line.overrides) ApplyOverride(config, o);
   return config;
 }

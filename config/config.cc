@@ -167,7 +167,8 @@ OptionTable ConfigTable(Config& c) {
   t.Add("Noise_salt_pepper", kRobustness, c.preprocess, c.preprocess.noise.salt_pepper, 0, 1,
         "Robustness studies: fraction of the pixels of every frame set to black or white (even "
         "odds), after the Gaussian noise; the side-window paper uses 0.1. 0 = off.");
-  t.Add("Noise_overexposure", kRobustness, c.preprocess, c.preprocess.noise.overexposure, 0, kNoLimit,
+  t.Add("Noise_overexposure", kRobustness, c.preprocess, c.preprocess.noise.overexposure, 0,
+        kNoLimit,
         "Robustness studies: overexposure of every frame, intensities v in [0, 1] multiplied by 1"
         " + this value and saturated at 1 (1 doubles the exposure: everything above 0.5 becomes "
         "white). Applied first. 0 = off.");
@@ -209,12 +210,13 @@ OptionTable ConfigTable(Config& c) {
         "settings describes only the frames not cached, and gives the same matrix bit for bit. "
         "Image folders only (not videos or stereo pairs). Created when missing.");
   // Evaluation
-  t.AddEnumName("Ground_truth_type", kEvaluation, c.evaluation, c.evaluation.truth.type, &ParseGroundTruthType,
-        &GroundTruthTypeText,
-        "Empty: no evaluation. matrix (0/1 text, image, .npy), pairs (CSV or whitespace row,col),"
-        " aligned (two traversals, query i is reference i), kitti (3x4 poses), tum (timestamp tx "
-        "ty tz qx qy qz qw), positions (x,y[,z]): the run's matrix is evaluated against it with "
-        "both protocols of docs/evaluation.md.");
+  t.AddEnumName(
+      "Ground_truth_type", kEvaluation, c.evaluation, c.evaluation.truth.type,
+      &ParseGroundTruthType, &GroundTruthTypeText,
+      "Empty: no evaluation. matrix (0/1 text, image, .npy), pairs (CSV or whitespace row,col),"
+      " aligned (two traversals, query i is reference i), kitti (3x4 poses), tum (timestamp tx "
+      "ty tz qx qy qz qw), positions (x,y[,z]): the run's matrix is evaluated against it with "
+      "both protocols of docs/evaluation.md.");
   t.Add("Ground_truth", kEvaluation, c.evaluation, c.evaluation.truth.path,
         "Ground-truth file (not needed for aligned). Pairs and poses count frames from the start "
         "of the source, as Initial_image does; for poses of two traversals, the poses of the "
@@ -228,7 +230,8 @@ OptionTable ConfigTable(Config& c) {
   t.Add("Ground_truth_radius", kEvaluation, c.evaluation, c.evaluation.truth.radius, 0, kNoLimit,
         "Poses: two frames are the same place when their positions are closer than this (the "
         "poses' unit, metres for KITTI).", true, /*min_excluded=*/true);
-  t.Add("Ground_truth_heading", kEvaluation, c.evaluation, c.evaluation.truth.heading_limit, -1, 180,
+  t.Add("Ground_truth_heading", kEvaluation, c.evaluation, c.evaluation.truth.heading_limit, -1,
+        180,
         "Poses: and when their viewing directions differ by less than this many degrees (a "
         "forward camera cannot recognise a place seen the other way); -1: no limit.");
   t.Add("Ground_truth_min_gap", kEvaluation, c.evaluation, c.evaluation.min_frame_gap, -1, kNoLimit,
@@ -325,7 +328,8 @@ OptionTable ConfigTable(Config& c) {
         "given in the paper).");
   t.Add("Snaps_attempts", kSnaps, c.snaps, c.snaps.search.attempts, 1, kNoLimit,
         "At most this many candidates, nearest first, are compared (not given in the paper).");
-  t.Add("Snaps_discount_length", kSnaps, c.snaps, c.snaps.search.discount.discount_length, 0, kNoLimit,
+  t.Add("Snaps_discount_length", kSnaps, c.snaps, c.snaps.search.discount.discount_length, 0,
+        kNoLimit,
         "K of Eq. 6: the last K poses move towards the reference (not given in the paper; gamma "
         "is 0 beyond 300 poses for the first loop).");
   t.Add("Snaps_pause", kSnaps, c.snaps, c.snaps.search.discount.pause, 0, kNoLimit,
@@ -335,18 +339,24 @@ OptionTable ConfigTable(Config& c) {
         "discounted (the paper's Eq. 6), pose-graph (least squares over odometry and loop edges) "
         "or both.");
   t.Add("Snaps_loop_weight", kSnaps, c.snaps, c.snaps.pose_graph.loop_weight, 0, kNoLimit,
-        "Pose graph: information of a loop edge's position residual, 1/m^2 (1 = sigma 1 m).", true, /*min_excluded=*/true);
-  t.Add("Snaps_odometry_translation_weight", kSnaps, c.snaps, c.snaps.pose_graph.odometry_translation_weight, 0, kNoLimit,
+        "Pose graph: information of a loop edge's position residual, 1/m^2 (1 = sigma 1 m).", true,
+        /*min_excluded=*/true);
+  t.Add("Snaps_odometry_translation_weight", kSnaps, c.snaps,
+        c.snaps.pose_graph.odometry_translation_weight, 0, kNoLimit,
         "Pose graph: information of an odometry edge's translation per pose step, 1/m^2 (2500 = "
-        "sigma 0.02 m).", true, /*min_excluded=*/true);
-  t.Add("Snaps_odometry_rotation_weight", kSnaps, c.snaps, c.snaps.pose_graph.odometry_rotation_weight, 0, kNoLimit,
+        "sigma 0.02 m).",
+        true, /*min_excluded=*/true);
+  t.Add("Snaps_odometry_rotation_weight", kSnaps, c.snaps,
+        c.snaps.pose_graph.odometry_rotation_weight, 0, kNoLimit,
         "Pose graph: information of an odometry edge's rotation per pose step, 1/rad^2 (1e6 = "
-        "sigma 0.001 rad).", true, /*min_excluded=*/true);
+        "sigma 0.001 rad).",
+        true, /*min_excluded=*/true);
   t.AddEnumName("Snaps_robust_kernel", kSnaps, c.snaps, c.snaps.pose_graph.robust_kernel,
         "Pose graph: robust kernel on loop edges, none, huber or cauchy (a few wrong loops then "
         "pull with a bounded force).");
   t.Add("Snaps_robust_scale", kSnaps, c.snaps, c.snaps.pose_graph.robust_scale, 0, kNoLimit,
-        "Pose graph: scale of the robust kernel in sigmas of a loop edge.", true, /*min_excluded=*/true);
+        "Pose graph: scale of the robust kernel in sigmas of a loop edge.", true,
+        /*min_excluded=*/true);
   t.AddEnumName("Snaps_axes", kSnaps, c.snaps, c.snaps.axes,
         "Ground plane of the plot and of the yaw: xz (KITTI: y points down) or xy (z up).");
   t.Add("Snaps_output_name", kSnaps, c.snaps, c.snaps.output_name,

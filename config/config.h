@@ -2,8 +2,8 @@
 // Config.txt key sets, gathered in Config, and the one table that binds each key to its field
 // (ConfigTable). That table drives reading Config.txt, the `--set Key=Value` overrides,
 // `--help` and the configuration reference in docs/configuration.md. Key names and meanings
-// are those of the original OpenABLE (../shared/guide/reference.md), so an old configuration
-// runs unchanged; keys marked "new" are additions documented in the reference.
+// are those of the original OpenABLE (Arroyo et al., ITSC 2016, and its Config.txt), so an old
+// configuration runs unchanged; keys marked "new" are additions documented in the reference.
 #pragma once
 
 #include <string>

@@ -101,8 +101,9 @@ class OptionTable {
   void AddEnumName(const char* key, const char* group, Owner& owner, E& field,
                    E (*parse)(const std::string&), std::string (*format)(E),
                    const char* meaning, bool is_new = true) {
-    AddEnum(key, group, meaning, is_new, [&field, parse](const std::string& v) { field = parse(v); },
-            [&field, format] { return format(field); }, CheckOf(owner));
+    AddEnum(
+        key, group, meaning, is_new, [&field, parse](const std::string& v) { field = parse(v); },
+        [&field, format] { return format(field); }, CheckOf(owner));
   }
 
   const std::vector<OptionBinding>& Bindings() const& { return bindings_; }

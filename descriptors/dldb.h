@@ -5,7 +5,7 @@
 // IROS 2014 (ABLE-S), reference [9] of the OpenABLE paper (Arroyo et al., ITSC 2016), which
 // adds disparity comparisons (D_avg) to the binary tests of LDB.
 //
-// As OpenABLE builds it (../shared/guide/reference.md): the descriptor of a patch is the LDB
+// As the original OpenABLE builds it: the descriptor of a patch is the LDB
 // string of its grey channel followed by the LDB string of its disparity channel, each with
 // the same tests (descriptors/ldb.h, Ldb_bits bits), matched with one Hamming distance. So
 // Width() = 2 x LDB width, and the first half of a D-LDB row is exactly the LDB row of the

@@ -1,4 +1,4 @@
-// The one table of descriptor names (conventions.md, item 2): descriptors are created only
+// The one table of descriptor names: descriptors are created only
 // here, from their configured name. Not self-registering: an explicit table.
 #pragma once
 

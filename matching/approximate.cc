@@ -292,7 +292,8 @@ void ExactL2(const cv::Mat& refs, const cv::Mat& queries, int k, int threads, Ca
       std::vector<Candidate>& list = out[static_cast<size_t>(q0 + i)];
       for (int j = 0; j < n; ++j)
         if (lower[static_cast<size_t>(j)] <= bound)
-          list.push_back(Candidate{j, L2Distance(queries.ptr<float>(q0 + i), refs.ptr<float>(j), d)});
+          list.push_back(
+              Candidate{j, L2Distance(queries.ptr<float>(q0 + i), refs.ptr<float>(j), d)});
       SortCandidates(list);
       list.resize(static_cast<size_t>(k));
     }

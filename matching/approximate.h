@@ -14,8 +14,8 @@
 //
 // Every distance returned is exact, recomputed for the pair after the search by RowDistance
 // (matching/distances.h): the number of differing bits, or the Euclidean (not squared) distance
-// summed in double precision and rounded to float. Exact and approximate results therefore give equal distances
-// for equal pairs, and recall can compare them with ==.
+// summed in double precision and rounded to float. Exact and approximate results therefore give
+// equal distances for equal pairs, and recall can compare them with ==.
 #pragma once
 
 #include <cstdint>

@@ -90,8 +90,8 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
   if (binary) packed = std::make_unique<HammingReferences>(references);
   // Rows per tile: the tile (with its L - 1 rows of history) within tile_bytes.
   const std::int64_t row_bytes = static_cast<std::int64_t>(m) * sizeof(float);
-  const int tile_rows = static_cast<int>(
-      std::max<std::int64_t>(16, options.tile_bytes / std::max<std::int64_t>(1, row_bytes) - (L - 1)));
+  const int tile_rows = static_cast<int>(std::max<std::int64_t>(
+      16, options.tile_bytes / std::max<std::int64_t>(1, row_bytes) - (L - 1)));
   std::vector<Match> kept;
   float max_seen = 0.0f;
   cv::Mat1f tile;

@@ -175,8 +175,9 @@ __attribute__((target("avx2,popcnt"))) void Avx2FixedKernel(const std::uint64_t*
   if (b < b1) PopcntKernel(q, refs, b, b1, out);  // an odd last block
 }
 
-__attribute__((target("avx2,popcnt"))) void Avx2Kernel(const std::uint64_t* q, const PackedRows& refs,
-                                                int b0, int b1, float* out) {
+__attribute__((target("avx2,popcnt"))) void Avx2Kernel(const std::uint64_t* q,
+                                                       const PackedRows& refs, int b0, int b1,
+                                                       float* out) {
   switch (refs.words) {
     case 4: return Avx2FixedKernel<4>(q, refs, b0, b1, out);    // 256 bits (LDB, ORB)
     case 8: return Avx2FixedKernel<8>(q, refs, b0, b1, out);    // 512 bits (BRISK)
@@ -291,7 +292,8 @@ namespace {
 // One pair, compiled twice: for baseline x86-64 (where __builtin_popcountll is a bit-twiddling
 // routine) and with the POPCNT instruction.
 template <int kUnused>
-__attribute__((always_inline)) inline int PairBits(const std::uint8_t* a, const std::uint8_t* b, int bytes) {
+__attribute__((always_inline)) inline int PairBits(const std::uint8_t* a, const std::uint8_t* b,
+                                                   int bytes) {
   int bits = 0;
   int k = 0;
   for (; k + 8 <= bytes; k += 8) {

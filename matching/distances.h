@@ -11,8 +11,8 @@
 
 namespace openable {
 
-// Called now and then with (cells done, cells in all) of the matrix computed; may be empty. Called from one thread
-// at a time.
+// Called now and then with (cells done, cells in all) of the matrix computed; may be empty. Called
+// from one thread at a time.
 using PairProgress = std::function<void(std::int64_t done, std::int64_t total)>;
 
 // Number of bits that differ between the byte strings a and b of `bytes` bytes.

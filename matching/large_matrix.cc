@@ -67,7 +67,8 @@ HugePageAllocator& Allocator() {
 
 cv::Mat1f LargeMatrix(int rows, int cols) {
   cv::Mat1f m;
-  if (static_cast<double>(rows) * cols * sizeof(float) >= 8.0 * (1 << 20)) m.allocator = &Allocator();
+  if (static_cast<double>(rows) * cols * sizeof(float) >= 8.0 * (1 << 20))
+    m.allocator = &Allocator();
   m.create(rows, cols);
   return m;
 }

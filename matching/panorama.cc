@@ -30,12 +30,14 @@ cv::Mat1f PanoramaDistances(const cv::Mat& rows, int strips, PanoramaMatching mo
   auto distances = [&](const cv::Mat& a, const cv::Mat& b, const PairProgress& p) {
     return binary ? HammingDistances(a, b, threads, p) : L2Distances(a, b, threads, p);
   };
-  if (mode == PanoramaMatching::kAligned || strips == 1) return distances(rows, cv::Mat(), progress);
+  if (mode == PanoramaMatching::kAligned || strips == 1)
+    return distances(rows, cv::Mat(), progress);
 
   const int n = rows.rows;
   const int w = rows.cols / strips;
   std::vector<cv::Mat> strip(static_cast<size_t>(strips));
-  for (int k = 0; k < strips; ++k) strip[static_cast<size_t>(k)] = rows.colRange(k * w, (k + 1) * w).clone();
+  for (int k = 0; k < strips; ++k)
+    strip[static_cast<size_t>(k)] = rows.colRange(k * w, (k + 1) * w).clone();
 
   // Progress over the strips^2 single-strip matrices.
   const std::int64_t cells = static_cast<std::int64_t>(n) * n;

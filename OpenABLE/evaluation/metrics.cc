@@ -74,8 +74,9 @@ void EvaluationOptions::Check() const {
     throw InputError("Tolerance: " + std::to_string(tolerance) +
                      " is negative; expected a number of frames >= 0");
   if (exclusion < 1)
-    throw InputError("Exclusion: " + std::to_string(exclusion) +
-                     " is too small; expected a number of frames >= 1 (a frame is not its own loop)");
+    throw InputError(
+        "Exclusion: " + std::to_string(exclusion) +
+        " is too small; expected a number of frames >= 1 (a frame is not its own loop)");
   if (vicinity < 0)
     throw InputError("Vicinity: " + std::to_string(vicinity) +
                      " is negative; expected a number of frames >= 0");
@@ -109,8 +110,9 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
         const float v = row[c];
         // Strictly smaller than the worst kept: ties keep the lower column.
         if (static_cast<int>(top.size()) < kMaxN || v < top.back().first) {
-          auto pos = std::upper_bound(top.begin(), top.end(), v,
-                                      [](float x, const std::pair<float, int>& e) { return x < e.first; });
+          auto pos =
+              std::upper_bound(top.begin(), top.end(), v,
+                               [](float x, const std::pair<float, int>& e) { return x < e.first; });
           top.insert(pos, {v, c});
           if (static_cast<int>(top.size()) > kMaxN) top.pop_back();
         }
@@ -217,8 +219,8 @@ AblePResult EvaluateAbleP(const cv::Mat1f& matrix, const EvaluationLayout& layou
       ++result.truth_cells;
     }
   }
-  const cv::Mat kernel =
-      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * options.vicinity + 1, 2 * options.vicinity + 1));
+  const cv::Mat kernel = cv::getStructuringElement(
+      cv::MORPH_RECT, cv::Size(2 * options.vicinity + 1, 2 * options.vicinity + 1));
   cv::Mat1b near_truth;
   cv::dilate(truth_mask, near_truth, kernel, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT,
              cv::Scalar(0));

@@ -290,7 +290,8 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
     for (int c : truth.matches[q]) {
       if (c < 0 || c >= cols) continue;
       cv::Vec3b& p = out[c];
-      for (int ch = 0; ch < 3; ++ch) p[ch] = static_cast<std::uint8_t>((p[ch] + kTruthTint[ch] + 1) / 2);
+      for (int ch = 0; ch < 3; ++ch)
+        p[ch] = static_cast<std::uint8_t>((p[ch] + kTruthTint[ch] + 1) / 2);
     }
   }
 

@@ -33,8 +33,9 @@ cv::Mat1b IlluminationInvariant(const cv::Mat& frame, double alpha) {
   if (frame.depth() != CV_32F)
     throw std::logic_error("IlluminationInvariant: expected a CV_32F frame");
   if (frame.channels() != 3)
-    throw InputError("the frame has " + std::to_string(frame.channels()) +
-                     " channel(s); Illumination_invariance 1 (Eq. 6) needs colour frames (R, G, B)");
+    throw InputError(
+        "the frame has " + std::to_string(frame.channels()) +
+        " channel(s); Illumination_invariance 1 (Eq. 6) needs colour frames (R, G, B)");
   constexpr float kFloor = 1.0f / 510.0f;
   cv::Mat1b out(frame.size());
   bool grey = true;

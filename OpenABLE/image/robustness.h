@@ -1,4 +1,4 @@
-// Robustness tools (issue 8, "noise and light"): side-window multilayer pixel fusion, a
+// Robustness to sensor noise and light: side-window multilayer pixel fusion, a
 // preprocessing of the grey image before description, and noise injection into frames for
 // robustness studies.
 //

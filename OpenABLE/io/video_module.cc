@@ -151,8 +151,10 @@ extern "C" void openable_video_open(const std::string& path, int first, int last
   int count = 0;
   int api = -1;
   std::error_code ec;
-  if (std::filesystem::is_regular_file(path, ec) && std::filesystem::file_size(path, ec) == 0 && !ec)
-    throw InputError("video " + Quoted(path) + " is an empty file (0 bytes; " + kExpectedVideo + ")");
+  if (std::filesystem::is_regular_file(path, ec) && std::filesystem::file_size(path, ec) == 0 &&
+      !ec)
+    throw InputError("video " + Quoted(path) + " is an empty file (0 bytes; " + kExpectedVideo +
+                     ")");
   // FFmpeg logs its complaints about a damaged file ("moov atom not found") on stderr before
   // OpenCV reports failure; our message says it in one line, so FFmpeg is kept quiet (unless
   // the user asked for its log level).

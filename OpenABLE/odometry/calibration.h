@@ -1,4 +1,4 @@
-// Camera intrinsics for the odometry front-end (issue 7) and the reader of KITTI's calib.txt.
+// Camera intrinsics for the odometry front-end of SNAPS and the reader of KITTI's calib.txt.
 #pragma once
 
 #include <string>

@@ -1,4 +1,4 @@
-// Monocular visual odometry (issue 7): features matched between consecutive frames, the
+// Monocular visual odometry: features matched between consecutive frames, the
 // essential matrix with RANSAC (Nister's five-point solver, cv::findEssentialMat) and its
 // decomposition into a rotation and a translation DIRECTION (cv::recoverPose, cheirality check).
 //

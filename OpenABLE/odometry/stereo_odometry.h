@@ -1,5 +1,5 @@
-// Stereo visual odometry as in the SNAPS paper, Sec. II-B to II-D
-// (../shared/papers/000_589a4d56462291ec.txt):
+// Stereo visual odometry as in the SNAPS paper ("Similarity and Location-based Real-time Loop
+// Closure: SNAPS for SLAM in Unexplored Environments"), Sec. II-B to II-D:
 //   1. disparity of the rectified pair by block matching (OpenCV), then the disparity map filter
 //      based on weighted least squares (cv::ximgproc::DisparityWLSFilter, Min et al.);
 //   2. depth of the previous frame's keypoints from the disparity, Eq. 1: z = B f / d, and their

@@ -1,4 +1,4 @@
-// The library's two ways in for programs that do not go through Config.txt (issue 9):
+// The library's two ways in for programs that do not go through Config.txt:
 //
 //  - OnlineDetector: a SLAM system feeds frames one by one and gets, for each, its loop
 //    candidates among earlier frames.
@@ -37,7 +37,7 @@ struct OnlineOptions {
   int ldb_bits = 256;
   int grid_x = 1, grid_y = 1;
   // Matching.
-  int sequence_length = 1;  // L (Image_sequence_length): frames summed along the diagonal
+  int sequence_length = 1;  // L (the key Image_sequences): frames summed along the diagonal
   int exclusion = 100;      // frame q's candidates are frames j <= q - exclusion (>= 1)
   int candidates = 5;       // candidates returned per frame (the k best), >= 1
   // A candidate is accepted when its normalised distance is <= threshold (see LoopCandidate).
@@ -88,8 +88,8 @@ struct OnlineResult {
 // searchable frame while exact (linear in the map up to exact_limit), then one FLANN query per
 // block (about log2(frames / block_frames) + 1 blocks; one more while a merge is built) plus
 // an exact scan of fewer than block_frames frames, plus L distances per candidate; every
-// block_frames frames one block of block_frames rows is indexed in AddFrame (milliseconds). Not thread-safe for AddFrame; the const
-// members may be called while no AddFrame runs.
+// block_frames frames one block of block_frames rows is indexed in AddFrame (milliseconds). Not
+// thread-safe for AddFrame; the const members may be called while no AddFrame runs.
 class OnlineDetector {
  public:
   explicit OnlineDetector(const OnlineOptions& options);  // throws InputError on bad options

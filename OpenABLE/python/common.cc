@@ -71,7 +71,8 @@ MatView Wrap(py::array a, int depth, int channels, bool copied) {
 MatView Matrix2D(const py::handle& object, Elements elements, const char* what) {
   py::array a = py::array::ensure(object);
   if (!a) {
-    throw py::value_error(std::string(what) + ": expected a NumPy array (or a nested list of numbers)");
+    throw py::value_error(std::string(what) +
+                          ": expected a NumPy array (or a nested list of numbers)");
   }
   if (a.ndim() != 1 && a.ndim() != 2) {
     throw py::value_error(std::string(what) + ": array of shape " + ShapeText(a) +

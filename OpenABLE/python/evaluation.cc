@@ -143,7 +143,8 @@ void AddPair(GroundTruth& gt, const EvaluationLayout& layout, std::int64_t a, st
   if (loop && a == b) {
     ++gt.dropped;
   } else if (loop) {
-    gt.matches[static_cast<std::size_t>(std::max(a, b))].push_back(static_cast<int>(std::min(a, b)));
+    gt.matches[static_cast<std::size_t>(std::max(a, b))].push_back(
+        static_cast<int>(std::min(a, b)));
   } else {
     gt.matches[static_cast<std::size_t>(a)].push_back(static_cast<int>(b));
   }
@@ -154,7 +155,8 @@ GroundTruth FromMatrix(const py::handle& object, const EvaluationLayout& layout,
   const MatView v = Matrix2D(object, Elements::kFloat32, "truth_matrix");
   const int rows = layout.queries, cols = layout.references;
   cv::Mat1f block(v.mat);
-  if (block.rows == full_rows && block.cols == full_cols && (rows != full_rows || cols != full_cols)) {
+  if (block.rows == full_rows && block.cols == full_cols &&
+      (rows != full_rows || cols != full_cols)) {
     block = block(cv::Rect(layout.col_offset, layout.row_offset, cols, rows));
   } else if (block.rows != rows || block.cols != cols) {
     throw py::value_error("truth_matrix: shape (" + std::to_string(block.rows) + ", " +
@@ -230,16 +232,20 @@ std::string LayoutName(const EvaluationLayout& l) {
 
 void RegisterEvaluation(py::module_& m) {
   py::class_<Curve>(m, "Curve", R"doc(A precision-recall curve: one point per threshold, in
-increasing order of threshold. Each property is a float64 NumPy array with one value per point.)doc")
+increasing order of threshold. Each property is a float64 NumPy array with one value per
+point.)doc")
       .def_property_readonly(
-          "threshold", [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.threshold; }); },
+          "threshold",
+          [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.threshold; }); },
           "Thresholds: per-query protocol, answers with distance <= threshold are accepted; "
           "ABLE-P, cells with M' < threshold are detections.")
       .def_property_readonly(
-          "precision", [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.precision; }); },
+          "precision",
+          [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.precision; }); },
           "Precision at each threshold (ABLE-P: 1 where nothing is detected).")
       .def_property_readonly(
-          "recall", [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.recall; }); },
+          "recall",
+          [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.recall; }); },
           "Recall at each threshold.")
       .def_property_readonly(
           "f1", [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.f1; }); },
@@ -250,13 +256,16 @@ increasing order of threshold. Each property is a float64 NumPy array with one v
       .def_property_readonly(
           "fp", [](const Curve& c) { return Column(c, [](const CurvePoint& p) { return p.fp; }); },
           "False positives at each threshold (as float64).")
-      .def("area", [](const Curve& c) { return CurveArea(c.points); },
-           "area() -> float\n\nStep-wise area: the sum of precision x (recall - previous recall) "
-           "over the points (AUC of the per-query curve; ABLE-P's average precision / 100).")
-      .def("to_dict", [](const py::object& self) { return PropertiesAsDict(self, true); },
-           "to_dict() -> dict[str, numpy.ndarray]\n\nThe columns threshold, precision, recall, "
-           "f1, tp, fp (as the CSV files openable writes).")
-      .def("__len__", [](const Curve& c) { return c.points.size(); }, "Number of points.")
+      .def(
+          "area", [](const Curve& c) { return CurveArea(c.points); },
+          "area() -> float\n\nStep-wise area: the sum of precision x (recall - previous recall) "
+          "over the points (AUC of the per-query curve; ABLE-P's average precision / 100).")
+      .def(
+          "to_dict", [](const py::object& self) { return PropertiesAsDict(self, true); },
+          "to_dict() -> dict[str, numpy.ndarray]\n\nThe columns threshold, precision, recall, "
+          "f1, tp, fp (as the CSV files openable writes).")
+      .def(
+          "__len__", [](const Curve& c) { return c.points.size(); }, "Number of points.")
       .def("__repr__", [](const Curve& c) {
         return "<openable.Curve of " + std::to_string(c.points.size()) + " points>";
       });
@@ -264,75 +273,105 @@ increasing order of threshold. Each property is a float64 NumPy array with one v
   py::class_<Result>(m, "EvaluationResult", R"doc(The figures and curves of evaluate(): the
 per-query best-match protocol (auc, recall_at_100p, max_f1, recall_at_1/5/10, curve) and the
 ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md defines each.)doc")
-      .def_property_readonly("label", [](const Result& r) { return r.run.label; },
-                             "The label given to evaluate().")
-      .def_property_readonly("layout", [](const Result& r) { return LayoutName(r.run.layout); },
-                             "\"loop_closure\" or \"query_reference\".")
       .def_property_readonly(
-          "block", [](const Result& r) {
+          "label", [](const Result& r) { return r.run.label; }, "The label given to evaluate().")
+      .def_property_readonly(
+          "layout", [](const Result& r) { return LayoutName(r.run.layout); },
+          "\"loop_closure\" or \"query_reference\".")
+      .def_property_readonly(
+          "block",
+          [](const Result& r) {
             const EvaluationLayout& l = r.run.layout;
             return py::make_tuple(l.row_offset, l.col_offset, l.queries, l.references);
           },
           "(first row, first column, rows, columns) of the evaluated block in the matrix.")
-      .def_property_readonly("auc", [](const Result& r) { return r.run.per_query.auc; },
-                             "Per-query protocol: step-wise area under the precision-recall curve.")
-      .def_property_readonly("recall_at_100p", [](const Result& r) { return r.run.per_query.recall_at_100p; },
-                             "Per-query protocol: highest recall with precision 1 (0 if none).")
-      .def_property_readonly("max_f1", [](const Result& r) { return r.run.per_query.max_f1; },
-                             "Per-query protocol: the largest F1 along the curve.")
-      .def_property_readonly("max_f1_threshold", [](const Result& r) { return r.run.per_query.max_f1_threshold; },
-                             "Distance threshold of max_f1 (the first on ties).")
-      .def_property_readonly("max_f1_precision", [](const Result& r) { return r.run.per_query.max_f1_precision; },
-                             "Precision at max_f1.")
-      .def_property_readonly("max_f1_recall", [](const Result& r) { return r.run.per_query.max_f1_recall; },
-                             "Recall at max_f1.")
-      .def_property_readonly("recall_at_1", [](const Result& r) { return r.run.per_query.recall_at_1; },
-                             "Share of positive queries whose best candidate is correct (within tolerance of a true match).")
-      .def_property_readonly("recall_at_5", [](const Result& r) { return r.run.per_query.recall_at_5; },
-                             "Share of positive queries with a correct match among their 5 best candidates.")
-      .def_property_readonly("recall_at_10", [](const Result& r) { return r.run.per_query.recall_at_10; },
-                             "Share of positive queries with a correct match among their 10 best candidates.")
-      .def_property_readonly("queries", [](const Result& r) { return r.run.per_query.queries; },
-                             "Queries with at least one candidate.")
-      .def_property_readonly("positive_queries", [](const Result& r) { return r.run.per_query.positive_queries; },
-                             "Queries with a true match among their candidates.")
-      .def_property_readonly("truth_pairs", [](const Result& r) { return r.run.truth_pairs; },
-                             "Ground-truth pairs over the evaluated block.")
-      .def_property_readonly("truth_dropped", [](const Result& r) { return r.run.truth_dropped; },
-                             "Pairs dropped while building the ground truth (the diagonal of a loop-closure block, pairs outside a selected frame range).")
-      .def_property_readonly("truth_pairs_outside_candidates",
-                             [](const Result& r) { return r.run.per_query.truth_pairs_outside_candidates; },
-                             "True pairs that no candidate set contains (inside the exclusion window); they do not count.")
-      .def_property_readonly("curve", [](const Result& r) { return Curve{r.run.per_query.curve}; },
-                             "Per-query precision-recall curve (openable.Curve), one point per distinct best-match distance.")
-      .def_property_readonly("best", [](const Result& r) { return ArrayOf(r.run.per_query.best); },
-                             "int32 array, per query row of the block: its best candidate column (-1 without candidates).")
-      .def_property_readonly("best_distance", [](const Result& r) { return ArrayOf(r.run.per_query.best_distance); },
-                             "float32 array: the distance of each query's best candidate (inf without candidates).")
       .def_property_readonly(
-          "positive", [](const Result& r) { return ArrayOf(r.run.per_query.positive).attr("astype")("bool"); },
+          "auc", [](const Result& r) { return r.run.per_query.auc; },
+          "Per-query protocol: step-wise area under the precision-recall curve.")
+      .def_property_readonly(
+          "recall_at_100p", [](const Result& r) { return r.run.per_query.recall_at_100p; },
+          "Per-query protocol: highest recall with precision 1 (0 if none).")
+      .def_property_readonly(
+          "max_f1", [](const Result& r) { return r.run.per_query.max_f1; },
+          "Per-query protocol: the largest F1 along the curve.")
+      .def_property_readonly(
+          "max_f1_threshold", [](const Result& r) { return r.run.per_query.max_f1_threshold; },
+          "Distance threshold of max_f1 (the first on ties).")
+      .def_property_readonly(
+          "max_f1_precision", [](const Result& r) { return r.run.per_query.max_f1_precision; },
+          "Precision at max_f1.")
+      .def_property_readonly(
+          "max_f1_recall", [](const Result& r) { return r.run.per_query.max_f1_recall; },
+          "Recall at max_f1.")
+      .def_property_readonly(
+          "recall_at_1", [](const Result& r) { return r.run.per_query.recall_at_1; },
+          "Share of positive queries whose best candidate is correct (within tolerance of a true "
+          "match).")
+      .def_property_readonly(
+          "recall_at_5", [](const Result& r) { return r.run.per_query.recall_at_5; },
+          "Share of positive queries with a correct match among their 5 best candidates.")
+      .def_property_readonly(
+          "recall_at_10", [](const Result& r) { return r.run.per_query.recall_at_10; },
+          "Share of positive queries with a correct match among their 10 best candidates.")
+      .def_property_readonly(
+          "queries", [](const Result& r) { return r.run.per_query.queries; },
+          "Queries with at least one candidate.")
+      .def_property_readonly(
+          "positive_queries", [](const Result& r) { return r.run.per_query.positive_queries; },
+          "Queries with a true match among their candidates.")
+      .def_property_readonly(
+          "truth_pairs", [](const Result& r) { return r.run.truth_pairs; },
+          "Ground-truth pairs over the evaluated block.")
+      .def_property_readonly(
+          "truth_dropped", [](const Result& r) { return r.run.truth_dropped; },
+          "Pairs dropped while building the ground truth (the diagonal of a loop-closure block, "
+          "pairs outside a selected frame range).")
+      .def_property_readonly(
+          "truth_pairs_outside_candidates",
+          [](const Result& r) { return r.run.per_query.truth_pairs_outside_candidates; },
+          "True pairs that no candidate set contains (inside the exclusion window); they do not "
+          "count.")
+      .def_property_readonly(
+          "curve", [](const Result& r) { return Curve{r.run.per_query.curve}; },
+          "Per-query precision-recall curve (openable.Curve), one point per distinct best-match "
+          "distance.")
+      .def_property_readonly(
+          "best", [](const Result& r) { return ArrayOf(r.run.per_query.best); },
+          "int32 array, per query row of the block: its best candidate column (-1 without "
+          "candidates).")
+      .def_property_readonly(
+          "best_distance", [](const Result& r) { return ArrayOf(r.run.per_query.best_distance); },
+          "float32 array: the distance of each query's best candidate (inf without candidates).")
+      .def_property_readonly(
+          "positive",
+          [](const Result& r) { return ArrayOf(r.run.per_query.positive).attr("astype")("bool"); },
           "bool array: the query has a true match among its candidates.")
       .def_property_readonly(
-          "correct", [](const Result& r) { return ArrayOf(r.run.per_query.correct).attr("astype")("bool"); },
+          "correct",
+          [](const Result& r) { return ArrayOf(r.run.per_query.correct).attr("astype")("bool"); },
           "bool array: the query's best candidate is within tolerance of a true match.")
-      .def_property_readonly("average_precision", [](const Result& r) { return r.run.able_p.average_precision; },
-                             "ABLE-P protocol: area under its 100-threshold curve, in percent.")
-      .def_property_readonly("able_p_curve", [](const Result& r) { return Curve{r.run.able_p.curve}; },
-                             "ABLE-P precision-recall curve (openable.Curve), thresholds k / (n - 1).")
-      .def_property_readonly("candidate_cells", [](const Result& r) { return r.run.able_p.candidate_cells; },
-                             "ABLE-P: cells of the block that are candidates.")
-      .def_property_readonly("truth_cells", [](const Result& r) { return r.run.able_p.truth_cells; },
-                             "ABLE-P: ground-truth pairs among the candidate cells.")
-      .def("truth_matches", [](const Result& r) { return TruthPairs(r.truth); },
-           "truth_matches() -> numpy.ndarray\n\nThe ground truth used: int64 (P, 2) pairs "
-           "(query row, reference column) in the block's indices (loop closure: later frame "
-           "first).")
-      .def("to_json",
-           [](const Result& r) {
-             return EncodeEvaluationJson(r.settings, {r.run}, kVersion);
-           },
-           "to_json() -> str\n\nThe evaluation as the JSON file Test_OpenABLE and "
-           "openable_evaluate write (Evaluation_name.json), with this one run.")
+      .def_property_readonly(
+          "average_precision", [](const Result& r) { return r.run.able_p.average_precision; },
+          "ABLE-P protocol: area under its 100-threshold curve, in percent.")
+      .def_property_readonly(
+          "able_p_curve", [](const Result& r) { return Curve{r.run.able_p.curve}; },
+          "ABLE-P precision-recall curve (openable.Curve), thresholds k / (n - 1).")
+      .def_property_readonly(
+          "candidate_cells", [](const Result& r) { return r.run.able_p.candidate_cells; },
+          "ABLE-P: cells of the block that are candidates.")
+      .def_property_readonly(
+          "truth_cells", [](const Result& r) { return r.run.able_p.truth_cells; },
+          "ABLE-P: ground-truth pairs among the candidate cells.")
+      .def(
+          "truth_matches", [](const Result& r) { return TruthPairs(r.truth); },
+          "truth_matches() -> numpy.ndarray\n\nThe ground truth used: int64 (P, 2) pairs "
+          "(query row, reference column) in the block's indices (loop closure: later frame "
+          "first).")
+      .def(
+          "to_json",
+          [](const Result& r) { return EncodeEvaluationJson(r.settings, {r.run}, kVersion); },
+          "to_json() -> str\n\nThe evaluation as the JSON file Test_OpenABLE and "
+          "openable_evaluate write (Evaluation_name.json), with this one run.")
       .def(
           "to_dict", [](const py::object& self) { return PropertiesAsDict(self); },
           "to_dict() -> dict\n\nEvery figure, and both curves as dicts of NumPy arrays.")
@@ -368,7 +407,8 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
         s.options.able_thresholds = able_thresholds;
         if (able_thresholds < 2) throw py::value_error("able_thresholds: expected >= 2");
         WithArgumentNames([&] { s.options.Check(); });
-        const EvaluationLayout layout = LayoutOf(layout_name, reference_frames, full_rows, full_cols);
+        const EvaluationLayout layout =
+            LayoutOf(layout_name, reference_frames, full_rows, full_cols);
         const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
 
         const int given = (truth_matrix.is_none() ? 0 : 1) + (pairs.is_none() ? 0 : 1) +
@@ -392,7 +432,8 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
           t.path = truth_file.cast<std::string>();
           t.path_2 = truth_file_2;
           if (truth_type.is_none())
-            throw py::value_error("truth_type: expected with truth_file (matrix, pairs, kitti, tum or positions)");
+            throw py::value_error(
+                "truth_type: expected with truth_file (matrix, pairs, kitti, tum or positions)");
           gt = WithArgumentNames([&] {
             t.type = ParseGroundTruthType(truth_type.cast<std::string>());
             return LoadGroundTruth(t, layout, full_rows, full_cols);
@@ -495,7 +536,11 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
       py::arg("radius") = 5.0, py::arg("heading_limit") = -1.0,
       py::arg("min_frame_gap") = py::none(), py::arg("axes") = "xyz", py::arg("normalize") = true,
       py::arg("label") = "python",
-      R"doc(evaluate(matrix, *, truth_matrix=None, pairs=None, poses=None, reference_poses=None, aligned=False, truth_file=None, truth_type=None, truth_file_2="", base=-1, first_frame=0, range_selected=False, layout=None, reference_frames=None, tolerance=2, exclusion=100, vicinity=7, able_thresholds=100, radius=5.0, heading_limit=-1.0, min_frame_gap=None, axes="xyz", normalize=True, label="python") -> EvaluationResult
+      R"doc(evaluate(matrix, *, truth_matrix=None, pairs=None, poses=None, reference_poses=None,
+    aligned=False, truth_file=None, truth_type=None, truth_file_2="", base=-1, first_frame=0,
+    range_selected=False, layout=None, reference_frames=None, tolerance=2, exclusion=100,
+    vicinity=7, able_thresholds=100, radius=5.0, heading_limit=-1.0, min_frame_gap=None, axes="xyz",
+    normalize=True, label="python") -> EvaluationResult
 
 Evaluates a distance matrix against ground truth with both protocols of docs/evaluation.md,
 exactly as Test_OpenABLE (Ground_truth_type) and openable_evaluate do.

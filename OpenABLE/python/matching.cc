@@ -135,7 +135,8 @@ Returns:
       py::arg("d"), py::arg("sequence_length"), py::arg("direction") = "forward",
       py::arg("row_starts") = py::none(), py::arg("col_starts") = py::none(),
       py::arg("threads") = 0, py::arg("in_place") = false,
-      R"doc(sequence_distances(d, sequence_length, direction="forward", row_starts=None, col_starts=None, threads=0, in_place=False) -> numpy.ndarray
+      R"doc(sequence_distances(d, sequence_length, direction="forward", row_starts=None,
+    col_starts=None, threads=0, in_place=False) -> numpy.ndarray
 
 Sequence matching (ABLE, after SeqSLAM): the distance of the places of frames i and j is the
 sum of the L single-frame distances along the diagonal ending at (i, j):

@@ -152,7 +152,8 @@ OnlineOptions OnlineOptionsOf(const py::kwargs& kwargs) {
   return options.cast<OnlineOptions>();
 }
 
-const char* const kDescriptionArgs = R"doc(    descriptor (str): a name of descriptor_names() but D-LDB (case-insensitive).
+const char* const kDescriptionArgs =
+    R"doc(    descriptor (str): a name of descriptor_names() but D-LDB (case-insensitive).
     description (str): "global" (the frame resized to patch_size x patch_size and described
         at its centre) or "grid" (grid cells, each resized to the patch, rows concatenated in
         row-major cell order).
@@ -167,14 +168,16 @@ void RegisterOnline(py::module_& m) {
       "describe",
       [](const py::object& image, const std::string& descriptor, const std::string& description,
          int patch_size, int ldb_bits, std::pair<int, int> grid) {
-        const OnlineOptions o = DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid);
+        const OnlineOptions o =
+            DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid);
         const cv::Mat rows = Describe({Image(image, "image")}, o, 1);
         return ToNumpy(rows.row(0).clone(), true);
       },
       py::arg("image"), py::arg("descriptor") = "LDB", py::arg("description") = "global",
-      py::arg("patch_size") = 64, py::arg("ldb_bits") = 256,
-      py::arg("grid") = std::make_pair(1, 1),
-      (std::string(R"doc(describe(image, descriptor="LDB", description="global", patch_size=64, ldb_bits=256, grid=(1, 1)) -> numpy.ndarray
+      py::arg("patch_size") = 64, py::arg("ldb_bits") = 256, py::arg("grid") = std::make_pair(1, 1),
+      (std::string(
+           R"doc(describe(image, descriptor="LDB", description="global", patch_size=64,
+    ldb_bits=256, grid=(1, 1)) -> numpy.ndarray
 
 The descriptor row of one image, as Test_OpenABLE describes a frame (grey conversion, then
 global or grid description).
@@ -182,7 +185,8 @@ global or grid description).
 Args:
     image (numpy.ndarray): (H, W) grey or (H, W, 3) BGR; uint8 (0-255) or float32 (0-1, as
         read_image() gives it). Read in place when contiguous.
-)doc") + kDescriptionArgs + R"doc(
+)doc") +
+       kDescriptionArgs + R"doc(
 
 Returns:
     numpy.ndarray: 1-D; uint8 bytes for binary descriptors, float32 for SIFT and HOG.
@@ -195,20 +199,24 @@ Raises:
       "describe_images",
       [](const py::object& images, const std::string& descriptor, const std::string& description,
          int patch_size, int ldb_bits, std::pair<int, int> grid, int threads) {
-        const OnlineOptions o = DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid);
+        const OnlineOptions o =
+            DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid);
         return ToNumpy(Describe(Images(images, "images"), o, threads));
       },
       py::arg("images"), py::arg("descriptor") = "LDB", py::arg("description") = "global",
-      py::arg("patch_size") = 64, py::arg("ldb_bits") = 256,
-      py::arg("grid") = std::make_pair(1, 1), py::arg("threads") = 0,
-      (std::string(R"doc(describe_images(images, descriptor="LDB", description="global", patch_size=64, ldb_bits=256, grid=(1, 1), threads=0) -> numpy.ndarray
+      py::arg("patch_size") = 64, py::arg("ldb_bits") = 256, py::arg("grid") = std::make_pair(1, 1),
+      py::arg("threads") = 0,
+      (std::string(
+           R"doc(describe_images(images, descriptor="LDB", description="global", patch_size=64,
+    ldb_bits=256, grid=(1, 1), threads=0) -> numpy.ndarray
 
 One descriptor row per image, described in parallel (the GIL is released).
 
 Args:
     images (list[numpy.ndarray] | numpy.ndarray): images as describe() takes them, or a stack
         (N, H, W) / (N, H, W, 3).
-)doc") + kDescriptionArgs + R"doc(
+)doc") +
+       kDescriptionArgs + R"doc(
     threads (int): threads; 0 = all cores.
 
 Returns:
@@ -239,7 +247,8 @@ Raises:
       py::arg("rows"), py::arg("sequence_length") = 1, py::arg("direction") = "forward",
       py::arg("traversal_starts") = py::none(), py::arg("threads") = 0,
       py::arg("return_max") = false,
-      R"doc(distance_matrix(rows, sequence_length=1, direction="forward", traversal_starts=None, threads=0, return_max=False) -> numpy.ndarray
+      R"doc(distance_matrix(rows, sequence_length=1, direction="forward", traversal_starts=None,
+    threads=0, return_max=False) -> numpy.ndarray
 
 The normalised matrix M' of Test_OpenABLE over descriptor rows: distances between all rows
 (Hamming for uint8 rows, L2 for float32), summed along sequences of L frames

@@ -85,7 +85,8 @@ Trajectory MakeTrajectory(const py::object& poses, const py::object& frame_ids,
     for (std::size_t i = 1; i < n; ++i)
       if (t.frame_ids[i] <= t.frame_ids[i - 1])
         throw py::value_error("frame_ids: " + std::to_string(t.frame_ids[i]) + " after " +
-                              std::to_string(t.frame_ids[i - 1]) + "; expected strictly increasing ids");
+                              std::to_string(t.frame_ids[i - 1]) +
+                              "; expected strictly increasing ids");
   }
   if (!timestamps.is_none()) {
     t.timestamps = timestamps.cast<std::vector<double>>();
@@ -152,7 +153,10 @@ TUM), loop pairs (from a pairs file or an OpenABLE matrix), the paper's discount
 (Eq. 6), a least-squares pose graph, and the absolute trajectory error against a ground truth.
 Loops are lists of (query, reference, similarity) tuples of pose indices (query > reference).)doc");
 
-  py::class_<Trajectory>(m, "Trajectory", R"doc(Trajectory(poses, frame_ids=None, timestamps=None, format="kitti", world_to_camera=False)
+  py::class_<Trajectory>(
+      m, "Trajectory",
+      R"doc(Trajectory(poses, frame_ids=None, timestamps=None, format="kitti",
+    world_to_camera=False)
 
 Camera-to-world poses of a camera over a run.
 
@@ -171,10 +175,12 @@ Args:
            py::arg("world_to_camera") = false,
            "__init__(poses, frame_ids=None, timestamps=None, format=\"kitti\", "
            "world_to_camera=False)\n\nSee help(openable.snaps.Trajectory).")
-      .def_property_readonly("poses", [](const Trajectory& t) { return PosesArray(t, 4); },
-                             "float64 (N, 4, 4) camera-to-world matrices (a copy).")
-      .def_property_readonly("poses_3x4", [](const Trajectory& t) { return PosesArray(t, 3); },
-                             "float64 (N, 3, 4) camera-to-world matrices [R | t] (a copy), the KITTI layout.")
+      .def_property_readonly(
+          "poses", [](const Trajectory& t) { return PosesArray(t, 4); },
+          "float64 (N, 4, 4) camera-to-world matrices (a copy).")
+      .def_property_readonly(
+          "poses_3x4", [](const Trajectory& t) { return PosesArray(t, 3); },
+          "float64 (N, 3, 4) camera-to-world matrices [R | t] (a copy), the KITTI layout.")
       .def_property_readonly(
           "positions",
           [](const Trajectory& t) {
@@ -192,12 +198,15 @@ Args:
             return a;
           },
           "int64 (N,) frame number of each pose.")
-      .def_property_readonly("timestamps", [](const Trajectory& t) { return DoubleArray(t.timestamps); },
-                             "float64 (N,) seconds (empty unless the format is tum).")
-      .def_property_readonly("format", [](const Trajectory& t) { return snaps::TrajectoryFormatName(t.format); },
-                             "\"kitti\", \"kitti-id\" or \"tum\".")
-      .def_property_readonly("world_to_camera", [](const Trajectory& t) { return t.world_to_camera; },
-                             "The file stores world-to-camera matrices (inverted on reading and writing).")
+      .def_property_readonly(
+          "timestamps", [](const Trajectory& t) { return DoubleArray(t.timestamps); },
+          "float64 (N,) seconds (empty unless the format is tum).")
+      .def_property_readonly(
+          "format", [](const Trajectory& t) { return snaps::TrajectoryFormatName(t.format); },
+          "\"kitti\", \"kitti-id\" or \"tum\".")
+      .def_property_readonly(
+          "world_to_camera", [](const Trajectory& t) { return t.world_to_camera; },
+          "The file stores world-to-camera matrices (inverted on reading and writing).")
       .def("encode", &snaps::EncodeTrajectory,
            "encode() -> str\n\nThe trajectory as the text of its file (its format and "
            "convention, 17 significant digits: read_trajectory gives it back).")
@@ -217,7 +226,8 @@ Args:
         std::string s = "<openable.snaps.Trajectory " + std::to_string(t.Size()) + " poses, " +
                         snaps::TrajectoryFormatName(t.format);
         if (!t.frame_ids.empty())
-          s += ", frames " + std::to_string(t.frame_ids.front()) + "-" + std::to_string(t.frame_ids.back());
+          s += ", frames " + std::to_string(t.frame_ids.front()) + "-" +
+               std::to_string(t.frame_ids.back());
         return s + ">";
       });
 
@@ -281,7 +291,8 @@ Raises:
       .def("__repr__", [](const snaps::TrajectoryError& e) {
         char b[200];
         std::snprintf(b, sizeof b,
-                      "<openable.snaps.TrajectoryError%s: RMSE %.4f m, mean %.4f m, median %.4f m, max %.4f m>",
+                      "<openable.snaps.TrajectoryError%s: RMSE %.4f m, mean %.4f m, median %.4f m, "
+                      "max %.4f m>",
                       e.aligned ? " (aligned)" : "", e.rmse, e.mean, e.median, e.max);
         return std::string(b);
       });
@@ -308,7 +319,8 @@ Raises:
       },
       py::arg("estimate"), py::arg("truth"), py::arg("association") = py::none(),
       py::arg("align") = false, py::arg("time_tolerance") = 0.02,
-      R"doc(trajectory_error(estimate, truth, association=None, align=False, time_tolerance=0.02) -> TrajectoryError
+      R"doc(trajectory_error(estimate, truth, association=None, align=False,
+    time_tolerance=0.02) -> TrajectoryError
 
 Absolute trajectory error of the estimate's positions against their ground-truth
 counterparts, as openable_snaps reports it.
@@ -332,7 +344,8 @@ Returns:
         std::vector<LoopPair> loops;
         {
           py::gil_scoped_release release;
-          loops = snaps::LoopsFromCsv(path, t, tolerance, &dropped, drop_outside ? &outside : nullptr);
+          loops =
+              snaps::LoopsFromCsv(path, t, tolerance, &dropped, drop_outside ? &outside : nullptr);
           if (middle_of_runs) loops = snaps::MiddleOfRuns(loops, t);
         }
         if (!counts) return LoopsList(loops);
@@ -342,9 +355,9 @@ Returns:
         return py::make_tuple(LoopsList(loops), c);
       },
       py::arg("path"), py::arg("trajectory"), py::arg("tolerance") = 0,
-      py::arg("drop_outside") = false, py::arg("middle_of_runs") = false,
-      py::arg("counts") = false,
-      R"doc(loops_from_csv(path, trajectory, tolerance=0, drop_outside=False, middle_of_runs=False, counts=False) -> list
+      py::arg("drop_outside") = false, py::arg("middle_of_runs") = false, py::arg("counts") = false,
+      R"doc(loops_from_csv(path, trajectory, tolerance=0, drop_outside=False, middle_of_runs=False,
+    counts=False) -> list
 
 Loop pairs from a CSV of frame pairs ("row,col" a line, row the later frame; '#' comments),
 as openable_snaps reads Snaps_loops_file with Snaps_loops = pairs.
@@ -401,7 +414,8 @@ reference.)doc");
           const MatView v = Matrix2D(matrix, Elements::kFloat32, "matrix");
           if (v.mat.rows != v.mat.cols)
             throw py::value_error("matrix: " + std::to_string(v.mat.rows) + "x" +
-                                  std::to_string(v.mat.cols) + "; expected a square matrix of one sequence");
+                                  std::to_string(v.mat.cols) +
+                                  "; expected a square matrix of one sequence");
           py::gil_scoped_release release;
           loops = snaps::LoopsFromMatrix(cv::Mat1f(v.mat), t, o);
         }
@@ -409,7 +423,8 @@ reference.)doc");
       },
       py::arg("matrix"), py::arg("trajectory"), py::arg("threshold") = 0.1,
       py::arg("exclusion") = 100, py::arg("initial") = 0, py::arg("tolerance") = 0,
-      R"doc(loops_from_matrix(matrix, trajectory, threshold=0.1, exclusion=100, initial=0, tolerance=0) -> list
+      R"doc(loops_from_matrix(matrix, trajectory, threshold=0.1, exclusion=100, initial=0,
+    tolerance=0) -> list
 
 Loops from an OpenABLE matrix of one sequence (Snaps_loops = matrix): for each row q its best
 earlier match j (smallest M'(q, j) with j <= q - exclusion) with M'(q, j) < threshold gives
@@ -445,7 +460,8 @@ frames before the loop's frame N, alpha >= 1 the number of loops closed so far.)
       [](const Trajectory& t, int n, int reference, double similarity, int alpha,
          int discount_length) {
         if (n < 0 || n >= t.Size() || reference < 0 || reference >= n)
-          throw py::value_error("n, reference: expected 0 <= reference < n < " + std::to_string(t.Size()));
+          throw py::value_error("n, reference: expected 0 <= reference < n < " +
+                                std::to_string(t.Size()));
         Trajectory out = t;
         const Eigen::Vector3d shift =
             snaps::ApplyDiscountedUpdate(out, n, reference, similarity, alpha, discount_length);
@@ -453,7 +469,8 @@ frames before the loop's frame N, alpha >= 1 the number of loops closed so far.)
       },
       py::arg("trajectory"), py::arg("n"), py::arg("reference"), py::arg("similarity") = 1.0,
       py::arg("alpha") = 1, py::arg("discount_length") = 300,
-      R"doc(apply_discounted_update(trajectory, n, reference, similarity=1.0, alpha=1, discount_length=300) -> tuple[Trajectory, numpy.ndarray]
+      R"doc(apply_discounted_update(trajectory, n, reference, similarity=1.0, alpha=1,
+    discount_length=300) -> tuple[Trajectory, numpy.ndarray]
 
 One loop of Eq. 6: pose n closes a loop with pose `reference`; positions of poses
 max(0, n-K)..n move by similarity * gamma(n - s) * (p_reference - p_n), later poses with pose
@@ -491,17 +508,19 @@ Returns:
   py::class_<snaps::PoseGraphReport>(m, "PoseGraphReport", "What correct_pose_graph() did.")
       .def_readonly("iterations", &snaps::PoseGraphReport::iterations, "Steps tried.")
       .def_readonly("loop_edges", &snaps::PoseGraphReport::loop_edges, "Loop edges in the graph.")
-      .def_readonly("initial_cost", &snaps::PoseGraphReport::initial_cost, "Robustified cost of the input.")
+      .def_readonly("initial_cost", &snaps::PoseGraphReport::initial_cost,
+                    "Robustified cost of the input.")
       .def_readonly("final_cost", &snaps::PoseGraphReport::final_cost, "Cost of the output.")
       .def_readonly("seconds", &snaps::PoseGraphReport::seconds, "Wall time of the correction.")
       .def_readonly("converged", &snaps::PoseGraphReport::converged,
                     "Stopped by relative_tolerance (not max_iterations).")
       .def("__repr__", [](const snaps::PoseGraphReport& r) {
         char b[200];
-        std::snprintf(b, sizeof b,
-                      "<openable.snaps.PoseGraphReport %d loop edges, %d iterations, cost %.6g -> %.6g%s>",
-                      r.loop_edges, r.iterations, r.initial_cost, r.final_cost,
-                      r.converged ? "" : " (not converged)");
+        std::snprintf(
+            b, sizeof b,
+            "<openable.snaps.PoseGraphReport %d loop edges, %d iterations, cost %.6g -> %.6g%s>",
+            r.loop_edges, r.iterations, r.initial_cost, r.final_cost,
+            r.converged ? "" : " (not converged)");
         return std::string(b);
       });
 
@@ -536,9 +555,11 @@ Returns:
       py::arg("odometry_rotation_weight") = 1e6, py::arg("loop_weight") = 1.0,
       py::arg("use_similarity") = false, py::arg("robust_kernel") = "huber",
       py::arg("robust_scale") = 3.0, py::arg("relative_tolerance") = 1e-9,
-      py::arg("max_iterations") = 100, py::arg("initial_lambda") = 1e-6,
-      py::arg("report") = false,
-      R"doc(correct_pose_graph(trajectory, loops, odometry_translation_weight=2500.0, odometry_rotation_weight=1e6, loop_weight=1.0, use_similarity=False, robust_kernel="huber", robust_scale=3.0, relative_tolerance=1e-9, max_iterations=100, initial_lambda=1e-6, report=False) -> Trajectory
+      py::arg("max_iterations") = 100, py::arg("initial_lambda") = 1e-6, py::arg("report") = false,
+      R"doc(correct_pose_graph(trajectory, loops, odometry_translation_weight=2500.0,
+    odometry_rotation_weight=1e6, loop_weight=1.0, use_similarity=False, robust_kernel="huber",
+    robust_scale=3.0, relative_tolerance=1e-9, max_iterations=100, initial_lambda=1e-6,
+    report=False) -> Trajectory
 
 Least-squares pose-graph correction (docs/snaps.md): odometry edges between consecutive poses
 (relative pose of the input; information diag(w_t I, w_R I)), loop edges pulling the two

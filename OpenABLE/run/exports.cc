@@ -25,7 +25,7 @@
 namespace openable {
 
 cv::Vec3f ColorOf(float s, int map) {
-  // (blue, green, red), as the original's table in ../shared/guide/reference.md.
+  // (blue, green, red), as the original OpenABLE's table (docs/output_formats.md).
   switch (map) {
     case 0: return {s, s, s};
     case 1: return {0, 0, s};
@@ -55,7 +55,8 @@ cv::Mat3b ColorizeMatrix(const cv::Mat1f& normalized, int map) {
       std::uint8_t* o = out.ptr<std::uint8_t>(i);
       for (int j = 0; j < normalized.cols; ++j) {
         const float v = std::min(1.f, std::max(0.f, in[j]));
-        for (int k = 0; k < 3; ++k) o[3 * j + k] = cv::saturate_cast<std::uint8_t>((b[k] + a[k] * v) * 255.f);
+        for (int k = 0; k < 3; ++k)
+          o[3 * j + k] = cv::saturate_cast<std::uint8_t>((b[k] + a[k] * v) * 255.f);
       }
     }
   });
@@ -211,7 +212,8 @@ void OutputBatch::Stage(const std::string& key, const std::string& path,
     throw InputError(key + ": cannot write \"" + path + "\": folder \"" + folder.string() +
                      "\" cannot be created (" + ec.message() + ")");
   if (fs::is_directory(dest, ec))
-    throw InputError(key + ": cannot write \"" + path + "\": it is a folder (expected a file name)");
+    throw InputError(key + ": cannot write \"" + path +
+                     "\": it is a folder (expected a file name)");
   RemoveStaleTemporaries(folder, dest.filename().string());
   const std::string temp = (folder / ("." + dest.filename().string() + ".tmp-" +
                                       std::to_string(::getpid()) + "-" +

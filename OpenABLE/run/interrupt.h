@@ -1,9 +1,9 @@
-// Interrupted runs (issue 8): temporary files that must not outlive the process.
+// Interrupted runs: temporary files that must not outlive the process.
 //
 // A program calls InstallInterruptCleanup once. From then on SIGINT, SIGTERM and SIGHUP remove
 // every registered temporary file (unlink, from the handler: async-signal-safe calls only),
-// print one line "<program>: interrupted by SIGTERM (temporary files removed)" on stderr and end the
-// process with status 128 + signal number (130 for SIGINT, 143 for SIGTERM, 129 for SIGHUP).
+// print one line "<program>: interrupted by SIGTERM (temporary files removed)" on stderr and end
+// the process with status 128 + signal number (130 for SIGINT, 143 for SIGTERM, 129 for SIGHUP).
 // SIGKILL cannot be caught: temporaries are named so that they cannot be taken for outputs
 // (OutputBatch: ".<name>.tmp-<pid>-<n>") and a later run removes stale ones (exports.h).
 #pragma once

@@ -312,7 +312,8 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
 
 EvaluationLayout LayoutOf(const RunResult& result) {
   if (result.traversals.size() == 2)
-    return EvaluationLayout::TwoTraversals(result.traversals[0].frames, result.traversals[1].frames);
+    return EvaluationLayout::TwoTraversals(result.traversals[0].frames,
+                                           result.traversals[1].frames);
   if (result.traversals.size() != 1)
     throw std::logic_error("LayoutOf: a run has one or two traversals");
   return EvaluationLayout::LoopClosure(result.normalized.rows);

@@ -113,7 +113,8 @@ std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& tr
     const std::string b = comma == std::string::npos ? "" : Trim(content.substr(comma + 1));
     long row = 0, col = 0;
     if (comma == std::string::npos || b.find(',') != std::string::npos)
-      throw InputError(at + ": " + Quoted(content) + " is not `row,col`; expected two frame numbers");
+      throw InputError(at + ": " + Quoted(content) +
+                       " is not `row,col`; expected two frame numbers");
     if (!ParseFrameId(a, &row))
       throw InputError(at + ": row " + Quoted(a) + " is not a non-negative integer frame number");
     if (!ParseFrameId(b, &col))

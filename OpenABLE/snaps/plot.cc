@@ -184,7 +184,8 @@ cv::Mat3b RenderTrajectories(const TrajectoryPlot& plot) {
   legend.push_back({plot.input_label, "", kInputColour});
   if (plot.corrected != nullptr) legend.push_back({plot.corrected_label, "", kCorrectedColour});
   if (!plot.loops.empty()) {
-    legend.push_back({"loop pairs", " (" + std::to_string(plot.loops.size()) + ")", kLoopColour, 1});
+    legend.push_back(
+        {"loop pairs", " (" + std::to_string(plot.loops.size()) + ")", kLoopColour, 1});
   }
   const std::array<LegendCorner, 4> corners = {LegendCorner::kUpperLeft, LegendCorner::kUpperRight,
                                                LegendCorner::kLowerLeft, LegendCorner::kLowerRight};

@@ -1,4 +1,4 @@
-// Top view of trajectories (SNAPS add-on, issue 6): ground truth, the drifting input and the
+// Top view of trajectories (the SNAPS add-on): ground truth, the drifting input and the
 // corrected trajectory, with the loop pairs, drawn with OpenCV in the house style of
 // evaluation/plots.cc (shared helpers in evaluation/drawing.h).
 #pragma once

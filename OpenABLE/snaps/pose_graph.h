@@ -1,6 +1,6 @@
 // Pose-graph correction of a drifting trajectory with loop pairs (the SNAPS add-on).
 //
-// The paper (../shared/papers/000_589a4d56462291ec.txt, Sec. II-C, Eq. 6) corrects the
+// The SNAPS paper (Sec. II-C, Eq. 6) corrects the
 // trajectory with a discounted update; this is the classical alternative it is compared with:
 // a least-squares pose graph (see docs/snaps.md, "Pose-graph correction").
 //
@@ -31,9 +31,9 @@
 //
 // Defaults, and why: per keyframe step (~1 m on KITTI), a stereo VO's relative error is of the
 // order of one or two centimetres and a twentieth of a degree, hence sigma_t = 0.02 m,
-// sigma_R = 0.001 rad (w = 1 / sigma^2); a ground-truth loop pair of KITTI says "within a few metres", hence
-// sigma_L = 1 m (w_L = 1) and a Huber scale of 3 (sigma units): a correct pair is quadratic,
-// a wrong one pulls with a bounded force. With these weights the loops move mostly the
+// sigma_R = 0.001 rad (w = 1 / sigma^2); a ground-truth loop pair of KITTI says "within a few
+// metres", hence sigma_L = 1 m (w_L = 1) and a Huber scale of 3 (sigma units): a correct pair is
+// quadratic, a wrong one pulls with a bounded force. With these weights the loops move mostly the
 // rotations (drift of a VO is mostly heading), which is what corrects a drifting trajectory
 // rather than bending it locally (a rotation is the cheaper correction beyond a lever arm of
 // sqrt(w_R / w_t) = 20 m).

@@ -11,7 +11,8 @@ namespace openable::snaps {
 namespace {
 
 cv::Mat1d ToDouble(const cv::Mat& m, const char* name) {
-  if (m.empty()) throw std::invalid_argument(std::string("UniversalQualityIndex: ") + name + " is empty");
+  if (m.empty())
+    throw std::invalid_argument(std::string("UniversalQualityIndex: ") + name + " is empty");
   if (m.channels() != 1 || (m.depth() != CV_8U && m.depth() != CV_32F && m.depth() != CV_64F))
     throw std::invalid_argument(std::string("UniversalQualityIndex: ") + name +
                                 " must be one channel of CV_8U, CV_32F or CV_64F");

@@ -2,7 +2,7 @@
 // association with a ground truth, and the absolute trajectory error.
 //
 // Paper: "Similarity and Location-based Real-time Loop Closure: SNAPS for SLAM in Unexplored
-// Environments" (../shared/papers/000_589a4d56462291ec.txt), Sec. II-III.
+// Environments", Sec. II-III.
 #pragma once
 
 #include <string>

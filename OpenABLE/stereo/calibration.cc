@@ -17,7 +17,9 @@ std::string Num(double v) {
   return buf;
 }
 
-std::string SizeText(int rows, int cols) { return std::to_string(rows) + "x" + std::to_string(cols); }
+std::string SizeText(int rows, int cols) {
+  return std::to_string(rows) + "x" + std::to_string(cols);
+}
 
 // The prefix of every message: calibration "<path>": <key>:
 class Reader {
@@ -131,14 +133,16 @@ StereoCalibration LoadStereoCalibration(const std::string& path) {
       r.Matrix("DL", 5, 1, true, "k1 k2 p1 p2 k3 of the left camera").ptr<double>());
   c.right_distortion = cv::Vec<double, 5>(
       r.Matrix("DR", 5, 1, true, "k1 k2 p1 p2 k3 of the right camera").ptr<double>());
-  c.rotation = cv::Matx33d(r.Matrix("R", 3, 3, false, "rotation from the left camera to the right"));
-  const double orthogonality = cv::norm(c.rotation.t() * c.rotation - cv::Matx33d::eye(), cv::NORM_INF);
+  c.rotation =
+      cv::Matx33d(r.Matrix("R", 3, 3, false, "rotation from the left camera to the right"));
+  const double orthogonality =
+      cv::norm(c.rotation.t() * c.rotation - cv::Matx33d::eye(), cv::NORM_INF);
   const double det = cv::determinant(c.rotation);
   if (orthogonality > 1e-3 || det <= 0.0)
     r.Fail("R", "not a rotation (|R^T R - I| = " + Num(orthogonality) + ", det = " + Num(det) +
                     "); expected an orthonormal 3x3 matrix with det +1");
-  c.translation =
-      cv::Vec3d(r.Matrix("T", 3, 1, true, "translation from the left camera to the right").ptr<double>());
+  c.translation = cv::Vec3d(
+      r.Matrix("T", 3, 1, true, "translation from the left camera to the right").ptr<double>());
   if (cv::norm(c.translation) == 0.0)
     r.Fail("T", "(0, 0, 0); expected the non-zero baseline from the left camera to the right");
   c.colormap = r.OptionalInt("colormap", -1, -1, 21);

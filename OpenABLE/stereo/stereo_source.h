@@ -31,7 +31,8 @@ struct StereoSourceOptions {
 //
 // Read(i) reads pair i and returns a CV_32FC2 frame of the left image's size: channel 0 the
 // rectified left image, grey, in [0, 1]; channel 1 its disparity, NormalizeDisparity of the
-// SGBM disparity, in [0, 1) (0 everywhere without compute_disparity). FrameName(i) is the left file's path. Reads are thread-safe.
+// SGBM disparity, in [0, 1) (0 everywhere without compute_disparity). FrameName(i) is the left
+// file's path. Reads are thread-safe.
 //
 // Throws InputError (one line naming the key, the folders and the counts) when a folder is
 // missing or empty, when the two folders hold different numbers of images, when the range is

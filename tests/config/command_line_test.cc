@@ -31,11 +31,13 @@ TEST(CommandLine, OverridesAloneOrHelpAloneAreEnough) {
 
 TEST(CommandLine, UsageErrorsAreOneLineNamingTheArgument) {
   CommandLine cl;
-  EXPECT_EQ(Parse({}, cl),
-            "prog: no configuration given; expected prog Config.txt or --set Key=Value (see --help)");
+  EXPECT_EQ(
+      Parse({}, cl),
+      "prog: no configuration given; expected prog Config.txt or --set Key=Value (see --help)");
   EXPECT_EQ(Parse({"--bogus"}, cl), "prog: unknown option \"--bogus\" (see --help)");
   EXPECT_EQ(Parse({"a.txt", "b.txt"}, cl),
-            "prog: more than one configuration file (\"a.txt\" and \"b.txt\"); expected one (see --help)");
+            "prog: more than one configuration file (\"a.txt\" and \"b.txt\"); expected one (see "
+            "--help)");
   EXPECT_EQ(Parse({"--set"}, cl), "prog: --set needs Key=Value (see --help)");
 }
 

@@ -134,7 +134,8 @@ TEST(Config, ParsesTextInMemoryLikeAFile) {
   EXPECT_EQ(from_text.descriptor.patch_size, 32);
   EXPECT_EQ(from_text.descriptor.name, "HOG");
   EXPECT_EQ(from_text, LoadConfig(WriteFile(text)));
-  const std::string msg = ErrorOf([] { ParseConfigText("Patch_size: 32\nPatch_size: x\n", "mem"); });
+  const std::string msg =
+      ErrorOf([] { ParseConfigText("Patch_size: 32\nPatch_size: x\n", "mem"); });
   EXPECT_EQ(msg.rfind("mem:2: Patch_size:", 0), 0u) << msg;
 }
 
@@ -154,10 +155,13 @@ TEST(Config, OverridesUseTheSameBinding) {
   ApplyOverride(c, "Images_path = /tmp/x");
   EXPECT_EQ(c.matching.sequence_length, 12);
   EXPECT_EQ(c.input.images_path, "/tmp/x");
-  EXPECT_NE(ErrorOf([&] { ApplyOverride(c, "Image_sequence=3"); }).find("did you mean \"Image_sequences\""),
+  EXPECT_NE(ErrorOf([&] {
+              ApplyOverride(c, "Image_sequence=3");
+            }).find("did you mean \"Image_sequences\""),
             std::string::npos);
   EXPECT_NE(ErrorOf([&] { ApplyOverride(c, "Patch_size"); }).find("Key=Value"), std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ApplyOverride(c, "Threads=-1"); }).find("--set: Threads"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ApplyOverride(c, "Threads=-1"); }).find("--set: Threads"),
+            std::string::npos);
 }
 
 TEST(Config, CrossKeyChecks) {
@@ -169,8 +173,9 @@ TEST(Config, CrossKeyChecks) {
   CheckConfig(c);  // panoramas read Images_path like a monocular run
   // Peak responses: all three or none.
   c.preprocess.lambda_red = 610;
-  EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Lambda_red, Lambda_green, Lambda_blue: 610, 0, 0"),
-            std::string::npos);
+  EXPECT_NE(
+      ErrorOf([&] { CheckConfig(c); }).find("Lambda_red, Lambda_green, Lambda_blue: 610, 0, 0"),
+      std::string::npos);
   c.preprocess.lambda_green = 535;
   c.preprocess.lambda_blue = 470;
   CheckConfig(c);

@@ -1,4 +1,4 @@
-// One conformance suite run over every registered descriptor (conventions.md, item 7).
+// One conformance suite run over every registered descriptor.
 // Adding a descriptor: one line in ExpectedFor64() below.
 
 #include <gtest/gtest.h>

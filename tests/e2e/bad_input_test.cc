@@ -1,4 +1,4 @@
-// The bad-input corpus (issue 8, item 4): every file is generated at run time in a temporary
+// The bad-input corpus: every file is generated at run time in a temporary
 // folder, then given to Test_OpenABLE. For each case the program must exit with status 1,
 // write exactly one line on stderr naming the file or key, leave no output behind, not crash
 // (a signal) and not hang (every run goes through `timeout`). docs/robustness.md lists the
@@ -102,16 +102,34 @@ std::size_t Idat(const std::string& png) { return png.find("IDAT") - 4; }
 const BadImage kBadImages[] = {
     {"PngCutInSignature", "bad.png", [] { return Png().substr(0, 4); }},
     {"PngCutInIhdr", "bad.png", [] { return Png().substr(0, 20); }},
-    {"PngCutInIdat", "bad.png", [] { const std::string p = Png(); return p.substr(0, Idat(p) + 30); }},
-    {"PngCutBeforeIend", "bad.png", [] { const std::string p = Png(); return p.substr(0, p.size() - 12); }},
-    {"PngCutInIend", "bad.png", [] { const std::string p = Png(); return p.substr(0, p.size() - 3); }},
-    {"PngCorruptCrc", "bad.png", [] {
+    {"PngCutInIdat", "bad.png",
+     [] {
+       const std::string p = Png();
+       return p.substr(0, Idat(p) + 30);
+     }},
+    {"PngCutBeforeIend", "bad.png",
+     [] {
+       const std::string p = Png();
+       return p.substr(0, p.size() - 12);
+     }},
+    {"PngCutInIend", "bad.png",
+     [] {
+       const std::string p = Png();
+       return p.substr(0, p.size() - 3);
+     }},
+    {"PngCorruptCrc", "bad.png",
+     [] {
        std::string p = Png();
        p[Idat(p) + 20] = static_cast<char>(p[Idat(p) + 20] ^ 0x5a);
        return p;
      }},
-    {"JpegWithoutEnd", "bad.jpg", [] { const std::string j = Jpeg(); return j.substr(0, j.size() / 2); }},
-    {"JpegGarbageInTheMiddle", "bad.jpg", [] {
+    {"JpegWithoutEnd", "bad.jpg",
+     [] {
+       const std::string j = Jpeg();
+       return j.substr(0, j.size() / 2);
+     }},
+    {"JpegGarbageInTheMiddle", "bad.jpg",
+     [] {
        std::string j = Jpeg();
        for (std::size_t i = j.size() / 2; i < j.size() / 2 + 64; ++i)
          j[i] = static_cast<char>((i * 37) & 0xff);
@@ -229,7 +247,8 @@ TEST(BadInputCorpus, ThousandsOfOddNames) {
     std::snprintf(name, sizeof name, kStyles[i % 6], i);
     testing::WriteBytes(folder + "/" + name, png);
   }
-  Outcome o = RunBounded(dir, {WriteConfig(dir, folder, "Txt_name: \"\"\nPng_name: \"\"\n"), "--quiet"});
+  Outcome o =
+      RunBounded(dir, {WriteConfig(dir, folder, "Txt_name: \"\"\nPng_name: \"\"\n"), "--quiet"});
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_EQ(ReadNpy(dir + "/out/matrix.npy").rows, 2000);
   fs::remove_all(dir + "/out");
@@ -334,8 +353,8 @@ TEST(BadInputCorpus, EveryNumericKeyWrongInTurn) {
       for (std::size_t i; (i = next++) < cases.size();) {
         const std::string run = dir + "/run" + std::to_string(i);
         fs::create_directories(run);
-        cases[i].outcome =
-            RunBounded(run, {WriteConfig(run, folder, cases[i].key + ": " + cases[i].value + "\n")});
+        cases[i].outcome = RunBounded(
+            run, {WriteConfig(run, folder, cases[i].key + ": " + cases[i].value + "\n")});
       }
     });
   for (auto& t : workers) t.join();
@@ -399,9 +418,9 @@ std::string Calibration(const std::string& ml, const std::string& r, const std::
     return std::string(key) + ": !!opencv-matrix\n   rows: " + std::to_string(rows) +
            "\n   cols: " + std::to_string(cols) + "\n   dt: d\n   data: [ " + data + " ]\n";
   };
-  return "%YAML:1.0\n" + matrix("ML", 3, 3, ml) + matrix("MR", 3, 3, "40, 0, 16, 0, 40, 12, 0, 0, 1") +
-         matrix("DL", 1, 5, "0, 0, 0, 0, 0") + matrix("DR", 1, 5, "0, 0, 0, 0, 0") +
-         matrix("R", 3, 3, r) + matrix("T", 3, 1, t);
+  return "%YAML:1.0\n" + matrix("ML", 3, 3, ml) +
+         matrix("MR", 3, 3, "40, 0, 16, 0, 40, 12, 0, 0, 1") + matrix("DL", 1, 5, "0, 0, 0, 0, 0") +
+         matrix("DR", 1, 5, "0, 0, 0, 0, 0") + matrix("R", 3, 3, r) + matrix("T", 3, 1, t);
 }
 
 TEST(BadInputCorpus, SingularCalibrations) {
@@ -449,14 +468,16 @@ TEST(BadInputCorpus, VideoWithoutFrames) {
     if (!writer.isOpened()) GTEST_SKIP() << "this OpenCV cannot write MJPG video";
   }
   ASSERT_TRUE(fs::exists(video));
-  Outcome o = RunBounded(dir, {WriteConfig(dir, "", "Frame_mode: 1\nVideo_path_1: \"none.avi\"\n")});
+  Outcome o =
+      RunBounded(dir, {WriteConfig(dir, "", "Frame_mode: 1\nVideo_path_1: \"none.avi\"\n")});
   ExpectRefused(o, dir, "none.avi");
   // A header only: the first 32 bytes of a RIFF AVI, or an empty file with a video extension.
   testing::WriteBytes(dir + "/header.avi", ReadAll(video).substr(0, 32));
   testing::WriteBytes(dir + "/empty.mp4", "");
   for (const char* name : {"header.avi", "empty.mp4"}) {
-    o = RunBounded(dir, {WriteConfig(dir, "", std::string("Frame_mode: 1\nVideo_path_1: \"") + name +
-                                           "\"\n")});
+    o = RunBounded(
+        dir,
+        {WriteConfig(dir, "", std::string("Frame_mode: 1\nVideo_path_1: \"") + name + "\"\n")});
     SCOPED_TRACE(name);
     ExpectRefused(o, dir, name);
   }

@@ -138,21 +138,26 @@ TEST_P(BadTruthInputs, OneLineNonZeroExitNoOutput) {
 INSTANTIATE_TEST_SUITE_P(
     Errors, BadTruthInputs,
     ::testing::Values(
-        BadTruth{"MatrixOfWrongSize", {"--gt-type", "matrix", "--ground-truth", "gt5.txt"}, "gt5.txt"},
-        BadTruth{"PairOutsideTheRun", {"--gt-type", "pairs", "--ground-truth", "far.csv"}, "far.csv"},
+        BadTruth{
+            "MatrixOfWrongSize", {"--gt-type", "matrix", "--ground-truth", "gt5.txt"}, "gt5.txt"},
+        BadTruth{
+            "PairOutsideTheRun", {"--gt-type", "pairs", "--ground-truth", "far.csv"}, "far.csv"},
         BadTruth{"MissingFile", {"--gt-type", "pairs", "--ground-truth", "nope.csv"}, "nope.csv"},
         BadTruth{"NegativeTolerance", {"--gt-type", "aligned", "--tolerance", "-1"}, "Tolerance"},
-        BadTruth{"ZeroRadius", {"--gt-type", "positions", "--ground-truth", "xy.csv", "--radius", "0"},
+        BadTruth{"ZeroRadius",
+                 {"--gt-type", "positions", "--ground-truth", "xy.csv", "--radius", "0"},
                  "Ground_truth_radius"},
         BadTruth{"AlignedOnOneSequence", {"--gt-type", "aligned"}, "aligned"},
         BadTruth{"HeadingWithoutOrientation",
                  {"--gt-type", "positions", "--ground-truth", "xy.csv", "--heading", "45"},
                  "Ground_truth_heading"},
-        BadTruth{"PositionsDoNotCoverTheRun", {"--gt-type", "positions", "--ground-truth", "xy.csv"},
+        BadTruth{"PositionsDoNotCoverTheRun",
+                 {"--gt-type", "positions", "--ground-truth", "xy.csv"},
                  "xy.csv"},
         BadTruth{"UnknownType", {"--gt-type", "gps"}, "Ground_truth_type"},
-        BadTruth{"NegativeVicinity", {"--gt-type", "aligned", "--reference-frames", "10",
-                                      "--vicinity", "-2"}, "Vicinity"}));
+        BadTruth{"NegativeVicinity",
+                 {"--gt-type", "aligned", "--reference-frames", "10", "--vicinity", "-2"},
+                 "Vicinity"}));
 
 // --- Real data, checked against the independent numpy implementation -------------------------
 

@@ -1,6 +1,6 @@
-// The library's batch path (OpenABLE/online/online.h, OpenABLE/evaluation/) gives what Test_OpenABLE
-// gives from a configuration, on real KITTI 00 frames 0-1699: the same normalised sequence
-// matrix and the same evaluation figures. docs/library.md quotes this code.
+// The library's batch path (OpenABLE/online/online.h, OpenABLE/evaluation/) gives what
+// Test_OpenABLE gives from a configuration, on real KITTI 00 frames 0-1699: the same normalised
+// sequence matrix and the same evaluation figures. docs/library.md quotes this code.
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -75,7 +75,8 @@ TEST(Library, BatchPathGivesTestOpenablesMatrixAndFigures) {
 
   double worst = 0;
   for (int i = 0; i < 1700; ++i)
-    for (int j = 0; j < 1700; ++j) worst = std::max(worst, double(std::abs(matrix(i, j) - cli(i, j))));
+    for (int j = 0; j < 1700; ++j)
+      worst = std::max(worst, double(std::abs(matrix(i, j) - cli(i, j))));
   EXPECT_LT(worst, 1e-6);
   const std::string json = testing::ReadBytes(dir + "/eval.json");
   EXPECT_NEAR(figures.auc, JsonNumber(json, "auc"), 1e-6);

@@ -55,7 +55,8 @@ double MeanDeviation(const std::map<long, Position>& a, const std::map<long, Pos
   double sum = 0;
   for (const auto& [id, p] : a) {
     const Position& g = truth.at(id);
-    sum += std::sqrt((p.x - g.x) * (p.x - g.x) + (p.y - g.y) * (p.y - g.y) + (p.z - g.z) * (p.z - g.z));
+    sum += std::sqrt((p.x - g.x) * (p.x - g.x) + (p.y - g.y) * (p.y - g.y) +
+                     (p.z - g.z) * (p.z - g.z));
   }
   return sum / static_cast<double>(a.size());
 }
@@ -68,12 +69,25 @@ double JsonNumber(const std::string& json, const std::string& key, size_t from =
 }
 
 std::vector<std::string> SoDsoArgs(const std::string& seq, const std::string& out) {
-  const std::string pairs = seq == "00" ? "groundTruth_KITTI00.pairs.csv" : "kitti06GroundTruth.pairs.csv";
-  return {"--quiet", "--set", "Snaps_trajectory=" + Kitti() + "/vo_so_dso/seq" + seq + "/poses_history_file.txt",
-          "--set", "Snaps_trajectory_format=kitti-id", "--set", "Snaps_world_to_camera=1",
-          "--set", "Snaps_ground_truth=" + Kitti() + "/poses/" + seq + ".txt",
-          "--set", "Snaps_loops=pairs", "--set", "Snaps_loops_file=" + Kitti() + "/loop_pairs/" + pairs,
-          "--set", "Snaps_drop_outside=1", "--set", "Snaps_output_name=" + out};
+  const std::string pairs =
+      seq == "00" ? "groundTruth_KITTI00.pairs.csv" : "kitti06GroundTruth.pairs.csv";
+  return {"--quiet",
+          "--set",
+          "Snaps_trajectory=" + Kitti() + "/vo_so_dso/seq" + seq + "/poses_history_file.txt",
+          "--set",
+          "Snaps_trajectory_format=kitti-id",
+          "--set",
+          "Snaps_world_to_camera=1",
+          "--set",
+          "Snaps_ground_truth=" + Kitti() + "/poses/" + seq + ".txt",
+          "--set",
+          "Snaps_loops=pairs",
+          "--set",
+          "Snaps_loops_file=" + Kitti() + "/loop_pairs/" + pairs,
+          "--set",
+          "Snaps_drop_outside=1",
+          "--set",
+          "Snaps_output_name=" + out};
 }
 
 // A bad input for openable_snaps: the overrides added to a good command line, and the text its
@@ -109,12 +123,14 @@ TEST_P(SoDso, CorrectsWithGroundTruthPairsAndWritesWhatItReports) {
   const Outcome o = RunProgram(testing::OpenableSnapsExe(), SoDsoArgs(seq, dir + "/out/run"), dir);
   ASSERT_EQ(o.status, 0) << o.err << o.out;
   std::cout << o.out;
-  for (const char* f : {"_discounted.txt", "_pose_graph.txt", "_loops.csv", ".json", ".png", "_discounted.png"})
+  for (const char* f :
+       {"_discounted.txt", "_pose_graph.txt", "_loops.csv", ".json", ".png", "_discounted.png"})
     EXPECT_TRUE(std::filesystem::exists(dir + "/out/run" + f)) << f;
 
   // The written trajectories keep the input's frames and convention; their mean deviation,
   // recomputed here, is the one the report gives.
-  const auto input = ReadPositions(Kitti() + "/vo_so_dso/seq" + seq + "/poses_history_file.txt", true, true);
+  const auto input =
+      ReadPositions(Kitti() + "/vo_so_dso/seq" + seq + "/poses_history_file.txt", true, true);
   const auto truth = ReadPositions(Kitti() + "/poses/" + seq + ".txt", false, false);
   const auto graph = ReadPositions(dir + "/out/run_pose_graph.txt", true, true);
   const auto discounted = ReadPositions(dir + "/out/run_discounted.txt", true, true);
@@ -148,7 +164,8 @@ TEST_P(SoDso, CorrectsWithGroundTruthPairsAndWritesWhatItReports) {
     std::istringstream(line) >> q >> comma >> r;
     auto gap = [&](const std::map<long, Position>& t) {
       const Position a = t.at(q), b = t.at(r);
-      return std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z));
+      return std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) +
+                       (a.z - b.z) * (a.z - b.z));
     };
     gap_in += gap(input);
     gap_out += gap(graph);
@@ -175,7 +192,8 @@ TEST(SnapsErrors, OneLineNonZeroExitNothingWritten) {
     for (int i = 0; i < 100 && std::getline(in, line); ++i) out << line << "\n";
   }
   const std::vector<RefusedCase> cases = {
-      {{"Snaps_trajectory=" + dir + "/short.txt", "Snaps_trajectory_format=kitti"}, "short.txt\":1"},
+      {{"Snaps_trajectory=" + dir + "/short.txt", "Snaps_trajectory_format=kitti"},
+       "short.txt\":1"},
       {{"Snaps_trajectory_format=kitty"}, "Snaps_trajectory_format"},
       {{"Snaps_drop_outside=0"}, "outside the trajectory's frames"},
       {{"Snaps_ground_truth=" + dir + "/truth100.txt"}, "Snaps_ground_truth"},
@@ -193,7 +211,7 @@ TEST(SnapsErrors, OneLineNonZeroExitNothingWritten) {
 namespace openable {
 namespace {
 
-// The whole chain from images (issue 7): KITTI 00 frames 0-1699 -> monocular odometry (scale
+// The whole chain from images: KITTI 00 frames 0-1699 -> monocular odometry (scale
 // from the ground truth's step lengths) -> loops found by OpenABLE on the same frames -> pose
 // graph and discounted update -> error against the ground truth, recomputed here from the
 // files written.

@@ -104,9 +104,11 @@ TEST(TestOpenABLE, SampleRunWritesEveryOutputAndFindsTheSeasonDiagonal) {
 
 TEST(TestOpenABLE, OverridesRangeAndSingleSequence) {
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram(testing::TestOpenableExe(), {SampleConfig(dir), "--set", "Images_path_2=", "--set", "Final_image=50",
-                         "--set", "Initial_image=10", "--set", "Image_sequences=1", "--quiet"},
-                        dir);
+  const Outcome o =
+      RunProgram(testing::TestOpenableExe(),
+                 {SampleConfig(dir), "--set", "Images_path_2=", "--set", "Final_image=50", "--set",
+                  "Initial_image=10", "--set", "Image_sequences=1", "--quiet"},
+                 dir);
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_EQ(o.err, "");  // --quiet: no progress
   const cv::Mat1f m = ReadNpy(dir + "/out/matrix.npy");
@@ -185,9 +187,10 @@ TEST(TestOpenABLE, VideoModeReadsFrames) {
     std::sort(names.begin(), names.end());
     for (int i = 0; i < 30; ++i) writer.write(cv::imread(names[i]));
   }
-  const Outcome o = RunProgram(testing::TestOpenableExe(), {SampleConfig(dir), "--set", "Frame_mode=1", "--set",
-                         "Video_path_1=" + video, "--set", "Image_sequences=3"},
-                        dir);
+  const Outcome o = RunProgram(testing::TestOpenableExe(),
+                               {SampleConfig(dir), "--set", "Frame_mode=1", "--set",
+                                "Video_path_1=" + video, "--set", "Image_sequences=3"},
+                               dir);
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_EQ(ReadNpy(dir + "/out/matrix.npy").rows, 30);
 }
@@ -294,10 +297,12 @@ TEST(TestOpenABLE, NordlandWinterVsSummerBeatsTheOriginal) {
   const std::string data = testing::DatasetsDir() + "/nordland_trimmed";
   OPENABLE_REQUIRE_PATH(data);
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram(testing::TestOpenableExe(), {SampleConfig(dir), "--set", "Images_path=" + data + "/summer", "--set",
-                         "Images_path_2=" + data + "/winter", "--set", "Txt_name=", "--set",
-                         "Png_name=", "--set", "Threshold=-1", "--quiet"},
-                        dir);
+  const Outcome o =
+      RunProgram(testing::TestOpenableExe(),
+                 {SampleConfig(dir), "--set", "Images_path=" + data + "/summer", "--set",
+                  "Images_path_2=" + data + "/winter", "--set", "Txt_name=", "--set",
+                  "Png_name=", "--set", "Threshold=-1", "--quiet"},
+                 dir);
   ASSERT_EQ(o.status, 0) << o.err;
   const cv::Mat1f m = ReadNpy(dir + "/out/matrix.npy");
   ASSERT_EQ(m.rows, 3576);
@@ -307,7 +312,7 @@ TEST(TestOpenABLE, NordlandWinterVsSummerBeatsTheOriginal) {
   EXPECT_GE(r1, 0.355);
 }
 
-// Reverse traversal with a monocular camera (issue 5, item 5) and the matrix image (item 6):
+// Reverse traversal with a monocular camera and the matrix image:
 // 300 Nordland summer frames, then the same stretch in winter played backwards as the second
 // traversal. Summing sequences along anti-diagonals (Sequence_direction 1) finds query i at
 // reference 299 - i; the forward sums do not. In the image of the matrix (Matrix_color 0:
@@ -319,7 +324,8 @@ TEST(TestOpenABLE, ReverseTraversalIsFoundAlongTheAntiDiagonal) {
   const std::string dir = testing::TempDir();
   const int n = 300;
   std::vector<std::string> winter;
-  for (const auto& e : fs::directory_iterator(data + "/winter")) winter.push_back(e.path().string());
+  for (const auto& e : fs::directory_iterator(data + "/winter"))
+    winter.push_back(e.path().string());
   std::sort(winter.begin(), winter.end());
   fs::create_directories(dir + "/backwards");
   char name[32];
@@ -383,7 +389,7 @@ TEST(TestOpenABLE, ReverseTraversalIsFoundAlongTheAntiDiagonal) {
 }  // namespace
 }  // namespace openable
 
-// --- Issue 8, item 6: interrupted runs, write errors, the descriptor cache --------------------
+// --- Interrupted runs, write errors, the descriptor cache ---------------------------------
 namespace openable {
 namespace {
 
@@ -453,7 +459,8 @@ TEST(TestOpenABLE, SigtermDuringARunLeavesNoOutput) {
     const int null = ::open("/dev/null", O_WRONLY);
     ::dup2(null, 1);
     const std::string exe = testing::TestOpenableExe();
-    const std::string a = "Images_path=" + data + "/summer", b = "Images_path_2=" + data + "/winter";
+    const std::string a = "Images_path=" + data + "/summer",
+                      b = "Images_path_2=" + data + "/winter";
     ::execl(exe.c_str(), exe.c_str(), config.c_str(), "--set", a.c_str(), "--set", b.c_str(),
             "--set", "Threads=1", static_cast<char*>(nullptr));
     ::_exit(98);

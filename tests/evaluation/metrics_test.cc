@@ -33,8 +33,9 @@ cv::Mat1f QueryReferenceBlock() {
 TEST(PerQuery, HandWorkedQueryReferenceExample) {
   EvaluationOptions o;
   o.tolerance = 1;
-  const PerQueryResult r = EvaluatePerQuery(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
-                                            Truth({{1}, {4}, {}, {3}}, 5), o);
+  const PerQueryResult r =
+      EvaluatePerQuery(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
+                       Truth({{1}, {4}, {}, {3}}, 5), o);
   EXPECT_EQ(r.queries, 4);
   EXPECT_EQ(r.positive_queries, 3);
   EXPECT_EQ(r.best, (std::vector<int>{1, 2, 3, 4}));
@@ -79,7 +80,8 @@ TEST(PerQuery, ToleranceZeroAndTwoChangeOnlyTheAmbiguousQuery) {
 // Truth: (4, 0), (5, 1) and (3, 2), the last inside the exclusion window.
 TEST(PerQuery, LoopClosureUsesEarlierFramesOutsideTheExclusionWindow) {
   cv::Mat1f m(6, 6, 1.0f);
-  const float lower[6][4] = {{}, {}, {0.6f}, {0.5f, 0.9f}, {0.2f, 0.7f, 0.8f}, {0.9f, 0.85f, 0.3f, 0.4f}};
+  const float lower[6][4] = {
+      {}, {}, {0.6f}, {0.5f, 0.9f}, {0.2f, 0.7f, 0.8f}, {0.9f, 0.85f, 0.3f, 0.4f}};
   for (int q = 2; q < 6; ++q)
     for (int j = 0; j <= q - 2; ++j) m(q, j) = m(j, q) = lower[q][j];
   for (int q = 0; q < 6; ++q) m(q, q) = 0.0f;  // the diagonal is never a candidate

@@ -165,7 +165,9 @@ GroundTruth Truth(std::vector<std::vector<int>> matches, int references) {
 }
 
 // Centre pixel of block cell (q, r) with enlargement k.
-cv::Vec3b Cell(const cv::Mat3b& img, int k, int q, int r) { return img(q * k + k / 2, r * k + k / 2); }
+cv::Vec3b Cell(const cv::Mat3b& img, int k, int q, int r) {
+  return img(q * k + k / 2, r * k + k / 2);
+}
 
 const cv::Vec3b kGreen(0, 200, 0);
 const cv::Vec3b kRed(0, 0, 230);

@@ -1,4 +1,4 @@
-// Side-window multilayer fusion and noise injection (issue 8, OpenABLE/image/robustness.h).
+// Side-window multilayer fusion and noise injection (OpenABLE/image/robustness.h).
 #include "OpenABLE/image/robustness.h"
 
 #include <cmath>
@@ -64,7 +64,8 @@ TEST(SideWindow, OneLayerEqualsBruteForceForSeveralRadii) {
     const cv::Mat1d got = SideWindowLayer(d, r);
     const auto want = BruteLayer(b, r);
     for (int y = 0; y < 9; ++y)
-      for (int x = 0; x < 11; ++x) ASSERT_NEAR(got(y, x), want[y][x], 1e-9) << r << " " << y << "," << x;
+      for (int x = 0; x < 11; ++x)
+        ASSERT_NEAR(got(y, x), want[y][x], 1e-9) << r << " " << y << "," << x;
   }
 }
 

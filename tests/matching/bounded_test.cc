@@ -31,8 +31,10 @@ std::vector<Match> SortedRow(const cv::Mat1f& s, int row, int q, int first, int 
   std::vector<Match> out;
   for (int r = 0; r < std::min<int>(rules.best, static_cast<int>(all.size())); ++r)
     out.push_back({q, all[r].second, all[r].first, r + 1});
-  for (int j = std::max(0, q - rules.band); rules.band >= 0 && j <= std::min(count - 1, q + rules.band); ++j)
-    if (std::none_of(out.begin(), out.end(), [&](const Match& m) { return m.rank > 0 && m.reference == j; }))
+  for (int j = std::max(0, q - rules.band);
+       rules.band >= 0 && j <= std::min(count - 1, q + rules.band); ++j)
+    if (std::none_of(out.begin(), out.end(),
+                     [&](const Match& m) { return m.rank > 0 && m.reference == j; }))
       out.push_back({q, j, s(row, first + j), 0});
   return out;
 }

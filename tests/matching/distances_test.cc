@@ -48,7 +48,8 @@ TEST_P(HammingWidths, MatrixMatchesBruteForce) {
     ASSERT_EQ(cross.rows, 37);
     ASSERT_EQ(cross.cols, 23);
     for (int i = 0; i < a.rows; ++i)
-      for (int j = 0; j < b.rows; ++j) ASSERT_EQ(cross(i, j), BitCount(a, i, b, j)) << i << "," << j;
+      for (int j = 0; j < b.rows; ++j)
+        ASSERT_EQ(cross(i, j), BitCount(a, i, b, j)) << i << "," << j;
     const cv::Mat1f self = HammingDistances(a, cv::Mat(), threads);
     for (int i = 0; i < a.rows; ++i)
       for (int j = 0; j < a.rows; ++j) ASSERT_EQ(self(i, j), BitCount(a, i, a, j)) << i << "," << j;

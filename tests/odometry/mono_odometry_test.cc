@@ -60,7 +60,9 @@ void CheckTwoViews(const std::string& features, double ransac_px, double max_dir
   ExpectClosePose(p1, second, 0.5, max_direction_deg);
 }
 
-TEST(MonoOdometry, RecoversAKnownMotionInASyntheticRoomWithSift) { CheckTwoViews("SIFT", 0.5, 3.0); }
+TEST(MonoOdometry, RecoversAKnownMotionInASyntheticRoomWithSift) {
+  CheckTwoViews("SIFT", 0.5, 3.0);
+}
 TEST(MonoOdometry, RecoversAKnownMotionInASyntheticRoomWithOrb) { CheckTwoViews("orb", 1.0, 5.0); }
 
 TEST(MonoOdometry, UnknownStepLengthGivesUnitSteps) {

@@ -77,7 +77,8 @@ TEST(StereoOdometry, DisparityOfTheSyntheticPairMatchesTheDepth) {
   // A fronto-parallel view of the back wall (z = 25 m from y = 0... the camera at z = 15 sees it
   // 10 m away): disparity f B / z = 400 x 0.2 / 10 = 8 pixels at the centre.
   const SyntheticRoom room(11);
-  const auto [l, r] = RenderPair(room, Pose(0, Eigen::Vector3d::UnitY(), Eigen::Vector3d(0, -1, 15)));
+  const auto [l, r] =
+      RenderPair(room, Pose(0, Eigen::Vector3d::UnitY(), Eigen::Vector3d(0, -1, 15)));
   const cv::Mat1f d = OdometryDisparity(l, r, StereoOdometryOptions());
   EXPECT_NEAR(d(240, 320), 8.0, 0.25);
   EXPECT_EQ(d(240, 10), 0.0f);  // the left band has no disparity
@@ -88,7 +89,8 @@ TEST(StereoOdometry, FallsBackToConstantVelocityOnAFeaturelessPair) {
   StereoOdometry stereo(kIntrinsics, kBaseline, StereoOdometryOptions());
   const auto [l0, r0] = RenderPair(room, Eigen::Isometry3d::Identity());
   stereo.Step(l0, r0);
-  const auto [l1, r1] = RenderPair(room, Pose(0, Eigen::Vector3d::UnitY(), Eigen::Vector3d(0, 0, 0.5)));
+  const auto [l1, r1] =
+      RenderPair(room, Pose(0, Eigen::Vector3d::UnitY(), Eigen::Vector3d(0, 0, 0.5)));
   const Eigen::Isometry3d p1 = stereo.Step(l1, r1);
   ASSERT_TRUE(stereo.last().ok);
   const cv::Mat flat(kSize, CV_8UC1, cv::Scalar(128));
@@ -209,8 +211,8 @@ TEST(StereoOdometry, EurocPairs3To2AgreeWithTheGroundTruth) {
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) rect(r, c) = rectifier.RectifyingRotationLeft()(r, c);
   const Eigen::Vector3d true_direction = (rect * truth.translation()).normalized();
-  const double direction =
-      Degrees(std::acos(std::clamp(true_direction.dot(pose.translation().normalized()), -1.0, 1.0)));
+  const double direction = Degrees(
+      std::acos(std::clamp(true_direction.dot(pose.translation().normalized()), -1.0, 1.0)));
   std::printf("EuRoC 3->2: %d inliers of %d; angle %.2f deg (truth %.2f), length %.3f m "
               "(truth %.3f), direction error %.1f deg\n",
               stereo.last().inliers, stereo.last().matches, angle, true_angle, length,

@@ -1,6 +1,7 @@
-// The online detector (OpenABLE/online/online.h) against the batch matrix and against an independent
-// brute force on real KITTI frames: single-frame distances counted bit by bit here, sequence sums written from their
-// definition (matching/sequence.h), candidates as the k smallest with ties to the earlier frame.
+// The online detector (OpenABLE/online/online.h) against the batch matrix and against an
+// independent brute force on real KITTI frames: single-frame distances counted bit by bit here,
+// sequence sums written from their definition (matching/sequence.h), candidates as the k smallest
+// with ties to the earlier frame.
 #include "OpenABLE/online/online.h"
 
 #include <bitset>
@@ -70,7 +71,8 @@ std::vector<Expected> BruteForce(const cv::Mat& rows, int q, int L, int exclusio
   for (int j = 0; j <= q - exclusion; ++j) all.emplace_back(Sequence(rows, q, j, L), j);
   std::sort(all.begin(), all.end());
   std::vector<Expected> out;
-  for (int i = 0; i < std::min<int>(k, all.size()); ++i) out.push_back({all[i].second, all[i].first});
+  for (int i = 0; i < std::min<int>(k, all.size()); ++i)
+    out.push_back({all[i].second, all[i].first});
   return out;
 }
 
@@ -206,8 +208,9 @@ TEST(OnlineDetector, SearchesFlannBlocksBeyondTheExactLimit) {
                      a.candidates[0].accepted;
     }
   }
-  std::printf("approximate top-1 = exact top-1 for %d of %d frames; accepted loops found %d of %d\n",
-              same, queries, loops_found, loops);
+  std::printf(
+      "approximate top-1 = exact top-1 for %d of %d frames; accepted loops found %d of %d\n", same,
+      queries, loops_found, loops);
   // LSH misses many nearest neighbours that are far anyway (non-loops: ~25 % of the bits
   // differ, so a 20-bit key rarely survives), but not the loops (~10 % differ).
   EXPECT_GT(same, 0.5 * queries);
@@ -250,8 +253,9 @@ TEST(OnlineDetector, BadOptionsAndFramesAreOneLineErrors) {
     change(o);
     return o;
   };
-  ExpectInputError([&] { OnlineDetector d(with([](OnlineOptions& o) { o.descriptor = "D-LDB"; })); },
-                   {"OnlineOptions.descriptor", "D-LDB", "stereo"});
+  ExpectInputError(
+      [&] { OnlineDetector d(with([](OnlineOptions& o) { o.descriptor = "D-LDB"; })); },
+      {"OnlineOptions.descriptor", "D-LDB", "stereo"});
   ExpectInputError([&] { OnlineDetector d(with([](OnlineOptions& o) { o.descriptor = "SURF"; })); },
                    {"SURF"});
   ExpectInputError([&] { OnlineDetector d(with([](OnlineOptions& o) { o.sequence_length = 0; })); },

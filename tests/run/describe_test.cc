@@ -49,7 +49,9 @@ class MemorySource : public FrameSource {
   bool parallel_;
 };
 
-cv::Mat Constant(int rows, int cols, float v) { return cv::Mat(rows, cols, CV_32FC1, cv::Scalar(v)); }
+cv::Mat Constant(int rows, int cols, float v) {
+  return cv::Mat(rows, cols, CV_32FC1, cv::Scalar(v));
+}
 
 TEST(FrameDescriber, GridCellsInRowMajorOrder) {
   // A 40x60 frame whose quadrants are 0.0, 0.2 / 0.4, 0.6 (x 255 after grey conversion).

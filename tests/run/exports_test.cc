@@ -19,7 +19,8 @@ namespace fs = std::filesystem;
 std::string ReadAll(const std::string& path) { return testing::ReadBytes(path); }
 
 TEST(ColorMaps, MatchTheOriginalTable) {
-  // (b, g, r) of s = 0.25 for each of the 12 maps, worked out by hand from reference.md.
+  // (b, g, r) of s = 0.25 for each of the 12 maps, worked out by hand from the original's
+  // table (docs/output_formats.md).
   const float s = 0.25f;
   const cv::Vec3f expected[12] = {
       {s, s, s},     {0, 0, s},      {0, s, 0},     {s, 0, 0},
@@ -90,7 +91,8 @@ TEST(Png, DecodesToTheSamePixels) {
   cv::Mat3b img(4, 6, cv::Vec3b(10, 20, 30));
   img(1, 2) = cv::Vec3b(255, 0, 7);
   const std::string bytes = EncodePng(img);
-  const cv::Mat back = cv::imdecode(std::vector<uchar>(bytes.begin(), bytes.end()), cv::IMREAD_COLOR);
+  const cv::Mat back =
+      cv::imdecode(std::vector<uchar>(bytes.begin(), bytes.end()), cv::IMREAD_COLOR);
   ASSERT_EQ(back.size(), img.size());
   EXPECT_EQ(cv::norm(back, img, cv::NORM_INF), 0.0);
 }

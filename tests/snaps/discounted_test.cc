@@ -70,8 +70,9 @@ TEST(Discounted, KBeyondTheStart) {
   const Trajectory before = t;
   ApplyDiscountedUpdate(t, 12, 1, 1.0, 1, 100);  // s from max(0, 12 - 100) = 0
   const Eigen::Vector3d delta = before.poses[1].translation() - before.poses[12].translation();
-  EXPECT_LT((t.poses[0].translation() - before.poses[0].translation() - Gamma(12, 1) * delta).norm(),
-            1e-12);
+  EXPECT_LT(
+      (t.poses[0].translation() - before.poses[0].translation() - Gamma(12, 1) * delta).norm(),
+      1e-12);
   EXPECT_THROW(ApplyDiscountedUpdate(t, 20, 1, 1.0, 1, 5), std::invalid_argument);
   EXPECT_THROW(ApplyDiscountedUpdate(t, 5, 5, 1.0, 1, 5), std::invalid_argument);
 }

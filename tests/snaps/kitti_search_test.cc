@@ -33,12 +33,14 @@ TEST(KittiSearch, LoopsFoundAreRealRevisits) {
   OPENABLE_REQUIRE_PATH(dir + "/image_0");
   const Trajectory truth = ReadKittiPoses(dir + "/poses/00_first1700.txt");
   ASSERT_EQ(truth.Size(), 1700);
-  const ImageSearchResult r = SearchLoopsInImages(dir + "/image_0", "png", 0, truth, SearchOptions());
+  const ImageSearchResult r =
+      SearchLoopsInImages(dir + "/image_0", "png", 0, truth, SearchOptions());
   ASSERT_EQ(r.steps.size(), 1700u);
   ASSERT_FALSE(r.loops.empty());
   int within = 0, in_revisit = 0;
   for (const LoopPair& l : r.loops) {
-    const double d = (truth.poses[l.query].translation() - truth.poses[l.reference].translation()).norm();
+    const double d =
+        (truth.poses[l.query].translation() - truth.poses[l.reference].translation()).norm();
     within += d < 5;
     in_revisit += l.query >= 1559 && l.query <= 1641 && l.reference >= 108 && l.reference <= 180;
     EXPECT_GE(l.similarity, 0.75);

@@ -179,8 +179,9 @@ TEST(OnlineSnaps, CorrectsAndLaterFramesFollow) {
   const double g0 = 1 - std::exp(-3.0);
   EXPECT_LT((snaps.corrected()[60].translation() - (p60 + g0 * delta)).norm(), 1e-12);
   const double g10 = 1 - 1 / std::exp(3 - 0.01 * 10);
-  EXPECT_LT((snaps.corrected()[50].translation() - (vo(50, 150).translation() + g10 * delta)).norm(),
-            1e-12);
+  EXPECT_LT(
+      (snaps.corrected()[50].translation() - (vo(50, 150).translation() + g10 * delta)).norm(),
+      1e-12);
   EXPECT_EQ(snaps.corrected()[29].translation(), vo(29, 29).translation());  // s < N - K
   snaps.Step(vo(61, 11), Noise(11));
   EXPECT_LT((snaps.corrected()[61].translation() - (vo(61, 11).translation() + g0 * delta)).norm(),

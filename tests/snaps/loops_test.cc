@@ -131,9 +131,10 @@ TEST(LoopsFromCsv, Errors) {
                         Case{"4,1,0\n", "\"4,1,0\""}, Case{"-4,1\n", "\"-4\""}}) {
     const std::string path = dir + "/bad.csv";
     WriteBytes(path, c.text);
-    const std::string line = c.text.rfind('\n', c.text.size() - 2) == std::string::npos
-                                 ? ":1:"
-                                 : ":" + std::to_string(std::count(c.text.begin(), c.text.end(), '\n')) + ":";
+    const std::string line =
+        c.text.rfind('\n', c.text.size() - 2) == std::string::npos
+            ? ":1:"
+            : ":" + std::to_string(std::count(c.text.begin(), c.text.end(), '\n')) + ":";
     ExpectInputError([&] { LoopsFromCsv(path, t); }, {Q(path) + line, c.part});
   }
   ExpectInputError([&] { LoopsFromCsv(dir + "/missing.csv", t); }, {Q(dir + "/missing.csv")});

@@ -50,7 +50,8 @@ Trajectory Square(int laps, double yaw_drift = 0, double scale_drift = 0) {
 
 double MeanDistance(const Trajectory& a, const Trajectory& b) {
   double sum = 0;
-  for (int i = 0; i < a.Size(); ++i) sum += (a.poses[i].translation() - b.poses[i].translation()).norm();
+  for (int i = 0; i < a.Size(); ++i)
+    sum += (a.poses[i].translation() - b.poses[i].translation()).norm();
   return sum / a.Size();
 }
 
@@ -97,7 +98,8 @@ TEST(CorrectPoseGraph, TranslationDriftIsRemovedExactly) {
   EXPECT_NEAR(MeanDistance(drifting, truth), 1.5, 1e-9);
   double worst = 0;
   for (int k = 0; k < truth.Size(); ++k) {
-    worst = std::max(worst, (corrected.poses[k].translation() - truth.poses[k].translation()).norm());
+    worst =
+        std::max(worst, (corrected.poses[k].translation() - truth.poses[k].translation()).norm());
   }
   EXPECT_LT(worst, 1e-4);
 }
@@ -238,7 +240,7 @@ void CorrectSoDso(const std::string& sequence, const std::string& pairs_file) {
   std::printf("  loop pairs' position gap: %.2f -> %.2f m\n", mean_gap(vo), mean_gap(corrected));
   EXPECT_LT(mean_gap(corrected), 0.5 * mean_gap(vo));
   // The paper's figure (mean deviation down by 65 %) is NOT reached on SO-DSO with these loop
-  // pairs (see docs/benchmarks.md, "SNAPS (issue 6)"): reported above, not asserted.
+  // pairs (see docs/benchmarks.md, "SNAPS and odometry"): reported above, not asserted.
   std::printf("  paper: mean deviation -65 %%; here (unaligned) %+.1f %%\n",
               -100 * (1 - after.mean / before.mean));
 }

@@ -101,7 +101,8 @@ TEST(StereoCalibration, MissingKey) {
 }
 
 TEST(StereoCalibration, WrongMatrixSize) {
-  const std::string ml = Write(CalibrationText({{"ML", MatrixNode("ML", 3, 2, "1, 0, 0, 1, 0, 0")}}));
+  const std::string ml =
+      Write(CalibrationText({{"ML", MatrixNode("ML", 3, 2, "1, 0, 0, 1, 0, 0")}}));
   ExpectInputError([&] { LoadStereoCalibration(ml); },
                    {testing::Q(ml), "ML: a 3x2 matrix; expected a 3x3 opencv-matrix"});
   const std::string dr = Write(CalibrationText({{"DR", MatrixNode("DR", 4, 1, "0, 0, 0, 0")}}));
@@ -125,15 +126,17 @@ TEST(StereoCalibration, NonFiniteValue) {
 TEST(StereoCalibration, NonPositiveFocalLength) {
   const std::string path = Write(CalibrationText(
       {{"ML", MatrixNode("ML", 3, 3, "-458.6, 0., 367.2, 0., 457.3, 248.4, 0., 0., 1.")}}));
-  ExpectInputError([&] { LoadStereoCalibration(path); },
-                   {testing::Q(path), "ML: focal length fx = -458.6, fy = 457.3; expected both > 0"});
+  ExpectInputError(
+      [&] { LoadStereoCalibration(path); },
+      {testing::Q(path), "ML: focal length fx = -458.6, fy = 457.3; expected both > 0"});
   const std::string zero = Write(CalibrationText(
       {{"MR", MatrixNode("MR", 3, 3, "458.6, 0., 367.2, 0., 0., 248.4, 0., 0., 1.")}}));
   ExpectInputError([&] { LoadStereoCalibration(zero); }, {"MR: focal length", "fy = 0;"});
 }
 
 TEST(StereoCalibration, OtherBadValues) {
-  const std::string rot = Write(CalibrationText({{"R", MatrixNode("R", 3, 3, "1, 0, 0, 0, 2, 0, 0, 0, 1")}}));
+  const std::string rot =
+      Write(CalibrationText({{"R", MatrixNode("R", 3, 3, "1, 0, 0, 0, 2, 0, 0, 0, 1")}}));
   ExpectInputError([&] { LoadStereoCalibration(rot); }, {"R: not a rotation", "det = 2"});
   const std::string t = Write(CalibrationText({{"T", MatrixNode("T", 3, 1, "0, 0, 0")}}));
   ExpectInputError([&] { LoadStereoCalibration(t); }, {"T: (0, 0, 0); expected the non-zero"});
@@ -156,7 +159,8 @@ TEST(StereoCalibration, PrincipalPointsMustLieInTheMiddleOfTheImages) {
   // middle half (cx 607 > 465).
   const StereoCalibration kitti = LoadStereoCalibration(Write(CalibrationText(
       {{"ML", MatrixNode("ML", 3, 3, "718.856, 0., 607.1928, 0., 718.856, 185.2157, 0., 0., 1.")},
-       {"MR", MatrixNode("MR", 3, 3, "718.856, 0., 607.1928, 0., 718.856, 185.2157, 0., 0., 1.")}})));
+       {"MR",
+        MatrixNode("MR", 3, 3, "718.856, 0., 607.1928, 0., 718.856, 185.2157, 0., 0., 1.")}})));
   EXPECT_NO_THROW(CheckCalibrationFits(kitti, cv::Size(1241, 376), "full.png"));
   ExpectInputError([&] { CheckCalibrationFits(kitti, cv::Size(620, 188), "half.png"); },
                    {"ML principal point (607.193, 185.216)", "620x188", "about 1214x370"});

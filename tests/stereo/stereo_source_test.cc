@@ -139,8 +139,8 @@ TEST_F(EurocDldb, RevisitIsCloserThanOtherPlaces) {
   const int revisit = Hamming(seq.rows.row(0), seq.rows.row(1));
   const int other2 = Hamming(seq.rows.row(0), seq.rows.row(2));
   const int other3 = Hamming(seq.rows.row(0), seq.rows.row(3));
-  std::cout << "D-LDB Hamming (of 2 x 1386 bits): pair 0-1 (revisit) " << revisit << ", 0-2 " << other2
-            << ", 0-3 " << other3 << ", 1-2 " << Hamming(seq.rows.row(1), seq.rows.row(2))
+  std::cout << "D-LDB Hamming (of 2 x 1386 bits): pair 0-1 (revisit) " << revisit << ", 0-2 "
+            << other2 << ", 0-3 " << other3 << ", 1-2 " << Hamming(seq.rows.row(1), seq.rows.row(2))
             << ", 1-3 " << Hamming(seq.rows.row(1), seq.rows.row(3)) << ", 2-3 (0.5 s apart) "
             << Hamming(seq.rows.row(2), seq.rows.row(3)) << "\n";
   EXPECT_LT(revisit, other2);

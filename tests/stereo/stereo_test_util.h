@@ -24,8 +24,12 @@ inline std::string EurocCalibrationFile() {
 }
 
 inline cv::Mat ReadGray(const std::string& path) { return cv::imread(path, cv::IMREAD_GRAYSCALE); }
-inline cv::Mat EurocLeft(int i) { return ReadGray(EurocDir() + "/left_img_" + std::to_string(i) + ".png"); }
-inline cv::Mat EurocRight(int i) { return ReadGray(EurocDir() + "/right_img_" + std::to_string(i) + ".png"); }
+inline cv::Mat EurocLeft(int i) {
+  return ReadGray(EurocDir() + "/left_img_" + std::to_string(i) + ".png");
+}
+inline cv::Mat EurocRight(int i) {
+  return ReadGray(EurocDir() + "/right_img_" + std::to_string(i) + ".png");
+}
 
 // Copies pairs [0, n) of EuRoC into <dir>/left and <dir>/right (file names 0.png ...).
 inline void CopyEurocPairs(const std::string& dir, int n) {
