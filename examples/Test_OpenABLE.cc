@@ -5,10 +5,8 @@
 
 #include <malloc.h>
 
-#include <opencv2/core/utils/logger.hpp>
-
 #include "OpenABLE/OpenABLE.h"
-#include "config/command_line.h"
+#include "OpenABLE/run/command_line.h"
 
 namespace {
 
@@ -39,26 +37,20 @@ const char* kUsage =
 }  // namespace
 
 int main(int argc, char** argv) {
-  // OpenCV's video back ends print [ WARN ] lines of their own when a file cannot be opened;
-  // the library already reports that as one InputError line, so keep only OpenCV errors.
-  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   // Every frame passes through buffers of several MB (a 960x540 colour frame as float is
   // 6 MB). glibc serves such blocks with mmap and returns them at free, so each frame paid
   // for fresh zeroed pages: 63% of a Gardens Point run was page faults in the kernel. Keeping
   // blocks up to 256 MB on the heap lets them be reused (Gardens Point 3.0 s -> 1.1 s).
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
-  // SIGINT/SIGTERM/SIGHUP remove the staged temporaries and exit with 128 + signal.
-  openable::InstallInterruptCleanup("Test_OpenABLE");
   return openable::RunConfigProgram(
       argc, argv, "Test_OpenABLE", kUsage, "OpenABLE " + std::string(openable::kVersion),
-      [](const openable::Config& config, const openable::CommandLine& cl) {
-        openable::ProgressReporter progress(std::cerr, !cl.quiet, openable::IsTerminal(2));
-        const openable::RunOutcome outcome =
-            openable::Run(config, progress, [](const std::string& line) {
-              std::cerr << "Test_OpenABLE: " << line << "\n";
-            });
-        std::cout << openable::FormatRunReport(config, outcome);
+      [](const openable::Config& config, const openable::CommandLine&,
+         openable::ProgressReporter& progress) {
+        const auto log = [](const std::string& line) {
+          std::cerr << "Test_OpenABLE: " << line << "\n";
+        };
+        std::cout << openable::FormatRunReport(config, openable::Run(config, progress, log));
         return 0;
       });
 }

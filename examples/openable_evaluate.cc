@@ -1,6 +1,6 @@
 // openable_evaluate: evaluates saved distance matrices against ground truth, with the same
 // protocols, keys and outputs as Test_OpenABLE's evaluation (docs/evaluation.md). A thin layer
-// over the library.
+// over openable::EvaluateMatrixFiles (OpenABLE/run/evaluate.h).
 #include <algorithm>
 #include <iostream>
 #include <string>
@@ -88,11 +88,9 @@ int main(int argc, char** argv) {
                                      [&](const auto& f) { return a == f.first; });
       if (flag != std::end(kFlagKeys)) {
         overrides.push_back(std::string(flag->second) + "=" + value_of(i, a));
-      } else if (a == "--help" || a == "-h") {
-        std::cout << kUsage;
-        return 0;
-      } else if (a == "--version") {
-        std::cout << "OpenABLE " << openable::kVersion << "\n";
+      } else if (a == "--help" || a == "-h" || a == "--version") {
+        std::cout << (a == "--version" ? "OpenABLE " + std::string(openable::kVersion) + "\n"
+                                       : std::string(kUsage));
         return 0;
       } else if (a == "--matrix") {
         matrices.push_back({value_of(i, a), ""});

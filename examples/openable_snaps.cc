@@ -8,12 +8,9 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/core/utils/logger.hpp>
-
 #include "OpenABLE/base/version.h"
-#include "OpenABLE/run/interrupt.h"
 #include "OpenABLE/snaps/chain.h"
-#include "config/command_line.h"
+#include "OpenABLE/run/command_line.h"
 
 namespace {
 
@@ -49,16 +46,14 @@ const char* const kUsage =
 }  // namespace
 
 int main(int argc, char** argv) {
-  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
-  openable::InstallInterruptCleanup("openable_snaps");
   return openable::RunConfigProgram(
       argc, argv, "openable_snaps", kUsage, "openable_snaps " + std::string(openable::kVersion),
-      [](const openable::Config& config, const openable::CommandLine& cl) {
-        openable::ProgressReporter progress(std::cerr, !cl.quiet, openable::IsTerminal(2));
-        const openable::snaps::ChainResult result =
-            openable::snaps::RunChain(config, progress, [&](const std::string& line) {
-              if (!cl.quiet) std::cerr << "  " << line << "\n";
-            });
+      [](const openable::Config& config, const openable::CommandLine& cl,
+         openable::ProgressReporter& progress) {
+        const auto say = [&](const std::string& line) {
+          if (!cl.quiet) std::cerr << "  " << line << "\n";
+        };
+        const openable::snaps::ChainResult result = openable::snaps::RunChain(config, progress, say);
         std::cout << openable::snaps::FormatChainReport(config, result);
         const std::vector<std::string> paths = openable::snaps::WriteChainOutputs(config, result);
         if (!paths.empty()) {

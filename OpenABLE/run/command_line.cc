@@ -1,8 +1,11 @@
-#include "config/command_line.h"
+#include "OpenABLE/run/command_line.h"
 
 #include <iostream>
 
+#include <opencv2/core/utils/logger.hpp>
+
 #include "OpenABLE/base/program.h"
+#include "OpenABLE/run/interrupt.h"
 
 namespace openable {
 
@@ -70,9 +73,12 @@ Config ConfigOf(const CommandLine& command_line) {
   return config;
 }
 
-int RunConfigProgram(int argc, const char* const* argv, const std::string& program,
-                     const std::string& usage, const std::string& version_line,
-                     const std::function<int(const Config&, const CommandLine&)>& body) {
+int RunConfigProgram(
+    int argc, const char* const* argv, const char* program, const std::string& usage,
+    const std::string& version_line,
+    const std::function<int(const Config&, const CommandLine&, ProgressReporter&)>& body) {
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+  InstallInterruptCleanup(program);
   CommandLine cl;
   const std::string usage_error = ParseCommandLine(argc, argv, program, cl);
   const int answered = AnswerWithoutRunning(cl, usage_error, usage, version_line);
@@ -83,7 +89,8 @@ int RunConfigProgram(int argc, const char* const* argv, const std::string& progr
       std::cout << FormatConfig(config);
       return 0;
     }
-    return body(config, cl);
+    ProgressReporter progress(std::cerr, !cl.quiet, IsTerminal(2));
+    return body(config, cl, progress);
   });
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "OpenABLE/run/progress.h"
 #include "config/config.h"
 
 namespace openable {
@@ -38,12 +39,17 @@ int AnswerWithoutRunning(const CommandLine& command_line, const std::string& usa
 // applied in order. Throws InputError as LoadConfig and ApplyOverride do.
 Config ConfigOf(const CommandLine& command_line);
 
-// The main of a program that reads Config.txt, around its work: parses the command line,
-// answers --help, --help-markdown, --version and usage errors (AnswerWithoutRunning), reads the
-// configuration (ConfigOf), prints it for --print-config, and otherwise returns `body`'s status;
-// errors become exit statuses through RunProgram (OpenABLE/base/program.h).
-int RunConfigProgram(int argc, const char* const* argv, const std::string& program,
-                     const std::string& usage, const std::string& version_line,
-                     const std::function<int(const Config&, const CommandLine&)>& body);
+// The main of a program that reads Config.txt, around its work: keeps only OpenCV's errors in
+// its log (OpenCV's video back ends print warnings of their own that the library reports as one
+// InputError line), installs the cleanup of interrupted runs (interrupt.h), parses the command
+// line, answers --help, --help-markdown, --version and usage errors (AnswerWithoutRunning),
+// reads the configuration (ConfigOf), prints it for --print-config, and otherwise returns the
+// status of `body`, given the configuration, the command line and the progress reporter of the
+// run (stderr, off with --quiet); errors become exit statuses through RunProgram
+// (OpenABLE/base/program.h). `program` must outlive the process (a string literal).
+int RunConfigProgram(
+    int argc, const char* const* argv, const char* program, const std::string& usage,
+    const std::string& version_line,
+    const std::function<int(const Config&, const CommandLine&, ProgressReporter&)>& body);
 
 }  // namespace openable

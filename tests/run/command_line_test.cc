@@ -1,4 +1,4 @@
-#include "config/command_line.h"
+#include "OpenABLE/run/command_line.h"
 
 #include <gtest/gtest.h>
 
