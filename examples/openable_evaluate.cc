@@ -72,6 +72,7 @@ const char* kUsage =
 }  // namespace
 
 int main(int argc, char** argv) {
+  openable::InstallInterruptCleanup("openable_evaluate");  // signals remove the temporaries
   std::vector<openable::MatrixFile> matrices;
   std::vector<std::string> overrides;
   std::string config_path;
