@@ -212,62 +212,73 @@ void ApplyOptionOverride(const OptionTable& table, const std::string& assignment
   Assign(table.Lookup(key, "--set"), Trim(assignment.substr(eq + 1)), "--set");
 }
 
+namespace {
+
+// Calls group(name) before the first binding of each group, then binding(b), in table order.
+void ForEachByGroup(const OptionTable& table, const std::function<void(const std::string&)>& group,
+                    const std::function<void(const OptionBinding&)>& binding) {
+  std::string current;
+  for (const auto& b : table.Bindings()) {
+    if (current != b.group) {
+      current = b.group;
+      group(current);
+    }
+    binding(b);
+  }
+}
+
+}  // namespace
+
 std::string FormatOptionText(const OptionTable& table) {
   std::ostringstream os;
   os << "%YAML:1.0\n";
-  std::string group;
-  for (const auto& b : table.Bindings()) {
-    if (group != b.group) {
-      group = b.group;
-      os << "\n# --- " << group << " ---\n";
-    }
-    os << "# " << b.meaning << "\n" << b.key << ": " << b.format() << "\n";
-  }
+  ForEachByGroup(
+      table, [&](const std::string& g) { os << "\n# --- " << g << " ---\n"; },
+      [&](const OptionBinding& b) {
+        os << "# " << b.meaning << "\n" << b.key << ": " << b.format() << "\n";
+      });
   return os.str();
 }
 
 std::string OptionHelpText(const OptionTable& table) {
   std::ostringstream os;
-  std::string group;
-  for (const auto& b : table.Bindings()) {
-    if (group != b.group) {
-      group = b.group;
-      os << "\n" << group << ":\n";
-    }
-    os << "  " << b.key << (b.is_new ? " (new)" : "") << "  [" << b.RangeText() << ", default "
-       << b.format() << "]\n";
-    // Wrap the meaning at about 90 columns, indented.
-    std::istringstream words(b.meaning);
-    std::string word, line = "      ";
-    while (words >> word) {
-      if (line.size() + word.size() + 1 > 92) {
+  ForEachByGroup(
+      table, [&](const std::string& g) { os << "\n" << g << ":\n"; },
+      [&](const OptionBinding& b) {
+        os << "  " << b.key << (b.is_new ? " (new)" : "") << "  [" << b.RangeText()
+           << ", default " << b.format() << "]\n";
+        // Wrap the meaning at about 90 columns, indented.
+        std::istringstream words(b.meaning);
+        std::string word, line = "      ";
+        while (words >> word) {
+          if (line.size() + word.size() + 1 > 92) {
+            os << line << "\n";
+            line = "      ";
+          }
+          line += (line.size() > 6 ? " " : "") + word;
+        }
         os << line << "\n";
-        line = "      ";
-      }
-      line += (line.size() > 6 ? " " : "") + word;
-    }
-    os << line << "\n";
-  }
+      });
   return os.str();
 }
 
 std::string OptionMarkdown(const OptionTable& table) {
   std::ostringstream os;
-  std::string group;
-  for (const auto& b : table.Bindings()) {
-    if (group != b.group) {
-      group = b.group;
-      os << "\n### " << group << "\n\n| key | values | default | meaning |\n|---|---|---|---|\n";
-    }
-    std::string meaning = b.meaning;
-    std::string::size_type pos = 0;
-    while ((pos = meaning.find('|', pos)) != std::string::npos) {
-      meaning.replace(pos, 1, "\\|");
-      pos += 2;
-    }
-    os << "| `" << b.key << "`" << (b.is_new ? " (new)" : "") << " | " << b.RangeText()
-       << " | `" << b.format() << "` | " << meaning << " |\n";
-  }
+  ForEachByGroup(
+      table,
+      [&](const std::string& g) {
+        os << "\n### " << g << "\n\n| key | values | default | meaning |\n|---|---|---|---|\n";
+      },
+      [&](const OptionBinding& b) {
+        std::string meaning = b.meaning;
+        std::string::size_type pos = 0;
+        while ((pos = meaning.find('|', pos)) != std::string::npos) {
+          meaning.replace(pos, 1, "\\|");
+          pos += 2;
+        }
+        os << "| `" << b.key << "`" << (b.is_new ? " (new)" : "") << " | " << b.RangeText()
+           << " | `" << b.format() << "` | " << meaning << " |\n";
+      });
   return os.str();
 }
 

@@ -53,27 +53,33 @@ void StereoOdometryOptions::Check() const {
   CheckIntAtLeast("Odometry_min_inliers (" + o + ".min_inliers)", min_inliers, 4);
 }
 
+namespace {
+
+// The keys both odometries share, over `o`'s defaults (empty or 0 keeps a default).
+template <typename Options>
+Options WithSharedKeys(const OdometryOptions& k, Options o) {
+  if (!k.features.empty()) o.features = k.features;
+  o.max_features = k.max_features;
+  o.ratio_test = k.ratio_test;
+  if (k.min_inliers > 0) o.min_inliers = k.min_inliers;
+  return o;
+}
+
+}  // namespace
+
 MonoOdometryOptions OdometryOptions::Mono() const {
-  MonoOdometryOptions o;
-  if (!features.empty()) o.features = features;
-  o.max_features = max_features;
-  o.ratio_test = ratio_test;
+  MonoOdometryOptions o = WithSharedKeys(*this, MonoOdometryOptions());
   if (ransac_threshold > 0) o.ransac_threshold_px = ransac_threshold;
-  if (min_inliers > 0) o.min_inliers = min_inliers;
   return o;
 }
 
 StereoOdometryOptions OdometryOptions::Stereo() const {
-  StereoOdometryOptions o;
+  StereoOdometryOptions o = WithSharedKeys(*this, StereoOdometryOptions());
   o.matcher = matcher;
   o.wls_filter = wls_filter;
   o.num_disparities = num_disparities;
-  if (!features.empty()) o.features = features;
-  o.max_features = max_features;
-  o.ratio_test = ratio_test;
   o.max_depth = max_depth;
   if (ransac_threshold > 0) o.pnp_reprojection_px = ransac_threshold;
-  if (min_inliers > 0) o.min_inliers = min_inliers;
   return o;
 }
 

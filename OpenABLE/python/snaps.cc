@@ -136,6 +136,12 @@ py::array_t<double> Matrix4(const Eigen::Isometry3d& pose) {
   return a;
 }
 
+// `value` as a Python object when `ran`, else None.
+template <typename T>
+py::object IfRan(bool ran, const T& value) {
+  return ran ? py::cast(value) : py::none();
+}
+
 // One run of the chain with the configuration it ran (the report needs both).
 struct ChainRun {
   Config config;
@@ -585,34 +591,26 @@ Returns:
 
   py::class_<ChainRun>(m, "ChainResult", R"doc(What run() did: the trajectories, the loops, the
 corrections and their errors, as openable_snaps reports them.)doc")
-      .def_property_readonly("input", [](const ChainRun& c) { return c.result.input; },
-                             "Trajectory: the one corrected (read, or computed by the odometry).")
+      .def_property_readonly(
+          "input", [](const ChainRun& c) { return c.result.input; },
+          "Trajectory: the one corrected (read, or computed by the odometry).")
       .def_property_readonly(
           "discounted",
-          [](const ChainRun& c) -> py::object {
-            return c.result.discounted_ran ? py::cast(c.result.discounted) : py::none();
-          },
+          [](const ChainRun& c) { return IfRan(c.result.discounted_ran, c.result.discounted); },
           "Trajectory corrected by the discounted update (Eq. 6); None when it did not run.")
       .def_property_readonly(
-          "pose_graph",
-          [](const ChainRun& c) -> py::object {
-            return c.result.graph_ran ? py::cast(c.result.graph) : py::none();
-          },
+          "pose_graph", [](const ChainRun& c) { return IfRan(c.result.graph_ran, c.result.graph); },
           "Trajectory corrected by the pose graph; None when it did not run.")
       .def_property_readonly(
           "pose_graph_report",
-          [](const ChainRun& c) -> py::object {
-            return c.result.graph_ran ? py::cast(c.result.graph_report) : py::none();
-          },
+          [](const ChainRun& c) { return IfRan(c.result.graph_ran, c.result.graph_report); },
           "PoseGraphReport of the pose graph; None when it did not run.")
       .def_property_readonly(
-          "truth",
-          [](const ChainRun& c) -> py::object {
-            return c.result.evaluated ? py::cast(c.result.truth) : py::none();
-          },
+          "truth", [](const ChainRun& c) { return IfRan(c.result.evaluated, c.result.truth); },
           "Trajectory of Snaps_ground_truth; None without one.")
-      .def_property_readonly("loops", [](const ChainRun& c) { return LoopsList(c.result.loops); },
-                             "Loop pairs (query, reference, similarity) of `input`'s poses.")
+      .def_property_readonly(
+          "loops", [](const ChainRun& c) { return LoopsList(c.result.loops); },
+          "Loop pairs (query, reference, similarity) of `input`'s poses.")
       .def_property_readonly(
           "closed", [](const ChainRun& c) { return LoopsList(c.result.closed); },
           "The loops the discounted update closed.")
@@ -626,12 +624,15 @@ corrections and their errors, as openable_snaps reports them.)doc")
           },
           "With a ground truth: {\"input\" | \"discounted\" | \"pose_graph\": (unaligned, "
           "aligned)} TrajectoryError pairs; empty without one.")
-      .def_property_readonly("written", [](const ChainRun& c) { return c.written; },
-                             "Paths of the files written (write=True).")
-      .def("report", [](const ChainRun& c) { return snaps::FormatChainReport(c.config, c.result); },
-           "report() -> str\n\nThe report openable_snaps prints.")
-      .def("to_json", [](const ChainRun& c) { return snaps::ChainJson(c.config, c.result); },
-           "to_json() -> str\n\nThe figures, as <Snaps_output_name>.json.")
+      .def_property_readonly(
+          "written", [](const ChainRun& c) { return c.written; },
+          "Paths of the files written (write=True).")
+      .def(
+          "report", [](const ChainRun& c) { return snaps::FormatChainReport(c.config, c.result); },
+          "report() -> str\n\nThe report openable_snaps prints.")
+      .def(
+          "to_json", [](const ChainRun& c) { return snaps::ChainJson(c.config, c.result); },
+          "to_json() -> str\n\nThe figures, as <Snaps_output_name>.json.")
       .def("__repr__", [](const ChainRun& c) {
         return "<openable.snaps.ChainResult " + std::to_string(c.result.input.Size()) +
                " poses, " + std::to_string(c.result.loops.size()) + " loops>";

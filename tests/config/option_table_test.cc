@@ -55,25 +55,21 @@ TEST(ConfigTable, EveryNumericRangeIsWhatItsCheckAccepts) {
                                   std::isinf(b.max) ? b.min + 1e6 : b.max};
     std::vector<double> outside = {b.min_excluded ? b.min : b.min - step};
     if (!std::isinf(b.max)) outside.push_back(b.max + step);
-    for (const double v : inside) {
+    // The error of the owner's Check() with the field set to `v`, past the table's reading.
+    const auto check_at = [&](double v) {
       Config c = Baseline();
       const OptionTable table = ConfigTable(c);
       const OptionBinding& bound = *table.Find(b.key);
       bound.set_number(v);
-      const std::string error = ErrorOf(bound.check);
-      EXPECT_FALSE(Names(error, b.key))
-          << b.key << " = " << v << " is inside " << b.RangeText() << " but: " << error;
-    }
-    for (const double v : outside) {
-      Config c = Baseline();
-      const OptionTable table = ConfigTable(c);
-      const OptionBinding& bound = *table.Find(b.key);
-      bound.set_number(v);
-      const std::string error = ErrorOf(bound.check);
-      EXPECT_TRUE(Names(error, b.key))
+      return ErrorOf(bound.check);
+    };
+    for (const double v : inside)
+      EXPECT_FALSE(Names(check_at(v), b.key))
+          << b.key << " = " << v << " is inside " << b.RangeText() << " but: " << check_at(v);
+    for (const double v : outside)
+      EXPECT_TRUE(Names(check_at(v), b.key))
           << b.key << " = " << v << " is outside " << b.RangeText()
-          << " but its Check() says: " << (error.empty() ? "nothing" : error);
-    }
+          << " but its Check() says: " << check_at(v);
   }
   EXPECT_EQ(walked, 54);  // every int and double key
 }
