@@ -3,6 +3,7 @@
 // randomised k-d trees for vector ones; each candidate is then scored by its exact sequence sum
 // (SequenceCellDistance). Declared in matching/bounded.h.
 #include <algorithm>
+#include <cmath>
 
 #include "OpenABLE/base/threading.h"
 #include "matching/approximate.h"
@@ -47,7 +48,7 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
       Candidates(refs, queries, asked, checks, options.threads);
 
   auto score = [&](int q, int j, bool rev) {
-    return SequenceCellDistance(queries, q, refs, j, L, rev);
+    return SequenceCellDistance(queries, q, refs, j, L, rev, nullptr, options.partial);
   };
   std::vector<std::vector<Match>> per_query(static_cast<size_t>(block.query_count));
   ParallelFor(block.query_count, options.threads, [&](int q) {
@@ -55,14 +56,20 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
     for (const int j : cand[static_cast<size_t>(q)]) {
       if (j < 0 || j >= m) continue;
       if (block.one_traversal && j > q - rules.exclusion) continue;
-      float s = both ? std::min(score(q, j, false), score(q, j, true)) : score(q, j, reverse);
-      scored.emplace_back(s, j);
+      const float s =
+          both ? std::min(score(q, j, false), score(q, j, true)) : score(q, j, reverse);
+      if (std::isfinite(s)) scored.emplace_back(s, j);
     }
     std::sort(scored.begin(), scored.end());
+    // Ratio scores among every candidate scored (the search's, not every reference's).
+    std::vector<float> scores(std::min(scored.size(), static_cast<size_t>(k)));
+    for (size_t r = 0; r < scores.size(); ++r)
+      scores[r] = ScoreOfCandidate(scored, r, rules.score, rules.score_window);
     if (static_cast<int>(scored.size()) > k) scored.resize(static_cast<size_t>(k));
     auto& out = per_query[static_cast<size_t>(q)];
     for (size_t r = 0; r < scored.size(); ++r)
-      out.push_back({q, scored[r].second, scored[r].first, static_cast<int>(r + 1)});
+      out.push_back(
+          {q, scored[r].second, scored[r].first, static_cast<int>(r + 1), scores[r]});
   });
   std::vector<Match> kept;
   float max_seen = 0.0f;
@@ -74,6 +81,8 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
   max_distance = max_seen;
   if (max_seen > 0.0f)
     for (Match& x : kept) x.distance /= max_seen;
+  if (rules.score == MatchScore::kDistance)
+    for (Match& x : kept) x.score = x.distance;
   return kept;
 }
 

@@ -1,6 +1,7 @@
 #include "matching/bounded.h"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <queue>
 #include <stdexcept>
@@ -42,6 +43,7 @@ void KeepRow(const float* s, int references, int q, const KeepRules& rules,
   std::priority_queue<Entry> heap;
   if (rules.best > 0) {
     for (int j = 0; j < limit; ++j) {
+      if (!std::isfinite(s[j])) continue;
       const Entry e{s[j], j};
       if (static_cast<int>(heap.size()) < rules.best) {
         heap.push(e);
@@ -55,15 +57,18 @@ void KeepRow(const float* s, int references, int q, const KeepRules& rules,
   best.reserve(heap.size());
   for (; !heap.empty(); heap.pop()) best.push_back(heap.top());
   std::reverse(best.begin(), best.end());
-  std::vector<char> taken;
+  const auto score = [&](int j) {
+    return ScoreOfCandidate(s, std::max(0, limit), j, rules.score, rules.score_window);
+  };
   for (size_t r = 0; r < best.size(); ++r)
-    out.push_back({q, best[r].second, best[r].first, static_cast<int>(r + 1)});
+    out.push_back({q, best[r].second, best[r].first, static_cast<int>(r + 1),
+                   score(best[r].second)});
   if (rules.band >= 0) {
     const int j0 = std::max(0, q - rules.band), j1 = std::min(references - 1, q + rules.band);
     for (int j = j0; j <= j1; ++j) {
       const bool ranked = std::any_of(best.begin(), best.end(),
                                       [&](const Entry& e) { return e.second == j; });
-      if (!ranked) out.push_back({q, j, s[j], 0});
+      if (!ranked && std::isfinite(s[j])) out.push_back({q, j, s[j], 0, score(j)});
     }
   }
 }
@@ -85,9 +90,9 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
   const int m = block.reference_count;
   const cv::Mat references = descriptors.rowRange(block.reference_first,
                                                   block.reference_first + m);
-  const bool binary = descriptors.depth() == CV_8U;
+  const Metric metric = options.metric.value_or(MetricOfType(descriptors.type()));
   std::unique_ptr<HammingReferences> packed;
-  if (binary) packed = std::make_unique<HammingReferences>(references);
+  if (metric == Metric::kHamming) packed = std::make_unique<HammingReferences>(references);
   // Rows per tile: the tile (with its L - 1 rows of history) within tile_bytes.
   const std::int64_t row_bytes = static_cast<std::int64_t>(m) * sizeof(float);
   const int tile_rows = static_cast<int>(std::max<std::int64_t>(
@@ -100,17 +105,19 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
     const int h0 = std::max(0, r0 - (L - 1));  // history rows for the sequence sums
     const cv::Mat queries =
         descriptors.rowRange(block.query_first + h0, block.query_first + r1);
-    if (binary) {
+    if (packed) {
       packed->DistancesInto(queries, tile, options.threads);
     } else {
-      tile = L2Distances(queries, references, options.threads);
+      tile = Distances(queries, references, metric, options.threads);
     }
     // Row h0 stands for the start of the query traversal: exact when h0 is 0, and rows from
     // r0 on have all L - 1 rows of history inside the tile otherwise.
-    SequenceDistancesInPlace(tile, L, {0}, {0}, options.direction, options.threads);
+    SequenceDistancesInPlace(tile, L, {0}, {0}, options.direction, options.threads,
+                             options.partial);
     for (int r = r0; r < r1; ++r) {
       const float* s = tile.ptr<float>(r - h0);
-      max_seen = std::max(max_seen, *std::max_element(s, s + m));
+      for (int j = 0; j < m; ++j)
+        if (std::isfinite(s[j])) max_seen = std::max(max_seen, s[j]);
       KeepRow(s, m, r, rules, kept);
     }
     if (progress) progress(r1, block.query_count);
@@ -118,6 +125,8 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
   max_distance = max_seen;
   if (max_seen > 0.0f)
     for (Match& k : kept) k.distance /= max_seen;
+  if (rules.score == MatchScore::kDistance)
+    for (Match& k : kept) k.score = k.distance;
   return kept;
 }
 

@@ -15,11 +15,14 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
+#include "matching/distances.h"
+#include "matching/score.h"
 #include "matching/sequence.h"
 
 namespace openable {
@@ -29,6 +32,8 @@ struct Match {
   int reference = 0;  // frame number in the reference traversal
   float distance = 0; // normalised (M')
   int rank = 0;       // 1 = best of its query, ..., k; 0 = kept by the band only
+  float score = 0;    // KeepRules::score of this match (matching/score.h): the normalised
+                      // distance, or its ratio to the best rival outside the window
 };
 
 struct KeepRules {
@@ -36,6 +41,8 @@ struct KeepRules {
   int band = -1;          // |i - j| <= band (Band_width); -1 none
   int exclusion = 100;    // one traversal: candidates at least this many frames earlier, >= 1
   bool one_traversal = true;
+  MatchScore score = MatchScore::kDistance;  // the score of each kept match (Match_score)
+  int score_window = 10;                     // its rivals' window, frames (Match_score_window)
 
   // Throws InputError naming the key (Best_matches, Band_width, Exclusion) of a bad value.
   void Check() const;
@@ -52,6 +59,8 @@ struct MatchBlock {
 MatchBlock BlockOf(const std::vector<int>& starts, int n);
 
 // The kept matches of one row of (unnormalised) distances `s` of query q; appended to `out`.
+// Non-finite cells (skipped sequence cells) are never kept. Scores are ratios, or the raw
+// distance with MatchScore::kDistance (the callers set it to the normalised distance).
 void KeepRow(const float* s, int references, int q, const KeepRules& rules,
              std::vector<Match>& out);
 
@@ -60,14 +69,18 @@ std::vector<Match> MatchesFromMatrix(const cv::Mat1f& normalized, const MatchBlo
                                      const KeepRules& rules);
 
 struct BoundedOptions {
+  // The metric of the descriptor rows; none: by their type (Hamming for CV_8U, L2 for CV_32F).
+  std::optional<Metric> metric;
   int sequence_length = 1;
   SequenceDirection direction = SequenceDirection::kForward;
+  SequencePartial partial = SequencePartial::kScale;
   int threads = 0;
   std::int64_t tile_bytes = std::int64_t{256} << 20;
 };
 
-// Computes the block tile by tile from the descriptors (CV_8U: Hamming, CV_32F: L2) and keeps
-// the matches; `max_distance` receives the Eq. 5 divisor. progress(done rows, rows).
+// Computes the block tile by tile from the descriptors (CV_8U: Hamming or L1 as
+// options.metric says, CV_32F: L2) and keeps the matches; `max_distance` receives the Eq. 5
+// divisor. progress(done rows, rows).
 std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& block,
                                   const KeepRules& rules, const BoundedOptions& options,
                                   float& max_distance,

@@ -331,11 +331,103 @@ float L2Distance(const float* a, const float* b, int width) {
   return static_cast<float>(std::sqrt(s));
 }
 
+Metric MetricOfType(int type) {
+  return CV_MAT_DEPTH(type) == CV_8U ? Metric::kHamming : Metric::kL2;
+}
+
 float RowDistance(const cv::Mat& a, int i, const cv::Mat& b, int j) {
-  if (a.depth() == CV_8U)
-    return static_cast<float>(
-        HammingDistance(a.ptr<std::uint8_t>(i), b.ptr<std::uint8_t>(j), a.cols));
+  return RowDistance(a, i, b, j, MetricOfType(a.type()));
+}
+
+float RowDistance(const cv::Mat& a, int i, const cv::Mat& b, int j, Metric metric) {
+  switch (metric) {
+    case Metric::kHamming:
+      return static_cast<float>(
+          HammingDistance(a.ptr<std::uint8_t>(i), b.ptr<std::uint8_t>(j), a.cols));
+    case Metric::kL1:
+      return static_cast<float>(
+          AbsoluteDifferences(a.ptr<std::uint8_t>(i), b.ptr<std::uint8_t>(j), a.cols));
+    case Metric::kL2:
+      break;
+  }
   return L2Distance(a.ptr<float>(i), b.ptr<float>(j), a.cols);
+}
+
+cv::Mat1f Distances(const cv::Mat& a, const cv::Mat& b, Metric metric, int threads,
+                    const PairProgress& progress) {
+  switch (metric) {
+    case Metric::kHamming:
+      return HammingDistances(a, b, threads, progress);
+    case Metric::kL1:
+      return L1Distances(a, b, threads, progress);
+    case Metric::kL2:
+      break;
+  }
+  return L2Distances(a, b, threads, progress);
+}
+
+namespace {
+
+std::int64_t AbsoluteDifferencesPortable(const std::uint8_t* a, const std::uint8_t* b,
+                                         int bytes) {
+  std::int64_t sum = 0;
+  for (int k = 0; k < bytes; ++k) sum += a[k] > b[k] ? a[k] - b[k] : b[k] - a[k];
+  return sum;
+}
+
+// 32 bytes a step with PSADBW (sums of absolute byte differences into four 64-bit lanes).
+__attribute__((target("avx2"))) std::int64_t AbsoluteDifferencesAvx2(const std::uint8_t* a,
+                                                                     const std::uint8_t* b,
+                                                                     int bytes) {
+  __m256i acc = _mm256_setzero_si256();
+  int k = 0;
+  for (; k + 32 <= bytes; k += 32) {
+    const __m256i x = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(a + k));
+    const __m256i y = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b + k));
+    acc = _mm256_add_epi64(acc, _mm256_sad_epu8(x, y));
+  }
+  alignas(32) std::uint64_t lanes[4];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(lanes), acc);
+  return static_cast<std::int64_t>(lanes[0] + lanes[1] + lanes[2] + lanes[3]) +
+         AbsoluteDifferencesPortable(a + k, b + k, bytes - k);
+}
+
+}  // namespace
+
+std::int64_t AbsoluteDifferences(const std::uint8_t* a, const std::uint8_t* b, int bytes) {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2 ? AbsoluteDifferencesAvx2(a, b, bytes) : AbsoluteDifferencesPortable(a, b, bytes);
+}
+
+cv::Mat1f L1Distances(const cv::Mat& a, const cv::Mat& b, int threads,
+                      const PairProgress& progress) {
+  CheckInputs(a, b, CV_8U, "L1Distances");
+  const cv::Mat& refs = b.empty() ? a : b;
+  const int n = a.rows, m = refs.rows, w = a.cols;
+  cv::Mat1f out = LargeMatrix(n, m);
+  if (n == 0 || m == 0) return out;
+  // Tasks of 16 query rows, each running over slices of references that stay in cache.
+  constexpr int kRowsPerTask = 16;
+  const int slice = std::max(16, (256 << 10) / std::max(1, w));
+  const int tasks = (n + kRowsPerTask - 1) / kRowsPerTask;
+  auto pairs_of_task = [&](int t) -> std::int64_t {
+    return static_cast<std::int64_t>(std::min(kRowsPerTask, n - t * kRowsPerTask)) * m;
+  };
+  ParallelRows(tasks, threads, progress, pairs_of_task, static_cast<std::int64_t>(n) * m,
+               [&](int t) {
+                 const int r0 = t * kRowsPerTask, r1 = std::min(n, r0 + kRowsPerTask);
+                 for (int j0 = 0; j0 < m; j0 += slice) {
+                   const int j1 = std::min(m, j0 + slice);
+                   for (int r = r0; r < r1; ++r) {
+                     const std::uint8_t* q = a.ptr<std::uint8_t>(r);
+                     float* o = out.ptr<float>(r);
+                     for (int j = j0; j < j1; ++j)
+                       o[j] = static_cast<float>(
+                           AbsoluteDifferences(q, refs.ptr<std::uint8_t>(j), w));
+                   }
+                 }
+               });
+  return out;
 }
 
 cv::Mat1f HammingDistances(const cv::Mat& a, const cv::Mat& b, int threads,

@@ -9,7 +9,17 @@
 
 #include <opencv2/core.hpp>
 
+#include "OpenABLE/base/enum_names.h"
+
 namespace openable {
+
+// The distance of a kind of descriptor rows: Hamming (binary rows, CV_8U), L2 (vector rows,
+// CV_32F), or L1, the sum of absolute differences of byte rows (CV_8U; SeqSLAM's SAD).
+enum class Metric { kHamming, kL2, kL1 };
+OPENABLE_ENUM_NAMES(Metric, "hamming", "l2", "l1")
+
+// The metric rows of `type` have when none is said: Hamming for CV_8U, L2 for CV_32F.
+Metric MetricOfType(int type);
 
 // Called now and then with (cells done, cells in all) of the matrix computed; may be empty. Called
 // from one thread at a time.
@@ -18,15 +28,29 @@ using PairProgress = std::function<void(std::int64_t done, std::int64_t total)>;
 // Number of bits that differ between the byte strings a and b of `bytes` bytes.
 int HammingDistance(const std::uint8_t* a, const std::uint8_t* b, int bytes);
 
+// Sum of the absolute differences of the bytes of a and b (AVX2 PSADBW when the CPU has it).
+std::int64_t AbsoluteDifferences(const std::uint8_t* a, const std::uint8_t* b, int bytes);
+
+// L1 distances (sums of absolute byte differences) between every row of `a` (N x W, CV_8U)
+// and every row of `b` (M x W, CV_8U); b empty means b = a. As HammingDistances otherwise.
+cv::Mat1f L1Distances(const cv::Mat& a, const cv::Mat& b = cv::Mat(), int threads = 0,
+                      const PairProgress& progress = {});
+
 // Euclidean distance between two rows of `width` floats, with the differences and their squares
 // summed in double precision and rounded once to float: the exact distance of a pair.
 float L2Distance(const float* a, const float* b, int width);
 
 // The distance of one pair of rows: row i of `a` and row j of `b` (same type and width):
-// HammingDistance for CV_8U rows, L2Distance for CV_32F rows. Every distance of single pairs
-// (candidates rescored after an approximate search, sequence cells computed one by one)
-// comes from here; the matrices below agree with it (L2: within float rounding).
+// HammingDistance for CV_8U rows, L2Distance for CV_32F rows (or `metric`). Every distance of
+// single pairs (candidates rescored after an approximate search, sequence cells computed one
+// by one) comes from here; the matrices below agree with it (L2: within float rounding).
 float RowDistance(const cv::Mat& a, int i, const cv::Mat& b, int j);
+float RowDistance(const cv::Mat& a, int i, const cv::Mat& b, int j, Metric metric);
+
+// The matrix of `metric` between the rows of `a` and `b` (HammingDistances, L2Distances or
+// L1Distances).
+cv::Mat1f Distances(const cv::Mat& a, const cv::Mat& b, Metric metric, int threads = 0,
+                    const PairProgress& progress = {});
 
 // Distances between every row of `a` (N x W, CV_8U) and every row of `b` (M x W, CV_8U):
 // an N x M matrix of bit counts, stored as float. When `b` is empty, b = a and the result

@@ -1,5 +1,9 @@
 #include "matching/matrix.h"
 
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/option_checks.h"
 #include "OpenABLE/base/strings.h"
@@ -13,23 +17,59 @@ void MatchingOptions::Check() const {
     throw InputError("Threshold: " + FormatNumber(threshold) +
                      " is not valid; expected -1 (disabled) or a number in [0, 1]");
   CheckIntRange("Threads", threads, 0, 1024);
+  CheckIntRange("Match_score_window", score_window, 0, 100000);
+  if (match_threshold != -1.0 && !(match_threshold >= 0.0 && match_threshold <= 1.0))
+    throw InputError("Match_threshold: " + FormatNumber(match_threshold) +
+                     " is not valid; expected -1 (none) or a number in [0, 1]");
+  CheckIntRange("Contrast_window", contrast_window, 1, 100000);
+  if (!fusion_weights.empty()) FusionWeights(-1);
+}
+
+std::vector<double> MatchingOptions::FusionWeights(int descriptors) const {
+  const auto fail = [&](const std::string& why) {
+    throw InputError("Fusion_weights: " + Quoted(fusion_weights) + " is not valid (" + why +
+                     "); expected one weight > 0 per fused descriptor, comma-separated, e.g. "
+                     "\"1,0.5\"");
+  };
+  if (fusion_weights.empty()) return std::vector<double>(std::max(descriptors, 0), 1.0);
+  std::vector<double> weights;
+  std::stringstream ss(fusion_weights);
+  for (std::string item; std::getline(ss, item, ',');) {
+    item = Trim(item);
+    char* end = nullptr;
+    const double w = std::strtod(item.c_str(), &end);
+    if (item.empty() || end != item.c_str() + item.size()) fail(Quoted(item) + " is not a number");
+    if (!(w > 0) || !std::isfinite(w)) fail(item + " is not > 0");
+    weights.push_back(w);
+  }
+  if (fusion_weights.back() == ',') fail("empty item");
+  if (descriptors >= 0 && static_cast<int>(weights.size()) != descriptors)
+    fail(std::to_string(weights.size()) + " weights for " + std::to_string(descriptors) +
+         " descriptors");
+  return weights;
+}
+
+cv::Mat1f PairwiseDistances(const cv::Mat& rows, Metric metric, int strips,
+                            PanoramaMatching mode, int threads, const PairProgress& progress) {
+  if (strips > 1) return PanoramaDistances(rows, strips, mode, threads, progress, metric);
+  return Distances(rows, cv::Mat(), metric, threads, progress);
 }
 
 cv::Mat1f PairwiseDistances(const cv::Mat& rows, int strips, PanoramaMatching mode, int threads,
                             const PairProgress& progress) {
-  if (strips > 1) return PanoramaDistances(rows, strips, mode, threads, progress);
-  return rows.depth() == CV_8U ? HammingDistances(rows, cv::Mat(), threads, progress)
-                               : L2Distances(rows, cv::Mat(), threads, progress);
+  return PairwiseDistances(rows, MetricOfType(rows.type()), strips, mode, threads, progress);
 }
 
 cv::Mat1f NormalizedDistanceMatrix(const cv::Mat& rows, int sequence_length,
                                    SequenceDirection direction,
                                    const std::vector<int>& traversal_starts, int threads,
-                                   float* max_distance) {
-  cv::Mat1f d = PairwiseDistances(rows, 1, PanoramaMatching::kAligned, threads);
+                                   float* max_distance, std::optional<Metric> metric,
+                                   SequencePartial partial) {
+  cv::Mat1f d = PairwiseDistances(rows, metric.value_or(MetricOfType(rows.type())), 1,
+                                  PanoramaMatching::kAligned, threads);
   if (sequence_length > 1 || direction != SequenceDirection::kForward)
     SequenceDistancesInPlace(d, sequence_length, traversal_starts, traversal_starts, direction,
-                             threads);
+                             threads, partial);
   const float m = NormalizeByMax(d);
   if (max_distance != nullptr) *max_distance = m;
   return d;

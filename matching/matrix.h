@@ -2,12 +2,15 @@
 // compared (Hamming, L2 or the sub-panorama comparison), sequences summed, Eq. 5 applied.
 #pragma once
 
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "matching/distances.h"
 #include "matching/panorama.h"
+#include "matching/score.h"
 #include "matching/sequence.h"
 
 namespace openable {
@@ -17,26 +20,50 @@ namespace openable {
 struct MatchingOptions {
   int sequence_length = 1;  // L: single-frame distances summed along a diagonal, 1..100000
   SequenceDirection direction = SequenceDirection::kForward;  // diagonals, anti-diagonals, both
+  SequencePartial partial = SequencePartial::kScale;  // cells with fewer than L terms
   PanoramaMatching panorama_matching = PanoramaMatching::kCrossCorrelation;  // panoramic frames
   double threshold = -1.0;  // theta of Eq. 9: -1 (no thresholded matrix) or a number in [0, 1]
   int threads = 0;          // worker threads for description and matching, 0..1024, 0 = all
+  // The confidence of a best match (matching/score.h) and its rivals' window, frames (>= 0).
+  MatchScore score = MatchScore::kDistance;
+  int score_window = 10;
+  // A query's best match is accepted when its score is <= this; -1: no threshold (in [0, 1]).
+  double match_threshold = -1.0;
+  // SeqSLAM's local contrast enhancement of the single-frame matrix (contrast.h), over
+  // +-contrast_window references (1..100000).
+  bool contrast_enhancement = false;
+  int contrast_window = 10;
+  // Several descriptors fused (Image_descriptor "HOG+LDB"): the weight of each normalised
+  // single-frame matrix, comma-separated, in the order of the names; empty: equal weights.
+  std::string fusion_weights;
 
+  // The weights of `descriptors` fused descriptors (FusionWeights): equal weights when
+  // fusion_weights is empty. Throws InputError naming Fusion_weights when they do not parse,
+  // are not positive, or are not one per descriptor.
+  std::vector<double> FusionWeights(int descriptors) const;
   // Throws InputError naming the key of a value out of range.
   void Check() const;
 };
 
-// Every row of `rows` against every row: HammingDistances for CV_8U rows, L2Distances for
-// CV_32F rows, or, with strips > 1 (panoramic frames), PanoramaDistances with `mode`.
+// Every row of `rows` against every row with `metric` (Distances), or, with strips > 1
+// (panoramic frames), PanoramaDistances with `mode`.
+cv::Mat1f PairwiseDistances(const cv::Mat& rows, Metric metric, int strips = 1,
+                            PanoramaMatching mode = PanoramaMatching::kAligned, int threads = 0,
+                            const PairProgress& progress = {});
+// The same with the metric of the rows' type (Hamming for CV_8U, L2 for CV_32F).
 cv::Mat1f PairwiseDistances(const cv::Mat& rows, int strips = 1,
                             PanoramaMatching mode = PanoramaMatching::kAligned, int threads = 0,
                             const PairProgress& progress = {});
 
-// M' of Eq. 5 of a single-camera run: PairwiseDistances, the sequence sums of sequence.h over
+// M' of Eq. 5 of a single-camera run: PairwiseDistances (with `metric`, or the rows' type's),
+// the sequence sums of sequence.h over
 // the traversals that start at `traversal_starts` (when L > 1 or not forward), divided by
 // their largest value. `max_distance` receives that divisor when given.
 cv::Mat1f NormalizedDistanceMatrix(const cv::Mat& rows, int sequence_length,
                                    SequenceDirection direction,
                                    const std::vector<int>& traversal_starts, int threads,
-                                   float* max_distance = nullptr);
+                                   float* max_distance = nullptr,
+                                   std::optional<Metric> metric = {},
+                                   SequencePartial partial = SequencePartial::kScale);
 
 }  // namespace openable

@@ -22,15 +22,15 @@ float NormalizeByMax(cv::Mat1f& m) {
     for (int i = r.start; i < r.end; ++i) {
       const float* p = m.ptr<float>(i);
       for (int j = 0; j < m.cols; ++j) {
-        ok &= p[j] >= 0.0f && p[j] <= std::numeric_limits<float>::max();  // false for NaN
-        local = std::max(local, p[j]);
+        ok &= p[j] >= 0.0f;  // false for NaN; +inf (a skipped sequence cell) is allowed
+        if (p[j] <= std::numeric_limits<float>::max()) local = std::max(local, p[j]);
       }
     }
     std::lock_guard<std::mutex> lock(mutex);
     valid &= ok;
     max_value = std::max(max_value, local);
   });
-  if (!valid) throw std::logic_error("NormalizeByMax: negative or non-finite distance");
+  if (!valid) throw std::logic_error("NormalizeByMax: negative or NaN distance");
   if (max_value > 0.0f) {
     cv::parallel_for_(cv::Range(0, m.rows), [&](const cv::Range& r) {
       for (int i = r.start; i < r.end; ++i) {

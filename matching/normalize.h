@@ -5,8 +5,10 @@
 
 namespace openable {
 
-// Eq. 5: M' = M / max(M). Returns max(M). A matrix whose maximum is 0 (every frame identical)
-// is left at 0. Throws std::logic_error on a negative or non-finite entry.
+// Eq. 5: M' = M / max(M). Returns max(M), the largest finite entry. A matrix whose maximum is 0
+// (every frame identical) is left at 0. +inf entries (sequence cells skipped at the start of a
+// traversal, matching/sequence.h) stay +inf. Throws std::logic_error on a negative or NaN
+// entry.
 float NormalizeByMax(cv::Mat1f& m);
 
 // Eq. 9: M'' = 0 where M' < theta, 1 otherwise. 0 marks a loop candidate (a small distance).

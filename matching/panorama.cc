@@ -19,16 +19,17 @@ void MinInto(cv::Mat1f& out, const cv::Mat1f& d) {
 }  // namespace
 
 cv::Mat1f PanoramaDistances(const cv::Mat& rows, int strips, PanoramaMatching mode, int threads,
-                            const PairProgress& progress) {
+                            const PairProgress& progress, std::optional<Metric> metric_given) {
   if (strips < 1)
     throw std::invalid_argument("PanoramaDistances: " + std::to_string(strips) +
                                 " strips; expected >= 1");
   if (rows.cols % strips != 0)
     throw std::invalid_argument("PanoramaDistances: row width " + std::to_string(rows.cols) +
                                 " is not a multiple of " + std::to_string(strips) + " strips");
-  const bool binary = rows.depth() == CV_8U;
+  const Metric metric = metric_given.value_or(MetricOfType(rows.type()));
+  const bool squared = metric == Metric::kL2;  // Euclidean strips add up as squares
   auto distances = [&](const cv::Mat& a, const cv::Mat& b, const PairProgress& p) {
-    return binary ? HammingDistances(a, b, threads, p) : L2Distances(a, b, threads, p);
+    return Distances(a, b, metric, threads, p);
   };
   if (mode == PanoramaMatching::kAligned || strips == 1)
     return distances(rows, cv::Mat(), progress);
@@ -72,14 +73,14 @@ cv::Mat1f PanoramaDistances(const cv::Mat& rows, int strips, PanoramaMatching mo
   for (int s = 0; s < strips; ++s) {
     for (int k = 0; k < strips; ++k) {
       cv::Mat1f d = strip_pair(k, (k + s) % strips);
-      if (!binary) cv::multiply(d, d, d);  // L2: squared strip distances add up
+      if (squared) cv::multiply(d, d, d);  // L2: squared strip distances add up
       if (k == 0) {
         d.copyTo(sum);
       } else {
         sum += d;
       }
     }
-    if (!binary) cv::sqrt(sum, sum);
+    if (squared) cv::sqrt(sum, sum);
     if (s == 0) {
       sum.copyTo(out);
     } else {

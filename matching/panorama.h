@@ -22,6 +22,8 @@
 // single-strip distance matrices; the aligned variant costs one.
 #pragma once
 
+#include <optional>
+
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/base/enum_names.h"
@@ -34,10 +36,12 @@ enum class PanoramaMatching { kAligned = 0, kCrossCorrelation = 1, kCircular = 2
 OPENABLE_ENUM_NAMES(PanoramaMatching, "aligned", "cross-correlation", "circular")
 
 // The N x N distance matrix of the rows of `rows` (N x (n * w): CV_8U compared with Hamming,
-// CV_32F with L2), each row made of `strips` = n descriptors of w elements. `threads` as in
+// CV_32F with L2, unless `metric` says otherwise), each row made of `strips` = n descriptors of
+// w elements. `threads` as in
 // distances.h (0 = all cores); `progress` counts single-strip matrices (cells). Throws
 // std::invalid_argument when strips < 1 or the row width is not a multiple of strips.
 cv::Mat1f PanoramaDistances(const cv::Mat& rows, int strips, PanoramaMatching mode,
-                            int threads = 0, const PairProgress& progress = {});
+                            int threads = 0, const PairProgress& progress = {},
+                            std::optional<Metric> metric = std::nullopt);
 
 }  // namespace openable

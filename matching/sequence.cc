@@ -66,7 +66,7 @@ class SpinBarrier {
 // One direction, in place. step = +1: diagonals (predecessor (i-1, j-1)); -1: anti-diagonals
 // (predecessor (i-1, j+1)).
 void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, bool reverse,
-           int threads) {
+           int threads, SequencePartial partial) {
   const int n = d.rows, m = d.cols;
   // ring[r % R] holds row r of D once row r has been overwritten by S. Row i - L is read only
   // when L < n, so R = min(L, n) + 1 slots suffice (and i - L sits in slot (i + 1) % R).
@@ -95,7 +95,7 @@ void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, 
           if (t >= L) w -= old[reverse ? j + L : j - L];
         }
         cur[static_cast<size_t>(j)] = w;
-        row[j] = ScaleSequenceSum(w, SequenceTerms(L, t), L);
+        row[j] = ScaleSequenceSum(w, SequenceTerms(L, t), L, partial);
       }
       barrier.Wait();  // every column of row i done before anyone reads it as row i - 1
       if (c0 == 0) std::swap(prev, cur);
@@ -113,7 +113,7 @@ void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, 
 void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length,
                               const std::vector<int>& row_starts,
                               const std::vector<int>& col_starts, SequenceDirection direction,
-                              int threads) {
+                              int threads, SequencePartial partial) {
   if (sequence_length < 1) throw std::logic_error("SequenceDistances: sequence length < 1");
   const Traversals rows = Bounds(row_starts, d.rows, "row");
   const Traversals cols = Bounds(col_starts, d.cols, "column");
@@ -122,26 +122,29 @@ void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length,
   if (direction == SequenceDirection::kBoth) {
     cv::Mat1f reverse = LargeMatrix(d.rows, d.cols);
     d.copyTo(reverse);
-    Sweep(d, sequence_length, rows, cols, false, threads);
-    Sweep(reverse, sequence_length, rows, cols, true, threads);
+    Sweep(d, sequence_length, rows, cols, false, threads, partial);
+    Sweep(reverse, sequence_length, rows, cols, true, threads, partial);
     cv::min(cv::InputArray(d), cv::InputArray(reverse), cv::OutputArray(d));
     return;
   }
-  Sweep(d, sequence_length, rows, cols, direction == SequenceDirection::kReverse, threads);
+  Sweep(d, sequence_length, rows, cols, direction == SequenceDirection::kReverse, threads,
+        partial);
 }
 
 cv::Mat1f SequenceDistances(const cv::Mat1f& d, int sequence_length,
                             const std::vector<int>& row_starts,
                             const std::vector<int>& col_starts, SequenceDirection direction,
-                            int threads) {
+                            int threads, SequencePartial partial) {
   cv::Mat1f out = LargeMatrix(d.rows, d.cols);
   d.copyTo(out);
-  SequenceDistancesInPlace(out, sequence_length, row_starts, col_starts, direction, threads);
+  SequenceDistancesInPlace(out, sequence_length, row_starts, col_starts, direction, threads,
+                           partial);
   return out;
 }
 
 float SequenceCellDistance(const cv::Mat& queries, int q, const cv::Mat& references, int j,
-                           int sequence_length, bool reverse, double* largest_term) {
+                           int sequence_length, bool reverse, double* largest_term,
+                           SequencePartial partial) {
   const int steps_back = std::min(q, reverse ? references.rows - 1 - j : j);
   const int terms = SequenceTerms(sequence_length, steps_back);
   double sum = 0;
@@ -150,7 +153,7 @@ float SequenceCellDistance(const cv::Mat& queries, int q, const cv::Mat& referen
     if (largest_term != nullptr && d > *largest_term) *largest_term = d;
     sum += d;
   }
-  return ScaleSequenceSum(sum, terms, sequence_length);
+  return ScaleSequenceSum(sum, terms, sequence_length, partial);
 }
 
 }  // namespace openable

@@ -12,10 +12,12 @@
 // a reference route). A sum never crosses from one traversal into another: the terms that
 // would leave the traversal of i, or of j, do not exist.
 //
-// Early frames: where only c < L terms exist (the first L - 1 frames of a traversal), the sum
-// of the c terms is scaled by L / c, i.e. the mean distance along the available part of the
-// diagonal times L. Leaving the short sums unscaled would make early frames look similar to
-// everything.
+// Early frames: where only c < L terms exist (the first L - 1 frames of a traversal; for
+// anti-diagonals, also the last L - 1 frames of the reference traversal), SequencePartial says
+// what the cell holds: kScale (the default) scales the sum of the c terms by L / c, i.e. the
+// mean distance along the available part of the diagonal times L (leaving the short sums
+// unscaled would make early frames look similar to everything); kSkip, the rule of
+// OpenSeqSLAM, makes the cell +inf: it is no candidate at all (docs/matching.md).
 //
 // Cost: one pass over the matrix whatever L is. Row i is obtained from row i - 1 by the running
 // sum S(i, j) = S(i - 1, j -+ 1) + D(i, j) - D(i - L, j -+ L), kept in double precision, with
@@ -23,6 +25,7 @@
 // split between threads, which meet once per row.
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -34,6 +37,10 @@ namespace openable {
 enum class SequenceDirection { kForward = 0, kReverse = 1, kBoth = 2 };  // kBoth: min of the two
 OPENABLE_ENUM_NAMES(SequenceDirection, "forward", "reverse", "both")
 
+// A cell with fewer than L terms (see above): scaled up to L terms, or skipped (+inf).
+enum class SequencePartial { kScale, kSkip };
+OPENABLE_ENUM_NAMES(SequencePartial, "scale", "skip")
+
 // The terms of S(i, j) that exist: min(L, t + 1), t being the steps the diagonal can go back
 // from (i, j) without leaving the traversal of i or that of j.
 inline int SequenceTerms(int sequence_length, int steps_back) {
@@ -41,10 +48,13 @@ inline int SequenceTerms(int sequence_length, int steps_back) {
 }
 
 // The sum of `terms` single-frame distances scaled to L terms (L / terms, when terms < L) and
-// rounded to float: how every sequence distance is finished, in the matrix sweep below and in
-// SequenceCellDistance.
-inline float ScaleSequenceSum(double sum, int terms, int sequence_length) {
-  return static_cast<float>(terms == sequence_length ? sum : sum * sequence_length / terms);
+// rounded to float, or +inf for a partial sum with kSkip: how every sequence distance is
+// finished, in the matrix sweep below and in SequenceCellDistance.
+inline float ScaleSequenceSum(double sum, int terms, int sequence_length,
+                              SequencePartial partial = SequencePartial::kScale) {
+  if (terms == sequence_length) return static_cast<float>(sum);
+  if (partial == SequencePartial::kSkip) return std::numeric_limits<float>::infinity();
+  return static_cast<float>(sum * sequence_length / terms);
 }
 
 // S(q, j) of one cell, straight from descriptor rows, for searches that score a few cells
@@ -56,7 +66,8 @@ inline float ScaleSequenceSum(double sum, int terms, int sequence_length) {
 // Hamming rows). `largest_term`, when given, is raised to the largest single-frame distance
 // summed.
 float SequenceCellDistance(const cv::Mat& queries, int q, const cv::Mat& references, int j,
-                           int sequence_length, bool reverse, double* largest_term = nullptr);
+                           int sequence_length, bool reverse, double* largest_term = nullptr,
+                           SequencePartial partial = SequencePartial::kScale);
 
 // D: N x M single-frame distances (rows: frames i, columns: frames j), replaced by S.
 // `row_starts` and `col_starts` are the first frame of each traversal along the rows and the
@@ -67,13 +78,15 @@ void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length,
                               const std::vector<int>& row_starts = {},
                               const std::vector<int>& col_starts = {},
                               SequenceDirection direction = SequenceDirection::kForward,
-                              int threads = 0);
+                              int threads = 0,
+                              SequencePartial partial = SequencePartial::kScale);
 
 // The same, returning S in a new matrix and leaving D as it is.
 cv::Mat1f SequenceDistances(const cv::Mat1f& d, int sequence_length,
                             const std::vector<int>& row_starts = {},
                             const std::vector<int>& col_starts = {},
                             SequenceDirection direction = SequenceDirection::kForward,
-                            int threads = 0);
+                            int threads = 0,
+                            SequencePartial partial = SequencePartial::kScale);
 
 }  // namespace openable

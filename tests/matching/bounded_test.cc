@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <cstring>
 #include <numeric>
 #include <random>
@@ -152,6 +154,67 @@ TEST(ApproximateMatches, FindsPlantedDuplicatesWithExactScores) {
     if (m.rank == 1 && m.reference == m.query) ++found;
   }
   EXPECT_GE(found, 0.95 * n);
+}
+
+
+// Sequence_partial skip, the ratio score and the L1 distance of SAD rows: the tiled run against
+// the dense matrix of the tested pieces, selected and scored by brute force (empty cells never
+// kept; the ratio of a kept match over the best finite candidate more than the window away).
+TEST(BoundedMatches, SkipCellsAndRatioScoresEqualBruteForce) {
+  const cv::Mat d = RandomBinary(120, 64, 9);
+  for (int traversals : {1, 2}) {
+    const std::vector<int> starts =
+        traversals == 1 ? std::vector<int>{0} : std::vector<int>{0, 50};
+    const MatchBlock block = BlockOf(starts, d.rows);
+    KeepRules rules;
+    rules.best = 3;
+    rules.exclusion = 10;
+    rules.one_traversal = block.one_traversal;
+    rules.score = MatchScore::kRatio;
+    rules.score_window = 4;
+    for (auto dir : {SequenceDirection::kForward, SequenceDirection::kReverse}) {
+      const int L = 6;
+      SCOPED_TRACE("traversals " + std::to_string(traversals));
+      cv::Mat1f full = L1Distances(d);
+      SequenceDistancesInPlace(full, L, starts, starts, dir, 0, SequencePartial::kSkip);
+      float block_max = 0;
+      std::vector<Match> expected;
+      for (int q = 0; q < block.query_count; ++q) {
+        const int row = block.query_first + q;
+        std::vector<std::pair<float, int>> all;
+        for (int j = 0; j < block.reference_count; ++j) {
+          const float v = full(row, block.reference_first + j);
+          if (!std::isfinite(v)) continue;
+          block_max = std::max(block_max, v);
+          if (!rules.one_traversal || j <= q - rules.exclusion) all.emplace_back(v, j);
+        }
+        std::sort(all.begin(), all.end());
+        for (int r = 0; r < std::min<int>(rules.best, static_cast<int>(all.size())); ++r) {
+          float rival = std::numeric_limits<float>::infinity();
+          for (const auto& [v, j] : all)
+            if (std::abs(j - all[r].second) > rules.score_window) rival = std::min(rival, v);
+          const float ratio =
+              std::isfinite(rival) && rival > 0 ? all[r].first / rival : 1.0f;
+          expected.push_back({q, all[r].second, all[r].first, r + 1, ratio});
+        }
+      }
+      BoundedOptions options;
+      options.metric = Metric::kL1;
+      options.sequence_length = L;
+      options.direction = dir;
+      options.partial = SequencePartial::kSkip;
+      options.tile_bytes = 7 * block.reference_count * 4;
+      float max_distance = 0;
+      const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
+      EXPECT_FLOAT_EQ(max_distance, block_max);
+      ExpectSame(got, expected, 1.0f / block_max);
+      for (size_t k = 0; k < got.size() && k < expected.size(); ++k)
+        EXPECT_NEAR(got[k].score, expected[k].score, 1e-5) << k;
+      // The first L - 1 queries of a traversal have no complete sequence along diagonals.
+      if (dir == SequenceDirection::kForward && traversals == 2)
+        for (const Match& m : got) EXPECT_GE(m.query, L - 1);
+    }
+  }
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <bitset>
 #include <cmath>
+#include <cstdlib>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -132,6 +133,52 @@ TEST(L2Distances, HandWorkedValues) {
   const cv::Mat1f cross = L2Distances(a, b);
   EXPECT_FLOAT_EQ(cross(0, 0), 10.f);
   EXPECT_FLOAT_EQ(cross(1, 0), 5.f);
+}
+
+
+// --- L1 (SAD rows) ---------------------------------------------------------------------------
+
+// Widths around the 32-byte step of the AVX2 kernel, and one that overflows 16-bit sums.
+TEST(L1Distances, MatchesDirectSumOfAbsoluteDifferences) {
+  std::mt19937 rng(12);
+  std::uniform_int_distribution<int> byte(0, 255);
+  for (const int w : {1, 31, 32, 33, 64, 100, 2048}) {
+    cv::Mat a(9, w, CV_8U), b(7, w, CV_8U);
+    for (int i = 0; i < a.rows; ++i)
+      for (int k = 0; k < w; ++k) a.at<std::uint8_t>(i, k) = static_cast<std::uint8_t>(byte(rng));
+    for (int i = 0; i < b.rows; ++i)
+      for (int k = 0; k < w; ++k) b.at<std::uint8_t>(i, k) = static_cast<std::uint8_t>(byte(rng));
+    a.row(0).setTo(0);
+    b.row(0).setTo(255);  // the largest difference of every byte
+    for (int threads : {1, 2}) {
+      const cv::Mat1f cross = L1Distances(a, b, threads);
+      ASSERT_EQ(cross.size(), cv::Size(b.rows, a.rows));
+      for (int i = 0; i < a.rows; ++i)
+        for (int j = 0; j < b.rows; ++j) {
+          long long direct = 0;
+          for (int k = 0; k < w; ++k)
+            direct += std::abs(int(a.at<std::uint8_t>(i, k)) - int(b.at<std::uint8_t>(j, k)));
+          ASSERT_EQ(cross(i, j), static_cast<float>(direct)) << "w=" << w << " " << i << "," << j;
+          ASSERT_EQ(RowDistance(a, i, b, j, Metric::kL1), static_cast<float>(direct));
+        }
+      EXPECT_EQ(cross(0, 0), 255.f * w);
+      const cv::Mat1f self = L1Distances(a, cv::Mat(), threads);
+      for (int i = 0; i < a.rows; ++i) {
+        EXPECT_EQ(self(i, i), 0.f);
+        for (int j = 0; j < a.rows; ++j) EXPECT_EQ(self(i, j), self(j, i));
+      }
+    }
+  }
+}
+
+TEST(L1Distances, DistancesPicksTheMetricAndRefusesFloatRows) {
+  const cv::Mat a = (cv::Mat_<std::uint8_t>(2, 2) << 0, 10, 3, 1);
+  // L1: |0-3| + |10-1| = 12; Hamming: popcount(0^3) + popcount(10^1) = 2 + 3 = 5.
+  EXPECT_EQ(Distances(a, cv::Mat(), Metric::kL1)(0, 1), 12.f);
+  EXPECT_EQ(Distances(a, cv::Mat(), Metric::kHamming)(0, 1), 5.f);
+  EXPECT_EQ(MetricOfType(CV_8U), Metric::kHamming);
+  EXPECT_EQ(MetricOfType(CV_32F), Metric::kL2);
+  EXPECT_THROW(L1Distances(cv::Mat1f(2, 2, 0.f)), std::logic_error);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "matching/sequence.h"
 
 #include <algorithm>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -24,7 +25,7 @@ int EndOf(const std::vector<int>& starts, int x, int n) {
 // Naive definition: sum over k of the terms that exist, scaled to L terms. reverse: the
 // column runs forward (j + k) while the row runs back (i - k).
 cv::Mat1f NaiveSequence(const cv::Mat1f& d, int L, const std::vector<int>& rs,
-                        const std::vector<int>& cs, bool reverse = false) {
+                        const std::vector<int>& cs, bool reverse = false, bool skip = false) {
   cv::Mat1f out(d.size());
   for (int i = 0; i < d.rows; ++i)
     for (int j = 0; j < d.cols; ++j) {
@@ -36,7 +37,8 @@ cv::Mat1f NaiveSequence(const cv::Mat1f& d, int L, const std::vector<int>& rs,
         sum += d(i - k, jk);
         ++count;
       }
-      out(i, j) = static_cast<float>(sum * L / count);
+      out(i, j) = skip && count < L ? std::numeric_limits<float>::infinity()
+                                    : static_cast<float>(sum * L / count);
     }
   return out;
 }
@@ -113,6 +115,44 @@ TEST(SequenceDistances, ReverseAndBothMatchNaiveLoops) {
                          both, cv::NORM_INF),
                 1e-3)
           << "L=" << L << " t=" << threads;
+    }
+  }
+}
+
+// Sequence_partial skip: a cell with fewer than L terms holds +inf, and only those; along
+// diagonals, anti-diagonals (which run off the end of the reference traversal) and both, with
+// two traversals along rows and three along columns, on 1-3 threads.
+TEST(SequenceDistances, SkipLeavesExactlyTheIncompleteCellsEmpty) {
+  const cv::Mat1f d = Random(45, 300, 11);
+  const std::vector<int> rows = {0, 20}, cols = {0, 120, 250};
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int L : {1, 3, 10, 25, 400}) {
+    const cv::Mat1f fwd = NaiveSequence(d, L, rows, cols, false, true);
+    const cv::Mat1f rev = NaiveSequence(d, L, rows, cols, true, true);
+    for (int threads : {1, 2, 3}) {
+      const auto got = [&](SequenceDirection dir) {
+        return SequenceDistances(d, L, rows, cols, dir, threads, SequencePartial::kSkip);
+      };
+      const cv::Mat1f f = got(SequenceDirection::kForward), r = got(SequenceDirection::kReverse),
+                      b = got(SequenceDirection::kBoth);
+      for (int i = 0; i < d.rows; ++i)
+        for (int j = 0; j < d.cols; ++j) {
+          ASSERT_EQ(f(i, j) == inf, fwd(i, j) == inf) << "L=" << L << " at " << i << "," << j;
+          ASSERT_EQ(r(i, j) == inf, rev(i, j) == inf) << "L=" << L << " at " << i << "," << j;
+          const float both = std::min(fwd(i, j), rev(i, j));
+          ASSERT_EQ(b(i, j) == inf, both == inf) << "L=" << L << " at " << i << "," << j;
+          if (fwd(i, j) != inf) ASSERT_NEAR(f(i, j), fwd(i, j), 1e-3);
+          if (rev(i, j) != inf) ASSERT_NEAR(r(i, j), rev(i, j), 1e-3);
+          if (both != inf) ASSERT_NEAR(b(i, j), both, 1e-3);
+        }
+      // Hand check: the first L - 1 rows of each row traversal are empty along diagonals.
+      if (L > 1 && L <= 20) {
+        EXPECT_EQ(f(L - 2, 200), inf);
+        EXPECT_EQ(f(20 + L - 2, 200), inf);
+        EXPECT_NE(f(L - 1, 200), inf);
+        EXPECT_EQ(r(L - 1, 119), inf);  // the anti-diagonal runs off reference 0-119
+        EXPECT_NE(r(L - 1, 120 - L), inf);
+      }
     }
   }
 }
