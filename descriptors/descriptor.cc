@@ -24,6 +24,10 @@ void DescriptorOptions::Check() const {
     throw InputError("Ldb_bits: " + std::to_string(ldb_bits) +
                      " is out of range; expected an integer in [1, 1386]");
   }
+  if (sad_patch < 2 || sad_patch > 64) {
+    throw InputError("Sad_patch: " + std::to_string(sad_patch) +
+                     " is out of range; expected an integer in [2, 64]");
+  }
 }
 
 Descriptor::Descriptor(const DescriptorOptions& options) : patch_size_(options.patch_size) {
@@ -41,7 +45,7 @@ void Descriptor::CheckPatch(const cv::Mat& patch) const {
 
 void Descriptor::Describe(const cv::Mat& patch, cv::Mat row) const {
   CheckPatch(patch);
-  const int row_type = Kind() == DescriptorKind::kBinary ? CV_8UC1 : CV_32FC1;
+  const int row_type = RowType(*this);
   if (row.type() != row_type || row.rows != 1 || row.cols != Width()) {
     throw std::logic_error(Name() + ": expected a 1 x " + std::to_string(Width()) + " " +
                            cv::typeToString(row_type) + " row, got " + Shape(row));

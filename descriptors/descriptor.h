@@ -2,7 +2,8 @@
 //
 // A descriptor turns a square grey patch (CV_8UC1, side = patch_size) into one row of
 // Width() elements: bytes for binary descriptors (matched with the Hamming distance, Eq. 4 of
-// the OpenABLE paper) or floats for vector descriptors (matched with the L2 norm, Eq. 8).
+// the OpenABLE paper), floats for vector descriptors (matched with the L2 norm, Eq. 8), or
+// bytes that are small integers (SeqSLAM's SAD, matched with the sum of absolute differences).
 // The keypoint is the patch centre, with no dominant orientation and the patch as its scale,
 // as ABLE computes its global descriptor.
 #pragma once
@@ -15,16 +16,22 @@
 
 namespace openable {
 
-enum class DescriptorKind { kBinary, kFloat };
-enum class DistanceKind { kHamming, kL2 };
+// What a row holds: bits (kBinary, CV_8U), floats (kFloat, CV_32F) or byte values (kBytes,
+// CV_8U).
+enum class DescriptorKind { kBinary, kFloat, kBytes };
+// How rows are compared: Hamming for bits, L2 for floats, L1 (sum of absolute differences) for
+// byte values.
+enum class DistanceKind { kHamming, kL2, kL1 };
 
 // Options every descriptor may read; defaults are those of the ABLE papers.
 struct DescriptorOptions {
   std::string name = "LDB";  // registry name (descriptors/registry.h), any case
   int patch_size = 64;       // side of the square patch, pixels, 16..1024
   int ldb_bits = 256;        // LDB bits kept after selection, 1..1386 (32 bytes = 256 in ABLE-P)
+  int sad_patch = 8;         // SAD: side of the normalised squares, pixels, 2..64 (SeqSLAM: 8)
 
-  // Throws InputError naming the key (Patch_size, Ldb_bits), the value and the valid range.
+  // Throws InputError naming the key (Patch_size, Ldb_bits, Sad_patch), the value and the
+  // valid range.
   // Every descriptor's constructor calls it (through the base class) before building
   // anything; descriptors add their own limits (HOG: a multiple of 8). The name is checked by
   // CreateDescriptor.
@@ -36,11 +43,16 @@ class Descriptor {
   virtual ~Descriptor() = default;
   // Registry name, upper case as in Config.txt ("LDB", "ORB", ...).
   virtual std::string Name() const = 0;
-  // Elements per row: bytes (kBinary) or floats (kFloat).
+  // Elements per row: bytes (kBinary, kBytes) or floats (kFloat).
   virtual int Width() const = 0;
   virtual DescriptorKind Kind() const = 0;
   DistanceKind Distance() const {
-    return Kind() == DescriptorKind::kBinary ? DistanceKind::kHamming : DistanceKind::kL2;
+    switch (Kind()) {
+      case DescriptorKind::kBinary: return DistanceKind::kHamming;
+      case DescriptorKind::kFloat: return DistanceKind::kL2;
+      case DescriptorKind::kBytes: break;
+    }
+    return DistanceKind::kL1;
   }
   // Side of the square patch this descriptor expects.
   int PatchSize() const { return patch_size_; }
@@ -68,9 +80,9 @@ class Descriptor {
   int patch_size_;
 };
 
-// CV type of one row element of a descriptor: CV_8U or CV_32F.
+// CV type of one row element of a descriptor: CV_32F for kFloat, CV_8U otherwise.
 inline int RowType(const Descriptor& d) {
-  return d.Kind() == DescriptorKind::kBinary ? CV_8U : CV_32F;
+  return d.Kind() == DescriptorKind::kFloat ? CV_32F : CV_8U;
 }
 
 }  // namespace openable

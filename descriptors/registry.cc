@@ -13,6 +13,7 @@
 #include "descriptors/hog.h"
 #include "descriptors/ldb.h"
 #include "descriptors/opencv_descriptors.h"
+#include "descriptors/sad.h"
 
 namespace openable {
 namespace {
@@ -39,6 +40,7 @@ const Entry kDescriptors[] = {
     {"FREAK", &Make<FreakDescriptor>},  // descriptors/freak.h
     {"SIFT", &Make<SiftDescriptor>},    // descriptors/opencv_descriptors.h
     {"HOG", &Make<HogDescriptor>},      // descriptors/hog.h
+    {"SAD", &Make<SadDescriptor>},      // descriptors/sad.h (SeqSLAM; byte values, L1 distance)
 };
 
 struct Unavailable {
@@ -96,6 +98,35 @@ std::unique_ptr<Descriptor> CreateDescriptor(const std::string& name,
 
 std::unique_ptr<Descriptor> CreateDescriptor(const DescriptorOptions& options) {
   return CreateDescriptor(options.name, options);
+}
+
+std::vector<std::string> DescriptorList(const std::string& value) {
+  std::vector<std::string> names;
+  std::string item;
+  const auto take = [&] {
+    const std::string name = Upper(Trim(item));
+    item.clear();
+    if (name.empty())
+      throw InputError("Image_descriptor: \"" + value + "\" has an empty name; expected one "
+                       "descriptor name, or several joined by + or , (e.g. HOG+LDB)");
+    for (const std::string& seen : names)
+      if (seen == name)
+        throw InputError("Image_descriptor: \"" + value + "\" names " + name +
+                         " twice; expected each fused descriptor once");
+    bool known = false;
+    for (const Entry& e : kDescriptors) known = known || name == e.name;
+    if (!known) CreateDescriptor(name, DescriptorOptions());  // throws the unknown-name error
+    names.push_back(name);
+  };
+  for (const char ch : value) {
+    if (ch == '+' || ch == ',') {
+      take();
+    } else {
+      item += ch;
+    }
+  }
+  take();
+  return names;
 }
 
 }  // namespace openable

@@ -25,4 +25,10 @@ std::unique_ptr<Descriptor> CreateDescriptor(const std::string& name,
 // The same with the name of `options` (the key Image_descriptor).
 std::unique_ptr<Descriptor> CreateDescriptor(const DescriptorOptions& options);
 
+// The descriptors an Image_descriptor value names: one name, or several joined by "+" or ","
+// (e.g. "HOG+LDB": a fusion of their matrices), each trimmed and in upper case. Throws
+// InputError naming Image_descriptor and the value on an empty item, a name given twice, or an
+// unknown or unavailable name (as CreateDescriptor).
+std::vector<std::string> DescriptorList(const std::string& value);
+
 }  // namespace openable

@@ -42,12 +42,20 @@ const std::map<std::string, Expected>& ExpectedFor64() {
       {"HOG", {1764, DescriptorKind::kFloat}},   // 7 x 7 blocks x 4 cells x 9 bins
       {"BRIEF", {32, DescriptorKind::kBinary}},  // 256 tests
       {"FREAK", {64, DescriptorKind::kBinary}},  // 512 pairs
+      {"SAD", {2048, DescriptorKind::kBytes}},   // 64 x 32 thumbnail
   };
   return table;
 }
 
-// Hamming distance counted bit by bit, or L2 norm as a direct sum of squares.
+// Hamming distance counted bit by bit, L1 as a direct sum of absolute byte differences, or L2
+// norm as a direct sum of squares.
 double Distance(const Descriptor& d, const cv::Mat& a, const cv::Mat& b) {
+  if (d.Distance() == DistanceKind::kL1) {
+    double sum = 0.0;
+    for (int i = 0; i < a.cols; ++i)
+      sum += std::abs(a.at<std::uint8_t>(0, i) - b.at<std::uint8_t>(0, i));
+    return sum;
+  }
   if (d.Distance() == DistanceKind::kHamming) {
     int bits = 0;
     for (int i = 0; i < a.cols; ++i) {
@@ -97,8 +105,9 @@ TEST_P(DescriptorConformance, DeclaresWidthAndRowType) {
   EXPECT_EQ(d->Width(), it->second.width);
   EXPECT_EQ(d->Kind(), it->second.kind);
   EXPECT_EQ(d->Distance(), it->second.kind == DescriptorKind::kBinary ? DistanceKind::kHamming
-                                                                      : DistanceKind::kL2);
-  EXPECT_EQ(RowType(*d), it->second.kind == DescriptorKind::kBinary ? CV_8U : CV_32F);
+                           : it->second.kind == DescriptorKind::kFloat ? DistanceKind::kL2
+                                                                       : DistanceKind::kL1);
+  EXPECT_EQ(RowType(*d), it->second.kind == DescriptorKind::kFloat ? CV_32F : CV_8U);
 
   const cv::Mat row = Describe(*d, PatchFor(*d, 64, 1));
   EXPECT_EQ(row.rows, 1);

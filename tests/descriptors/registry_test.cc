@@ -45,7 +45,7 @@ DescriptorOptions Options(int patch_size, int ldb_bits = 256) {
 TEST(Registry, ListsTheBuiltDescriptorsInOrder) {
   EXPECT_EQ(RegisteredDescriptorNames(),
             (std::vector<std::string>{"LDB", "D-LDB", "ORB", "BRISK", "BRIEF", "FREAK", "SIFT",
-                                      "HOG"}));
+                                      "HOG", "SAD"}));
 }
 
 TEST(Registry, ListsUnavailableDescriptorsWithReasons) {
@@ -62,7 +62,8 @@ TEST(Registry, ListsUnavailableDescriptorsWithReasons) {
 TEST(Registry, LookupIsCaseInsensitive) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"ldb", "LDB"},     {"d-Ldb", "D-LDB"}, {"Orb", "ORB"},   {"bRiSk", "BRISK"},
-      {"brief", "BRIEF"}, {"Freak", "FREAK"}, {"sift", "SIFT"}, {"Hog", "HOG"}};
+      {"brief", "BRIEF"}, {"Freak", "FREAK"}, {"sift", "SIFT"}, {"Hog", "HOG"},
+      {"Sad", "SAD"}};
   for (const auto& [given, name] : cases) {
     const auto d = CreateDescriptor(given, Options(64));
     ASSERT_NE(d, nullptr) << given;
@@ -74,7 +75,7 @@ TEST(Registry, UnknownNameNamesTheValueAndListsValidNames) {
   const std::string message = InputErrorMessage([] { CreateDescriptor("XYZ", Options(64)); });
   EXPECT_EQ(message,
             "Image_descriptor: unknown descriptor \"XYZ\"; expected one of LDB, D-LDB, ORB, BRISK, "
-            "BRIEF, FREAK, SIFT, HOG");
+            "BRIEF, FREAK, SIFT, HOG, SAD");
   EXPECT_TRUE(Contains(InputErrorMessage([] { CreateDescriptor("", Options(64)); }), "\"\""));
 }
 
