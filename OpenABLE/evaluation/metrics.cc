@@ -82,6 +82,9 @@ void EvaluationOptions::Check() const {
                      " is negative; expected a number of frames >= 0");
   if (able_thresholds < 2)
     throw std::logic_error("EvaluationOptions: able_thresholds must be >= 2");
+  if (score_window < 0)
+    throw InputError("Match_score_window: " + std::to_string(score_window) +
+                     " is negative; expected a number of frames >= 0");
 }
 
 PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout& layout,
@@ -91,7 +94,14 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
   PerQueryResult r;
   r.best.assign(nq, -1);
   r.best_distance.assign(nq, std::numeric_limits<float>::infinity());
+  r.score.assign(nq, std::numeric_limits<float>::infinity());
   r.positive.assign(nq, 0);
+  if (options.score == MatchScore::kRatio && options.score_window >= layout.references)
+    throw InputError("Match_score_window: " + std::to_string(options.score_window) +
+                     " frames is not smaller than the " + std::to_string(layout.references) +
+                     " frames of the reference traversal; expected a smaller window (no rival "
+                     "would remain outside it)");
+  std::vector<std::uint8_t> has_candidates(nq, 0);
   r.correct.assign(nq, 0);
   std::vector<std::array<std::uint8_t, 3>> correct_at_n(nq, {0, 0, 0});
   std::vector<std::int64_t> outside(nq, 0);
@@ -104,10 +114,13 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
       const std::vector<int> t = CandidateTruth(truth.matches[q], end);
       outside[q] = static_cast<std::int64_t>(truth.matches[q].size() - t.size());
       if (end == 0) continue;
+      has_candidates[q] = 1;
+      r.positive[q] = t.empty() ? 0 : 1;
       const float* row = matrix.ptr<float>(layout.row_offset + q) + layout.col_offset;
       top.clear();
       for (int c = 0; c < end; ++c) {
         const float v = row[c];
+        if (!std::isfinite(v)) continue;  // a skipped sequence cell is no candidate
         // Strictly smaller than the worst kept: ties keep the lower column.
         if (static_cast<int>(top.size()) < kMaxN || v < top.back().first) {
           auto pos =
@@ -117,9 +130,10 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
           if (static_cast<int>(top.size()) > kMaxN) top.pop_back();
         }
       }
+      if (top.empty()) continue;  // no finite candidate: no answer
       r.best[q] = top.front().second;
       r.best_distance[q] = top.front().first;
-      r.positive[q] = t.empty() ? 0 : 1;
+      r.score[q] = ScoreOfCandidate(row, end, r.best[q], options.score, options.score_window);
       if (t.empty()) continue;
       r.correct[q] = NearTruth(t, r.best[q], options.tolerance) ? 1 : 0;
       bool hit = false;
@@ -136,13 +150,16 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
   std::array<int, 3> hits_at_n = {0, 0, 0};
   for (int q = 0; q < nq; ++q) {
     r.truth_pairs_outside_candidates += outside[q];
-    if (r.best[q] < 0) continue;
+    if (!has_candidates[q]) continue;
     ++r.queries;
-    order.push_back(q);
-    if (r.positive[q]) {
-      ++r.positive_queries;
-      for (int k = 0; k < 3; ++k) hits_at_n[k] += correct_at_n[q][k];
+    if (r.positive[q]) ++r.positive_queries;
+    if (r.best[q] < 0) {
+      ++r.unanswered;
+      continue;
     }
+    order.push_back(q);
+    if (r.positive[q])
+      for (int k = 0; k < 3; ++k) hits_at_n[k] += correct_at_n[q][k];
   }
   const double positives = r.positive_queries;
   if (r.positive_queries > 0) {
@@ -151,13 +168,13 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
     r.recall_at_10 = hits_at_n[2] / positives;
   }
 
-  // Sweep the acceptance threshold over every distinct best-match distance.
+  // Sweep the acceptance threshold over every distinct score of a best match.
   std::stable_sort(order.begin(), order.end(),
-                   [&](int a, int b) { return r.best_distance[a] < r.best_distance[b]; });
+                   [&](int a, int b) { return r.score[a] < r.score[b]; });
   std::int64_t tp = 0, fp = 0;
   for (std::size_t i = 0; i < order.size();) {
-    const float threshold = r.best_distance[order[i]];
-    for (; i < order.size() && r.best_distance[order[i]] == threshold; ++i) {
+    const float threshold = r.score[order[i]];
+    for (; i < order.size() && r.score[order[i]] == threshold; ++i) {
       if (r.correct[order[i]])
         ++tp;
       else
@@ -173,6 +190,16 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
     r.curve.push_back(p);
   }
   r.auc = CurveArea(r.curve);
+  if (options.accept_threshold >= 0) {
+    r.has_operating_point = true;
+    r.operating_point.threshold = options.accept_threshold;
+    r.operating_point.precision = 1.0;
+    for (const CurvePoint& p : r.curve)
+      if (p.threshold <= options.accept_threshold) {
+        r.operating_point = p;
+        r.operating_point.threshold = options.accept_threshold;
+      }
+  }
   for (const CurvePoint& p : r.curve) {
     if (p.fp == 0 && p.tp > 0) r.recall_at_100p = p.recall;
     if (p.f1 > r.max_f1) {

@@ -10,6 +10,7 @@
 
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/layout.h"
+#include "matching/score.h"
 
 namespace openable {
 
@@ -18,8 +19,15 @@ struct EvaluationOptions {
   int exclusion = 100;        // loop closure: candidates are frames at least this far back
   int vicinity = 7;           // ABLE-P protocol: temporal vicinity, frames
   int able_thresholds = 100;  // ABLE-P protocol: thresholds evenly spaced in [0, 1]
+  // Per-query protocol: what ranks and accepts a query's best match (matching/score.h): its
+  // distance, or the ratio to the best rival outside +-score_window frames (>= 0).
+  MatchScore score = MatchScore::kDistance;
+  int score_window = 10;
+  // Per-query protocol: the operating point a user chose (Match_threshold): answers with a
+  // score <= accept_threshold are accepted; -1: none.
+  double accept_threshold = -1.0;
 
-  // Throws InputError naming Tolerance, Exclusion or Vicinity.
+  // Throws InputError naming Tolerance, Exclusion, Vicinity or Match_score_window.
   void Check() const;
 };
 
@@ -35,21 +43,32 @@ struct CurvePoint {
 struct PerQueryResult {
   int queries = 0;            // queries with at least one candidate
   int positive_queries = 0;   // of those, queries with a true match among their candidates
+  // Of the queries, those whose candidates are all non-finite (sequence cells skipped at the
+  // start of a traversal): they give no answer, and a positive one lowers recall.
+  int unanswered = 0;
   std::int64_t truth_pairs_outside_candidates = 0;  // true pairs no candidate set contains
-  // One point per distinct best-match distance, in increasing order of threshold.
+  // One point per distinct score of a best match (EvaluationOptions::score: the distance or
+  // the ratio), in increasing order of threshold: a query's answer is accepted when its score
+  // is <= the threshold.
   std::vector<CurvePoint> curve;
   double auc = 0;             // sum of precision x recall increments along the curve
   double recall_at_100p = 0;  // highest recall with precision exactly 1 (0 if none)
   double max_f1 = 0;
   double max_f1_threshold = 0;
   double max_f1_precision = 0, max_f1_recall = 0;
+  // At EvaluationOptions::accept_threshold (when >= 0): the answers accepted, and their
+  // precision (1 when none is accepted) and recall.
+  bool has_operating_point = false;
+  CurvePoint operating_point;
   // R@N for N = 1, 5, 10: share of positive queries with a correct match among the N best
   // candidates (ties broken by lower column index).
   double recall_at_1 = 0, recall_at_5 = 0, recall_at_10 = 0;
-  // Per query row of the block: best candidate column (-1 without candidates), its distance,
-  // whether the query is positive and whether its best candidate is correct.
+  // Per query row of the block: best candidate column (-1 without a finite candidate), its
+  // distance and its score, whether the query is positive and whether its best candidate is
+  // correct.
   std::vector<int> best;
   std::vector<float> best_distance;
+  std::vector<float> score;
   std::vector<std::uint8_t> positive, correct;
 };
 

@@ -317,12 +317,12 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
   if (k == 1) grow = std::max(grow, std::max(rows, cols) / 1200);
   const cv::Rect image_area(0, 0, image_w, image_h);
   const int marked = std::min(
-      rows, static_cast<int>(std::min({result.best.size(), result.best_distance.size(),
-                                       result.correct.size()})));
+      rows, static_cast<int>(
+                std::min({result.best.size(), result.score.size(), result.correct.size()})));
   for (int pass = 0; pass < 2; ++pass) {  // wrong marks last, so a neighbour never hides them
     for (int q = 0; q < marked; ++q) {
       const int c = result.best[q];
-      const float d = result.best_distance[q];
+      const float d = result.score[q];
       if (c < 0 || c >= cols || !(d <= accept_threshold)) continue;
       const bool correct = result.correct[q] != 0;
       if (correct != (pass == 0)) continue;

@@ -67,6 +67,8 @@ std::string EncodeEvaluationJson(const EvaluationSettings& s, const std::vector<
     << "    \"tolerance\": " << s.options.tolerance << ",\n"
     << "    \"exclusion\": " << s.options.exclusion << ",\n"
     << "    \"vicinity\": " << s.options.vicinity << ",\n"
+    << "    \"match_score\": " << JsonString(EnumName(s.options.score)) << ",\n"
+    << "    \"match_score_window\": " << s.options.score_window << ",\n"
     << "    \"able_thresholds\": " << s.options.able_thresholds << "\n  },\n";
   o << "  \"runs\": [";
   for (std::size_t i = 0; i < runs.size(); ++i) {
@@ -93,6 +95,14 @@ std::string EncodeEvaluationJson(const EvaluationSettings& s, const std::vector<
       << "        \"recall_at_10\": " << Number(q.recall_at_10) << ",\n"
       << "        \"queries\": " << q.queries << ",\n"
       << "        \"positive_queries\": " << q.positive_queries << ",\n"
+      << "        \"unanswered_queries\": " << q.unanswered << ",\n"
+      << (q.has_operating_point
+              ? "        \"accepted\": {\"threshold\": " + Number(q.operating_point.threshold) +
+                    ", \"matches\": " +
+                    std::to_string(q.operating_point.tp + q.operating_point.fp) +
+                    ", \"precision\": " + Number(q.operating_point.precision) +
+                    ", \"recall\": " + Number(q.operating_point.recall) + "},\n"
+              : std::string())
       << "        \"truth_pairs_outside_candidates\": " << q.truth_pairs_outside_candidates
       << "\n      },\n"
       << "      \"able_p\": {\n"
@@ -112,6 +122,8 @@ std::string FormatEvaluationTable(const EvaluationSettings& s,
     << s.options.tolerance << " frames";
   if (!runs.empty() && runs[0].layout.kind == EvaluationLayout::Kind::kLoopClosure)
     o << ", candidates at least " << s.options.exclusion << " frames back";
+  if (s.options.score == MatchScore::kRatio)
+    o << "; score: ratio to the best rival beyond +-" << s.options.score_window << " frames";
   o << "; ABLE-P vicinity " << s.options.vicinity << "\n";
   char line[512];
   std::snprintf(line, sizeof line, "  %-18s %7s %7s %7s %7s %16s %6s %6s %6s %8s\n", "run",
@@ -134,6 +146,16 @@ std::string FormatEvaluationTable(const EvaluationSettings& s,
     if (r.truth_dropped > 0)
       o << "    (" << r.truth_dropped
         << " ground-truth pairs dropped: on the diagonal or outside the processed frames)\n";
+    if (q.unanswered > 0)
+      o << "    (" << q.unanswered
+        << " queries have no candidate with a full sequence: no answer, counted as misses)\n";
+    if (q.has_operating_point) {
+      const CurvePoint& p = q.operating_point;
+      std::snprintf(line, sizeof line,
+                    "    accepted at score <= %g: %lld answers, precision %.3f, recall %.3f\n",
+                    p.threshold, static_cast<long long>(p.tp + p.fp), p.precision, p.recall);
+      o << line;
+    }
   }
   return o.str();
 }

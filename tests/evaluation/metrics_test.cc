@@ -4,9 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <random>
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "tests/brute_per_query.h"
 
 namespace openable {
 namespace {
@@ -208,6 +211,151 @@ TEST(EvaluationOptions, CheckNamesTheKey) {
   EXPECT_THROW(o.Check(), InputError);
   o = EvaluationOptions();
   o.vicinity = -3;
+  EXPECT_THROW(o.Check(), InputError);
+}
+
+
+// --- The ratio score ---------------------------------------------------------------------------
+
+// The query-reference block above with the ratio, window 1: q0 best c1 0.10, rivals c3 0.7 and
+// c4 0.8: 0.1 / 0.7; q1 best c2 0.20, rivals c0 0.3 and c4 0.4: 0.2 / 0.3; q2 best c3 0.35,
+// rivals c0 0.5 and c1 0.5: 0.35 / 0.5 = 0.7; q3 best c4 0.45, rivals c0 0.8, c1 0.7, c2 0.6:
+// 0.45 / 0.6 = 0.75. Order: q0 (TP), q1 (FP), q2 (FP), q3 (TP), as with the distance.
+TEST(PerQueryRatio, HandWorkedQueryReferenceExample) {
+  EvaluationOptions o;
+  o.tolerance = 1;
+  o.score = MatchScore::kRatio;
+  o.score_window = 1;
+  const PerQueryResult r =
+      EvaluatePerQuery(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
+                       Truth({{1}, {4}, {}, {3}}, 5), o);
+  ASSERT_EQ(r.score.size(), 4u);
+  EXPECT_FLOAT_EQ(r.score[0], 0.1f / 0.7f);
+  EXPECT_FLOAT_EQ(r.score[1], 0.2f / 0.3f);
+  EXPECT_FLOAT_EQ(r.score[2], 0.35f / 0.5f);
+  EXPECT_FLOAT_EQ(r.score[3], 0.45f / 0.6f);
+  EXPECT_EQ(r.best_distance[3], 0.45f);  // the distance is kept beside the score
+  ASSERT_EQ(r.curve.size(), 4u);
+  EXPECT_NEAR(r.curve[0].threshold, 0.1 / 0.7, 1e-6);
+  EXPECT_NEAR(r.auc, 0.5, 1e-12);
+}
+
+// The ratio re-orders answers: a wrong best match with a close rival (ratio near 1) falls
+// below a right one that stands out, although its distance is smaller.
+TEST(PerQueryRatio, SeparatesWhatTheDistanceCannot) {
+  // q0: best c0 0.10 (wrong, truth c4), rival c3 0.11: ratio 0.91.
+  // q1: best c4 0.30 (right), rivals at 0.9: ratio 0.33.
+  const cv::Mat1f m = (cv::Mat1f(2, 5) << 0.10f, 0.9f, 0.9f, 0.11f, 0.5f,  //
+                       0.9f, 0.9f, 0.9f, 0.9f, 0.30f);
+  EvaluationOptions o;
+  o.tolerance = 0;
+  const auto layout = EvaluationLayout::QueryReference(2, 5);
+  const GroundTruth t = Truth({{4}, {4}}, 5);
+  const PerQueryResult by_distance = EvaluatePerQuery(m, layout, t, o);
+  EXPECT_EQ(by_distance.recall_at_100p, 0.0);  // the wrong answer comes first
+  o.score = MatchScore::kRatio;
+  o.score_window = 1;
+  const PerQueryResult by_ratio = EvaluatePerQuery(m, layout, t, o);
+  EXPECT_NEAR(by_ratio.recall_at_100p, 0.5, 1e-12);
+  EXPECT_NEAR(by_ratio.auc, 0.5, 1e-12);
+}
+
+// Random matrices with ties (few distinct levels) and skipped cells (+inf), in both layouts,
+// against the brute force of tests/brute_per_query.h.
+TEST(PerQueryRatio, RandomMatricesMatchBruteForce) {
+  std::mt19937 rng(21);
+  std::uniform_int_distribution<int> level(1, 12), chance(0, 14), pick(0, 59);
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int trial = 0; trial < 60; ++trial) {
+    const bool loop = trial % 2 == 0;
+    const int n = 60;
+    cv::Mat1f m(n, n);
+    for (float& v : m) v = chance(rng) == 0 ? inf : level(rng) / 12.0f;
+    for (int q = 0; q < 3; ++q) m.row(q).setTo(inf);  // unanswered queries (skip cells)
+    std::vector<std::vector<int>> truth(n);
+    for (int q = 0; q < n; ++q) {
+      if (chance(rng) < 3) continue;  // a negative query
+      const int c = loop ? (q >= 10 ? pick(rng) % (q - 9) : -1) : pick(rng);
+      if (c >= 0) truth[q] = {c};
+    }
+    for (const bool ratio : {false, true}) {
+      EvaluationOptions o;
+      o.tolerance = 1;
+      o.exclusion = 10;
+      o.score = ratio ? MatchScore::kRatio : MatchScore::kDistance;
+      o.score_window = trial % 5;
+      const EvaluationLayout layout =
+          loop ? EvaluationLayout::LoopClosure(n) : EvaluationLayout::QueryReference(n, n);
+      const PerQueryResult r = EvaluatePerQuery(m, layout, Truth(truth, n), o);
+      const testing::BruteFigures b =
+          testing::BrutePerQuery(m, truth, loop, o.exclusion, o.tolerance, ratio, o.score_window);
+      for (int q = 0; q < n; ++q) {
+        const testing::BruteQuery& e = b.queries[q];
+        ASSERT_EQ(r.best[q], e.best) << "trial " << trial << " q " << q;
+        if (e.answered) ASSERT_FLOAT_EQ(r.score[q], static_cast<float>(e.score)) << q;
+        ASSERT_EQ(r.correct[q] != 0, e.correct) << q;
+      }
+      EXPECT_EQ(r.unanswered, b.unanswered);
+      EXPECT_EQ(r.positive_queries, b.positives);
+      EXPECT_NEAR(r.auc, b.auc, 1e-9) << "trial " << trial << " ratio " << ratio;
+      EXPECT_NEAR(r.recall_at_100p, b.recall_at_100p, 1e-9) << "trial " << trial;
+    }
+  }
+}
+
+// A query whose every candidate is +inf gives no answer; a positive one still counts in the
+// recall's denominator.
+TEST(PerQuery, UnansweredQueriesLowerRecall) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const cv::Mat1f m = (cv::Mat1f(2, 2) << inf, inf, 0.2f, 0.5f);
+  EvaluationOptions o;
+  o.tolerance = 0;
+  const PerQueryResult r =
+      EvaluatePerQuery(m, EvaluationLayout::QueryReference(2, 2), Truth({{0}, {0}}, 2), o);
+  EXPECT_EQ(r.queries, 2);
+  EXPECT_EQ(r.unanswered, 1);
+  EXPECT_EQ(r.best, (std::vector<int>{-1, 0}));
+  EXPECT_NEAR(r.recall_at_100p, 0.5, 1e-12);
+  EXPECT_NEAR(r.recall_at_1, 0.5, 1e-12);
+}
+
+// The operating point of Match_threshold: the last curve point at or below it.
+TEST(PerQuery, OperatingPointIsTheCurveAtTheAcceptThreshold) {
+  EvaluationOptions o;
+  o.tolerance = 1;
+  o.accept_threshold = 0.3;  // accepts q0 (0.10, TP) and q1 (0.20, FP)
+  PerQueryResult r = EvaluatePerQuery(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
+                                      Truth({{1}, {4}, {}, {3}}, 5), o);
+  ASSERT_TRUE(r.has_operating_point);
+  EXPECT_EQ(r.operating_point.tp, 1);
+  EXPECT_EQ(r.operating_point.fp, 1);
+  EXPECT_NEAR(r.operating_point.precision, 0.5, 1e-12);
+  EXPECT_NEAR(r.operating_point.recall, 1.0 / 3, 1e-12);
+  EXPECT_EQ(r.operating_point.threshold, 0.3);
+  o.accept_threshold = 0.05;  // nothing accepted: precision 1, recall 0
+  r = EvaluatePerQuery(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
+                       Truth({{1}, {4}, {}, {3}}, 5), o);
+  EXPECT_EQ(r.operating_point.tp + r.operating_point.fp, 0);
+  EXPECT_EQ(r.operating_point.precision, 1.0);
+  EXPECT_EQ(r.operating_point.recall, 0.0);
+  o.accept_threshold = -1;
+  EXPECT_FALSE(EvaluatePerQuery(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
+                                Truth({{1}, {4}, {}, {3}}, 5), o)
+                   .has_operating_point);
+}
+
+TEST(PerQueryRatio, WindowAsLargeAsTheReferencesIsAnError) {
+  EvaluationOptions o;
+  o.score = MatchScore::kRatio;
+  o.score_window = 5;
+  try {
+    EvaluatePerQuery(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
+                     Truth({{1}, {4}, {}, {3}}, 5), o);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("Match_score_window: 5"), std::string::npos) << e.what();
+  }
+  o.score_window = -1;
   EXPECT_THROW(o.Check(), InputError);
 }
 

