@@ -6,6 +6,7 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
+#include "descriptors/registry.h"
 
 namespace openable {
 namespace {
@@ -132,24 +133,63 @@ OptionTable ConfigTable(Config& c) {
         "Peak spectral response of the blue channel, nm; see Lambda_red.");
   t.Add("Image_descriptor", kDescription, c.descriptor, c.descriptor.name,
         "LDB, D-LDB (LDB of the grey and of the disparity image; needs Camera_type 1), ORB, "
-        "BRISK, BRIEF, FREAK (binary, Hamming distance) or SIFT, HOG (vector, L2 distance). SURF "
-        "is not available (non-free, absent from Debian's OpenCV).", false);
+        "BRISK, BRIEF, FREAK (binary, Hamming distance), SIFT, HOG (vector, L2 distance) or SAD "
+        "(SeqSLAM's patch-normalised thumbnail, sum of absolute differences; Sad_patch). Several "
+        "names joined by + or , (HOG+LDB) fuse their matrices (Fusion_weights). SURF is not "
+        "available (non-free, absent from Debian's OpenCV).", false);
   t.Add("Image_sequences", kDescription, c.matching, c.matching.sequence_length, 1, 100000,
         "Sequence length L: the distance of two places sums L single-frame distances along the "
-        "diagonal; 1 = single images. Frames with fewer than L predecessors in their traversal "
-        "use the available terms scaled to L.", false);
+        "diagonal; 1 = single images. Frames with fewer than L predecessors in their traversal: "
+        "see Sequence_partial.", false);
   t.Add("Threshold", kDescription, c.matching, c.matching.threshold, -1, 1,
         "Theta of Eq. 9: M'' = 0 where M' < Threshold, 1 elsewhere. -1 disables; otherwise in [0,"
         " 1].", false);
   t.Add("Ldb_bits", kDescription, c.descriptor, c.descriptor.ldb_bits, 1, 1386,
         "Bits of the LDB descriptor (256 = 32 bytes, as in ABLE-P; 1386 = every test of the 2x2 "
         "to 5x5 grids). See docs/descriptors.md for the selection.");
+  t.Add("Sad_patch", kDescription, c.descriptor, c.descriptor.sad_patch, 2, 64,
+        "SAD: side in pixels of the squares of the Patch_size x Patch_size/2 thumbnail that are "
+        "each normalised to zero mean and unit deviation (8 in SeqSLAM); at most Patch_size/2.");
   t.Add("Threads", kDescription, c.matching, c.matching.threads, 0, 1024,
         "Worker threads for description and matching; 0 = all cores.");
   t.AddEnumNumber("Sequence_direction", kDescription, c.matching, c.matching.direction,
         "0 sums along diagonals (both routes driven the same way, the original); 1 along anti-"
         "diagonals (the reference route driven the opposite way); 2 the smaller of the two for "
         "every cell (needs a second matrix in dense mode).");
+  t.AddEnumName("Sequence_partial", kDescription, c.matching, c.matching.partial,
+        "What a sequence cell holds when fewer than L frames precede it in its traversal (the "
+        "first L - 1 frames; along anti-diagonals also the last L - 1 references): scale, the "
+        "terms it has scaled up to L; skip, no value, the rule of OpenSeqSLAM: never a "
+        "candidate nor a best match, written as the largest value of the matrix in Txt_name "
+        "and the PNGs and as NaN in Npy_name (docs/matching.md compares the two).");
+  t.AddEnumName("Match_score", kDescription, c.matching, c.matching.score,
+        "How confident a query's best match is, for Match_threshold, the per-query evaluation "
+        "(PR curve, AUC, R@100P, F1), the score column of Matches_name: distance (its "
+        "normalised distance) or ratio (its distance over the smallest distance of the query's "
+        "other candidates more than Match_score_window frames away: Lowe's ratio test, as "
+        "SeqSLAM uses it; 1 without such a rival). docs/evaluation.md defines both.");
+  t.Add("Match_score_window", kDescription, c.matching, c.matching.score_window, 0, 100000,
+        "Frames on each side of a best match whose cells are not its rivals for the ratio "
+        "score (they show the same place); smaller than the reference traversal.");
+  t.Add("Match_threshold", kDescription, c.matching, c.matching.match_threshold, -1, 1,
+        "A query's best match is accepted when its score (Match_score) is <= this: the report "
+        "counts the accepted matches and the evaluation gives their precision and recall (the "
+        "overlay marks them). -1: no threshold. Threshold (Eq. 9) still applies to the "
+        "matrix.");
+  t.Add("Contrast_enhancement", kDescription, c.matching, c.matching.contrast_enhancement,
+        "1 applies SeqSLAM's local contrast enhancement to the single-frame distances, before "
+        "sequences: each cell minus the mean of its row's cells within +-Contrast_window "
+        "references of its traversal, over their standard deviation (0 where they are all "
+        "equal), then the matrix shifted so that its smallest value is 0. Any descriptor; "
+        "dense matrices only.");
+  t.Add("Contrast_window", kDescription, c.matching, c.matching.contrast_window, 1, 100000,
+        "References on each side of a cell that give its local mean and deviation "
+        "(Contrast_enhancement).");
+  t.Add("Fusion_weights", kDescription, c.matching, c.matching.fusion_weights,
+        "Image_descriptor lists several descriptors (HOG+LDB): the weight of each one's "
+        "single-frame matrix, first divided by its largest value, comma-separated in the order "
+        "of the names (\"1,0.5\"); empty: equal weights, which fusing descriptors of different "
+        "distances (Hamming, L2, L1) does not allow. Dense matrices only.");
   // Robustness
   t.Add("Side_window", kRobustness, c.preprocess, c.preprocess.side_window,
         "1 applies side-window multilayer pixel fusion to the grey image before description "
@@ -438,9 +478,10 @@ void CheckConfig(const Config& c) {
   c.description.Check();
   c.preprocess.Check();
   const CameraType camera = c.input.camera_type;
-  if (Upper(c.descriptor.name) == "D-LDB" && camera != CameraType::kStereo)
-    throw InputError("Image_descriptor: D-LDB needs Camera_type 1 (stereo); Camera_type is " +
-                     std::to_string(static_cast<int>(camera)));
+  for (const std::string& name : DescriptorList(c.descriptor.name))
+    if (name == "D-LDB" && camera != CameraType::kStereo)
+      throw InputError("Image_descriptor: D-LDB needs Camera_type 1 (stereo); Camera_type is " +
+                       std::to_string(static_cast<int>(camera)));
   c.input.Check();
   if (camera == CameraType::kStereo && c.preprocess.illumination_invariance)
     throw InputError("Illumination_invariance: 1 with Camera_type 1 (stereo); expected 0: the "

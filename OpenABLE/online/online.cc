@@ -64,6 +64,10 @@ void OnlineOptions::Check() const {
           "1..1000");
   Require(std::isfinite(threshold) && threshold >= 0, "threshold", std::to_string(threshold),
           "a number >= 0");
+  Require(score == MatchScore::kDistance || score == MatchScore::kRatio, "score",
+          std::to_string(static_cast<int>(score)), "distance or ratio");
+  Require(score_window >= 0, "score_window", std::to_string(score_window),
+          ">= 0 (frames on each side of a candidate that are not its rivals)");
   Require(exact_limit >= 0, "exact_limit", std::to_string(exact_limit), ">= 0");
   Require(block_frames >= 16, "block_frames", std::to_string(block_frames), ">= 16");
   try {
@@ -80,6 +84,7 @@ Describer MakeDescriber(const OnlineOptions& options) {
   DescriptorOptions d;
   d.patch_size = options.patch_size;
   d.ldb_bits = options.ldb_bits;
+  d.sad_patch = options.sad_patch;
   Describer out;
   out.descriptor = CreateDescriptor(options.descriptor, d);
   // A grey image per frame: descriptors of several channels (D-LDB: grey + disparity) need
@@ -130,15 +135,21 @@ cv::Mat DescribeImages(const std::vector<cv::Mat>& images, const OnlineOptions& 
 
 cv::Mat1f DistanceMatrix(const cv::Mat& rows, int sequence_length, SequenceDirection direction,
                          const std::vector<int>& traversal_starts, int threads,
-                         float* max_distance) {
+                         float* max_distance, std::optional<Metric> metric,
+                         SequencePartial partial) {
   if (rows.empty() || (rows.type() != CV_8UC1 && rows.type() != CV_32FC1))
     throw InputError("descriptor rows of OpenCV type " + cv::typeToString(rows.type()) + " and " +
                      std::to_string(rows.rows) + " rows: expected at least one row of CV_8UC1 "
                      "(Hamming) or CV_32FC1 (L2)");
   if (sequence_length < 1)
     throw InputError("sequence_length = " + std::to_string(sequence_length) + ": expected >= 1");
+  const Metric m = metric.value_or(MetricOfType(rows.type()));
+  if ((m == Metric::kL2) != (rows.type() == CV_32FC1))
+    throw InputError("descriptor rows of OpenCV type " + cv::typeToString(rows.type()) +
+                     " with the " + EnumName(m) + " distance: expected CV_32FC1 rows for l2, "
+                     "CV_8UC1 rows for hamming and l1");
   return NormalizedDistanceMatrix(rows, sequence_length, direction, traversal_starts, threads,
-                                  max_distance);
+                                  max_distance, m, partial);
 }
 
 // ---- OnlineDetector ------------------------------------------------------------------------
@@ -155,6 +166,11 @@ OnlineDetector::OnlineDetector(const OnlineOptions& options) : state_(std::make_
   State& s = *state_;
   s.options = options;
   s.describer = MakeDescriber(options);  // checks the options
+  Require(s.describer.descriptor->Distance() != DistanceKind::kL1, "descriptor",
+          options.descriptor,
+          "a Hamming or L2 descriptor (" + s.describer.descriptor->Name() +
+              "'s L1 distance has no index for the search beyond exact_limit: use "
+              "DescribeImages and DistanceMatrix, or Test_OpenABLE)");
   s.width = s.describer.frame->RowWidth();
   s.type = s.describer.frame->RowType();
   if (s.type == CV_8U) s.unit = 8.0 * s.width;
@@ -227,13 +243,20 @@ OnlineResult OnlineDetector::AddDescriptor(const cv::Mat& row) {
           SequenceCellDistance(rows, q, rows, j, s.options.sequence_length, false, largest), j);
     const size_t k = std::min(scored.size(), static_cast<size_t>(s.options.candidates));
     std::partial_sort(scored.begin(), scored.begin() + k, scored.end());
+    // The ratio's rivals: every candidate scored, best first (the first k are sorted).
+    std::vector<std::pair<float, int>> rivals;
+    if (s.options.score == MatchScore::kRatio)
+      for (const auto& [d, j] : scored) rivals.emplace_back(static_cast<float>(d), j);
     const double scale = s.options.sequence_length * s.unit;
     for (size_t i = 0; i < k; ++i) {
       LoopCandidate c;
       c.frame = scored[i].second;
       c.distance = scored[i].first;
       c.normalized = scale > 0 ? c.distance / scale : 0.0;
-      c.accepted = c.normalized <= s.options.threshold;
+      c.score = s.options.score == MatchScore::kRatio
+                    ? ScoreOfCandidate(rivals, i, MatchScore::kRatio, s.options.score_window)
+                    : c.normalized;
+      c.accepted = c.score <= s.options.threshold;
       r.candidates.push_back(c);
     }
   }

@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,24 +26,35 @@
 
 #include "OpenABLE/run/describe.h"
 #include "matching/approximate.h"
+#include "matching/distances.h"
+#include "matching/score.h"
 #include "matching/sequence.h"
 
 namespace openable {
 
 struct OnlineOptions {
-  // Description (as the keys Description_type, Patch_size, Ldb_bits, Grid_x, Grid_y).
+  // Description (as the keys Description_type, Patch_size, Ldb_bits, Sad_patch, Grid_x,
+  // Grid_y).
   std::string descriptor = "LDB";
   DescriptionType description = DescriptionType::kGlobal;
   int patch_size = 64;
   int ldb_bits = 256;
+  int sad_patch = 8;  // SAD (DescribeImages only): side of the normalised squares (Sad_patch)
   int grid_x = 1, grid_y = 1;
   // Matching.
   int sequence_length = 1;  // L (the key Image_sequences): frames summed along the diagonal
   int exclusion = 100;      // frame q's candidates are frames j <= q - exclusion (>= 1)
   int candidates = 5;       // candidates returned per frame (the k best), >= 1
-  // A candidate is accepted when its normalised distance is <= threshold (see LoopCandidate).
-  // Default: on KITTI 00 frames 0-1699 with LDB 256 bits, every top-1 candidate up to 0.137
-  // (L = 1) and 0.17 (L = 5, 10) is a true loop (bench/bench_online.cc, docs/library.md).
+  // The confidence of a candidate (matching/score.h, the key Match_score): its normalised
+  // distance, or the ratio of its distance to the best candidate more than score_window
+  // frames away from it (the rivals are the candidates the search scored: every searchable
+  // frame while exact, the FLANN candidates beyond).
+  MatchScore score = MatchScore::kDistance;
+  int score_window = 10;  // >= 0
+  // A candidate is accepted when its score is <= threshold (see LoopCandidate). Default, for
+  // the distance score: on KITTI 00 frames 0-1699 with LDB 256 bits, every top-1 candidate up
+  // to 0.137 (L = 1) and 0.17 (L = 5, 10) is a true loop (bench/bench_online.cc,
+  // docs/library.md). With the ratio score choose it anew (docs/library.md gives figures).
   double threshold = 0.13;
   // Search: exact (every earlier frame) while the searchable map holds at most exact_limit
   // frames; beyond, frames are indexed by FLANN (LSH for binary rows, k-d trees for float
@@ -70,7 +82,10 @@ struct LoopCandidate {
   // single-frame distance the detector has computed so far. Not the scale of Config.txt's
   // Threshold (which divides by the largest distance of the finished matrix, Eq. 5).
   double normalized = 0;
-  bool accepted = false;  // normalized <= OnlineOptions::threshold
+  // OnlineOptions::score: `normalized`, or the ratio of `distance` to the best candidate
+  // outside +-score_window frames of this one (1 without one).
+  double score = 0;
+  bool accepted = false;  // score <= OnlineOptions::threshold
 };
 
 struct OnlineResult {
@@ -137,12 +152,14 @@ Describer MakeDescriber(const OnlineOptions& options);
 cv::Mat DescribeImages(const std::vector<cv::Mat>& images, const OnlineOptions& options,
                        int threads = 0);
 
-// Distances between all rows of `rows` (Hamming for CV_8U, L2 for CV_32F), summed along
-// sequences of L frames (matching/sequence.h; `traversal_starts` as there), normalised by their
-// largest value (Eq. 5). `max_distance` receives that divisor (0 leaves the matrix as is).
+// Distances between all rows of `rows` (`metric`; by default Hamming for CV_8U, L2 for
+// CV_32F; L1 for SAD's byte rows), summed along sequences of L frames (matching/sequence.h;
+// `traversal_starts` and `partial` as there), normalised by their largest value (Eq. 5).
+// `max_distance` receives that divisor (0 leaves the matrix as is).
 cv::Mat1f DistanceMatrix(const cv::Mat& rows, int sequence_length = 1,
                          SequenceDirection direction = SequenceDirection::kForward,
                          const std::vector<int>& traversal_starts = {}, int threads = 0,
-                         float* max_distance = nullptr);
+                         float* max_distance = nullptr, std::optional<Metric> metric = {},
+                         SequencePartial partial = SequencePartial::kScale);
 
 }  // namespace openable

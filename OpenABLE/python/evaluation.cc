@@ -41,7 +41,8 @@ auto WithArgumentNames(F f) {
       {"Ground_truth_base:", "base:"},        {"Initial_image:", "first_frame:"},
       {"Tolerance:", "tolerance:"},          {"Exclusion:", "exclusion:"},
       {"Vicinity:", "vicinity:"},            {"Ground_truth_2:", "truth_file_2:"},
-      {"Ground_truth:", "truth_file:"},      {"Ground_truth_type:", "truth_type:"}};
+      {"Ground_truth:", "truth_file:"},      {"Ground_truth_type:", "truth_type:"},
+      {"Match_score_window:", "score_window:"}};
   try {
     return f();
   } catch (const InputError& e) {
@@ -296,7 +297,29 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
           "Per-query protocol: the largest F1 along the curve.")
       .def_property_readonly(
           "max_f1_threshold", [](const Result& r) { return r.run.per_query.max_f1_threshold; },
-          "Distance threshold of max_f1 (the first on ties).")
+          "Score threshold of max_f1 (the first on ties).")
+      .def_property_readonly(
+          "score", [](const Result& r) { return EnumName(r.settings.options.score); },
+          "The match score that ranked and accepted the answers: \"distance\" or \"ratio\".")
+      .def_property_readonly(
+          "scores", [](const Result& r) { return ArrayOf(r.run.per_query.score); },
+          "float32 array: the score of each query's best candidate (inf without candidates).")
+      .def_property_readonly(
+          "unanswered_queries", [](const Result& r) { return r.run.per_query.unanswered; },
+          "Queries whose candidates all hold no value (skipped sequence cells): no answer.")
+      .def_property_readonly(
+          "operating_point",
+          [](const Result& r) -> py::object {
+            const PerQueryResult& p = r.run.per_query;
+            if (!p.has_operating_point) return py::none();
+            py::dict d;
+            d["threshold"] = p.operating_point.threshold;
+            d["precision"] = p.operating_point.precision;
+            d["recall"] = p.operating_point.recall;
+            return std::move(d);
+          },
+          "With accept_threshold: {\"threshold\", \"precision\", \"recall\"} of the answers "
+          "whose score is <= it; else None.")
       .def_property_readonly(
           "max_f1_precision", [](const Result& r) { return r.run.per_query.max_f1_precision; },
           "Precision at max_f1.")
@@ -334,7 +357,7 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
       .def_property_readonly(
           "curve", [](const Result& r) { return Curve{r.run.per_query.curve}; },
           "Per-query precision-recall curve (openable.Curve), one point per distinct best-match "
-          "distance.")
+          "score.")
       .def_property_readonly(
           "best", [](const Result& r) { return ArrayOf(r.run.per_query.best); },
           "int32 array, per query row of the block: its best candidate column (-1 without "
@@ -396,7 +419,8 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
          const py::object& layout_name, const py::object& reference_frames, int tolerance,
          int exclusion, int vicinity, int able_thresholds, double radius, double heading_limit,
          const py::object& min_frame_gap, const std::string& axes, bool normalize,
-         const std::string& label) {
+         const std::string& label, const std::string& score, int score_window,
+         const py::object& accept_threshold) {
         const MatView view = Matrix2D(matrix, Elements::kFloat32, "matrix");
         const int full_rows = view.mat.rows, full_cols = view.mat.cols;
         Result result;
@@ -405,6 +429,13 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
         s.options.exclusion = exclusion;
         s.options.vicinity = vicinity;
         s.options.able_thresholds = able_thresholds;
+        s.options.score = ParseEnum<MatchScore>(score, "score");
+        s.options.score_window = score_window;
+        if (!accept_threshold.is_none()) {
+          s.options.accept_threshold = accept_threshold.cast<double>();
+          if (!(s.options.accept_threshold >= 0))
+            throw py::value_error("accept_threshold: expected None or a number >= 0");
+        }
         if (able_thresholds < 2) throw py::value_error("able_thresholds: expected >= 2");
         WithArgumentNames([&] { s.options.Check(); });
         const EvaluationLayout layout =
@@ -520,7 +551,8 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
               m = scaled;
             }
           }
-          run.per_query = EvaluatePerQuery(m, layout, gt, s.options);
+          run.per_query =
+              WithArgumentNames([&] { return EvaluatePerQuery(m, layout, gt, s.options); });
           run.able_p = EvaluateAbleP(m, layout, gt, s.options);
         }
         return result;
@@ -535,12 +567,14 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
       py::arg("exclusion") = 100, py::arg("vicinity") = 7, py::arg("able_thresholds") = 100,
       py::arg("radius") = 5.0, py::arg("heading_limit") = -1.0,
       py::arg("min_frame_gap") = py::none(), py::arg("axes") = "xyz", py::arg("normalize") = true,
-      py::arg("label") = "python",
+      py::arg("label") = "python", py::arg("score") = "distance", py::arg("score_window") = 10,
+      py::arg("accept_threshold") = py::none(),
       R"doc(evaluate(matrix, *, truth_matrix=None, pairs=None, poses=None, reference_poses=None,
     aligned=False, truth_file=None, truth_type=None, truth_file_2="", base=-1, first_frame=0,
     range_selected=False, layout=None, reference_frames=None, tolerance=2, exclusion=100,
     vicinity=7, able_thresholds=100, radius=5.0, heading_limit=-1.0, min_frame_gap=None, axes="xyz",
-    normalize=True, label="python") -> EvaluationResult
+    normalize=True, label="python", score="distance", score_window=10,
+    accept_threshold=None) -> EvaluationResult
 
 Evaluates a distance matrix against ground truth with both protocols of docs/evaluation.md,
 exactly as Test_OpenABLE (Ground_truth_type) and openable_evaluate do.
@@ -580,6 +614,13 @@ Args:
     normalize (bool): divide the matrix by its maximum first (Eq. 5), as openable_evaluate
         does; Test_OpenABLE's M' is unchanged by it.
     label (str): the run's label in to_json().
+    score (str): what ranks and accepts each query's best match in the per-query protocol
+        (Match_score): "distance" or "ratio" (its distance over the best candidate more than
+        score_window frames away; docs/evaluation.md). The ABLE-P cell protocol is unchanged.
+    score_window (int): frames on each side of the best match that are not its rivals (>= 0,
+        smaller than the references).
+    accept_threshold (float | None): an operating point (Match_threshold): operating_point
+        gives the precision and recall of the answers whose score is <= it.
 
 Returns:
     EvaluationResult: figures (auc, recall_at_100p, max_f1, recall_at_1/5/10,

@@ -1,11 +1,16 @@
-// Distance matrices: hamming_distances, l2_distances, sequence_distances, normalize_by_max,
-// threshold_matrix, read_matrix.
+// Distance matrices: hamming_distances, l2_distances, l1_distances, sequence_distances,
+// contrast_enhancement, normalize_by_max, threshold_matrix, best_matches, read_matrix.
+#include <limits>
+
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/python/common.h"
+#include "matching/contrast.h"
 #include "matching/distances.h"
 #include "matching/normalize.h"
+#include "matching/score.h"
 #include "matching/sequence.h"
 
 namespace openable::python {
@@ -106,11 +111,44 @@ Returns:
     numpy.ndarray: float32, shape (N, M) (no copy of the C++ result).)doc");
 
   m.def(
+      "l1_distances",
+      [](const py::object& a, const py::object& b, int threads) {
+        const MatView va = Matrix2D(a, Elements::kUint8, "a");
+        MatView vb;
+        if (!b.is_none()) vb = Matrix2D(b, Elements::kUint8, "b");
+        CheckWidths(va.mat, vb.mat);
+        cv::Mat1f out;
+        {
+          py::gil_scoped_release release;
+          out = L1Distances(va.mat, vb.mat, threads);
+        }
+        return ToNumpy(out);
+      },
+      py::arg("a"), py::arg("b") = py::none(), py::arg("threads") = 0,
+      R"doc(l1_distances(a, b=None, threads=0) -> numpy.ndarray
+
+Sums of absolute byte differences between every row of `a` and every row of `b`: the
+distance of SAD rows (SeqSLAM), with the CPU's sum-of-absolute-differences instruction (AVX2)
+when it has one.
+
+Args:
+    a (numpy.ndarray): uint8, shape (N, W) (a 1-D array is one row).
+    b (numpy.ndarray | None): uint8, shape (M, W); None compares `a` with itself.
+    threads (int): threads; 0 = all cores.
+
+Returns:
+    numpy.ndarray: float32, shape (N, M) (no copy of the C++ result).
+
+Raises:
+    ValueError: not uint8, or rows of different widths.)doc");
+
+  m.def(
       "sequence_distances",
       [](const py::object& d, int sequence_length, const std::string& direction,
          const py::object& row_starts, const py::object& col_starts, int threads,
-         bool in_place) -> py::object {
+         bool in_place, const std::string& partial) -> py::object {
         const auto dir = ParseEnum<SequenceDirection>(direction, "direction");
+        const auto part = ParseEnum<SequencePartial>(partial, "partial");
         const std::vector<int> rows = Starts(row_starts, "row_starts");
         const std::vector<int> cols = Starts(col_starts, "col_starts");
         if (in_place) {
@@ -119,7 +157,7 @@ Returns:
           const uchar* before = target.data;
           {
             py::gil_scoped_release release;
-            SequenceDistancesInPlace(target, sequence_length, rows, cols, dir, threads);
+            SequenceDistancesInPlace(target, sequence_length, rows, cols, dir, threads, part);
             if (target.data != before) target.copyTo(view.mat);  // never expected; kept safe
           }
           return view.owner;
@@ -128,21 +166,23 @@ Returns:
         cv::Mat1f out;
         {
           py::gil_scoped_release release;
-          out = SequenceDistances(cv::Mat1f(view.mat), sequence_length, rows, cols, dir, threads);
+          out = SequenceDistances(cv::Mat1f(view.mat), sequence_length, rows, cols, dir, threads,
+                                  part);
         }
         return ToNumpy(out);
       },
       py::arg("d"), py::arg("sequence_length"), py::arg("direction") = "forward",
       py::arg("row_starts") = py::none(), py::arg("col_starts") = py::none(),
-      py::arg("threads") = 0, py::arg("in_place") = false,
+      py::arg("threads") = 0, py::arg("in_place") = false, py::arg("partial") = "scale",
       R"doc(sequence_distances(d, sequence_length, direction="forward", row_starts=None,
-    col_starts=None, threads=0, in_place=False) -> numpy.ndarray
+    col_starts=None, threads=0, in_place=False, partial="scale") -> numpy.ndarray
 
 Sequence matching (ABLE, after SeqSLAM): the distance of the places of frames i and j is the
 sum of the L single-frame distances along the diagonal ending at (i, j):
 forward S(i, j) = sum_k D(i-k, j-k), reverse S(i, j) = sum_k D(i-k, j+k) (the reference
 route driven the other way), both = the smaller of the two; k = 0 .. L-1. Where fewer than L
-terms exist (the first frames of a traversal) the available terms are scaled to L. Sums never
+terms exist (the first frames of a traversal) the available terms are scaled to L
+(partial="scale") or the cell holds +inf (partial="skip", OpenSeqSLAM's rule). Sums never
 cross from one traversal into another. One pass whatever L.
 
 Args:
@@ -156,12 +196,46 @@ Args:
     threads (int): threads; 0 = all cores.
     in_place (bool): overwrite `d` (a writable float32 array with contiguous rows) and return
         it, instead of returning a new matrix.
+    partial (str): "scale" or "skip" (Sequence_partial).
 
 Returns:
     numpy.ndarray: float32, shape (N, M).
 
 Raises:
-    ValueError: L < 1, starts not increasing from 0, a bad direction.)doc");
+    ValueError: L < 1, starts not increasing from 0, a bad direction or partial.)doc");
+
+  m.def(
+      "contrast_enhancement",
+      [](const py::object& d, int window, const py::object& col_starts, int threads) {
+        const MatView view = Matrix2D(d, Elements::kFloat32, "d");
+        const std::vector<int> cols = Starts(col_starts, "col_starts");
+        if (window < 1) throw py::value_error("window: " + std::to_string(window) +
+                                              "; expected >= 1 (references on each side)");
+        cv::Mat1f out;
+        {
+          py::gil_scoped_release release;
+          cv::Mat1f(view.mat).copyTo(out);
+          EnhanceContrast(out, window, cols, threads);
+        }
+        return ToNumpy(out);
+      },
+      py::arg("d"), py::arg("window") = 10, py::arg("col_starts") = py::none(),
+      py::arg("threads") = 0,
+      R"doc(contrast_enhancement(d, window=10, col_starts=None, threads=0) -> numpy.ndarray
+
+SeqSLAM's local contrast enhancement of single-frame distances (Contrast_enhancement): each
+cell minus the mean of its row's cells within +-window columns of its traversal, divided by
+their standard deviation (0 where they are all equal), then the whole matrix shifted so that
+its smallest value is 0. Non-finite cells are left out and kept.
+
+Args:
+    d (numpy.ndarray): shape (N, M) single-frame distances (a new matrix is returned).
+    window (int): columns on each side (Contrast_window), >= 1.
+    col_starts (list[int] | None): first column of each traversal (None: one traversal).
+    threads (int): threads; 0 = all cores.
+
+Returns:
+    numpy.ndarray: float32, shape (N, M).)doc");
 
   m.def(
       "normalize_by_max",
@@ -180,16 +254,17 @@ Raises:
       R"doc(normalize_by_max(matrix) -> tuple[numpy.ndarray, float]
 
 Eq. 5: M' = M / max(M), as Test_OpenABLE normalises its matrix (a matrix whose maximum is 0
-stays 0).
+stays 0). +inf entries (sequence cells skipped, partial="skip") are left out of the maximum
+and stay +inf.
 
 Args:
-    matrix (numpy.ndarray): non-negative finite distances, shape (N, M).
+    matrix (numpy.ndarray): non-negative distances, shape (N, M).
 
 Returns:
-    (numpy.ndarray, float): M' (float32, a new array) and max(M).
+    (numpy.ndarray, float): M' (float32, a new array) and the largest finite entry of M.
 
 Raises:
-    ValueError: a negative or non-finite entry.)doc");
+    ValueError: a negative or NaN entry.)doc");
 
   m.def(
       "threshold_matrix",
@@ -213,6 +288,54 @@ Args:
 
 Returns:
     numpy.ndarray: uint8 0/1, shape (N, M).)doc");
+
+  m.def(
+      "best_matches",
+      [](const py::object& matrix, const std::string& score, int score_window) {
+        const MatView view = Matrix2D(matrix, Elements::kFloat32, "matrix");
+        const MatchScore kind = ParseEnum<MatchScore>(score, "score");
+        if (score_window < 0)
+          throw py::value_error("score_window: " + std::to_string(score_window) +
+                                "; expected >= 0");
+        const cv::Mat1f d(view.mat);
+        const int n = d.rows;
+        py::array_t<int> best(n);
+        py::array_t<float> distance(n), scores(n);
+        {
+          auto b = best.mutable_unchecked<1>();
+          auto dist = distance.mutable_unchecked<1>();
+          auto sc = scores.mutable_unchecked<1>();
+          py::gil_scoped_release release;
+          for (int q = 0; q < n; ++q) {
+            const float* row = d.ptr<float>(q);
+            const int c = BestCandidate(row, d.cols);
+            b(q) = c;
+            dist(q) = c < 0 ? std::numeric_limits<float>::quiet_NaN() : row[c];
+            sc(q) = c < 0 ? std::numeric_limits<float>::quiet_NaN()
+                          : ScoreOfCandidate(row, d.cols, c, kind, score_window);
+          }
+        }
+        return py::make_tuple(best, distance, scores);
+      },
+      py::arg("matrix"), py::arg("score") = "distance", py::arg("score_window") = 10,
+      R"doc(best_matches(matrix, score="distance", score_window=10) -> tuple
+
+Each row's best match and its confidence (Match_score), as the evaluation and the matches
+file score them: the best column is the smallest finite value (lowest column on ties); the
+distance score is that value; the ratio score divides it by the smallest finite value of the
+row more than score_window columns away from it (1 when there is none, or when that value
+is 0). To leave columns out (the last Exclusion frames of a loop-closure row, another
+traversal), set them to +inf first.
+
+Args:
+    matrix (numpy.ndarray): shape (N, M): queries x candidates (e.g. the query-reference
+        block of a normalised matrix).
+    score (str): "distance" or "ratio".
+    score_window (int): columns on each side of the best that are not its rivals, >= 0.
+
+Returns:
+    (best, distance, score): int32 (N,) columns (-1 where a row has no finite value), and
+    float32 (N,) distances and scores (NaN there).)doc");
 
   m.def(
       "read_matrix",

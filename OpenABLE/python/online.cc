@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <tuple>
 #include <type_traits>
 #include <utility>
@@ -18,12 +19,14 @@ namespace {
 
 // The description part of OnlineOptions.
 OnlineOptions DescriptionOptions(const std::string& descriptor, const std::string& description,
-                                 int patch_size, int ldb_bits, std::pair<int, int> grid) {
+                                 int patch_size, int ldb_bits, std::pair<int, int> grid,
+                                 int sad_patch) {
   OnlineOptions o;
   o.descriptor = descriptor;
   o.description = ParseEnum<DescriptionType>(description, "description");
   o.patch_size = patch_size;
   o.ldb_bits = ldb_bits;
+  o.sad_patch = sad_patch;
   o.grid_x = grid.first;
   o.grid_y = grid.second;
   return o;
@@ -47,7 +50,7 @@ struct Detector {
 py::tuple ResultTuple(const OnlineResult& r) {
   py::list candidates;
   for (const LoopCandidate& c : r.candidates)
-    candidates.append(py::make_tuple(c.frame, c.distance, c.normalized, c.accepted));
+    candidates.append(py::make_tuple(c.frame, c.distance, c.normalized, c.accepted, c.score));
   py::dict timings;
   timings["describe_seconds"] = r.describe_seconds;
   timings["search_seconds"] = r.search_seconds;
@@ -79,6 +82,9 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
           "\"global\" (the frame resized to the patch) or \"grid\" (grid cells).")
       .def_readwrite("patch_size", &O::patch_size, "Side of the square patch, pixels.")
       .def_readwrite("ldb_bits", &O::ldb_bits, "Bits of LDB rows (1..1386).")
+      .def_readwrite("sad_patch", &O::sad_patch,
+                     "SAD: side of the normalised squares, pixels (2..64; describe_images only: "
+                     "the detector needs a Hamming or L2 descriptor).")
       .def_property(
           "grid", [](const O& o) { return std::make_pair(o.grid_x, o.grid_y); },
           [](O& o, std::pair<int, int> g) { std::tie(o.grid_x, o.grid_y) = g; },
@@ -88,12 +94,22 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
       .def_readwrite("exclusion", &O::exclusion,
                      "Frame q's candidates are frames j <= q - exclusion (>= 1).")
       .def_readwrite("candidates", &O::candidates, "Candidates returned per frame (>= 1).")
+      .def_property(
+          "score", [](const O& o) { return EnumName(o.score); },
+          [](O& o, const std::string& n) { o.score = ParseEnum<MatchScore>(n, "score"); },
+          "\"distance\" (a candidate's normalised distance) or \"ratio\" (its distance over "
+          "that of the best candidate more than score_window frames away; 1 without one): "
+          "what threshold accepts (Match_score).")
+      .def_readwrite("score_window", &O::score_window,
+                     "Frames on each side of a candidate that are not its rivals for the ratio "
+                     "score (>= 0; Match_score_window).")
       .def_readwrite("threshold", &O::threshold,
-                     "A candidate is accepted when its normalised distance is <= threshold: "
-                     "the distance divided by L x the descriptor's bit count for binary "
-                     "descriptors (the mean fraction of differing bits), by L x the largest "
-                     "single-frame distance seen so far for float descriptors. Not the scale "
-                     "of Config.txt's Threshold.")
+                     "A candidate is accepted when its score is <= threshold. The distance "
+                     "score is the distance divided by L x the descriptor's bit count for "
+                     "binary descriptors (the mean fraction of differing bits), by L x the "
+                     "largest single-frame distance seen so far for float descriptors: not the "
+                     "scale of Config.txt's Threshold. The default 0.13 is for that score; "
+                     "choose another for the ratio (docs/library.md).")
       .def_readwrite("exact_limit", &O::exact_limit,
                      "Exact search while the searchable map holds at most this many frames.")
       .def_readwrite("block_frames", &O::block_frames, "Frames per FLANN block beyond it.")
@@ -159,7 +175,9 @@ const char* const kDescriptionArgs =
         row-major cell order).
     patch_size (int): side of the square patch, pixels (>= 16; HOG: a multiple of 8).
     ldb_bits (int): bits of LDB rows (1..1386; 256 = 32 bytes).
-    grid (tuple[int, int]): (cells across, cells down) for description="grid".)doc";
+    grid (tuple[int, int]): (cells across, cells down) for description="grid".
+    sad_patch (int): SAD: side of the normalised squares of its Patch_size x Patch_size/2
+        thumbnail, pixels (2..64).)doc";
 
 }  // namespace
 
@@ -167,17 +185,18 @@ void RegisterOnline(py::module_& m) {
   m.def(
       "describe",
       [](const py::object& image, const std::string& descriptor, const std::string& description,
-         int patch_size, int ldb_bits, std::pair<int, int> grid) {
+         int patch_size, int ldb_bits, std::pair<int, int> grid, int sad_patch) {
         const OnlineOptions o =
-            DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid);
+            DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid, sad_patch);
         const cv::Mat rows = Describe({Image(image, "image")}, o, 1);
         return ToNumpy(rows.row(0).clone(), true);
       },
       py::arg("image"), py::arg("descriptor") = "LDB", py::arg("description") = "global",
       py::arg("patch_size") = 64, py::arg("ldb_bits") = 256, py::arg("grid") = std::make_pair(1, 1),
+      py::arg("sad_patch") = 8,
       (std::string(
            R"doc(describe(image, descriptor="LDB", description="global", patch_size=64,
-    ldb_bits=256, grid=(1, 1)) -> numpy.ndarray
+    ldb_bits=256, grid=(1, 1), sad_patch=8) -> numpy.ndarray
 
 The descriptor row of one image, as Test_OpenABLE describes a frame (grey conversion, then
 global or grid description).
@@ -189,7 +208,7 @@ Args:
        kDescriptionArgs + R"doc(
 
 Returns:
-    numpy.ndarray: 1-D; uint8 bytes for binary descriptors, float32 for SIFT and HOG.
+    numpy.ndarray: 1-D; uint8 bytes for binary descriptors and SAD, float32 for SIFT and HOG.
 
 Raises:
     openable.InputError: unknown descriptor, bad options, or an image too small.)doc")
@@ -198,17 +217,17 @@ Raises:
   m.def(
       "describe_images",
       [](const py::object& images, const std::string& descriptor, const std::string& description,
-         int patch_size, int ldb_bits, std::pair<int, int> grid, int threads) {
+         int patch_size, int ldb_bits, std::pair<int, int> grid, int sad_patch, int threads) {
         const OnlineOptions o =
-            DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid);
+            DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid, sad_patch);
         return ToNumpy(Describe(Images(images, "images"), o, threads));
       },
       py::arg("images"), py::arg("descriptor") = "LDB", py::arg("description") = "global",
       py::arg("patch_size") = 64, py::arg("ldb_bits") = 256, py::arg("grid") = std::make_pair(1, 1),
-      py::arg("threads") = 0,
+      py::arg("sad_patch") = 8, py::arg("threads") = 0,
       (std::string(
            R"doc(describe_images(images, descriptor="LDB", description="global", patch_size=64,
-    ldb_bits=256, grid=(1, 1), threads=0) -> numpy.ndarray
+    ldb_bits=256, grid=(1, 1), sad_patch=8, threads=0) -> numpy.ndarray
 
 One descriptor row per image, described in parallel (the GIL is released).
 
@@ -220,7 +239,8 @@ Args:
     threads (int): threads; 0 = all cores.
 
 Returns:
-    numpy.ndarray: (N, W) uint8 (binary) or float32 (SIFT, HOG); no copy of the C++ result.
+    numpy.ndarray: (N, W) uint8 (binary, SAD) or float32 (SIFT, HOG); no copy of the C++
+    result.
 
 Raises:
     openable.InputError: naming the image index.)doc")
@@ -229,16 +249,20 @@ Raises:
   m.def(
       "distance_matrix",
       [](const py::object& rows, int sequence_length, const std::string& direction,
-         const py::object& traversal_starts, int threads, bool return_max) -> py::object {
+         const py::object& traversal_starts, int threads, bool return_max,
+         const py::object& metric, const std::string& partial) -> py::object {
         const MatView v = Matrix2D(rows, Elements::kUint8OrFloat32, "rows");
         const auto dir = ParseEnum<SequenceDirection>(direction, "direction");
+        const auto part = ParseEnum<SequencePartial>(partial, "partial");
+        std::optional<Metric> m;
+        if (!metric.is_none()) m = ParseEnum<Metric>(metric.cast<std::string>(), "metric");
         std::vector<int> starts;
         if (!traversal_starts.is_none()) starts = traversal_starts.cast<std::vector<int>>();
         float max = 0;
         cv::Mat1f out;
         {
           py::gil_scoped_release release;
-          out = DistanceMatrix(v.mat, sequence_length, dir, starts, threads, &max);
+          out = DistanceMatrix(v.mat, sequence_length, dir, starts, threads, &max, m, part);
         }
         py::array a = ToNumpy(out);
         if (return_max) return py::make_tuple(a, max);
@@ -246,12 +270,13 @@ Raises:
       },
       py::arg("rows"), py::arg("sequence_length") = 1, py::arg("direction") = "forward",
       py::arg("traversal_starts") = py::none(), py::arg("threads") = 0,
-      py::arg("return_max") = false,
+      py::arg("return_max") = false, py::arg("metric") = py::none(),
+      py::arg("partial") = "scale",
       R"doc(distance_matrix(rows, sequence_length=1, direction="forward", traversal_starts=None,
-    threads=0, return_max=False) -> numpy.ndarray
+    threads=0, return_max=False, metric=None, partial="scale") -> numpy.ndarray
 
 The normalised matrix M' of Test_OpenABLE over descriptor rows: distances between all rows
-(Hamming for uint8 rows, L2 for float32), summed along sequences of L frames
+(Hamming for uint8 rows, L2 for float32, or `metric`), summed along sequences of L frames
 (sequence_distances), divided by their largest value (Eq. 5).
 
 Args:
@@ -263,10 +288,14 @@ Args:
         concatenated (e.g. [0, N1]): sums never cross between them. None: one traversal.
     threads (int): threads; 0 = all cores.
     return_max (bool): also return the divisor max(M).
+    metric (str | None): "hamming" or "l1" (uint8 rows; l1 for SAD's rows) or "l2" (float32
+        rows); None: by the rows' type.
+    partial (str): "scale" or "skip" (Sequence_partial): cells with fewer than L frames
+        before them are scaled up, or hold +inf (never a best match).
 
 Returns:
-    numpy.ndarray: float32 (N, N) in [0, 1], owning the C++ result (no copy); or (matrix,
-    max) with return_max=True.)doc");
+    numpy.ndarray: float32 (N, N) in [0, 1] (+inf for skipped cells), owning the C++ result
+    (no copy); or (matrix, max) with return_max=True.)doc");
 
   BindOnlineOptions(m);
   // The signature of the constructor, from the defaults of the options' properties.
@@ -324,7 +353,7 @@ earlier run, which later frames find as candidates like any other frame.)doc")
             return ResultTuple(r);
           },
           py::arg("image"),
-          R"doc(add_frame(image) -> tuple[int, list[tuple[int, float, float, bool]], dict]
+          R"doc(add_frame(image) -> tuple[int, list[tuple[int, float, float, bool, float]], dict]
 
 Describes `image` and adds it as the next frame (the GIL is released meanwhile).
 
@@ -334,7 +363,8 @@ Args:
 Returns:
     (frame, candidates, timings): the index of the frame added (0, 1, ...); its candidates,
     best first (ties: earlier frame first), each (earlier frame, raw sequence distance,
-    normalised distance, accepted), empty while no frame is old enough; timings
+    normalised distance, accepted, score: the normalised distance or the ratio, as the option
+    score says; accepted is score <= threshold), empty while no frame is old enough; timings
     {"describe_seconds", "search_seconds", "approximate": whether FLANN blocks were used}.
 
 Raises:

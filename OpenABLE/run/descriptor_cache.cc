@@ -102,7 +102,7 @@ const std::vector<std::string>& DescriptionKeys() {
       "Camera_type",  "Description_type", "Patch_size",  "Grid_x",
       "Grid_y",       "Panoramas",        "Illumination_invariance",
       "Alpha",        "Lambda_red",       "Lambda_green", "Lambda_blue",
-      "Image_descriptor", "Ldb_bits",  "Side_window", "Side_window_radii",
+      "Image_descriptor", "Ldb_bits", "Sad_patch", "Side_window", "Side_window_radii",
       "Noise_gaussian", "Noise_salt_pepper", "Noise_overexposure", "Noise_seed"};
   return keys;
 }

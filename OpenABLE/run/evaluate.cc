@@ -1,10 +1,13 @@
 #include "OpenABLE/run/evaluate.h"
 
 #include <cctype>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <stdexcept>
 
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/evaluation/plots.h"
@@ -37,6 +40,9 @@ EvaluationSettings EvaluationSettingsFrom(const Config& c) {
   s.truth.range_selected = c.input.initial_image > 0 || c.input.final_image != -1;
   s.truth.min_frame_gap =
       c.evaluation.min_frame_gap >= 0 ? c.evaluation.min_frame_gap : s.options.exclusion;
+  s.options.score = c.matching.score;
+  s.options.score_window = c.matching.score_window;
+  s.options.accept_threshold = c.matching.match_threshold;
   s.truth.Check();
   s.options.Check();
   return s;
@@ -90,7 +96,10 @@ void StageEvaluation(OutputBatch& batch, const std::string& key, const std::stri
     batch.Stage(key, stem + "_ablep.csv", EncodeCurveCsv(run.able_p.curve));
     batch.Stage(key, stem + "_overlay.png",
                 EncodePng(RenderOverlay(*matrices[i], run.layout, evaluation.truths[i],
-                                        run.per_query, run.per_query.max_f1_threshold)));
+                                        run.per_query,
+                                        run.per_query.has_operating_point
+                                            ? run.per_query.operating_point.threshold
+                                            : run.per_query.max_f1_threshold)));
     series.push_back({run.label, run.per_query.curve, run.able_p.curve});
   }
   std::string title = "Precision-recall, " + GroundTruthTypeName(s.truth.type) +
@@ -108,9 +117,21 @@ std::vector<cv::Mat1f> EvaluateMatrixFiles(Evaluation& evaluation,
   loaded.reserve(files.size());
   for (const MatrixFile& m : files) {
     cv::Mat1f matrix = ReadMatrixFile(m.path);
-    if (!cv::checkRange(matrix, true, nullptr, 0.0, 3.0e38))
-      throw InputError("matrix " + Quoted(m.path) +
-                       " holds a negative, infinite or NaN value; expected distances >= 0");
+    // NaN marks a cell without a value (Test_OpenABLE's .npy with Sequence_partial skip): it
+    // becomes +inf, never a candidate, as in the run itself. A plain loop: OpenCV's vectorised
+    // comparisons do not single out NaN.
+    for (int i = 0; i < matrix.rows; ++i) {
+      float* row = matrix.ptr<float>(i);
+      for (int j = 0; j < matrix.cols; ++j) {
+        if (std::isnan(row[j])) {
+          row[j] = std::numeric_limits<float>::infinity();
+        } else if (!(row[j] >= 0.0f) || std::isinf(row[j])) {
+          throw InputError("matrix " + Quoted(m.path) + " holds " + FormatNumber(row[j]) +
+                           " at row " + std::to_string(i) + ", column " + std::to_string(j) +
+                           "; expected distances >= 0 (NaN for a cell without a value)");
+        }
+      }
+    }
     NormalizeByMax(matrix);
     EvaluationLayout layout;
     if (matrix.rows != matrix.cols) {

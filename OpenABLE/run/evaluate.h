@@ -53,8 +53,8 @@ struct MatrixFile {
   std::string label;  // legend label; empty: the file name without its extension
 };
 
-// Reads each matrix (ReadMatrixFile: .npy, text or image), refuses negative, infinite or NaN
-// values, normalises it by its maximum (Eq. 5; no change for Test_OpenABLE's M'), takes its
+// Reads each matrix (ReadMatrixFile: .npy, text or image), refuses negative or infinite values
+// (NaN is a cell without a value: never a candidate), normalises it by its maximum (Eq. 5; no change for Test_OpenABLE's M'), takes its
 // layout (not square: queries x references; square: two traversals of which the first
 // `reference_frames` frames are the reference when reference_frames > 0, else one sequence)
 // and evaluates it into `evaluation` (EvaluateMatrix). Returns the normalised matrices in the

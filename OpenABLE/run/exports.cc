@@ -291,8 +291,8 @@ std::vector<std::string> OutputBatch::Paths() const {
 
 std::string EncodeMatches(const std::vector<Match>& matches, bool csv) {
   if (csv) {
-    std::string out = "query,reference,distance,rank\n";
-    char buf[96];
+    std::string out = "query,reference,distance,rank,score\n";
+    char buf[128];
     for (const Match& k : matches) {
       char* p = buf;
       p = std::to_chars(p, buf + sizeof buf, k.query).ptr;
@@ -302,14 +302,16 @@ std::string EncodeMatches(const std::vector<Match>& matches, bool csv) {
       p = std::to_chars(p, buf + sizeof buf, k.distance, std::chars_format::general, 7).ptr;
       *p++ = ',';
       p = std::to_chars(p, buf + sizeof buf, k.rank).ptr;
+      *p++ = ',';
+      p = std::to_chars(p, buf + sizeof buf, k.score, std::chars_format::general, 7).ptr;
       *p++ = '\n';
       out.append(buf, p);
     }
     return out;
   }
-  // A structured .npy: one record of 16 bytes per match (written by hand, as NpyHeader).
+  // A structured .npy: one record of 20 bytes per match (written by hand, as NpyHeader).
   std::string dict = "{'descr': [('query', '<i4'), ('reference', '<i4'), ('distance', '<f4'), "
-                     "('rank', '<i4')], 'fortran_order': False, 'shape': (" +
+                     "('rank', '<i4'), ('score', '<f4')], 'fortran_order': False, 'shape': (" +
                      std::to_string(matches.size()) + ",), }";
   const size_t total = 10 + dict.size() + 1;
   dict.append((total + 63) / 64 * 64 - total, ' ');
@@ -318,14 +320,15 @@ std::string EncodeMatches(const std::vector<Match>& matches, bool csv) {
   out.push_back(static_cast<char>(dict.size() & 0xFF));
   out.push_back(static_cast<char>(dict.size() >> 8));
   out += dict;
-  out.reserve(out.size() + matches.size() * 16);
+  out.reserve(out.size() + matches.size() * 20);
   for (const Match& k : matches) {
-    char rec[16];
+    char rec[20];
     std::memcpy(rec, &k.query, 4);
     std::memcpy(rec + 4, &k.reference, 4);
     std::memcpy(rec + 8, &k.distance, 4);
     std::memcpy(rec + 12, &k.rank, 4);
-    out.append(rec, 16);
+    std::memcpy(rec + 16, &k.score, 4);
+    out.append(rec, 20);
   }
   return out;
 }

@@ -36,7 +36,7 @@ std::string EncodeText(const cv::Mat& m);
 std::string EncodePng(const cv::Mat& image);
 
 // Bytes of the matches file: .npy (structured array: query, reference int32; distance
-// float32; rank int32) or .csv (header "query,reference,distance,rank").
+// float32; rank int32; score float32) or .csv (header "query,reference,distance,rank,score").
 std::string EncodeMatches(const std::vector<Match>& matches, bool csv);
 
 

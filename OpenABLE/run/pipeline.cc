@@ -1,10 +1,12 @@
 #include "OpenABLE/run/pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <unistd.h>
 #include <future>
+#include <limits>
 #include <stdexcept>
 #include <filesystem>
 
@@ -18,6 +20,7 @@
 #include "OpenABLE/stereo/calibration.h"
 #include "OpenABLE/stereo/stereo_source.h"
 #include "descriptors/registry.h"
+#include "matching/contrast.h"
 #include "matching/matrix.h"
 #include "matching/normalize.h"
 #include "matching/panorama.h"
@@ -69,21 +72,201 @@ bool HasDisplay() {
   return std::getenv("DISPLAY") != nullptr || std::getenv("WAYLAND_DISPLAY") != nullptr;
 }
 
+Metric MetricOf(const Descriptor& d) {
+  switch (d.Distance()) {
+    case DistanceKind::kHamming: return Metric::kHamming;
+    case DistanceKind::kL2: return Metric::kL2;
+    case DistanceKind::kL1: break;
+  }
+  return Metric::kL1;
+}
+
+const char* DistanceText(Metric m) {
+  switch (m) {
+    case Metric::kHamming: return "Hamming";
+    case Metric::kL2: return "L2";
+    case Metric::kL1: break;
+  }
+  return "L1";
+}
+
+// The frames of every source described with one descriptor.
+struct Described {
+  cv::Mat rows;                      // the traversals' rows, concatenated
+  std::vector<Traversal> traversals;
+  std::string cache;
+  std::vector<std::string> warnings, notes;
+  double seconds = 0;
+  int frames = 0;
+};
+
+// Describes every source with `describer`; `config` is the run's with Image_descriptor the one
+// descriptor described (it keys the descriptor cache).
+Described DescribeSources(const Config& config, const FrameDescriber& describer,
+                          const std::string& name, const std::vector<SourceSpec>& specs,
+                          const std::vector<std::unique_ptr<FrameSource>>& sources,
+                          ProgressReporter& progress) {
+  const InputOptions& input = config.input;
+  Described out;
+  DescribeOptions options;
+  options.threads = config.matching.threads;
+  options.skip_unreadable = input.skip_unreadable;
+  options.show_images = config.output.show_images && HasDisplay();
+  options.preprocess = config.preprocess;
+
+  // Descriptor cache: image folders only (a video frame or a stereo pair has no one file).
+  std::unique_ptr<DescriptorCache> cache;
+  const ScaleOptions& scale = config.scale;
+  if (!scale.descriptor_cache.empty()) {
+    if (specs.front().kind != SourceKind::kFolder) {
+      out.notes.push_back("Descriptor_cache: not used: the cache keeps rows of image "
+                          "files (Frame_mode 0, Camera_type 0 or 2), not of videos or "
+                          "stereo pairs");
+    } else if (options.show_images) {
+      out.notes.push_back("Descriptor_cache: not used with Show_images 1");
+    } else if (options.preprocess.noise.Any()) {
+      // The noise of a frame depends on its position in the run, not only on its bytes.
+      out.notes.push_back("Descriptor_cache: not used with Noise_* (a frame's noise depends "
+                          "on its position in the run, not only on the image)");
+    } else {
+      cache = DescriptorCache::Open(
+          scale.descriptor_cache,
+          DescriptionSettingsText(config, name, describer.RowWidth(), describer.RowType()),
+          describer.RowWidth(), describer.RowType(), out.warnings);
+      options.cache = cache.get();
+    }
+  }
+
+  const auto t = Clock::now();
+  std::vector<cv::Mat> blocks;
+  int row = 0;
+  for (size_t s = 0; s < sources.size(); ++s) {
+    const bool stereo = specs[s].kind == SourceKind::kStereo;
+    options.key = stereo ? "" : specs[s].key;  // stereo read errors name their own key
+    options.noise_stream = static_cast<int>(s);  // each traversal its own noise
+    progress.Begin("describing", sources[s]->Size(),
+                   stereo ? "stereo pairs (rectify" +
+                                std::string(describer.Channels() == 2 ? ", SGBM" : "") + ", " +
+                                name + ")"
+                          : "frames of " + specs[s].key + " (" + name + ")");
+    DescribedSequence seq = DescribeSequence(*sources[s], describer, options,
+                                             [&](int done, int) { progress.Update(done); });
+    progress.End();
+    Traversal tr;
+    tr.key = specs[s].key;
+    tr.path = specs[s].path;
+    tr.first_row = row;
+    tr.frames = seq.rows.rows;
+    tr.skipped = seq.skipped;
+    tr.frame_size = seq.frame_size;
+    for (int i : seq.kept) tr.names.push_back(sources[s]->FrameName(i));
+    row += tr.frames;
+    out.frames += sources[s]->Size();
+    out.traversals.push_back(std::move(tr));
+    blocks.push_back(seq.rows);
+  }
+  out.seconds = SecondsSince(t);
+  if (cache) {
+    out.cache = std::to_string(cache->Hits()) + " of " +
+                std::to_string(out.frames) + " frames from the cache, " +
+                std::to_string(cache->Stored()) + " added (\"" + cache->Path() + "\")";
+    const std::string problem = cache->WriteProblem();
+    if (!problem.empty()) out.warnings.push_back(problem);
+  }
+  cv::vconcat(blocks, out.rows);
+  return out;
+}
+
+// Adds `more` to `all`, each line once.
+void AddLines(std::vector<std::string>& all, const std::vector<std::string>& more) {
+  for (const std::string& line : more)
+    if (std::find(all.begin(), all.end(), line) == all.end()) all.push_back(line);
+}
+
 }  // namespace
 
-RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
+const SingleFrame* SingleFrameStore::Find(const std::string& key) const {
+  for (const auto& [k, frame] : kept_)
+    if (k == key) return frame.get();
+  return nullptr;
+}
+
+const SingleFrame& SingleFrameStore::Keep(const std::string& key, SingleFrame frame) {
+  kept_.emplace_back(key, std::make_unique<SingleFrame>(std::move(frame)));
+  return *kept_.back().second;
+}
+
+std::string SingleFrameKey(const Config& config, const std::string& name) {
+  // Everything that can change a frame's row or a pair's distance stays; what acts after the
+  // single-frame matrix (sequences, scores, fusion, outputs, evaluation, tools) is reset.
+  Config c = config;
+  c.descriptor.name = name;
+  const PanoramaMatching panorama = c.matching.panorama_matching;
+  c.matching = MatchingOptions();
+  c.matching.panorama_matching = panorama;
+  c.output = OutputOptions();
+  c.scale = ScaleOptions();
+  c.evaluation = EvaluationConfig();
+  c.snaps = snaps::SnapsOptions();
+  c.odometry = odometry::OdometryOptions();
+  return FormatConfig(c);
+}
+
+RunResult ComputeRun(const Config& config, ProgressReporter& progress, SingleFrameStore* store) {
   CheckConfig(config);
   const auto run_start = Clock::now();
   RunResult result;
 
   const InputOptions& input = config.input;
   const MatchingOptions& matching = config.matching;
-  const auto descriptor = CreateDescriptor(config.descriptor);
+  // The descriptors (several: a fusion of their matrices), each created (and so checked) now.
+  const std::vector<std::string> names = DescriptorList(config.descriptor.name);
+  const bool fused = names.size() > 1;
+  std::vector<std::unique_ptr<Descriptor>> descriptors;
+  for (const std::string& name : names) {
+    DescriptorOptions o = config.descriptor;
+    o.name = name;
+    descriptors.push_back(CreateDescriptor(o));
+    if (fused && descriptors.back()->Channels() != 1)
+      throw InputError("Image_descriptor: \"" + config.descriptor.name + "\" fuses " + name +
+                       ", whose stereo frames carry a disparity channel the others do not "
+                       "read; expected " + name + " alone");
+    result.descriptors.push_back({name, 0, MetricOf(*descriptors.back())});
+  }
+  result.descriptor = names.front();
+  for (size_t k = 1; k < names.size(); ++k) result.descriptor += "+" + names[k];
+  if (fused) {
+    result.fusion_weights = matching.FusionWeights(static_cast<int>(names.size()));
+    if (matching.fusion_weights.empty()) {
+      for (const RunDescriptor& d : result.descriptors) {
+        if (d.metric == result.descriptors.front().metric) continue;
+        std::string kinds;
+        for (const RunDescriptor& e : result.descriptors)
+          kinds += (kinds.empty() ? "" : ", ") + e.name + ": " + DistanceText(e.metric);
+        std::string example = "1";
+        for (size_t k = 1; k < names.size(); ++k) example += ",1";
+        throw InputError("Fusion_weights: empty, but Image_descriptor \"" +
+                         config.descriptor.name + "\" fuses distances of different kinds (" +
+                         kinds + "); expected one weight per descriptor, e.g. Fusion_weights: " +
+                         example);
+      }
+    }
+  } else if (!matching.fusion_weights.empty()) {
+    result.notes.push_back("Fusion_weights: \"" + matching.fusion_weights + "\" not used: "
+                           "Image_descriptor " + names.front() + " is one descriptor");
+  }
+
   const bool panoramic = input.camera_type == CameraType::kPanoramic;
   const int strips = panoramic ? config.description.panoramas : 1;
   const PanoramaMatching panorama_matching = matching.panorama_matching;
-  const FrameDescriber describer(*descriptor, config.description.type, config.description.grid_x,
-                                 config.description.grid_y, strips);
+  std::vector<std::unique_ptr<FrameDescriber>> describers;
+  for (size_t k = 0; k < descriptors.size(); ++k) {
+    describers.push_back(std::make_unique<FrameDescriber>(
+        *descriptors[k], config.description.type, config.description.grid_x,
+        config.description.grid_y, strips));
+    result.descriptors[k].row_width = describers.back()->RowWidth();
+  }
+  const bool disparity = describers.front()->Channels() == 2;  // D-LDB, never fused
   // Eq. 7 replaces Alpha when the three peak responses are given.
   const bool lambdas = config.preprocess.lambda_red > 0;
   const double alpha = config.preprocess.Alpha();
@@ -93,7 +276,7 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
                                     EnumName(panorama_matching) + " matching"
                   : input.camera_type == CameraType::kStereo
                       ? std::string("stereo, rectified") +
-                            (descriptor->Channels() == 2 ? ", SGBM disparity" : ", left image")
+                            (disparity ? ", SGBM disparity" : ", left image")
                       : "monocular";
     if (config.preprocess.illumination_invariance) {
       std::snprintf(text, sizeof text, ", illumination invariant (Eq. 6, alpha %.4f%s)", alpha,
@@ -103,9 +286,6 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
       result.camera += ", grey";
     }
   }
-  result.descriptor = descriptor->Name();
-  result.row_width = describer.RowWidth();
-  result.binary = descriptor->Kind() == DescriptorKind::kBinary;
 
   // Open every source first, so that a bad second folder is reported before any work.
   std::vector<std::unique_ptr<FrameSource>> sources;
@@ -115,7 +295,7 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
       // The stereo source's messages name their keys (Images_path_left, Images_path_right,
       // Calibration_path) themselves.
       StereoSourceOptions stereo_options;
-      stereo_options.compute_disparity = describer.Channels() == 2;  // only D-LDB reads it
+      stereo_options.compute_disparity = disparity;  // only D-LDB reads it
       const StereoCalibration calibration = WithKey(
           "Calibration_path", [&] { return LoadStereoCalibration(input.calibration_path); });
       sources.push_back(OpenStereoFolders(input.images_path_left, input.images_path_right,
@@ -129,6 +309,17 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
                  : OpenImageFolder(spec.path, input.images_format, input.initial_image,
                                    input.final_image);
     }));
+  }
+
+  // The ratio score needs rivals: its window must leave references outside it.
+  if (matching.score == MatchScore::kRatio) {
+    const int references = sources.front()->Size();  // the reference traversal, or the one
+    if (matching.score_window >= references)
+      throw InputError("Match_score_window: " + std::to_string(matching.score_window) +
+                       " is not smaller than the reference traversal (" +
+                       std::to_string(references) + " frames of " + specs.front().key +
+                       "); expected a window that leaves rivals outside it for Match_score "
+                       "ratio (10 frames is typical), or Match_score distance");
   }
 
   // Dense or bounded (Matrix_mode), said in one line, decided before any work from the frame
@@ -171,85 +362,54 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
                      "matrix, but the run is " + result.mode_reason +
                      "; expected Matrix_mode 1 (or 0 with a larger Memory_limit) or "
                      "Panorama_matching 0");
+  // Fusion normalises each whole matrix and contrast enhancement reads a window of every row:
+  // both need the dense matrix.
+  if (result.bounded && fused)
+    throw InputError("Image_descriptor: \"" + config.descriptor.name + "\" fuses descriptors, "
+                     "which needs the dense matrix, but the run is " + result.mode_reason +
+                     "; expected one descriptor, or Matrix_mode 1 (or 0 with a larger "
+                     "Memory_limit)");
+  if (result.bounded && matching.contrast_enhancement)
+    throw InputError("Contrast_enhancement: 1 needs the dense matrix, but the run is " +
+                     result.mode_reason + "; expected 0, or Matrix_mode 1 (or 0 with a larger "
+                     "Memory_limit)");
+  if (scale.approximate_search && result.descriptors.front().metric == Metric::kL1)
+    throw InputError("Approximate_search: 1 with Image_descriptor " + names.front() +
+                     " (L1 distance), which FLANN's LSH and k-d trees do not index; expected "
+                     "Approximate_search 0 (the exact bounded mode) or another descriptor");
 
-  DescribeOptions options;
-  options.threads = matching.threads;
-  options.skip_unreadable = input.skip_unreadable;
-  options.show_images = config.output.show_images && HasDisplay();
-  options.preprocess = config.preprocess;
-
-  // Descriptor cache: image folders only (a video frame or a stereo pair has no one file).
-  std::unique_ptr<DescriptorCache> cache;
-  if (!scale.descriptor_cache.empty()) {
-    if (specs.front().kind != SourceKind::kFolder) {
-      result.notes.push_back("Descriptor_cache: not used: the cache keeps rows of image "
-                             "files (Frame_mode 0, Camera_type 0 or 2), not of videos or "
-                             "stereo pairs");
-    } else if (options.show_images) {
-      result.notes.push_back("Descriptor_cache: not used with Show_images 1");
-    } else if (options.preprocess.noise.Any()) {
-      // The noise of a frame depends on its position in the run, not only on its bytes.
-      result.notes.push_back("Descriptor_cache: not used with Noise_* (a frame's noise depends "
-                             "on its position in the run, not only on the image)");
-    } else {
-      cache = DescriptorCache::Open(
-          scale.descriptor_cache,
-          DescriptionSettingsText(config, descriptor->Name(), describer.RowWidth(),
-                                  describer.RowType()),
-          describer.RowWidth(), describer.RowType(), result.warnings);
-      options.cache = cache.get();
+  std::vector<int> starts;  // set from the first description
+  auto set_traversals = [&](const std::vector<Traversal>& traversals) {
+    if (result.traversals.empty()) {
+      result.traversals = traversals;
+      for (const auto& tr : traversals) starts.push_back(tr.first_row);
+      return;
     }
-  }
-
-  // Describe.
-  auto t = Clock::now();
-  std::vector<cv::Mat> blocks;
-  int row = 0;
-  for (size_t s = 0; s < sources.size(); ++s) {
-    const bool stereo = specs[s].kind == SourceKind::kStereo;
-    options.key = stereo ? "" : specs[s].key;  // stereo read errors name their own key
-    options.noise_stream = static_cast<int>(s);  // each traversal its own noise
-    progress.Begin("describing", sources[s]->Size(),
-                   stereo ? "stereo pairs (rectify" +
-                                std::string(describer.Channels() == 2 ? ", SGBM" : "") + ", " +
-                                result.descriptor + ")"
-                          : "frames of " + specs[s].key);
-    DescribedSequence seq = DescribeSequence(*sources[s], describer, options,
-                                             [&](int done, int) { progress.Update(done); });
-    progress.End();
-    Traversal tr;
-    tr.key = specs[s].key;
-    tr.path = specs[s].path;
-    tr.first_row = row;
-    tr.frames = seq.rows.rows;
-    tr.skipped = seq.skipped;
-    tr.frame_size = seq.frame_size;
-    for (int i : seq.kept) tr.names.push_back(sources[s]->FrameName(i));
-    row += tr.frames;
-    result.timings.frames += sources[s]->Size();
-    result.traversals.push_back(std::move(tr));
-    blocks.push_back(seq.rows);
-  }
-  result.timings.describe_seconds = SecondsSince(t);
-  if (cache) {
-    result.cache = std::to_string(cache->Hits()) + " of " +
-                   std::to_string(result.timings.frames) + " frames from the cache, " +
-                   std::to_string(cache->Stored()) + " added (\"" + cache->Path() + "\")";
-    const std::string problem = cache->WriteProblem();
-    if (!problem.empty()) result.warnings.push_back(problem);
-  }
-  cv::Mat descriptors;
-  cv::vconcat(blocks, descriptors);
-
-  std::vector<int> starts;
-  for (const auto& tr : result.traversals) starts.push_back(tr.first_row);
-  const std::int64_t n = descriptors.rows;
-  const MatchBlock block = BlockOf(starts, static_cast<int>(n));
-  KeepRules rules = scale.keep;
-  rules.exclusion = config.evaluation.protocol.exclusion;
-  rules.one_traversal = block.one_traversal;
+    // Every descriptor reads the same frames; a frame readable for one and not another would
+    // misalign the fused matrices.
+    for (size_t s = 0; s < traversals.size(); ++s)
+      if (traversals[s].names != result.traversals[s].names)
+        throw InputError(traversals[s].key + ": the frames read differ between the fused "
+                         "descriptors (a file changed during the run?); expected the same "
+                         "frames for each");
+  };
 
   if (result.bounded) {
+    const Described described = DescribeSources(config, *describers.front(), names.front(),
+                                                specs, sources, progress);
+    set_traversals(described.traversals);
+    result.cache = described.cache;
+    AddLines(result.warnings, described.warnings);
+    AddLines(result.notes, described.notes);
+    result.timings.describe_seconds = described.seconds;
+    result.timings.frames = described.frames;
+    const std::int64_t n = described.rows.rows;
+    const MatchBlock block = BlockOf(starts, static_cast<int>(n));
+    KeepRules rules = scale.keep;
+    rules.exclusion = config.evaluation.protocol.exclusion;
+    rules.score = matching.score;
+    rules.score_window = matching.score_window;
+    rules.one_traversal = block.one_traversal;
     for (const char* key : {"Txt_name", "Npy_name", "Png_name", "Png_threshold_name"}) {
       const OutputOptions& o = config.output;
       const std::string& v = std::string(key) == "Txt_name"  ? o.txt_name
@@ -260,51 +420,146 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress) {
         result.notes.push_back(std::string(key) + ": not written: the run is bounded and "
                                "keeps no dense matrix (see Matches_name)");
     }
-    t = Clock::now();
+    const auto t = Clock::now();
     result.timings.pairs =
         static_cast<std::int64_t>(block.query_count) * block.reference_count;
     progress.Begin("matching", block.query_count, "queries (bounded: tiles of rows)");
     BoundedOptions options;
+    options.metric = result.descriptors.front().metric;
     options.sequence_length = matching.sequence_length;
     options.direction = direction;
+    options.partial = matching.partial;
     options.threads = matching.threads;
     if (scale.approximate_search) {
-      result.matches = ApproximateMatches(descriptors, block, rules, options,
+      result.matches = ApproximateMatches(described.rows, block, rules, options,
                                           scale.approximate_checks, result.max_distance);
     } else {
-      result.matches = BoundedMatches(descriptors, block, rules, options, result.max_distance,
+      result.matches = BoundedMatches(described.rows, block, rules, options,
+                                      result.max_distance,
                                       [&](int done, int) { progress.Update(done); });
     }
     progress.End();
     result.timings.match_seconds = SecondsSince(t);
+    if (matching.match_threshold >= 0.0) {
+      result.accepted_queries = 0;
+      for (const Match& m : result.matches) {
+        if (m.rank != 1) continue;
+        ++result.answered_queries;
+        if (m.score <= matching.match_threshold) ++result.accepted_queries;
+      }
+    }
     result.timings.total_seconds = SecondsSince(run_start);
     return result;
   }
 
-  // Dense: every frame against every frame of the concatenated traversals, as the original.
-  t = Clock::now();
-  result.timings.pairs = n * (n - 1) / 2;
+  // Dense: every frame against every frame of the concatenated traversals, as the original;
+  // one single-frame matrix per descriptor, from the store when a sweep computed it already.
   const bool cross = panoramic && panorama_matching != PanoramaMatching::kAligned;
-  progress.Begin("matching", n * n * (cross ? strips * strips : 1),
-                 cross ? "cells of sub-panorama pairs" : "cells");
-  const PairProgress on_pairs = [&](std::int64_t done, std::int64_t) { progress.Update(done); };
-  cv::Mat1f distances =
-      PairwiseDistances(descriptors, strips, panorama_matching, matching.threads, on_pairs);
-  progress.End();
-  result.timings.match_seconds = SecondsSince(t);
+  std::vector<const SingleFrame*> singles;
+  std::vector<SingleFrame> computed;  // without a store
+  computed.reserve(names.size());
+  for (size_t k = 0; k < names.size(); ++k) {
+    const std::string key = store ? SingleFrameKey(config, names[k]) : std::string();
+    if (store)
+      if (const SingleFrame* kept = store->Find(key)) {
+        singles.push_back(kept);
+        continue;
+      }
+    Config one = config;
+    one.descriptor.name = names[k];
+    Described described =
+        DescribeSources(one, *describers[k], names[k], specs, sources, progress);
+    SingleFrame frame;
+    frame.descriptor = result.descriptors[k];
+    frame.traversals = described.traversals;
+    frame.cache = described.cache;
+    frame.warnings = described.warnings;
+    frame.notes = described.notes;
+    frame.describe_seconds = described.seconds;
+    frame.frames = described.frames;
+    const std::int64_t n = described.rows.rows;
+    frame.pairs = n * (n - 1) / 2;
+    const auto t = Clock::now();
+    progress.Begin("matching", n * n * (cross ? strips * strips : 1),
+                   std::string(cross ? "cells of sub-panorama pairs" : "cells") +
+                       (fused ? " (" + names[k] + ")" : ""));
+    const PairProgress on_pairs = [&](std::int64_t done, std::int64_t) {
+      progress.Update(done);
+    };
+    frame.distances = PairwiseDistances(described.rows, frame.descriptor.metric, strips,
+                                        panorama_matching, matching.threads, on_pairs);
+    progress.End();
+    frame.match_seconds = SecondsSince(t);
+    if (store) {
+      singles.push_back(&store->Keep(key, std::move(frame)));
+    } else {
+      computed.push_back(std::move(frame));
+      singles.push_back(&computed.back());
+    }
+  }
+  for (const SingleFrame* f : singles) {
+    set_traversals(f->traversals);
+    if (!f->cache.empty())
+      result.cache += (result.cache.empty() ? "" : "; ") +
+                      (fused ? f->descriptor.name + ": " : std::string()) + f->cache;
+    AddLines(result.warnings, f->warnings);
+    AddLines(result.notes, f->notes);
+    result.timings.describe_seconds += f->describe_seconds;
+    result.timings.match_seconds += f->match_seconds;
+    result.timings.frames = f->frames;
+    result.timings.pairs = f->pairs;
+  }
 
-  // Sequences, Eq. 5, Eq. 9.
-  t = Clock::now();
+  // Fusion (each matrix over its largest value, weighted), contrast enhancement, sequences,
+  // Eq. 5, Eq. 9.
+  const auto t = Clock::now();
+  cv::Mat1f distances;
+  if (!fused) {
+    // The store keeps its matrix for the next run; without one, the matrix is taken over.
+    distances = store ? singles.front()->distances.clone() : singles.front()->distances;
+    if (!store) computed.front().distances.release();
+  } else {
+    distances = cv::Mat1f::zeros(singles.front()->distances.size());
+    for (size_t k = 0; k < singles.size(); ++k) {
+      double largest = 0;
+      cv::minMaxLoc(singles[k]->distances, nullptr, &largest);
+      // A descriptor whose frames are all alike (largest 0) adds nothing.
+      if (largest > 0)
+        cv::scaleAdd(singles[k]->distances, result.fusion_weights[k] / largest, distances,
+                     distances);
+    }
+  }
+  if (matching.contrast_enhancement)
+    EnhanceContrast(distances, matching.contrast_window, starts, matching.threads);
   SequenceDistancesInPlace(distances, matching.sequence_length, starts, starts, direction,
-                           matching.threads);
+                           matching.threads, matching.partial);
   result.normalized = distances;
   distances.release();
   result.max_distance = NormalizeByMax(result.normalized);
+  if (matching.partial == SequencePartial::kSkip)
+    result.empty_cells = static_cast<std::int64_t>(result.normalized.total()) -
+                         cv::countNonZero(result.normalized <= 1.0f);
   if (matching.threshold >= 0.0)
     result.thresholded =
         ThresholdMatrix(result.normalized, static_cast<float>(matching.threshold));
+  const MatchBlock block = BlockOf(starts, result.normalized.rows);
+  KeepRules rules = scale.keep;
+  rules.exclusion = config.evaluation.protocol.exclusion;
+  rules.score = matching.score;
+  rules.score_window = matching.score_window;
+  rules.one_traversal = block.one_traversal;
   if (!scale.matches_name.empty())
     result.matches = MatchesFromMatrix(result.normalized, block, rules);
+  if (matching.match_threshold >= 0.0) {
+    KeepRules best = rules;
+    best.best = 1;
+    best.band = -1;
+    result.accepted_queries = 0;
+    for (const Match& m : MatchesFromMatrix(result.normalized, block, best)) {
+      ++result.answered_queries;
+      if (m.score <= matching.match_threshold) ++result.accepted_queries;
+    }
+  }
   result.timings.sequence_seconds = SecondsSince(t);
   result.timings.total_seconds = SecondsSince(run_start);
   return result;
@@ -338,14 +593,30 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
   };
   const OutputOptions& out = config.output;
   const bool dense = !result.bounded;  // bounded runs keep no matrix: only Matches_name
+  // Cells without a value (+inf) are shown as the largest finite value in the text and the
+  // image, and are NaN in the .npy file: readable exports, and NumPy code that skips NaN.
+  cv::Mat1f shown = result.normalized, saved = result.normalized;
+  if (dense && result.empty_cells > 0) {
+    const cv::Mat1b empty = result.normalized == std::numeric_limits<float>::infinity();
+    double largest = 0;
+    cv::minMaxLoc(result.normalized, nullptr, &largest, nullptr, nullptr, ~empty);
+    if (!out.txt_name.empty() || !out.png_name.empty()) {
+      shown = result.normalized.clone();
+      shown.setTo(largest, empty);
+    }
+    if (!out.npy_name.empty()) {
+      saved = result.normalized.clone();
+      saved.setTo(std::numeric_limits<float>::quiet_NaN(), empty);
+    }
+  }
   if (dense && !out.txt_name.empty())
     encode("Txt_name", out.txt_name, [&] {
-      return EncodeText(result.thresholded.empty() ? cv::Mat(result.normalized)
+      return EncodeText(result.thresholded.empty() ? cv::Mat(shown)
                                                    : cv::Mat(result.thresholded));
     });
   if (dense && !out.png_name.empty())
     encode("Png_name", out.png_name,
-           [&] { return EncodePng(ColorizeMatrix(result.normalized, out.matrix_color)); });
+           [&] { return EncodePng(ColorizeMatrix(shown, out.matrix_color)); });
   const std::string threshold_png = ThresholdPngPath(config);
   if (dense && !threshold_png.empty()) {
     encode(out.png_threshold_name.empty() ? "Png_name" : "Png_threshold_name", threshold_png,
@@ -358,11 +629,11 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
   OutputBatch batch;
   if (dense && !out.npy_name.empty()) {
     // Written from the matrix itself while the other outputs are being encoded.
-    const std::string header = NpyHeader(result.normalized.rows, result.normalized.cols);
+    const std::string header = NpyHeader(saved.rows, saved.cols);
     std::vector<std::string_view> parts = {header};
-    for (int i = 0; i < result.normalized.rows; ++i)
-      parts.emplace_back(reinterpret_cast<const char*>(result.normalized.ptr<float>(i)),
-                         result.normalized.cols * sizeof(float));
+    for (int i = 0; i < saved.rows; ++i)
+      parts.emplace_back(reinterpret_cast<const char*>(saved.ptr<float>(i)),
+                         saved.cols * sizeof(float));
     batch.Stage("Npy_name", out.npy_name, parts);
   }
   for (Pending& p : pending) batch.Stage(p.key, p.path, p.bytes.get());

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 
 #include "OpenABLE/evaluation/layout.h"
 #include "matching/bounded.h"
+#include "matching/distances.h"
 #include "OpenABLE/run/progress.h"
 #include "config/config.h"
 
@@ -39,15 +41,28 @@ struct RunTimings {
   std::int64_t pairs = 0;        // distinct pairs of frames compared
 };
 
+// One descriptor of a run (several when Image_descriptor fuses them).
+struct RunDescriptor {
+  std::string name;       // registry name
+  int row_width = 0;      // elements per frame descriptor
+  Metric metric = Metric::kHamming;
+};
+
 struct RunResult {
   std::vector<Traversal> traversals;  // in matrix order
-  std::string descriptor;             // registry name
-  int row_width = 0;                  // elements per frame descriptor
-  bool binary = true;                 // Hamming (true) or L2
+  std::string descriptor;             // registry name, or the fused names joined by "+"
+  std::vector<RunDescriptor> descriptors;  // each descriptor (one unless fused)
+  std::vector<double> fusion_weights;      // fused: the weight of each descriptor's matrix
   std::string camera;                 // camera and preprocessing, one line ("monocular, grey")
   cv::Mat1f normalized;               // M' of Eq. 5 (N x N over the concatenated traversals)
   float max_distance = 0;             // max(M), the divisor of Eq. 5
+  // Cells of `normalized` that hold +inf: sequences skipped at a traversal's start
+  // (Sequence_partial skip); never a best match, exported as documented in WriteOutputs.
+  std::int64_t empty_cells = 0;
   cv::Mat1b thresholded;              // M'' of Eq. 9; empty when Threshold is -1
+  // Match_threshold >= 0: queries of the evaluated block with a best match, and those whose
+  // best match's score (Match_score) is <= Match_threshold.
+  int answered_queries = 0, accepted_queries = -1;
   bool bounded = false;               // Matrix_mode: the bounded mode ran (no dense matrix)
   std::string mode_reason;            // which mode and why, one line
   std::vector<std::string> notes;     // outputs asked for but not possible in this mode
@@ -57,9 +72,42 @@ struct RunResult {
   RunTimings timings;
 };
 
+// The single-frame distance matrix of one descriptor over a run's frames, before fusion,
+// contrast enhancement and sequences, with what the run reports of its description.
+struct SingleFrame {
+  RunDescriptor descriptor;
+  cv::Mat1f distances;                // N x N, every frame against every frame
+  std::vector<Traversal> traversals;
+  std::string camera, cache;
+  std::vector<std::string> warnings, notes;
+  double describe_seconds = 0, match_seconds = 0;
+  int frames = 0;
+  std::int64_t pairs = 0;
+};
+
+// Single-frame matrices kept between dense runs of the same frames (openable_sweep): a run
+// whose description settings (every key but those of matching, sequences, scores, outputs and
+// evaluation) and descriptor match a kept matrix takes it instead of describing and comparing
+// the frames again. Not thread-safe: one run at a time.
+class SingleFrameStore {
+ public:
+  const SingleFrame* Find(const std::string& key) const;
+  const SingleFrame& Keep(const std::string& key, SingleFrame frame);
+  int Size() const { return static_cast<int>(kept_.size()); }
+
+ private:
+  std::vector<std::pair<std::string, std::unique_ptr<SingleFrame>>> kept_;
+};
+
+// The key of descriptor `name`'s single-frame matrix for the run of `config`.
+std::string SingleFrameKey(const Config& config, const std::string& name);
+
 // Computes the matrices of a run. Throws InputError (one line naming the key, file or value)
 // on any problem with the configuration or the input data. Progress goes to `progress`.
-RunResult ComputeRun(const Config& config, ProgressReporter& progress);
+// With `store`, a dense run takes its single-frame matrices from it when they are there, and
+// keeps those it computes.
+RunResult ComputeRun(const Config& config, ProgressReporter& progress,
+                     SingleFrameStore* store = nullptr);
 
 // The block a run's matrix is evaluated on: the query-reference block of two traversals, or
 // the whole matrix of one sequence as loop closure.
@@ -67,8 +115,9 @@ EvaluationLayout LayoutOf(const RunResult& result);
 
 // Writes the outputs the configuration asks for (Txt_name, Npy_name, Png_name,
 // Png_threshold_name, and the files of Evaluation_name when `evaluation` is given)
-// all-or-nothing; returns the paths written. Adds the time spent to
-// result.timings.export_seconds. Throws InputError naming the key and path on failure.
+// all-or-nothing. Cells without a value (+inf, Sequence_partial skip) are written as the
+// largest finite value in Txt_name and the PNG images and as NaN in Npy_name. Returns the
+// paths written. Adds the time spent to result.timings.export_seconds. Throws InputError naming the key and path on failure.
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
                                       const Evaluation* evaluation = nullptr);
 

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/version.h"
 
 namespace openable {
@@ -57,14 +58,32 @@ std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
   const int patch = c.descriptor.patch_size;
   const DescriptionOptions& d = c.description;
   std::ostringstream out;
-  out << "OpenABLE " << kVersion << ": " << r.descriptor << " (" << r.row_width
-      << (r.binary ? " bytes, Hamming" : " floats, L2") << "), "
+  out << "OpenABLE " << kVersion << ": ";
+  for (size_t k = 0; k < r.descriptors.size(); ++k) {
+    const RunDescriptor& e = r.descriptors[k];
+    out << (k ? " + " : "") << e.name << " (" << e.row_width
+        << (e.metric == Metric::kL2 ? " floats, L2" : e.metric == Metric::kL1 ? " bytes, L1"
+                                                                               : " bytes, Hamming")
+        << (r.fusion_weights.empty() ? "" : ", weight " + FormatNumber(r.fusion_weights[k]))
+        << ")";
+  }
+  out << ", "
       << (d.type == DescriptionType::kGlobal ? "global " : "grid ")
       << (d.type == DescriptionType::kGlobal
               ? std::to_string(patch) + "x" + std::to_string(patch)
               : std::to_string(d.grid_x) + "x" + std::to_string(d.grid_y) + " cells of " +
                     std::to_string(patch) + "x" + std::to_string(patch))
-      << ", sequence length " << c.matching.sequence_length << "\n";
+      << ", sequence length " << c.matching.sequence_length
+      << (c.matching.sequence_length > 1 && c.matching.partial == SequencePartial::kSkip
+              ? " (skip partial)" : "")
+      << (c.matching.contrast_enhancement
+              ? ", contrast enhancement +-" + std::to_string(c.matching.contrast_window)
+              : std::string())
+      << ", score " << EnumName(c.matching.score)
+      << (c.matching.score == MatchScore::kRatio
+              ? " (window +-" + std::to_string(c.matching.score_window) + ")"
+              : std::string())
+      << "\n";
   if (!r.camera.empty()) out << "  camera: " << r.camera << "\n";
   if (!r.cache.empty()) out << "  descriptor cache: " << r.cache << "\n";
   for (const auto& t : r.traversals) {
@@ -83,10 +102,16 @@ std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
     out << "  matrix: " << r.normalized.rows << "x" << r.normalized.cols << ", max distance "
         << r.max_distance << " (Eq. 5 divisor)";
   }
+  if (r.empty_cells > 0)
+    out << ", " << r.empty_cells << " cells without a value (Sequence_partial skip)";
   if (!r.thresholded.empty())
     out << ", threshold " << c.matching.threshold << ": "
         << r.thresholded.total() - static_cast<size_t>(cv::countNonZero(r.thresholded))
         << " cells below";
+  if (r.accepted_queries >= 0)
+    out << "\n  accepted: " << r.accepted_queries << " of " << r.answered_queries
+        << " best matches with " << EnumName(c.matching.score) << " score <= "
+        << c.matching.match_threshold << " (Match_threshold)";
   out << "\nTimings (wall clock):\n"
       << "  total            " << Fixed(tm.total_seconds, 3) << " s\n"
       << "  description      " << Fixed(tm.describe_seconds, 3) << " s  ("

@@ -3,14 +3,17 @@
 
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
 #include "tests/test_support.h"
@@ -81,6 +84,32 @@ inline double AlignedRecallAt1(const cv::Mat1f& d, int q0, int r0, int n, int to
 // True when `s` is exactly one line.
 inline bool OneLine(const std::string& s) {
   return !s.empty() && s.back() == '\n' && s.find('\n') == s.size() - 1;
+}
+
+
+// The number after "key": in a JSON text (the first occurrence), NaN when absent.
+inline double JsonNumber(const std::string& json, const std::string& key, std::size_t from = 0) {
+  const std::string k = "\"" + key + "\": ";
+  const auto p = json.find(k, from);
+  if (p == std::string::npos) return std::nan("");
+  return std::strtod(json.c_str() + p + k.size(), nullptr);
+}
+
+// Runs the reference on `json`'s matrix; returns its output, and fails the test when a figure
+// differs by more than 5e-4.
+inline void CheckAgainstReference(const std::string& dir, const std::vector<std::string>& args) {
+  if (std::system("/usr/bin/python3 -c 'import numpy' 2>/dev/null") != 0)
+    GTEST_SKIP() << "/usr/bin/python3 with numpy is absent (examples/setup.sh installs it)";
+  const Outcome o = RunProgram(
+      "/usr/bin/python3",
+      [&] {
+        std::vector<std::string> a = {testing::SourceDir() + "/tests/tools/evaluate_reference.py"};
+        a.insert(a.end(), args.begin(), args.end());
+        return a;
+      }(),
+      dir);
+  EXPECT_EQ(o.status, 0) << o.out << o.err;
+  std::cout << o.out.substr(o.out.rfind('\n', o.out.size() - 2) + 1);
 }
 
 }  // namespace e2e

@@ -17,14 +17,6 @@ namespace {
 
 using namespace e2e;  // NOLINT: the e2e helpers are this file's vocabulary
 
-// The number after "key": in a JSON text (the first occurrence), NaN when absent.
-double JsonNumber(const std::string& json, const std::string& key, std::size_t from = 0) {
-  const std::string k = "\"" + key + "\": ";
-  const auto p = json.find(k, from);
-  if (p == std::string::npos) return std::nan("");
-  return std::strtod(json.c_str() + p + k.size(), nullptr);
-}
-
 std::string SampleConfig(const std::string& dir, const std::string& extra) {
   const std::string path = dir + "/Config.txt";
   std::ofstream(path) << "Images_path: \"" << testing::SampleDir() << "/summer\"\n"
@@ -160,23 +152,6 @@ INSTANTIATE_TEST_SUITE_P(
                  "Vicinity"}));
 
 // --- Real data, checked against the independent numpy implementation -------------------------
-
-// Runs the reference on `json`'s matrix; returns its output, and fails the test when a figure
-// differs by more than 5e-4.
-void CheckAgainstReference(const std::string& dir, const std::vector<std::string>& args) {
-  if (std::system("/usr/bin/python3 -c 'import numpy' 2>/dev/null") != 0)
-    GTEST_SKIP() << "/usr/bin/python3 with numpy is absent (examples/setup.sh installs it)";
-  const Outcome o = RunProgram(
-      "/usr/bin/python3",
-      [&] {
-        std::vector<std::string> a = {testing::SourceDir() + "/tests/tools/evaluate_reference.py"};
-        a.insert(a.end(), args.begin(), args.end());
-        return a;
-      }(),
-      dir);
-  EXPECT_EQ(o.status, 0) << o.out << o.err;
-  std::cout << o.out.substr(o.out.rfind('\n', o.out.size() - 2) + 1);
-}
 
 TEST(EvaluationOnDatasets, NordlandWinterAgainstSummer) {
   const std::string data = testing::DatasetsDir() + "/nordland_trimmed";

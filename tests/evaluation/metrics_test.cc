@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
-#include "tests/brute_per_query.h"
+#include "tests/tools/brute_per_query.h"
 
 namespace openable {
 namespace {
@@ -292,7 +292,9 @@ TEST(PerQueryRatio, RandomMatricesMatchBruteForce) {
       for (int q = 0; q < n; ++q) {
         const testing::BruteQuery& e = b.queries[q];
         ASSERT_EQ(r.best[q], e.best) << "trial " << trial << " q " << q;
-        if (e.answered) ASSERT_FLOAT_EQ(r.score[q], static_cast<float>(e.score)) << q;
+        if (e.answered) {
+          ASSERT_FLOAT_EQ(r.score[q], static_cast<float>(e.score)) << q;
+        }
         ASSERT_EQ(r.correct[q] != 0, e.correct) << q;
       }
       EXPECT_EQ(r.unanswered, b.unanswered);

@@ -14,8 +14,9 @@ def hamming_reference(a, b):
     return out
 
 
-def sequence_reference(d, length, direction, row_starts=(0,), col_starts=(0,)):
-    """S of matching/sequence.h written out term by term in float64."""
+def sequence_reference(d, length, direction, row_starts=(0,), col_starts=(0,), skip=False):
+    """S of matching/sequence.h written out term by term in float64 (skip: +inf where fewer
+    than L terms exist)."""
     n, m = d.shape
     row_starts, col_starts = list(row_starts), list(col_starts)
     row_bounds = [(s, e) for s, e in zip(row_starts, row_starts[1:] + [n])]
@@ -37,7 +38,7 @@ def sequence_reference(d, length, direction, row_starts=(0,), col_starts=(0,)):
                         break
                     total += d[ii, jj]
                     count += 1
-                s[i, j] = total * length / count
+                s[i, j] = np.inf if skip and count < length else total * length / count
         return s
 
     if direction == "forward":
@@ -147,8 +148,14 @@ class NormalizeThresholdTest(unittest.TestCase):
         np.testing.assert_allclose(normalized, m / m.max(), rtol=1e-6)
         np.testing.assert_array_equal(openable.threshold_matrix(normalized, 0.3),
                                       (normalized >= 0.3).astype(np.uint8))
-        with self.assertRaisesRegex(ValueError, "negative or non-finite"):
+        with self.assertRaisesRegex(ValueError, "negative or NaN"):
             openable.normalize_by_max(-m)
+        # +inf (a skipped sequence cell) is left out of the maximum and stays +inf.
+        with_inf = m.copy()
+        with_inf[0, 0] = np.inf
+        normalized, peak = openable.normalize_by_max(with_inf)
+        self.assertAlmostEqual(peak, float(m[np.isfinite(with_inf)].max()), places=4)
+        self.assertEqual(normalized[0, 0], np.inf)
 
     def test_read_matrix_reads_numpy_files(self):
         import tempfile, os
@@ -159,6 +166,77 @@ class NormalizeThresholdTest(unittest.TestCase):
             np.testing.assert_allclose(openable.read_matrix(path), m, rtol=1e-7)
             with self.assertRaises(openable.InputError):
                 openable.read_matrix(os.path.join(tmp, "missing.npy"))
+
+
+class SeqSlamPiecesTest(unittest.TestCase):
+    def test_skip_partial_sequences(self):
+        rng = np.random.default_rng(13)
+        d = rng.random((24, 20), dtype=np.float32) * 100
+        for direction in ("forward", "reverse", "both"):
+            got = openable.sequence_distances(d, 4, direction, [0, 10], [0, 8], partial="skip")
+            ref = sequence_reference(d.astype(np.float64), 4, direction, [0, 10], [0, 8],
+                                     skip=True)
+            np.testing.assert_array_equal(np.isinf(got), np.isinf(ref))
+            finite = np.isfinite(ref)
+            np.testing.assert_allclose(got[finite], ref[finite], rtol=2e-6, atol=1e-4)
+        with self.assertRaisesRegex(ValueError, "partial"):
+            openable.sequence_distances(d, 4, partial="drop")
+
+    def test_l1_distances_and_sad_rows(self):
+        rng = np.random.default_rng(3)
+        a = rng.integers(0, 256, (7, 70), dtype=np.uint8)
+        b = rng.integers(0, 256, (5, 70), dtype=np.uint8)
+        ref = np.abs(a[:, None, :].astype(np.int64) - b[None, :, :]).sum(axis=2)
+        np.testing.assert_array_equal(openable.l1_distances(a, b), ref)
+        images = [rng.integers(0, 256, (60, 120), dtype=np.uint8) for _ in range(4)]
+        rows = openable.describe_images(images, descriptor="SAD")
+        self.assertEqual(rows.shape, (4, 64 * 32))
+        self.assertEqual(rows.dtype, np.uint8)
+        m = openable.distance_matrix(rows, metric="l1")
+        l1 = openable.l1_distances(rows).astype(np.float64)
+        np.testing.assert_allclose(m, l1 / l1.max(), rtol=1e-6)
+        with self.assertRaises(openable.InputError):
+            openable.distance_matrix(rows, metric="l2")  # l2 needs float32 rows
+
+    def test_contrast_enhancement_written_out(self):
+        rng = np.random.default_rng(8)
+        d = rng.random((6, 30), dtype=np.float32) * 50
+        w = 4
+        ref = np.zeros(d.shape)
+        for i in range(d.shape[0]):
+            for j in range(d.shape[1]):
+                win = d[i, max(0, j - w):j + w + 1].astype(np.float64)
+                ref[i, j] = (d[i, j] - win.mean()) / win.std()
+        ref -= ref.min()
+        np.testing.assert_allclose(openable.contrast_enhancement(d, w), ref, atol=1e-4)
+
+    def test_best_matches_and_the_ratio(self):
+        m = np.array([[0.5, 0.9, 0.25, 0.2, 0.3, 0.8],
+                      [np.inf, np.inf, np.inf, np.inf, np.inf, np.inf]], dtype=np.float32)
+        best, distance, score = openable.best_matches(m, "ratio", 1)
+        self.assertEqual(list(best), [3, -1])
+        self.assertAlmostEqual(float(distance[0]), 0.2, places=6)
+        self.assertAlmostEqual(float(score[0]), 0.2 / 0.5, places=6)
+        self.assertTrue(np.isnan(score[1]))
+        _, _, score = openable.best_matches(m, "distance")
+        self.assertAlmostEqual(float(score[0]), 0.2, places=6)
+
+    def test_evaluate_with_the_ratio_score(self):
+        # Two queries: q0's wrong best match has a close rival, q1's right one stands out.
+        m = np.array([[0.10, 0.9, 0.9, 0.11, 0.5],
+                      [0.9, 0.9, 0.9, 0.9, 0.30]], dtype=np.float32)
+        pairs = [(0, 4), (1, 4)]
+        by_distance = openable.evaluate(m, pairs=pairs, tolerance=0, normalize=False)
+        self.assertEqual(by_distance.recall_at_100p, 0.0)
+        by_ratio = openable.evaluate(m, pairs=pairs, tolerance=0, normalize=False,
+                                     score="ratio", score_window=1, accept_threshold=0.5)
+        self.assertEqual(by_ratio.score, "ratio")
+        self.assertAlmostEqual(by_ratio.recall_at_100p, 0.5)
+        np.testing.assert_allclose(by_ratio.scores, [0.10 / 0.11, 0.30 / 0.9], rtol=1e-6)
+        self.assertEqual(by_ratio.operating_point["precision"], 1.0)
+        self.assertAlmostEqual(by_ratio.operating_point["recall"], 0.5)
+        with self.assertRaisesRegex(openable.InputError, "score_window"):
+            openable.evaluate(m, pairs=pairs, score="ratio", score_window=5)
 
 
 if __name__ == "__main__":

@@ -46,12 +46,39 @@ class OnlineAgainstBatchTest(unittest.TestCase):
                 continue
             self.assertEqual(len(candidates), min(K, q - EXCLUSION + 1))
             self.assertEqual([c[0] for c in candidates], self.expected(q), "frame %d" % q)
-            for j, distance, normalized, ok in candidates:
+            for j, distance, normalized, ok, score in candidates:
                 self.assertAlmostEqual(distance, self.sums[q, j], delta=1e-3 * max(1, distance))
                 self.assertAlmostEqual(normalized, distance / (L * 256), places=9)
+                self.assertEqual(score, normalized)  # the distance score
                 self.assertEqual(ok, normalized <= THRESHOLD)
                 accepted += ok
         self.assertGreater(accepted, 0)
+
+    def test_ratio_score_against_brute_force(self):
+        # While the search is exact every earlier frame j <= q - EXCLUSION is a rival: the
+        # ratio of candidate j is S(q, j) over the smallest S(q, j') with |j' - j| > W.
+        W, ratio_threshold = 10, 0.9
+        d = openable.OnlineDetector(sequence_length=L, exclusion=EXCLUSION, candidates=K,
+                                    score="ratio", score_window=W, threshold=ratio_threshold)
+        self.assertEqual(d.options["score"], "ratio")
+        checked = 0
+        for q, row in enumerate(self.rows):
+            _, candidates, _ = d.add_descriptor(row)
+            eligible = np.arange(0, q - EXCLUSION + 1)
+            for j, distance, _, ok, score in candidates:
+                rivals = self.sums[q, eligible[np.abs(eligible - j) > W]]
+                expected = 1.0 if rivals.size == 0 or rivals.min() <= 0 else \
+                    self.sums[q, j] / rivals.min()
+                self.assertAlmostEqual(score, expected, delta=1e-4, msg="frame %d, %d" % (q, j))
+                self.assertEqual(ok, score <= ratio_threshold)
+                checked += 1
+        self.assertGreater(checked, 1000)
+        with self.assertRaises(ValueError):
+            openable.OnlineDetector(score="confidence")
+        with self.assertRaisesRegex(openable.InputError, "score_window"):
+            openable.OnlineDetector(score_window=-1)
+        with self.assertRaisesRegex(openable.InputError, "SAD"):
+            openable.OnlineDetector(descriptor="SAD")
 
     def test_batch_matrix_is_the_sums_over_their_maximum(self):
         np.testing.assert_allclose(self.matrix * self.peak, self.sums, rtol=1e-6, atol=1e-3)
@@ -99,7 +126,7 @@ class OnlineAgainstBatchTest(unittest.TestCase):
         for q, row in enumerate(self.rows):
             _, candidates, timings = d.add_descriptor(row)
             used = used or timings["approximate"]
-            for j, distance, _, _ in candidates:
+            for j, distance, _, _, _ in candidates:
                 self.assertLessEqual(j, q - EXCLUSION)
                 self.assertAlmostEqual(distance, self.sums[q, j], delta=1e-3 * max(1, distance))
         self.assertTrue(used)

@@ -50,7 +50,8 @@ const std::set<std::string> kNotDescription = {
     "Matrix_color", "Show_images", "Panorama_matching", "Image_sequences", "Threshold",
     "Threads", "Sequence_direction", "Matrix_mode", "Memory_limit", "Best_matches",
     "Band_width", "Matches_name", "Approximate_search", "Approximate_checks",
-    "Descriptor_cache"};
+    "Descriptor_cache", "Sequence_partial", "Match_score", "Match_score_window",
+    "Match_threshold", "Contrast_enhancement", "Contrast_window", "Fusion_weights"};
 
 bool Perturb(Config& c, const std::string& key) {
   const std::string v = ConfigValueText(c, key);

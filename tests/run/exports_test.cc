@@ -175,21 +175,24 @@ TEST(EncodeText, MatchesPrintfOnRandomFloats) {
 }
 
 TEST(EncodeMatches, NpyRecordsAndCsvText) {
-  const std::vector<Match> m = {{1, 2, 0.5f, 1}, {3, 4, 0.25f, 0}};
+  const std::vector<Match> m = {{1, 2, 0.5f, 1, 0.25f}, {3, 4, 0.25f, 0, 0.75f}};
   const std::string csv = EncodeMatches(m, true);
-  EXPECT_EQ(csv, "query,reference,distance,rank\n1,2,0.5,1\n3,4,0.25,0\n");
+  EXPECT_EQ(csv, "query,reference,distance,rank,score\n1,2,0.5,1,0.25\n3,4,0.25,0,0.75\n");
   const std::string npy = EncodeMatches(m, false);
-  ASSERT_EQ(npy.size() % 16, 0u);  // 64-byte aligned header, 16-byte records
-  const size_t header = npy.size() - 32;
+  ASSERT_EQ(npy.size() % 4, 0u);
+  const size_t header = npy.size() - 40;  // 64-byte aligned header, 20-byte records
   EXPECT_EQ(header % 64, 0u);
   EXPECT_NE(npy.find("('distance', '<f4')"), std::string::npos);
+  EXPECT_NE(npy.find("('score', '<f4')"), std::string::npos);
   EXPECT_NE(npy.find("'shape': (2,)"), std::string::npos);
   int q = 0;
-  float dist = 0;
-  std::memcpy(&q, npy.data() + header + 16, 4);
-  std::memcpy(&dist, npy.data() + header + 16 + 8, 4);
+  float dist = 0, score = 0;
+  std::memcpy(&q, npy.data() + header + 20, 4);
+  std::memcpy(&dist, npy.data() + header + 20 + 8, 4);
+  std::memcpy(&score, npy.data() + header + 20 + 16, 4);
   EXPECT_EQ(q, 3);
   EXPECT_EQ(dist, 0.25f);
+  EXPECT_EQ(score, 0.75f);
 }
 
 }  // namespace

@@ -7,7 +7,9 @@ R@1/5/10) and the ABLE-P cell protocol (thresholds k/99, vicinity, average preci
 
   evaluate_reference.py --matrix M.npy [--reference-frames N] --exclusion E --tolerance T
       --vicinity V (--aligned | --pairs FILE [--base 0|1] [--max-col4 X])
-      [--compare openable.json]
+      [--score distance|ratio] [--score-window W] [--compare openable.json]
+
+NaN (or +inf) cells hold no value (Sequence_partial skip): never a candidate nor a rival.
 
 With --compare, exits 1 when a figure of the JSON written by OpenABLE differs by more than
 5e-4 (three decimals); prints both sets of figures either way.
@@ -47,30 +49,42 @@ def load_truth(args, queries, references, loop):
     return truth
 
 
-def per_query(block, truth, loop, exclusion, tolerance):
+def per_query(block, truth, loop, exclusion, tolerance, score='distance', window=10):
     q_count, r_count = block.shape
     true_of = {}
     for (q, r) in truth:
         true_of.setdefault(q, []).append(r)
     best_d, correct, positive, rank_hits = [], [], [], {1: 0, 5: 0, 10: 0}
+    queries, unanswered = 0, 0
     for q in range(q_count):
         end = r_count if not loop else max(0, q - exclusion + 1)
         if end == 0:
             continue
+        queries += 1
         d = block[q, :end]
-        b = int(np.argmin(d))
         t = [r for r in true_of.get(q, []) if r < end]
         pos = len(t) > 0
-        ok = pos and any(abs(b - r) <= tolerance for r in t)
-        best_d.append(float(d[b]))
-        correct.append(ok)
         positive.append(pos)
+        finite = np.flatnonzero(np.isfinite(d))
+        if finite.size == 0:
+            unanswered += 1
+            continue
+        b = int(finite[np.argmin(d[finite])])  # the first of equal minima
+        ok = pos and any(abs(b - r) <= tolerance for r in t)
+        if score == 'ratio':
+            rivals = finite[np.abs(finite - b) > window]
+            rival = float(d[rivals].min()) if rivals.size else 0.0
+            value = float(d[b]) / rival if rival > 0 else 1.0
+        else:
+            value = float(d[b])
+        best_d.append(np.float32(value))
+        correct.append(ok)
         if pos:
-            order = np.argsort(d, kind='stable')
+            order = finite[np.argsort(d[finite], kind='stable')]
             for n in rank_hits:
                 if any(abs(int(c) - r) <= tolerance for c in order[:n] for r in t):
                     rank_hits[n] += 1
-    best_d = np.array(best_d)
+    best_d = np.array(best_d, dtype=np.float32)
     correct = np.array(correct, dtype=bool)
     p_count = int(np.sum(positive))
     auc, r100, f1max, f1thr, prev_r = 0.0, 0.0, 0.0, 0.0, 0.0
@@ -92,7 +106,7 @@ def per_query(block, truth, loop, exclusion, tolerance):
         'recall_at_1': rank_hits[1] / p_count if p_count else 0.0,
         'recall_at_5': rank_hits[5] / p_count if p_count else 0.0,
         'recall_at_10': rank_hits[10] / p_count if p_count else 0.0,
-        'queries': len(best_d), 'positive_queries': p_count,
+        'queries': queries, 'positive_queries': p_count, 'unanswered_queries': unanswered,
     }
 
 
@@ -150,11 +164,15 @@ def main():
     ap.add_argument('--pairs')
     ap.add_argument('--base', type=int, default=0)
     ap.add_argument('--max-col4', type=float)
+    ap.add_argument('--score', choices=['distance', 'ratio'], default='distance')
+    ap.add_argument('--score-window', type=int, default=10)
     ap.add_argument('--compare')
     args = ap.parse_args()
 
     m = np.load(args.matrix).astype(np.float32)
-    m = m / m.max() if m.max() > 0 else m
+    m[~np.isfinite(m)] = np.inf  # a cell without a value
+    top = m[np.isfinite(m)].max() if np.isfinite(m).any() else 0
+    m = m / top if top > 0 else m
     if m.shape[0] != m.shape[1]:
         block, loop = m, False
     elif args.reference_frames > 0:
@@ -163,7 +181,8 @@ def main():
     else:
         block, loop = m, True
     truth = load_truth(args, block.shape[0], block.shape[1], loop)
-    ours = {'per_query': per_query(block, truth, loop, args.exclusion, args.tolerance),
+    ours = {'per_query': per_query(block, truth, loop, args.exclusion, args.tolerance,
+                                   args.score, args.score_window),
             'able_p': able_p(block, truth, loop, args.exclusion, args.vicinity)}
     print('reference:', json.dumps(ours, indent=1))
     if not args.compare:
