@@ -21,6 +21,7 @@
 #include "OpenABLE/run/pipeline.h"
 #include "OpenABLE/run/progress.h"
 #include "OpenABLE/run/run.h"
+#include "OpenABLE/run/sweep.h"
 #include "OpenABLE/stereo/calibration.h"
 #include "OpenABLE/stereo/disparity.h"
 #include "OpenABLE/stereo/rectification.h"

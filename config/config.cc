@@ -467,8 +467,8 @@ Config LoadConfig(const std::string& path) {
   return ParseConfigText(text.str(), path);
 }
 
-void ApplyOverride(Config& config, const std::string& assignment) {
-  ApplyOptionOverride(ConfigTable(config), assignment);
+void ApplyOverride(Config& config, const std::string& assignment, const std::string& where) {
+  ApplyOptionOverride(ConfigTable(config), assignment, where);
 }
 
 void CheckEvaluationConfig(const Config& c) { c.evaluation.Check(); }

@@ -54,8 +54,10 @@ Config LoadConfig(const std::string& path);
 // for the file in messages ("<name>:<line>: ..."). Same checks, same InputError messages.
 Config ParseConfigText(const std::string& text, const std::string& name);
 
-// Applies one "Key=Value" override (from --set). Same checks and messages as LoadConfig.
-void ApplyOverride(Config& config, const std::string& assignment);
+// Applies one "Key=Value" override (from --set; `where` names the option in messages). Same
+// checks and messages as LoadConfig.
+void ApplyOverride(Config& config, const std::string& assignment,
+                   const std::string& where = "--set");
 
 // What a run of Test_OpenABLE needs, checked before any work: the Check() of every struct it
 // uses, then the rules across structs (D-LDB needs a stereo camera, a stereo camera describes

@@ -204,12 +204,13 @@ void ParseOptionText(const OptionTable& table, const std::string& contents,
                      " holds no key (expected lines of the form Key: value)");
 }
 
-void ApplyOptionOverride(const OptionTable& table, const std::string& assignment) {
+void ApplyOptionOverride(const OptionTable& table, const std::string& assignment,
+                         const std::string& where) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
-    throw InputError("--set: " + Quoted(assignment) + " is not of the form Key=Value");
+    throw InputError(where + ": " + Quoted(assignment) + " is not of the form Key=Value");
   const std::string key = Trim(assignment.substr(0, eq));
-  Assign(table.Lookup(key, "--set"), Trim(assignment.substr(eq + 1)), "--set");
+  Assign(table.Lookup(key, where), Trim(assignment.substr(eq + 1)), where);
 }
 
 namespace {

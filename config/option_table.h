@@ -142,8 +142,10 @@ class OptionTable {
 // key, or a value of the wrong type or out of range.
 void ParseOptionText(const OptionTable& table, const std::string& text, const std::string& name);
 
-// Applies one "Key=Value" (from --set). Same checks and messages, with "--set" as the place.
-void ApplyOptionOverride(const OptionTable& table, const std::string& assignment);
+// Applies one "Key=Value" (from --set). Same checks and messages, with `where` ("--set",
+// "--vary") as the place.
+void ApplyOptionOverride(const OptionTable& table, const std::string& assignment,
+                         const std::string& where = "--set");
 
 // The whole table in the format ParseOptionText reads, a comment with each key's meaning.
 std::string FormatOptionText(const OptionTable& table);

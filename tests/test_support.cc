@@ -75,6 +75,7 @@ std::string TestOpenableExe() { return OPENABLE_TEST_OPENABLE_EXE; }
 std::string OpenableEvaluateExe() { return OPENABLE_EVALUATE_EXE; }
 
 std::string OpenableSnapsExe() { return OPENABLE_SNAPS_EXE; }
+std::string OpenableSweepExe() { return OPENABLE_SWEEP_EXE; }
 
 std::string TempDir() {
   static std::atomic<int> counter{0};

@@ -37,6 +37,8 @@ std::string TestOpenableExe();
 std::string OpenableEvaluateExe();
 // The openable_snaps program built with the tests.
 std::string OpenableSnapsExe();
+// The openable_sweep program built with the tests.
+std::string OpenableSweepExe();
 
 }  // namespace openable::testing
 

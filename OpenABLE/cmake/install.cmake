@@ -47,7 +47,7 @@ install(TARGETS openable_oiio openable_video openable_gui
   LIBRARY DESTINATION "${OPENABLE_INSTALL_MODULEDIR}")
 
 # The command-line programs of examples/.
-install(TARGETS Test_OpenABLE openable_evaluate openable_snaps
+install(TARGETS Test_OpenABLE openable_evaluate openable_snaps openable_sweep
   RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}")
 
 # find_package(OpenABLE): the config file finds the dependencies, then loads the targets.

@@ -49,67 +49,85 @@ std::string EncodeCurveCsv(const std::vector<CurvePoint>& curve) {
   return out;
 }
 
+std::string JsonNumber(double v) { return Number(v); }
+
+std::string JsonText(const std::string& s) { return JsonString(s); }
+
+std::string EncodeEvaluationSettingsJson(const EvaluationSettings& s, const std::string& indent) {
+  std::ostringstream o;
+  const GroundTruthOptions& t = s.truth;
+  const std::string in = indent + "  ";
+  o << "{\n"
+    << in << "\"ground_truth_type\": " << JsonString(GroundTruthTypeName(t.type)) << ",\n"
+    << in << "\"ground_truth\": " << JsonString(t.path) << ",\n"
+    << in << "\"ground_truth_2\": " << JsonString(t.path_2) << ",\n"
+    << in << "\"ground_truth_base\": " << t.base << ",\n"
+    << in << "\"first_frame\": " << t.first_frame << ",\n"
+    << in << "\"radius\": " << Number(t.radius) << ",\n"
+    << in << "\"heading_limit_deg\": " << Number(t.heading_limit) << ",\n"
+    << in << "\"min_frame_gap\": " << t.min_frame_gap << ",\n"
+    << in << "\"axes\": " << JsonString(t.axes) << ",\n"
+    << in << "\"tolerance\": " << s.options.tolerance << ",\n"
+    << in << "\"exclusion\": " << s.options.exclusion << ",\n"
+    << in << "\"vicinity\": " << s.options.vicinity << ",\n"
+    << in << "\"match_score\": " << JsonString(EnumName(s.options.score)) << ",\n"
+    << in << "\"match_score_window\": " << s.options.score_window << ",\n"
+    << in << "\"able_thresholds\": " << s.options.able_thresholds << "\n"
+    << indent << "}";
+  return o.str();
+}
+
+std::string EncodeEvaluatedRunFieldsJson(const EvaluatedRun& r, const std::string& indent) {
+  const PerQueryResult& q = r.per_query;
+  const std::string& in = indent;
+  std::ostringstream o;
+  o << in << "\"label\": " << JsonString(r.label) << ",\n"
+    << in << "\"source\": " << JsonString(r.source) << ",\n"
+    << in << "\"layout\": {\"kind\": " << JsonString(KindName(r.layout.kind))
+    << ", \"queries\": " << r.layout.queries << ", \"references\": " << r.layout.references
+    << ", \"row_offset\": " << r.layout.row_offset << ", \"col_offset\": " << r.layout.col_offset
+    << "},\n"
+    << in << "\"ground_truth\": {\"pairs\": " << r.truth_pairs << ", \"dropped\": "
+    << r.truth_dropped << "},\n"
+    << in << "\"per_query\": {\n"
+    << in << "  \"auc\": " << Number(q.auc) << ",\n"
+    << in << "  \"recall_at_100p\": " << Number(q.recall_at_100p) << ",\n"
+    << in << "  \"max_f1\": " << Number(q.max_f1) << ",\n"
+    << in << "  \"max_f1_threshold\": " << Number(q.max_f1_threshold) << ",\n"
+    << in << "  \"max_f1_precision\": " << Number(q.max_f1_precision) << ",\n"
+    << in << "  \"max_f1_recall\": " << Number(q.max_f1_recall) << ",\n"
+    << in << "  \"recall_at_1\": " << Number(q.recall_at_1) << ",\n"
+    << in << "  \"recall_at_5\": " << Number(q.recall_at_5) << ",\n"
+    << in << "  \"recall_at_10\": " << Number(q.recall_at_10) << ",\n"
+    << in << "  \"queries\": " << q.queries << ",\n"
+    << in << "  \"positive_queries\": " << q.positive_queries << ",\n"
+    << in << "  \"unanswered_queries\": " << q.unanswered << ",\n"
+    << (q.has_operating_point
+            ? in + "  \"accepted\": {\"threshold\": " + Number(q.operating_point.threshold) +
+                  ", \"matches\": " +
+                  std::to_string(q.operating_point.tp + q.operating_point.fp) +
+                  ", \"precision\": " + Number(q.operating_point.precision) +
+                  ", \"recall\": " + Number(q.operating_point.recall) + "},\n"
+            : std::string())
+    << in << "  \"truth_pairs_outside_candidates\": " << q.truth_pairs_outside_candidates << "\n"
+    << in << "},\n"
+    << in << "\"able_p\": {\n"
+    << in << "  \"average_precision_percent\": " << Number(r.able_p.average_precision) << ",\n"
+    << in << "  \"candidate_cells\": " << r.able_p.candidate_cells << ",\n"
+    << in << "  \"truth_cells\": " << r.able_p.truth_cells << "\n"
+    << in << "}";
+  return o.str();
+}
+
 std::string EncodeEvaluationJson(const EvaluationSettings& s, const std::vector<EvaluatedRun>& runs,
                                  const std::string& version) {
   std::ostringstream o;
-  const GroundTruthOptions& t = s.truth;
   o << "{\n  \"openable_version\": " << JsonString(version) << ",\n";
-  o << "  \"settings\": {\n"
-    << "    \"ground_truth_type\": " << JsonString(GroundTruthTypeName(t.type)) << ",\n"
-    << "    \"ground_truth\": " << JsonString(t.path) << ",\n"
-    << "    \"ground_truth_2\": " << JsonString(t.path_2) << ",\n"
-    << "    \"ground_truth_base\": " << t.base << ",\n"
-    << "    \"first_frame\": " << t.first_frame << ",\n"
-    << "    \"radius\": " << Number(t.radius) << ",\n"
-    << "    \"heading_limit_deg\": " << Number(t.heading_limit) << ",\n"
-    << "    \"min_frame_gap\": " << t.min_frame_gap << ",\n"
-    << "    \"axes\": " << JsonString(t.axes) << ",\n"
-    << "    \"tolerance\": " << s.options.tolerance << ",\n"
-    << "    \"exclusion\": " << s.options.exclusion << ",\n"
-    << "    \"vicinity\": " << s.options.vicinity << ",\n"
-    << "    \"match_score\": " << JsonString(EnumName(s.options.score)) << ",\n"
-    << "    \"match_score_window\": " << s.options.score_window << ",\n"
-    << "    \"able_thresholds\": " << s.options.able_thresholds << "\n  },\n";
+  o << "  \"settings\": " << EncodeEvaluationSettingsJson(s, "  ") << ",\n";
   o << "  \"runs\": [";
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    const EvaluatedRun& r = runs[i];
-    const PerQueryResult& q = r.per_query;
-    o << (i ? ",\n" : "\n") << "    {\n"
-      << "      \"label\": " << JsonString(r.label) << ",\n"
-      << "      \"source\": " << JsonString(r.source) << ",\n"
-      << "      \"layout\": {\"kind\": " << JsonString(KindName(r.layout.kind))
-      << ", \"queries\": " << r.layout.queries << ", \"references\": " << r.layout.references
-      << ", \"row_offset\": " << r.layout.row_offset << ", \"col_offset\": " << r.layout.col_offset
-      << "},\n"
-      << "      \"ground_truth\": {\"pairs\": " << r.truth_pairs << ", \"dropped\": "
-      << r.truth_dropped << "},\n"
-      << "      \"per_query\": {\n"
-      << "        \"auc\": " << Number(q.auc) << ",\n"
-      << "        \"recall_at_100p\": " << Number(q.recall_at_100p) << ",\n"
-      << "        \"max_f1\": " << Number(q.max_f1) << ",\n"
-      << "        \"max_f1_threshold\": " << Number(q.max_f1_threshold) << ",\n"
-      << "        \"max_f1_precision\": " << Number(q.max_f1_precision) << ",\n"
-      << "        \"max_f1_recall\": " << Number(q.max_f1_recall) << ",\n"
-      << "        \"recall_at_1\": " << Number(q.recall_at_1) << ",\n"
-      << "        \"recall_at_5\": " << Number(q.recall_at_5) << ",\n"
-      << "        \"recall_at_10\": " << Number(q.recall_at_10) << ",\n"
-      << "        \"queries\": " << q.queries << ",\n"
-      << "        \"positive_queries\": " << q.positive_queries << ",\n"
-      << "        \"unanswered_queries\": " << q.unanswered << ",\n"
-      << (q.has_operating_point
-              ? "        \"accepted\": {\"threshold\": " + Number(q.operating_point.threshold) +
-                    ", \"matches\": " +
-                    std::to_string(q.operating_point.tp + q.operating_point.fp) +
-                    ", \"precision\": " + Number(q.operating_point.precision) +
-                    ", \"recall\": " + Number(q.operating_point.recall) + "},\n"
-              : std::string())
-      << "        \"truth_pairs_outside_candidates\": " << q.truth_pairs_outside_candidates
-      << "\n      },\n"
-      << "      \"able_p\": {\n"
-      << "        \"average_precision_percent\": " << Number(r.able_p.average_precision) << ",\n"
-      << "        \"candidate_cells\": " << r.able_p.candidate_cells << ",\n"
-      << "        \"truth_cells\": " << r.able_p.truth_cells << "\n      }\n    }";
-  }
+  for (std::size_t i = 0; i < runs.size(); ++i)
+    o << (i ? ",\n" : "\n") << "    {\n" << EncodeEvaluatedRunFieldsJson(runs[i], "      ")
+      << "\n    }";
   o << "\n  ]\n}\n";
   return o.str();
 }

@@ -40,6 +40,16 @@ std::string EncodeCurveCsv(const std::vector<CurvePoint>& curve);
 std::string EncodeEvaluationJson(const EvaluationSettings& settings,
                                  const std::vector<EvaluatedRun>& runs, const std::string& version);
 
+// The pieces of that JSON, for documents that hold evaluated runs among other things
+// (openable_sweep): a number (9 significant digits, null when not finite), a string literal,
+// the "settings" object (its closing brace indented by `indent`), and the members of one run
+// object without its braces, each line indented by `indent`.
+std::string JsonNumber(double value);
+std::string JsonText(const std::string& text);
+std::string EncodeEvaluationSettingsJson(const EvaluationSettings& settings,
+                                         const std::string& indent);
+std::string EncodeEvaluatedRunFieldsJson(const EvaluatedRun& run, const std::string& indent);
+
 // A few lines for a terminal: the protocol settings, then one row per run with AUC, R@100P,
 // max F1 (threshold), R@1/5/10 and ABLE-P AP.
 std::string FormatEvaluationTable(const EvaluationSettings& settings,

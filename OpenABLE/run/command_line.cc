@@ -1,5 +1,6 @@
 #include "OpenABLE/run/command_line.h"
 
+#include <algorithm>
 #include <iostream>
 
 #include <opencv2/core/utils/logger.hpp>
@@ -10,11 +11,23 @@
 namespace openable {
 
 std::string ParseCommandLine(int argc, const char* const* argv, const std::string& program,
-                             CommandLine& out) {
+                             CommandLine& out, const std::vector<std::string>& value_options) {
   out = CommandLine();
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "-h" || a == "--help") {
+    const auto own = std::find_if(value_options.begin(), value_options.end(),
+                                  [&a](const std::string& o) {
+                                    return a == o || a.rfind(o + "=", 0) == 0;
+                                  });
+    if (own != value_options.end()) {
+      if (a != *own) {
+        out.options.emplace_back(*own, a.substr(own->size() + 1));
+      } else if (i + 1 >= argc) {
+        return program + ": " + a + " needs a value (see --help)";
+      } else {
+        out.options.emplace_back(*own, argv[++i]);
+      }
+    } else if (a == "-h" || a == "--help") {
       out.help = true;
     } else if (a == "--help-markdown") {
       out.help_markdown = true;
@@ -76,11 +89,12 @@ Config ConfigOf(const CommandLine& command_line) {
 int RunConfigProgram(
     int argc, const char* const* argv, const char* program, const std::string& usage,
     const std::string& version_line,
-    const std::function<int(const Config&, const CommandLine&, ProgressReporter&)>& body) {
+    const std::function<int(const Config&, const CommandLine&, ProgressReporter&)>& body,
+    const std::vector<std::string>& value_options) {
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   InstallInterruptCleanup(program);
   CommandLine cl;
-  const std::string usage_error = ParseCommandLine(argc, argv, program, cl);
+  const std::string usage_error = ParseCommandLine(argc, argv, program, cl, value_options);
   const int answered = AnswerWithoutRunning(cl, usage_error, usage, version_line);
   if (answered >= 0) return answered;
   return RunProgram(program, [&] {

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "OpenABLE/run/progress.h"
@@ -20,14 +21,18 @@ struct CommandLine {
   bool help = false;                   // -h, --help
   bool help_markdown = false;          // --help-markdown
   bool version = false;                // --version
+  // The program's own options that take a value ("--vary", "--output"), as given, in order.
+  std::vector<std::pair<std::string, std::string>> options;
 };
 
 // Parses argv. Returns an empty string on success, or one line (prefixed with `program`)
 // naming the bad argument and pointing at --help: an unknown option, --set without a value,
 // two configuration files, or neither a file nor an override (unless a help or version
-// option was given).
+// option was given). `value_options` are the program's own options that take a value
+// ("--vary" for "--vary X" or "--vary=X"), collected into out.options.
 std::string ParseCommandLine(int argc, const char* const* argv, const std::string& program,
-                             CommandLine& out);
+                             CommandLine& out,
+                             const std::vector<std::string>& value_options = {});
 
 // Answers what needs no run: --help (`usage` then every key), --help-markdown (the key
 // reference), --version (`version_line`), or a usage error (on stderr). Returns the exit status
@@ -47,9 +52,11 @@ Config ConfigOf(const CommandLine& command_line);
 // status of `body`, given the configuration, the command line and the progress reporter of the
 // run (stderr, off with --quiet); errors become exit statuses through RunProgram
 // (OpenABLE/base/program.h). `program` must outlive the process (a string literal).
+// `value_options` as ParseCommandLine.
 int RunConfigProgram(
     int argc, const char* const* argv, const char* program, const std::string& usage,
     const std::string& version_line,
-    const std::function<int(const Config&, const CommandLine&, ProgressReporter&)>& body);
+    const std::function<int(const Config&, const CommandLine&, ProgressReporter&)>& body,
+    const std::vector<std::string>& value_options = {});
 
 }  // namespace openable

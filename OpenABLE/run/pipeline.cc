@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <unistd.h>
 #include <future>
+#include <iostream>
 #include <limits>
 #include <stdexcept>
 #include <filesystem>
@@ -212,7 +213,12 @@ std::string SingleFrameKey(const Config& config, const std::string& name) {
   return FormatConfig(c);
 }
 
-RunResult ComputeRun(const Config& config, ProgressReporter& progress, SingleFrameStore* store) {
+namespace {
+
+// ComputeRun, or with `check_only` its checks alone: it returns before the first frame is
+// described, once the configuration, the descriptors, the sources and the mode are checked.
+RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
+                            SingleFrameStore* store, bool check_only) {
   CheckConfig(config);
   const auto run_start = Clock::now();
   RunResult result;
@@ -377,6 +383,7 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress, SingleFra
     throw InputError("Approximate_search: 1 with Image_descriptor " + names.front() +
                      " (L1 distance), which FLANN's LSH and k-d trees do not index; expected "
                      "Approximate_search 0 (the exact bounded mode) or another descriptor");
+  if (check_only) return result;
 
   std::vector<int> starts;  // set from the first description
   auto set_traversals = [&](const std::vector<Traversal>& traversals) {
@@ -563,6 +570,17 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress, SingleFra
   result.timings.sequence_seconds = SecondsSince(t);
   result.timings.total_seconds = SecondsSince(run_start);
   return result;
+}
+
+}  // namespace
+
+RunResult ComputeRun(const Config& config, ProgressReporter& progress, SingleFrameStore* store) {
+  return ComputeOrCheckRun(config, progress, store, false);
+}
+
+void CheckRun(const Config& config) {
+  ProgressReporter silent(std::cerr, false, false);
+  ComputeOrCheckRun(config, silent, nullptr, true);
 }
 
 EvaluationLayout LayoutOf(const RunResult& result) {

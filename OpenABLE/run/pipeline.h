@@ -109,6 +109,11 @@ std::string SingleFrameKey(const Config& config, const std::string& name);
 RunResult ComputeRun(const Config& config, ProgressReporter& progress,
                      SingleFrameStore* store = nullptr);
 
+// The checks of ComputeRun that come before its first frame is described: the
+// configuration, the descriptors and their fusion, the sources (folders, videos, calibration
+// are opened, not read), the ratio window, the mode. Throws InputError as ComputeRun does.
+void CheckRun(const Config& config);
+
 // The block a run's matrix is evaluated on: the query-reference block of two traversals, or
 // the whole matrix of one sequence as loop closure.
 EvaluationLayout LayoutOf(const RunResult& result);

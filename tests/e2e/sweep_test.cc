@@ -1,0 +1,176 @@
+// openable_sweep on the bundled sample: each run's figures equal those of the same single run
+// of Test_OpenABLE, the ranking follows the chosen figure, frames are described once per
+// description setting, and bad --vary values stop it before any work with one line.
+#include <algorithm>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "tests/e2e/e2e_support.h"
+#include "tests/test_support.h"
+
+namespace openable {
+namespace {
+
+using namespace e2e;  // NOLINT: the e2e helpers are this file's vocabulary
+
+std::vector<std::string> SampleArgs() {
+  return {testing::SourceDir() + "/config/Config.txt",
+          "--quiet",
+          "--set", "Images_path=" + testing::SampleDir() + "/summer",
+          "--set", "Images_path_2=" + testing::SampleDir() + "/winter",
+          "--set", "Ground_truth_type=aligned",
+          "--set", "Evaluation_name=",
+          "--set", "Txt_name=", "--set", "Npy_name=", "--set", "Png_name="};
+}
+
+std::vector<std::string> With(std::vector<std::string> args,
+                              const std::vector<std::string>& more) {
+  args.insert(args.end(), more.begin(), more.end());
+  return args;
+}
+
+// The JSON object of the sweep run whose settings are `settings` ({"Key": "value", ...} as
+// the sweep writes it), from its opening brace; empty when absent.
+std::string SweepRunJson(const std::string& json, const std::string& settings) {
+  const auto p = json.find("\"settings\": " + settings);
+  if (p == std::string::npos) return "";
+  const auto end = json.find("\"able_p\"", p);
+  return json.substr(p, json.find('}', end) - p);
+}
+
+TEST(Sweep, FiguresEqualTheSingleRunsAndAreRanked) {
+  const std::string dir = testing::TempDir();
+  const Outcome sweep = RunProgram(
+      testing::OpenableSweepExe(),
+      With(SampleArgs(), {"--vary", "Image_descriptor=LDB,HOG", "--vary", "Image_sequences=1,5",
+                          "--vary", "Match_score=distance,ratio", "--output", "out/sweep"}),
+      dir);
+  ASSERT_EQ(sweep.status, 0) << sweep.err;
+  const std::string json = ReadAll(dir + "/out/sweep.json");
+  ASSERT_FALSE(json.empty());
+  EXPECT_TRUE(fs::exists(dir + "/out/sweep_pr.png"));
+  // Frames described once per descriptor, not once per combination.
+  EXPECT_EQ(JsonNumber(json, "descriptions"), 2);
+
+  const char* metrics[] = {"auc", "recall_at_100p", "max_f1", "recall_at_1", "recall_at_5",
+                           "average_precision_percent", "unanswered_queries"};
+  int compared = 0;
+  for (const std::string d : {"LDB", "HOG"})
+    for (const std::string l : {"1", "5"})
+      for (const std::string s : {"distance", "ratio"}) {
+        const std::string run = SweepRunJson(
+            json, "{\"Image_descriptor\": \"" + d + "\", \"Image_sequences\": \"" + l +
+                      "\", \"Match_score\": \"" + s + "\"}");
+        ASSERT_FALSE(run.empty()) << d << " " << l << " " << s;
+        const Outcome single = RunProgram(
+            testing::TestOpenableExe(),
+            With(SampleArgs(), {"--set", "Image_descriptor=" + d, "--set", "Image_sequences=" + l,
+                                "--set", "Match_score=" + s, "--set", "Evaluation_name=one"}),
+            dir);
+        ASSERT_EQ(single.status, 0) << single.err;
+        const std::string one = ReadAll(dir + "/one.json");
+        for (const char* m : metrics) {
+          const double want = JsonNumber(one, m);
+          ASSERT_FALSE(std::isnan(want)) << m;
+          EXPECT_EQ(JsonNumber(run, m), want) << d << " L=" << l << " " << s << ": " << m;
+        }
+        ++compared;
+      }
+  EXPECT_EQ(compared, 8);
+
+  // Ranked by AUC, best first, ranks 1..8 in order; the CSV has the same rows.
+  std::vector<double> aucs;
+  for (std::size_t p = json.find("\"rank\": "); p != std::string::npos;
+       p = json.find("\"rank\": ", p + 1)) {
+    EXPECT_EQ(JsonNumber(json, "rank", p), static_cast<double>(aucs.size() + 1));
+    aucs.push_back(JsonNumber(json, "auc", p));
+  }
+  ASSERT_EQ(aucs.size(), 8u);
+  EXPECT_TRUE(std::is_sorted(aucs.rbegin(), aucs.rend()));
+  std::istringstream csv(ReadAll(dir + "/out/sweep.csv"));
+  std::string line;
+  int rows = 0;
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("rank,Image_descriptor,Image_sequences,Match_score,label,auc,", 0), 0u)
+      << line;
+  while (std::getline(csv, line)) ++rows;
+  EXPECT_EQ(rows, 8);
+  // The table on stdout names the best run first.
+  EXPECT_NE(sweep.out.find("ranked by AUC"), std::string::npos) << sweep.out;
+}
+
+TEST(Sweep, RanksByTheChosenFigure) {
+  const std::string dir = testing::TempDir();
+  const Outcome sweep = RunProgram(
+      testing::OpenableSweepExe(),
+      With(SampleArgs(), {"--vary", "Image_sequences=1,3,5", "--rank-by", "recall_at_1",
+                          "--best", "2", "--output", "r"}),
+      dir);
+  ASSERT_EQ(sweep.status, 0) << sweep.err;
+  const std::string json = ReadAll(dir + "/r.json");
+  std::vector<double> r1;
+  for (std::size_t p = json.find("\"rank\": "); p != std::string::npos;
+       p = json.find("\"rank\": ", p + 1))
+    r1.push_back(JsonNumber(json, "recall_at_1", p));
+  ASSERT_EQ(r1.size(), 3u);
+  EXPECT_TRUE(std::is_sorted(r1.rbegin(), r1.rend()));
+  EXPECT_EQ(JsonNumber(json, "descriptions"), 1);
+}
+
+// Bad sweeps: one line naming the option, key and value, exit 1, nothing written, and no run
+// started (the checks come before the first frame is read).
+TEST(Sweep, BadValuesStopBeforeAnyWork) {
+  const std::string dir = testing::TempDir();
+  struct Case {
+    std::vector<std::string> args;
+    std::vector<std::string> parts;
+  } cases[] = {
+      {{"--vary", "Imge_sequences=1,5"}, {"--vary", "Imge_sequences", "Image_sequences"}},
+      {{"--vary", "Image_sequences=1,0"}, {"--vary", "Image_sequences", "\"0\""}},
+      {{"--vary", "Image_sequences=1,,5"}, {"--vary", "Image_sequences", "empty value"}},
+      {{"--vary", "Image_sequences=1,1"}, {"Image_sequences", "\"1\"", "twice"}},
+      {{"--vary", "Match_score=distance,ratoi"}, {"Match_score", "ratoi", "distance or ratio"}},
+      {{"--vary", "Image_descriptor=LDB,HOG+LDBX"}, {"Image_descriptor", "LDBX"}},
+      {{"--vary", "Txt_name=a,b"}, {"--vary", "Txt_name", "cannot be varied"}},
+      {{"--vary", "Image_sequences"}, {"--vary", "Image_sequences", "Key=v1,v2"}},
+      {{"--vary", "Image_sequences=1,5", "--vary", "Image_sequences=10"},
+       {"Image_sequences", "twice"}},
+      {{}, {"--vary", "none given"}},
+      {{"--vary", "Match_score=distance,ratio", "--set", "Match_score_window=400"},
+       {"Match_score=ratio", "Match_score_window", "400"}},
+      {{"--vary", "Image_sequences=1,5", "--set", "Ground_truth_type="},
+       {"Ground_truth_type", "empty"}},
+      {{"--vary", "Image_sequences=1,5", "--set", "Matrix_mode=2", "--set", "Matches_name=m.csv"},
+       {"Matrix_mode", "2", "dense"}},
+      {{"--vary", "Image_sequences=1,5", "--best", "0"}, {"--best", "\"0\""}},
+      {{"--vary", "Image_sequences=1,5", "--rank-by", "speed"}, {"--rank-by", "speed", "auc"}},
+      {{"--vary", "Image_descriptor=LDB,HOG+LDB", "--set", "Image_sequences=2"},
+       {"Image_descriptor=HOG+LDB", "Fusion_weights"}},
+  };
+  for (const Case& c : cases) {
+    fs::remove_all(dir + "/bad");
+    const Outcome o = RunProgram(
+        testing::OpenableSweepExe(),
+        With(With(SampleArgs(), {"--output", "bad/sweep"}), c.args), dir);
+    std::string what;
+    for (const auto& a : c.args) what += a + " ";
+    EXPECT_EQ(o.status, 1) << what << o.err;
+    EXPECT_TRUE(OneLine(o.err)) << what << o.err;
+    for (const auto& part : c.parts)
+      EXPECT_NE(o.err.find(part), std::string::npos) << what << ": " << part << " in " << o.err;
+    EXPECT_EQ(o.err.find("run 1 of"), std::string::npos) << what;
+    EXPECT_FALSE(fs::exists(dir + "/bad")) << what;
+    EXPECT_TRUE(o.out.empty()) << what << o.out;
+  }
+  // A usage error (an option without its value) exits 2.
+  const Outcome usage = RunProgram(testing::OpenableSweepExe(), {"x.txt", "--vary"}, dir);
+  EXPECT_EQ(usage.status, 2) << usage.err;
+  EXPECT_NE(usage.err.find("--vary needs a value"), std::string::npos) << usage.err;
+}
+
+}  // namespace
+}  // namespace openable
