@@ -69,5 +69,6 @@ void RegisterMatching(py::module_& m);
 void RegisterEvaluation(py::module_& m);
 void RegisterOnline(py::module_& m);
 void RegisterSnaps(py::module_& m);
+void RegisterSweep(py::module_& m);
 
 }  // namespace openable::python

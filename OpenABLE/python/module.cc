@@ -22,7 +22,8 @@ Parts:
   descriptors   descriptor_names, describe, describe_images, read_image, list_images, to_gray8
   matching      hamming_distances, l2_distances, sequence_distances, distance_matrix,
                 normalize_by_max, threshold_matrix, read_matrix
-  evaluation    evaluate -> EvaluationResult (figures and Curve objects)
+  evaluation    evaluate -> EvaluationResult (figures and Curve objects); sweep ->
+                SweepResult (every combination of a few keys, ranked)
   online        OnlineDetector (loop candidates frame by frame)
   snaps         openable.snaps: trajectories, loops, discounted update, pose graph, errors
 
@@ -51,6 +52,7 @@ the command-line programs; other invalid arguments raise ValueError.)doc";
   openable::python::RegisterEvaluation(m);
   openable::python::RegisterOnline(m);
   openable::python::RegisterSnaps(m);
+  openable::python::RegisterSweep(m);
   // `import openable.snaps` and `from openable.snaps import ...` work like the attribute.
   py::module_::import("sys").attr("modules")["openable.snaps"] = m.attr("snaps");
 }
