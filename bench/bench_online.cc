@@ -4,7 +4,8 @@
 // against loop_gt_5m.txt, with a threshold sweep of its top-1 candidates.
 //
 // Usage: bench_online [--datasets DIR] [--descriptor LDB] [--sequence L] [--exclusion E]
-//                     [--threshold T] [--heading-limit DEG] [--prefill N] [--exact-limit N]
+//                     [--threshold T] [--score distance|ratio] [--score-window W]
+//                     [--heading-limit DEG] [--prefill N] [--exact-limit N]
 //                     [--block-frames N] [--foreground-merges] [--csv FILE]
 // --prefill N adds N random rows before the frames (a map of N + 1700 frames, for the latency
 // of large maps only: random rows are never loop candidates of real frames in practice).
@@ -73,6 +74,9 @@ int main(int argc, char** argv) {
     else if (a == "--sequence") options.sequence_length = std::stoi(next());
     else if (a == "--exclusion") options.exclusion = std::stoi(next());
     else if (a == "--threshold") options.threshold = std::stod(next());
+    else if (a == "--score")
+      options.score = openable::ParseEnum<openable::MatchScore>(next(), "--score");
+    else if (a == "--score-window") options.score_window = std::stoi(next());
     else if (a == "--heading-limit") heading_limit = std::stod(next());
     else if (a == "--prefill") prefill = std::stoi(next());
     else if (a == "--exact-limit") options.exact_limit = std::stoi(next());
@@ -146,7 +150,7 @@ int main(int argc, char** argv) {
       // Right within 2 frames of a ground-truth pair (docs/evaluation.md, Tolerance 2).
       bool correct = false;
       for (int d = -2; d <= 2 && !correct; ++d) correct = truth.count({f, best + d}) > 0;
-      top.emplace_back(c.normalized, correct);
+      top.emplace_back(c.score, correct);  // the normalised distance, or the ratio
       if (c.accepted) ++accepted, accepted_correct += correct;
       if (out)
         out << f << ',' << best << ',' << c.distance << ',' << c.normalized << ',' << c.accepted
@@ -154,12 +158,12 @@ int main(int argc, char** argv) {
             << 1e3 * r.search_seconds << '\n';
     }
     const int positives = std::count(positive.begin(), positive.end(), 1);
-    std::printf("OnlineDetector on KITTI 00 frames 0-1699: %s, L=%d, exclusion %d, threshold "
-                "%.3f, %d random rows before (map %d frames at the end), exact limit %d, %d "
+    std::printf("OnlineDetector on KITTI 00 frames 0-1699: %s, L=%d, exclusion %d, score %s, "
+                "threshold %.3f, %d random rows before (map %d frames at the end), exact limit %d, %d "
                 "frames searched with FLANN blocks (%d blocks at the end, merges %s), memory "
                 "%.1f MB\n",
                 options.descriptor.c_str(), options.sequence_length, options.exclusion,
-                options.threshold, prefill, detector.Size(), options.exact_limit,
+                openable::EnumName(options.score).c_str(), options.threshold, prefill, detector.Size(), options.exact_limit,
                 approximate_frames, detector.Blocks(),
                 options.background_merges ? "in the background" : "in AddFrame",
                 detector.MemoryBytes() / 1e6);
@@ -174,7 +178,7 @@ int main(int argc, char** argv) {
                 options.threshold, accepted, accepted_correct,
                 accepted ? double(accepted_correct) / accepted : 1.0,
                 positives ? double(accepted_correct) / positives : 0.0);
-    // Sweep: accepting the top-1 candidate when normalised <= t.
+    // Sweep: accepting the top-1 candidate when its score (--score) <= t.
     std::sort(top.begin(), top.end());
     double best_f1 = 0, best_t = 0, r100 = 0, t100 = 0;
     int tp = 0, fp = 0;

@@ -32,11 +32,13 @@ struct EvaluationSettings {
 // "threshold,precision,recall,f1,tp,fp" then one line per point, 9 significant digits.
 std::string EncodeCurveCsv(const std::vector<CurvePoint>& curve);
 
-// A JSON object: {"openable_version", "settings": {...}, "runs": [{"label", "source",
+// A JSON object: {"openable_version", "settings": {ground truth, tolerance, exclusion, vicinity,
+// match_score, match_score_window, able_thresholds}, "runs": [{"label", "source",
 // "layout": {...}, "ground_truth": {...}, "per_query": {auc, recall_at_100p, max_f1,
 // max_f1_threshold, max_f1_precision, max_f1_recall, recall_at_1, recall_at_5, recall_at_10,
-// queries, positive_queries, truth_pairs_outside_candidates}, "able_p": {average_precision,
-// thresholds, vicinity, candidate_cells, truth_cells}}]}. Numbers with 9 significant digits.
+// queries, positive_queries, unanswered_queries, accepted (at Match_threshold, when set),
+// truth_pairs_outside_candidates}, "able_p": {average_precision_percent, candidate_cells,
+// truth_cells}}]}. Numbers with 9 significant digits (docs/output_formats.md).
 std::string EncodeEvaluationJson(const EvaluationSettings& settings,
                                  const std::vector<EvaluatedRun>& runs, const std::string& version);
 

@@ -207,6 +207,7 @@ py::dict PropertiesAsDict(const py::handle& object, bool arrays) {
     } else if (value.is_none() || py::isinstance<py::bool_>(value) ||
                py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value) ||
                py::isinstance<py::str>(value) || py::isinstance<py::tuple>(value) ||
+               py::isinstance<py::dict>(value) ||
                (arrays && py::isinstance<py::array>(value))) {
       out[name.c_str()] = value;
     }

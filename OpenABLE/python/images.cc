@@ -14,7 +14,8 @@ void RegisterImages(py::module_& m) {
 
 Names of the descriptors this build provides, in the order shown to users:
 LDB, D-LDB, ORB, BRISK, BRIEF, FREAK (binary rows, uint8, matched with the Hamming
-distance) and SIFT, HOG (vector rows, float32, matched with the L2 distance). D-LDB needs a
+distance), SIFT, HOG (vector rows, float32, matched with the L2 distance) and SAD (SeqSLAM's
+patch-normalised thumbnail: uint8 values, matched with the L1 distance). D-LDB needs a
 grey + disparity image (stereo) and is not usable through describe(). Names are
 case-insensitive wherever a descriptor is asked for.)doc");
 

@@ -20,8 +20,9 @@ result (no copy); contiguous input arrays are read in place. Long computations r
 
 Parts:
   descriptors   descriptor_names, describe, describe_images, read_image, list_images, to_gray8
-  matching      hamming_distances, l2_distances, sequence_distances, distance_matrix,
-                normalize_by_max, threshold_matrix, read_matrix
+  matching      hamming_distances, l2_distances, l1_distances, sequence_distances,
+                distance_matrix, contrast_enhancement, normalize_by_max, threshold_matrix,
+                best_matches, read_matrix
   evaluation    evaluate -> EvaluationResult (figures and Curve objects); sweep ->
                 SweepResult (every combination of a few keys, ranked)
   online        OnlineDetector (loop candidates frame by frame)

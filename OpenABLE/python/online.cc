@@ -383,7 +383,7 @@ Raises:
             return ResultTuple(r);
           },
           py::arg("row"),
-          R"doc(add_descriptor(row) -> tuple[int, list[tuple[int, float, float, bool]], dict]
+          R"doc(add_descriptor(row) -> tuple[int, list[tuple[int, float, float, bool, float]], dict]
 
 Adds an already computed descriptor row (1-D, row_width elements of row_dtype, e.g. a row of
 describe_images()) as the next frame; returns what add_frame() returns.)doc")

@@ -71,11 +71,20 @@ Methods: table() (the ranked table openable_sweep prints), to_csv(), to_json().)
                                for (std::size_t i = 0; i < s.result.runs.size(); ++i)
                                  runs.append(RunDict(s.result, i));
                                return runs;
-                             })
-      .def_property_readonly("rank_by", [](const Sweep& s) { return EnumName(s.result.rank_by); })
-      .def_property_readonly("descriptions", [](const Sweep& s) { return s.result.descriptions; })
-      .def_property_readonly("seconds", [](const Sweep& s) { return s.result.seconds; })
-      .def_property_readonly("written", [](const Sweep& s) { return s.written; })
+                             },
+                             "list[dict]: one dict per combination, best first (see the class).")
+      .def_property_readonly(
+          "rank_by", [](const Sweep& s) { return EnumName(s.result.rank_by); },
+          "str: the figure the runs are ranked by.")
+      .def_property_readonly(
+          "descriptions", [](const Sweep& s) { return s.result.descriptions; },
+          "int: single-frame matrices computed (frames described that many times).")
+      .def_property_readonly(
+          "seconds", [](const Sweep& s) { return s.result.seconds; },
+          "float: wall time of the sweep.")
+      .def_property_readonly(
+          "written", [](const Sweep& s) { return s.written; },
+          "list[str]: the paths written (output given), else empty.")
       .def("table", [](const Sweep& s) { return FormatSweepTable(s.result); },
            "table() -> str\n\nThe ranked table, as openable_sweep prints it.")
       .def("to_csv", [](const Sweep& s) { return EncodeSweepCsv(s.result); },
