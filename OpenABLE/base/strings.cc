@@ -1,7 +1,10 @@
 #include "OpenABLE/base/strings.h"
 
 #include <cmath>
+#include <filesystem>
 #include <sstream>
+
+#include "OpenABLE/base/error.h"
 
 namespace openable {
 
@@ -31,6 +34,15 @@ std::string FormatNumber(double value) {
   std::ostringstream os;
   os << value;
   return os.str();
+}
+
+std::string WorkingDirectoryNote(std::string_view path) {
+  const std::filesystem::path p(path);
+  if (path.empty() || p.is_absolute()) return "";
+  std::error_code ec;
+  const std::filesystem::path cwd = std::filesystem::current_path(ec);
+  if (ec) return " (a relative path)";
+  return " (relative to the working directory " + Quoted(cwd.string()) + ")";
 }
 
 }  // namespace openable

@@ -2,12 +2,14 @@
 
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <system_error>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 
 namespace openable::evaluation_internal {
 
@@ -16,7 +18,7 @@ namespace fs = std::filesystem;
 void RequireFile(const std::string& path, const std::string& where) {
   std::error_code ec;
   const fs::file_status st = fs::status(path, ec);
-  if (!fs::exists(st)) throw InputError(where + ": file not found");
+  if (!fs::exists(st)) throw InputError(where + ": file not found" + WorkingDirectoryNote(path));
   if (fs::is_directory(st)) throw InputError(where + ": is a folder; expected a file");
 }
 
@@ -37,5 +39,40 @@ bool ParseNumber(std::string_view token, double* value) {
   return r.ec == std::errc() && r.ptr == end;
 }
 
+
+bool ParseIndex(std::string_view field, std::int64_t* value) {
+  std::string_view f = field;
+  if (!f.empty() && f.front() == '+') f.remove_prefix(1);
+  const char* end = f.data() + f.size();
+  const auto r = std::from_chars(f.data(), end, *value);
+  if (!f.empty() && r.ec == std::errc() && r.ptr == end) return true;
+  double d = 0.0;
+  if (!ParseNumber(field, &d) || !std::isfinite(d) || d != std::floor(d) || std::abs(d) > 1e15) {
+    return false;
+  }
+  *value = static_cast<std::int64_t>(d);
+  return true;
+}
+
+void SplitFields(std::string_view s, std::vector<std::string_view>* out) {
+  out->clear();
+  std::size_t i = 0;
+  bool after_comma = false;
+  while (true) {
+    while (i < s.size() && IsBlank(s[i])) ++i;
+    if (i == s.size()) break;
+    if (s[i] == ',') {
+      if (out->empty() || after_comma) out->emplace_back();
+      after_comma = true;
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j < s.size() && !IsBlank(s[j]) && s[j] != ',') ++j;
+    out->push_back(s.substr(i, j - i));
+    after_comma = false;
+    i = j;
+  }
+}
 
 }  // namespace openable::evaluation_internal

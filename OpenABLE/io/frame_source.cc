@@ -22,6 +22,7 @@
 #include <jpeglib.h>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/io/io_common.h"
 #include "OpenABLE/io/module_api.h"
 #include "OpenABLE/io/module_loader.h"
@@ -375,7 +376,8 @@ std::vector<std::string> ListImages(const std::string& folder, const std::string
   std::error_code ec;
   const fs::file_status status = fs::status(folder, ec);
   if (!fs::exists(status)) {
-    throw InputError("folder " + Quoted(folder) + " does not exist (" + kExpectedFolder + ")");
+    throw InputError("folder " + Quoted(folder) + " does not exist" +
+                     WorkingDirectoryNote(folder) + " (" + kExpectedFolder + ")");
   }
   if (!fs::is_directory(status)) {
     throw InputError("folder " + Quoted(folder) + " is not a folder but a file (" +
@@ -399,11 +401,17 @@ std::vector<std::string> ListImages(const std::string& folder, const std::string
     if (name.empty() || name.front() == '.') continue;
     std::error_code file_ec;
     const std::string ext = ExtensionOf(name);
-    // A symbolic link that leads nowhere (dangling, or a loop) under an image name is a frame
-    // the user meant: it is listed so that reading it names it. Folders are passed over.
+    // A symbolic link that leads nowhere (dangling, or a loop), or a FIFO, socket or device (or
+    // a link to one, such as /dev/zero) under an image name is a frame the user meant: it is
+    // listed so that reading it names it (or Skip_unreadable skips and counts it) instead of the
+    // later frame numbers silently shifting. Folders are passed over.
     const bool broken_link = it->is_symlink(file_ec) && !fs::exists(it->path(), file_ec);
-    if (!broken_link && (!it->is_regular_file(file_ec) || file_ec)) continue;  // follows links
-    if (broken_link && !accepted(ext)) continue;
+    std::error_code type_ec;
+    const bool regular = it->is_regular_file(type_ec) && !type_ec;  // follows links
+    const bool special = !broken_link && !regular && !type_ec &&
+                         !it->is_directory(type_ec) && !type_ec;
+    if (!broken_link && !regular && !special) continue;
+    if ((broken_link || special) && !accepted(ext)) continue;
     ++file_count;
     if (accepted(ext)) {
       names.push_back(name);
@@ -455,9 +463,19 @@ cv::Mat ReadImageFile(const std::string& path) {
       throw fail("is a symbolic link to " + Quoted(target) + " that leads nowhere (" +
                  (ec ? FirstLine(ec.message()) : std::string("dangling: no such file")) + ")");
     }
-    throw fail("does not exist");
+    throw fail("does not exist" + WorkingDirectoryNote(path));
   }
-  if (!fs::is_regular_file(status)) throw fail("is not a regular file");
+  if (!fs::is_regular_file(status)) {
+    const fs::file_type type = status.type();
+    throw fail(std::string("is ") +
+               (type == fs::file_type::fifo        ? "a FIFO (named pipe)"
+                : type == fs::file_type::socket    ? "a socket"
+                : type == fs::file_type::character ? "a character device"
+                : type == fs::file_type::block     ? "a block device"
+                : type == fs::file_type::directory ? "a folder"
+                                                   : "a special file") +
+               ", not a regular file");
+  }
   if (fs::file_size(path, ec) == 0 && !ec) throw fail("is an empty file (0 bytes)");
 
   std::vector<unsigned char> bytes;
@@ -508,7 +526,8 @@ std::unique_ptr<FrameSource> OpenImageFolder(const std::string& folder,
 std::unique_ptr<FrameSource> OpenVideo(const std::string& path, int first, int last) {
   std::error_code ec;
   if (!fs::exists(path, ec) && path.find("://") == std::string::npos) {
-    throw InputError("video " + Quoted(path) + " does not exist (" + kExpectedVideo + ")");
+    throw InputError("video " + Quoted(path) + " does not exist" + WorkingDirectoryNote(path) +
+                     " (" + kExpectedVideo + ")");
   }
   // FFmpeg's "tty" demuxer renders any text file as ANSI-art frames, so a configuration or
   // ground-truth file given as a video by mistake would "work". Refuse the usual text types.

@@ -6,12 +6,18 @@
 #include <atomic>
 #include <thread>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <iomanip>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
@@ -272,6 +278,49 @@ TEST(BadInputCorpus, DanglingSymbolicLink) {
   const Outcome o = RunBounded(dir, {WriteConfig(dir, folder)});
   ExpectRefused(o, dir, "a3.png");
   EXPECT_NE(o.err.find("symbolic link"), std::string::npos) << o.err;
+}
+
+// A FIFO, a socket or a link to a device under an image name is a frame the user meant: the run
+// names it and stops (reading a FIFO would block), or Skip_unreadable skips and lists it; it is
+// never dropped without a word, which would shift the later frame numbers.
+TEST(BadInputCorpus, SpecialFilesUnderImageNamesAreNamed) {
+  const std::string dir = testing::TempDir();
+  struct Case {
+    const char* name;
+    std::function<void(const std::string&)> make;
+    const char* what;
+  } cases[] = {
+      {"a15.png", [](const std::string& p) { ASSERT_EQ(::mkfifo(p.c_str(), 0644), 0); },
+       "FIFO"},
+      {"a16.png", [](const std::string& p) { fs::create_symlink("/dev/zero", p); },
+       "character device"},
+      {"a17.png",
+       [](const std::string& p) {
+         const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+         ASSERT_GE(fd, 0);
+         sockaddr_un addr{};
+         addr.sun_family = AF_UNIX;
+         ASSERT_LT(p.size(), sizeof addr.sun_path);
+         std::strcpy(addr.sun_path, p.c_str());
+         ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+         ::close(fd);
+       },
+       "socket"},
+  };
+  for (const Case& c : cases) {
+    fs::remove_all(dir + "/out");  // the previous case's Skip_unreadable run wrote it
+    const std::string folder = SoundFolder(dir, std::string("imgs_") + c.name);
+    if (std::string(c.what) == "socket" && (folder + "/" + c.name).size() >= 100) continue;
+    c.make(folder + "/" + c.name);
+    const Outcome o = RunBounded(dir, {WriteConfig(dir, folder)});
+    ExpectRefused(o, dir, c.name);
+    EXPECT_NE(o.err.find(c.what), std::string::npos) << o.err;
+    const Outcome skipped = RunBounded(dir, {WriteConfig(dir, folder, "Skip_unreadable: 1\n")});
+    ASSERT_EQ(skipped.status, 0) << skipped.err;
+    EXPECT_NE(skipped.out.find(std::string("skipped: ")), std::string::npos) << skipped.out;
+    EXPECT_NE(skipped.out.find(c.name), std::string::npos) << skipped.out;
+    EXPECT_EQ(ReadNpy(dir + "/out/matrix.npy").rows, 2);
+  }
 }
 
 // A link to a folder is that folder; links to sound images are those images.
