@@ -1,5 +1,6 @@
 #include "config/config.h"
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -327,7 +328,7 @@ OptionTable ConfigTable(Config& c) {
         " online with the discounted update, as the paper), openable (an OpenABLE run on the same"
         " images with the description keys of this file: each frame's best match at least "
         "Snaps_frame_distance frames back, kept below Snaps_matrix_threshold), pairs "
-        "(Snaps_loops_file: row,col frame numbers per line, row the later frame), matrix "
+        "(Snaps_loops_file: two frame numbers per line, read as Ground_truth_type pairs), matrix "
         "(Snaps_loops_file: the normalised matrix of an OpenABLE run of one sequence, "
         ".npy/.txt/image: each frame's best match at least Snaps_frame_distance frames back, kept"
         " below Snaps_matrix_threshold).");
@@ -457,10 +458,13 @@ Config ParseConfigText(const std::string& text, const std::string& name) {
 
 Config LoadConfig(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in)
+  if (!in) {
+    std::error_code ec;
+    const bool exists = std::filesystem::exists(path, ec);
     throw InputError("configuration file " + Quoted(path) +
-                     " cannot be opened (expected a readable Config.txt; see Test_OpenABLE "
-                     "--help)");
+                     (exists ? " cannot be opened" : " does not exist" + WorkingDirectoryNote(path)) +
+                     " (expected a readable Config.txt; see Test_OpenABLE --help)");
+  }
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw InputError("configuration file " + Quoted(path) + " could not be read");

@@ -46,7 +46,9 @@ std::string Unquote(const std::string& v, const std::string& where, const std::s
   return v;
 }
 
-// Removes a '#' comment that is not inside quotes.
+// Removes a '#' comment that is not inside quotes. As in YAML (and OpenCV's FileStorage,
+// which read the original's files), '#' starts a comment only at the start of the line or after
+// a space or tab: "out/run#1.npy" is a value, "out/run.npy # first run" a value and a comment.
 std::string StripComment(const std::string& line) {
   char quote = 0;
   for (size_t i = 0; i < line.size(); ++i) {
@@ -55,7 +57,7 @@ std::string StripComment(const std::string& line) {
       if (ch == quote) quote = 0;
     } else if (ch == '"' || ch == '\'') {
       quote = ch;
-    } else if (ch == '#') {
+    } else if (ch == '#' && (i == 0 || line[i - 1] == ' ' || line[i - 1] == '\t')) {
       return line.substr(0, i);
     }
   }
@@ -70,11 +72,17 @@ void Assign(const OptionBinding& b, const std::string& raw, const std::string& w
 
 std::string OptionBinding::RangeText() const {
   if (kind == Kind::kText || kind == Kind::kEnumName) return "text";
-  const char* type = kind == Kind::kDouble ? "number" : "integer";
+  if (kind != Kind::kDouble) {
+    // Integers are stored as int: an open range ends at the type's limit, which is stated
+    // (a value beyond it is refused with this text).
+    const auto bound = [](double v) { return std::to_string(static_cast<long long>(v)); };
+    const double top = std::isinf(max) ? std::numeric_limits<int>::max() : max;
+    return "integer in [" + bound(min) + ", " + bound(top) + "]";
+  }
   if (std::isinf(max))
-    return std::string(type) + " >= " + FormatNumber(min) +
+    return "number >= " + FormatNumber(min) +
            (min_excluded ? " (" + FormatNumber(min) + " excluded)" : "");
-  return std::string(type) + " in [" + FormatNumber(min) + ", " + FormatNumber(max) + "]";
+  return "number in [" + FormatNumber(min) + ", " + FormatNumber(max) + "]";
 }
 
 void OptionTable::AddNumber(const char* key, const char* group, const char* meaning, bool is_new,

@@ -28,6 +28,24 @@ std::string ErrorOf(F f) {
   return "";
 }
 
+// '#' starts a comment only at the start of a line or after a space or tab (YAML, and OpenCV's
+// FileStorage, which read the original's files): inside an unquoted value it is a character.
+TEST(Config, HashInsideAnUnquotedValueIsKept) {
+  const std::string path = WriteFile(
+      "%YAML:1.0\n"
+      "#Txt_name: commented.txt\n"
+      "   # an indented comment\n"
+      "Npy_name: out/run#1.npy\n"
+      "Png_name: out/run#2.png # the image\n"
+      "Txt_name: out/m.txt\t# after a tab\n"
+      "Images_format: png#\n");
+  const Config c = LoadConfig(path);
+  EXPECT_EQ(c.output.npy_name, "out/run#1.npy");
+  EXPECT_EQ(c.output.png_name, "out/run#2.png");
+  EXPECT_EQ(c.output.txt_name, "out/m.txt");
+  EXPECT_EQ(c.input.images_format, "png#");
+}
+
 TEST(Config, ReadsTheOriginalFormat) {
   const std::string path = WriteFile(
       "%YAML:1.0\n"
