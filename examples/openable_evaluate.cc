@@ -134,6 +134,7 @@ int main(int argc, char** argv) {
           "Ground_truth_type: not set; expected --gt-type matrix, pairs, aligned, kitti, tum or "
           "positions");
     openable::CheckEvaluationConfig(config);
+    openable::CheckOutputPrefix("Evaluation_name", config.evaluation.name);
     openable::Evaluation evaluation;
     evaluation.settings = openable::EvaluationSettingsFrom(config);
     const std::vector<cv::Mat1f> loaded =

@@ -92,6 +92,7 @@ int main(int argc, char** argv) {
             options.best = ParseCount("--best", value);
           }
         }
+        openable::CheckOutputPrefix("--output", prefix);
         const bool quiet = command_line.quiet;
         const auto log = [quiet](const std::string& line) {
           if (!quiet || line.rfind("run ", 0) != 0)

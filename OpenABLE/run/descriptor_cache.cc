@@ -124,7 +124,9 @@ std::unique_ptr<DescriptorCache> DescriptorCache::Open(const std::string& folder
                                                        std::vector<std::string>& warnings) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (!fs::is_directory(folder, ec) && !fs::create_directories(folder, ec))
+  // Another run may create the folder first (create_directories then returns false).
+  if (!fs::is_directory(folder, ec) && !fs::create_directories(folder, ec) &&
+      !fs::is_directory(folder))
     throw InputError("Descriptor_cache: folder \"" + folder + "\" cannot be created (" +
                      ec.message() + "); expected a writable folder, or empty for no cache");
   std::unique_ptr<DescriptorCache> c(new DescriptorCache());

@@ -5,13 +5,16 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <set>
 #include <fstream>
 #include <stdexcept>
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -197,6 +200,47 @@ OutputBatch::~OutputBatch() {
   }
 }
 
+namespace {
+
+// The file `path` names, for comparing outputs: absolute, ".", ".." and existing links resolved.
+std::string SameFileKey(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+  if (ec) return path;
+  const std::filesystem::path resolved = std::filesystem::weakly_canonical(absolute, ec);
+  return (ec ? absolute.lexically_normal() : resolved).string();
+}
+
+std::string ClashMessage(const std::string& key, const std::string& path,
+                         const std::string& other_key, const std::string& other_path) {
+  return key + ": \"" + path + "\" is also the file of " + other_key +
+         (other_path == path ? std::string() : " (\"" + other_path + "\")") +
+         "; expected a different file for each output (one would overwrite the other)";
+}
+
+}  // namespace
+
+void CheckDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  std::vector<std::string> keys;
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    keys.push_back(SameFileKey(outputs[i].second));
+    for (size_t j = 0; j < i; ++j)
+      if (keys[j] == keys[i])
+        throw InputError(ClashMessage(outputs[i].first, outputs[i].second, outputs[j].first,
+                                      outputs[j].second));
+  }
+}
+
+void CheckOutputPrefix(const std::string& key, const std::string& prefix) {
+  std::error_code ec;
+  if (!prefix.empty() &&
+      (prefix.back() == '/' || std::filesystem::is_directory(prefix, ec)))
+    throw InputError(key + ": \"" + prefix + "\" is a folder; expected a path prefix for the " +
+                     "files, such as \"" +
+                     (std::filesystem::path(prefix) / "eval").lexically_normal().string() +
+                     "\" (writing eval.json, eval_pr.png, ... in it)");
+}
+
 void OutputBatch::Stage(const std::string& key, const std::string& path,
                         const std::string& bytes) {
   Stage(key, path, std::vector<std::string_view>{bytes});
@@ -205,19 +249,28 @@ void OutputBatch::Stage(const std::string& key, const std::string& path,
 void OutputBatch::Stage(const std::string& key, const std::string& path,
                         const std::vector<std::string_view>& parts) {
   namespace fs = std::filesystem;
+  for (const Item& item : items_)
+    if (SameFileKey(item.path) == SameFileKey(path))
+      throw InputError(ClashMessage(key, path, item.key, item.path));
   const fs::path dest(path);
   const fs::path folder = dest.has_parent_path() ? dest.parent_path() : fs::path(".");
   std::error_code ec;
-  if (!fs::is_directory(folder, ec) && !fs::create_directories(folder, ec))
+  // create_directories returns false when another process created the folder first: an
+  // existing folder is what is needed, so look again before reporting a failure.
+  if (!fs::is_directory(folder, ec) && !fs::create_directories(folder, ec) &&
+      !fs::is_directory(folder))
     throw InputError(key + ": cannot write \"" + path + "\": folder \"" + folder.string() +
                      "\" cannot be created (" + ec.message() + ")");
   if (fs::is_directory(dest, ec))
     throw InputError(key + ": cannot write \"" + path +
                      "\": it is a folder (expected a file name)");
   RemoveStaleTemporaries(folder, dest.filename().string());
+  // Unique within the process too: two batches of one process (threads, a Python program
+  // running two runs) may stage the same destination at once.
+  static std::atomic<std::uint64_t> staged{0};
   const std::string temp = (folder / ("." + dest.filename().string() + ".tmp-" +
                                       std::to_string(::getpid()) + "-" +
-                                      std::to_string(items_.size())))
+                                      std::to_string(staged++)))
                                .string();
   // Registered before it exists, so that a signal between open and write removes it too.
   items_.push_back({key, temp, path, RegisterTemporary(temp)});
@@ -225,6 +278,9 @@ void OutputBatch::Stage(const std::string& key, const std::string& path,
   int error = fd < 0 ? errno : 0;
   for (const std::string_view part : parts)
     if (error == 0) error = WriteAll(fd, part.data(), part.size());
+  // On disk before the rename makes it visible: a power cut after the commit must not leave a
+  // renamed but empty file (ext4 and XFS may order the rename before the data).
+  if (fd >= 0 && error == 0 && ::fsync(fd) != 0 && errno != EINVAL) error = errno;
   // close() reports the errors of delayed writes on some file systems (NFS).
   if (fd >= 0 && ::close(fd) != 0 && error == 0) error = errno;
   if (error != 0) {
@@ -236,8 +292,61 @@ void OutputBatch::Stage(const std::string& key, const std::string& path,
   }
 }
 
+namespace {
+
+// fsync of a folder: its entries (the temporaries before the renames, the renamed names after)
+// reach the disk. Best effort: a file system that cannot sync folders says EINVAL.
+void SyncFolder(const std::string& folder) {
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
+// The folders of `paths`, each once, sorted (so that two commits lock them in the same order).
+std::vector<std::string> FoldersOf(const std::vector<std::string>& paths) {
+  std::set<std::string> folders;
+  for (const std::string& p : paths) {
+    const std::filesystem::path dest(p);
+    folders.insert(std::filesystem::absolute(dest.has_parent_path() ? dest.parent_path()
+                                                                    : std::filesystem::path("."))
+                       .lexically_normal()
+                       .string());
+  }
+  return {folders.begin(), folders.end()};
+}
+
+// An advisory lock (flock) on each folder the commit writes into, held while its renames run:
+// two runs writing the same outputs commit one after the other, so the final set is one run's,
+// never a mix. Linux locks a folder's descriptor like a file's, so no lock file is left behind.
+class CommitLocks {
+ public:
+  explicit CommitLocks(const std::vector<std::string>& folders) {
+    for (const std::string& folder : folders) {
+      const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+      if (fd < 0) continue;  // cannot happen for a folder just staged into; no lock then
+      while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
+      }
+      fds_.push_back(fd);
+    }
+  }
+  ~CommitLocks() {
+    for (const int fd : fds_) ::close(fd);  // closing releases the lock
+  }
+  CommitLocks(const CommitLocks&) = delete;
+  CommitLocks& operator=(const CommitLocks&) = delete;
+
+ private:
+  std::vector<int> fds_;
+};
+
+}  // namespace
+
 void OutputBatch::Commit() {
   InterruptDeferral defer;  // a signal now acts after the renames (or their undoing)
+  const std::vector<std::string> folders = FoldersOf(Paths());
+  for (const std::string& folder : folders) SyncFolder(folder);
+  const CommitLocks locks(folders);
   struct Done {
     std::string path, backup;  // backup empty: the destination did not exist (or no link)
     bool existed;
@@ -252,8 +361,9 @@ void OutputBatch::Commit() {
       const std::filesystem::path dest(item.path);
       const std::filesystem::path folder =
           dest.has_parent_path() ? dest.parent_path() : std::filesystem::path(".");
+      static std::atomic<std::uint64_t> backups{0};
       backup = (folder / ("." + dest.filename().string() + ".old-" +
-                          std::to_string(::getpid()) + "-" + std::to_string(k)))
+                          std::to_string(::getpid()) + "-" + std::to_string(backups++)))
                    .string();
       ::unlink(backup.c_str());
       if (::link(item.path.c_str(), backup.c_str()) != 0) backup.clear();
@@ -280,6 +390,7 @@ void OutputBatch::Commit() {
   }
   for (const Done& d : done)
     if (!d.backup.empty()) ::unlink(d.backup.c_str());
+  for (const std::string& folder : folders) SyncFolder(folder);
   items_.clear();
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <string_view>
 #include <vector>
 
@@ -53,6 +54,17 @@ std::string EncodeMatches(const std::vector<Match>& matches, bool csv);
 //    renamed are put back (the old file restored from its backup, or removed when there was
 //    none), so the destinations hold either the whole new batch or the whole old state.
 //    Signals are deferred during Commit (interrupt.h).
+// The outputs of one run must be distinct files: two keys naming the same file would leave one
+// output silently overwritten by the other. `outputs` are (key, path) pairs; paths are compared
+// after making them absolute and resolving ".", ".." and existing links. Throws InputError
+// "<key>: "<path>" is also the file of <other key> ..." naming both keys.
+void CheckDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs);
+
+// An output prefix (Evaluation_name, openable_sweep --output, Snaps_output_name): the files
+// are <prefix>.json, <prefix>_pr.png, ..., so a prefix that is a folder (or ends with '/')
+// would write hidden files in it. Throws InputError naming `key` and the prefix.
+void CheckOutputPrefix(const std::string& key, const std::string& prefix);
+
 class OutputBatch {
  public:
   OutputBatch() = default;
@@ -62,7 +74,8 @@ class OutputBatch {
   ~OutputBatch();
   // Writes `bytes` to a temporary file beside `path`, creating its folder when missing.
   // Throws InputError naming `key`, the path and the system's reason (e.g. "No space left on
-  // device") when the file cannot be written; the partial temporary is removed.
+  // device") when the file cannot be written; the partial temporary is removed; and naming
+  // both keys when `path` is a file already staged in this batch (CheckDistinctOutputs).
   void Stage(const std::string& key, const std::string& path, const std::string& bytes);
   // The same for a file made of several pieces written one after the other (no copy into
   // one buffer: a matrix's rows can be written from where they are).

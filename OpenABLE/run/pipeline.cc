@@ -265,6 +265,30 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
   const bool panoramic = input.camera_type == CameraType::kPanoramic;
   const int strips = panoramic ? config.description.panoramas : 1;
   const PanoramaMatching panorama_matching = matching.panorama_matching;
+  // The row of a frame, refused up front when it cannot be held: Patch_size 1024 with a 64 x 32
+  // grid of HOG cells would need gigabytes per frame (and overflow the row's int width).
+  const int cells = (config.description.type == DescriptionType::kGrid
+                         ? config.description.grid_x * config.description.grid_y
+                         : 1) *
+                    strips;
+  std::int64_t row_bytes = 0;  // every descriptor's row of one frame
+  for (size_t k = 0; k < descriptors.size(); ++k)
+    row_bytes += static_cast<std::int64_t>(descriptors[k]->Width()) * cells *
+                 (descriptors[k]->Kind() == DescriptorKind::kFloat ? 4 : 1);
+  constexpr std::int64_t kMaxRowBytes = std::int64_t{1} << 30;
+  if (row_bytes > kMaxRowBytes) {
+    char text[96];
+    std::snprintf(text, sizeof text, "%.1f GiB", static_cast<double>(row_bytes) / kMaxRowBytes);
+    throw InputError("Patch_size: " + std::to_string(config.descriptor.patch_size) + " with " +
+                     (config.description.type == DescriptionType::kGrid
+                          ? "Grid_x " + std::to_string(config.description.grid_x) + " x Grid_y " +
+                                std::to_string(config.description.grid_y)
+                          : std::string("the global description")) +
+                     (strips > 1 ? " and " + std::to_string(strips) + " sub-panoramas" : "") +
+                     " makes a descriptor row of " + text + " per frame (" +
+                     config.descriptor.name + "); expected at most 1 GiB: a smaller Patch_size "
+                     "or grid");
+  }
   std::vector<std::unique_ptr<FrameDescriber>> describers;
   for (size_t k = 0; k < descriptors.size(); ++k) {
     describers.push_back(std::make_unique<FrameDescriber>(
@@ -355,6 +379,16 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     result.bounded = dense_bytes > limit_bytes;
     result.mode_reason = std::string(result.bounded ? "bounded" : "dense") + " (Matrix_mode 0: " +
                          sizes + ")";
+  }
+  if (static_cast<double>(row_bytes) * static_cast<double>(planned) > limit_bytes) {
+    char text[160];
+    std::snprintf(text, sizeof text, "%.2f GiB of descriptor rows (%lld frames of %.1f MB)",
+                  static_cast<double>(row_bytes) * planned / gib, static_cast<long long>(planned),
+                  row_bytes / 1e6);
+    throw InputError(std::string("Patch_size: ") + std::to_string(config.descriptor.patch_size) +
+                     " (" + config.descriptor.name + ") needs " + text + ", more than " +
+                     (scale.memory_limit > 0 ? "Memory_limit" : "3/4 of the RAM") +
+                     "; expected a smaller Patch_size or grid");
   }
   if (result.bounded && scale.matches_name.empty())
     throw InputError("Matches_name: empty, but the run is " + result.mode_reason +
@@ -594,6 +628,27 @@ EvaluationLayout LayoutOf(const RunResult& result) {
 
 std::string ThresholdPngPath(const Config& config) {
   return config.output.ThresholdPngPath(config.matching.threshold >= 0.0);
+}
+
+std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& config) {
+  std::vector<std::pair<std::string, std::string>> out;
+  const OutputOptions& o = config.output;
+  if (!o.txt_name.empty()) out.emplace_back("Txt_name", o.txt_name);
+  if (!o.npy_name.empty()) out.emplace_back("Npy_name", o.npy_name);
+  if (!o.png_name.empty()) out.emplace_back("Png_name", o.png_name);
+  const std::string threshold_png = ThresholdPngPath(config);
+  if (!threshold_png.empty())
+    out.emplace_back(o.png_threshold_name.empty() ? "Png_name (thresholded image)"
+                                                  : "Png_threshold_name",
+                     threshold_png);
+  if (!config.scale.matches_name.empty())
+    out.emplace_back("Matches_name", config.scale.matches_name);
+  const std::string& prefix = config.evaluation.name;
+  if (EvaluationRequested(config) && !prefix.empty())
+    for (const char* suffix :
+         {".json", "_pr.png", "_per_query.csv", "_ablep.csv", "_overlay.png"})
+      out.emplace_back("Evaluation_name", prefix + suffix);
+  return out;
 }
 
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,

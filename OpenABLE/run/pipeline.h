@@ -126,6 +126,11 @@ EvaluationLayout LayoutOf(const RunResult& result);
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
                                       const Evaluation* evaluation = nullptr);
 
+// Every file a run of `config` may write, as (key, path): the matrix files, the thresholded
+// image, the matches and, when Ground_truth_type and Evaluation_name are set, the evaluation's
+// files (StageEvaluation). Run checks them with CheckDistinctOutputs before any work.
+std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& config);
+
 // The thresholded image's path: Png_threshold_name, or Png_name with "_thresholded" before
 // its extension; empty when no threshold or no PNG is asked for.
 std::string ThresholdPngPath(const Config& config);

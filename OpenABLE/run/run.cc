@@ -26,6 +26,10 @@ RunOutcome Run(const Config& config, ProgressReporter& progress,
     log("warning: Show_images is 1 but there is no display (DISPLAY is not set); frames are "
         "not shown");
   RunOutcome out;
+  // Outputs are checked before the long part of the run: no two at one file, no prefix that
+  // is a folder.
+  CheckDistinctOutputs(PlannedOutputs(config));
+  if (EvaluationRequested(config)) CheckOutputPrefix("Evaluation_name", config.evaluation.name);
   // Evaluation settings are checked before the long part of the run.
   if (EvaluationRequested(config)) {
     out.evaluation = std::make_unique<Evaluation>();

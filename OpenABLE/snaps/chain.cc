@@ -11,6 +11,7 @@
 #include "OpenABLE/odometry/calibration.h"
 #include "OpenABLE/odometry/mono_odometry.h"
 #include "OpenABLE/odometry/stereo_odometry.h"
+#include "OpenABLE/run/exports.h"
 #include "OpenABLE/run/pipeline.h"
 #include "OpenABLE/snaps/discounted.h"
 #include "OpenABLE/stereo/calibration.h"
@@ -193,6 +194,7 @@ Config OpenableRunOf(const Config& c) {
 ChainResult RunChain(const Config& c, ProgressReporter& progress,
                      const std::function<void(const std::string&)>& say_in) {
   CheckSnapsConfig(c);
+  CheckOutputPrefix("Snaps_output_name", c.snaps.output_name);
   auto say = [&](const std::string& line) {
     if (say_in) say_in(line);
   };

@@ -530,5 +530,64 @@ TEST(TestOpenABLE, FullDiskFailsWithOneLineAndLeavesNothing) {
   EXPECT_TRUE(left.empty()) << left.front();
 }
 
+// Two outputs of one run at one file, or an evaluation prefix that is a folder: refused before
+// any work, one line naming both keys, nothing written.
+TEST(TestOpenABLE, OutputsAtTheSameFileAreRefusedBeforeWork) {
+  const std::string dir = testing::TempDir();
+  fs::create_directories(dir + "/evalfolder");
+  const std::vector<std::vector<std::string>> cases = {
+      {"Txt_name=out/m", "Npy_name=out/m", "Txt_name", "Npy_name"},
+      {"Png_name=out/m.png", "Png_threshold_name=out/./m.png", "Png_threshold_name", "Png_name"},
+      {"Npy_name=out/e.json", "Evaluation_name=out/e", "Evaluation_name", "Npy_name"},
+      {"Evaluation_name=evalfolder", "Png_name=", "Evaluation_name", "is a folder"},
+  };
+  for (const auto& c : cases) {
+    const Outcome o = RunProgram(
+        testing::TestOpenableExe(),
+        {testing::SourceDir() + "/config/Config.txt", "--set",
+         "Images_path=" + testing::SampleDir() + "/summer", "--set",
+         "Images_path_2=" + testing::SampleDir() + "/winter", "--set", "Txt_name=",
+         "--set", "Npy_name=", "--set", "Png_name=", "--set", "Evaluation_name=", "--set",
+         "Threshold=0.4", "--set", c[0], "--set", c[1]},
+        dir);
+    EXPECT_EQ(o.status, 1) << c[0] << " " << o.err;
+    EXPECT_TRUE(OneLine(o.err)) << o.err;
+    EXPECT_NE(o.err.find(c[2]), std::string::npos) << o.err;
+    EXPECT_NE(o.err.find(c[3]), std::string::npos) << o.err;
+    EXPECT_EQ(o.err.find("describing"), std::string::npos) << "work started: " << o.err;
+    EXPECT_FALSE(fs::exists(dir + "/out")) << c[0];
+    EXPECT_TRUE(fs::is_empty(dir + "/evalfolder"));
+  }
+}
+
+// Messages that name the real culprit: the real limit of an integer, the working directory a
+// relative path was taken from, a descriptor row too large to hold (refused before any work).
+TEST(TestOpenABLE, MessagesNameTheRealLimitAndTheWorkingDirectory) {
+  const std::string dir = testing::TempDir();
+  struct Case {
+    std::vector<std::string> args;
+    std::vector<std::string> parts;
+  } cases[] = {
+      {{"--set", "Initial_image=4294967296"}, {"Initial_image", "2147483647"}},
+      {{"--set", "Images_path=no/such/folder"},
+       {"no/such/folder", "relative to the working directory", dir}},
+      {{"--set", "Image_descriptor=HOG", "--set", "Patch_size=1024", "--set",
+        "Description_type=1", "--set", "Grid_x=64", "--set", "Grid_y=32"},
+       {"Patch_size", "1024", "Grid_x 64 x Grid_y 32", "GiB per frame"}},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"--set", "Images_path=" + testing::SampleDir() + "/summer",
+                                     "--set", "Npy_name=m.npy"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    const Outcome o = RunProgram(testing::TestOpenableExe(), args, dir);
+    EXPECT_EQ(o.status, 1) << o.err;
+    EXPECT_TRUE(OneLine(o.err)) << o.err;
+    for (const std::string& part : c.parts)
+      EXPECT_NE(o.err.find(part), std::string::npos) << part << " in " << o.err;
+    EXPECT_EQ(o.err.find("describing"), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(dir + "/m.npy"));
+  }
+}
+
 }  // namespace
 }  // namespace openable

@@ -1,6 +1,9 @@
 #include "OpenABLE/run/exports.h"
 
+#include <atomic>
 #include <cstdio>
+#include <thread>
+#include <vector>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -108,6 +111,91 @@ TEST(OutputBatch, NothingVisibleUntilCommit) {
   }
   EXPECT_EQ(ReadAll(dir + "/a.txt"), "hello");
   EXPECT_EQ(ReadAll(dir + "/sub/b.npy"), "bytes");
+}
+
+// Two outputs of one batch at the same file (also through "." or a link) are refused, naming both
+// keys, and nothing is left behind.
+TEST(OutputBatch, TwoOutputsAtOneFileAreRefused) {
+  const std::string dir = testing::TempDir();
+  fs::create_directories(dir + "/real");
+  fs::create_directory_symlink(dir + "/real", dir + "/link");
+  const std::pair<std::string, std::string> clashes[] = {
+      {dir + "/m.txt", dir + "/m.txt"},
+      {dir + "/m.txt", dir + "/./sub/../m.txt"},
+      {dir + "/real/m.png", dir + "/link/m.png"},
+  };
+  for (const auto& [first, second] : clashes) {
+    {
+      OutputBatch batch;
+      batch.Stage("Txt_name", first, "a");
+      try {
+        batch.Stage("Npy_name", second, "b");
+        FAIL() << "expected an InputError for " << second;
+      } catch (const InputError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("Npy_name"), std::string::npos) << m;
+        EXPECT_NE(m.find("Txt_name"), std::string::npos) << m;
+        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+      }
+    }
+    EXPECT_FALSE(fs::exists(first));
+  }
+  EXPECT_NO_THROW(CheckDistinctOutputs({{"Txt_name", dir + "/a.txt"}, {"Npy_name", dir + "/a.npy"}}));
+  EXPECT_THROW(CheckDistinctOutputs({{"Txt_name", dir + "/a"}, {"Npy_name", dir + "/./a"}}),
+               InputError);
+}
+
+// A prefix that is a folder would write hidden files (".json") in it.
+TEST(OutputBatch, PrefixThatIsAFolderIsRefused) {
+  const std::string dir = testing::TempDir();
+  testing::ExpectInputError([&] { CheckOutputPrefix("Evaluation_name", dir); },
+                            {"Evaluation_name", "is a folder", "eval"});
+  testing::ExpectInputError([&] { CheckOutputPrefix("--output", "results/"); },
+                            {"--output", "results/", "results/eval"});
+  EXPECT_NO_THROW(CheckOutputPrefix("Evaluation_name", dir + "/eval"));
+  EXPECT_NO_THROW(CheckOutputPrefix("Evaluation_name", ""));
+}
+
+// Runs that create the same missing output folder at once all succeed: a folder created by
+// another is what each needs.
+TEST(OutputBatch, ConcurrentBatchesCreatingOneFolderAllSucceed) {
+  const std::string dir = testing::TempDir();
+  for (int round = 0; round < 20; ++round) {
+    const std::string folder = dir + "/r" + std::to_string(round) + "/a/b/c";
+    std::vector<std::thread> threads;
+    std::atomic<int> failures{0};
+    for (int t = 0; t < 8; ++t)
+      threads.emplace_back([&, t] {
+        try {
+          OutputBatch batch;
+          batch.Stage("Npy_name", folder + "/m" + std::to_string(t) + ".npy", "x");
+          batch.Commit();
+        } catch (const InputError&) {
+          ++failures;
+        }
+      });
+    for (auto& th : threads) th.join();
+    EXPECT_EQ(failures.load(), 0) << "round " << round;
+  }
+}
+
+// Two batches committing the same outputs at once leave one batch's whole set, never a mix
+// (the commit's lock on the folder).
+TEST(OutputBatch, ConcurrentCommitsOfTheSameOutputsNeverMix) {
+  const std::string dir = testing::TempDir();
+  const std::vector<std::string> names = {"m.txt", "m.npy", "m.png", "e.json", "e_pr.png"};
+  for (int round = 0; round < 30; ++round) {
+    std::vector<std::thread> threads;
+    for (const std::string run : {"A", "B"})
+      threads.emplace_back([&, run] {
+        OutputBatch batch;
+        for (const std::string& n : names) batch.Stage("Txt_name", dir + "/" + n, run);
+        batch.Commit();
+      });
+    for (auto& th : threads) th.join();
+    const std::string first = ReadAll(dir + "/" + names[0]);
+    for (const std::string& n : names) EXPECT_EQ(ReadAll(dir + "/" + n), first) << round << n;
+  }
 }
 
 TEST(OutputBatch, FailureLeavesNoFile) {
