@@ -22,11 +22,16 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/evaluation/text_parsing.h"
 #include "OpenABLE/evaluation/matrix_file.h"
+#include "OpenABLE/evaluation/pairs_file.h"
+#include "OpenABLE/evaluation/pose_file.h"
 
 namespace openable {
 namespace {
 
+using evaluation_internal::ForEachLine;
 using evaluation_internal::IsBlank;
+using evaluation_internal::Line;
+using evaluation_internal::ParseIndex;
 using evaluation_internal::ParseNumber;
 using evaluation_internal::ReadWholeFile;
 
@@ -34,69 +39,6 @@ namespace fs = std::filesystem;
 
 // ---------------------------------------------------------------------------------------------
 // Text files of pairs and poses
-
-// One line of a text file: its number (from 1), its fields (split at blanks and commas, the
-// comment left out; "1,,2" gives an empty field, a trailing comma none) and its comment (the
-// text after '#').
-struct Line {
-  int number = 0;
-  std::vector<std::string_view> fields;
-  std::string_view comment;
-};
-
-void SplitFields(std::string_view s, std::vector<std::string_view>* out) {
-  out->clear();
-  std::size_t i = 0;
-  bool after_comma = false;
-  while (true) {
-    while (i < s.size() && IsBlank(s[i])) ++i;
-    if (i == s.size()) break;
-    if (s[i] == ',') {
-      if (out->empty() || after_comma) out->emplace_back();
-      after_comma = true;
-      ++i;
-      continue;
-    }
-    std::size_t j = i;
-    while (j < s.size() && !IsBlank(s[j]) && s[j] != ',') ++j;
-    out->push_back(s.substr(i, j - i));
-    after_comma = false;
-    i = j;
-  }
-}
-
-// Calls f(const Line&) for every line of `data`.
-template <typename F>
-void ForEachLine(const std::string& data, F&& f) {
-  Line line;
-  std::size_t pos = data.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;  // UTF-8 BOM
-  while (pos < data.size()) {
-    std::size_t end = data.find('\n', pos);
-    if (end == std::string::npos) end = data.size();
-    const std::string_view text(data.data() + pos, end - pos);
-    pos = end + 1;
-    ++line.number;
-    const std::size_t hash = text.find('#');
-    line.comment = hash == std::string_view::npos ? std::string_view() : text.substr(hash + 1);
-    SplitFields(text.substr(0, hash), &line.fields);
-    f(static_cast<const Line&>(line));
-  }
-}
-
-// A whole field as an integer; "12.0" is accepted as 12.
-bool ParseIndex(std::string_view field, std::int64_t* value) {
-  std::string_view f = field;
-  if (!f.empty() && f.front() == '+') f.remove_prefix(1);
-  const char* end = f.data() + f.size();
-  const auto r = std::from_chars(f.data(), end, *value);
-  if (!f.empty() && r.ec == std::errc() && r.ptr == end) return true;
-  double d = 0.0;
-  if (!ParseNumber(field, &d) || !std::isfinite(d) || d != std::floor(d) || std::abs(d) > 1e15) {
-    return false;
-  }
-  *value = static_cast<std::int64_t>(d);
-  return true;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Options
@@ -237,57 +179,15 @@ void LoadMatrix(const GroundTruthOptions& o, const EvaluationLayout& layout, int
 }
 
 void LoadPairs(const GroundTruthOptions& o, const EvaluationLayout& layout, GroundTruth* gt) {
-  const std::string where = "ground truth pairs " + Quoted(o.path);
-  const std::string data = ReadWholeFile(o.path, where);
+  const PairsFile file = ReadPairsFile(o.path, o.base, "ground truth pairs");
   const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
-
-  int base = o.base;
-  std::string base_note;
-  if (base == -1) {
-    bool says_1 = false, says_0 = false;
-    ForEachLine(data, [&](const Line& line) {
-      const std::string c = Lower(line.comment);
-      says_1 = says_1 || c.find("1-based") != std::string::npos;
-      says_0 = says_0 || c.find("0-based") != std::string::npos;
-    });
-    if (says_1 && says_0) {
-      throw InputError(where +
-                       ": comments say both \"0-based\" and \"1-based\"; set "
-                       "Ground_truth_base to 0 or 1");
-    }
-    base = says_1 ? 1 : 0;
-    base_note = says_1 || says_0 ? " (" + std::to_string(base) + "-based, as a comment says)"
-                                 : " (0-based; set Ground_truth_base to 1 if the file counts "
-                                   "from 1)";
-  } else {
-    base_note = " (" + std::to_string(base) + "-based, Ground_truth_base)";
-  }
-
+  const int base = file.base;
   const std::int64_t rows = layout.queries, cols = layout.references;
   const std::int64_t first = o.first_frame;
   const bool ranged = first > 0 || o.range_selected;
-  bool first_content = true;
-  ForEachLine(data, [&](const Line& line) {
-    if (line.fields.empty()) return;
-    const std::string at = where + ":" + std::to_string(line.number);
-    double unused = 0;
-    const bool header =
-        first_content && !line.fields[0].empty() && !ParseNumber(line.fields[0], &unused);
-    first_content = false;
-    if (header) return;
-    if (line.fields.size() < 2) {
-      throw InputError(at + ": line has 1 value; expected two frame indices \"a,b\"");
-    }
-    std::int64_t raw[2];
-    for (int k = 0; k < 2; ++k) {
-      if (!ParseIndex(line.fields[static_cast<std::size_t>(k)], &raw[k])) {
-        throw InputError(at + ": value " + Quoted(line.fields[static_cast<std::size_t>(k)]) +
-                         " in column " + std::to_string(k + 1) +
-                         " is not an integer; expected two frame indices \"a,b\"");
-      }
-    }
-    const std::int64_t a = raw[0] - base - first, b = raw[1] - base - first;
-    const bool negative = raw[0] - base < 0 || raw[1] - base < 0;
+  for (const PairsFile::Pair& p : file.pairs) {
+    const std::int64_t a = p.a - first, b = p.b - first;
+    const bool negative = p.a < 0 || p.b < 0;
     const bool outside = a < 0 || b < 0 || a >= rows || b >= (loop ? rows : cols);
     if (negative || (outside && !ranged)) {
       std::string range;
@@ -301,12 +201,13 @@ void LoadPairs(const GroundTruthOptions& o, const EvaluationLayout& layout, Grou
                 std::to_string(base + rows - 1) + "] and reference indices in [" +
                 std::to_string(base) + ", " + std::to_string(base + cols - 1) + "]";
       }
-      throw InputError(at + ": pair " + std::to_string(raw[0]) + "," + std::to_string(raw[1]) +
-                       " is out of range; " + range + base_note);
+      throw InputError(file.where + ":" + std::to_string(p.line) + ": pair " +
+                       std::to_string(p.a + base) + "," + std::to_string(p.b + base) +
+                       " is out of range; " + range + file.base_note);
     }
     if (outside || (loop && a == b)) {  // outside the selected frames, or diagonal
       ++gt->dropped;
-      return;
+      continue;
     }
     if (loop) {
       gt->matches[static_cast<std::size_t>(std::max(a, b))].push_back(
@@ -314,7 +215,7 @@ void LoadPairs(const GroundTruthOptions& o, const EvaluationLayout& layout, Grou
     } else {
       gt->matches[static_cast<std::size_t>(a)].push_back(static_cast<int>(b));
     }
-  });
+  }
 }
 
 void LoadPoses(const GroundTruthOptions& o, const EvaluationLayout& layout, GroundTruth* gt) {
@@ -428,9 +329,25 @@ std::vector<FramePose> ReadPoses(const std::string& path, GroundTruthType type) 
   if (!IsPoseType(type)) {
     throw std::logic_error("ReadPoses: type " + GroundTruthTypeName(type) + " is not a pose type");
   }
+  std::vector<FramePose> poses;
+  if (type == GroundTruthType::kKitti || type == GroundTruthType::kTum) {
+    // The pose reader SNAPS uses too (pose_file.h): one format, one set of checks (a rotation
+    // that is not one, timestamps out of order, ...).
+    for (const PoseFileLine& line :
+         ReadPoseFile(path,
+                      type == GroundTruthType::kKitti ? PoseFileFormat::kKitti
+                                                      : PoseFileFormat::kTum,
+                      PoseFileLabel(type))) {
+      FramePose pose;
+      pose.position = line.translation;
+      pose.forward = line.rotation.col(2);  // the optical axis (R is orthonormal)
+      pose.has_forward = true;
+      poses.push_back(pose);
+    }
+    return poses;
+  }
   const std::string where = std::string(PoseFileLabel(type)) + " " + Quoted(path);
   const std::string data = ReadWholeFile(path, where);
-  std::vector<FramePose> poses;
   bool first_content = true;
   std::size_t position_count = 0;  // numbers per line of a positions file
   int position_line = 0;
@@ -452,43 +369,18 @@ std::vector<FramePose> ReadPoses(const std::string& path, GroundTruthType type) 
     }
     const std::string count = std::to_string(v.size()) + (v.size() == 1 ? " number" : " numbers");
     FramePose pose;
-    if (type == GroundTruthType::kKitti) {
-      if (v.size() != 12) {
-        throw InputError(at + ": line has " + count +
-                         "; expected 12 (a 3x4 matrix [R | t], row by row)");
-      }
-      pose.position = Eigen::Vector3d(v[3], v[7], v[11]);
-      pose.forward = Eigen::Vector3d(v[2], v[6], v[10]);
-      const double norm = pose.forward.norm();
-      if (!(norm > 0)) throw InputError(at + ": the third column of R is zero");
-      pose.forward /= norm;
-      pose.has_forward = true;
-    } else if (type == GroundTruthType::kTum) {
-      if (v.size() != 8) {
-        throw InputError(at + ": line has " + count +
-                         "; expected 8 (timestamp tx ty tz qx qy qz qw)");
-      }
-      pose.position = Eigen::Vector3d(v[1], v[2], v[3]);
-      Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
-      const double norm = q.norm();
-      if (!(norm > 0)) throw InputError(at + ": the quaternion is zero");
-      q.coeffs() /= norm;
-      pose.forward = q.toRotationMatrix().col(2);
-      pose.has_forward = true;
-    } else {
-      if (v.size() != 2 && v.size() != 3) {
-        throw InputError(at + ": line has " + count + "; expected 2 or 3 (x, y[, z])");
-      }
-      if (position_count == 0) {
-        position_count = v.size();
-        position_line = line.number;
-      } else if (v.size() != position_count) {
-        throw InputError(at + ": line has " + count + "; expected " +
-                         std::to_string(position_count) + " like the first position (line " +
-                         std::to_string(position_line) + ")");
-      }
-      pose.position = Eigen::Vector3d(v[0], v[1], v.size() == 3 ? v[2] : 0.0);
+    if (v.size() != 2 && v.size() != 3) {
+      throw InputError(at + ": line has " + count + "; expected 2 or 3 (x, y[, z])");
     }
+    if (position_count == 0) {
+      position_count = v.size();
+      position_line = line.number;
+    } else if (v.size() != position_count) {
+      throw InputError(at + ": line has " + count + "; expected " +
+                       std::to_string(position_count) + " like the first position (line " +
+                       std::to_string(position_line) + ")");
+    }
+    pose.position = Eigen::Vector3d(v[0], v[1], v.size() == 3 ? v[2] : 0.0);
     poses.push_back(pose);
   });
   if (poses.empty()) {

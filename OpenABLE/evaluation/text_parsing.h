@@ -1,9 +1,12 @@
-// Internal helpers of the evaluation readers (matrix_file.cc, ground_truth.cc): whole-file
+// Internal helpers of the evaluation readers (matrix_file.cc, ground_truth.cc, pairs_file.cc): whole-file
 // reading with one-line errors, and number parsing without locale surprises.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace openable::evaluation_internal {
 
@@ -21,5 +24,38 @@ inline bool IsBlank(char c) {
 
 // A whole token as a number ("1", "-2.5e3", "+4", "nan", "inf"); false on anything else.
 bool ParseNumber(std::string_view token, double* value);
+
+// A whole field as an integer; "12.0" is accepted as 12.
+bool ParseIndex(std::string_view field, std::int64_t* value);
+
+// One line of a text file: its number (from 1), its fields (split at blanks and commas, the
+// comment left out; "1,,2" gives an empty field, a trailing comma none) and its comment (the
+// text after '#').
+struct Line {
+  int number = 0;
+  std::vector<std::string_view> fields;
+  std::string_view comment;
+};
+
+// The fields of `s` as Line::fields describes them.
+void SplitFields(std::string_view s, std::vector<std::string_view>* out);
+
+// Calls f(const Line&) for every line of `data` (a UTF-8 byte order mark is skipped).
+template <typename F>
+void ForEachLine(const std::string& data, F&& f) {
+  Line line;
+  std::size_t pos = data.compare(0, 3, "\xEF\xBB\xBF") == 0 ? 3 : 0;
+  while (pos < data.size()) {
+    std::size_t end = data.find('\n', pos);
+    if (end == std::string::npos) end = data.size();
+    const std::string_view text(data.data() + pos, end - pos);
+    pos = end + 1;
+    ++line.number;
+    const std::size_t hash = text.find('#');
+    line.comment = hash == std::string_view::npos ? std::string_view() : text.substr(hash + 1);
+    SplitFields(text.substr(0, hash), &line.fields);
+    f(static_cast<const Line&>(line));
+  }
+}
 
 }  // namespace openable::evaluation_internal

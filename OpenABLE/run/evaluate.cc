@@ -110,6 +110,36 @@ void StageEvaluation(OutputBatch& batch, const std::string& key, const std::stri
   batch.Stage(key, prefix + "_pr.png", EncodePng(RenderPrPlot(series, title, s.options.vicinity)));
 }
 
+cv::Mat1f DistancesForEvaluation(const cv::Mat1f& matrix, const std::string& what) {
+  if (matrix.empty())
+    throw InputError(what + " is empty (" + std::to_string(matrix.rows) + " x " +
+                     std::to_string(matrix.cols) + "); expected a distance matrix with at least "
+                     "one query and one reference");
+  // A plain loop: OpenCV's vectorised comparisons do not single out NaN.
+  bool has_nan = false;
+  for (int i = 0; i < matrix.rows; ++i) {
+    const float* row = matrix.ptr<float>(i);
+    for (int j = 0; j < matrix.cols; ++j) {
+      const float v = row[j];
+      if (std::isnan(v)) {
+        has_nan = true;
+      } else if (!(v >= 0.0f)) {
+        throw InputError(what + " holds " + FormatNumber(v) + " at row " + std::to_string(i) +
+                         ", column " + std::to_string(j) +
+                         "; expected distances >= 0 (NaN or inf for a cell without a value)");
+      }
+    }
+  }
+  if (!has_nan) return matrix;
+  cv::Mat1f out = matrix.clone();
+  for (int i = 0; i < out.rows; ++i) {
+    float* row = out.ptr<float>(i);
+    for (int j = 0; j < out.cols; ++j)
+      if (std::isnan(row[j])) row[j] = std::numeric_limits<float>::infinity();
+  }
+  return out;
+}
+
 std::vector<cv::Mat1f> EvaluateMatrixFiles(Evaluation& evaluation,
                                            const std::vector<MatrixFile>& files,
                                            int reference_frames) {
@@ -117,21 +147,7 @@ std::vector<cv::Mat1f> EvaluateMatrixFiles(Evaluation& evaluation,
   loaded.reserve(files.size());
   for (const MatrixFile& m : files) {
     cv::Mat1f matrix = ReadMatrixFile(m.path);
-    // NaN marks a cell without a value (Test_OpenABLE's .npy with Sequence_partial skip): it
-    // becomes +inf, never a candidate, as in the run itself. A plain loop: OpenCV's vectorised
-    // comparisons do not single out NaN.
-    for (int i = 0; i < matrix.rows; ++i) {
-      float* row = matrix.ptr<float>(i);
-      for (int j = 0; j < matrix.cols; ++j) {
-        if (std::isnan(row[j])) {
-          row[j] = std::numeric_limits<float>::infinity();
-        } else if (!(row[j] >= 0.0f) || std::isinf(row[j])) {
-          throw InputError("matrix " + Quoted(m.path) + " holds " + FormatNumber(row[j]) +
-                           " at row " + std::to_string(i) + ", column " + std::to_string(j) +
-                           "; expected distances >= 0 (NaN for a cell without a value)");
-        }
-      }
-    }
+    matrix = DistancesForEvaluation(matrix, "matrix " + Quoted(m.path));
     NormalizeByMax(matrix);
     EvaluationLayout layout;
     if (matrix.rows != matrix.cols) {

@@ -47,14 +47,21 @@ void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
 void StageEvaluation(OutputBatch& batch, const std::string& key, const std::string& prefix,
                      const Evaluation& evaluation, const std::vector<const cv::Mat1f*>& matrices);
 
+// The checks of a distance matrix before it is evaluated, shared by openable_evaluate
+// (EvaluateMatrixFiles) and Python's evaluate: not empty; every cell >= 0, or a cell without a
+// value (NaN, as Test_OpenABLE's .npy writes it, or +inf, as it is held in memory), which is
+// never a candidate. Returns `matrix` itself, or a copy with NaN made +inf when it holds NaN.
+// Throws InputError "<what> holds -1 at row 3, column 7; expected distances >= 0 ...".
+cv::Mat1f DistancesForEvaluation(const cv::Mat1f& matrix, const std::string& what);
+
 // A saved matrix to evaluate (openable_evaluate's --matrix and --label).
 struct MatrixFile {
   std::string path;
   std::string label;  // legend label; empty: the file name without its extension
 };
 
-// Reads each matrix (ReadMatrixFile: .npy, text or image), refuses negative or infinite values
-// (NaN is a cell without a value: never a candidate), normalises it by its maximum (Eq. 5; no change for Test_OpenABLE's M'), takes its
+// Reads each matrix (ReadMatrixFile: .npy, text or image), checks it (DistancesForEvaluation),
+// normalises it by its maximum (Eq. 5; no change for Test_OpenABLE's M'), takes its
 // layout (not square: queries x references; square: two traversals of which the first
 // `reference_frames` frames are the reference when reference_frames > 0, else one sequence)
 // and evaluates it into `evaluation` (EvaluateMatrix). Returns the normalised matrices in the

@@ -12,31 +12,10 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/evaluation/pairs_file.h"
 #include "OpenABLE/image/preprocess.h"
 
 namespace openable::snaps {
-namespace {
-
-std::string Trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string::npos) return "";
-  const auto e = s.find_last_not_of(" \t\r");
-  return s.substr(b, e - b + 1);
-}
-
-// A non-negative integer written with digits only; false otherwise (or on overflow).
-bool ParseFrameId(const std::string& s, long* out) {
-  if (s.empty() || s.size() > 15) return false;
-  long v = 0;
-  for (const char c : s) {
-    if (c < '0' || c > '9') return false;
-    v = v * 10 + (c - '0');
-  }
-  *out = v;
-  return true;
-}
-
-}  // namespace
 
 int IndexOfFrame(const Trajectory& trajectory, long frame_id, long tolerance) {
   const auto& ids = trajectory.frame_ids;
@@ -95,36 +74,27 @@ std::vector<LoopPair> LoopsFromMatrix(cv::Mat1f m, const Trajectory& trajectory,
 
 std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& trajectory,
                                    long tolerance, int* dropped, int* outside) {
-  std::ifstream in(path);
-  if (!in) throw InputError("loop pairs file " + Quoted(path) + ": cannot be opened");
+  // The same reader and checks as the evaluation's ground-truth pairs (pairs_file.h): commas
+  // or blanks, a header line, comments, 0-based unless a comment says "1-based".
+  const PairsFile file = ReadPairsFile(path, -1, "loop pairs file");
   if (trajectory.frame_ids.empty())
-    throw InputError("loop pairs file " + Quoted(path) + ": the trajectory is empty");
+    throw InputError(file.where + ": the trajectory is empty");
   const long first = trajectory.frame_ids.front(), last = trajectory.frame_ids.back();
   std::vector<LoopPair> out;
   int drop = 0, outside_count = 0;
-  std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    const std::string at = "loop pairs file " + Quoted(path) + ":" + std::to_string(number);
-    const auto hash = line.find('#');
-    const std::string content = Trim(line.substr(0, hash));
-    if (content.empty()) continue;
-    const auto comma = content.find(',');
-    const std::string a = Trim(content.substr(0, comma));
-    const std::string b = comma == std::string::npos ? "" : Trim(content.substr(comma + 1));
-    long row = 0, col = 0;
-    if (comma == std::string::npos || b.find(',') != std::string::npos)
-      throw InputError(at + ": " + Quoted(content) +
-                       " is not `row,col`; expected two frame numbers");
-    if (!ParseFrameId(a, &row))
-      throw InputError(at + ": row " + Quoted(a) + " is not a non-negative integer frame number");
-    if (!ParseFrameId(b, &col))
-      throw InputError(at + ": col " + Quoted(b) + " is not a non-negative integer frame number");
-    if (row <= col)
-      throw InputError(at + ": row " + a + " <= col " + b + "; expected row = the later frame");
+  for (const PairsFile::Pair& p : file.pairs) {
+    const std::string at = file.where + ":" + std::to_string(p.line);
+    // A loop joins the later frame to the earlier one, in either order in the file.
+    const long row = static_cast<long>(std::max(p.a, p.b));
+    const long col = static_cast<long>(std::min(p.a, p.b));
+    if (row == col) {  // a frame with itself: no loop (as the evaluation drops the diagonal)
+      ++drop;
+      continue;
+    }
     bool out_of_range = false;
     for (const long f : {row, col})
       if (f < first || f > last) {
-        if (!outside)
+        if (!outside || f < 0)
           throw InputError(at + ": frame " + std::to_string(f) +
                            " outside the trajectory's frames " + std::to_string(first) + ".." +
                            std::to_string(last));

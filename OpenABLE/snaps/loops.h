@@ -42,13 +42,14 @@ std::vector<LoopPair> LoopsFromMatrix(const std::string& path, const Trajectory&
 std::vector<LoopPair> LoopsFromMatrix(cv::Mat1f matrix, const Trajectory& trajectory,
                                       const MatrixLoopOptions& options);
 
-// (b) Loops from a CSV of pairs: one `row,col` per line (spaces allowed around the numbers,
-// '#' starts a comment, blank lines skipped), row = the later frame id, col the earlier.
-// Frame ids map to trajectory indices by IndexOfFrame(tolerance); a pair with a frame
-// inside the trajectory's frame range that maps to no pose (not a keyframe) is dropped
-// (counted in `dropped` when given); similarity 1. Throws InputError, one line naming
-// file:line and the value, when a line is not two non-negative integers, row <= col, or a
-// frame id is outside the trajectory's frame ids [first, last].
+// (b) Loops from a file of pairs, read by ReadPairsFile (OpenABLE/evaluation/pairs_file.h): the
+// format and checks of the evaluation's ground-truth pairs (comma or blanks, '#' comments, a
+// header line, 0-based unless a comment says "1-based"), the later frame id first or second.
+// Frame ids map to trajectory indices by IndexOfFrame(tolerance); a pair of a frame with
+// itself, or with a frame inside the trajectory's frame range that maps to no pose (not a
+// keyframe), is dropped (counted in `dropped` when given); similarity 1. Throws InputError,
+// one line naming file:line and the value, as ReadPairsFile does, or when a frame id is
+// outside the trajectory's frame ids [first, last].
 // With `outside` given, pairs with a frame outside the trajectory's frame ids are dropped and
 // counted there instead (a ground-truth list of a whole sequence against a trajectory that
 // stops a few frames early).

@@ -17,86 +17,22 @@
 #include <Eigen/SVD>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/evaluation/pose_file.h"
 
 namespace openable::snaps {
+
+static_assert(kRotationTolerance == kPoseRotationTolerance,
+              "SNAPS and the pose reader take the same matrices for rotations");
+
 namespace {
 
-// Largest |R^T R - I| entry accepted as a rotation, and the one below which a rotation is kept
-// as it is (so that a file written by EncodeTrajectory reads back to the same bits).
-constexpr double kExactEnough = 1e-12;
+// The shortest text that reads back as `v` (for messages).
+std::string Short(double v) { return ShortestNumber(v); }
 
 std::string G17(double v) {
   char buffer[40];
   std::snprintf(buffer, sizeof(buffer), "%.17g", v);
   return buffer;
-}
-
-// The shortest text that reads back as `v` (for messages).
-std::string Short(double v) {
-  char buffer[40];
-  for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buffer, sizeof(buffer), "%.*g", digits, v);
-    if (std::strtod(buffer, nullptr) == v) break;
-  }
-  return buffer;
-}
-
-// "file":line
-std::string Where(const std::string& path, int line) {
-  return Quoted(path) + ":" + std::to_string(line);
-}
-
-std::vector<std::string> Tokens(const std::string& line) {
-  std::vector<std::string> out;
-  std::istringstream in(line);
-  std::string t;
-  while (in >> t) out.push_back(t);
-  return out;
-}
-
-// A finite double, or InputError naming the place, the token and its position.
-double ParseNumber(const std::string& token, const std::string& where, int column,
-                   const char* what) {
-  const char* begin = token.c_str();
-  char* end = nullptr;
-  errno = 0;
-  const double v = std::strtod(begin, &end);
-  if (end == begin || *end != '\0') {
-    throw InputError(where + ": " + Quoted(token) + " (column " + std::to_string(column) +
-                     ") is not a number; expected " + what);
-  }
-  if (!std::isfinite(v)) {
-    throw InputError(where + ": " + Quoted(token) + " (column " + std::to_string(column) +
-                     ") is not finite; expected a finite " + what);
-  }
-  return v;
-}
-
-long ParseFrameId(const std::string& token, const std::string& where) {
-  const char* begin = token.c_str();
-  char* end = nullptr;
-  errno = 0;
-  const long v = std::strtol(begin, &end, 10);
-  if (end == begin || *end != '\0' || errno == ERANGE || v < 0) {
-    throw InputError(where + ": " + Quoted(token) +
-                     " (column 1) is not a frame number; expected a non-negative integer");
-  }
-  return v;
-}
-
-// The nearest rotation to `m` when it is one within kRotationTolerance; InputError otherwise.
-Eigen::Matrix3d CheckedRotation(const Eigen::Matrix3d& m, const std::string& where) {
-  const double deviation = (m.transpose() * m - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-  const double det = m.determinant();
-  if (!(deviation <= kRotationTolerance) || det <= 0) {
-    throw InputError(where + ": the 3x3 part is not a rotation (max |R^T R - I| = " +
-                     Short(deviation) + ", det = " + Short(det) +
-                     "); expected an orthonormal matrix with determinant +1 within " +
-                     Short(kRotationTolerance));
-  }
-  if (deviation <= kExactEnough) return m;
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  return svd.matrixU() * svd.matrixV().transpose();
 }
 
 Eigen::Isometry3d Inverse(const Eigen::Isometry3d& t) {
@@ -112,87 +48,58 @@ Eigen::Isometry3d CheckedPose(const Eigen::Matrix3d& r, const Eigen::Vector3d& t
                               const std::string& where) {
   if (!t.allFinite()) throw InputError(where + ": the translation is not finite");
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = CheckedRotation(r, where);
+  pose.linear() = CheckedRotationMatrix(r, where);
   pose.translation() = t;
   return pose;
 }
 
+void CheckTrajectory(const Trajectory& t, const std::string& what) {
+  const std::size_t n = t.poses.size();
+  if (t.frame_ids.size() != n)
+    throw InputError(what + ": " + std::to_string(t.frame_ids.size()) +
+                     " frame ids; expected one per pose (" + std::to_string(n) + ")");
+  for (std::size_t i = 1; i < n; ++i)
+    if (t.frame_ids[i] <= t.frame_ids[i - 1])
+      throw InputError(what + ": frame " + std::to_string(t.frame_ids[i]) + " after frame " +
+                       std::to_string(t.frame_ids[i - 1]) +
+                       "; expected strictly increasing frame numbers");
+  if (t.timestamps.empty()) {
+    if (t.format == TrajectoryFormat::kTum)
+      throw InputError(what + ": no timestamps; expected one per pose for format \"tum\"");
+    return;
+  }
+  if (t.timestamps.size() != n)
+    throw InputError(what + ": " + std::to_string(t.timestamps.size()) +
+                     " timestamps; expected one per pose (" + std::to_string(n) + ")");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(t.timestamps[i]))
+      throw InputError(what + ": timestamp " + Short(t.timestamps[i]) + " (pose " +
+                       std::to_string(i) + "); expected finite seconds");
+    if (i > 0 && !(t.timestamps[i] > t.timestamps[i - 1]))
+      throw InputError(what + ": timestamp " + Short(t.timestamps[i]) + " after " +
+                       Short(t.timestamps[i - 1]) + " (pose " + std::to_string(i) +
+                       "); expected strictly increasing timestamps");
+  }
+}
+
 Trajectory ReadTrajectory(const std::string& path, TrajectoryFormat format,
                           bool world_to_camera) {
-  std::ifstream in(path);
-  if (!in) {
-    throw InputError(Quoted(path) + ": cannot open the trajectory file (" +
-                     TrajectoryFormatName(format) + " format); expected a readable text file");
-  }
+  // The reader and checks the evaluation's ground truth uses too (pose_file.h).
+  const PoseFileFormat file_format = format == TrajectoryFormat::kKitti ? PoseFileFormat::kKitti
+                                     : format == TrajectoryFormat::kKittiWithId
+                                         ? PoseFileFormat::kKittiWithId
+                                         : PoseFileFormat::kTum;
   Trajectory trajectory;
   trajectory.format = format;
   trajectory.world_to_camera = world_to_camera;
-  const std::size_t expected = format == TrajectoryFormat::kKitti ? 12 : format ==
-                                   TrajectoryFormat::kKittiWithId ? 13 : 8;
-  const char* layout = format == TrajectoryFormat::kKitti
-                           ? "12 numbers (row-major 3x4 [R | t])"
-                           : format == TrajectoryFormat::kKittiWithId
-                                 ? "13 numbers (frame number, row-major 3x4 [R | t])"
-                                 : "8 numbers (timestamp tx ty tz qx qy qz qw)";
-  std::string line;
-  int line_number = 0;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    const std::size_t first = line.find_first_not_of(" \t");
-    if (first == std::string::npos || line[first] == '#') continue;  // blank or comment
-    const std::string where = Where(path, line_number);
-    const std::vector<std::string> tokens = Tokens(line);
-    if (tokens.size() != expected) {
-      throw InputError(where + ": " + std::to_string(tokens.size()) + " values; expected " +
-                       layout);
-    }
+  for (const PoseFileLine& line : ReadPoseFile(path, file_format, "trajectory")) {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    long frame_id = trajectory.Size();
-    double timestamp = 0;
-    if (format == TrajectoryFormat::kTum) {
-      timestamp = ParseNumber(tokens[0], where, 1, "timestamp (seconds)");
-      double v[7];
-      for (int k = 0; k < 7; ++k) v[k] = ParseNumber(tokens[k + 1], where, k + 2, "pose value");
-      const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);  // w, x, y, z
-      const double norm = q.norm();
-      if (!(std::abs(norm - 1) <= kRotationTolerance)) {
-        throw InputError(where + ": quaternion (" + tokens[4] + " " + tokens[5] + " " +
-                         tokens[6] + " " + tokens[7] + ") has norm " + Short(norm) +
-                         "; expected a unit quaternion within " + Short(kRotationTolerance));
-      }
-      pose.linear() = CheckedRotation(q.normalized().toRotationMatrix(), where);
-      pose.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
-    } else {
-      const int offset = format == TrajectoryFormat::kKittiWithId ? 1 : 0;
-      if (offset == 1) frame_id = ParseFrameId(tokens[0], where);
-      Eigen::Matrix<double, 3, 4> m;
-      for (int k = 0; k < 12; ++k) {
-        m(k / 4, k % 4) = ParseNumber(tokens[k + offset], where, k + offset + 1, "pose value");
-      }
-      pose.linear() = CheckedRotation(m.leftCols<3>(), where);
-      pose.translation() = m.col(3);
-    }
+    pose.linear() = line.rotation;
+    pose.translation() = line.translation;
     if (world_to_camera) pose = Inverse(pose);
-    if (!trajectory.frame_ids.empty() && frame_id <= trajectory.frame_ids.back()) {
-      throw InputError(where + ": frame " + std::to_string(frame_id) + " after frame " +
-                       std::to_string(trajectory.frame_ids.back()) +
-                       "; expected strictly increasing frame numbers");
-    }
-    if (format == TrajectoryFormat::kTum && !trajectory.timestamps.empty() &&
-        !(timestamp > trajectory.timestamps.back())) {
-      throw InputError(where + ": timestamp " + tokens[0] + " after " +
-                       Short(trajectory.timestamps.back()) +
-                       "; expected strictly increasing timestamps");
-    }
     trajectory.poses.push_back(pose);
-    trajectory.frame_ids.push_back(frame_id);
-    if (format == TrajectoryFormat::kTum) trajectory.timestamps.push_back(timestamp);
-  }
-  if (in.bad()) throw InputError(Quoted(path) + ": read error; expected a readable text file");
-  if (trajectory.poses.empty()) {
-    throw InputError(Quoted(path) + ":" + std::to_string(line_number) +
-                     ": no pose in the file; expected lines of " + layout);
+    trajectory.frame_ids.push_back(line.frame_id);
+    if (format == TrajectoryFormat::kTum) trajectory.timestamps.push_back(line.timestamp);
   }
   return trajectory;
 }

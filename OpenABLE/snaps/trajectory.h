@@ -45,6 +45,7 @@ struct Trajectory {
 
 // The largest |R^T R - I| of a 3x3 matrix taken for a rotation (files and programs round their
 // numbers; a larger deviation is not a rotation).
+// (The same value as the pose reader's, kPoseRotationTolerance in evaluation/pose_file.h.)
 inline constexpr double kRotationTolerance = 1e-3;
 
 // The camera-to-world pose [r | t]: `r` must be a rotation within kRotationTolerance
@@ -55,11 +56,18 @@ inline constexpr double kRotationTolerance = 1e-3;
 Eigen::Isometry3d CheckedPose(const Eigen::Matrix3d& r, const Eigen::Vector3d& t,
                               const std::string& where);
 
-// Reads a trajectory. `world_to_camera`: the file's matrices map world points into the camera
-// (SO-DSO's poses_history_file.txt); they are inverted so that `poses` are camera-to-world.
-// Throws InputError naming the file and the line (wrong count of numbers, not a number,
-// non-finite value, a rotation that is not one within 1e-3, frame ids not increasing, empty
-// file).
+// Checks a trajectory built in memory (the Python module) as a file is checked when read: one
+// frame id per pose, strictly increasing; timestamps (required for kTum) one per pose, finite and
+// strictly increasing, so that what EncodeTrajectory writes reads back. Throws InputError
+// "<what>: ..." naming the value.
+void CheckTrajectory(const Trajectory& trajectory, const std::string& what);
+
+// Reads a trajectory with the pose reader the evaluation's ground truth uses too
+// (OpenABLE/evaluation/pose_file.h, ReadPoseFile). `world_to_camera`: the file's matrices map
+// world points into the camera (SO-DSO's poses_history_file.txt); they are inverted so that
+// `poses` are camera-to-world. Throws InputError naming the file and the line (wrong count of
+// numbers, not a number, non-finite value, a rotation that is not one within 1e-3, frame ids or
+// timestamps not increasing, empty or missing file).
 Trajectory ReadTrajectory(const std::string& path, TrajectoryFormat format,
                           bool world_to_camera = false);
 

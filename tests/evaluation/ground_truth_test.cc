@@ -245,6 +245,10 @@ TEST(GroundTruthPairs, OutOfRangeMessagesNameTheLinePairAndRange) {
                    {Q(dir + "/word.txt") + ":2:", "\"b\"", "not an integer"});
   ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/absent.txt"), 4); },
                    {Q(dir + "/absent.txt"), "not found"});
+  // An empty ground truth would give figures of 0 for any matrix: refused.
+  WriteBytes(dir + "/empty.txt", "query,reference\n# nothing\n");
+  ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/empty.txt"), 4); },
+                   {Q(dir + "/empty.txt"), "holds no pair"});
 }
 
 TEST(GroundTruthPairs, QueryReferenceKeepsTheOrder) {
@@ -424,12 +428,12 @@ TEST(PosesKitti, TwoTraversals) {
 
 TEST(PosesTum, QuaternionHeadingExcludesOppositeViews) {
   const std::string path = TempDir() + "/trajectory.txt";
-  // Same spot: facing +z; facing -z (180 degrees about y, quaternion not normalised); 0.5 m
-  // away turned by 30 degrees about y.
+  // Same spot: facing +z; facing -z (180 degrees about y); 0.5 m away turned by 30 degrees
+  // about y. (A quaternion that is not of unit norm is refused, as SNAPS refuses it.)
   WriteBytes(path,
             "# timestamp tx ty tz qx qy qz qw\n"
             "1305031102.175304 1 2 3 0 0 0 1\n"
-            "1305031102.211214 1 2 3 0 2 0 0\n"
+            "1305031102.211214 1 2 3 0 1 0 0\n"
             "1305031102.243211 1.5 2 3 0 0.25881904510252074 0 0.9659258262890683\n");
   const std::vector<FramePose> poses = ReadPoses(path, GroundTruthType::kTum);
   ASSERT_EQ(poses.size(), 3u);
@@ -514,10 +518,18 @@ TEST(PosesErrors, MalformedFilesNameFileAndLine) {
                    {Q(dir + "/q.txt") + ":1:", "quaternion"});
   WriteBytes(dir + "/empty.txt", "# nothing\n");
   ExpectInputError([&] { ReadPoses(dir + "/empty.txt", GroundTruthType::kKitti); },
-                   {Q(dir + "/empty.txt"), "no poses"});
+                   {Q(dir + "/empty.txt"), "no pose"});
   ExpectInputError([&] { ReadPoses(dir + "/absent.txt", GroundTruthType::kTum); },
                    {Q(dir + "/absent.txt"), "not found"});
   EXPECT_THROW(ReadPoses(dir + "/k.txt", GroundTruthType::kMatrix), std::logic_error);
+  // The checks SNAPS applies to the same files (one reader, pose_file.h): a matrix that is not
+  // a rotation, timestamps out of order.
+  WriteBytes(dir + "/scaled.txt", "2 0 0 0 0 2 0 0 0 0 2 0\n");
+  ExpectInputError([&] { ReadPoses(dir + "/scaled.txt", GroundTruthType::kKitti); },
+                   {Q(dir + "/scaled.txt") + ":1:", "not a rotation"});
+  WriteBytes(dir + "/late.txt", "0.5 1 2 3 0 0 0 1\n0.25 1 2 3 0 0 0 1\n");
+  ExpectInputError([&] { ReadPoses(dir + "/late.txt", GroundTruthType::kTum); },
+                   {Q(dir + "/late.txt") + ":2:", "timestamp 0.25 after 0.5"});
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -119,6 +119,24 @@ TEST(LoopsFromCsv, PairsMappedByFrameId) {
   EXPECT_EQ(LoopsFromCsv(path, WithIds({10, 13, 15, 16}), 1).size(), 3u);
 }
 
+// The file is read by the evaluation's reader (ReadPairsFile): blanks or commas, a header, the
+// later frame first or second, extra columns ignored; a frame with itself is dropped.
+TEST(LoopsFromCsv, SameFormatAsTheGroundTruthPairs) {
+  const Trajectory t = WithIds({0, 1, 2, 3, 4, 5});
+  const std::string path = TempDir() + "/pairs.txt";
+  WriteBytes(path, "query reference\n4 1\n2,4\n3 3\n5,0,0.9\n");
+  int dropped = -1;
+  const auto loops = LoopsFromCsv(path, t, 0, &dropped);
+  ASSERT_EQ(loops.size(), 3u);
+  EXPECT_EQ(loops[0].query, 4);
+  EXPECT_EQ(loops[0].reference, 1);
+  EXPECT_EQ(loops[1].query, 4);  // "2,4": the later frame second
+  EXPECT_EQ(loops[1].reference, 2);
+  EXPECT_EQ(loops[2].query, 5);
+  EXPECT_EQ(loops[2].reference, 0);
+  EXPECT_EQ(dropped, 1);  // 3,3
+}
+
 TEST(LoopsFromCsv, Errors) {
   const Trajectory t = WithIds({0, 1, 2, 3, 4, 5});
   const std::string dir = TempDir();
@@ -126,9 +144,8 @@ TEST(LoopsFromCsv, Errors) {
     std::string text, part;
   };
   for (const Case& c : {Case{"4,1\nfive,1\n", "\"five\""}, Case{"4,1\n\n3,x2\n", "\"x2\""},
-                        Case{"2,4\n", "row 2 <= col 4"}, Case{"3,3\n", "row 3 <= col 3"},
-                        Case{"9,1\n", "frame 9 outside"}, Case{"4\n", "\"4\""},
-                        Case{"4,1,0\n", "\"4,1,0\""}, Case{"-4,1\n", "\"-4\""}}) {
+                        Case{"9,1\n", "frame 9 outside"}, Case{"4\n", "1 value"},
+                        Case{"-4,1\n", "frame -4"}}) {
     const std::string path = dir + "/bad.csv";
     WriteBytes(path, c.text);
     const std::string line =
@@ -138,6 +155,9 @@ TEST(LoopsFromCsv, Errors) {
     ExpectInputError([&] { LoopsFromCsv(path, t); }, {Q(path) + line, c.part});
   }
   ExpectInputError([&] { LoopsFromCsv(dir + "/missing.csv", t); }, {Q(dir + "/missing.csv")});
+  // A file without a pair is an error, not zero loops.
+  WriteBytes(dir + "/empty.csv", "# no loops here\n\n");
+  ExpectInputError([&] { LoopsFromCsv(dir + "/empty.csv", t); }, {"holds no pair"});
 }
 
 }  // namespace

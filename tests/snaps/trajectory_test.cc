@@ -166,10 +166,10 @@ TEST(ReadTrajectory, ErrorsNameFileLineValueAndExpectation) {
   };
   const std::string ok = "1 0 0 0 0 1 0 0 0 0 1 0\n";
   std::string p = Write("count.txt", ok + ok + "1 0 0 0 0 1 0 0 0 0 1\n");
-  ExpectInputError(read(p, TrajectoryFormat::kKitti), {Q(p) + ":3", "11 values", "expected 12"});
+  ExpectInputError(read(p, TrajectoryFormat::kKitti), {Q(p) + ":3", "11 numbers", "expected 12"});
   p = Write("count_id.txt", ok);
   ExpectInputError(read(p, TrajectoryFormat::kKittiWithId),
-                   {Q(p) + ":1", "12 values", "expected 13"});
+                   {Q(p) + ":1", "12 numbers", "expected 13"});
   p = Write("nan_word.txt", ok + "1 0 0 x1 0 1 0 0 0 0 1 0\n");
   ExpectInputError(read(p, TrajectoryFormat::kKitti),
                    {Q(p) + ":2", "\"x1\"", "column 4", "not a number"});
@@ -193,7 +193,7 @@ TEST(ReadTrajectory, ErrorsNameFileLineValueAndExpectation) {
   p = Write("empty.txt", "\n  \n");
   ExpectInputError(read(p, TrajectoryFormat::kKitti), {Q(p), "no pose", "12 numbers"});
   p = TempDir() + "/missing.txt";
-  ExpectInputError(read(p, TrajectoryFormat::kKitti), {Q(p), "cannot open"});
+  ExpectInputError(read(p, TrajectoryFormat::kKitti), {Q(p), "not found"});
   p = Write("quat.txt", "0 1 2 3 0 0 0 1\n1 1 2 3 0 0 0.5 0.5\n");
   ExpectInputError(read(p, TrajectoryFormat::kTum),
                    {Q(p) + ":2", "norm 0.70710678118654", "unit quaternion"});
