@@ -10,6 +10,17 @@
 #include "matching/large_matrix.h"
 
 namespace openable {
+void CheckTraversalStarts(const std::vector<int>& starts, int n, const char* what) {
+  int prev = -1;
+  for (const int v : starts) {
+    if (v <= prev || v < 0 || (prev < 0 && v != 0) || (n > 0 && v >= n))
+      throw std::logic_error(std::string(what) + " starts " + std::to_string(v) +
+                             ": expected first frames increasing from 0 and below the " +
+                             std::to_string(n) + " frames");
+    prev = v;
+  }
+}
+
 namespace {
 
 // first[x] = first frame of the traversal holding x; last[x] = its last frame.
@@ -18,14 +29,8 @@ struct Traversals {
 };
 
 Traversals Bounds(const std::vector<int>& starts, int n, const char* what) {
+  CheckTraversalStarts(starts, n, what);
   std::vector<int> s = starts.empty() ? std::vector<int>{0} : starts;
-  int prev = -1;
-  for (int v : s) {
-    if (v <= prev || v < 0 || (prev < 0 && v != 0))
-      throw std::logic_error(std::string("SequenceDistances: ") + what +
-                             " starts must increase from 0");
-    prev = v;
-  }
   Traversals t;
   t.first.resize(static_cast<size_t>(n));
   t.last.resize(static_cast<size_t>(n));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <exception>
 #include <mutex>
 #include <thread>
@@ -32,13 +33,28 @@ void RunOnThreads(int count, const std::function<void(int)>& body) {
   if (error) std::rethrow_exception(error);
 }
 
+namespace {
+std::atomic<InterruptCheck> g_interrupt_check{nullptr};
+}  // namespace
+
+void SetInterruptCheck(InterruptCheck check) { g_interrupt_check = check; }
+
 void ParallelFor(int count, int threads, const std::function<void(int)>& body) {
   if (count <= 0) return;
   std::atomic<int> next{0};
   std::atomic<bool> failed{false};
-  RunOnThreads(std::min(EffectiveThreads(threads), count), [&](int) {
+  const InterruptCheck check = g_interrupt_check.load();
+  RunOnThreads(std::min(EffectiveThreads(threads), count), [&](int t) {
+    auto last_check = std::chrono::steady_clock::now();
     for (int i = next++; i < count && !failed; i = next++) {
       try {
+        if (check != nullptr && t == 0) {
+          const auto now = std::chrono::steady_clock::now();
+          if (now - last_check >= std::chrono::milliseconds(50)) {
+            last_check = now;
+            check();
+          }
+        }
         body(i);
       } catch (...) {
         failed = true;

@@ -21,6 +21,16 @@ void RunOnThreads(int count, const std::function<void(int)>& body);
 // handing indices out one at a time in increasing order (items of unequal cost balance
 // themselves). After a body throws, no further index is started; the first exception is
 // rethrown once the threads have ended.
+//
+// Between items the calling thread runs the interrupt check (SetInterruptCheck) at most every
+// 50 ms; an exception it throws stops the loop like one thrown by a body.
 void ParallelFor(int count, int threads, const std::function<void(int)>& body);
+
+// A check a host installs so that long computations stop when the user asks (the Python module:
+// Ctrl-C, which Python only notices between bytecodes, while the computation runs in C++). It
+// throws to stop the computation; nullptr removes it. Called on the thread that started the
+// loop only (ParallelFor), never from a signal handler.
+using InterruptCheck = void (*)();
+void SetInterruptCheck(InterruptCheck check);
 
 }  // namespace openable

@@ -19,9 +19,33 @@ std::string ShapeText(const py::array& a) {
 bool IsUint8(const py::array& a) { return py::isinstance<py::array_t<std::uint8_t>>(a); }
 bool IsFloat32(const py::array& a) { return py::isinstance<py::array_t<float>>(a); }
 
+// A C-contiguous copy of `a` with elements T. Through numpy.ascontiguousarray rather than
+// pybind11's array_t::ensure: ensure() answers a failed allocation (a broadcast 100000 x 100000
+// array, a memory limit) with an empty handle and clears the error, which then crashed the
+// caller; NumPy raises MemoryError itself, and that reaches the user.
 template <typename T>
 py::array ContiguousCopy(const py::array& a) {
-  return py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a);
+  // Leaked on purpose: a static py::object would be released after the interpreter has ended.
+  static const py::object* const ascontiguousarray =
+      new py::object(py::module_::import("numpy").attr("ascontiguousarray"));
+  return (*ascontiguousarray)(a, py::dtype::of<T>()).template cast<py::array>();
+}
+
+// Float images are in [0, 1] (uint8 images in 0-255): a float image in 0-255 would saturate
+// to white without a word. NaN is refused too.
+void CheckFloatImage(const cv::Mat& image, const char* what) {
+  const cv::Mat flat = image.reshape(1);
+  for (int i = 0; i < flat.rows; ++i) {
+    const float* row = flat.ptr<float>(i);
+    for (int j = 0; j < flat.cols; ++j) {
+      const float v = row[j];
+      if (!(v >= 0.0f && v <= 1.0f))
+        throw py::value_error(std::string(what) + ": float32 value " + FormatNumber(v) +
+                              " at row " + std::to_string(i) +
+                              "; expected values in [0, 1] (divide a 0-255 image by 255, or "
+                              "pass it as uint8)");
+    }
+  }
 }
 
 // True when the memory of `a` (2-D or 3-D, elements of `item` bytes) can be described by a
@@ -67,6 +91,19 @@ MatView Wrap(py::array a, int depth, int channels, bool copied) {
 }
 
 }  // namespace
+
+std::string FileSystemPath(const py::handle& path, const char* what) {
+  // Leaked on purpose, as in ContiguousCopy.
+  static const py::object* const fsencode =
+      new py::object(py::module_::import("os").attr("fsencode"));
+  try {
+    return (*fsencode)(path).cast<std::string>();
+  } catch (const py::error_already_set&) {
+    throw py::value_error(std::string(what) + ": " +
+                          py::str(py::type::of(path).attr("__name__")).cast<std::string>() +
+                          "; expected a path (str, bytes or os.PathLike)");
+  }
+}
 
 MatView Matrix2D(const py::handle& object, Elements elements, const char* what) {
   py::array a = py::array::ensure(object);
@@ -118,17 +155,19 @@ MatView Image(const py::handle& object, const char* what) {
   } else if (IsFloat32(a)) {
     depth = CV_32F;
   } else if (a.dtype().kind() == 'f') {
-    return Wrap(ContiguousCopy<float>(a), CV_32F, channels, true);
+    MatView v = Wrap(ContiguousCopy<float>(a), CV_32F, channels, true);
+    CheckFloatImage(v.mat, what);
+    return v;
   } else {
     throw py::value_error(std::string(what) + ": dtype " + DtypeName(a) +
                           "; expected uint8 (0-255) or float32 (0-1); scale other types first, "
                           "e.g. image / 65535.0 for 16-bit");
   }
-  if (!Viewable(a, depth == CV_8U ? 1 : 4)) {
-    a = depth == CV_8U ? ContiguousCopy<std::uint8_t>(a) : ContiguousCopy<float>(a);
-    return Wrap(std::move(a), depth, channels, true);
-  }
-  return Wrap(std::move(a), depth, channels, false);
+  const bool copy = !Viewable(a, depth == CV_8U ? 1 : 4);
+  if (copy) a = depth == CV_8U ? ContiguousCopy<std::uint8_t>(a) : ContiguousCopy<float>(a);
+  MatView v = Wrap(std::move(a), depth, channels, copy);
+  if (depth == CV_32F) CheckFloatImage(v.mat, what);
+  return v;
 }
 
 std::vector<MatView> Images(const py::handle& sequence, const char* what) {

@@ -64,6 +64,11 @@ std::vector<std::string> PropertyNames(const py::handle& cls);
 py::dict PropertiesAsDict(const py::handle& object, bool arrays = false);
 
 // Registration of each part of the module (one source file each).
+// A path argument (str, bytes or os.PathLike) as the bytes the file system takes
+// (os.fsencode: a name that is not UTF-8, decoded with surrogateescape, gets its bytes back).
+// Throws ValueError naming `what` for anything else.
+std::string FileSystemPath(const py::handle& path, const char* what);
+
 void RegisterImages(py::module_& m);
 void RegisterMatching(py::module_& m);
 void RegisterEvaluation(py::module_& m);

@@ -14,6 +14,7 @@
 #include "OpenABLE/evaluation/metrics.h"
 #include "OpenABLE/evaluation/report.h"
 #include "OpenABLE/python/common.h"
+#include "OpenABLE/run/evaluate.h"
 #include "matching/normalize.h"
 
 namespace openable::python {
@@ -541,7 +542,8 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
         run.truth_dropped = gt.dropped;
         {
           py::gil_scoped_release release;
-          cv::Mat1f m(view.mat);
+          // The checks of openable_evaluate: distances >= 0, NaN or inf for no value.
+          cv::Mat1f m = DistancesForEvaluation(cv::Mat1f(view.mat), "matrix");
           if (normalize) {
             double lo = 0, hi = 0;
             cv::minMaxLoc(m, &lo, &hi);

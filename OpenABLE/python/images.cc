@@ -33,7 +33,8 @@ Descriptors of the original OpenABLE that this build cannot provide, each with t
 
   m.def(
       "read_image",
-      [](const std::string& path) {
+      [](const py::object& path_object) {
+        const std::string path = FileSystemPath(path_object, "path");
         cv::Mat image;
         {
           py::gil_scoped_release release;
@@ -49,7 +50,7 @@ and BMP by OpenCV's codecs after OpenABLE's own integrity checks; TIFF and the r
 OpenImageIO).
 
 Args:
-    path (str): the image file.
+    path (str | os.PathLike | bytes): the image file.
 
 Returns:
     numpy.ndarray: float32 in [0, 1] whatever the bit depth of the file, shape (H, W) for a
@@ -62,8 +63,13 @@ Raises:
 
   m.def(
       "list_images",
-      [](const std::string& folder, const std::string& extension) {
-        return ListImages(folder, extension);
+      [](const py::object& folder, const std::string& extension) {
+        // Names are bytes on Linux: decoded as Python decodes file names (surrogateescape), so
+        // a name that is not UTF-8 still comes back, and read_image() takes it as it is.
+        py::list out;
+        for (const std::string& p : ListImages(FileSystemPath(folder, "folder"), extension))
+          out.append(py::reinterpret_steal<py::object>(PyUnicode_DecodeFSDefault(p.c_str())));
+        return out;
       },
       py::arg("folder"), py::arg("extension") = "",
       R"doc(list_images(folder, extension="") -> list[str]
@@ -72,7 +78,7 @@ The image files of a folder in natural order of their names (img2 before img10),
 Test_OpenABLE takes them (not recursive).
 
 Args:
-    folder (str): the folder.
+    folder (str | os.PathLike | bytes): the folder.
     extension (str): keep only files with this extension ("png", case-insensitive, with or
         without the dot); empty keeps every supported image type.
 

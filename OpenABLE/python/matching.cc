@@ -1,5 +1,6 @@
 // Distance matrices: hamming_distances, l2_distances, l1_distances, sequence_distances,
 // contrast_enhancement, normalize_by_max, threshold_matrix, best_matches, read_matrix.
+#include <cmath>
 #include <limits>
 
 #include <pybind11/numpy.h>
@@ -269,7 +270,20 @@ Raises:
   m.def(
       "threshold_matrix",
       [](const py::object& normalized, float theta) {
+        // Eq. 9 compares M' (in [0, 1]) with theta in [0, 1]; NaN would compare as "not a
+        // candidate" without a word.
+        if (!(theta >= 0.0f && theta <= 1.0f))
+          throw py::value_error("theta: " + FormatNumber(theta) + " is not valid; expected a "
+                                "threshold in [0, 1] (Eq. 9 on the normalised matrix)");
         const MatView view = Matrix2D(normalized, Elements::kFloat32, "normalized");
+        for (int i = 0; i < view.mat.rows; ++i) {
+          const float* row = view.mat.ptr<float>(i);
+          for (int j = 0; j < view.mat.cols; ++j)
+            if (std::isnan(row[j]))
+              throw py::value_error("normalized: NaN at row " + std::to_string(i) + ", column " +
+                                    std::to_string(j) + "; expected M' in [0, 1] (inf for a "
+                                    "cell without a value)");
+        }
         cv::Mat1b out;
         {
           py::gil_scoped_release release;

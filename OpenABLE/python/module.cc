@@ -1,9 +1,27 @@
 // The Python module `openable` (docs/python.md).
 #include <stdexcept>
 
+#include <opencv2/core.hpp>
+
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/threading.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/python/common.h"
+
+namespace {
+
+// Ctrl-C during a long call: Python runs its SIGINT handler only between bytecodes, and the
+// call runs in C++ with the GIL released. The library's loops call this between items
+// (SetInterruptCheck, OpenABLE/base/threading.h): it takes the GIL, lets Python run pending
+// signal handlers, and stops the computation with their exception (KeyboardInterrupt), which
+// reaches the caller once the C++ stack has unwound.
+void CheckPythonSignals() {
+  if (!Py_IsInitialized()) return;
+  pybind11::gil_scoped_acquire gil;
+  if (PyErr_CheckSignals() != 0) throw pybind11::error_already_set();
+}
+
+}  // namespace
 
 PYBIND11_MODULE(openable, m) {
   namespace py = pybind11;
@@ -45,9 +63,21 @@ the command-line programs; other invalid arguments raise ValueError.)doc";
       throw;  // pybind11's own translation: IndexError
     } catch (const std::logic_error& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const cv::Exception& e) {
+      // OpenCV's own text spans lines and names its source file (alloc.cpp): one line here,
+      // and a failed allocation is a MemoryError, as NumPy's are.
+      if (e.code == cv::Error::StsNoMem) {
+        PyErr_SetString(PyExc_MemoryError,
+                        ("not enough memory for this request (OpenCV could not allocate: " +
+                         openable::Trim(e.err) + ")").c_str());
+      } else {
+        PyErr_SetString(PyExc_RuntimeError,
+                        ("OpenCV error in " + e.func + ": " + openable::Trim(e.err)).c_str());
+      }
     }
   });
 
+  openable::SetInterruptCheck(&CheckPythonSignals);
   openable::python::RegisterImages(m);
   openable::python::RegisterMatching(m);
   openable::python::RegisterEvaluation(m);

@@ -79,23 +79,11 @@ Trajectory MakeTrajectory(const py::object& poses, const py::object& frame_ids,
     for (std::size_t i = 0; i < n; ++i) t.frame_ids.push_back(static_cast<long>(i));
   } else {
     t.frame_ids = frame_ids.cast<std::vector<long>>();
-    if (t.frame_ids.size() != n)
-      throw py::value_error("frame_ids: " + std::to_string(t.frame_ids.size()) +
-                            " ids; expected one per pose (" + std::to_string(n) + ")");
-    for (std::size_t i = 1; i < n; ++i)
-      if (t.frame_ids[i] <= t.frame_ids[i - 1])
-        throw py::value_error("frame_ids: " + std::to_string(t.frame_ids[i]) + " after " +
-                              std::to_string(t.frame_ids[i - 1]) +
-                              "; expected strictly increasing ids");
   }
-  if (!timestamps.is_none()) {
-    t.timestamps = timestamps.cast<std::vector<double>>();
-    if (t.timestamps.size() != n)
-      throw py::value_error("timestamps: " + std::to_string(t.timestamps.size()) +
-                            " values; expected one per pose (" + std::to_string(n) + ")");
-  } else if (t.format == snaps::TrajectoryFormat::kTum) {
-    throw py::value_error("timestamps: expected one per pose for format \"tum\"");
-  }
+  if (!timestamps.is_none()) t.timestamps = timestamps.cast<std::vector<double>>();
+  // The checks a trajectory file passes (ids and timestamps one per pose, increasing), so that
+  // what save() writes reads back.
+  snaps::CheckTrajectory(t, "Trajectory");
   return t;
 }
 
