@@ -211,8 +211,9 @@ TEST(BoundedMatches, SkipCellsAndRatioScoresEqualBruteForce) {
       for (size_t k = 0; k < got.size() && k < expected.size(); ++k)
         EXPECT_NEAR(got[k].score, expected[k].score, 1e-5) << k;
       // The first L - 1 queries of a traversal have no complete sequence along diagonals.
-      if (dir == SequenceDirection::kForward && traversals == 2)
+      if (dir == SequenceDirection::kForward && traversals == 2) {
         for (const Match& m : got) EXPECT_GE(m.query, L - 1);
+      }
     }
   }
 }

@@ -72,7 +72,7 @@ TEST(ContrastEnhancement, MatchesTheDefinitionWithTraversalsAndEmptyCells) {
           ASSERT_NEAR(got(i, j), want(i, j), 1e-4) << "R=" << window << " at " << i << "," << j;
         }
       double lo = 0;
-      cv::Mat1b finite = d == d & d != std::numeric_limits<float>::infinity();
+      cv::Mat1b finite = (d == d) & (d != std::numeric_limits<float>::infinity());
       cv::minMaxLoc(got, &lo, nullptr, nullptr, nullptr, finite);
       EXPECT_NEAR(lo, 0.0, 1e-6);  // shifted so that the smallest value is 0
     }

@@ -141,9 +141,15 @@ TEST(SequenceDistances, SkipLeavesExactlyTheIncompleteCellsEmpty) {
           ASSERT_EQ(r(i, j) == inf, rev(i, j) == inf) << "L=" << L << " at " << i << "," << j;
           const float both = std::min(fwd(i, j), rev(i, j));
           ASSERT_EQ(b(i, j) == inf, both == inf) << "L=" << L << " at " << i << "," << j;
-          if (fwd(i, j) != inf) ASSERT_NEAR(f(i, j), fwd(i, j), 1e-3);
-          if (rev(i, j) != inf) ASSERT_NEAR(r(i, j), rev(i, j), 1e-3);
-          if (both != inf) ASSERT_NEAR(b(i, j), both, 1e-3);
+          if (fwd(i, j) != inf) {
+            ASSERT_NEAR(f(i, j), fwd(i, j), 1e-3);
+          }
+          if (rev(i, j) != inf) {
+            ASSERT_NEAR(r(i, j), rev(i, j), 1e-3);
+          }
+          if (both != inf) {
+            ASSERT_NEAR(b(i, j), both, 1e-3);
+          }
         }
       // Hand check: the first L - 1 rows of each row traversal are empty along diagonals.
       if (L > 1 && L <= 20) {
