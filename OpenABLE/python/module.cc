@@ -1,6 +1,7 @@
 // The Python module `openable` (docs/python.md).
 #include <stdexcept>
 
+#include <pybind11/eval.h>
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/base/error.h"
@@ -84,6 +85,54 @@ the command-line programs; other invalid arguments raise ValueError.)doc";
   openable::python::RegisterOnline(m);
   openable::python::RegisterSnaps(m);
   openable::python::RegisterSweep(m);
+  // pybind11 reports arguments of the wrong type (a string for patch_size, an integer beyond
+  // 64 bits) as a TypeError of ten lines listing every overload and echoing the arguments,
+  // arrays included. Every public function and method is wrapped (functools.wraps keeps its
+  // name, docstring and signature) so that this error is one line naming the function and what
+  // it takes.
+  py::exec(R"py(
+import functools as _functools
+import inspect as _inspect
+
+def _one_line(function, qualified):
+    @_functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        try:
+            return function(*args, **kwargs)
+        except TypeError as error:
+            text = str(error)
+            if "incompatible function arguments" not in text and                "incompatible constructor arguments" not in text:
+                raise
+            lines = [line.strip() for line in text.splitlines()]
+            expected = next((line[3:] for line in lines if line.startswith("1. ")), "")
+            raise TypeError("%s: arguments of the wrong type; expected %s (see help(%s))"
+                            % (qualified, expected, qualified)) from None
+    return wrapper
+
+def _wrap_module(module):
+    for name in dir(module):
+        if name.startswith("_"):
+            continue
+        obj = getattr(module, name)
+        qualified = module.__name__ + "." + name
+        if _inspect.isbuiltin(obj):
+            setattr(module, name, _one_line(obj, qualified))
+        elif _inspect.isclass(obj) and not issubclass(obj, BaseException):
+            for member in list(vars(obj)):
+                if member.startswith("_") and member != "__init__":
+                    continue
+                attribute = vars(obj)[member]
+                where = qualified + "." + member
+                if type(attribute).__name__ == "instancemethod":
+                    setattr(obj, member, _one_line(getattr(obj, member), where))
+                elif isinstance(attribute, property) and attribute.fset is not None:
+                    setattr(obj, member, property(attribute.fget,
+                                                  _one_line(attribute.fset, where),
+                                                  attribute.fdel, attribute.__doc__))
+)py", m.attr("__dict__"));
+  m.attr("_wrap_module")(m);
+  m.attr("_wrap_module")(m.attr("snaps"));
+
   // `import openable.snaps` and `from openable.snaps import ...` work like the attribute.
   py::module_::import("sys").attr("modules")["openable.snaps"] = m.attr("snaps");
 }
