@@ -3,8 +3,6 @@
 #include <iostream>
 #include <string>
 
-#include <malloc.h>
-
 #include "OpenABLE/OpenABLE.h"
 #include "OpenABLE/run/command_line.h"
 
@@ -37,12 +35,7 @@ const char* kUsage =
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Every frame passes through buffers of several MB (a 960x540 colour frame as float is
-  // 6 MB). glibc serves such blocks with mmap and returns them at free, so each frame paid
-  // for fresh zeroed pages: 63% of a Gardens Point run was page faults in the kernel. Keeping
-  // blocks up to 256 MB on the heap lets them be reused (Gardens Point 3.0 s -> 1.1 s).
-  mallopt(M_MMAP_THRESHOLD, 256 << 20);
-  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  openable::KeepFrameBuffersOnTheHeap();
   return openable::RunConfigProgram(
       argc, argv, "Test_OpenABLE", kUsage, "OpenABLE " + std::string(openable::kVersion),
       [](const openable::Config& config, const openable::CommandLine&,

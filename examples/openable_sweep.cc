@@ -4,8 +4,6 @@
 #include <iostream>
 #include <string>
 
-#include <malloc.h>
-
 #include "OpenABLE/OpenABLE.h"
 #include "OpenABLE/run/command_line.h"
 
@@ -70,9 +68,7 @@ int ParseCount(const std::string& option, const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // As Test_OpenABLE: keep large frame buffers on the heap between frames.
-  mallopt(M_MMAP_THRESHOLD, 256 << 20);
-  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  openable::KeepFrameBuffersOnTheHeap();
   return openable::RunConfigProgram(
       argc, argv, "openable_sweep", kUsage, "OpenABLE " + std::string(openable::kVersion),
       [](const openable::Config& config, const openable::CommandLine& command_line,

@@ -279,6 +279,22 @@ void ParallelRows(int rows, int threads, const PairProgress& progress, PairsOfRo
   if (progress) progress(done.load(), total_pairs);
 }
 
+// Runs body(r0, r1) over the n query rows of an n x m matrix in tasks of 16 rows (ParallelRows),
+// reporting progress in pairs.
+template <typename Body>
+void InTasksOfRows(int n, int m, int threads, const PairProgress& progress, Body body) {
+  constexpr int kRowsPerTask = 16;
+  const int tasks = (n + kRowsPerTask - 1) / kRowsPerTask;
+  auto pairs_of_task = [&](int t) -> std::int64_t {
+    return static_cast<std::int64_t>(std::min(kRowsPerTask, n - t * kRowsPerTask)) * m;
+  };
+  ParallelRows(tasks, threads, progress, pairs_of_task, static_cast<std::int64_t>(n) * m,
+               [&](int t) {
+                 const int r0 = t * kRowsPerTask;
+                 body(r0, std::min(n, r0 + kRowsPerTask));
+               });
+}
+
 void CheckInputs(const cv::Mat& a, const cv::Mat& b, int depth, const char* what) {
   if (a.depth() != depth || a.channels() != 1)
     throw std::logic_error(std::string(what) + ": descriptors of the wrong type");
@@ -407,27 +423,19 @@ cv::Mat1f L1Distances(const cv::Mat& a, const cv::Mat& b, int threads,
   const int n = a.rows, m = refs.rows, w = a.cols;
   cv::Mat1f out = LargeMatrix(n, m);
   if (n == 0 || m == 0) return out;
-  // Tasks of 16 query rows, each running over slices of references that stay in cache.
-  constexpr int kRowsPerTask = 16;
+  // Each task of query rows runs over slices of references that stay in cache.
   const int slice = std::max(16, (256 << 10) / std::max(1, w));
-  const int tasks = (n + kRowsPerTask - 1) / kRowsPerTask;
-  auto pairs_of_task = [&](int t) -> std::int64_t {
-    return static_cast<std::int64_t>(std::min(kRowsPerTask, n - t * kRowsPerTask)) * m;
-  };
-  ParallelRows(tasks, threads, progress, pairs_of_task, static_cast<std::int64_t>(n) * m,
-               [&](int t) {
-                 const int r0 = t * kRowsPerTask, r1 = std::min(n, r0 + kRowsPerTask);
-                 for (int j0 = 0; j0 < m; j0 += slice) {
-                   const int j1 = std::min(m, j0 + slice);
-                   for (int r = r0; r < r1; ++r) {
-                     const std::uint8_t* q = a.ptr<std::uint8_t>(r);
-                     float* o = out.ptr<float>(r);
-                     for (int j = j0; j < j1; ++j)
-                       o[j] = static_cast<float>(
-                           AbsoluteDifferences(q, refs.ptr<std::uint8_t>(j), w));
-                   }
-                 }
-               });
+  InTasksOfRows(n, m, threads, progress, [&](int r0, int r1) {
+    for (int j0 = 0; j0 < m; j0 += slice) {
+      const int j1 = std::min(m, j0 + slice);
+      for (int r = r0; r < r1; ++r) {
+        const std::uint8_t* q = a.ptr<std::uint8_t>(r);
+        float* o = out.ptr<float>(r);
+        for (int j = j0; j < j1; ++j)
+          o[j] = static_cast<float>(AbsoluteDifferences(q, refs.ptr<std::uint8_t>(j), w));
+      }
+    }
+  });
   return out;
 }
 
@@ -442,16 +450,9 @@ cv::Mat1f HammingDistances(const cv::Mat& a, const cv::Mat& b, int threads,
   // written in order, which costs less than mirroring one triangle column by column.
   const PackedRows refs = Pack(refs_mat);
   const std::vector<std::uint64_t> qwords = RowWords(a);
-  constexpr int kRowsPerTask = 16;
-  const int tasks = (n + kRowsPerTask - 1) / kRowsPerTask;
-  auto pairs_of_task = [&](int t) -> std::int64_t {
-    return static_cast<std::int64_t>(std::min(kRowsPerTask, n - t * kRowsPerTask)) * m;
-  };
-  ParallelRows(tasks, threads, progress, pairs_of_task, static_cast<std::int64_t>(n) * m,
-               [&](int t) {
-                 const int r0 = t * kRowsPerTask, r1 = std::min(n, r0 + kRowsPerTask);
-                 QueryRange(qwords, r0, r1, refs, out.ptr<float>(r0), out.step1());
-               });
+  InTasksOfRows(n, m, threads, progress, [&](int r0, int r1) {
+    QueryRange(qwords, r0, r1, refs, out.ptr<float>(r0), out.step1());
+  });
   return out;
 }
 
@@ -491,10 +492,7 @@ void HammingReferences::DistancesInto(const cv::Mat& queries, cv::Mat1f& out,
   if (out.rows != n || out.cols != m) out = LargeMatrix(n, m);
   if (n == 0 || m == 0) return;
   const std::vector<std::uint64_t> qwords = RowWords(queries);
-  constexpr int kRowsPerTask = 16;
-  const int tasks = (n + kRowsPerTask - 1) / kRowsPerTask;
-  ParallelRows(tasks, threads, {}, [](int) -> std::int64_t { return 0; }, 0, [&](int t) {
-    const int r0 = t * kRowsPerTask, r1 = std::min(n, r0 + kRowsPerTask);
+  InTasksOfRows(n, m, threads, {}, [&](int r0, int r1) {
     QueryRange(qwords, r0, r1, packed_->rows, out.ptr<float>(r0), out.step1());
   });
 }

@@ -14,9 +14,9 @@ void CheckTraversalStarts(const std::vector<int>& starts, int n, const char* wha
   int prev = -1;
   for (const int v : starts) {
     if (v <= prev || v < 0 || (prev < 0 && v != 0) || (n > 0 && v >= n))
-      throw std::logic_error(std::string(what) + " starts " + std::to_string(v) +
-                             ": expected first frames increasing from 0 and below the " +
-                             std::to_string(n) + " frames");
+      throw std::logic_error(std::string(what) + ": " + std::to_string(v) +
+                             " is not valid; expected first frames increasing from 0 and below "
+                             "the " + std::to_string(n) + " frames");
     prev = v;
   }
 }
@@ -29,7 +29,7 @@ struct Traversals {
 };
 
 Traversals Bounds(const std::vector<int>& starts, int n, const char* what) {
-  CheckTraversalStarts(starts, n, what);
+  CheckTraversalStarts(starts, n, (std::string("SequenceDistances: ") + what + " starts").c_str());
   std::vector<int> s = starts.empty() ? std::vector<int>{0} : starts;
   Traversals t;
   t.first.resize(static_cast<size_t>(n));

@@ -38,8 +38,8 @@ enum class SequenceDirection { kForward = 0, kReverse = 1, kBoth = 2 };  // kBot
 OPENABLE_ENUM_NAMES(SequenceDirection, "forward", "reverse", "both")
 
 // Checks the first frames of the traversals along one axis of `n` frames: increasing from 0,
-// each below n (empty: one traversal). Throws std::logic_error naming `what` ("row",
-// "traversal") and the value otherwise (a ValueError in Python).
+// each below n (empty: one traversal). Throws std::logic_error "<what>: <value> is not valid;
+// ..." otherwise (a ValueError in Python); `what` names the argument ("traversal_starts").
 void CheckTraversalStarts(const std::vector<int>& starts, int n, const char* what);
 
 // A cell with fewer than L terms (see above): scaled up to L terms, or skipped (+inf).

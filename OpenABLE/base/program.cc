@@ -3,9 +3,16 @@
 #include <exception>
 #include <iostream>
 
+#include <malloc.h>
+
 #include "OpenABLE/base/error.h"
 
 namespace openable {
+
+void KeepFrameBuffersOnTheHeap() {
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+}
 
 int RunProgram(const std::string& program, const std::function<int()>& body) {
   try {

@@ -1,6 +1,7 @@
 #include "OpenABLE/base/strings.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <sstream>
 
@@ -34,6 +35,12 @@ std::string FormatNumber(double value) {
   std::ostringstream os;
   os << value;
   return os.str();
+}
+
+std::string FormatFixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
 }
 
 std::string WorkingDirectoryNote(std::string_view path) {

@@ -18,6 +18,9 @@ std::string Trim(std::string_view s);
 // six significant digits ("0.47", "2500", "1e+06"), "inf" for infinity.
 std::string FormatNumber(double value);
 
+// `value` with `decimals` digits after the point ("%.3f"): figures in tables and reports.
+std::string FormatFixed(double value, int decimals);
+
 // For a message about a path that was not found: " (relative to the working directory
 // "/home/user/run")" when `path` is relative, else "". A relative path in a Config.txt is
 // relative to where the program runs, not to the file, which is what users most often miss.

@@ -39,6 +39,10 @@ std::atomic<InterruptCheck> g_interrupt_check{nullptr};
 
 void SetInterruptCheck(InterruptCheck check) { g_interrupt_check = check; }
 
+void CheckForInterrupt() {
+  if (const InterruptCheck check = g_interrupt_check.load()) check();
+}
+
 void ParallelFor(int count, int threads, const std::function<void(int)>& body) {
   if (count <= 0) return;
   std::atomic<int> next{0};

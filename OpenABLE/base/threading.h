@@ -33,4 +33,8 @@ void ParallelFor(int count, int threads, const std::function<void(int)>& body);
 using InterruptCheck = void (*)();
 void SetInterruptCheck(InterruptCheck check);
 
+// Runs the installed interrupt check now (nothing when none is installed): for loops of long
+// steps that do not go through ParallelFor (the runs of a sweep).
+void CheckForInterrupt();
+
 }  // namespace openable

@@ -45,22 +45,30 @@ cv::Mat1f WritableFloatView(const py::object& d, MatView& view) {
   return cv::Mat1f(view.mat);
 }
 
+// hamming_distances, l2_distances and l1_distances: every row of `a` against every row of `b`
+// (None: `a` itself) with `distances`, the GIL released.
+py::array PairDistances(const py::object& a, const py::object& b, int threads, Elements elements,
+                        cv::Mat1f (*distances)(const cv::Mat&, const cv::Mat&, int,
+                                               const PairProgress&)) {
+  const MatView va = Matrix2D(a, elements, "a");
+  MatView vb;
+  if (!b.is_none()) vb = Matrix2D(b, elements, "b");
+  CheckWidths(va.mat, vb.mat);
+  cv::Mat1f out;
+  {
+    py::gil_scoped_release release;
+    out = distances(va.mat, vb.mat, threads, PairProgress());
+  }
+  return ToNumpy(out);
+}
+
 }  // namespace
 
 void RegisterMatching(py::module_& m) {
   m.def(
       "hamming_distances",
       [](const py::object& a, const py::object& b, int threads) {
-        const MatView va = Matrix2D(a, Elements::kUint8, "a");
-        MatView vb;
-        if (!b.is_none()) vb = Matrix2D(b, Elements::kUint8, "b");
-        CheckWidths(va.mat, vb.mat);
-        cv::Mat1f out;
-        {
-          py::gil_scoped_release release;
-          out = HammingDistances(va.mat, vb.mat, threads);
-        }
-        return ToNumpy(out);
+        return PairDistances(a, b, threads, Elements::kUint8, HammingDistances);
       },
       py::arg("a"), py::arg("b") = py::none(), py::arg("threads") = 0,
       R"doc(hamming_distances(a, b=None, threads=0) -> numpy.ndarray
@@ -84,16 +92,7 @@ Raises:
   m.def(
       "l2_distances",
       [](const py::object& a, const py::object& b, int threads) {
-        const MatView va = Matrix2D(a, Elements::kFloat32, "a");
-        MatView vb;
-        if (!b.is_none()) vb = Matrix2D(b, Elements::kFloat32, "b");
-        CheckWidths(va.mat, vb.mat);
-        cv::Mat1f out;
-        {
-          py::gil_scoped_release release;
-          out = L2Distances(va.mat, vb.mat, threads);
-        }
-        return ToNumpy(out);
+        return PairDistances(a, b, threads, Elements::kFloat32, L2Distances);
       },
       py::arg("a"), py::arg("b") = py::none(), py::arg("threads") = 0,
       R"doc(l2_distances(a, b=None, threads=0) -> numpy.ndarray
@@ -114,16 +113,7 @@ Returns:
   m.def(
       "l1_distances",
       [](const py::object& a, const py::object& b, int threads) {
-        const MatView va = Matrix2D(a, Elements::kUint8, "a");
-        MatView vb;
-        if (!b.is_none()) vb = Matrix2D(b, Elements::kUint8, "b");
-        CheckWidths(va.mat, vb.mat);
-        cv::Mat1f out;
-        {
-          py::gil_scoped_release release;
-          out = L1Distances(va.mat, vb.mat, threads);
-        }
-        return ToNumpy(out);
+        return PairDistances(a, b, threads, Elements::kUint8, L1Distances);
       },
       py::arg("a"), py::arg("b") = py::none(), py::arg("threads") = 0,
       R"doc(l1_distances(a, b=None, threads=0) -> numpy.ndarray

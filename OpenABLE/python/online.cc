@@ -259,7 +259,7 @@ Raises:
         if (!metric.is_none()) m = ParseEnum<Metric>(metric.cast<std::string>(), "metric");
         std::vector<int> starts;
         if (!traversal_starts.is_none()) starts = traversal_starts.cast<std::vector<int>>();
-        CheckTraversalStarts(starts, v.mat.rows, "traversal_starts:");
+        CheckTraversalStarts(starts, v.mat.rows, "traversal_starts");
         float max = 0;
         cv::Mat1f out;
         {

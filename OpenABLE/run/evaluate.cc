@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <iterator>
 #include <set>
 #include <stdexcept>
 
@@ -79,7 +80,10 @@ void StageEvaluation(OutputBatch& batch, const std::string& key, const std::stri
   if (matrices.size() != evaluation.runs.size())
     throw std::logic_error("StageEvaluation: one matrix per run expected");
   const EvaluationSettings& s = evaluation.settings;
-  batch.Stage(key, prefix + ".json", EncodeEvaluationJson(s, evaluation.runs, kVersion));
+  static_assert(std::size(kEvaluationSetSuffixes) == 2 && std::size(kEvaluationRunSuffixes) == 3,
+                "one suffix per file staged below");
+  batch.Stage(key, prefix + kEvaluationSetSuffixes[0],
+              EncodeEvaluationJson(s, evaluation.runs, kVersion));
 
   std::vector<PrSeries> series;
   std::set<std::string> used;
@@ -92,9 +96,9 @@ void StageEvaluation(OutputBatch& batch, const std::string& key, const std::stri
       used.insert(part);
       stem += "_" + part;
     }
-    batch.Stage(key, stem + "_per_query.csv", EncodeCurveCsv(run.per_query.curve));
-    batch.Stage(key, stem + "_ablep.csv", EncodeCurveCsv(run.able_p.curve));
-    batch.Stage(key, stem + "_overlay.png",
+    batch.Stage(key, stem + kEvaluationRunSuffixes[0], EncodeCurveCsv(run.per_query.curve));
+    batch.Stage(key, stem + kEvaluationRunSuffixes[1], EncodeCurveCsv(run.able_p.curve));
+    batch.Stage(key, stem + kEvaluationRunSuffixes[2],
                 EncodePng(RenderOverlay(*matrices[i], run.layout, evaluation.truths[i],
                                         run.per_query,
                                         run.per_query.has_operating_point
@@ -107,7 +111,8 @@ void StageEvaluation(OutputBatch& batch, const std::string& key, const std::stri
   if (!evaluation.runs.empty() &&
       evaluation.runs[0].layout.kind == EvaluationLayout::Kind::kLoopClosure)
     title += ", exclusion " + std::to_string(s.options.exclusion);
-  batch.Stage(key, prefix + "_pr.png", EncodePng(RenderPrPlot(series, title, s.options.vicinity)));
+  batch.Stage(key, prefix + kEvaluationSetSuffixes[1],
+              EncodePng(RenderPrPlot(series, title, s.options.vicinity)));
 }
 
 cv::Mat1f DistancesForEvaluation(const cv::Mat1f& matrix, const std::string& what) {

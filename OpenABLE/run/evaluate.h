@@ -40,6 +40,13 @@ void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
                     const EvaluationLayout& layout, const std::string& label,
                     const std::string& source);
 
+// The suffixes of the evaluation's files: once per evaluation (<prefix>.json, <prefix>_pr.png)
+// and once per run (<prefix>[_<label>]_per_query.csv, ...), in the order StageEvaluation
+// stages them.
+inline constexpr const char* kEvaluationSetSuffixes[] = {".json", "_pr.png"};
+inline constexpr const char* kEvaluationRunSuffixes[] = {"_per_query.csv", "_ablep.csv",
+                                                         "_overlay.png"};
+
 // Stages the evaluation's files under `prefix` into `batch` (key = the config key to name in
 // errors): <prefix>.json, <prefix>_pr.png, and per run <prefix>[_<label>]_per_query.csv,
 // <prefix>[_<label>]_ablep.csv and <prefix>[_<label>]_overlay.png (the label part only when

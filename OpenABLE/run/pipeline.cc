@@ -32,10 +32,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double SecondsSince(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
 
 enum class SourceKind { kFolder, kVideo, kStereo };
 
@@ -644,10 +640,12 @@ std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& co
   if (!config.scale.matches_name.empty())
     out.emplace_back("Matches_name", config.scale.matches_name);
   const std::string& prefix = config.evaluation.name;
-  if (EvaluationRequested(config) && !prefix.empty())
-    for (const char* suffix :
-         {".json", "_pr.png", "_per_query.csv", "_ablep.csv", "_overlay.png"})
+  if (EvaluationRequested(config) && !prefix.empty()) {  // one run: no label in the names
+    for (const char* suffix : kEvaluationSetSuffixes)
       out.emplace_back("Evaluation_name", prefix + suffix);
+    for (const char* suffix : kEvaluationRunSuffixes)
+      out.emplace_back("Evaluation_name", prefix + suffix);
+  }
   return out;
 }
 

@@ -37,6 +37,11 @@ class ProgressReporter {
   std::chrono::steady_clock::time_point start_, last_print_;
 };
 
+// Wall time since `start`, in seconds (the timings of the reports).
+inline double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 // True when file descriptor `fd` is a terminal.
 bool IsTerminal(int fd);
 

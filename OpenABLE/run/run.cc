@@ -9,15 +9,6 @@
 #include "OpenABLE/base/version.h"
 
 namespace openable {
-namespace {
-
-std::string Fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
-
-}  // namespace
 
 RunOutcome Run(const Config& config, ProgressReporter& progress,
                const std::function<void(const std::string&)>& log) {
@@ -117,17 +108,17 @@ std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
         << " best matches with " << EnumName(c.matching.score) << " score <= "
         << c.matching.match_threshold << " (Match_threshold)";
   out << "\nTimings (wall clock):\n"
-      << "  total            " << Fixed(tm.total_seconds, 3) << " s\n"
-      << "  description      " << Fixed(tm.describe_seconds, 3) << " s  ("
-      << Fixed(tm.frames ? 1e3 * tm.describe_seconds / tm.frames : 0, 3) << " ms per image, "
+      << "  total            " << FormatFixed(tm.total_seconds, 3) << " s\n"
+      << "  description      " << FormatFixed(tm.describe_seconds, 3) << " s  ("
+      << FormatFixed(tm.frames ? 1e3 * tm.describe_seconds / tm.frames : 0, 3) << " ms per image, "
       << tm.frames << " images, reading included)\n"
-      << "  matching         " << Fixed(tm.match_seconds, 3) << " s  ("
-      << Fixed(tm.pairs ? 1e9 * tm.match_seconds / static_cast<double>(tm.pairs) : 0, 1)
+      << "  matching         " << FormatFixed(tm.match_seconds, 3) << " s  ("
+      << FormatFixed(tm.pairs ? 1e9 * tm.match_seconds / static_cast<double>(tm.pairs) : 0, 1)
       << " ns per pair, " << tm.pairs << " pairs)\n"
-      << "  sequences+norm.  " << Fixed(tm.sequence_seconds, 3) << " s\n";
+      << "  sequences+norm.  " << FormatFixed(tm.sequence_seconds, 3) << " s\n";
   if (evaluation != nullptr)
-    out << "  evaluation       " << Fixed(tm.evaluate_seconds, 3) << " s\n";
-  out << "  export           " << Fixed(tm.export_seconds, 3) << " s\n";
+    out << "  evaluation       " << FormatFixed(tm.evaluate_seconds, 3) << " s\n";
+  out << "  export           " << FormatFixed(tm.export_seconds, 3) << " s\n";
   if (evaluation != nullptr)
     out << FormatEvaluationTable(evaluation->settings, evaluation->runs);
   if (outcome.written.empty()) {

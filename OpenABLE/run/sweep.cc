@@ -8,6 +8,7 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
+#include "OpenABLE/base/threading.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/evaluation/plots.h"
 #include "OpenABLE/run/evaluate.h"
@@ -18,10 +19,6 @@ namespace openable {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
 
 // Groups whose keys a sweep does not vary: outputs (a sweep writes only its own files), the
 // bounded mode and its matches (a sweep evaluates dense matrices), and the tools that do not
@@ -70,12 +67,6 @@ const char* RankTitle(SweepRank rank) {
     case SweepRank::kAveragePrecision: return "ABLE-P average precision";
   }
   return "";
-}
-
-std::string Fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
 }
 
 // The combination's label: descriptor and sequence length (always, as Test_OpenABLE labels a
@@ -217,6 +208,8 @@ SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressRe
     SweepRun run;
     run.values = combinations[i];
     run.label = LabelOf(config, options.axes, run.values);
+    // A run that reuses kept matrices may not pass through ParallelFor: check between runs.
+    CheckForInterrupt();
     log("run " + std::to_string(i + 1) + " of " + std::to_string(n) + ": " + run.label);
     const auto t = Clock::now();
     const int kept_before = store.Size();
@@ -249,7 +242,7 @@ std::string FormatSweepTable(const SweepResult& r) {
   o << "Sweep: " << r.runs.size() << " runs (" << keys << "), ranked by "
     << RankTitle(r.rank_by) << "; frames described " << r.descriptions
     << (r.descriptions == 1 ? " time" : " times") << " (once per description setting), "
-    << Fixed(r.seconds, 1) << " s\n";
+    << FormatFixed(r.seconds, 1) << " s\n";
   const EvaluationSettings& s = r.settings;
   o << "Evaluation against " << GroundTruthTypeName(s.truth.type) << " ground truth"
     << (s.truth.path.empty() ? "" : " \"" + s.truth.path + "\"") << ": tolerance +-"
@@ -269,13 +262,13 @@ std::string FormatSweepTable(const SweepResult& r) {
     const PerQueryResult& q = run.evaluation.per_query;
     std::vector<std::string> row = {std::to_string(i + 1)};
     for (const std::string& v : run.values) row.push_back(v);
-    row.push_back(Fixed(q.auc, 3));
-    row.push_back(Fixed(q.recall_at_100p, 3));
-    row.push_back(Fixed(q.max_f1, 3));
-    row.push_back(Fixed(q.recall_at_1, 3));
-    row.push_back(Fixed(q.recall_at_5, 3));
-    row.push_back(Fixed(run.evaluation.able_p.average_precision, 1));
-    row.push_back(Fixed(run.seconds, 3));
+    row.push_back(FormatFixed(q.auc, 3));
+    row.push_back(FormatFixed(q.recall_at_100p, 3));
+    row.push_back(FormatFixed(q.max_f1, 3));
+    row.push_back(FormatFixed(q.recall_at_1, 3));
+    row.push_back(FormatFixed(q.recall_at_5, 3));
+    row.push_back(FormatFixed(run.evaluation.able_p.average_precision, 1));
+    row.push_back(FormatFixed(run.seconds, 3));
     row.push_back(run.described ? "" : "*");
     rows.push_back(row);
   }

@@ -3,6 +3,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -10,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -79,6 +81,25 @@ inline double AlignedRecallAt1(const cv::Mat1f& d, int q0, int r0, int n, int to
     hits += std::abs(best - q) <= tol;
   }
   return static_cast<double>(hits) / n;
+}
+
+// Brute force over two traversals of `n` frames each (references rows/columns 0..n-1, queries
+// rows first_query..first_query+n-1): the queries whose best reference (smallest distance,
+// lowest column on ties) has a ratio to the smallest distance more than `window` columns away
+// (1 without such a rival, or when it is 0) of at most `threshold`.
+inline int AcceptedByRatio(const cv::Mat1f& m, int first_query, int n, int window,
+                           float threshold) {
+  int accepted = 0;
+  for (int q = first_query; q < first_query + n; ++q) {
+    int best = 0;
+    for (int c = 1; c < n; ++c)
+      if (m(q, c) < m(q, best)) best = c;
+    float rival = std::numeric_limits<float>::infinity();
+    for (int c = 0; c < n; ++c)
+      if (std::abs(c - best) > window) rival = std::min(rival, m(q, c));
+    accepted += (rival > 0 ? m(q, best) / rival : 1.0f) <= threshold;
+  }
+  return accepted;
 }
 
 // True when `s` is exactly one line.

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -174,16 +173,7 @@ TEST(MatchScore, ReportCountsTheAcceptedBestMatches) {
   ASSERT_EQ(o.status, 0) << o.err;
   // Count independently: each winter frame's best summer frame and its ratio (window 10).
   const cv::Mat1f m = ReadNpy(dir + "/m.npy");
-  int accepted = 0;
-  for (int q = 300; q < 600; ++q) {
-    int best = 0;
-    for (int c = 1; c < 300; ++c)
-      if (m(q, c) < m(q, best)) best = c;
-    float rival = std::numeric_limits<float>::infinity();
-    for (int c = 0; c < 300; ++c)
-      if (std::abs(c - best) > 10) rival = std::min(rival, m(q, c));
-    accepted += (rival > 0 ? m(q, best) / rival : 1.0f) <= 0.9f;
-  }
+  const int accepted = AcceptedByRatio(m, 300, 300, 10, 0.9f);
   EXPECT_NE(o.out.find("accepted: " + std::to_string(accepted) + " of 300 best matches with "
                        "ratio score <= 0.9 (Match_threshold)"),
             std::string::npos)

@@ -2,7 +2,6 @@
 // (Test_OpenABLE <preset> --set Images_path=...), and what they report is checked against the
 // matrix they wrote.
 #include <cmath>
-#include <limits>
 #include <string>
 #include <vector>
 
@@ -45,16 +44,7 @@ TEST(Presets, AcrossConditionsRunsOnTheSample) {
   ASSERT_EQ(m.size(), cv::Size(600, 600));
   const std::string json = ReadAll(dir + "/eval.json");
   EXPECT_NEAR(JsonNumber(json, "recall_at_1"), AlignedRecallAt1(m, 300, 0, 300, 2), 1e-9);
-  int accepted = 0;
-  for (int q = 300; q < 600; ++q) {
-    int best = 0;
-    for (int c = 1; c < 300; ++c)
-      if (m(q, c) < m(q, best)) best = c;
-    float rival = std::numeric_limits<float>::infinity();
-    for (int c = 0; c < 300; ++c)
-      if (std::abs(c - best) > 10) rival = std::min(rival, m(q, c));
-    accepted += (rival > 0 ? m(q, best) / rival : 1.0f) <= 0.9f;
-  }
+  const int accepted = AcceptedByRatio(m, 300, 300, 10, 0.9f);
   EXPECT_NE(o.out.find("accepted: " + std::to_string(accepted) + " of 300 best matches"),
             std::string::npos)
       << o.out;

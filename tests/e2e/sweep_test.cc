@@ -42,6 +42,15 @@ std::string SweepRunJson(const std::string& json, const std::string& settings) {
   return json.substr(p, json.find('}', end) - p);
 }
 
+// `key`'s figure of each run of the sweep JSON, in the order the runs are listed (best first).
+std::vector<double> RankedFigures(const std::string& json, const std::string& key) {
+  std::vector<double> out;
+  for (std::size_t p = json.find("\"rank\": "); p != std::string::npos;
+       p = json.find("\"rank\": ", p + 1))
+    out.push_back(JsonNumber(json, key, p));
+  return out;
+}
+
 TEST(Sweep, FiguresEqualTheSingleRunsAndAreRanked) {
   const std::string dir = testing::TempDir();
   const Outcome sweep = RunProgram(
@@ -83,12 +92,9 @@ TEST(Sweep, FiguresEqualTheSingleRunsAndAreRanked) {
   EXPECT_EQ(compared, 8);
 
   // Ranked by AUC, best first, ranks 1..8 in order; the CSV has the same rows.
-  std::vector<double> aucs;
-  for (std::size_t p = json.find("\"rank\": "); p != std::string::npos;
-       p = json.find("\"rank\": ", p + 1)) {
-    EXPECT_EQ(JsonNumber(json, "rank", p), static_cast<double>(aucs.size() + 1));
-    aucs.push_back(JsonNumber(json, "auc", p));
-  }
+  const std::vector<double> ranks = RankedFigures(json, "rank");
+  for (std::size_t i = 0; i < ranks.size(); ++i) EXPECT_EQ(ranks[i], static_cast<double>(i + 1));
+  const std::vector<double> aucs = RankedFigures(json, "auc");
   ASSERT_EQ(aucs.size(), 8u);
   EXPECT_TRUE(std::is_sorted(aucs.rbegin(), aucs.rend()));
   std::istringstream csv(ReadAll(dir + "/out/sweep.csv"));
@@ -99,7 +105,7 @@ TEST(Sweep, FiguresEqualTheSingleRunsAndAreRanked) {
       << line;
   while (std::getline(csv, line)) ++rows;
   EXPECT_EQ(rows, 8);
-  // The table on stdout names the best run first.
+  // The table on stdout says what it is ranked by.
   EXPECT_NE(sweep.out.find("ranked by AUC"), std::string::npos) << sweep.out;
 }
 
@@ -112,10 +118,7 @@ TEST(Sweep, RanksByTheChosenFigure) {
       dir);
   ASSERT_EQ(sweep.status, 0) << sweep.err;
   const std::string json = ReadAll(dir + "/r.json");
-  std::vector<double> r1;
-  for (std::size_t p = json.find("\"rank\": "); p != std::string::npos;
-       p = json.find("\"rank\": ", p + 1))
-    r1.push_back(JsonNumber(json, "recall_at_1", p));
+  const std::vector<double> r1 = RankedFigures(json, "recall_at_1");
   ASSERT_EQ(r1.size(), 3u);
   EXPECT_TRUE(std::is_sorted(r1.rbegin(), r1.rend()));
   EXPECT_EQ(JsonNumber(json, "descriptions"), 1);

@@ -1,5 +1,8 @@
 """openable.sweep against openable_sweep (the same runs, the same figures) and against single
 runs of openable.evaluate on the matrices of Test_OpenABLE, on the bundled sample."""
+import _thread
+import os
+import threading
 import unittest
 
 import openable
@@ -62,6 +65,37 @@ class SweepTest(TempDirTestCase):
         self.assertAlmostEqual(result.runs[0]["auc"], ev.auc, places=6)
         self.assertAlmostEqual(result.runs[0]["recall_at_100p"], ev.recall_at_100p, places=6)
         self.assertAlmostEqual(result.runs[0]["recall_at_1"], ev.recall_at_1, places=6)
+
+    def test_ctrl_c_stops_a_sweep_between_runs(self):
+        # The sweep's own lines ("run 2 of 40") go to stderr: a reader thread presses Ctrl-C
+        # (interrupt_main) when it sees the second run start. KeyboardInterrupt must then end
+        # the call before its last run; counted in runs, not in seconds.
+        read_fd, write_fd = os.pipe()
+        saved = os.dup(2)
+        os.dup2(write_fd, 2)
+        os.close(write_fd)
+        lines = []
+
+        def reader():
+            with os.fdopen(read_fd, "r", errors="replace") as stream:
+                for line in stream:
+                    lines.append(line)
+                    if "run 2 of 40" in line:
+                        _thread.interrupt_main()
+
+        thread = threading.Thread(target=reader)
+        thread.start()
+        try:
+            with self.assertRaises(KeyboardInterrupt):
+                openable.sweep(CONFIG, settings=SETTINGS, quiet=False,
+                               vary={"Image_sequences": list(range(1, 41))})
+        finally:
+            os.dup2(saved, 2)  # closes the pipe's last write end: the reader sees its end
+            os.close(saved)
+            thread.join()
+        started = [line for line in lines if " of 40: " in line]
+        self.assertGreaterEqual(len(started), 2)
+        self.assertLess(len(started), 40)
 
     def test_bad_values_raise_one_line(self):
         with self.assertRaises(openable.InputError) as caught:
