@@ -19,6 +19,7 @@ constexpr const char* kDescription = "Description and matching";
 constexpr const char* kRobustness = "Robustness";
 constexpr const char* kScale = "Scale";
 constexpr const char* kEvaluation = "Evaluation";
+constexpr const char* kVerification = "Verification";
 constexpr const char* kSnaps = "SNAPS";
 constexpr const char* kOdometry = "Odometry";
 
@@ -298,6 +299,55 @@ OptionTable ConfigTable(Config& c) {
   t.Add("Evaluation_label", kEvaluation, c.evaluation, c.evaluation.label,
         "Name of this run in the figure's legend and the JSON; empty: descriptor and L, e.g. "
         "\"LDB L=10\".");
+  // Verification
+  t.Add("Verification", kVerification, c.verification, c.verification.enabled,
+        "1: check each query's Verification_candidates best candidates geometrically (local "
+        "features, ratio test, RANSAC fundamental or essential matrix, homography fallback) and "
+        "by temporal consistency; the run's answer for a query is its best-ranked verified "
+        "candidate, and a query without one has no answer (docs/verification.md). The frames "
+        "of the candidates are read again: image folders and stereo pairs, not videos.");
+  t.AddEnumName("Verification_features", kVerification, c.verification,
+        c.verification.features,
+        "Local features of the verification: ORB (binary, fast) or SIFT (slower, more "
+        "matches across seasons and light); OpenCV's implementations.");
+  t.Add("Verification_max_features", kVerification, c.verification,
+        c.verification.max_features, 10, 100000,
+        "Features kept per frame (the strongest).");
+  t.Add("Verification_ratio", kVerification, c.verification, c.verification.ratio, 0.1, 1,
+        "Lowe's ratio test: a feature match is kept when its distance is below this fraction of"
+        " the second nearest's.");
+  t.Add("Verification_min_inliers", kVerification, c.verification, c.verification.min_inliers,
+        5, 100000,
+        "A candidate is verified when its geometric model has at least this many inliers.");
+  t.Add("Verification_ransac_threshold", kVerification, c.verification,
+        c.verification.ransac_threshold, 0.1, 100,
+        "RANSAC: pixels between a point and its epipolar line (or its homography image) for "
+        "the point to be an inlier.");
+  t.Add("Verification_candidates", kVerification, c.verification, c.verification.candidates,
+        1, 100,
+        "k: candidates checked per query, the k best at distinct places (each more than "
+        "Match_score_window frames from the others), in order of distance.");
+  t.Add("Verification_consistency", kVerification, c.verification,
+        c.verification.consistency, 0, kNoLimit,
+        "n: a verified candidate is accepted only when the n previous queries also had verified "
+        "candidates at references within Tolerance frames of it (DLoopDetector's temporal "
+        "consistency); 0: off.");
+  t.Add("Verification_calibration", kVerification, c.verification, c.verification.calibration,
+        "Camera intrinsics of the frames: a KITTI calib.txt (P0) or an OpenCV YAML stereo "
+        "calibration (ML). Given: the essential matrix is estimated instead of the fundamental "
+        "matrix. Empty: uncalibrated.");
+  t.Add("Verification_calibration_scale", kVerification, c.verification,
+        c.verification.calibration_scale, 0.01, 10,
+        "Multiplies the calibration's focal lengths and principal point (0.5 for frames at half "
+        "the calibrated size).");
+  t.Add("Verification_cache", kVerification, c.verification, c.verification.cache_mb, 1,
+        kNoLimit,
+        "MB of frame features kept in memory; beyond, the least recently used are dropped and "
+        "computed again when needed (the report counts it).");
+  t.Add("Loops_name", kVerification, c.output, c.output.loops_name,
+        "Verification: CSV of every candidate checked (query, reference, rank, distance, score, "
+        "matches, inliers, model, geometric, streak, verified); frame numbers count from the "
+        "start of their traversal. Empty: not written.");
   // SNAPS
   t.Add("Snaps_trajectory", kSnaps, c.snaps, c.snaps.trajectory,
         "openable_snaps: the drifting trajectory to correct (visual odometry), in "

@@ -12,6 +12,7 @@
 #include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/odometry/options.h"
 #include "OpenABLE/snaps/options.h"
+#include "OpenABLE/verification/verification.h"
 #include "config/option_table.h"
 #include "config/run_options.h"
 #include "descriptors/descriptor.h"
@@ -31,6 +32,7 @@ struct Config {
                                     // Threshold, Threads
   ScaleOptions scale;               // Scale
   EvaluationConfig evaluation;      // Evaluation
+  VerificationOptions verification;  // Verification
   snaps::SnapsOptions snaps;        // SNAPS (openable_snaps)
   odometry::OdometryOptions odometry;  // Odometry and Snaps_odometry (openable_snaps)
 

@@ -52,6 +52,7 @@ struct OutputOptions {
   std::string npy_name;            // M' as float32 .npy; empty: not written
   std::string png_name;            // M' as a colour image; empty: not written
   std::string png_threshold_name;  // M'' as an image; empty: Png_name + "_thresholded"
+  std::string loops_name;          // verification: every candidate checked, CSV; empty: none
   int matrix_color = 0;            // colour map, 0..11 (docs/output_formats.md)
   bool show_images = false;        // show each frame while it is described
 

@@ -1,6 +1,8 @@
 #include "matching/score.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <cstdlib>
 
 namespace openable {
@@ -38,6 +40,26 @@ float ScoreOfCandidate(const std::vector<std::pair<float, int>>& candidates, std
   for (const auto& [d, f] : candidates)
     if (std::abs(f - frame) > window && d < rival) rival = d;
   return Ratio(distance, rival);
+}
+
+std::vector<std::size_t> DistinctBest(const std::vector<std::pair<float, int>>& candidates,
+                                      int k, int window) {
+  std::vector<std::size_t> order;
+  order.reserve(candidates.size());
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+    if (std::isfinite(candidates[i].first)) order.push_back(i);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return candidates[a] < candidates[b];  // distance, then frame
+  });
+  std::vector<std::size_t> taken;
+  for (const std::size_t i : order) {
+    if (static_cast<int>(taken.size()) >= k) break;
+    bool near = false;
+    for (const std::size_t t : taken)
+      near = near || std::abs(candidates[t].second - candidates[i].second) <= window;
+    if (!near) taken.push_back(i);
+  }
+  return taken;
 }
 
 }  // namespace openable

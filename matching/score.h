@@ -40,4 +40,13 @@ float ScoreOfCandidate(const std::vector<std::pair<float, int>>& candidates, std
 // when no distance is finite.
 int BestCandidate(const float* distances, int count);
 
+// The k best candidates at distinct places, for a check that looks at several candidates of a
+// query (geometric verification): candidates in increasing order of distance (ties: the lower
+// frame first), each taken unless it lies within +-`window` frames of one already taken (the
+// frames next to a candidate show the same place). Returns indices into `candidates`, best
+// first; non-finite distances are never taken. The first is the query's best match
+// (BestCandidate on a dense row).
+std::vector<std::size_t> DistinctBest(const std::vector<std::pair<float, int>>& candidates,
+                                      int k, int window);
+
 }  // namespace openable

@@ -20,7 +20,7 @@ set(OPENABLE_INSTALL_MODULEDIR "${CMAKE_INSTALL_LIBDIR}/openable")
 set(OPENABLE_EXPORTED_LIBRARIES
   openable_base openable_io openable_descriptors openable_matching openable_config
   openable_evaluation openable_stereo openable_image openable_run OpenABLE
-  openable_snaps_core openable_snaps_chain openable_odometry)
+  openable_snaps_core openable_snaps_chain openable_odometry openable_verification)
 install(TARGETS ${OPENABLE_EXPORTED_LIBRARIES}
   EXPORT OpenABLETargets
   ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}"

@@ -58,94 +58,53 @@ double F1(double precision, double recall) {
 constexpr int kRecallAtN[] = {1, 5, 10};
 constexpr int kMaxN = 10;
 
-}  // namespace
-
-double CurveArea(const std::vector<CurvePoint>& curve) {
-  double area = 0, previous = 0;
-  for (const CurvePoint& p : curve) {
-    area += p.precision * (p.recall - previous);
-    previous = p.recall;
+// Whether a right answer is among the first 1, 5 and 10 of `count` answers in rank order
+// (column_of(n): the n-th answer's column), against the true columns `t`.
+template <typename ColumnOf>
+std::array<std::uint8_t, 3> HitsAtN(const std::vector<int>& t, int count, ColumnOf column_of,
+                                    int tolerance) {
+  std::array<std::uint8_t, 3> out = {0, 0, 0};
+  bool hit = false;
+  int k = 0;
+  for (int n = 0; n < count && n < kMaxN; ++n) {
+    hit = hit || NearTruth(t, column_of(n), tolerance);
+    while (k < 3 && n + 1 == kRecallAtN[k]) out[k++] = hit ? 1 : 0;
   }
-  return area;
+  for (; k < 3; ++k) out[k] = hit ? 1 : 0;  // fewer answers than N
+  return out;
 }
 
-void EvaluationOptions::Check() const {
-  if (tolerance < 0)
-    throw InputError("Tolerance: " + std::to_string(tolerance) +
-                     " is negative; expected a number of frames >= 0");
-  if (exclusion < 1)
-    throw InputError(
-        "Exclusion: " + std::to_string(exclusion) +
-        " is too small; expected a number of frames >= 1 (a frame is not its own loop)");
-  if (vicinity < 0)
-    throw InputError("Vicinity: " + std::to_string(vicinity) +
-                     " is negative; expected a number of frames >= 0");
-  if (able_thresholds < 2)
-    throw std::logic_error("EvaluationOptions: able_thresholds must be >= 2");
-  if (score_window < 0)
-    throw InputError("Match_score_window: " + std::to_string(score_window) +
-                     " is negative; expected a number of frames >= 0");
+// The ground truth of query q among its candidates (`t`), its true pairs outside them, and
+// whether it has candidates and is positive. False when it has no candidate.
+bool BeginQuery(const EvaluationLayout& layout, const GroundTruth& truth,
+                const EvaluationOptions& options, int q, PerQueryResult& r,
+                std::vector<std::uint8_t>& has_candidates, std::vector<std::int64_t>& outside,
+                std::vector<int>& t) {
+  const int end = CandidateEnd(layout, q, options.exclusion);
+  t = CandidateTruth(truth.matches[q], end);
+  outside[q] = static_cast<std::int64_t>(truth.matches[q].size() - t.size());
+  if (end == 0) return false;
+  has_candidates[q] = 1;
+  r.positive[q] = t.empty() ? 0 : 1;
+  return true;
 }
 
-PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout& layout,
-                                const GroundTruth& truth, const EvaluationOptions& options) {
-  CheckShapes(matrix, layout, truth);
-  const int nq = layout.queries;
-  PerQueryResult r;
+// Every query without an answer yet.
+void NoAnswers(PerQueryResult& r, int nq) {
   r.best.assign(nq, -1);
   r.best_distance.assign(nq, std::numeric_limits<float>::infinity());
   r.score.assign(nq, std::numeric_limits<float>::infinity());
   r.positive.assign(nq, 0);
-  if (options.score == MatchScore::kRatio && options.score_window >= layout.references)
-    throw InputError("Match_score_window: " + std::to_string(options.score_window) +
-                     " frames is not smaller than the " + std::to_string(layout.references) +
-                     " frames of the reference traversal; expected a smaller window (no rival "
-                     "would remain outside it)");
-  std::vector<std::uint8_t> has_candidates(nq, 0);
   r.correct.assign(nq, 0);
-  std::vector<std::array<std::uint8_t, 3>> correct_at_n(nq, {0, 0, 0});
-  std::vector<std::int64_t> outside(nq, 0);
+}
 
-  // Each query row is independent: best candidate, its correctness, and the N best for R@N.
-  cv::parallel_for_(cv::Range(0, nq), [&](const cv::Range& range) {
-    std::vector<std::pair<float, int>> top;  // up to kMaxN best (distance, column), sorted
-    for (int q = range.start; q < range.end; ++q) {
-      const int end = CandidateEnd(layout, q, options.exclusion);
-      const std::vector<int> t = CandidateTruth(truth.matches[q], end);
-      outside[q] = static_cast<std::int64_t>(truth.matches[q].size() - t.size());
-      if (end == 0) continue;
-      has_candidates[q] = 1;
-      r.positive[q] = t.empty() ? 0 : 1;
-      const float* row = matrix.ptr<float>(layout.row_offset + q) + layout.col_offset;
-      top.clear();
-      for (int c = 0; c < end; ++c) {
-        const float v = row[c];
-        if (!std::isfinite(v)) continue;  // a skipped sequence cell is no candidate
-        // Strictly smaller than the worst kept: ties keep the lower column.
-        if (static_cast<int>(top.size()) < kMaxN || v < top.back().first) {
-          auto pos =
-              std::upper_bound(top.begin(), top.end(), v,
-                               [](float x, const std::pair<float, int>& e) { return x < e.first; });
-          top.insert(pos, {v, c});
-          if (static_cast<int>(top.size()) > kMaxN) top.pop_back();
-        }
-      }
-      if (top.empty()) continue;  // no finite candidate: no answer
-      r.best[q] = top.front().second;
-      r.best_distance[q] = top.front().first;
-      r.score[q] = ScoreOfCandidate(row, end, r.best[q], options.score, options.score_window);
-      if (t.empty()) continue;
-      r.correct[q] = NearTruth(t, r.best[q], options.tolerance) ? 1 : 0;
-      bool hit = false;
-      int k = 0;
-      for (int n = 0; n < static_cast<int>(top.size()) && n < kMaxN; ++n) {
-        hit = hit || NearTruth(t, top[n].second, options.tolerance);
-        while (k < 3 && n + 1 == kRecallAtN[k]) correct_at_n[q][k++] = hit ? 1 : 0;
-      }
-      for (; k < 3; ++k) correct_at_n[q][k] = hit ? 1 : 0;  // fewer candidates than N
-    }
-  });
-
+// The figures of the per-query protocol from each query's answer (r.best, r.score,
+// r.correct, r.positive), whether it has candidates, its hits among the N best and its true
+// pairs outside the candidates.
+void Summarize(PerQueryResult& r, const std::vector<std::uint8_t>& has_candidates,
+               const std::vector<std::array<std::uint8_t, 3>>& correct_at_n,
+               const std::vector<std::int64_t>& outside, const EvaluationOptions& options) {
+  const int nq = static_cast<int>(has_candidates.size());
   std::vector<int> order;
   std::array<int, 3> hits_at_n = {0, 0, 0};
   for (int q = 0; q < nq; ++q) {
@@ -209,6 +168,118 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
       r.max_f1_recall = p.recall;
     }
   }
+}
+
+}  // namespace
+
+double CurveArea(const std::vector<CurvePoint>& curve) {
+  double area = 0, previous = 0;
+  for (const CurvePoint& p : curve) {
+    area += p.precision * (p.recall - previous);
+    previous = p.recall;
+  }
+  return area;
+}
+
+void EvaluationOptions::Check() const {
+  if (tolerance < 0)
+    throw InputError("Tolerance: " + std::to_string(tolerance) +
+                     " is negative; expected a number of frames >= 0");
+  if (exclusion < 1)
+    throw InputError(
+        "Exclusion: " + std::to_string(exclusion) +
+        " is too small; expected a number of frames >= 1 (a frame is not its own loop)");
+  if (vicinity < 0)
+    throw InputError("Vicinity: " + std::to_string(vicinity) +
+                     " is negative; expected a number of frames >= 0");
+  if (able_thresholds < 2)
+    throw std::logic_error("EvaluationOptions: able_thresholds must be >= 2");
+  if (score_window < 0)
+    throw InputError("Match_score_window: " + std::to_string(score_window) +
+                     " is negative; expected a number of frames >= 0");
+}
+
+PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                                const GroundTruth& truth, const EvaluationOptions& options) {
+  CheckShapes(matrix, layout, truth);
+  const int nq = layout.queries;
+  PerQueryResult r;
+  NoAnswers(r, nq);
+  if (options.score == MatchScore::kRatio && options.score_window >= layout.references)
+    throw InputError("Match_score_window: " + std::to_string(options.score_window) +
+                     " frames is not smaller than the " + std::to_string(layout.references) +
+                     " frames of the reference traversal; expected a smaller window (no rival "
+                     "would remain outside it)");
+  std::vector<std::uint8_t> has_candidates(nq, 0);
+  std::vector<std::array<std::uint8_t, 3>> correct_at_n(nq, {0, 0, 0});
+  std::vector<std::int64_t> outside(nq, 0);
+
+  // Each query row is independent: best candidate, its correctness, and the N best for R@N.
+  cv::parallel_for_(cv::Range(0, nq), [&](const cv::Range& range) {
+    std::vector<std::pair<float, int>> top;  // up to kMaxN best (distance, column), sorted
+    std::vector<int> t;
+    for (int q = range.start; q < range.end; ++q) {
+      if (!BeginQuery(layout, truth, options, q, r, has_candidates, outside, t)) continue;
+      const int end = CandidateEnd(layout, q, options.exclusion);
+      const float* row = matrix.ptr<float>(layout.row_offset + q) + layout.col_offset;
+      top.clear();
+      for (int c = 0; c < end; ++c) {
+        const float v = row[c];
+        if (!std::isfinite(v)) continue;  // a skipped sequence cell is no candidate
+        // Strictly smaller than the worst kept: ties keep the lower column.
+        if (static_cast<int>(top.size()) < kMaxN || v < top.back().first) {
+          auto pos =
+              std::upper_bound(top.begin(), top.end(), v,
+                               [](float x, const std::pair<float, int>& e) { return x < e.first; });
+          top.insert(pos, {v, c});
+          if (static_cast<int>(top.size()) > kMaxN) top.pop_back();
+        }
+      }
+      if (top.empty()) continue;  // no finite candidate: no answer
+      r.best[q] = top.front().second;
+      r.best_distance[q] = top.front().first;
+      r.score[q] = ScoreOfCandidate(row, end, r.best[q], options.score, options.score_window);
+      if (t.empty()) continue;
+      r.correct[q] = NearTruth(t, r.best[q], options.tolerance) ? 1 : 0;
+      correct_at_n[q] = HitsAtN(
+          t, static_cast<int>(top.size()), [&](int n) { return top[n].second; },
+          options.tolerance);
+    }
+  });
+
+  Summarize(r, has_candidates, correct_at_n, outside, options);
+  return r;
+}
+
+PerQueryResult EvaluateAnswers(const EvaluationLayout& layout, const GroundTruth& truth,
+                               const std::vector<std::vector<Answer>>& answers,
+                               const EvaluationOptions& options) {
+  const int nq = layout.queries;
+  if (static_cast<int>(answers.size()) != nq || static_cast<int>(truth.matches.size()) != nq)
+    throw std::logic_error("EvaluateAnswers: one answer list and one truth row per query");
+  PerQueryResult r;
+  NoAnswers(r, nq);
+  std::vector<std::uint8_t> has_candidates(nq, 0);
+  std::vector<std::array<std::uint8_t, 3>> correct_at_n(nq, {0, 0, 0});
+  std::vector<std::int64_t> outside(nq, 0);
+  std::vector<int> t;
+  for (int q = 0; q < nq; ++q) {
+    if (!BeginQuery(layout, truth, options, q, r, has_candidates, outside, t)) continue;
+    const int end = CandidateEnd(layout, q, options.exclusion);
+    const std::vector<Answer>& a = answers[q];
+    if (a.empty()) continue;  // no accepted candidate: no answer
+    for (const Answer& x : a)
+      if (x.column < 0 || x.column >= end)
+        throw std::logic_error("EvaluateAnswers: an answer outside the query's candidates");
+    r.best[q] = a.front().column;
+    r.best_distance[q] = a.front().distance;
+    r.score[q] = a.front().score;
+    if (t.empty()) continue;
+    r.correct[q] = NearTruth(t, r.best[q], options.tolerance) ? 1 : 0;
+    correct_at_n[q] = HitsAtN(
+        t, static_cast<int>(a.size()), [&](int n) { return a[n].column; }, options.tolerance);
+  }
+  Summarize(r, has_candidates, correct_at_n, outside, options);
   return r;
 }
 

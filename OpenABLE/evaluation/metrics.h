@@ -90,6 +90,22 @@ double CurveArea(const std::vector<CurvePoint>& curve);
 // Precondition (std::logic_error): the layout fits the matrix and the ground truth the layout.
 PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                                 const GroundTruth& truth, const EvaluationOptions& options);
+// One accepted answer of a query (geometric verification): a candidate column of the block,
+// its normalised distance and its score.
+struct Answer {
+  int column = -1;
+  float distance = 0;
+  float score = 0;
+};
+
+// The per-query protocol over answers chosen elsewhere: answers[q] lists query q's accepted
+// candidates, best first (empty: no answer, a miss when q is positive). The query's answer is
+// the first; R@N counts the first N. Queries, positives and the curve are as EvaluatePerQuery's
+// (the curve sweeps the answers' scores); `unanswered` counts the candidate queries without
+// an answer.
+PerQueryResult EvaluateAnswers(const EvaluationLayout& layout, const GroundTruth& truth,
+                               const std::vector<std::vector<Answer>>& answers,
+                               const EvaluationOptions& options);
 AblePResult EvaluateAbleP(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                           const GroundTruth& truth, const EvaluationOptions& options);
 

@@ -204,6 +204,7 @@ constexpr int kLegendLine = 30;      // height of one line of the legend strip
 const cv::Vec3b kTruthTint(255, 128, 0);
 const cv::Vec3b kCorrect(0, 200, 0);
 const cv::Vec3b kWrong(0, 0, 230);
+const cv::Vec3b kRejected(220, 0, 220);  // magenta: apart from green, red and the blue tint
 
 // Grey level of a normalised value: 255 v rounded, clamped to [0, 255]; NaN is white.
 inline std::uint8_t Grey(float v) {
@@ -213,7 +214,7 @@ inline std::uint8_t Grey(float v) {
 }
 
 // The legend strip: swatches and texts, flowing onto further lines when `width` is too small.
-cv::Mat3b OverlayLegend(int width) {
+cv::Mat3b OverlayLegend(int width, bool verification) {
   struct Item {
     std::string text;
     bool swatch;
@@ -221,16 +222,18 @@ cv::Mat3b OverlayLegend(int width) {
   };
   const std::vector<Item> items = {
       {"ground truth", true, cv::Vec3b(192, 128, 64)},  // the tint over mid grey
-      {"accepted, correct", true, kCorrect},
-      {"accepted, wrong", true, kWrong},
-      {"rows: queries, columns: references", false, cv::Vec3b()},
+      {verification ? "verified, correct" : "accepted, correct", true, kCorrect},
+      {verification ? "verified, wrong" : "accepted, wrong", true, kWrong},
   };
+  std::vector<Item> all = items;
+  if (verification) all.push_back({"rejected by verification", true, kRejected});
+  all.push_back({"rows: queries, columns: references", false, cv::Vec3b()});
   const double scale = 0.5;
   const int swatch = 14, swatch_gap = 6, item_gap = 22, margin = 10;
   // Lay out: positions (line, x) for each item.
   std::vector<std::pair<int, int>> where;
   int line = 0, x = margin;
-  for (const Item& item : items) {
+  for (const Item& item : all) {
     const int w =
         (item.swatch ? swatch + swatch_gap : 0) + TextSize(item.text, scale, 1).width;
     if (x > margin && x + w > width - margin) {
@@ -242,17 +245,17 @@ cv::Mat3b OverlayLegend(int width) {
   }
   cv::Mat3b strip((line + 1) * kLegendLine, width, cv::Vec3b(255, 255, 255));
   const int text_height = TextSize("Ag", scale, 1).height;
-  for (std::size_t i = 0; i < items.size(); ++i) {
+  for (std::size_t i = 0; i < all.size(); ++i) {
     const int top = where[i].first * kLegendLine;
     int left = where[i].second;
     const int mid = top + kLegendLine / 2;
-    if (items[i].swatch) {
+    if (all[i].swatch) {
       const cv::Rect r(left, mid - swatch / 2, swatch, swatch);
-      cv::rectangle(strip, r, cv::Scalar(items[i].colour), cv::FILLED);
+      cv::rectangle(strip, r, cv::Scalar(all[i].colour), cv::FILLED);
       cv::rectangle(strip, r, cv::Scalar(90, 90, 90), 1);
       left += swatch + swatch_gap;
     }
-    PutText(strip, items[i].text, {left, mid + text_height / 2}, scale, 1, kBlack);
+    PutText(strip, all[i].text, {left, mid + text_height / 2}, scale, 1, kBlack);
   }
   return strip;
 }
@@ -261,7 +264,7 @@ cv::Mat3b OverlayLegend(int width) {
 
 cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                         const GroundTruth& truth, const PerQueryResult& result,
-                        double accept_threshold) {
+                        double accept_threshold, const std::vector<cv::Point>* rejected) {
   const int rows = layout.queries, cols = layout.references;
   if (rows <= 0 || cols <= 0 || layout.row_offset < 0 || layout.col_offset < 0 ||
       layout.row_offset + rows > matrix.rows || layout.col_offset + cols > matrix.cols) {
@@ -298,7 +301,7 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
   // Nearest-neighbour enlargement by an integer factor.
   const int k = std::max(1, (kOverlayTarget + std::max(rows, cols) - 1) / std::max(rows, cols));
   const int image_w = cols * k, image_h = rows * k;
-  const cv::Mat3b legend = OverlayLegend(std::max(image_w, kOverlayTarget));
+  const cv::Mat3b legend = OverlayLegend(std::max(image_w, kOverlayTarget), rejected != nullptr);
   cv::Mat3b img(image_h + legend.rows, legend.cols, cv::Vec3b(255, 255, 255));
   if (k == 1) {
     cells.copyTo(img(cv::Rect(0, 0, cols, rows)));
@@ -316,6 +319,13 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
   int grow = k >= 3 ? 0 : 1;
   if (k == 1) grow = std::max(grow, std::max(rows, cols) / 1200);
   const cv::Rect image_area(0, 0, image_w, image_h);
+  if (rejected != nullptr)  // first, so that an answer at the same cell stays visible
+    for (const cv::Point& cell : *rejected) {
+      if (cell.x < 0 || cell.x >= cols || cell.y < 0 || cell.y >= rows) continue;
+      img(cv::Rect(cell.x * k - grow, cell.y * k - grow, k + 2 * grow, k + 2 * grow) &
+          image_area)
+          .setTo(kRejected);
+    }
   const int marked = std::min(
       rows, static_cast<int>(
                 std::min({result.best.size(), result.score.size(), result.correct.size()})));

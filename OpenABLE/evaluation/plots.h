@@ -34,9 +34,12 @@ cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& t
 // threshold: green when correct, red when wrong. Queries are rows, references columns. Small
 // blocks are enlarged by an integer factor (nearest neighbour) to at least 600 pixels on the
 // longer side; marks are at least 3 x 3 output pixels. A legend strip below the image names the
-// colours.
+// colours. With `rejected` (geometric verification: cells (x = reference column, y = query row)
+// of candidates that verification rejected), those are marked in magenta under the answers,
+// and the answers are labelled "verified".
 cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                         const GroundTruth& truth, const PerQueryResult& result,
-                        double accept_threshold);
+                        double accept_threshold,
+                        const std::vector<cv::Point>* rejected = nullptr);
 
 }  // namespace openable

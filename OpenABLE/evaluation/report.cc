@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "OpenABLE/base/strings.h"
+
 namespace openable {
 namespace {
 
@@ -77,20 +79,12 @@ std::string EncodeEvaluationSettingsJson(const EvaluationSettings& s, const std:
   return o.str();
 }
 
-std::string EncodeEvaluatedRunFieldsJson(const EvaluatedRun& r, const std::string& indent) {
-  const PerQueryResult& q = r.per_query;
-  const std::string& in = indent;
+namespace {
+
+// The members of a "per_query" object, each line indented by `in`.
+std::string PerQueryJson(const PerQueryResult& q, const std::string& in) {
   std::ostringstream o;
-  o << in << "\"label\": " << JsonString(r.label) << ",\n"
-    << in << "\"source\": " << JsonString(r.source) << ",\n"
-    << in << "\"layout\": {\"kind\": " << JsonString(KindName(r.layout.kind))
-    << ", \"queries\": " << r.layout.queries << ", \"references\": " << r.layout.references
-    << ", \"row_offset\": " << r.layout.row_offset << ", \"col_offset\": " << r.layout.col_offset
-    << "},\n"
-    << in << "\"ground_truth\": {\"pairs\": " << r.truth_pairs << ", \"dropped\": "
-    << r.truth_dropped << "},\n"
-    << in << "\"per_query\": {\n"
-    << in << "  \"auc\": " << Number(q.auc) << ",\n"
+  o << in << "  \"auc\": " << Number(q.auc) << ",\n"
     << in << "  \"recall_at_100p\": " << Number(q.recall_at_100p) << ",\n"
     << in << "  \"max_f1\": " << Number(q.max_f1) << ",\n"
     << in << "  \"max_f1_threshold\": " << Number(q.max_f1_threshold) << ",\n"
@@ -109,9 +103,30 @@ std::string EncodeEvaluatedRunFieldsJson(const EvaluatedRun& r, const std::strin
                   ", \"precision\": " + Number(q.operating_point.precision) +
                   ", \"recall\": " + Number(q.operating_point.recall) + "},\n"
             : std::string())
-    << in << "  \"truth_pairs_outside_candidates\": " << q.truth_pairs_outside_candidates << "\n"
-    << in << "},\n"
-    << in << "\"able_p\": {\n"
+    << in << "  \"truth_pairs_outside_candidates\": " << q.truth_pairs_outside_candidates
+    << "\n";
+  return o.str();
+}
+
+}  // namespace
+
+std::string EncodeEvaluatedRunFieldsJson(const EvaluatedRun& r, const std::string& indent) {
+  const std::string& in = indent;
+  std::ostringstream o;
+  o << in << "\"label\": " << JsonString(r.label) << ",\n"
+    << in << "\"source\": " << JsonString(r.source) << ",\n"
+    << in << "\"layout\": {\"kind\": " << JsonString(KindName(r.layout.kind))
+    << ", \"queries\": " << r.layout.queries << ", \"references\": " << r.layout.references
+    << ", \"row_offset\": " << r.layout.row_offset << ", \"col_offset\": " << r.layout.col_offset
+    << "},\n"
+    << in << "\"ground_truth\": {\"pairs\": " << r.truth_pairs << ", \"dropped\": "
+    << r.truth_dropped << "},\n"
+    << in << "\"verified\": " << (r.verified ? "true" : "false") << ",\n"
+    << in << "\"per_query\": {\n" << PerQueryJson(r.per_query, in) << in << "},\n";
+  if (r.verified)
+    o << in << "\"per_query_unverified\": {\n" << PerQueryJson(r.per_query_unverified, in)
+      << in << "},\n";
+  o << in << "\"able_p\": {\n"
     << in << "  \"average_precision_percent\": " << Number(r.able_p.average_precision) << ",\n"
     << in << "  \"candidate_cells\": " << r.able_p.candidate_cells << ",\n"
     << in << "  \"truth_cells\": " << r.able_p.truth_cells << "\n"
@@ -149,30 +164,43 @@ std::string FormatEvaluationTable(const EvaluationSettings& s,
                 "ABLE AP");
   o << line;
   for (const EvaluatedRun& r : runs) {
-    const PerQueryResult& q = r.per_query;
-    char f1[32];
-    std::snprintf(f1, sizeof f1, "%.3f (%.3f)", q.max_f1, q.max_f1_threshold);
-    std::snprintf(line, sizeof line,
-                  "  %-18s %7d %7d %7.3f %7.3f %16s %6.3f %6.3f %6.3f %7.1f%%\n",
-                  r.label.substr(0, 18).c_str(), q.queries, q.positive_queries, q.auc,
-                  q.recall_at_100p, f1, q.recall_at_1, q.recall_at_5, q.recall_at_10,
-                  r.able_p.average_precision);
-    o << line;
-    if (q.truth_pairs_outside_candidates > 0)
-      o << "    (" << q.truth_pairs_outside_candidates
-        << " ground-truth pairs are not candidates: inside the exclusion window)\n";
-    if (r.truth_dropped > 0)
-      o << "    (" << r.truth_dropped
-        << " ground-truth pairs dropped: on the diagonal or outside the processed frames)\n";
-    if (q.unanswered > 0)
-      o << "    (" << q.unanswered
-        << " queries have no candidate with a full sequence: no answer, counted as misses)\n";
-    if (q.has_operating_point) {
-      const CurvePoint& p = q.operating_point;
+    // With verification: the matrix's answers first, then the verified ones.
+    const bool both = r.verified;
+    for (int pass = both ? 0 : 1; pass < 2; ++pass) {
+      const PerQueryResult& q = pass == 0 ? r.per_query_unverified : r.per_query;
+      const std::string label = pass == 0 || !both ? r.label.substr(0, 18)
+                                                   : std::string("  + verification");
+      char f1[32];
+      std::snprintf(f1, sizeof f1, "%.3f (%.3f)", q.max_f1, q.max_f1_threshold);
       std::snprintf(line, sizeof line,
-                    "    accepted at score <= %g: %lld answers, precision %.3f, recall %.3f\n",
-                    p.threshold, static_cast<long long>(p.tp + p.fp), p.precision, p.recall);
+                    "  %-18s %7d %7d %7.3f %7.3f %16s %6.3f %6.3f %6.3f %7.1f%%\n",
+                    label.c_str(), q.queries, q.positive_queries, q.auc, q.recall_at_100p, f1,
+                    q.recall_at_1, q.recall_at_5, q.recall_at_10, r.able_p.average_precision);
       o << line;
+      if (pass == 0 || !both) {
+        if (q.truth_pairs_outside_candidates > 0)
+          o << "    (" << q.truth_pairs_outside_candidates
+            << " ground-truth pairs are not candidates: inside the exclusion window)\n";
+        if (r.truth_dropped > 0)
+          o << "    (" << r.truth_dropped
+            << " ground-truth pairs dropped: on the diagonal or outside the processed "
+               "frames)\n";
+      }
+      if (q.unanswered > 0)
+        o << "    (" << q.unanswered
+          << (pass == 1 && both
+                  ? " queries have no verified candidate: no answer, counted as misses)\n"
+                  : " queries have no candidate with a full sequence: no answer, counted as "
+                    "misses)\n");
+      if (q.has_operating_point) {
+        const CurvePoint& p = q.operating_point;
+        const std::string at = std::isfinite(p.threshold)
+                                   ? "accepted at score <= " + FormatNumber(p.threshold)
+                                   : std::string("accepted (every verified answer)");
+        std::snprintf(line, sizeof line, "    %s: %lld answers, precision %.3f, recall %.3f\n",
+                      at.c_str(), static_cast<long long>(p.tp + p.fp), p.precision, p.recall);
+        o << line;
+      }
     }
   }
   return o.str();

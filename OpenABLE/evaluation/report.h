@@ -19,7 +19,12 @@ struct EvaluatedRun {
   EvaluationLayout layout;
   std::int64_t truth_pairs = 0;    // ground-truth pairs loaded over the block
   std::int64_t truth_dropped = 0;  // GroundTruth::dropped
+  // The run's final answers: with verification (`verified`), each query's best-ranked verified
+  // candidate (a query without one has no answer), and per_query_unverified the matrix's best
+  // matches; without verification, per_query holds the matrix's best matches.
+  bool verified = false;
   PerQueryResult per_query;
+  PerQueryResult per_query_unverified;
   AblePResult able_p;
 };
 
@@ -34,10 +39,11 @@ std::string EncodeCurveCsv(const std::vector<CurvePoint>& curve);
 
 // A JSON object: {"openable_version", "settings": {ground truth, tolerance, exclusion, vicinity,
 // match_score, match_score_window, able_thresholds}, "runs": [{"label", "source",
-// "layout": {...}, "ground_truth": {...}, "per_query": {auc, recall_at_100p, max_f1,
+// "layout": {...}, "ground_truth": {...}, "verified", "per_query": {auc, recall_at_100p, max_f1,
 // max_f1_threshold, max_f1_precision, max_f1_recall, recall_at_1, recall_at_5, recall_at_10,
 // queries, positive_queries, unanswered_queries, accepted (at Match_threshold, when set),
-// truth_pairs_outside_candidates}, "able_p": {average_precision_percent, candidate_cells,
+// truth_pairs_outside_candidates}, "per_query_unverified" (the same, when verified),
+// "able_p": {average_precision_percent, candidate_cells,
 // truth_cells}}]}. Numbers with 9 significant digits (docs/output_formats.md).
 std::string EncodeEvaluationJson(const EvaluationSettings& settings,
                                  const std::vector<EvaluatedRun>& runs, const std::string& version);

@@ -77,6 +77,16 @@ void OnlineOptions::Check() const {
   }
   Require(approximate.k >= candidates, "approximate.k", std::to_string(approximate.k),
           ">= candidates (" + std::to_string(candidates) + ")");
+  if (verification.enabled) {
+    try {
+      verification.Check();
+    } catch (const std::exception& e) {
+      throw InputError("OnlineOptions.verification: " + std::string(e.what()));
+    }
+    Require(approximate.k >= verification.candidates, "approximate.k",
+            std::to_string(approximate.k),
+            ">= verification.candidates (" + std::to_string(verification.candidates) + ")");
+  }
 }
 
 Describer MakeDescriber(const OnlineOptions& options) {
@@ -160,6 +170,12 @@ struct OnlineDetector::State {
   int width = 0, type = CV_8U;
   double unit = 0;  // binary: bits per row; float: largest single-frame distance so far
   std::unique_ptr<IncrementalIndex> map;  // the rows of every frame, searched (matching/)
+  // Verification: the checker, every frame's features, the previous frame's candidates.
+  std::unique_ptr<PairVerifier> verifier;
+  std::vector<FrameFeatures> features;
+  QueryVerification previous;
+  // The search of a frame whose row is in the map (AddDescriptor without the checks).
+  OnlineResult Search(const cv::Mat& row);
 };
 
 OnlineDetector::OnlineDetector(const OnlineOptions& options) : state_(std::make_unique<State>()) {
@@ -180,6 +196,14 @@ OnlineDetector::OnlineDetector(const OnlineOptions& options) : state_(std::make_
   index.background_merges = options.background_merges;
   index.approximate = options.approximate;
   s.map = std::make_unique<IncrementalIndex>(s.width, s.type, index);
+  if (options.verification.enabled) {
+    std::optional<CameraIntrinsics> camera;
+    if (!options.verification.calibration.empty())
+      camera = ReadVerificationCalibration(options.verification.calibration,
+                                           options.verification.calibration_scale,
+                                           "OnlineOptions.verification.calibration");
+    s.verifier = std::make_unique<PairVerifier>(options.verification, camera);
+  }
 }
 
 OnlineDetector::~OnlineDetector() = default;
@@ -194,17 +218,57 @@ void OnlineDetector::FinishMerges() { state_->map->FinishMerges(); }
 std::int64_t OnlineDetector::MemoryBytes() const { return state_->map->MemoryBytes(); }
 
 OnlineResult OnlineDetector::AddFrame(const cv::Mat& image) {
+  State& s = *state_;
   const auto start = Clock::now();
-  cv::Mat row(1, state_->width, state_->type);
-  DescribeInto(*state_->describer.frame, image, "frame " + std::to_string(Size()), row);
+  cv::Mat row(1, s.width, s.type);
+  const std::string what = "frame " + std::to_string(Size());
+  DescribeInto(*s.describer.frame, image, what, row);
   const double describe = Seconds(start);
-  OnlineResult r = AddDescriptor(row);
+  if (!s.verifier) {
+    OnlineResult r = AddDescriptor(row);
+    r.describe_seconds = describe;
+    return r;
+  }
+  const auto verify_start = Clock::now();
+  s.features.push_back(s.verifier->Extract(GreyOf(image, what)));
+  double verify = Seconds(verify_start);
+  OnlineResult r = s.Search(row);
   r.describe_seconds = describe;
+  // The candidates checked against this frame, then the temporal consistency.
+  const auto check_start = Clock::now();
+  QueryVerification current;
+  current.query = r.frame;
+  for (const LoopCandidate& c : r.candidates) {
+    VerifiedCandidate v;
+    v.reference = c.frame;
+    v.check = s.verifier->Verify(s.features[r.frame], s.features[c.frame]);
+    current.candidates.push_back(v);
+  }
+  ContinueStreaks(s.previous.candidates.empty() ? nullptr : &s.previous, current,
+                  s.options.verification.consistency, s.options.verification.tolerance);
+  for (std::size_t i = 0; i < r.candidates.size(); ++i) {
+    LoopCandidate& c = r.candidates[i];
+    const VerifiedCandidate& v = current.candidates[i];
+    c.matches = v.check.matches;
+    c.inliers = v.check.inliers;
+    c.model = v.check.model;
+    c.geometric = v.check.verified;
+    c.streak = v.streak;
+    c.verified = v.accepted;
+    c.accepted = v.accepted;
+  }
+  s.previous = std::move(current);
+  verify += Seconds(check_start);
+  r.verify_seconds = verify;
   return r;
 }
 
 void OnlineDetector::AddToMap(const cv::Mat& rows) {
   State& s = *state_;
+  if (s.verifier)
+    throw InputError("OnlineDetector::AddToMap: verification is on (OnlineOptions::"
+                     "verification.enabled) and needs each frame's image: add the frames with "
+                     "AddFrame");
   if (rows.empty()) return;
   if (rows.cols != s.width || rows.type() != s.type)
     throw InputError("map rows of " + std::to_string(rows.rows) + "x" + std::to_string(rows.cols) +
@@ -226,6 +290,14 @@ OnlineResult OnlineDetector::AddDescriptor(const cv::Mat& row) {
                      cv::typeToString(s.type) + " (" + s.describer.descriptor->Name() + ")");
   if (s.type == CV_32F && !cv::checkRange(row))
     throw InputError("descriptor row holds a value that is not finite");
+  if (s.verifier)
+    throw InputError("OnlineDetector::AddDescriptor: verification is on (OnlineOptions::"
+                     "verification.enabled) and needs each frame's image: use AddFrame");
+  return s.Search(row);
+}
+
+OnlineResult OnlineDetector::State::Search(const cv::Mat& row) {
+  State& s = *this;
   const auto start = Clock::now();
   s.map->Append(row);
   OnlineResult r;
@@ -241,14 +313,24 @@ OnlineResult OnlineDetector::AddDescriptor(const cv::Mat& row) {
     for (const int j : s.map->Candidates(row, searchable, &r.approximate))
       scored.emplace_back(
           SequenceCellDistance(rows, q, rows, j, s.options.sequence_length, false, largest), j);
-    const size_t k = std::min(scored.size(), static_cast<size_t>(s.options.candidates));
-    std::partial_sort(scored.begin(), scored.begin() + k, scored.end());
-    // The ratio's rivals: every candidate scored, best first (the first k are sorted).
+    // The candidates returned: the k best, or with verification the k best at distinct places
+    // (the choice of Test_OpenABLE's verification, DistinctBest).
+    std::vector<std::size_t> chosen;
+    if (s.verifier) {
+      std::vector<std::pair<float, int>> cells;
+      for (const auto& [d, j] : scored) cells.emplace_back(static_cast<float>(d), j);
+      chosen = DistinctBest(cells, s.options.verification.candidates, s.options.score_window);
+    } else {
+      const size_t k = std::min(scored.size(), static_cast<size_t>(s.options.candidates));
+      std::partial_sort(scored.begin(), scored.begin() + k, scored.end());
+      for (size_t i = 0; i < k; ++i) chosen.push_back(i);
+    }
+    // The ratio's rivals: every candidate scored.
     std::vector<std::pair<float, int>> rivals;
     if (s.options.score == MatchScore::kRatio)
       for (const auto& [d, j] : scored) rivals.emplace_back(static_cast<float>(d), j);
     const double scale = s.options.sequence_length * s.unit;
-    for (size_t i = 0; i < k; ++i) {
+    for (const size_t i : chosen) {
       LoopCandidate c;
       c.frame = scored[i].second;
       c.distance = scored[i].first;

@@ -29,6 +29,7 @@
 #include "matching/distances.h"
 #include "matching/score.h"
 #include "matching/sequence.h"
+#include "OpenABLE/verification/verification.h"
 
 namespace openable {
 
@@ -68,6 +69,15 @@ struct OnlineOptions {
   // builds merges in AddFrame instead, for repeatable results (at the cost of those waits).
   bool background_merges = true;
   ApproximateOptions approximate;  // its k is the per-block candidate count (>= candidates)
+  // Geometric verification and temporal consistency (OpenABLE/verification/verification.h,
+  // the Verification_* keys; verification.tolerance: the frames within which references
+  // count as neighbours for the consistency). When enabled: each frame's local features are
+  // computed in AddFrame and kept (about 20 KB a frame with 500 ORB features); the candidates
+  // of a frame are its verification.candidates best at distinct places (more than
+  // score_window frames apart), each checked against the frame; a candidate is accepted when
+  // it is verified (the threshold is not applied). AddDescriptor and AddToMap, which give no
+  // image, are refused.
+  VerificationOptions verification;
   // Throws InputError naming the field, the value and what was expected.
   void Check() const;
 };
@@ -85,7 +95,16 @@ struct LoopCandidate {
   // OnlineOptions::score: `normalized`, or the ratio of `distance` to the best candidate
   // outside +-score_window frames of this one (1 without one).
   double score = 0;
-  bool accepted = false;  // score <= OnlineOptions::threshold
+  // score <= OnlineOptions::threshold; with verification: `verified`.
+  bool accepted = false;
+  // Verification (OnlineOptions::verification.enabled): feature matches after the ratio test,
+  // inliers of the model kept, the model, whether it reached min_inliers (`geometric`), the
+  // streak of the temporal consistency, and whether the candidate passed both (`verified`).
+  int matches = 0, inliers = 0;
+  GeometricModel model = GeometricModel::kNone;
+  bool geometric = false;
+  int streak = 0;
+  bool verified = false;
 };
 
 struct OnlineResult {
@@ -95,6 +114,7 @@ struct OnlineResult {
   bool approximate = false;                  // the search used the FLANN blocks
   double describe_seconds = 0;               // AddFrame: describing the image
   double search_seconds = 0;                 // searching and bookkeeping (index builds too)
+  double verify_seconds = 0;                 // verification: features of the frame and checks
 };
 
 // Loop candidates frame by frame. Memory: the descriptor rows of every frame (row bytes x

@@ -48,13 +48,27 @@ struct Detector {
   std::mutex mutex;
 };
 
-py::tuple ResultTuple(const OnlineResult& r) {
+py::tuple ResultTuple(const OnlineResult& r, bool verification) {
   py::list candidates;
-  for (const LoopCandidate& c : r.candidates)
-    candidates.append(py::make_tuple(c.frame, c.distance, c.normalized, c.accepted, c.score));
+  for (const LoopCandidate& c : r.candidates) {
+    if (!verification) {
+      candidates.append(py::make_tuple(c.frame, c.distance, c.normalized, c.accepted, c.score));
+      continue;
+    }
+    py::dict v;
+    v["matches"] = c.matches;
+    v["inliers"] = c.inliers;
+    v["model"] = EnumName(c.model);
+    v["geometric"] = c.geometric;
+    v["streak"] = c.streak;
+    v["verified"] = c.verified;
+    candidates.append(
+        py::make_tuple(c.frame, c.distance, c.normalized, c.accepted, c.score, v));
+  }
   py::dict timings;
   timings["describe_seconds"] = r.describe_seconds;
   timings["search_seconds"] = r.search_seconds;
+  if (verification) timings["verify_seconds"] = r.verify_seconds;
   timings["approximate"] = r.approximate;
   return py::make_tuple(r.frame, candidates, timings);
 }
@@ -118,12 +132,16 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
                      "Build merges of two blocks on a background thread (no frame waits for a "
                      "large index build; candidates then depend on when a merge finishes); "
                      "False builds them inside add_frame, for repeatable results.");
-  // The FLANN search (matching/approximate.h), at the top level.
-  const auto flann = [&c](const char* name, auto member, const char* doc) {
-    using T = std::remove_reference_t<decltype(std::declval<ApproximateOptions&>().*member)>;
+  // Members of the nested option structs as top-level properties: the FLANN search
+  // (matching/approximate.h) and the verification (prefix verification_).
+  const auto nested = [&c](const char* name, auto outer, auto member, const char* doc) {
+    using T = std::remove_reference_t<decltype(std::declval<O&>().*outer.*member)>;
     c.def_property(
-        name, [member](const O& o) { return o.approximate.*member; },
-        [member](O& o, T v) { o.approximate.*member = v; }, doc);
+        name, [outer, member](const O& o) { return o.*outer.*member; },
+        [outer, member](O& o, T v) { o.*outer.*member = v; }, doc);
+  };
+  const auto flann = [&nested](const char* name, auto member, const char* doc) {
+    nested(name, &O::approximate, member, doc);
   };
   flann("approximate_k", &ApproximateOptions::k, "FLANN candidates per block (>= candidates).");
   flann("checks", &ApproximateOptions::checks, "k-d trees: references examined per query.");
@@ -133,6 +151,40 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
   flann("kd_trees", &ApproximateOptions::kd_trees, "Randomised k-d trees.");
   flann("threads", &ApproximateOptions::threads, "Threads of a search; 0 = all cores.");
   flann("seed", &ApproximateOptions::seed, "Seed of the index build.");
+  // Geometric verification (OpenABLE/verification/verification.h, the Verification_* keys).
+  const auto verify = [&nested](const char* name, auto member, const char* doc) {
+    nested(name, &O::verification, member, doc);
+  };
+  verify("verification", &VerificationOptions::enabled,
+         "Check each frame's candidates geometrically and by temporal consistency; candidates "
+         "then carry a sixth element, a dict (matches, inliers, model, geometric, streak, "
+         "verified), and accepted means verified. Needs add_frame (images).");
+  c.def_property(
+      "verification_features",
+      [](const O& o) { return EnumName(o.verification.features); },
+      [](O& o, const std::string& v) {
+        o.verification.features = ParseEnum<LocalFeatures>(v, "verification_features");
+      },
+      "Local features: \"ORB\" or \"SIFT\".");
+  verify("verification_max_features", &VerificationOptions::max_features,
+         "Features kept per frame (10..100000).");
+  verify("verification_ratio", &VerificationOptions::ratio, "Lowe's ratio test, [0.1, 1].");
+  verify("verification_min_inliers", &VerificationOptions::min_inliers,
+         "Inliers a candidate needs to be verified (>= 5).");
+  verify("verification_ransac_threshold", &VerificationOptions::ransac_threshold,
+         "RANSAC inlier distance, pixels.");
+  verify("verification_candidates", &VerificationOptions::candidates,
+         "Candidates checked per frame: the best at distinct places (more than score_window "
+         "frames apart).");
+  verify("verification_consistency", &VerificationOptions::consistency,
+         "Previous frames that must also have verified loops nearby (0: off).");
+  verify("verification_tolerance", &VerificationOptions::tolerance,
+         "Frames within which references are neighbours for the consistency.");
+  verify("verification_calibration", &VerificationOptions::calibration,
+         "KITTI calib.txt or OpenCV YAML stereo calibration: the essential matrix; empty: "
+         "the fundamental matrix.");
+  verify("verification_calibration_scale", &VerificationOptions::calibration_scale,
+         "Multiplies the calibration's intrinsics (0.5 for half-size frames).");
   c.def(
        "__getitem__",
        [](const py::object& self, const std::string& name) -> py::object {
@@ -352,7 +404,7 @@ earlier run, which later frames find as candidates like any other frame.)doc")
               std::lock_guard<std::mutex> lock(d.mutex);
               r = d.detector->AddFrame(v.mat);
             }
-            return ResultTuple(r);
+            return ResultTuple(r, d.detector->Options().verification.enabled);
           },
           py::arg("image"),
           R"doc(add_frame(image) -> tuple[int, list[tuple[int, float, float, bool, float]], dict]
@@ -382,7 +434,7 @@ Raises:
               std::lock_guard<std::mutex> lock(d.mutex);
               r = d.detector->AddDescriptor(v.mat);
             }
-            return ResultTuple(r);
+            return ResultTuple(r, d.detector->Options().verification.enabled);
           },
           py::arg("row"),
           R"doc(add_descriptor(row) -> tuple[int, list[tuple[int, float, float, bool, float]], dict]

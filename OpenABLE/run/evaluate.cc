@@ -60,7 +60,7 @@ std::string RunLabel(const Config& config) {
 
 void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
                     const EvaluationLayout& layout, const std::string& label,
-                    const std::string& source) {
+                    const std::string& source, const VerifiedAnswers* verified) {
   GroundTruth truth =
       LoadGroundTruth(evaluation.settings.truth, layout, normalized.rows, normalized.cols);
   EvaluatedRun run;
@@ -70,9 +70,20 @@ void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
   run.truth_pairs = truth.PairCount();
   run.truth_dropped = truth.dropped;
   run.per_query = EvaluatePerQuery(normalized, layout, truth, evaluation.settings.options);
+  if (verified != nullptr) {
+    run.verified = true;
+    run.per_query_unverified = std::move(run.per_query);
+    // The operating point: Match_threshold when set, else every verified answer.
+    EvaluationOptions options = evaluation.settings.options;
+    if (options.accept_threshold < 0)
+      options.accept_threshold = std::numeric_limits<double>::infinity();
+    run.per_query = EvaluateAnswers(layout, truth, verified->accepted, options);
+  }
   run.able_p = EvaluateAbleP(normalized, layout, truth, evaluation.settings.options);
   evaluation.runs.push_back(std::move(run));
   evaluation.truths.push_back(std::move(truth));
+  evaluation.rejected.push_back(verified != nullptr ? verified->rejected
+                                                    : std::vector<cv::Point>());
 }
 
 void StageEvaluation(OutputBatch& batch, const std::string& key, const std::string& prefix,
@@ -103,8 +114,12 @@ void StageEvaluation(OutputBatch& batch, const std::string& key, const std::stri
                                         run.per_query,
                                         run.per_query.has_operating_point
                                             ? run.per_query.operating_point.threshold
-                                            : run.per_query.max_f1_threshold)));
-    series.push_back({run.label, run.per_query.curve, run.able_p.curve});
+                                            : run.per_query.max_f1_threshold,
+                                        run.verified ? &evaluation.rejected[i] : nullptr)));
+    if (run.verified)
+      series.push_back({run.label + " unverified", run.per_query_unverified.curve, {}});
+    series.push_back({run.label + (run.verified ? " verified" : ""), run.per_query.curve,
+                      run.able_p.curve});
   }
   std::string title = "Precision-recall, " + GroundTruthTypeName(s.truth.type) +
                       " ground truth, tolerance +-" + std::to_string(s.options.tolerance);

@@ -22,6 +22,15 @@ struct Evaluation {
   EvaluationSettings settings;
   std::vector<EvaluatedRun> runs;
   std::vector<GroundTruth> truths;  // truths[i] belongs to runs[i]
+  // rejected[i]: cells (x = reference column, y = query row of the block) of the candidates
+  // geometric verification rejected in runs[i]; empty without verification.
+  std::vector<std::vector<cv::Point>> rejected;
+};
+
+// What geometric verification gives the evaluation of a run.
+struct VerifiedAnswers {
+  std::vector<std::vector<Answer>> accepted;  // per query of the layout, best first
+  std::vector<cv::Point> rejected;            // candidates rejected, as Evaluation::rejected
 };
 
 // True when Ground_truth_type is set.
@@ -35,10 +44,13 @@ EvaluationSettings EvaluationSettingsFrom(const Config& config);
 std::string RunLabel(const Config& config);
 
 // Loads the ground truth for `layout` (a block of `normalized`) and evaluates `normalized` with
-// both protocols; appends the result to `evaluation`. Throws InputError on bad ground truth.
+// both protocols; appends the result to `evaluation`. With `verified` (the accepted candidates
+// of geometric verification per query of the layout, best first), the run's
+// per-query figures are those of the verified answers (EvaluateAnswers) and the matrix's best
+// matches go to per_query_unverified. Throws InputError on bad ground truth.
 void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
                     const EvaluationLayout& layout, const std::string& label,
-                    const std::string& source);
+                    const std::string& source, const VerifiedAnswers* verified = nullptr);
 
 // The suffixes of the evaluation's files: once per evaluation (<prefix>.json, <prefix>_pr.png)
 // and once per run (<prefix>[_<label>]_per_query.csv, ...), in the order StageEvaluation

@@ -16,6 +16,7 @@
 #include "OpenABLE/run/descriptor_cache.h"
 #include "OpenABLE/run/evaluate.h"
 #include "OpenABLE/run/exports.h"
+#include "OpenABLE/run/verify.h"
 #include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/stereo/calibration.h"
@@ -195,7 +196,8 @@ const SingleFrame& SingleFrameStore::Keep(const std::string& key, SingleFrame fr
 
 std::string SingleFrameKey(const Config& config, const std::string& name) {
   // Everything that can change a frame's row or a pair's distance stays; what acts after the
-  // single-frame matrix (sequences, scores, fusion, outputs, evaluation, tools) is reset.
+  // single-frame matrix (sequences, scores, fusion, outputs, evaluation, verification, tools)
+  // is reset.
   Config c = config;
   c.descriptor.name = name;
   const PanoramaMatching panorama = c.matching.panorama_matching;
@@ -206,6 +208,7 @@ std::string SingleFrameKey(const Config& config, const std::string& name) {
   c.evaluation = EvaluationConfig();
   c.snaps = snaps::SnapsOptions();
   c.odometry = odometry::OdometryOptions();
+  c.verification = VerificationOptions();
   return FormatConfig(c);
 }
 
@@ -346,6 +349,22 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
                        std::to_string(references) + " frames of " + specs.front().key +
                        "); expected a window that leaves rivals outside it for Match_score "
                        "ratio (10 frames is typical), or Match_score distance");
+  }
+
+  // Verification reads the candidates' frames again: checked now, before the long part.
+  if (config.verification.enabled) {
+    const bool video = specs.front().kind == SourceKind::kVideo;
+    const int query_frames = sources.back()->Size();
+    const int queries = sources.size() > 1
+                            ? query_frames
+                            : std::max(0, query_frames - config.evaluation.protocol.exclusion);
+    std::string first;
+    cv::Size size;
+    if (!video && !config.verification.calibration.empty()) {
+      first = sources.front()->FrameName(0);
+      size = WithKey(specs.front().key, [&] { return ReadImageFile(first).size(); });
+    }
+    CheckVerification(config, video, queries, first, size);
   }
 
   // Dense or bounded (Matrix_mode), said in one line, decided before any work from the frame
@@ -639,6 +658,8 @@ std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& co
                      threshold_png);
   if (!config.scale.matches_name.empty())
     out.emplace_back("Matches_name", config.scale.matches_name);
+  if (config.verification.enabled && !o.loops_name.empty())
+    out.emplace_back("Loops_name", o.loops_name);
   const std::string& prefix = config.evaluation.name;
   if (EvaluationRequested(config) && !prefix.empty()) {  // one run: no label in the names
     for (const char* suffix : kEvaluationSetSuffixes)
@@ -650,7 +671,8 @@ std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& co
 }
 
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
-                                      const Evaluation* evaluation) {
+                                      const Evaluation* evaluation,
+                                      const RunVerification* verification) {
   const auto t = Clock::now();
   // The encodings are independent; the two PNG images dominate (OpenCV's PNG encoder is
   // single-threaded), so every output is encoded on its own thread, then staged in order.
@@ -714,6 +736,8 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
         matches.size() >= 4 && matches.compare(matches.size() - 4, 4, ".csv") == 0;
     batch.Stage("Matches_name", matches, EncodeMatches(result.matches, csv));
   }
+  if (verification != nullptr && !out.loops_name.empty())
+    batch.Stage("Loops_name", out.loops_name, EncodeLoops(*verification));
   if (evaluation != nullptr && !config.evaluation.name.empty())
     StageEvaluation(batch, "Evaluation_name", config.evaluation.name, *evaluation,
                     {&result.normalized});

@@ -17,7 +17,8 @@
 
 namespace openable {
 
-struct Evaluation;  // OpenABLE/run/evaluate.h
+struct Evaluation;       // OpenABLE/run/evaluate.h
+struct RunVerification;  // OpenABLE/run/verify.h
 
 // One traversal of the run (a folder or a video) and the rows it holds in the matrix.
 struct Traversal {
@@ -119,15 +120,17 @@ void CheckRun(const Config& config);
 EvaluationLayout LayoutOf(const RunResult& result);
 
 // Writes the outputs the configuration asks for (Txt_name, Npy_name, Png_name,
-// Png_threshold_name, and the files of Evaluation_name when `evaluation` is given)
+// Png_threshold_name, Loops_name when `verification` is given, and the files of
+// Evaluation_name when `evaluation` is given)
 // all-or-nothing. Cells without a value (+inf, Sequence_partial skip) are written as the
 // largest finite value in Txt_name and the PNG images and as NaN in Npy_name. Returns the
 // paths written. Adds the time spent to result.timings.export_seconds. Throws InputError naming the key and path on failure.
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
-                                      const Evaluation* evaluation = nullptr);
+                                      const Evaluation* evaluation = nullptr,
+                                      const RunVerification* verification = nullptr);
 
 // Every file a run of `config` may write, as (key, path): the matrix files, the thresholded
-// image, the matches and, when Ground_truth_type and Evaluation_name are set, the evaluation's
+// image, the matches, the loops (Verification) and, when Ground_truth_type and Evaluation_name are set, the evaluation's
 // files (StageEvaluation). Run checks them with CheckDistinctOutputs before any work.
 std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& config);
 

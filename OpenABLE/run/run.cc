@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
+#include <stdexcept>
 
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/version.h"
@@ -26,10 +27,17 @@ RunOutcome Run(const Config& config, ProgressReporter& progress,
     out.evaluation = std::make_unique<Evaluation>();
     out.evaluation->settings = EvaluationSettingsFrom(config);
   }
+  if (!config.verification.enabled && !config.output.loops_name.empty())
+    log("note: Loops_name: not written: Verification is 0 (no candidate is checked)");
   out.result = ComputeRun(config, progress);
   RunResult& result = out.result;
   for (const std::string& w : result.warnings) log("warning: " + w);
   for (const std::string& note : result.notes) log("note: " + note);
+  if (config.verification.enabled) {
+    out.verification =
+        std::make_unique<RunVerification>(VerifyRun(config, result, progress));
+    result.timings.total_seconds += out.verification->seconds;
+  }
   if (out.evaluation && result.bounded) {
     log("note: Ground_truth_type: no evaluation in bounded mode (the protocols need the dense "
         "matrix); evaluate Matches_name yourself or use Matrix_mode 1");
@@ -37,13 +45,36 @@ RunOutcome Run(const Config& config, ProgressReporter& progress,
   }
   if (out.evaluation) {
     const auto start = std::chrono::steady_clock::now();
-    EvaluateMatrix(*out.evaluation, result.normalized, LayoutOf(result), RunLabel(config),
-                   "Test_OpenABLE run");
+    const EvaluationLayout layout = LayoutOf(result);
+    if (out.verification) {
+      const VerifiedAnswers answers = AnswersOf(*out.verification, layout);
+      EvaluateMatrix(*out.evaluation, result.normalized, layout, RunLabel(config),
+                     "Test_OpenABLE run", &answers);
+    } else {
+      EvaluateMatrix(*out.evaluation, result.normalized, layout, RunLabel(config),
+                     "Test_OpenABLE run");
+    }
     result.timings.evaluate_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.timings.total_seconds += result.timings.evaluate_seconds;
   }
-  out.written = WriteOutputs(config, result, out.evaluation.get());
+  out.written = WriteOutputs(config, result, out.evaluation.get(), out.verification.get());
+  return out;
+}
+
+VerifiedAnswers AnswersOf(const RunVerification& verification, const EvaluationLayout& layout) {
+  VerifiedAnswers out;
+  out.accepted.resize(layout.queries);
+  for (const QueryVerification& q : verification.queries) {
+    if (q.query < 0 || q.query >= layout.queries)
+      throw std::logic_error("AnswersOf: a query outside the layout");
+    for (const VerifiedCandidate& c : q.candidates) {
+      if (c.accepted)
+        out.accepted[q.query].push_back({c.reference, c.distance, c.score});
+      else
+        out.rejected.emplace_back(c.reference, q.query);
+    }
+  }
   return out;
 }
 
@@ -107,6 +138,20 @@ std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
     out << "\n  accepted: " << r.accepted_queries << " of " << r.answered_queries
         << " best matches with " << EnumName(c.matching.score) << " score <= "
         << c.matching.match_threshold << " (Match_threshold)";
+  if (const RunVerification* v = outcome.verification.get()) {
+    const VerificationOptions& o = v->options;
+    out << "\n  verification: " << EnumName(o.features) << " (" << o.max_features
+        << " features), ratio " << FormatNumber(o.ratio) << ", " << v->geometry
+        << ", RANSAC " << FormatNumber(o.ransac_threshold) << " px, >= " << o.min_inliers
+        << " inliers, " << o.candidates << " candidates per query, consistency "
+        << o.consistency << " (+-" << o.tolerance << " frames)"
+        << "\n    " << v->queries.size() << " queries, " << v->pairs << " candidates checked, "
+        << v->geometric << " geometrically verified; " << v->answered
+        << " queries answered by a verified loop";
+    if (v->extractions > v->frames)
+      out << "\n    features of " << v->frames << " frames computed " << v->extractions
+          << " times (Verification_cache " << FormatNumber(o.cache_mb) << " MB is full)";
+  }
   out << "\nTimings (wall clock):\n"
       << "  total            " << FormatFixed(tm.total_seconds, 3) << " s\n"
       << "  description      " << FormatFixed(tm.describe_seconds, 3) << " s  ("
@@ -116,6 +161,13 @@ std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
       << FormatFixed(tm.pairs ? 1e9 * tm.match_seconds / static_cast<double>(tm.pairs) : 0, 1)
       << " ns per pair, " << tm.pairs << " pairs)\n"
       << "  sequences+norm.  " << FormatFixed(tm.sequence_seconds, 3) << " s\n";
+  if (const RunVerification* v = outcome.verification.get()) {
+    const LatencySummary features = Summarize(v->extract_ms), pairs = Summarize(v->pair_ms);
+    out << "  verification     " << FormatFixed(v->seconds, 3) << " s  (features "
+        << FormatFixed(features.mean, 2) << " ms per frame, p99 " << FormatFixed(features.p99, 2)
+        << "; check " << FormatFixed(pairs.mean, 2) << " ms per candidate, p99 "
+        << FormatFixed(pairs.p99, 2) << ")\n";
+  }
   if (evaluation != nullptr)
     out << "  evaluation       " << FormatFixed(tm.evaluate_seconds, 3) << " s\n";
   out << "  export           " << FormatFixed(tm.export_seconds, 3) << " s\n";

@@ -10,23 +10,30 @@
 #include "OpenABLE/run/evaluate.h"
 #include "OpenABLE/run/pipeline.h"
 #include "OpenABLE/run/progress.h"
+#include "OpenABLE/run/verify.h"
 #include "config/config.h"
 
 namespace openable {
 
 struct RunOutcome {
   RunResult result;
+  std::unique_ptr<RunVerification> verification;  // when Verification is 1
   std::unique_ptr<Evaluation> evaluation;  // when Ground_truth_type is set (not bounded)
   std::vector<std::string> written;        // the paths of the outputs
 };
 
-// Checks the evaluation settings, computes the run (ComputeRun), evaluates its matrix when
+// Checks the evaluation settings, computes the run (ComputeRun), verifies its candidates when
+// Verification is 1 (VerifyRun), evaluates its matrix (and the verified answers) when
 // Ground_truth_type is set, and writes the outputs (WriteOutputs). `log` receives, as they
 // arise, lines "warning: ..." (a problem that only costs time or a feature unavailable here)
 // and "note: ..." (an output or evaluation this mode cannot give). Throws InputError naming
 // the key, file or value.
 RunOutcome Run(const Config& config, ProgressReporter& progress,
                const std::function<void(const std::string&)>& log);
+
+// The answers of a verification for the evaluation of `layout`: each query's accepted
+// candidates, best first, and the cells of the rejected ones.
+VerifiedAnswers AnswersOf(const RunVerification& verification, const EvaluationLayout& layout);
 
 // The report Test_OpenABLE prints at the end: descriptor and camera, traversals, mode and
 // matrix, timings, the evaluation table, the files written.

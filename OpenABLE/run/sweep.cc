@@ -1,5 +1,7 @@
 #include "OpenABLE/run/sweep.h"
 
+#include "OpenABLE/run/run.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -221,8 +223,16 @@ SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressRe
       if (said.insert("note: " + note).second) log("note: " + note);
     Evaluation evaluation;
     evaluation.settings = EvaluationSettingsFrom(config);
-    EvaluateMatrix(evaluation, result.normalized, LayoutOf(result), run.label,
-                   "openable_sweep run");
+    if (config.verification.enabled) {
+      // Verified answers rank the run (per_query), the matrix's best matches beside them.
+      const RunVerification verification = VerifyRun(config, result, progress);
+      const VerifiedAnswers answers = AnswersOf(verification, LayoutOf(result));
+      EvaluateMatrix(evaluation, result.normalized, LayoutOf(result), run.label,
+                     "openable_sweep run", &answers);
+    } else {
+      EvaluateMatrix(evaluation, result.normalized, LayoutOf(result), run.label,
+                     "openable_sweep run");
+    }
     run.evaluation = std::move(evaluation.runs.front());
     run.seconds = SecondsSince(t);
     out.runs.push_back(std::move(run));

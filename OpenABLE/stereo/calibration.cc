@@ -150,25 +150,27 @@ StereoCalibration LoadStereoCalibration(const std::string& path) {
   return c;
 }
 
+void CheckPrincipalPointFits(const std::string& calibration, const std::string& camera,
+                             double cx, double cy, const cv::Size& size,
+                             const std::string& first_image) {
+  const double w = size.width, h = size.height;
+  if (cx < w / 4 || cx > 3 * w / 4 || cy < h / 4 || cy > 3 * h / 4)
+    throw InputError("calibration \"" + calibration + "\" does not fit the images: " + camera +
+                     " principal point (" + Num(cx) + ", " + Num(cy) +
+                     ") lies outside the middle half of the " + std::to_string(size.width) +
+                     "x" + std::to_string(size.height) + " image \"" + first_image +
+                     "\" (it suits images of about " +
+                     std::to_string(static_cast<int>(std::lround(2 * cx))) + "x" +
+                     std::to_string(static_cast<int>(std::lround(2 * cy))) +
+                     "); expected width/4 <= cx <= 3 width/4 and height/4 <= cy <= 3 height/4");
+}
+
 void CheckCalibrationFits(const StereoCalibration& c, const cv::Size& size,
                           const std::string& first_image) {
-  const struct {
-    const char* key;
-    const cv::Matx33d& k;
-  } cameras[] = {{"ML", c.left_camera}, {"MR", c.right_camera}};
-  for (const auto& cam : cameras) {
-    const double cx = cam.k(0, 2), cy = cam.k(1, 2);
-    const double w = size.width, h = size.height;
-    if (cx < w / 4 || cx > 3 * w / 4 || cy < h / 4 || cy > 3 * h / 4)
-      throw InputError("calibration \"" + c.path + "\" does not fit the images: " + cam.key +
-                       " principal point (" + Num(cx) + ", " + Num(cy) +
-                       ") lies outside the middle half of the " + std::to_string(size.width) +
-                       "x" + std::to_string(size.height) + " image \"" + first_image +
-                       "\" (it suits images of about " +
-                       std::to_string(static_cast<int>(std::lround(2 * cx))) + "x" +
-                       std::to_string(static_cast<int>(std::lround(2 * cy))) +
-                       "); expected width/4 <= cx <= 3 width/4 and height/4 <= cy <= 3 height/4");
-  }
+  CheckPrincipalPointFits(c.path, "ML", c.left_camera(0, 2), c.left_camera(1, 2), size,
+                          first_image);
+  CheckPrincipalPointFits(c.path, "MR", c.right_camera(0, 2), c.right_camera(1, 2), size,
+                          first_image);
 }
 
 }  // namespace openable

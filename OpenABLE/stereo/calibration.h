@@ -39,6 +39,11 @@ struct StereoCalibration {
 // rotation (|R^T R - I| > 1e-3 or det R <= 0), a zero T, or colormap/use_log out of range.
 StereoCalibration LoadStereoCalibration(const std::string& path);
 
+// The rule of CheckCalibrationFits for one camera (`camera` names it in the message: "ML").
+void CheckPrincipalPointFits(const std::string& calibration, const std::string& camera,
+                             double cx, double cy, const cv::Size& size,
+                             const std::string& first_image);
+
 // Checks that the calibration fits images of `image_size` (the size of the first left image,
 // named `first_image` in the message). Rule: the principal point (cx, cy) of each camera lies
 // inside the image, and more strictly in its middle half: width/4 <= cx <= 3 width/4 and

@@ -54,7 +54,7 @@ TEST(Presets, AcrossConditionsRunsOnTheSample) {
 }
 
 // One traversal (the 300 summer frames) without ground truth: the loop-closure preset writes
-// the matrix of SIFT with sequences of 5 frames and says so.
+// the matrix of SIFT with sequences of 5 frames, verifies its candidates and says so.
 TEST(Presets, LoopClosureRunsOnTheSample) {
   const std::string dir = testing::TempDir();
   const Outcome o = RunProgram(
@@ -67,6 +67,9 @@ TEST(Presets, LoopClosureRunsOnTheSample) {
   EXPECT_NE(o.out.find("SIFT ("), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("sequence length 5"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("score distance"), std::string::npos) << o.out;
+  // The preset verifies its loops (20 candidates per query, ORB features).
+  EXPECT_NE(o.out.find("verification: ORB"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("20 candidates per query"), std::string::npos) << o.out;
   const cv::Mat1f m = ReadNpy(dir + "/m.npy");
   ASSERT_EQ(m.size(), cv::Size(300, 300));
   double max = 0;
