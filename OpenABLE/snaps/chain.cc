@@ -1,5 +1,7 @@
 #include "OpenABLE/snaps/chain.h"
 
+#include "OpenABLE/run/verify.h"
+
 #include <chrono>
 #include <map>
 #include <memory>
@@ -186,6 +188,10 @@ Config OpenableRunOf(const Config& c) {
   run.scale.matrix_mode = MatrixMode::kDense;
   run.scale.approximate_search = false;
   run.evaluation.truth.type = GroundTruthType::kNone;
+  // The candidates of a frame (verification) are the frames Snaps_frame_distance back, as for
+  // the loops from the matrix.
+  run.evaluation.protocol.exclusion = c.snaps.search.frame_distance;
+  run.output.loops_name.clear();
   return run;
 }
 
@@ -229,8 +235,8 @@ ChainResult RunChain(const Config& c, ProgressReporter& progress,
     case LoopSource::kPairs:
       try {
         r.loops = WithKey("Snaps_loops_file", [&] {
-          return LoopsFromCsv(s.loops_file, r.input, s.keyframe_tolerance, &r.dropped,
-                              s.drop_outside ? &r.outside : nullptr);
+          return LoopsFromCsv(s.loops_file, r.input, s.keyframe_tolerance, nullptr,
+                              s.drop_outside ? &r.pairs.outside : nullptr, &r.pairs);
         });
       } catch (const InputError& e) {
         const std::string m = e.what();
@@ -240,12 +246,32 @@ ChainResult RunChain(const Config& c, ProgressReporter& progress,
       if (s.middle_of_runs) r.loops = MiddleOfRuns(r.loops, r.input);
       break;
     case LoopSource::kMatrix:
-      r.loops = WithKey("Snaps_loops_file",
-                        [&] { return LoopsFromMatrix(s.loops_file, r.input, MatrixLoops(c)); });
+      r.loops = WithKey("Snaps_loops_file", [&] {
+        return LoopsFromMatrix(s.loops_file, r.input, MatrixLoops(c), &r.pairs);
+      });
       break;
     case LoopSource::kOpenable: {
-      const RunResult run = ComputeRun(OpenableRunOf(c), progress);
-      r.loops = LoopsFromMatrix(run.normalized, r.input, MatrixLoops(c));
+      const Config openable = OpenableRunOf(c);
+      const RunResult run = ComputeRun(openable, progress);
+      if (c.verification.enabled) {
+        // The verified answers are the loops: no threshold on M'.
+        const RunVerification verification = VerifyRun(openable, run, progress);
+        std::vector<FrameMatch> answers;
+        for (const QueryVerification& q : verification.queries)
+          if (q.answer >= 0)
+            answers.push_back({q.query, q.candidates[q.answer].reference,
+                               q.candidates[q.answer].distance});
+        r.loops = LoopsFromMatches(answers, r.input, c.input.initial_image,
+                                   c.snaps.keyframe_tolerance, &r.pairs);
+        r.verified_loops = true;
+        say("OpenABLE: " + run.descriptor + ", L=" + std::to_string(c.matching.sequence_length) +
+            ", " + std::to_string(run.normalized.rows) + " frames, " +
+            std::to_string(verification.pairs) + " candidates checked, " +
+            std::to_string(answers.size()) + " verified loops, " +
+            FormatNumber(run.timings.total_seconds + verification.seconds) + " s");
+        break;
+      }
+      r.loops = LoopsFromMatrix(run.normalized, r.input, MatrixLoops(c), &r.pairs);
       say("OpenABLE: " + run.descriptor + ", L=" + std::to_string(c.matching.sequence_length) +
           ", " + std::to_string(run.normalized.rows) + " frames, " +
           FormatNumber(run.timings.total_seconds) + " s");
@@ -263,11 +289,17 @@ ChainResult RunChain(const Config& c, ProgressReporter& progress,
   }
   r.loop_seconds = Seconds(t);
   say(std::to_string(r.loops.size()) + " loop pairs (" + EnumName(s.loops) + ")" +
-      (r.dropped > 0 ? ", " + std::to_string(r.dropped) +
-                           " pairs with a frame that is not a pose dropped"
-                     : std::string()) +
-      (r.outside > 0 ? ", " + std::to_string(r.outside) + " pairs outside the trajectory dropped"
-                     : std::string()));
+      (r.pairs.associated > 0 ? ", " + std::to_string(r.pairs.associated) +
+                                    " pairs associated to the nearest pose within +-" +
+                                    std::to_string(s.keyframe_tolerance) +
+                                    (s.keyframe_tolerance == 1 ? " frame" : " frames")
+                              : std::string()) +
+      (r.pairs.dropped > 0 ? ", " + std::to_string(r.pairs.dropped) +
+                                 " pairs with a frame that is not a pose dropped"
+                           : std::string()) +
+      (r.pairs.outside > 0
+           ? ", " + std::to_string(r.pairs.outside) + " pairs outside the trajectory dropped"
+           : std::string()));
 
   // Corrections.
   r.discounted_ran = s.corrector != Corrector::kPoseGraph;

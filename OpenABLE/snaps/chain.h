@@ -44,8 +44,12 @@ struct ChainResult {
   Trajectory truth;
   std::vector<int> association;  // index in `truth` of each pose of `input`
   std::vector<LoopPair> loops;   // indices of `input`
-  int dropped = 0;               // pairs file: pairs with a frame that is not a pose
-  int outside = 0;               // pairs file: pairs outside the trajectory (dropped)
+  bool verified_loops = false;   // Snaps_loops openable with Verification 1: verified answers
+  // Snaps_loops pairs, matrix, openable: the pairs of the file or the matrix's matches below the
+  // threshold, on poses, associated to the nearest pose within Snaps_keyframe_tolerance, dropped
+  // or (pairs file) outside the trajectory; `loops` is what remains after MiddleOfRuns (pairs)
+  // or one loop per query pose (matrix).
+  PairCounts pairs;
   double loop_seconds = 0;       // finding or reading the loops
   ImageSearchResult searched;    // Snaps_loops search: the online search and its latencies
   bool discounted_ran = false;   // Snaps_corrector discounted or both

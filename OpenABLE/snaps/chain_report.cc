@@ -67,6 +67,48 @@ SearchLatencies LatenciesOf(const ImageSearchResult& searched) {
           Summarize(searched.correction_seconds), Summarize(searched.thumbnail_seconds)};
 }
 
+// Snaps_loops pairs, matrix and openable: what became of the pairs of the file, or of the
+// matrix's matches, when their frames were mapped to the trajectory's poses (keyframes).
+bool HasPairCounts(const Config& c) {
+  return c.snaps.loops == LoopSource::kPairs || c.snaps.loops == LoopSource::kMatrix ||
+         c.snaps.loops == LoopSource::kOpenable;
+}
+
+std::string PairCountsLine(const Config& c, const ChainResult& r) {
+  const PairCounts& n = r.pairs;
+  const int tolerance = c.snaps.keyframe_tolerance;
+  std::ostringstream o;
+  if (c.snaps.loops == LoopSource::kPairs)
+    o << "pairs file: " << n.Total() << " pairs: ";
+  else if (r.verified_loops)
+    o << "verified loops: " << n.Total() << " queries answered by geometric verification: ";
+  else
+    o << "matrix: " << n.Total() << " matches below " << Number(c.snaps.matrix_threshold)
+      << ": ";
+  o << n.on_poses << " on keyframes, " << n.associated;
+  if (tolerance > 0)
+    o << " associated to the nearest keyframe within +-" << tolerance
+      << (tolerance == 1 ? " frame, " : " frames, ");
+  else
+    o << " associated (Snaps_keyframe_tolerance 0), ";
+  o << n.dropped << " dropped";
+  if (n.outside > 0) o << ", " << n.outside << " outside the trajectory dropped";
+  if (c.snaps.loops == LoopSource::kPairs && c.snaps.middle_of_runs)
+    o << "; the middle reference of each run kept";
+  if (n.merged > 0)
+    o << "; " << n.merged << " merged (one loop per query keyframe, the most similar)";
+  return o.str();
+}
+
+std::string PairCountsJson(const Config& c, const PairCounts& n) {
+  std::ostringstream o;
+  o << "{\"keyframe_tolerance\": " << c.snaps.keyframe_tolerance << ", \"total\": " << n.Total()
+    << ", \"on_poses\": " << n.on_poses << ", \"associated\": " << n.associated
+    << ", \"dropped\": " << n.dropped << ", \"outside\": " << n.outside
+    << ", \"merged\": " << n.merged << "}";
+  return o.str();
+}
+
 }  // namespace
 
 std::string FormatChainReport(const Config& c, const ChainResult& r) {
@@ -84,14 +126,12 @@ std::string FormatChainReport(const Config& c, const ChainResult& r) {
         << "\n  odometry per frame " << StatsLine(Summarize(r.odometry.seconds))
         << " (paper: 0.295 s per frame with loop closure)\n";
   out << "  loops: " << r.loops.size() << " pairs from " << source << " ("
-      << Number(r.loop_seconds) << " s";
-  if (r.dropped > 0) out << "; " << r.dropped << " pairs with a frame that is not a pose dropped";
-  if (r.outside > 0) out << "; " << r.outside << " pairs outside the trajectory dropped";
-  out << ")";
+      << Number(r.loop_seconds) << " s)";
   if (r.discounted_ran)
     out << "; discounted update closes " << r.closed.size() << " (pause "
         << s.search.discount.pause << ", K " << s.search.discount.discount_length << ")";
   out << "\n";
+  if (HasPairCounts(c)) out << "  " << PairCountsLine(c, r) << "\n";
   if (r.graph_ran)
     out << "  pose graph: " << r.graph_report.loop_edges << " loop edges, "
         << r.graph_report.iterations << " iterations, cost "
@@ -134,7 +174,9 @@ std::string ChainJson(const Config& c, const ChainResult& r) {
   std::ostringstream json;
   json << "{\n  \"trajectory\": \"" << r.trajectory_name << "\",\n  \"poses\": " << r.input.Size()
        << ",\n  \"loop_source\": \"" << EnumName(c.snaps.loops) << "\",\n  \"loops\": "
-       << r.loops.size() << ",\n  \"loops_closed_by_discounted_update\": " << r.closed.size()
+       << r.loops.size();
+  if (HasPairCounts(c)) json << ",\n  \"pairs\": " << PairCountsJson(c, r.pairs);
+  json << ",\n  \"loops_closed_by_discounted_update\": " << r.closed.size()
        << ",\n  \"pose_graph\": {\"loop_edges\": " << g.loop_edges << ", \"iterations\": "
        << g.iterations << ", \"initial_cost\": " << Number(g.initial_cost)
        << ", \"final_cost\": " << Number(g.final_cost) << ", \"seconds\": " << Number(g.seconds)

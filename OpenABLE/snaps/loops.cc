@@ -33,23 +33,61 @@ int IndexOfFrame(const Trajectory& trajectory, long frame_id, long tolerance) {
   return best;
 }
 
+namespace {
+
+// Whether both frames of a pair mapped (by IndexOfFrame, to valid indices) onto their own poses.
+bool OnPoses(const Trajectory& trajectory, int qi, long query_frame, int ri,
+             long reference_frame) {
+  return trajectory.frame_ids[static_cast<std::size_t>(qi)] == query_frame &&
+         trajectory.frame_ids[static_cast<std::size_t>(ri)] == reference_frame;
+}
+
+}  // namespace
+
 std::vector<LoopPair> LoopsFromMatrix(const std::string& path, const Trajectory& trajectory,
-                                      const MatrixLoopOptions& options) {
+                                      const MatrixLoopOptions& options, PairCounts* counts) {
   const cv::Mat1f m = ReadMatrixFile(path);
   if (m.rows != m.cols)
     throw InputError("matrix file " + Quoted(path) + ": " + std::to_string(m.rows) + "x" +
                      std::to_string(m.cols) +
                      " is not square; expected the matrix of one sequence");
-  return LoopsFromMatrix(m, trajectory, options);
+  return LoopsFromMatrix(m, trajectory, options, counts);
+}
+
+std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
+                                       const Trajectory& trajectory, long initial,
+                                       long tolerance, PairCounts* counts) {
+  std::map<int, LoopPair> by_query;
+  PairCounts n;
+  for (const FrameMatch& match : matches) {
+    const long query_frame = initial + match.query, reference_frame = initial + match.reference;
+    const int qi = IndexOfFrame(trajectory, query_frame, tolerance);
+    const int ri = IndexOfFrame(trajectory, reference_frame, tolerance);
+    if (qi < 0 || ri < 0 || ri >= qi) {
+      ++n.dropped;
+      continue;
+    }
+    ++(OnPoses(trajectory, qi, query_frame, ri, reference_frame) ? n.on_poses : n.associated);
+    const LoopPair loop{qi, ri, 1.0 - match.distance};
+    auto [it, inserted] = by_query.emplace(qi, loop);
+    if (!inserted) {
+      ++n.merged;
+      if (loop.similarity > it->second.similarity) it->second = loop;
+    }
+  }
+  if (counts) *counts = n;
+  std::vector<LoopPair> out;
+  for (const auto& [q, loop] : by_query) out.push_back(loop);
+  return out;
 }
 
 std::vector<LoopPair> LoopsFromMatrix(cv::Mat1f m, const Trajectory& trajectory,
-                                      const MatrixLoopOptions& options) {
+                                      const MatrixLoopOptions& options, PairCounts* counts) {
   if (m.rows != m.cols) throw std::invalid_argument("LoopsFromMatrix: matrix not square");
   double max_value = 0;
   cv::minMaxLoc(m, nullptr, &max_value);
   if (max_value > 1) m = m / max_value;
-  std::map<int, LoopPair> by_query;
+  std::vector<FrameMatch> best_matches;
   for (int q = options.exclusion; q < m.rows; ++q) {
     const float* row = m.ptr<float>(q);
     int best_j = -1;
@@ -60,20 +98,14 @@ std::vector<LoopPair> LoopsFromMatrix(cv::Mat1f m, const Trajectory& trajectory,
         best_j = j;
       }
     if (best_j < 0 || !(best < options.threshold)) continue;
-    const int qi = IndexOfFrame(trajectory, options.initial + q, options.tolerance);
-    const int ri = IndexOfFrame(trajectory, options.initial + best_j, options.tolerance);
-    if (qi < 0 || ri < 0 || ri >= qi) continue;
-    const LoopPair loop{qi, ri, 1.0 - best};
-    auto [it, inserted] = by_query.emplace(qi, loop);
-    if (!inserted && loop.similarity > it->second.similarity) it->second = loop;
+    best_matches.push_back({q, best_j, best});
   }
-  std::vector<LoopPair> out;
-  for (const auto& [q, loop] : by_query) out.push_back(loop);
-  return out;
+  return LoopsFromMatches(best_matches, trajectory, options.initial, options.tolerance, counts);
 }
 
 std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& trajectory,
-                                   long tolerance, int* dropped, int* outside) {
+                                   long tolerance, int* dropped, int* outside,
+                                   PairCounts* counts) {
   // The same reader and checks as the evaluation's ground-truth pairs (pairs_file.h): commas
   // or blanks, a header line, comments, 0-based unless a comment says "1-based".
   const PairsFile file = ReadPairsFile(path, -1, "loop pairs file");
@@ -81,14 +113,14 @@ std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& tr
     throw InputError(file.where + ": the trajectory is empty");
   const long first = trajectory.frame_ids.front(), last = trajectory.frame_ids.back();
   std::vector<LoopPair> out;
-  int drop = 0, outside_count = 0;
+  PairCounts n;
   for (const PairsFile::Pair& p : file.pairs) {
     const std::string at = file.where + ":" + std::to_string(p.line);
     // A loop joins the later frame to the earlier one, in either order in the file.
     const long row = static_cast<long>(std::max(p.a, p.b));
     const long col = static_cast<long>(std::min(p.a, p.b));
     if (row == col) {  // a frame with itself: no loop (as the evaluation drops the diagonal)
-      ++drop;
+      ++n.dropped;
       continue;
     }
     bool out_of_range = false;
@@ -101,19 +133,21 @@ std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& tr
         out_of_range = true;
       }
     if (out_of_range) {
-      ++outside_count;
+      ++n.outside;
       continue;
     }
     const int qi = IndexOfFrame(trajectory, row, tolerance);
     const int ri = IndexOfFrame(trajectory, col, tolerance);
     if (qi < 0 || ri < 0 || ri >= qi) {
-      ++drop;
+      ++n.dropped;
       continue;
     }
+    ++(OnPoses(trajectory, qi, row, ri, col) ? n.on_poses : n.associated);
     out.push_back(LoopPair{qi, ri, 1.0});
   }
-  if (dropped) *dropped = drop;
-  if (outside) *outside = outside_count;
+  if (dropped) *dropped = n.dropped;
+  if (outside) *outside = n.outside;
+  if (counts) *counts = n;
   return out;
 }
 

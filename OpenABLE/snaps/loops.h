@@ -15,6 +15,23 @@ namespace openable::snaps {
 // frames (ties: the earlier pose). -1 when none.
 int IndexOfFrame(const Trajectory& trajectory, long frame_id, long tolerance);
 
+// What became of the frame pairs of a pairs file or a matrix when their frame ids were mapped to
+// the poses of a trajectory that may hold keyframes only (IndexOfFrame with a tolerance). Each
+// pair considered is counted in exactly one of on_poses, associated, dropped, outside.
+struct PairCounts {
+  int on_poses = 0;    // kept, both frames are poses
+  int associated = 0;  // kept, one frame or both moved to the nearest pose within the tolerance
+  // A frame with no pose within the tolerance, or no loop once mapped (a frame with itself, or
+  // both frames on one pose).
+  int dropped = 0;
+  int outside = 0;  // LoopsFromCsv with `outside`: a frame outside the trajectory's frame ids
+  // LoopsFromMatrix: kept pairs (counted in on_poses or associated) whose query pose already has
+  // a pair; each query pose keeps its most similar pair, so loops = on_poses + associated -
+  // merged.
+  int merged = 0;
+  int Total() const { return on_poses + associated + dropped + outside; }
+};
+
 struct MatrixLoopOptions {
   // A loop needs M'(q, j) < threshold (M' in [0, 1]; 0 = identical).
   double threshold = 0.1;
@@ -34,13 +51,30 @@ struct MatrixLoopOptions {
 // pairs with a frame that maps to no pose, or whose indices are not query > reference, are
 // dropped; when several rows map to one query index the most similar is kept. A matrix whose
 // maximum exceeds 1 (an image, 0-255) is first divided by its maximum. Throws InputError
-// naming the file when the matrix is not square.
+// naming the file when the matrix is not square. With `counts` given, the pairs (rows whose
+// best match is below the threshold) are counted there (outside stays 0).
 std::vector<LoopPair> LoopsFromMatrix(const std::string& path, const Trajectory& trajectory,
-                                      const MatrixLoopOptions& options);
+                                      const MatrixLoopOptions& options,
+                                      PairCounts* counts = nullptr);
 // The same on a matrix in memory (e.g. RunResult::normalized of an OpenABLE run of the same
 // frames); std::invalid_argument when it is not square.
 std::vector<LoopPair> LoopsFromMatrix(cv::Mat1f matrix, const Trajectory& trajectory,
-                                      const MatrixLoopOptions& options);
+                                      const MatrixLoopOptions& options,
+                                      PairCounts* counts = nullptr);
+
+// One best match of an OpenABLE run of one sequence: rows of its matrix (frame ids initial +
+// row) and the normalised distance M'.
+struct FrameMatch {
+  int query = 0, reference = 0;
+  float distance = 0;
+};
+
+// Loops from best matches chosen elsewhere (a run's verified answers): frames mapped to
+// trajectory indices as LoopsFromMatrix maps them, with the same drops, merges and counts;
+// similarity 1 - distance.
+std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
+                                       const Trajectory& trajectory, long initial,
+                                       long tolerance, PairCounts* counts = nullptr);
 
 // (b) Loops from a file of pairs, read by ReadPairsFile (OpenABLE/evaluation/pairs_file.h): the
 // format and checks of the evaluation's ground-truth pairs (comma or blanks, '#' comments, a
@@ -52,10 +86,11 @@ std::vector<LoopPair> LoopsFromMatrix(cv::Mat1f matrix, const Trajectory& trajec
 // outside the trajectory's frame ids [first, last].
 // With `outside` given, pairs with a frame outside the trajectory's frame ids are dropped and
 // counted there instead (a ground-truth list of a whole sequence against a trajectory that
-// stops a few frames early).
+// stops a few frames early). With `counts` given, every pair of the file is counted there
+// (its dropped and outside equal the two counts above).
 std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& trajectory,
                                    long tolerance = 0, int* dropped = nullptr,
-                                   int* outside = nullptr);
+                                   int* outside = nullptr, PairCounts* counts = nullptr);
 
 // The nearest place of each loop run: ground-truth lists pair a query with every earlier frame
 // within some radius (up to 40 m in KITTI 00), so a query's references come in runs of
