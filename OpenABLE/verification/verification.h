@@ -45,7 +45,7 @@ struct VerificationOptions {
   LocalFeatures features = LocalFeatures::kOrb;  // Verification_features
   int max_features = 500;                      // Verification_max_features, 10..100000
   double ratio = 0.8;                          // Verification_ratio, [0.1, 1]
-  int min_inliers = 30;                        // Verification_min_inliers, 5..100000
+  int min_inliers = 40;                        // Verification_min_inliers, 5..100000
   double ransac_threshold = 2.0;               // Verification_ransac_threshold, pixels
   int candidates = 5;                          // Verification_candidates: k, 1..100
   int consistency = 1;                         // Verification_consistency: n, >= 0

@@ -125,7 +125,7 @@ TEST(Verification, LoopsFileAgreesWithTheEvaluationOnKittiRevisit) {
     EXPECT_GT(l.rank, last_rank[l.query]) << "ranks in order";
     last_rank[l.query] = l.rank;
     EXPECT_GE(l.geometric, l.verified);
-    if (l.geometric) EXPECT_GE(l.inliers, 30);  // Verification_min_inliers
+    if (l.geometric) EXPECT_GE(l.inliers, 40);  // Verification_min_inliers
     if (l.verified && !answer.count(l.query)) answer[l.query] = l.reference;
   }
   int tp = 0, fp = 0, positives = 0;

@@ -28,7 +28,7 @@ class OnlineVerification(unittest.TestCase):
                 check = candidate[5]
                 self.assertEqual(candidate[3], check["verified"])
                 if check["geometric"]:
-                    self.assertGreaterEqual(check["inliers"], 30)
+                    self.assertGreaterEqual(check["inliers"], 40)
                     self.assertIn(check["model"], ("fundamental", "homography"))
                 else:
                     self.assertFalse(check["verified"])
