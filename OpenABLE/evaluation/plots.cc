@@ -179,6 +179,9 @@ cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& t
     for (std::size_t i = 0; i < series.size(); ++i) {
       const cv::Scalar& colour = kPalette[i % kPaletteSize];
       const std::vector<CurvePoint>& curve = panel == 0 ? series[i].per_query : series[i].able_p;
+      // A series without cells (the verified answers of a run, whose cells are its
+      // unverified series') is left out of the ABLE-P panel.
+      if (panel == 1 && curve.empty()) continue;
       DrawCurve(img, axes, curve, colour);
       std::string suffix;
       if (curve.empty())

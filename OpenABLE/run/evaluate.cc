@@ -116,10 +116,14 @@ void StageEvaluation(OutputBatch& batch, const std::string& key, const std::stri
                                             ? run.per_query.operating_point.threshold
                                             : run.per_query.max_f1_threshold,
                                         run.verified ? &evaluation.rejected[i] : nullptr)));
-    if (run.verified)
-      series.push_back({run.label + " unverified", run.per_query_unverified.curve, {}});
-    series.push_back({run.label + (run.verified ? " verified" : ""), run.per_query.curve,
-                      run.able_p.curve});
+    // With verification: the matrix's answers (and its ABLE-P cells), then the verified ones.
+    if (run.verified) {
+      series.push_back({run.label + " unverified", run.per_query_unverified.curve,
+                        run.able_p.curve});
+      series.push_back({run.label + " verified", run.per_query.curve, {}});
+    } else {
+      series.push_back({run.label, run.per_query.curve, run.able_p.curve});
+    }
   }
   std::string title = "Precision-recall, " + GroundTruthTypeName(s.truth.type) +
                       " ground truth, tolerance +-" + std::to_string(s.options.tolerance);
