@@ -133,6 +133,36 @@ TEST(PerQuery, TwoTraversalLayoutReadsTheLowerLeftBlock) {
   EXPECT_NEAR(r.recall_at_1, 1.0, 1e-12);
 }
 
+// Answers chosen elsewhere (geometric verification): 4 queries of 4 references, tolerance 0,
+// query q's true match is reference q. q0 answers 0 (right, score 0.2); q1 has no answer; q2
+// answers 0 (wrong, score 0.1) then 2; q3 answers 3 (right, score 0.3). By hand: the curve
+// over scores 0.1, 0.2, 0.3 is (P 0, R 0), (P 1/2, R 1/4), (P 2/3, R 1/2); AUC = 1/2 x 1/4 +
+// 2/3 x 1/4; R@1 = 2/4, R@5 = 3/4 (q2's second answer).
+TEST(PerQuery, AnswersChosenElsewhere) {
+  EvaluationOptions o;
+  o.tolerance = 0;
+  const std::vector<std::vector<Answer>> answers = {
+      {{0, 0.5f, 0.2f}}, {}, {{0, 0.4f, 0.1f}, {2, 0.6f, 0.7f}}, {{3, 0.3f, 0.3f}}};
+  const PerQueryResult r = EvaluateAnswers(EvaluationLayout::QueryReference(4, 4),
+                                           Truth({{0}, {1}, {2}, {3}}, 4), answers, o);
+  EXPECT_EQ(r.queries, 4);
+  EXPECT_EQ(r.positive_queries, 4);
+  EXPECT_EQ(r.unanswered, 1);
+  EXPECT_EQ(r.best, (std::vector<int>{0, -1, 0, 3}));
+  ASSERT_EQ(r.curve.size(), 3u);
+  EXPECT_NEAR(r.curve[0].precision, 0.0, 1e-12);
+  EXPECT_NEAR(r.curve[1].precision, 0.5, 1e-12);
+  EXPECT_NEAR(r.curve[2].recall, 0.5, 1e-12);
+  EXPECT_NEAR(r.auc, 0.5 * 0.25 + 2.0 / 3.0 * 0.25, 1e-12);
+  EXPECT_NEAR(r.recall_at_1, 0.5, 1e-12);
+  EXPECT_NEAR(r.recall_at_5, 0.75, 1e-12);
+  EXPECT_NEAR(r.recall_at_100p, 0.0, 1e-12);  // the first answer accepted is wrong
+  // An answer outside the query's candidates is a programming error.
+  EXPECT_THROW(EvaluateAnswers(EvaluationLayout::QueryReference(4, 4),
+                               Truth({{0}, {1}, {2}, {3}}, 4), {{{7, 0, 0}}, {}, {}, {}}, o),
+               std::logic_error);
+}
+
 // ABLE-P protocol with 3 thresholds (0, 0.5, 1) on the query-reference block above; truth
 // cells (0,1), (1,4), (3,3).
 TEST(AbleP, HandWorkedVicinityZero) {
