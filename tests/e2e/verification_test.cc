@@ -211,6 +211,33 @@ TEST(Verification, OnlineDetectorGivesTheBatchRunsLoops) {
   EXPECT_GT(verified, 20);
 }
 
+// The bounded mode verifies the candidates among its kept matches: each query's best match
+// (rank 1) is the dense run's, with the same checks.
+TEST(Verification, BoundedModeChecksTheSameBestMatches) {
+  OPENABLE_REQUIRE_PATH(testing::DatasetsDir() + "/kitti00_first1700/image_0");
+  const std::string dir = testing::TempDir();
+  const Revisit r = MakeRevisit(dir);
+  std::vector<std::string> dense = RunArgs(r, dir);
+  ASSERT_EQ(RunProgram(testing::TestOpenableExe(), dense, dir).status, 0);
+  fs::rename(dir + "/loops.csv", dir + "/dense.csv");
+  std::vector<std::string> bounded = RunArgs(r, dir);
+  for (const std::string& a : {"Matrix_mode=2", "Best_matches=50", "Evaluation_name=",
+                               "Ground_truth_type="})
+    bounded.insert(bounded.end(), {"--set", a});
+  bounded.insert(bounded.end(), {"--set", "Matches_name=" + dir + "/matches.csv"});
+  const Outcome o = RunProgram(testing::TestOpenableExe(), bounded, dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  auto best = [](const std::vector<LoopLine>& lines) {
+    std::map<int, std::pair<int, int>> out;  // query -> (reference, inliers) of rank 1
+    for (const LoopLine& l : lines)
+      if (l.rank == 1) out[l.query] = {l.reference, l.inliers};
+    return out;
+  };
+  const auto a = best(ReadLoops(dir + "/dense.csv")), b = best(ReadLoops(dir + "/loops.csv"));
+  EXPECT_EQ(a.size(), 190u - kExclusion);
+  EXPECT_EQ(a, b);
+}
+
 TEST(Verification, RefusedSettingsNameTheKeyAndWriteNothing) {
   OPENABLE_REQUIRE_PATH(testing::DatasetsDir() + "/kitti00_first1700/image_0");
   const std::string dir = testing::TempDir();
