@@ -60,10 +60,10 @@ cv::Mat1f Distances(const cv::Mat& a, const cv::Mat& b, Metric metric, int threa
 cv::Mat1f HammingDistances(const cv::Mat& a, const cv::Mat& b = cv::Mat(), int threads = 0,
                            const PairProgress& progress = {});
 
-// Hamming kernels. The fastest one the CPU has is chosen at run time (AVX2 > POPCNT >
-// portable), so one binary runs everywhere.
-enum class HammingKernel { kAuto, kPortable, kPopcnt, kAvx2 };
-// Name of the kernel in use: "avx2", "popcnt" or "portable".
+// Hamming kernels. The fastest one the CPU has is chosen at run time (AVX-512 with VPOPCNTQ >
+// AVX2 > POPCNT > portable), so one binary runs everywhere.
+enum class HammingKernel { kAuto, kPortable, kPopcnt, kAvx2, kAvx512 };
+// Name of the kernel in use: "avx512", "avx2", "popcnt" or "portable".
 const char* HammingKernelName();
 // Forces a kernel for the whole process (tests and benchmarks); kAuto restores the choice.
 // Returns false, changing nothing, when the CPU lacks it.

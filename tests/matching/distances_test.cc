@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 namespace openable {
 namespace {
 
@@ -41,8 +43,12 @@ TEST_P(HammingWidths, MatrixMatchesBruteForce) {
   const int width = GetParam();
   const cv::Mat a = RandomBytes(37, width, 1 + width), b = RandomBytes(23, width, 99 + width);
   for (HammingKernel kernel : {HammingKernel::kPortable, HammingKernel::kPopcnt,
-                               HammingKernel::kAvx2, HammingKernel::kAuto}) {
-  if (!ForceHammingKernel(kernel)) continue;  // the CPU lacks it
+                               HammingKernel::kAvx2, HammingKernel::kAvx512,
+                               HammingKernel::kAuto}) {
+  if (!ForceHammingKernel(kernel)) {  // the CPU lacks it: said, not hidden
+    std::printf("[ SKIPPED  ] Hamming kernel %d: this CPU lacks it\n", static_cast<int>(kernel));
+    continue;
+  }
   SCOPED_TRACE(HammingKernelName());
   for (int threads : {1, 2, 3}) {
     const cv::Mat1f cross = HammingDistances(a, b, threads);
@@ -68,7 +74,11 @@ INSTANTIATE_TEST_SUITE_P(Widths, HammingWidths,
 
 TEST(HammingKernel, TheBestKernelOfTheCpuIsChosen) {
   __builtin_cpu_init();
-  const std::string expected = __builtin_cpu_supports("avx2")     ? "avx2"
+  const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+                      __builtin_cpu_supports("avx512vl") &&
+                      __builtin_cpu_supports("avx512vpopcntdq");
+  const std::string expected = avx512                              ? "avx512"
+                               : __builtin_cpu_supports("avx2")   ? "avx2"
                                : __builtin_cpu_supports("popcnt") ? "popcnt"
                                                                   : "portable";
   EXPECT_EQ(HammingKernelName(), expected);
