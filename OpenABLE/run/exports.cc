@@ -94,36 +94,92 @@ std::string EncodeNpy(const cv::Mat1f& m) {
   return out;
 }
 
-std::string EncodeText(const cv::Mat& m) {
-  if (m.depth() != CV_8U && m.depth() != CV_32F)
-    throw std::logic_error("EncodeText: expected CV_8U or CV_32F");
-  // Blocks of rows are formatted in parallel, then joined. std::to_chars with a precision
-  // formats as printf's "%.6g" does, without locale or format-string parsing.
-  const int block = 64;
-  std::vector<std::string> parts(static_cast<size_t>((m.rows + block - 1) / block));
-  cv::parallel_for_(cv::Range(0, static_cast<int>(parts.size())), [&](const cv::Range& r) {
-    char buf[32];
-    for (int b = r.start; b < r.end; ++b) {
-      std::string& out = parts[static_cast<size_t>(b)];
-      for (int i = b * block; i < std::min(m.rows, (b + 1) * block); ++i) {
-        for (int j = 0; j < m.cols; ++j) {
-          const std::to_chars_result res =
-              m.depth() == CV_8U
-                  ? std::to_chars(buf, buf + sizeof buf, int{m.at<std::uint8_t>(i, j)})
-                  : std::to_chars(buf, buf + sizeof buf, m.at<float>(i, j),
-                                  std::chars_format::general, 6);
-          if (j) out.push_back(' ');
-          out.append(buf, res.ptr);
-        }
-        out.push_back('\n');
+namespace {
+
+// The text of a float as printf's "%.6g" writes it (std::to_chars with a precision: no locale,
+// no format string), remembered by its bits: a matrix of Hamming sums divided by their largest
+// holds a few thousand distinct values (at most L x bits + 1), so most cells are a lookup.
+// Direct-mapped, one per thread; a collision formats again. The digits are those of to_chars
+// either way.
+class FloatTexts {
+ public:
+  FloatTexts() : entries_(kSize) {}
+  std::string_view Of(float v) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    Entry& e = entries_[(bits * 2654435761u) >> (32 - kBits)];
+    if (e.length == 0 || e.bits != bits) {
+      const std::to_chars_result r =
+          std::to_chars(e.text, e.text + sizeof e.text, v, std::chars_format::general, 6);
+      e.bits = bits;
+      e.length = static_cast<std::uint8_t>(r.ptr - e.text);
+    }
+    return {e.text, e.length};
+  }
+
+ private:
+  static constexpr int kBits = 14;
+  static constexpr std::size_t kSize = std::size_t{1} << kBits;
+  struct Entry {
+    std::uint32_t bits = 0;
+    std::uint8_t length = 0;  // 0: empty
+    char text[19];            // "-1.23457e-05" and the like: at most 13 characters
+  };
+  std::vector<Entry> entries_;
+};
+
+// Rows [r0, r1) of `m` as text into `out` (appended).
+void FormatRows(const cv::Mat& m, int r0, int r1, FloatTexts& texts, std::string& out) {
+  char buf[8];
+  for (int i = r0; i < r1; ++i) {
+    for (int j = 0; j < m.cols; ++j) {
+      if (j) out.push_back(' ');
+      if (m.depth() == CV_8U) {
+        const std::to_chars_result res =
+            std::to_chars(buf, buf + sizeof buf, int{m.at<std::uint8_t>(i, j)});
+        out.append(buf, res.ptr);
+      } else {
+        out.append(texts.Of(m.at<float>(i, j)));
       }
     }
+    out.push_back('\n');
+  }
+}
+
+}  // namespace
+
+TextChunks::TextChunks(const cv::Mat& m) : m_(m) {
+  if (m.depth() != CV_8U && m.depth() != CV_32F)
+    throw std::logic_error("TextChunks: expected CV_8U or CV_32F");
+}
+
+bool TextChunks::Next(std::string_view& piece) {
+  if (next_row_ >= m_.rows) return false;
+  // A chunk is kBlocks blocks of kBlockRows rows, formatted in parallel (one block per task)
+  // and written while the next is formatted: the whole text is never in memory.
+  constexpr int kBlockRows = 32, kBlocks = 16;
+  const int r0 = next_row_, r1 = std::min(m_.rows, r0 + kBlockRows * kBlocks);
+  const int blocks = (r1 - r0 + kBlockRows - 1) / kBlockRows;
+  parts_.resize(static_cast<std::size_t>(blocks));
+  cv::parallel_for_(cv::Range(0, blocks), [&](const cv::Range& range) {
+    thread_local FloatTexts texts;
+    for (int b = range.start; b < range.end; ++b) {
+      std::string& out = parts_[static_cast<std::size_t>(b)];
+      out.clear();
+      FormatRows(m_, r0 + b * kBlockRows, std::min(r1, r0 + (b + 1) * kBlockRows), texts, out);
+    }
   });
-  size_t size = 0;
-  for (const auto& part : parts) size += part.size();
+  chunk_.clear();
+  for (const std::string& part : parts_) chunk_ += part;
+  next_row_ = r1;
+  piece = chunk_;
+  return true;
+}
+
+std::string EncodeText(const cv::Mat& m) {
+  TextChunks chunks(m);
   std::string out;
-  out.reserve(size);
-  for (const auto& part : parts) out += part;
+  for (std::string_view piece; chunks.Next(piece);) out += piece;
   return out;
 }
 
@@ -248,6 +304,16 @@ void OutputBatch::Stage(const std::string& key, const std::string& path,
 
 void OutputBatch::Stage(const std::string& key, const std::string& path,
                         const std::vector<std::string_view>& parts) {
+  std::size_t i = 0;
+  Stage(key, path, [&](std::string_view& piece) {
+    if (i == parts.size()) return false;
+    piece = parts[i++];
+    return true;
+  });
+}
+
+void OutputBatch::Stage(const std::string& key, const std::string& path,
+                        const std::function<bool(std::string_view&)>& next) {
   namespace fs = std::filesystem;
   for (const Item& item : items_)
     if (SameFileKey(item.path) == SameFileKey(path))
@@ -276,8 +342,8 @@ void OutputBatch::Stage(const std::string& key, const std::string& path,
   items_.push_back({key, temp, path, RegisterTemporary(temp)});
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   int error = fd < 0 ? errno : 0;
-  for (const std::string_view part : parts)
-    if (error == 0) error = WriteAll(fd, part.data(), part.size());
+  for (std::string_view piece; error == 0 && next(piece);)
+    error = WriteAll(fd, piece.data(), piece.size());
   // On disk before the rename makes it visible: a power cut after the commit must not leave a
   // renamed but empty file (ext4 and XFS may order the rename before the data).
   if (fd >= 0 && error == 0 && ::fsync(fd) != 0 && errno != EINVAL) error = errno;

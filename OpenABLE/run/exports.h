@@ -5,6 +5,7 @@
 // a half-written file, nor a set of outputs that looks complete but is not.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <utility>
 #include <string_view>
@@ -32,6 +33,22 @@ std::string NpyHeader(int rows, int cols);
 // Text of the matrix: one row per line, values separated by one space. Floats are written
 // with 6 significant digits; CV_8U matrices (thresholded) as integers.
 std::string EncodeText(const cv::Mat& m);
+
+// The same text in pieces of a few hundred rows, each formatted in parallel when asked for,
+// for writing a large matrix without holding its whole text (OutputBatch::Stage with a
+// producer). `m` must outlive the object.
+class TextChunks {
+ public:
+  explicit TextChunks(const cv::Mat& m);
+  // The next piece (valid until the next call); false when the text is done.
+  bool Next(std::string_view& piece);
+
+ private:
+  cv::Mat m_;
+  int next_row_ = 0;
+  std::vector<std::string> parts_;
+  std::string chunk_;
+};
 
 // Bytes of a PNG image (OpenCV's encoder).
 std::string EncodePng(const cv::Mat& image);
@@ -81,6 +98,10 @@ class OutputBatch {
   // one buffer: a matrix's rows can be written from where they are).
   void Stage(const std::string& key, const std::string& path,
              const std::vector<std::string_view>& parts);
+  // The same for a file whose pieces are produced while it is written: next(piece) sets the
+  // next piece (valid until the following call) and returns false when there is none.
+  void Stage(const std::string& key, const std::string& path,
+             const std::function<bool(std::string_view&)>& next);
   // Renames every staged file to its destination, all or nothing (see above). Throws
   // InputError naming the key and path whose rename failed.
   void Commit();

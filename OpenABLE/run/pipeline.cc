@@ -675,7 +675,8 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
                                       const RunVerification* verification) {
   const auto t = Clock::now();
   // The encodings are independent; the two PNG images dominate (OpenCV's PNG encoder is
-  // single-threaded), so every output is encoded on its own thread, then staged in order.
+  // single-threaded), so each is encoded on its own thread while the .npy and the text are
+  // written, then staged in order.
   struct Pending {
     std::string key, path;
     std::future<std::string> bytes;
@@ -702,11 +703,6 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
       saved.setTo(std::numeric_limits<float>::quiet_NaN(), empty);
     }
   }
-  if (dense && !out.txt_name.empty())
-    encode("Txt_name", out.txt_name, [&] {
-      return EncodeText(result.thresholded.empty() ? cv::Mat(shown)
-                                                   : cv::Mat(result.thresholded));
-    });
   if (dense && !out.png_name.empty())
     encode("Png_name", out.png_name,
            [&] { return EncodePng(ColorizeMatrix(shown, out.matrix_color)); });
@@ -728,6 +724,13 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
       parts.emplace_back(reinterpret_cast<const char*>(saved.ptr<float>(i)),
                          saved.cols * sizeof(float));
     batch.Stage("Npy_name", out.npy_name, parts);
+  }
+  if (dense && !out.txt_name.empty()) {
+    // Formatted in pieces and written as they come (the PNGs encode meanwhile): the text of a
+    // large matrix is never whole in memory.
+    TextChunks text(result.thresholded.empty() ? cv::Mat(shown) : cv::Mat(result.thresholded));
+    batch.Stage("Txt_name", out.txt_name,
+                [&](std::string_view& piece) { return text.Next(piece); });
   }
   for (Pending& p : pending) batch.Stage(p.key, p.path, p.bytes.get());
   const std::string& matches = config.scale.matches_name;

@@ -243,13 +243,8 @@ TEST(ColorizeMatrix, EqualsColorOfForEveryPixelAndMap) {
   }
 }
 
-// The text writer against printf's "%.6g" on values of every magnitude.
-TEST(EncodeText, MatchesPrintfOnRandomFloats) {
-  cv::Mat1f m(130, 7);  // more rows than one parallel block
-  cv::RNG rng(9);
-  for (int i = 0; i < m.rows; ++i)
-    for (int j = 0; j < m.cols; ++j)
-      m(i, j) = static_cast<float>(rng.uniform(0.0, 1.0) * std::pow(10.0, rng.uniform(-9, 4)));
+// printf's "%.6g" of every cell, one row per line: the reference of the text writer.
+std::string PrintfText(const cv::Mat1f& m) {
   std::string expected;
   char buf[64];
   for (int i = 0; i < m.rows; ++i) {
@@ -259,7 +254,39 @@ TEST(EncodeText, MatchesPrintfOnRandomFloats) {
     }
     expected += "\n";
   }
-  EXPECT_EQ(EncodeText(m), expected);
+  return expected;
+}
+
+// The text writer against printf's "%.6g" on values of every magnitude.
+TEST(EncodeText, MatchesPrintfOnRandomFloats) {
+  cv::Mat1f m(130, 7);  // more rows than one parallel block
+  cv::RNG rng(9);
+  for (int i = 0; i < m.rows; ++i)
+    for (int j = 0; j < m.cols; ++j)
+      m(i, j) = static_cast<float>(rng.uniform(0.0, 1.0) * std::pow(10.0, rng.uniform(-9, 4)));
+  EXPECT_EQ(EncodeText(m), PrintfText(m));
+}
+
+// A matrix as a Hamming run makes it (integer sums over their largest, few distinct values,
+// each formatted once and then looked up) and many distinct values (more than the lookup
+// holds: colliding entries are formatted again), over several pieces of TextChunks.
+TEST(EncodeText, PiecesMatchPrintfWithRepeatedAndManyDistinctValues) {
+  cv::Mat1f hamming(1100, 300), distinct(700, 60);
+  cv::RNG rng(4);
+  for (int i = 0; i < hamming.rows; ++i)
+    for (int j = 0; j < hamming.cols; ++j)
+      hamming(i, j) = static_cast<float>(rng.uniform(0, 7681)) / 7680.0f;  // L = 30, 256 bits
+  for (int i = 0; i < distinct.rows; ++i)
+    for (int j = 0; j < distinct.cols; ++j)
+      distinct(i, j) = static_cast<float>(rng.uniform(0.0, 1.0));
+  for (const cv::Mat1f* m : {&hamming, &distinct}) {
+    TextChunks chunks(*m);
+    std::string joined;
+    int pieces = 0;
+    for (std::string_view piece; chunks.Next(piece); ++pieces) joined += piece;
+    EXPECT_GT(pieces, 1);
+    EXPECT_EQ(joined, PrintfText(*m));
+  }
 }
 
 TEST(EncodeMatches, NpyRecordsAndCsvText) {
