@@ -231,10 +231,8 @@ OPENABLE_AVX512 __attribute__((always_inline)) inline __m512i BlockPair(
 }
 
 // out[4 * b ...]: the counts of blocks b (acc0) and b + 1 (acc1), `valid` of the 8 floats.
-OPENABLE_AVX512 __attribute__((always_inline)) inline void StorePair(__m512i acc0,
-                                                                          __m512i acc1,
-                                                                          int valid,
-                                                                          float* out) {
+OPENABLE_AVX512 __attribute__((always_inline)) inline void StorePair(__m512i acc0, __m512i acc1,
+                                                                     int valid, float* out) {
   const __m512i lo_lanes = _mm512_setr_epi64(0, 1, 2, 3, 8, 9, 10, 11);
   const __m512i hi_lanes = _mm512_setr_epi64(4, 5, 6, 7, 12, 13, 14, 15);
   const __m512i sum = _mm512_add_epi64(_mm512_permutex2var_epi64(acc0, lo_lanes, acc1),
@@ -242,10 +240,16 @@ OPENABLE_AVX512 __attribute__((always_inline)) inline void StorePair(__m512i acc
   _mm256_mask_storeu_ps(out, static_cast<__mmask8>((1u << valid) - 1), _mm512_cvtepi64_ps(sum));
 }
 
+// sum + the bits of words k, k + 1 of `block` that differ from the query's (qv).
+OPENABLE_AVX512 __attribute__((always_inline)) inline __m512i AddPairCount(
+    __m512i sum, __m512i qv, const std::uint64_t* block, int k, int words) {
+  return _mm512_add_epi64(sum,
+                          _mm512_popcnt_epi64(_mm512_xor_si512(qv, BlockPair(block, k, words))));
+}
+
 template <int Pairs>  // word pairs per row; 0: any (read from refs.words)
-OPENABLE_AVX512 void Avx512Blocks(const std::uint64_t* q,
-                                                        const PackedRows& refs, int b0, int b1,
-                                                        float* out) {
+OPENABLE_AVX512 void Avx512Blocks(const std::uint64_t* q, const PackedRows& refs, int b0, int b1,
+                                  float* out) {
   const int words = refs.words;
   const int pairs = Pairs > 0 ? Pairs : (words + 1) / 2;
   constexpr int kKept = Pairs > 0 ? Pairs : 1;
@@ -261,13 +265,10 @@ OPENABLE_AVX512 void Avx512Blocks(const std::uint64_t* q,
     for (int p = 0; p < pairs; ++p) {
       const int k = 2 * p;
       const __m512i qv = Pairs > 0 ? qk[p] : QueryPair(q, k, words);
-      a0 = _mm512_add_epi64(a0, _mm512_popcnt_epi64(_mm512_xor_si512(qv, BlockPair(block, k, words))));
-      a1 = _mm512_add_epi64(
-          a1, _mm512_popcnt_epi64(_mm512_xor_si512(qv, BlockPair(block + stride, k, words))));
-      a2 = _mm512_add_epi64(
-          a2, _mm512_popcnt_epi64(_mm512_xor_si512(qv, BlockPair(block + 2 * stride, k, words))));
-      a3 = _mm512_add_epi64(
-          a3, _mm512_popcnt_epi64(_mm512_xor_si512(qv, BlockPair(block + 3 * stride, k, words))));
+      a0 = AddPairCount(a0, qv, block, k, words);
+      a1 = AddPairCount(a1, qv, block + stride, k, words);
+      a2 = AddPairCount(a2, qv, block + 2 * stride, k, words);
+      a3 = AddPairCount(a3, qv, block + 3 * stride, k, words);
     }
     StorePair(a0, a1, std::min(8, refs.rows - 4 * b), out + 4 * b);
     StorePair(a2, a3, std::max(0, std::min(8, refs.rows - 4 * (b + 2))), out + 4 * b + 8);
@@ -279,18 +280,15 @@ OPENABLE_AVX512 void Avx512Blocks(const std::uint64_t* q,
     for (int p = 0; p < pairs; ++p) {
       const int k = 2 * p;
       const __m512i qv = Pairs > 0 ? qk[p] : QueryPair(q, k, words);
-      a0 = _mm512_add_epi64(a0, _mm512_popcnt_epi64(_mm512_xor_si512(qv, BlockPair(block, k, words))));
-      if (two)
-        a1 = _mm512_add_epi64(
-            a1, _mm512_popcnt_epi64(_mm512_xor_si512(qv, BlockPair(refs.Block(b + 1), k, words))));
+      a0 = AddPairCount(a0, qv, block, k, words);
+      if (two) a1 = AddPairCount(a1, qv, refs.Block(b + 1), k, words);
     }
     StorePair(a0, a1, std::min(two ? 8 : 4, refs.rows - 4 * b), out + 4 * b);
   }
 }
 
-OPENABLE_AVX512 void Avx512Kernel(const std::uint64_t* q,
-                                                         const PackedRows& refs, int b0, int b1,
-                                                         float* out) {
+OPENABLE_AVX512 void Avx512Kernel(const std::uint64_t* q, const PackedRows& refs, int b0, int b1,
+                                  float* out) {
   switch (refs.words) {
     case 4: return Avx512Blocks<2>(q, refs, b0, b1, out);    // 256 bits (LDB, ORB)
     case 8: return Avx512Blocks<4>(q, refs, b0, b1, out);    // 512 bits (BRISK)

@@ -33,6 +33,13 @@ struct EvaluationLayout {
   static EvaluationLayout QueryReference(int queries, int references) {
     return {Kind::kQueryReference, queries, references, 0, 0};
   }
+  // Query q's candidates are the block's columns [0, CandidateEnd(q, exclusion)): every
+  // reference, or with one sequence the frames at least `exclusion` back.
+  int CandidateEnd(int q, int exclusion) const {
+    if (kind == Kind::kQueryReference) return references;
+    const int end = q - exclusion + 1;
+    return end < 0 ? 0 : end > references ? references : end;
+  }
 };
 
 }  // namespace openable

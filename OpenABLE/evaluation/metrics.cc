@@ -33,12 +33,6 @@ void CheckShapes(const cv::Mat1f& matrix, const EvaluationLayout& layout,
     throw std::logic_error("evaluation: a loop-closure layout must be square");
 }
 
-// Last candidate column of query q plus one (candidates are columns [0, end)).
-int CandidateEnd(const EvaluationLayout& layout, int q, int exclusion) {
-  if (layout.kind == EvaluationLayout::Kind::kQueryReference) return layout.references;
-  return std::max(0, std::min(layout.references, q - exclusion + 1));
-}
-
 // True matches of q among its candidates (matches are sorted, so this is a prefix).
 std::vector<int> CandidateTruth(const std::vector<int>& matches, int end) {
   return std::vector<int>(matches.begin(),
@@ -80,7 +74,7 @@ bool BeginQuery(const EvaluationLayout& layout, const GroundTruth& truth,
                 const EvaluationOptions& options, int q, PerQueryResult& r,
                 std::vector<std::uint8_t>& has_candidates, std::vector<std::int64_t>& outside,
                 std::vector<int>& t) {
-  const int end = CandidateEnd(layout, q, options.exclusion);
+  const int end = layout.CandidateEnd(q, options.exclusion);
   t = CandidateTruth(truth.matches[q], end);
   outside[q] = static_cast<std::int64_t>(truth.matches[q].size() - t.size());
   if (end == 0) return false;
@@ -220,7 +214,7 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
     std::vector<int> t;
     for (int q = range.start; q < range.end; ++q) {
       if (!BeginQuery(layout, truth, options, q, r, has_candidates, outside, t)) continue;
-      const int end = CandidateEnd(layout, q, options.exclusion);
+      const int end = layout.CandidateEnd(q, options.exclusion);
       const float* row = matrix.ptr<float>(layout.row_offset + q) + layout.col_offset;
       top.clear();
       for (int c = 0; c < end; ++c) {
@@ -265,7 +259,7 @@ PerQueryResult EvaluateAnswers(const EvaluationLayout& layout, const GroundTruth
   std::vector<int> t;
   for (int q = 0; q < nq; ++q) {
     if (!BeginQuery(layout, truth, options, q, r, has_candidates, outside, t)) continue;
-    const int end = CandidateEnd(layout, q, options.exclusion);
+    const int end = layout.CandidateEnd(q, options.exclusion);
     const std::vector<Answer>& a = answers[q];
     if (a.empty()) continue;  // no accepted candidate: no answer
     for (const Answer& x : a)
@@ -306,7 +300,7 @@ AblePResult EvaluateAbleP(const cv::Mat1f& matrix, const EvaluationLayout& layou
   cv::Mat1f values(nq, nr);  // candidate values, +inf elsewhere
   const float kNotCandidate = std::numeric_limits<float>::infinity();
   for (int q = 0; q < nq; ++q) {
-    const int end = CandidateEnd(layout, q, options.exclusion);
+    const int end = layout.CandidateEnd(q, options.exclusion);
     const float* row = matrix.ptr<float>(layout.row_offset + q) + layout.col_offset;
     float* out = values.ptr<float>(q);
     for (int c = 0; c < nr; ++c) out[c] = c < end ? row[c] : kNotCandidate;

@@ -23,8 +23,8 @@ struct PrSeries {
 
 // A white figure, two panels side by side: "Per-query best match" (precision against recall of
 // each series' per_query curve) and "ABLE-P cells (vicinity V)" (the able_p curves of the
-// series that have one; the panel is left out when every able_p is empty). Axes from 0 to 1 labelled "Recall" and "Precision" with
-// ticks every 0.1 and a light grid, one distinct colour per series, a legend with the labels
+// series that have one; the panel is left out when every able_p is empty). Axes from 0 to 1
+// labelled "Recall" and "Precision" with ticks every 0.1 and a light grid, one distinct colour per series, a legend with the labels
 // and each series' AUC / AP, and `title` above. About 1400 x 640 pixels with two panels.
 cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& title,
                        int vicinity);

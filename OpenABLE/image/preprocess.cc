@@ -14,6 +14,20 @@
 
 namespace openable {
 
+cv::Mat1b GreyOfImage(const cv::Mat& image, const std::string& what) {
+  if (image.empty()) throw InputError(what + " is empty (expected an image)");
+  const int depth = image.depth(), channels = image.channels();
+  if ((depth != CV_8U && depth != CV_32F) || (channels != 1 && channels != 3))
+    throw InputError(what + " has OpenCV type " + cv::typeToString(image.type()) +
+                     " (expected CV_8UC1, CV_8UC3 (BGR), CV_32FC1 or CV_32FC3 in [0, 1])");
+  if (depth == CV_32F) return ToGray8(image);
+  // 8-bit grey is already what ToGray8 would give back (x / 255 x 255 rounds to x).
+  if (channels == 1) return image;
+  cv::Mat scaled;
+  image.convertTo(scaled, CV_32F, 1.0 / 255.0);
+  return ToGray8(scaled);
+}
+
 cv::Mat1b ToGray8(const cv::Mat& frame) {
   if (frame.depth() != CV_32F || frame.channels() > 3)
     throw std::logic_error("ToGray8: expected a CV_32FC1, CV_32FC2 or CV_32FC3 frame");

@@ -17,6 +17,12 @@ namespace openable {
 // Throws std::logic_error on any other type.
 cv::Mat1b ToGray8(const cv::Mat& frame);
 
+// The grey 8-bit image of an image a program gives (the online detector, verification):
+// CV_8UC1, CV_8UC3 (BGR), CV_32FC1 or CV_32FC3 in [0, 1]. 8-bit images are first scaled to
+// [0, 1] floats, as frame sources give them, so that the grey conversion is ToGray8's, the one
+// Test_OpenABLE applies. Throws InputError "<what> is empty / has OpenCV type ..." otherwise.
+cv::Mat1b GreyOfImage(const cv::Mat& image, const std::string& what);
+
 // Both channels of a stereo frame (CV_32FC2 in [0, 1]) as CV_8UC2 (value x 255, rounded): the
 // patch D-LDB describes. Throws std::logic_error on any other type.
 cv::Mat ToGrayDisparity8(const cv::Mat& frame);

@@ -34,21 +34,6 @@ std::string SizeText(cv::Size s) {
   return std::to_string(s.width) + "x" + std::to_string(s.height);
 }
 
-// The grey 8-bit image the descriptors see, from the image types AddFrame takes: 8-bit images
-// are first scaled to [0, 1] floats, as frame sources give them, so that the grey conversion
-// (ToGray8) is the one Test_OpenABLE applies and rows equal the batch rows bit for bit.
-cv::Mat1b GreyOf(const cv::Mat& image, const std::string& what) {
-  if (image.empty()) throw InputError(what + " is empty (expected an image)");
-  const int depth = image.depth(), channels = image.channels();
-  if ((depth != CV_8U && depth != CV_32F) || (channels != 1 && channels != 3))
-    throw InputError(what + " has OpenCV type " + cv::typeToString(image.type()) +
-                     " (expected CV_8UC1, CV_8UC3 (BGR), CV_32FC1 or CV_32FC3 in [0, 1])");
-  if (depth == CV_32F) return ToGray8(image);
-  cv::Mat scaled;
-  image.convertTo(scaled, CV_32F, 1.0 / 255.0);
-  return ToGray8(scaled);
-}
-
 }  // namespace
 
 void OnlineOptions::Check() const {
@@ -109,10 +94,9 @@ Describer MakeDescriber(const OnlineOptions& options) {
 
 namespace {
 
-// Describes one image with `describer`, checking its size.
-void DescribeInto(const FrameDescriber& describer, const cv::Mat& image, const std::string& what,
+// Describes the grey image of a frame (GreyOfImage) with `describer`, checking its size.
+void DescribeInto(const FrameDescriber& describer, const cv::Mat1b& grey, const std::string& what,
                   cv::Mat row) {
-  const cv::Mat1b grey = GreyOf(image, what);
   const cv::Size need = describer.MinimumFrame();
   if (grey.cols < need.width || grey.rows < need.height)
     throw InputError(what + " is " + SizeText(grey.size()) + "; the grid needs at least " +
@@ -133,7 +117,8 @@ cv::Mat DescribeImages(const std::vector<cv::Mat>& images, const OnlineOptions& 
   std::string error;
   ParallelFor(n, threads, [&](int i) {
     try {
-      DescribeInto(*d.frame, images[i], "image " + std::to_string(i), rows.row(i));
+      const std::string what = "image " + std::to_string(i);
+      DescribeInto(*d.frame, GreyOfImage(images[i], what), what, rows.row(i));
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex);
       if (i < error_index) error_index = i, error = e.what();
@@ -222,7 +207,8 @@ OnlineResult OnlineDetector::AddFrame(const cv::Mat& image) {
   const auto start = Clock::now();
   cv::Mat row(1, s.width, s.type);
   const std::string what = "frame " + std::to_string(Size());
-  DescribeInto(*s.describer.frame, image, what, row);
+  const cv::Mat1b grey = GreyOfImage(image, what);
+  DescribeInto(*s.describer.frame, grey, what, row);
   const double describe = Seconds(start);
   if (!s.verifier) {
     OnlineResult r = AddDescriptor(row);
@@ -230,7 +216,7 @@ OnlineResult OnlineDetector::AddFrame(const cv::Mat& image) {
     return r;
   }
   const auto verify_start = Clock::now();
-  s.features.push_back(s.verifier->Extract(GreyOf(image, what)));
+  s.features.push_back(s.verifier->Extract(grey));
   double verify = Seconds(verify_start);
   OnlineResult r = s.Search(row);
   r.describe_seconds = describe;

@@ -124,14 +124,16 @@ EvaluationLayout LayoutOf(const RunResult& result);
 // Evaluation_name when `evaluation` is given)
 // all-or-nothing. Cells without a value (+inf, Sequence_partial skip) are written as the
 // largest finite value in Txt_name and the PNG images and as NaN in Npy_name. Returns the
-// paths written. Adds the time spent to result.timings.export_seconds. Throws InputError naming the key and path on failure.
+// paths written. Adds the time spent to result.timings.export_seconds. Throws InputError
+// naming the key and path on failure.
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
                                       const Evaluation* evaluation = nullptr,
                                       const RunVerification* verification = nullptr);
 
 // Every file a run of `config` may write, as (key, path): the matrix files, the thresholded
-// image, the matches, the loops (Verification) and, when Ground_truth_type and Evaluation_name are set, the evaluation's
-// files (StageEvaluation). Run checks them with CheckDistinctOutputs before any work.
+// image, the matches, the loops (Verification) and, when Ground_truth_type and
+// Evaluation_name are set, the evaluation's files (StageEvaluation). Run checks them with
+// CheckDistinctOutputs before any work.
 std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& config);
 
 // The thresholded image's path: Png_threshold_name, or Png_name with "_thresholded" before

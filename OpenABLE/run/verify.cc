@@ -14,6 +14,7 @@
 #include "OpenABLE/base/threading.h"
 #include "OpenABLE/io/frame_source.h"
 #include "matching/bounded.h"
+#include "OpenABLE/evaluation/layout.h"
 #include "matching/score.h"
 
 namespace openable {
@@ -25,25 +26,21 @@ double Ms(Clock::time_point since) {
   return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
 }
 
-std::vector<int> StartsOf(const RunResult& result) {
-  std::vector<int> starts;
-  for (const Traversal& t : result.traversals) starts.push_back(t.first_row);
-  return starts;
-}
-
 int FrameCount(const RunResult& result) {
   int n = 0;
   for (const Traversal& t : result.traversals) n += t.frames;
   return n;
 }
 
-// Candidates of one query from (distance, reference) pairs and the score of each.
+// The candidates `chosen` (DistinctBest, best first) of one query's (distance, reference)
+// cells, with the score of each.
 QueryVerification FromCandidates(int query, const std::vector<std::pair<float, int>>& cells,
-                                 const std::vector<float>& scores, int k, int window) {
+                                 const std::vector<std::size_t>& chosen,
+                                 const std::vector<float>& scores) {
   QueryVerification v;
   v.query = query;
   int rank = 0;
-  for (const std::size_t i : DistinctBest(cells, k, window)) {
+  for (const std::size_t i : chosen) {
     VerifiedCandidate c;
     c.reference = cells[i].second;
     c.rank = ++rank;
@@ -107,7 +104,7 @@ void CheckVerification(const Config& config, bool from_video, int queries,
         v.calibration, v.calibration_scale, "Verification_calibration");
     CheckIntrinsicsFit(camera, v.calibration, size, first_frame, "Verification_calibration");
   }
-  if (v.consistency >= queries)
+  if (v.consistency > 0 && v.consistency >= queries)
     throw InputError("Verification_consistency: " + std::to_string(v.consistency) +
                      " queries before a loop must also have loops, but the run has " +
                      std::to_string(queries) + " queries; expected fewer than " +
@@ -118,29 +115,25 @@ std::vector<QueryVerification> VerificationCandidates(const Config& config,
                                                       const RunResult& result) {
   const VerificationOptions& v = config.verification;
   const MatchingOptions& m = config.matching;
-  const MatchBlock block = BlockOf(StartsOf(result), FrameCount(result));
-  const int exclusion = config.evaluation.protocol.exclusion;
   std::vector<QueryVerification> out;
   std::vector<std::pair<float, int>> cells;
   std::vector<float> scores;
   if (!result.bounded) {
-    for (int q = 0; q < block.query_count; ++q) {
-      const int end = block.one_traversal
-                          ? std::max(0, std::min(block.reference_count, q - exclusion + 1))
-                          : block.reference_count;
+    // The candidates of the evaluation (EvaluationLayout::CandidateEnd).
+    const EvaluationLayout layout = LayoutOf(result);
+    for (int q = 0; q < layout.queries; ++q) {
+      const int end = layout.CandidateEnd(q, config.evaluation.protocol.exclusion);
       if (end == 0) continue;
-      const float* row =
-          result.normalized.ptr<float>(block.query_first + q) + block.reference_first;
+      const float* row = result.normalized.ptr<float>(layout.row_offset + q) + layout.col_offset;
       cells.clear();
-      scores.clear();
       for (int c = 0; c < end; ++c) cells.emplace_back(row[c], c);
+      const std::vector<std::size_t> chosen = DistinctBest(cells, v.candidates, m.score_window);
+      if (chosen.empty()) continue;
       // Scores of the chosen candidates only: ScoreOfCandidate is linear in the row.
-      const std::vector<std::size_t> best = DistinctBest(cells, v.candidates, m.score_window);
-      if (best.empty()) continue;
       scores.assign(cells.size(), 0.0f);
-      for (const std::size_t i : best)
+      for (const std::size_t i : chosen)
         scores[i] = ScoreOfCandidate(row, end, cells[i].second, m.score, m.score_window);
-      out.push_back(FromCandidates(q, cells, scores, v.candidates, m.score_window));
+      out.push_back(FromCandidates(q, cells, chosen, scores));
     }
     return out;
   }
@@ -154,8 +147,8 @@ std::vector<QueryVerification> VerificationCandidates(const Config& config,
       cells.emplace_back(match->distance, match->reference);
       scores.push_back(match->score);
     }
-    QueryVerification query = FromCandidates(q, cells, scores, v.candidates, m.score_window);
-    if (!query.candidates.empty()) out.push_back(std::move(query));
+    const std::vector<std::size_t> chosen = DistinctBest(cells, v.candidates, m.score_window);
+    if (!chosen.empty()) out.push_back(FromCandidates(q, cells, chosen, scores));
   }
   return out;
 }
@@ -199,19 +192,18 @@ RunVerification VerifyRun(const Config& config, const RunResult& result,
   std::mutex mutex;
   for (int first = 0; first < total; first += kBatch) {
     const int last = std::min(total, first + kBatch);
-    // The frames of the batch whose features are not kept.
-    std::vector<int> missing;
-    auto need = [&](int row) {
-      if (cache.Find(row) == nullptr &&
-          std::find(missing.begin(), missing.end(), row) == missing.end())
-        missing.push_back(row);
-    };
+    // The frames of the batch whose features are not kept, each once, in row order.
+    std::vector<int> rows;
     for (int i = first; i < last; ++i) {
-      need(query.first_row + out.queries[i].query);
+      rows.push_back(query.first_row + out.queries[i].query);
       for (const VerifiedCandidate& c : out.queries[i].candidates)
-        need(reference.first_row + c.reference);
+        rows.push_back(reference.first_row + c.reference);
     }
-    std::sort(missing.begin(), missing.end());
+    std::sort(rows.begin(), rows.end());
+    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    std::vector<int> missing;
+    for (const int row : rows)
+      if (cache.Find(row) == nullptr) missing.push_back(row);
     std::vector<FrameFeatures> computed(missing.size());
     std::vector<float> computed_ms(missing.size());
     ParallelFor(static_cast<int>(missing.size()), threads, [&](int i) {

@@ -22,20 +22,6 @@ void Require(bool ok, const char* key, const std::string& value, const std::stri
   if (!ok) throw InputError(std::string(key) + ": " + value + "; expected " + expected);
 }
 
-// The grey 8-bit image features are detected on.
-cv::Mat1b Grey8(const cv::Mat& image) {
-  if (image.empty()) throw InputError("verification: an empty image (expected a frame)");
-  const int depth = image.depth(), channels = image.channels();
-  if ((depth != CV_8U && depth != CV_32F) || (channels != 1 && channels != 3))
-    throw InputError("verification: an image of OpenCV type " + cv::typeToString(image.type()) +
-                     "; expected CV_8UC1, CV_8UC3, CV_32FC1 or CV_32FC3");
-  if (depth == CV_32F) return ToGray8(image);
-  if (channels == 1) return image;
-  cv::Mat1b grey;
-  cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-  return grey;
-}
-
 int CountMask(const cv::Mat& mask) { return mask.empty() ? 0 : cv::countNonZero(mask); }
 
 }  // namespace
@@ -107,7 +93,7 @@ PairVerifier::PairVerifier(const VerificationOptions& options,
 }
 
 FrameFeatures PairVerifier::Extract(const cv::Mat& image) const {
-  const cv::Mat1b grey = Grey8(image);
+  const cv::Mat1b grey = GreyOfImage(image, "verification: the frame");
   // One detector per call: OpenCV's Feature2D objects are not documented as thread-safe.
   const odometry::FeatureExtractor extractor(EnumName(options_.features),
                                              options_.max_features, "Verification_features");

@@ -125,7 +125,9 @@ TEST(Verification, LoopsFileAgreesWithTheEvaluationOnKittiRevisit) {
     EXPECT_GT(l.rank, last_rank[l.query]) << "ranks in order";
     last_rank[l.query] = l.rank;
     EXPECT_GE(l.geometric, l.verified);
-    if (l.geometric) EXPECT_GE(l.inliers, 40);  // Verification_min_inliers
+    if (l.geometric) {
+      EXPECT_GE(l.inliers, 40);  // Verification_min_inliers
+    }
     if (l.verified && !answer.count(l.query)) answer[l.query] = l.reference;
   }
   int tp = 0, fp = 0, positives = 0;
@@ -223,7 +225,7 @@ TEST(Verification, BoundedModeChecksTheSameBestMatches) {
   ASSERT_EQ(RunProgram(testing::TestOpenableExe(), dense, dir).status, 0);
   fs::rename(dir + "/loops.csv", dir + "/dense.csv");
   std::vector<std::string> bounded = RunArgs(r, dir);
-  for (const std::string& a : {"Matrix_mode=2", "Best_matches=50", "Evaluation_name=",
+  for (const char* a : {"Matrix_mode=2", "Best_matches=50", "Evaluation_name=",
                                "Ground_truth_type=", "Verification_candidates=1"})
     bounded.insert(bounded.end(), {"--set", a});
   bounded.insert(bounded.end(), {"--set", "Matches_name=" + dir + "/matches.csv"});
@@ -278,6 +280,15 @@ TEST(Verification, RefusedSettingsNameTheKeyAndWriteNothing) {
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_NE(o.out.find("essential matrix"), std::string::npos) << o.out;
   EXPECT_NE(e2e::ReadAll(dir + "/loops.csv").find(",essential,"), std::string::npos);
+  // A run without queries (every frame within Exclusion of the first) and the consistency off
+  // is not refused: it verifies nothing.
+  std::vector<std::string> none = RunArgs(r, dir);
+  for (const char* a : {"Exclusion=500", "Verification_consistency=0",
+                               "Ground_truth_type=", "Evaluation_name="})
+    none.insert(none.end(), {"--set", a});
+  const Outcome empty = RunProgram(testing::TestOpenableExe(), none, dir);
+  ASSERT_EQ(empty.status, 0) << empty.err;
+  EXPECT_NE(empty.out.find("0 queries, 0 candidates checked"), std::string::npos) << empty.out;
 }
 
 TEST(Verification, VideoFramesCannotBeReadAgain) {
