@@ -12,6 +12,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
+#include <memory>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -25,8 +27,40 @@ using namespace openable::io_internal;
 
 namespace {
 
+// Opens `file` with the reader its extension names or else with the first still-image reader
+// that recognises it; an empty pointer and `error` set when none does. ImageInput::open would
+// do the same but also offer the file to the FFmpeg (video) reader, which a damaged image can
+// drive into an exception or a leak (found by the image fuzzer); frames here are still images,
+// and videos go through OpenCV's videoio instead.
+std::unique_ptr<OIIO::ImageInput> OpenImageReader(const std::string& file,
+                                                  const OIIO::ImageSpec& config,
+                                                  std::string& error) {
+  error.clear();
+  auto try_reader = [&](const std::string& format) -> std::unique_ptr<OIIO::ImageInput> {
+    if (format.empty() || format == "ffmpeg") return nullptr;
+    auto in = OIIO::ImageInput::create(format, /*do_open=*/false, &config);
+    if (!in || std::string(in->format_name()) == "ffmpeg" || !in->valid_file(file)) {
+      (void)OIIO::geterror();  // the complaint of a reader the file is not for
+      return nullptr;
+    }
+    OIIO::ImageSpec spec;
+    if (in->open(file, spec, config)) return in;
+    if (error.empty()) error = in->geterror();  // the file's own reader, failing on it
+    return nullptr;
+  };
+  if (auto in = try_reader(file)) return in;  // the reader of the extension, if there is one
+  const std::string formats = OIIO::get_string_attribute("input_format_list");
+  for (std::size_t begin = 0; begin < formats.size();) {
+    const std::size_t end = std::min(formats.find(',', begin), formats.size());
+    if (auto in = try_reader(formats.substr(begin, end - begin))) return in;
+    begin = end + 1;
+  }
+  if (error.empty()) error = "no image reader of OpenImageIO recognises its contents";
+  return nullptr;
+}
+
 // Decodes the file `oiio_name`, named `path` in messages.
-void Read(const std::string& path, const std::string& oiio_name, cv::Mat& frame) {
+void ReadUnguarded(const std::string& path, const std::string& oiio_name, cv::Mat& frame) {
   auto fail = [&](const std::string& what) -> InputError {
     return InputError("image " + Quoted(path) + " " + what + " (" + kExpectedImage + ")");
   };
@@ -34,8 +68,9 @@ void Read(const std::string& path, const std::string& oiio_name, cv::Mat& frame)
   // premultiply them by alpha), since the alpha channel is dropped below.
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
-  auto in = OIIO::ImageInput::open(oiio_name, &config);
-  if (!in) throw fail("cannot be decoded: " + FirstLine(OIIO::geterror()));
+  std::string error;
+  auto in = OpenImageReader(oiio_name, config, error);
+  if (!in) throw fail("cannot be decoded: " + FirstLine(error));
   // Callers read many files in parallel; one thread per file avoids OIIO's own fan-out.
   in->threads(1);
 
@@ -121,6 +156,21 @@ void Read(const std::string& path, const std::string& oiio_name, cv::Mat& frame)
     cv::max(image, 0.0, image);
   }
   frame = image;
+}
+
+// ReadUnguarded, with any other exception from inside OpenImageIO named as a decoding failure
+// of the file. A damaged file that no reader claims is offered to every reader OpenImageIO
+// has, its FFmpeg (video) reader included, and that reader has thrown std::length_error on
+// bytes the image fuzzer made; such an exception must not end the program.
+void Read(const std::string& path, const std::string& oiio_name, cv::Mat& frame) {
+  try {
+    ReadUnguarded(path, oiio_name, frame);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError("image " + Quoted(path) + " cannot be decoded: OpenImageIO failed (" +
+                     FirstLine(e.what()) + ") (" + kExpectedImage + ")");
+  }
 }
 
 }  // namespace

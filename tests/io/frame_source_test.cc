@@ -589,6 +589,34 @@ TEST(ReadImageFile, HugeAnnouncedSizeIsRefusedBeforeAllocating) {
   ExpectInputError([&] { DecodeImageBytes(bytes, "huge.pgm"); }, {"huge.pgm", "too large"});
 }
 
+// Found by tests/fuzz/image_fuzzer.cc: a damaged PAM header ("P7", a format neither OpenCV nor
+// the signature table names) went to every reader of OpenImageIO, its FFmpeg (video) reader
+// included, which threw std::length_error (ending the process) in a long fuzzing run. Such a
+// file is now offered to still-image readers only, and the message names the file the user
+// gave, never the temporary copy that OpenImageIO reads bytes from.
+TEST(ReadImageFile, UnrecognisedContentsAreNamedWithoutTheTemporaryCopy) {
+  const std::string bytes(
+      "\x50\x37\x0a\x38\x20\x36\x0a\x32\x35\x35\x0a\x32\x48\xa4\x35\x0a\x32\x48\xa4\x3f\x3a\xc5"
+      "\x4d\xbe\xb0\x19\xd5\x70\xa1\x1e\x68\x92\x60\x80\x9e\xa9\xce\x51\x26\x87\xe2\x8f\x18\x4a"
+      "\x80\x27\x41\xf1\xc9\xc5\xd9\xc3\x63\x2e\x4b\xc2\xc0\x9b\xdf\x38\x17\xef\x2c\x69\xeb\x87"
+      "\x4f\x15\x1b\xd1\x50\x04\xe6\x50\x5b\x69\xbc\x3f\x3a\xc5\x4d\xbe\xb0\x19\xd5\x70\xa1\x1e"
+      "\x68\x92\x60\x80\x9e\xa9\xce\x51\x26\x87\xe2\x8f\x18\x4a\x80\x27\x41\xf1\xc9\xc5\xd9\xc3"
+      "\x63\x2e\x4b\xc2\xc0\x9b\xdf\x38\x17\xef\x2c\x69\xeb\x87\x4f\x15\x1b\xd1\x50\x04\xe6\x50"
+      "\x5b\x69\xbc\x28\x17\xe9\x80\xec\xba\x76\x6f\x43\xbc\x83",
+      146);
+  ASSERT_EQ(bytes.compare(0, 3, "P7\n"), 0);
+  ExpectInputError([&] { DecodeImageBytes(bytes, "damaged.pam"); },
+                   {"damaged.pam", "cannot be decoded", "no image reader"});
+  try {
+    DecodeImageBytes(bytes, "damaged.pam");
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).find("openable_image_"), std::string::npos) << e.what();
+  }
+  const std::string path = TempDir() + "/damaged";
+  WriteBytes(path, bytes);
+  ExpectInputError([&] { ReadImageFile(path); }, {Q(path), "cannot be decoded"});
+}
+
 TEST(ModuleSymbol, MissingModuleIsNamed) {
   ExpectInputError([] { ModuleSymbol("no_such_module", "f"); },
                    {"libopenable_no_such_module.so", "cannot be loaded", "OPENABLE_MODULE_PATH"});
