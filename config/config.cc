@@ -221,8 +221,8 @@ OptionTable ConfigTable(Config& c) {
   t.AddEnumNumber("Matrix_mode", kScale, c.scale, c.scale.matrix_mode,
         "0 auto: dense when the N x N matrix fits in Memory_limit, bounded otherwise (the run "
         "says which and why); 1 dense: the whole matrix, every output; 2 bounded: the matrix is "
-        "computed in tiles of rows and only the matches of Best_matches and Band_width are kept "
-        "(Matches_name); with two traversals only queries (Images_path_2) against references "
+        "never held: rows are computed in ranges and only the matches of Best_matches and "
+        "Band_width are kept (Matches_name); with two traversals only queries (Images_path_2) against references "
         "(Images_path) are computed.");
   t.Add("Memory_limit", kScale, c.scale, c.scale.memory_limit, 0, kNoLimit,
         "GiB the dense matrices may take before auto mode switches to bounded; 0 = three quarters"

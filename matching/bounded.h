@@ -1,7 +1,9 @@
 // Memory-bounded matching (Matrix_mode 2, or auto when the dense matrix would not fit): the
-// matrix is computed in tiles of rows, sequence sums included, and only the matches the user
-// asked for are kept: the Best_matches smallest distances of every query and the cells of the
-// band |i - j| <= Band_width. Memory: one tile (about 256 MB) plus the kept matches, whatever N.
+// matrix is never held. Each thread takes ranges of query rows and, row by row, computes the
+// distances, the sequence sums over a ring of the last L + 1 rows and the row's kept matches:
+// the Best_matches smallest distances of every query and the cells of the band
+// |i - j| <= Band_width. Memory: per thread about (L + 5) rows of references x 4 bytes, plus
+// the kept matches, whatever the number of queries.
 //
 // Rows and columns: with two traversals, the queries are the frames of the second
 // (Images_path_2) and the references those of the first (Images_path), and only that block is
@@ -75,10 +77,12 @@ struct BoundedOptions {
   SequenceDirection direction = SequenceDirection::kForward;
   SequencePartial partial = SequencePartial::kScale;
   int threads = 0;
-  std::int64_t tile_bytes = std::int64_t{256} << 20;
+  // Query rows per range of the fused pipeline (each thread takes ranges in turn); 0 chooses
+  // from the rows and threads (64 to 1024). Tests set a few rows to cross many range starts.
+  int range_rows = 0;
 };
 
-// Computes the block tile by tile from the descriptors (CV_8U: Hamming or L1 as
+// Computes the block range by range from the descriptors (CV_8U: Hamming or L1 as
 // options.metric says, CV_32F: L2) and keeps the matches; `max_distance` receives the Eq. 5
 // divisor. progress(done rows, rows).
 std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& block,

@@ -479,7 +479,7 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     const auto t = Clock::now();
     result.timings.pairs =
         static_cast<std::int64_t>(block.query_count) * block.reference_count;
-    progress.Begin("matching", block.query_count, "queries (bounded: tiles of rows)");
+    progress.Begin("matching", block.query_count, "queries (bounded: ranges of rows)");
     BoundedOptions options;
     options.metric = result.descriptors.front().metric;
     options.sequence_length = matching.sequence_length;

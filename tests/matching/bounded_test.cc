@@ -51,9 +51,9 @@ void ExpectSame(const std::vector<Match>& a, const std::vector<Match>& b, float 
   }
 }
 
-// The tiled run against the dense matrix computed by the separate, tested pieces, then
+// The fused run against the dense matrix computed by the separate, tested pieces, then
 // selected by brute force: one traversal (exclusion) and two (cross block), several L and
-// both directions, with tiles of a few rows so that many tile borders are crossed.
+// every direction, with ranges of a few rows so that many range starts are crossed.
 TEST(BoundedMatches, EqualsBruteForceSelectionOfTheDenseMatrix) {
   const cv::Mat d = RandomBinary(150, 32, 3);
   for (int traversals : {1, 2}) {
@@ -65,8 +65,10 @@ TEST(BoundedMatches, EqualsBruteForceSelectionOfTheDenseMatrix) {
     rules.exclusion = 10;
     rules.one_traversal = block.one_traversal;
     for (int L : {1, 3, 8}) {
-      for (auto dir : {SequenceDirection::kForward, SequenceDirection::kReverse}) {
-        SCOPED_TRACE("traversals " + std::to_string(traversals) + " L " + std::to_string(L));
+      for (auto dir : {SequenceDirection::kForward, SequenceDirection::kReverse,
+                       SequenceDirection::kBoth}) {
+        SCOPED_TRACE("traversals " + std::to_string(traversals) + " L " + std::to_string(L) +
+                     " direction " + std::to_string(static_cast<int>(dir)));
         // Dense: the block of the full matrix, with sums restricted to the block's traversals.
         cv::Mat1f full = HammingDistances(d);
         SequenceDistancesInPlace(full, L, starts, starts, dir);
@@ -83,7 +85,7 @@ TEST(BoundedMatches, EqualsBruteForceSelectionOfTheDenseMatrix) {
         BoundedOptions options;
         options.sequence_length = L;
         options.direction = dir;
-        options.tile_bytes = 7 * block.reference_count * 4;  // a few rows per tile
+        options.range_rows = 7;  // many ranges, each starting L - 1 rows early
         float max_distance = 0;
         const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
         EXPECT_FLOAT_EQ(max_distance, block_max);
@@ -104,7 +106,7 @@ TEST(MatchesFromMatrix, SameSelectionAsBoundedOnOneTraversal) {
   NormalizeByMax(full);  // one traversal: the block is the whole matrix, same divisor
   BoundedOptions options;
   options.sequence_length = 4;
-  options.tile_bytes = 5 * d.rows * 4;
+  options.range_rows = 5;
   float max_distance = 0;
   ExpectSame(BoundedMatches(d, block, rules, options, max_distance),
              MatchesFromMatrix(full, block, rules), 1.0f);
@@ -123,6 +125,42 @@ TEST(BoundedMatches, VectorDescriptorsUseL2) {
   for (const Match& m : got) {
     const float direct = static_cast<float>(cv::norm(d.row(30 + m.query), d.row(m.reference)));
     EXPECT_NEAR(m.distance * max_distance, direct, 1e-4);
+  }
+}
+
+// L2 rows with sequences, in every direction: the same kept matches as the dense matrix of the
+// separate pieces, distances within float rounding (the sums are formed in the same order,
+// from each range's first row instead of the traversal's).
+TEST(BoundedMatches, VectorDescriptorsWithSequencesEqualTheDenseMatrix) {
+  cv::Mat d(130, 24, CV_32F);
+  cv::RNG(8).fill(d, cv::RNG::UNIFORM, 0.0, 1.0);
+  const std::vector<int> starts = {0, 60};
+  const MatchBlock block = BlockOf(starts, d.rows);
+  KeepRules rules;
+  rules.best = 3;
+  rules.one_traversal = false;
+  for (auto dir : {SequenceDirection::kForward, SequenceDirection::kReverse,
+                   SequenceDirection::kBoth}) {
+    SCOPED_TRACE(static_cast<int>(dir));
+    cv::Mat1f full = L2Distances(d);
+    SequenceDistancesInPlace(full, 6, starts, starts, dir);
+    float block_max = 0;
+    std::vector<Match> expected;
+    for (int q = 0; q < block.query_count; ++q) {
+      const int row = block.query_first + q;
+      for (int j = 0; j < block.reference_count; ++j)
+        block_max = std::max(block_max, full(row, j));
+      for (const Match& m : SortedRow(full, row, q, 0, block.reference_count, rules))
+        expected.push_back(m);
+    }
+    BoundedOptions options;
+    options.sequence_length = 6;
+    options.direction = dir;
+    options.range_rows = 9;
+    float max_distance = 0;
+    const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
+    EXPECT_NEAR(max_distance, block_max, 1e-6 * block_max);
+    ExpectSame(got, expected, 1.0f / block_max);
   }
 }
 
@@ -157,7 +195,7 @@ TEST(ApproximateMatches, FindsPlantedDuplicatesWithExactScores) {
 }
 
 
-// Sequence_partial skip, the ratio score and the L1 distance of SAD rows: the tiled run against
+// Sequence_partial skip, the ratio score and the L1 distance of SAD rows: the fused run against
 // the dense matrix of the tested pieces, selected and scored by brute force (empty cells never
 // kept; the ratio of a kept match over the best finite candidate more than the window away).
 TEST(BoundedMatches, SkipCellsAndRatioScoresEqualBruteForce) {
@@ -203,7 +241,7 @@ TEST(BoundedMatches, SkipCellsAndRatioScoresEqualBruteForce) {
       options.sequence_length = L;
       options.direction = dir;
       options.partial = SequencePartial::kSkip;
-      options.tile_bytes = 7 * block.reference_count * 4;
+      options.range_rows = 7;
       float max_distance = 0;
       const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
       EXPECT_FLOAT_EQ(max_distance, block_max);
