@@ -69,6 +69,44 @@ TEST(SideWindow, OneLayerEqualsBruteForceForSeveralRadii) {
   }
 }
 
+// The interior of the image goes through a vectorised row loop: every output must be the very
+// double of the clipped-box formula computed pixel by pixel (integral-image box sums, a
+// division by the count, ties to the first window), on an image wide enough for full vectors,
+// and within rounding of the brute-force means.
+TEST(SideWindow, InteriorRowsAreTheSameDoublesAsThePixelByPixelFormula) {
+  const int h = 37, w = 83;
+  const cv::Mat1b im = RandomImage(h, w, 12);
+  cv::Mat1d d;
+  im.convertTo(d, CV_64F);
+  std::vector<std::vector<double>> b(h, std::vector<double>(w));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) b[y][x] = im(y, x);
+  for (int r : {1, 2, 3, 5}) {
+    cv::Mat1d sum;
+    cv::integral(d, sum, CV_64F);
+    auto box = [&](int y0, int y1, int x0, int x1) {
+      y0 = std::max(y0, 0), x0 = std::max(x0, 0);
+      y1 = std::min(y1, h - 1), x1 = std::min(x1, w - 1);
+      const double s = sum(y1 + 1, x1 + 1) - sum(y0, x1 + 1) - sum(y1 + 1, x0) + sum(y0, x0);
+      return s / ((y1 - y0 + 1) * (x1 - x0 + 1));
+    };
+    const cv::Mat1d got = SideWindowLayer(d, r);
+    const auto brute = BruteLayer(b, r);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const double q[8] = {box(y - r, y, x - r, x + r), box(y, y + r, x - r, x + r),
+                             box(y - r, y + r, x - r, x), box(y - r, y + r, x, x + r),
+                             box(y - r, y, x - r, x),     box(y - r, y, x, x + r),
+                             box(y, y + r, x - r, x),     box(y, y + r, x, x + r)};
+        int k = 0;
+        for (int n = 1; n < 8; ++n)
+          if (std::abs(q[n] - d(y, x)) < std::abs(q[k] - d(y, x)) - 1e-9) k = n;
+        ASSERT_EQ(got(y, x), q[k]) << "r " << r << " at " << y << "," << x;
+        ASSERT_NEAR(got(y, x), brute[y][x], 1e-9) << "r " << r << " at " << y << "," << x;
+      }
+  }
+}
+
 TEST(SideWindow, StackedLayersEqualBruteForceAndRoundAtTheEnd) {
   const cv::Mat1b im = RandomImage(8, 13, 7);
   std::vector<std::vector<double>> b(8, std::vector<double>(13));
