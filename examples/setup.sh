@@ -7,6 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make pkg-config libopencv-dev libopencv-contrib-dev libeigen3-dev
+          libpng-dev zlib1g-dev libjpeg-dev
           libopenimageio-dev openimageio-tools libgtest-dev libgmock-dev libbenchmark-dev
           python3-numpy python3-dev pybind11-dev clang libclang-rt-14-dev)
 missing=()

@@ -43,7 +43,7 @@ foreach(folder OpenABLE descriptors matching config)
 endforeach()
 
 # Run-time modules (OpenABLE/io/module_loader.h), where module_loader.cc looks for them.
-install(TARGETS openable_oiio openable_video openable_gui
+install(TARGETS openable_oiio openable_video openable_gui openable_codecs
   LIBRARY DESTINATION "${OPENABLE_INSTALL_MODULEDIR}")
 
 # The command-line programs of examples/.

@@ -11,7 +11,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgcodecs.hpp>  // the IMREAD_ flags only
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -20,6 +20,8 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/text_parsing.h"
+#include "OpenABLE/io/module_api.h"
+#include "OpenABLE/io/module_loader.h"
 
 namespace openable {
 namespace {
@@ -388,8 +390,10 @@ cv::Mat1f ReadNpy(const std::string& path, const std::string& where) {
 // Images
 
 cv::Mat1f ReadImage(const std::string& path, const std::string& where) {
-  const cv::Mat image =
-      cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION);
+  // OpenCV's imgcodecs, loaded on first use (io/module_loader.h).
+  cv::Mat image;
+  reinterpret_cast<OpenableCodecsRead>(ModuleSymbol("codecs", "openable_codecs_read"))(
+      path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION, image);
   if (image.empty()) {
     throw InputError(where +
                      ": cannot be decoded as an image; expected an image OpenCV reads "

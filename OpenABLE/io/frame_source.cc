@@ -11,7 +11,6 @@
 #include <fstream>
 #include <mutex>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -20,12 +19,14 @@
 #include <vector>
 
 #include <jpeglib.h>
+#include <zlib.h>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/io/io_common.h"
 #include "OpenABLE/io/module_api.h"
 #include "OpenABLE/io/module_loader.h"
+#include "OpenABLE/io/png_codec.h"
 
 namespace openable {
 namespace {
@@ -43,21 +44,9 @@ std::string JoinSupported() {
   return out;
 }
 
-// CRC-32 of PNG chunks (ISO 3309, polynomial 0xEDB88320), byte-wise with a 256-entry table.
-// Written by hand: OpenCV has no public CRC, and zlib is not one of our dependencies.
+// CRC-32 of PNG chunks (ISO 3309), zlib's.
 std::uint32_t Crc32(const unsigned char* data, std::size_t size) {
-  static const auto table = [] {
-    std::array<std::uint32_t, 256> t{};
-    for (std::uint32_t n = 0; n < 256; ++n) {
-      std::uint32_t c = n;
-      for (int k = 0; k < 8; ++k) c = (c & 1U) != 0 ? 0xEDB88320U ^ (c >> 1) : c >> 1;
-      t[n] = c;
-    }
-    return t;
-  }();
-  std::uint32_t c = 0xFFFFFFFFU;
-  for (std::size_t i = 0; i < size; ++i) c = table[(c ^ data[i]) & 0xFFU] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFU;
+  return static_cast<std::uint32_t>(crc32(0L, data, static_cast<uInt>(size)));
 }
 
 std::uint32_t BigEndian32(const unsigned char* p) {
@@ -223,10 +212,11 @@ int PnmMaxValue(const std::vector<unsigned char>& bytes) {
   return values[2];
 }
 
-// Decodes the common formats with OpenCV's codecs, which load with the program (see
-// module_loader.h): PNG whose chunks are sound, JPEG with its end marker, binary and plain
-// PGM/PPM of 8 or 16 bits, BMP. Returns an empty Mat for anything else, or when OpenCV fails,
-// so that OpenImageIO decodes the file or says precisely what is wrong with it.
+// Decodes the common formats: PNG whose chunks are sound (libpng, png_codec.h) and JPEG with
+// its end marker (libjpeg), both in the program, and binary and plain PGM/PPM of 8 or 16 bits
+// and BMP through OpenCV's imgcodecs, a module loaded on first use (module_loader.h). Returns
+// an empty Mat for anything else, or when the decoder fails, so that OpenImageIO decodes the
+// file or says precisely what is wrong with it.
 cv::Mat DecodeWithOpenCV(const std::vector<unsigned char>& bytes, bool& grey_alpha) {
   grey_alpha = false;
   std::string why;
@@ -261,11 +251,15 @@ cv::Mat DecodeWithOpenCV(const std::vector<unsigned char>& bytes, bool& grey_alp
     if (!DecodeJpeg(bytes, image, why)) throw InputError(why);
     if (!image.empty()) return image;
   }
-  try {
-    return cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception&) {
-    return cv::Mat();
+  if (png == PngCheck::kSound) {
+    cv::Mat image;
+    return DecodePng(bytes, image, why) ? image : cv::Mat();  // libpng's refusal: OpenImageIO
   }
+  // PGM/PPM and BMP: OpenCV's imgcodecs, loaded on first use.
+  cv::Mat image;
+  reinterpret_cast<OpenableCodecsDecode>(ModuleSymbol("codecs", "openable_codecs_decode"))(
+      bytes, image);
+  return image;
 }
 
 // The decoding shared by ReadImageFile and DecodeImageBytes: OpenCV's codecs for the common

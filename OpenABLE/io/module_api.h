@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -18,6 +19,15 @@ using OpenableOiioRead = void (*)(const std::string&, cv::Mat&);
 extern "C" void openable_oiio_read_memory(const std::string& bytes, const std::string& name,
                                           cv::Mat& frame);
 using OpenableOiioReadMemory = void (*)(const std::string&, const std::string&, cv::Mat&);
+
+// libopenable_codecs.so: OpenCV's imgcodecs (cv::imdecode with IMREAD_UNCHANGED) for the
+// formats the program does not decode itself (PGM/PPM, BMP); an empty `image` when OpenCV
+// cannot decode the bytes.
+extern "C" void openable_codecs_decode(const std::vector<unsigned char>& bytes, cv::Mat& image);
+using OpenableCodecsDecode = void (*)(const std::vector<unsigned char>&, cv::Mat&);
+// cv::imread(path, flags); an empty `image` when OpenCV cannot read the file.
+extern "C" void openable_codecs_read(const std::string& path, int flags, cv::Mat& image);
+using OpenableCodecsRead = void (*)(const std::string&, int, cv::Mat&);
 
 // libopenable_video.so: the frames [first, last) of a video (see OpenVideo).
 extern "C" void openable_video_open(const std::string& path, int first, int last,

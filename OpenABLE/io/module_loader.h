@@ -4,6 +4,8 @@
 //   openable_oiio   OpenImageIO reading (TIFF and the files OpenCV's decoders refuse)
 //   openable_video  OpenCV videoio (FFmpeg, GStreamer)
 //   openable_gui    OpenCV highgui (Show_images)
+//   openable_codecs OpenCV imgcodecs (PGM/PPM and BMP frames, matrix images other than PNG;
+//                   PNG and JPEG are decoded and PNG written in the program itself)
 //
 // Debian's OpenImageIO and videoio pull in about 250 shared libraries each (FFmpeg, GDAL,
 // OpenVDB, Qt, ...), all bound at start-up (BIND_NOW): linking them into Test_OpenABLE cost

@@ -20,9 +20,9 @@
 #include <unistd.h>
 
 #include <opencv2/core/utility.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/io/png_codec.h"
 #include "OpenABLE/run/interrupt.h"
 
 namespace openable {
@@ -183,11 +183,7 @@ std::string EncodeText(const cv::Mat& m) {
   return out;
 }
 
-std::string EncodePng(const cv::Mat& image) {
-  std::vector<std::uint8_t> buf;
-  if (!cv::imencode(".png", image, buf)) throw std::logic_error("EncodePng: encoder failed");
-  return std::string(buf.begin(), buf.end());
-}
+std::string EncodePng(const cv::Mat& image) { return EncodePngFile(image); }
 
 namespace {
 

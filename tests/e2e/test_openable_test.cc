@@ -102,6 +102,21 @@ TEST(TestOpenABLE, SampleRunWritesEveryOutputAndFindsTheSeasonDiagonal) {
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 }
 
+// PNG frames are decoded and the matrix images written without OpenCV's imgcodecs, whose
+// GDAL, GDCM and OpenEXR chain (about 120 libraries) cost every run about 80 ms at start-up:
+// the dynamic loader's own log (LD_DEBUG=files) must not name it.
+TEST(TestOpenABLE, PngRunDoesNotLoadImgcodecs) {
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunProgram("/usr/bin/env", {"LD_DEBUG=files", testing::TestOpenableExe(),
+                                                SampleConfig(dir)}, dir);
+  ASSERT_EQ(o.status, 0) << o.out;
+  ASSERT_NE(o.err.find("file=libopencv_core"), std::string::npos)
+      << "the loader's log is missing, so the test cannot see what was loaded";
+  EXPECT_EQ(o.err.find("libopencv_imgcodecs"), std::string::npos);
+  EXPECT_EQ(o.err.find("libgdal"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir + "/out/matrix.png"));
+}
+
 TEST(TestOpenABLE, OverridesRangeAndSingleSequence) {
   const std::string dir = testing::TempDir();
   const Outcome o =

@@ -1,0 +1,256 @@
+#include "OpenABLE/io/png_codec.h"
+
+#include <png.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <csetjmp>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "OpenABLE/base/threading.h"
+
+namespace openable {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Decoding (libpng). libpng reports errors by longjmp to the setjmp of the caller; the functions
+// holding a setjmp below keep no C++ object with a destructor alive across libpng's calls.
+
+struct Reader {
+  const unsigned char* data = nullptr;
+  std::size_t size = 0, pos = 0;
+  char error[200] = {0};
+};
+
+void ReadBytes(png_structp png, png_bytep out, png_size_t n) {
+  Reader* r = static_cast<Reader*>(png_get_io_ptr(png));
+  if (r->size - r->pos < n) png_error(png, "the file ends inside its image data");
+  std::memcpy(out, r->data + r->pos, n);
+  r->pos += n;
+}
+
+void OnError(png_structp png, png_const_charp message) {
+  Reader* r = static_cast<Reader*>(png_get_error_ptr(png));
+  std::snprintf(r->error, sizeof r->error, "%s", message);
+  png_longjmp(png, 1);
+}
+
+void OnWarning(png_structp, png_const_charp) {}  // e.g. sRGB profile notes: not errors
+
+bool IsLittleEndian() {
+  const std::uint16_t one = 1;
+  unsigned char first = 0;
+  std::memcpy(&first, &one, 1);
+  return first == 1;
+}
+
+// Reads the header and sets the transformations; false on a libpng error.
+bool ReadHeader(png_structp png, png_infop info, int& width, int& height, int& channels,
+                int& depth, std::size_t& row_bytes) {
+  if (setjmp(png_jmpbuf(png))) return false;
+  png_read_info(png, info);
+  const int color = png_get_color_type(png, info);
+  const int bits = png_get_bit_depth(png, info);
+  if (color == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
+  if ((color & PNG_COLOR_MASK_COLOR) == 0 && bits < 8) png_set_expand_gray_1_2_4_to_8(png);
+  png_set_strip_alpha(png);
+  if (bits == 16 && IsLittleEndian()) png_set_swap(png);  // cv::Mat holds native uint16
+  if ((color & PNG_COLOR_MASK_COLOR) != 0) png_set_bgr(png);
+  png_set_interlace_handling(png);
+  png_read_update_info(png, info);
+  width = static_cast<int>(png_get_image_width(png, info));
+  height = static_cast<int>(png_get_image_height(png, info));
+  channels = png_get_channels(png, info);
+  depth = png_get_bit_depth(png, info);
+  row_bytes = png_get_rowbytes(png, info);
+  return true;
+}
+
+bool ReadRows(png_structp png, png_infop info, png_bytepp rows) {
+  if (setjmp(png_jmpbuf(png))) return false;
+  png_read_image(png, rows);
+  png_read_end(png, info);
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Encoding (zlib). Written here rather than through libpng's writer, which compresses on one
+// thread: the PNG container itself is a few fixed chunks, and zlib does the compression.
+
+void Put32(std::string& out, std::uint32_t v) {
+  const char b[4] = {static_cast<char>(v >> 24), static_cast<char>(v >> 16),
+                     static_cast<char>(v >> 8), static_cast<char>(v)};
+  out.append(b, 4);
+}
+
+void PutChunk(std::string& out, const char type[4], const std::string& data) {
+  Put32(out, static_cast<std::uint32_t>(data.size()));
+  const std::size_t start = out.size();
+  out.append(type, 4);
+  out += data;
+  const uLong crc = crc32(0L, reinterpret_cast<const Bytef*>(out.data() + start),
+                          static_cast<uInt>(out.size() - start));
+  Put32(out, static_cast<std::uint32_t>(crc));
+}
+
+// One row in PNG sample order: RGB(A) from BGR(A), 16-bit values big-endian.
+void SwapToPng(const unsigned char* src, unsigned char* raw, int cols, int channels,
+               int sample) {
+  for (int x = 0; x < cols; ++x) {
+    for (int c = 0; c < channels; ++c) {
+      const int from = channels >= 3 && c < 3 ? 2 - c : c;
+      const unsigned char* s = src + (static_cast<std::size_t>(x) * channels + from) * sample;
+      unsigned char* d = raw + (static_cast<std::size_t>(x) * channels + c) * sample;
+      if (sample == 1) {
+        d[0] = s[0];
+      } else {
+        std::uint16_t v = 0;
+        std::memcpy(&v, s, 2);
+        d[0] = static_cast<unsigned char>(v >> 8);
+        d[1] = static_cast<unsigned char>(v & 0xFF);
+      }
+    }
+  }
+}
+
+// One band of rows: filtered (Sub) and deflated as raw deflate blocks, ending on a byte
+// boundary (a sync flush) or, for the last band, with the final block.
+struct Band {
+  std::string deflated;
+  uLong adler = 1;
+  std::size_t filtered_size = 0;
+};
+
+void CompressBand(const cv::Mat& image, int y0, int y1, bool last, Band& band) {
+  const int channels = image.channels();
+  const int sample = image.depth() == CV_16U ? 2 : 1;
+  const int bpp = channels * sample;  // bytes per pixel
+  const std::size_t row_size = static_cast<std::size_t>(image.cols) * bpp;
+  std::string filtered((row_size + 1) * static_cast<std::size_t>(y1 - y0), '\0');
+  std::vector<unsigned char> raw(row_size);
+  for (int y = y0; y < y1; ++y) {
+    // The PNG sample order: RGB(A) from BGR(A), 16-bit values big-endian.
+    const unsigned char* src = image.ptr<unsigned char>(y);
+    if (sample == 1 && channels == 1) {
+      std::memcpy(raw.data(), src, row_size);
+    } else if (sample == 1 && channels == 3) {
+      for (int x = 0; x < image.cols; ++x) {
+        raw[3 * x] = src[3 * x + 2];
+        raw[3 * x + 1] = src[3 * x + 1];
+        raw[3 * x + 2] = src[3 * x];
+      }
+    } else {
+      SwapToPng(src, raw.data(), image.cols, channels, sample);
+    }
+    char* out = &filtered[(row_size + 1) * static_cast<std::size_t>(y - y0)];
+    out[0] = 1;  // filter type Sub: each byte minus the byte one pixel to its left
+    for (std::size_t i = 0; i < row_size; ++i) {
+      const unsigned char left = i >= static_cast<std::size_t>(bpp) ? raw[i - bpp] : 0;
+      out[1 + i] = static_cast<char>(static_cast<unsigned char>(raw[i] - left));
+    }
+  }
+  band.filtered_size = filtered.size();
+  band.adler = adler32(1L, reinterpret_cast<const Bytef*>(filtered.data()),
+                       static_cast<uInt>(filtered.size()));
+  z_stream z{};
+  if (deflateInit2(&z, 1, Z_DEFLATED, -15, 8, Z_RLE) != Z_OK)
+    throw std::runtime_error("PNG encoder: zlib cannot start");
+  band.deflated.resize(deflateBound(&z, static_cast<uLong>(filtered.size())) + 16);
+  z.next_in = reinterpret_cast<Bytef*>(filtered.data());
+  z.avail_in = static_cast<uInt>(filtered.size());
+  z.next_out = reinterpret_cast<Bytef*>(band.deflated.data());
+  z.avail_out = static_cast<uInt>(band.deflated.size());
+  const int status = deflate(&z, last ? Z_FINISH : Z_SYNC_FLUSH);
+  const bool ok = last ? status == Z_STREAM_END : status == Z_OK && z.avail_in == 0;
+  band.deflated.resize(band.deflated.size() - z.avail_out);
+  deflateEnd(&z);
+  if (!ok) throw std::runtime_error("PNG encoder: zlib failed on a band of rows");
+}
+
+}  // namespace
+
+bool DecodePng(const std::vector<unsigned char>& bytes, cv::Mat& image, std::string& why) {
+  Reader reader;
+  reader.data = bytes.data();
+  reader.size = bytes.size();
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &reader, OnError, OnWarning);
+  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
+  if (png == nullptr || info == nullptr) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    why = "libpng cannot start (out of memory)";
+    return false;
+  }
+  png_set_read_fn(png, &reader, ReadBytes);
+  int width = 0, height = 0, channels = 0, depth = 0;
+  std::size_t row_bytes = 0;
+  bool ok = ReadHeader(png, info, width, height, channels, depth, row_bytes);
+  if (ok && ((channels != 1 && channels != 3) || (depth != 8 && depth != 16) || width <= 0 ||
+             height <= 0)) {
+    std::snprintf(reader.error, sizeof reader.error, "unexpected layout after conversion");
+    ok = false;
+  }
+  if (ok) {
+    cv::Mat out(height, width, CV_MAKETYPE(depth == 16 ? CV_16U : CV_8U, channels));
+    if (row_bytes != out.step[0]) {
+      std::snprintf(reader.error, sizeof reader.error, "unexpected row size");
+      ok = false;
+    } else {
+      std::vector<png_bytep> rows(static_cast<std::size_t>(height));
+      for (int y = 0; y < height; ++y) rows[static_cast<std::size_t>(y)] = out.ptr(y);
+      ok = ReadRows(png, info, rows.data());
+      if (ok) image = out;
+    }
+  }
+  png_destroy_read_struct(&png, &info, nullptr);
+  if (!ok) why = reader.error[0] != '\0' ? reader.error : "libpng could not decode it";
+  return ok;
+}
+
+std::string EncodePngFile(const cv::Mat& image, int threads) {
+  const int depth = image.depth(), channels = image.channels();
+  if ((depth != CV_8U && depth != CV_16U) || (channels != 1 && channels != 3 && channels != 4) ||
+      image.empty()) {
+    throw std::logic_error("EncodePngFile: expected a non-empty 8- or 16-bit image of 1, 3 or 4 "
+                           "channels, got " + cv::typeToString(image.type()));
+  }
+  // Bands of about 64 rows (at least one per thread when the image is tall enough): small
+  // enough to balance, large enough that the restarts of the compressor cost little size.
+  const int band_rows = std::max(16, std::min(64, image.rows / std::max(1, EffectiveThreads(
+                                                                              threads))));
+  const int bands = (image.rows + band_rows - 1) / band_rows;
+  std::vector<Band> parts(static_cast<std::size_t>(bands));
+  ParallelFor(bands, threads, [&](int b) {
+    CompressBand(image, b * band_rows, std::min(image.rows, (b + 1) * band_rows), b == bands - 1,
+                 parts[static_cast<std::size_t>(b)]);
+  });
+
+  std::string out("\x89PNG\r\n\x1a\n", 8);
+  std::string header;
+  Put32(header, static_cast<std::uint32_t>(image.cols));
+  Put32(header, static_cast<std::uint32_t>(image.rows));
+  header += static_cast<char>(depth == CV_16U ? 16 : 8);
+  header += static_cast<char>(channels == 1 ? 0 : channels == 3 ? 2 : 6);  // grey, RGB, RGBA
+  header += std::string(3, '\0');  // deflate, adaptive filtering, no interlace
+  PutChunk(out, "IHDR", header);
+  // One zlib stream over the bands: its header (deflate, 32 KB window, fastest level), the
+  // bands' deflate blocks in order, and the Adler-32 of all the filtered bytes.
+  uLong adler = 1;
+  for (std::size_t b = 0; b < parts.size(); ++b) {
+    std::string data = b == 0 ? std::string("\x78\x01", 2) : std::string();
+    data += parts[b].deflated;
+    adler = b == 0 ? parts[b].adler
+                   : adler32_combine(adler, parts[b].adler,
+                                     static_cast<z_off_t>(parts[b].filtered_size));
+    if (b + 1 == parts.size()) Put32(data, static_cast<std::uint32_t>(adler));
+    PutChunk(out, "IDAT", data);
+  }
+  PutChunk(out, "IEND", std::string());
+  return out;
+}
+
+}  // namespace openable

@@ -1,0 +1,165 @@
+// PNG decoding (libpng) and writing (zlib) of png_codec.h against OpenCV's own codecs.
+#include "OpenABLE/io/png_codec.h"
+
+#include <png.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace openable {
+namespace {
+
+cv::Mat Random(int rows, int cols, int type, int seed) {
+  cv::Mat m(rows, cols, type);
+  cv::RNG rng(seed);
+  rng.fill(m, cv::RNG::UNIFORM, 0, CV_MAT_DEPTH(type) == CV_16U ? 65536 : 256);
+  return m;
+}
+
+// What the frame reader took from OpenCV's decoder: IMREAD_UNCHANGED, alpha dropped (grey +
+// alpha, which OpenCV gives as four channels, kept as its grey channel).
+cv::Mat OpenCvPixels(const std::vector<unsigned char>& bytes, bool grey_alpha) {
+  cv::Mat m = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+  if (m.channels() == 4) {
+    if (grey_alpha) {
+      cv::extractChannel(m, m, 0);
+    } else {
+      cv::cvtColor(m, m, cv::COLOR_BGRA2BGR);
+    }
+  }
+  return m;
+}
+
+void ExpectEqualImages(const cv::Mat& a, const cv::Mat& b) {
+  ASSERT_EQ(a.type(), b.type());
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
+}
+
+// A PNG written by libpng itself, for the layouts OpenCV's encoder does not write: palettes
+// (with transparency), grey of 2 and 4 bits, grey + alpha, Adam7 interlacing.
+std::vector<unsigned char> LibpngFile(int width, int height, int bit_depth, int color_type,
+                                      bool interlaced, const std::vector<unsigned char>& data,
+                                      bool palette_alpha = false) {
+  std::vector<unsigned char> out;
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png_create_info_struct(png);
+  png_set_write_fn(
+      png, &out,
+      [](png_structp p, png_bytep d, png_size_t n) {
+        auto* o = static_cast<std::vector<unsigned char>*>(png_get_io_ptr(p));
+        o->insert(o->end(), d, d + n);
+      },
+      nullptr);
+  png_set_IHDR(png, info, width, height, bit_depth, color_type,
+               interlaced ? PNG_INTERLACE_ADAM7 : PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
+  if (color_type == PNG_COLOR_TYPE_PALETTE) {
+    png_color palette[16];
+    for (int i = 0; i < 16; ++i)
+      palette[i] = {static_cast<png_byte>(i * 16), static_cast<png_byte>(255 - i * 15),
+                    static_cast<png_byte>(i * 7)};
+    png_set_PLTE(png, info, palette, 16);
+    if (palette_alpha) {
+      png_byte alpha[16];
+      for (int i = 0; i < 16; ++i) alpha[i] = static_cast<png_byte>(i * 17);
+      png_set_tRNS(png, info, alpha, 16, nullptr);
+    }
+  }
+  png_write_info(png, info);
+  const std::size_t row = png_get_rowbytes(png, info);
+  std::vector<png_bytep> rows(static_cast<std::size_t>(height));
+  for (int y = 0; y < height; ++y)
+    rows[static_cast<std::size_t>(y)] = const_cast<png_bytep>(data.data() + row * y);
+  png_write_image(png, rows.data());
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return out;
+}
+
+TEST(DecodePng, SamePixelsAsOpenCvForEveryLayout) {
+  struct Case {
+    std::string name;
+    std::vector<unsigned char> bytes;
+    bool grey_alpha;
+  };
+  std::vector<Case> cases;
+  for (int type : {CV_8UC1, CV_8UC3, CV_8UC4, CV_16UC1, CV_16UC3, CV_16UC4}) {
+    std::vector<unsigned char> bytes;
+    ASSERT_TRUE(cv::imencode(".png", Random(23, 37, type, type), bytes));
+    cases.push_back({"OpenCV " + cv::typeToString(type), bytes, false});
+  }
+  std::vector<unsigned char> bilevel;
+  ASSERT_TRUE(cv::imencode(".png", Random(9, 21, CV_8UC1, 5) > 128, bilevel,
+                           {cv::IMWRITE_PNG_BILEVEL, 1}));
+  cases.push_back({"1-bit grey", bilevel, false});
+  const int w = 19, h = 11;
+  cv::RNG rng(4);
+  auto bytes_of = [&](std::size_t n, int max) {
+    std::vector<unsigned char> v(n);
+    for (auto& b : v) b = static_cast<unsigned char>(rng.uniform(0, max));
+    return v;
+  };
+  cases.push_back({"palette", LibpngFile(w, h, 8, PNG_COLOR_TYPE_PALETTE, false,
+                                         bytes_of(w * h, 16)), false});
+  cases.push_back({"palette + tRNS", LibpngFile(w, h, 8, PNG_COLOR_TYPE_PALETTE, false,
+                                                bytes_of(w * h, 16), true), false});
+  cases.push_back({"4-bit grey", LibpngFile(w, h, 4, PNG_COLOR_TYPE_GRAY, false,
+                                            bytes_of((w + 1) / 2 * h, 256)), false});
+  cases.push_back({"2-bit grey", LibpngFile(w, h, 2, PNG_COLOR_TYPE_GRAY, false,
+                                            bytes_of((w + 3) / 4 * h, 256)), false});
+  cases.push_back({"grey + alpha 8", LibpngFile(w, h, 8, PNG_COLOR_TYPE_GRAY_ALPHA, false,
+                                                bytes_of(w * h * 2, 256)), true});
+  cases.push_back({"grey + alpha 16", LibpngFile(w, h, 16, PNG_COLOR_TYPE_GRAY_ALPHA, false,
+                                                 bytes_of(w * h * 4, 256)), true});
+  cases.push_back({"interlaced RGB", LibpngFile(w, h, 8, PNG_COLOR_TYPE_RGB, true,
+                                                bytes_of(w * h * 3, 256)), false});
+  cases.push_back({"interlaced 16-bit grey", LibpngFile(w, h, 16, PNG_COLOR_TYPE_GRAY, true,
+                                                        bytes_of(w * h * 2, 256)), false});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    cv::Mat got;
+    std::string why;
+    ASSERT_TRUE(DecodePng(c.bytes, got, why)) << why;
+    ExpectEqualImages(got, OpenCvPixels(c.bytes, c.grey_alpha));
+  }
+}
+
+TEST(DecodePng, DamagedDataIsRefusedWithAReason) {
+  std::vector<unsigned char> bytes;
+  ASSERT_TRUE(cv::imencode(".png", Random(40, 40, CV_8UC3, 1), bytes));
+  bytes.resize(bytes.size() / 2);
+  cv::Mat got;
+  std::string why;
+  EXPECT_FALSE(DecodePng(bytes, got, why));
+  EXPECT_FALSE(why.empty());
+  EXPECT_TRUE(got.empty());
+}
+
+// Written in bands compressed in parallel, read back by OpenCV (libpng) pixel for pixel, for
+// every type the exports write and for images of one band and of many.
+TEST(EncodePngFile, OpenCvReadsBackTheSamePixels) {
+  for (int type : {CV_8UC1, CV_8UC3, CV_8UC4, CV_16UC1, CV_16UC3}) {
+    for (const cv::Size size : {cv::Size(1, 1), cv::Size(37, 5), cv::Size(130, 301)}) {
+      SCOPED_TRACE(cv::typeToString(type) + " " + std::to_string(size.width) + "x" +
+                   std::to_string(size.height));
+      const cv::Mat image = Random(size.height, size.width, type, size.area());
+      for (int threads : {1, 2, 3}) {
+        const std::string file = EncodePngFile(image, threads);
+        const std::vector<unsigned char> bytes(file.begin(), file.end());
+        ExpectEqualImages(cv::imdecode(bytes, cv::IMREAD_UNCHANGED), image);
+      }
+    }
+  }
+  EXPECT_THROW(EncodePngFile(cv::Mat(3, 3, CV_32F)), std::logic_error);
+  EXPECT_THROW(EncodePngFile(cv::Mat()), std::logic_error);
+}
+
+}  // namespace
+}  // namespace openable
