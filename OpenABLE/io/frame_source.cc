@@ -217,7 +217,7 @@ int PnmMaxValue(const std::vector<unsigned char>& bytes) {
 // and BMP through OpenCV's imgcodecs, a module loaded on first use (module_loader.h). Returns
 // an empty Mat for anything else, or when the decoder fails, so that OpenImageIO decodes the
 // file or says precisely what is wrong with it.
-cv::Mat DecodeWithOpenCV(const std::vector<unsigned char>& bytes, bool& grey_alpha) {
+cv::Mat DecodeCommonFormat(const std::vector<unsigned char>& bytes, bool& grey_alpha) {
   grey_alpha = false;
   std::string why;
   const PngCheck png = CheckPng(bytes, why);  // before the size check: a cut PNG is short
@@ -262,7 +262,7 @@ cv::Mat DecodeWithOpenCV(const std::vector<unsigned char>& bytes, bool& grey_alp
   return image;
 }
 
-// The decoding shared by ReadImageFile and DecodeImageBytes: OpenCV's codecs for the common
+// The decoding shared by ReadImageFile and DecodeImageBytes: DecodeCommonFormat for the common
 // formats, else `oiio_fallback` (OpenImageIO on the file or on the bytes). `name` names the
 // image in messages.
 template <typename Fallback>
@@ -271,7 +271,7 @@ cv::Mat DecodeBytes(const std::vector<unsigned char>& bytes, const std::string& 
   bool grey_alpha = false;
   cv::Mat image;
   try {
-    image = DecodeWithOpenCV(bytes, grey_alpha);
+    image = DecodeCommonFormat(bytes, grey_alpha);
   } catch (const InputError& e) {
     const std::string what = e.what();  // "is ..." (too large) or the damage found
     throw InputError("image " + Quoted(name) + " " +
