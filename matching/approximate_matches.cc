@@ -44,16 +44,23 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
   const cv::Mat refs = descriptors.rowRange(block.reference_first, block.reference_first + m);
   const cv::Mat queries =
       descriptors.rowRange(block.query_first, block.query_first + block.query_count);
+  // The share of the queries searched (BoundedOptions::query_begin/end); the sequences read
+  // the rows before it.
+  const int q_begin = std::clamp(options.query_begin, 0, block.query_count);
+  const int q_end = options.query_end < 0
+                        ? block.query_count
+                        : std::clamp(options.query_end, q_begin, block.query_count);
   const std::vector<std::vector<int>> cand =
-      Candidates(refs, queries, asked, checks, options.threads);
+      Candidates(refs, queries.rowRange(q_begin, q_end), asked, checks, options.threads);
 
   auto score = [&](int q, int j, bool rev) {
     return SequenceCellDistance(queries, q, refs, j, L, rev, nullptr, options.partial);
   };
-  std::vector<std::vector<Match>> per_query(static_cast<size_t>(block.query_count));
-  ParallelFor(block.query_count, options.threads, [&](int q) {
+  std::vector<std::vector<Match>> per_query(static_cast<size_t>(q_end - q_begin));
+  ParallelFor(q_end - q_begin, options.threads, [&](int share_row) {
+    const int q = q_begin + share_row;
     std::vector<std::pair<float, int>> scored;
-    for (const int j : cand[static_cast<size_t>(q)]) {
+    for (const int j : cand[static_cast<size_t>(share_row)]) {
       if (j < 0 || j >= m) continue;
       if (block.one_traversal && j > q - rules.exclusion) continue;
       const float s =
@@ -66,7 +73,7 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
     for (size_t r = 0; r < scores.size(); ++r)
       scores[r] = ScoreOfCandidate(scored, r, rules.score, rules.score_window);
     if (static_cast<int>(scored.size()) > k) scored.resize(static_cast<size_t>(k));
-    auto& out = per_query[static_cast<size_t>(q)];
+    auto& out = per_query[static_cast<size_t>(share_row)];
     for (size_t r = 0; r < scored.size(); ++r)
       out.push_back(
           {q, scored[r].second, scored[r].first, static_cast<int>(r + 1), scores[r]});
@@ -79,10 +86,7 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
       kept.push_back(x);
     }
   max_distance = max_seen;
-  if (max_seen > 0.0f)
-    for (Match& x : kept) x.distance /= max_seen;
-  if (rules.score == MatchScore::kDistance)
-    for (Match& x : kept) x.score = x.distance;
+  if (options.normalize) NormalizeMatches(kept, max_seen, rules.score);
   return kept;
 }
 

@@ -187,7 +187,11 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
   const int L = options.sequence_length;
   if (L < 1) throw std::logic_error("BoundedMatches: sequence length < 1");
   const int m = block.reference_count;
-  const int queries = block.query_count;
+  const int q_begin = std::clamp(options.query_begin, 0, block.query_count);
+  const int q_end = options.query_end < 0 ? block.query_count
+                                          : std::clamp(options.query_end, q_begin,
+                                                       block.query_count);
+  const int queries = q_end - q_begin;
   const cv::Mat references = descriptors.rowRange(block.reference_first,
                                                   block.reference_first + m);
   const Metric metric = options.metric.value_or(MetricOfType(descriptors.type()));
@@ -210,7 +214,7 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
   std::atomic<int> rows_done{0};
   std::mutex progress_mutex;
   ParallelFor(ranges, threads, [&](int c) {
-    const int r0 = c * range_rows, r1 = std::min(queries, r0 + range_rows);
+    const int r0 = q_begin + c * range_rows, r1 = std::min(q_end, r0 + range_rows);
     const int h0 = std::max(0, r0 - (L - 1));  // first row summed
     const int slots = L + 1;  // ring: rows i - L .. i of D
     const std::size_t width = static_cast<std::size_t>(std::max(m, 1));
@@ -277,11 +281,15 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
   float max_seen = 0.0f;
   for (const float v : range_max) max_seen = std::max(max_seen, v);
   max_distance = max_seen;
-  if (max_seen > 0.0f)
-    for (Match& k : all) k.distance /= max_seen;
-  if (rules.score == MatchScore::kDistance)
-    for (Match& k : all) k.score = k.distance;
+  if (options.normalize) NormalizeMatches(all, max_seen, rules.score);
   return all;
+}
+
+void NormalizeMatches(std::vector<Match>& matches, float max_distance, MatchScore score) {
+  if (max_distance > 0.0f)
+    for (Match& k : matches) k.distance /= max_distance;
+  if (score == MatchScore::kDistance)
+    for (Match& k : matches) k.score = k.distance;
 }
 
 }  // namespace openable

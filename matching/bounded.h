@@ -80,7 +80,20 @@ struct BoundedOptions {
   // Query rows per range of the fused pipeline (each thread takes ranges in turn); 0 chooses
   // from the rows and threads (64 to 1024). Tests set a few rows to cross many range starts.
   int range_rows = 0;
+  // The queries computed: rows [query_begin, query_end) of the block (end -1: to the last),
+  // with the sequence history read from the rows before query_begin. A distributed run gives
+  // each process one share (OpenABLE/run/cluster.h); the matches are those the whole block
+  // gives for these queries.
+  int query_begin = 0, query_end = -1;
+  // false: distances stay raw (unnormalised, the scores of MatchScore::kDistance too) and
+  // max_distance is the largest of this share; the caller normalises with NormalizeMatches
+  // once the largest distance of every share is known.
+  bool normalize = true;
 };
+
+// Divides the distances by `max_distance` (Eq. 5; nothing when it is 0) and, for
+// MatchScore::kDistance, sets the scores to the normalised distances.
+void NormalizeMatches(std::vector<Match>& matches, float max_distance, MatchScore score);
 
 // Computes the block range by range from the descriptors (CV_8U: Hamming or L1 as
 // options.metric says, CV_32F: L2) and keeps the matches; `max_distance` receives the Eq. 5
