@@ -23,6 +23,9 @@ const char* kUsage =
     "  --version         print the version\n"
     "  -h, --help        this help\n"
     "\n"
+    "Spread over processes (one machine or many, with Open MPI; docs/distributed.md):\n"
+    "  mpirun -np K Test_OpenABLE Config.txt   the same run, the same outputs\n"
+    "\n"
     "Exit status: 0 success, 1 bad configuration or input data (or an output that cannot be\n"
     "written: no output of the run is kept), 2 bad command line, 3 internal error,\n"
     "128 + signal when interrupted (130 SIGINT, 143 SIGTERM, 129 SIGHUP; temporaries removed).\n"
@@ -45,5 +48,6 @@ int main(int argc, char** argv) {
         };
         std::cout << openable::FormatRunReport(config, openable::Run(config, progress, log));
         return 0;
-      });
+      },
+      {}, /*spreads_over_processes=*/true);
 }

@@ -10,9 +10,9 @@
 
 namespace openable {
 
-float NormalizeByMax(cv::Mat1f& m) {
+float LargestFiniteEntry(const cv::Mat1f& m) {
   if (m.empty()) return 0.0f;
-  // One parallel pass for the check and the maximum, one for the division.
+  // One parallel pass for the check and the maximum.
   std::mutex mutex;
   float max_value = 0.0f;
   bool valid = true;
@@ -31,14 +31,22 @@ float NormalizeByMax(cv::Mat1f& m) {
     max_value = std::max(max_value, local);
   });
   if (!valid) throw std::logic_error("NormalizeByMax: negative or NaN distance");
-  if (max_value > 0.0f) {
-    cv::parallel_for_(cv::Range(0, m.rows), [&](const cv::Range& r) {
-      for (int i = r.start; i < r.end; ++i) {
-        float* p = m.ptr<float>(i);
-        for (int j = 0; j < m.cols; ++j) p[j] /= max_value;
-      }
-    });
-  }
+  return max_value;
+}
+
+void DivideByLargest(cv::Mat1f& m, float largest) {
+  if (m.empty() || !(largest > 0.0f)) return;
+  cv::parallel_for_(cv::Range(0, m.rows), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      float* p = m.ptr<float>(i);
+      for (int j = 0; j < m.cols; ++j) p[j] /= largest;
+    }
+  });
+}
+
+float NormalizeByMax(cv::Mat1f& m) {
+  const float max_value = LargestFiniteEntry(m);
+  DivideByLargest(m, max_value);
   return max_value;
 }
 

@@ -11,6 +11,12 @@ namespace openable {
 // entry.
 float NormalizeByMax(cv::Mat1f& m);
 
+// The two steps of NormalizeByMax, for a matrix held in shares (a run spread over processes):
+// the largest finite entry of one share (0 when empty; std::logic_error on a negative or NaN
+// entry), and the division of a share by the largest of all (nothing when it is 0).
+float LargestFiniteEntry(const cv::Mat1f& m);
+void DivideByLargest(cv::Mat1f& m, float largest);
+
 // Eq. 9: M'' = 0 where M' < theta, 1 otherwise. 0 marks a loop candidate (a small distance).
 cv::Mat1b ThresholdMatrix(const cv::Mat1f& normalized, float theta);
 

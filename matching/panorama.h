@@ -44,4 +44,12 @@ cv::Mat1f PanoramaDistances(const cv::Mat& rows, int strips, PanoramaMatching mo
                             int threads = 0, const PairProgress& progress = {},
                             std::optional<Metric> metric = std::nullopt);
 
+// The rows of `rows` (N of them) against those of `references` (M, same width and type; empty:
+// `rows` itself, as above): an N x M matrix whose cells equal those of the single-set matrix
+// for the same pairs. A run spread over processes computes its share of rows with it.
+cv::Mat1f PanoramaDistances(const cv::Mat& rows, const cv::Mat& references, int strips,
+                            PanoramaMatching mode, int threads = 0,
+                            const PairProgress& progress = {},
+                            std::optional<Metric> metric = std::nullopt);
+
 }  // namespace openable

@@ -2,6 +2,7 @@
 // program that loads it come from the same build, so C++ types cross the boundary.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -38,3 +39,25 @@ using OpenableVideoOpen = void (*)(const std::string&, int, int,
 // libopenable_gui.so: shows a frame in the window "OpenABLE" (Show_images 1).
 extern "C" void openable_gui_show(const cv::Mat& frame);
 using OpenableGuiShow = void (*)(const cv::Mat&);
+
+// libopenable_mpi.so: Open MPI for a run spread over the processes mpirun started
+// (OpenABLE/run/cluster.h). Built only when CMake finds MPI. Every call but init and abort is
+// collective: each process of the world makes it, in the same order.
+// MPI_Init (with MPI_THREAD_FUNNELED: only the calling thread talks to MPI) and this process's
+// rank and the world's size.
+extern "C" void openable_mpi_init(int* rank, int* size);
+using OpenableMpiInit = void (*)(int*, int*);
+extern "C" void openable_mpi_finalize();
+using OpenableMpiFinalize = void (*)();
+// MPI_Abort(MPI_COMM_WORLD, code): ends every process of the run.
+extern "C" void openable_mpi_abort(int code);
+using OpenableMpiAbort = void (*)(int);
+// The bytes of every process in rank order, on rank `root` only (root -1: on every process);
+// `sizes` receives each process's byte count there. Any size (sent in pieces below 2^31).
+extern "C" void openable_mpi_gather(const std::vector<char>& mine, int root,
+                                    std::vector<char>& all, std::vector<std::int64_t>& sizes);
+using OpenableMpiGather = void (*)(const std::vector<char>&, int, std::vector<char>&,
+                                   std::vector<std::int64_t>&);
+// The largest of every process's `value`, on every process.
+extern "C" double openable_mpi_max(double value);
+using OpenableMpiMax = double (*)(double);

@@ -1,11 +1,14 @@
 #include "OpenABLE/run/command_line.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <iostream>
 
 #include <opencv2/core/utils/logger.hpp>
 
+#include "OpenABLE/base/error.h"
 #include "OpenABLE/base/program.h"
+#include "OpenABLE/run/cluster.h"
 #include "OpenABLE/run/interrupt.h"
 
 namespace openable {
@@ -90,22 +93,54 @@ int RunConfigProgram(
     int argc, const char* const* argv, const char* program, const std::string& usage,
     const std::string& version_line,
     const std::function<int(const Config&, const CommandLine&, ProgressReporter&)>& body,
-    const std::vector<std::string>& value_options) {
+    const std::vector<std::string>& value_options, bool spreads_over_processes) {
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   InstallInterruptCleanup(program);
+  // Under mpirun, process 0 speaks for the run (cluster.h): the others print nothing, neither
+  // answers (--help) nor progress, notes, reports or the errors every process meets alike.
+  Cluster& cluster = Cluster::Get();
+  if (cluster.LaunchRank() > 0) {
+    std::cout.setstate(std::ios::badbit);
+    std::cerr.setstate(std::ios::badbit);
+  }
   CommandLine cl;
   const std::string usage_error = ParseCommandLine(argc, argv, program, cl, value_options);
   const int answered = AnswerWithoutRunning(cl, usage_error, usage, version_line);
   if (answered >= 0) return answered;
-  return RunProgram(program, [&] {
+  const int status = RunProgram(program, [&]() -> int {
     const Config config = ConfigOf(cl);
     if (cl.print_config) {
       std::cout << FormatConfig(config);
       return 0;
     }
+    if (cluster.LaunchSize() > 1) {
+      if (!spreads_over_processes)
+        throw InputError(std::string(program) + " runs as one process, but mpirun started " +
+                         std::to_string(cluster.LaunchSize()) +
+                         "; expected one (Test_OpenABLE spreads a run over processes)");
+      cluster.Connect();
+    }
     ProgressReporter progress(std::cerr, !cl.quiet, IsTerminal(2));
-    return body(config, cl, progress);
+    try {
+      return body(config, cl, progress);
+    } catch (const ClusterFailure& e) {
+      // Every process throws it: process 0 says it, once.
+      if (e.InputErrorCause()) throw InputError(e.what());
+      throw std::runtime_error(e.what());
+    } catch (const std::exception& e) {
+      if (!cluster.Collective()) throw;
+      // This process alone failed where the others may wait for it: it says so itself (even
+      // when not process 0) and ends the run.
+      const bool input = dynamic_cast<const InputError*>(&e) != nullptr;
+      std::fprintf(stderr, "%s: %s%s (%s)\n", program,
+                   input ? "error: " : "internal error (please report): ", e.what(),
+                   cluster.Name(cluster.Rank()).c_str());
+      std::fflush(stderr);
+      cluster.Abort(input ? kExitInputError : kExitInternalError);
+    }
   });
+  cluster.Disconnect();
+  return status;
 }
 
 }  // namespace openable

@@ -52,11 +52,13 @@ Config ConfigOf(const CommandLine& command_line);
 // status of `body`, given the configuration, the command line and the progress reporter of the
 // run (stderr, off with --quiet); errors become exit statuses through RunProgram
 // (OpenABLE/base/program.h). `program` must outlive the process (a string literal).
-// `value_options` as ParseCommandLine.
+// `value_options` as ParseCommandLine. Started by mpirun with several processes, a program
+// whose `spreads_over_processes` is true connects them (OpenABLE/run/cluster.h) and process 0
+// alone prints; any other program refuses in one line.
 int RunConfigProgram(
     int argc, const char* const* argv, const char* program, const std::string& usage,
     const std::string& version_line,
     const std::function<int(const Config&, const CommandLine&, ProgressReporter&)>& body,
-    const std::vector<std::string>& value_options = {});
+    const std::vector<std::string>& value_options = {}, bool spreads_over_processes = false);
 
 }  // namespace openable

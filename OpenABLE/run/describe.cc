@@ -67,7 +67,9 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
     // Grey (or Eq. 6) for every descriptor; grey + disparity (a stereo frame) for D-LDB.
     // Noise (robustness studies) on the frame as read, before any conversion.
     const cv::Mat input =
-        noise.Any() ? AddNoise(frame, noise, NoiseState(noise.seed, options.noise_stream, i))
+        noise.Any() ? AddNoise(frame, noise,
+                               NoiseState(noise.seed, options.noise_stream,
+                                          options.share_first + i))
                     : frame;
     cv::Mat image;
     try {
@@ -161,7 +163,7 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
       out.skipped.push_back(read_errors[i]);
     }
   }
-  if (out.kept.empty())
+  if (out.kept.empty() && !options.share)
     throw InputError(prefix + "none of the " + std::to_string(n) +
                      " frames could be read (first failure: " +
                      (out.skipped.empty() ? std::string("none") : out.skipped.front()) + ")");

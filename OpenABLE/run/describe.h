@@ -47,6 +47,12 @@ struct DescribeOptions {
   // Eq. 6's, side-window fusion of it.
   PreprocessOptions preprocess;
   int noise_stream = 0;          // traversal index: 0 Images_path, 1 Images_path_2
+  // `source` is a share of a traversal (a run spread over processes, OpenABLE/run/cluster.h):
+  // its frame 0 is frame `share_first` of the traversal (the noise of a frame is seeded from
+  // that index), and a share whose frames are all skipped is not an error here (the run checks
+  // the whole traversal).
+  bool share = false;
+  int share_first = 0;
 };
 
 // Reads and describes every frame of `source` (in parallel when the source allows it).

@@ -14,6 +14,7 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/run/describe.h"
 #include "OpenABLE/run/descriptor_cache.h"
+#include "OpenABLE/run/distributed.h"
 #include "OpenABLE/run/evaluate.h"
 #include "OpenABLE/run/exports.h"
 #include "OpenABLE/run/verify.h"
@@ -127,8 +128,14 @@ Described DescribeSources(const Config& config, const FrameDescriber& describer,
       out.notes.push_back("Descriptor_cache: not used with Noise_* (a frame's noise depends "
                           "on its position in the run, not only on the image)");
     } else {
+      // Spread over processes, each process keeps its own cache (its share of the frames) in
+      // a folder of the cache named after it.
+      const Cluster& cluster = Cluster::Get();
       cache = DescriptorCache::Open(
-          scale.descriptor_cache,
+          cluster.Distributed() ? scale.descriptor_cache + "/process-" +
+                                      std::to_string(cluster.Rank()) + "-of-" +
+                                      std::to_string(cluster.Size())
+                                : scale.descriptor_cache,
           DescriptionSettingsText(config, name, describer.RowWidth(), describer.RowType()),
           describer.RowWidth(), describer.RowType(), out.warnings);
       options.cache = cache.get();
@@ -142,13 +149,15 @@ Described DescribeSources(const Config& config, const FrameDescriber& describer,
     const bool stereo = specs[s].kind == SourceKind::kStereo;
     options.key = stereo ? "" : specs[s].key;  // stereo read errors name their own key
     options.noise_stream = static_cast<int>(s);  // each traversal its own noise
-    progress.Begin("describing", sources[s]->Size(),
+    // Spread over processes: process 0's progress counts its share.
+    const auto [share_first, share_last] = Cluster::Get().Share(sources[s]->Size());
+    progress.Begin("describing", share_last - share_first,
                    stereo ? "stereo pairs (rectify" +
                                 std::string(describer.Channels() == 2 ? ", SGBM" : "") + ", " +
                                 name + ")"
                           : "frames of " + specs[s].key + " (" + name + ")");
-    DescribedSequence seq = DescribeSequence(*sources[s], describer, options,
-                                             [&](int done, int) { progress.Update(done); });
+    DescribedSequence seq = DescribeShared(Cluster::Get(), *sources[s], describer, options,
+                                           [&](int done, int) { progress.Update(done); });
     progress.End();
     Traversal tr;
     tr.key = specs[s].key;
@@ -479,22 +488,30 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     const auto t = Clock::now();
     result.timings.pairs =
         static_cast<std::int64_t>(block.query_count) * block.reference_count;
-    progress.Begin("matching", block.query_count, "queries (bounded: ranges of rows)");
+    Cluster& cluster = Cluster::Get();
+    const auto [query_first, query_last] = cluster.Share(block.query_count);
+    progress.Begin("matching", query_last - query_first,
+                   "queries (bounded: ranges of rows" +
+                       std::string(cluster.Distributed() ? ", this process's share)" : ")"));
     BoundedOptions options;
     options.metric = result.descriptors.front().metric;
     options.sequence_length = matching.sequence_length;
     options.direction = direction;
     options.partial = matching.partial;
     options.threads = matching.threads;
-    if (scale.approximate_search) {
-      result.matches = ApproximateMatches(described.rows, block, rules, options,
-                                          scale.approximate_checks, result.max_distance);
-    } else {
-      result.matches = BoundedMatches(described.rows, block, rules, options,
-                                      result.max_distance,
-                                      [&](int done, int) { progress.Update(done); });
-    }
+    // This process's share of the queries (all of them in a single process), raw or normalised
+    // as `share` says.
+    const auto match_share = [&](const BoundedOptions& share, float& largest) {
+      if (scale.approximate_search)
+        return ApproximateMatches(described.rows, block, rules, share,
+                                  scale.approximate_checks, largest);
+      return BoundedMatches(described.rows, block, rules, share, largest,
+                            [&](int done, int) { progress.Update(done); });
+    };
+    result.matches =
+        SharedBoundedMatches(cluster, block, rules, options, match_share, result.max_distance);
     progress.End();
+    cluster.Release();
     result.timings.match_seconds = SecondsSince(t);
     if (matching.match_threshold >= 0.0) {
       result.accepted_queries = 0;
@@ -510,6 +527,9 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
 
   // Dense: every frame against every frame of the concatenated traversals, as the original;
   // one single-frame matrix per descriptor, from the store when a sweep computed it already.
+  // Spread over processes, each computes the rows of its share (DenseShare) and process 0
+  // gathers the normalised rows.
+  Cluster& cluster = Cluster::Get();
   const bool cross = panoramic && panorama_matching != PanoramaMatching::kAligned;
   std::vector<const SingleFrame*> singles;
   std::vector<SingleFrame> computed;  // without a store
@@ -536,14 +556,21 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     const std::int64_t n = described.rows.rows;
     frame.pairs = n * (n - 1) / 2;
     const auto t = Clock::now();
-    progress.Begin("matching", n * n * (cross ? strips * strips : 1),
+    // Spread over processes: this process's rows, with the L - 1 rows its sequences read.
+    const DenseShare share =
+        DenseShareOf(cluster, static_cast<int>(n), matching.sequence_length);
+    const std::int64_t share_rows = share.last - share.history;
+    progress.Begin("matching", share_rows * n * (cross ? strips * strips : 1),
                    std::string(cross ? "cells of sub-panorama pairs" : "cells") +
                        (fused ? " (" + names[k] + ")" : ""));
     const PairProgress on_pairs = [&](std::int64_t done, std::int64_t) {
       progress.Update(done);
     };
-    frame.distances = PairwiseDistances(described.rows, frame.descriptor.metric, strips,
-                                        panorama_matching, matching.threads, on_pairs);
+    cluster.Agree([&] {
+      frame.distances = DistanceRows(described.rows, share.history, share.last,
+                                     frame.descriptor.metric, strips, panorama_matching,
+                                     matching.threads, on_pairs);
+    });
     progress.End();
     frame.match_seconds = SecondsSince(t);
     if (store) {
@@ -578,7 +605,9 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     distances = cv::Mat1f::zeros(singles.front()->distances.size());
     for (size_t k = 0; k < singles.size(); ++k) {
       double largest = 0;
-      cv::minMaxLoc(singles[k]->distances, nullptr, &largest);
+      if (!singles[k]->distances.empty())
+        cv::minMaxLoc(singles[k]->distances, nullptr, &largest);
+      largest = cluster.Max(largest);  // over every process's rows
       // A descriptor whose frames are all alike (largest 0) adds nothing.
       if (largest > 0)
         cv::scaleAdd(singles[k]->distances, result.fusion_weights[k] / largest, distances,
@@ -587,11 +616,34 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
   }
   if (matching.contrast_enhancement)
     EnhanceContrast(distances, matching.contrast_window, starts, matching.threads);
-  SequenceDistancesInPlace(distances, matching.sequence_length, starts, starts, direction,
-                           matching.threads, matching.partial);
-  result.normalized = distances;
-  distances.release();
-  result.max_distance = NormalizeByMax(result.normalized);
+  if (!cluster.Distributed()) {
+    SequenceDistancesInPlace(distances, matching.sequence_length, starts, starts, direction,
+                             matching.threads, matching.partial);
+    result.normalized = distances;
+    distances.release();
+    result.max_distance = NormalizeByMax(result.normalized);
+  } else {
+    // This process's rows: the sequences over its rows and the L - 1 before (a start of the
+    // computed rows for the sums, which the kept rows never reach back to), Eq. 5 with the
+    // largest value of every process, the rows gathered on process 0.
+    const int n = distances.cols;
+    const DenseShare share = DenseShareOf(cluster, n, matching.sequence_length);
+    cv::Mat1f rows;
+    float largest = 0.0f;
+    cluster.Agree([&] {
+      SequenceDistancesInPlace(distances, matching.sequence_length,
+                               ShareRowStarts(starts, share), starts, direction,
+                               matching.threads, matching.partial);
+      rows = distances.rowRange(share.first - share.history, share.last - share.history);
+      largest = LargestFiniteEntry(rows);
+    });
+    result.max_distance = static_cast<float>(cluster.Max(largest));
+    DivideByLargest(rows, result.max_distance);
+    result.normalized = GatherRows(cluster, rows, n, n);
+    distances.release();
+    cluster.Release();
+    if (cluster.Rank() != 0) return result;  // process 0 keeps the matrix and goes on
+  }
   if (matching.partial == SequencePartial::kSkip)
     result.empty_cells = static_cast<std::int64_t>(result.normalized.total()) -
                          cv::countNonZero(result.normalized <= 1.0f);

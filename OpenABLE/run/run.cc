@@ -8,6 +8,7 @@
 
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/version.h"
+#include "OpenABLE/run/cluster.h"
 
 namespace openable {
 
@@ -18,6 +19,19 @@ RunOutcome Run(const Config& config, ProgressReporter& progress,
     log("warning: Show_images is 1 but there is no display (DISPLAY is not set); frames are "
         "not shown");
   RunOutcome out;
+  // Spread over processes (cluster.h): what a single process checks before its first frame,
+  // checked by every process together, so that a check that fails on one of them (a folder
+  // it cannot see) ends the run on all.
+  Cluster& cluster = Cluster::Get();
+  if (cluster.Distributed())
+    cluster.Agree([&] {
+      CheckDistinctOutputs(PlannedOutputs(config));
+      if (EvaluationRequested(config)) {
+        CheckOutputPrefix("Evaluation_name", config.evaluation.name);
+        (void)EvaluationSettingsFrom(config);
+      }
+      CheckRun(config);
+    });
   // Outputs are checked before the long part of the run: no two at one file, no prefix that
   // is a folder.
   CheckDistinctOutputs(PlannedOutputs(config));
@@ -30,6 +44,8 @@ RunOutcome Run(const Config& config, ProgressReporter& progress,
   if (!config.verification.enabled && !config.output.loops_name.empty())
     log("note: Loops_name: not written: Verification is 0 (no candidate is checked)");
   out.result = ComputeRun(config, progress);
+  // Process 0 evaluates, verifies and writes; the others have given it their shares.
+  if (cluster.Distributed() && cluster.Rank() != 0) return out;
   RunResult& result = out.result;
   for (const std::string& w : result.warnings) log("warning: " + w);
   for (const std::string& note : result.notes) log("note: " + note);
@@ -120,6 +136,10 @@ std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
   }
   const auto& tm = r.timings;
   out << "  mode: " << r.mode_reason << "\n";
+  const Cluster& cluster = Cluster::Get();
+  if (cluster.Distributed())
+    out << "  processes: " << cluster.Size() << " (mpirun; each described and matched its "
+        << "share, the timings below are process 0's)\n";
   if (r.bounded) {
     out << "  bounded: " << r.matches.size() << " matches kept (Best_matches "
         << c.scale.keep.best << ", Band_width " << c.scale.keep.band << "), max distance "

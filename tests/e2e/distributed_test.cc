@@ -1,0 +1,224 @@
+// Runs spread over processes with mpirun (OpenABLE/run/cluster.h, docs/distributed.md): every
+// output equals the single-process run's, byte for byte for Hamming distances and within
+// 1e-6 for L2 (whose matrix products sum in another order when the rows are split), in the
+// dense and the bounded mode, for one and two traversals, L = 1 and L = 10, with 1, 2 and 3
+// processes; a process that fails ends the run with one line naming it and leaves no output.
+// Skipped, saying why, when mpirun or the MPI module is absent.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "tests/e2e/e2e_support.h"
+#include "tests/test_support.h"
+
+namespace openable {
+namespace {
+
+using namespace e2e;  // NOLINT: the e2e helpers are this file's vocabulary
+
+namespace fs = std::filesystem;
+
+// Why the tests cannot run here, or empty.
+std::string MissingMpi() {
+  if (std::system("command -v mpirun > /dev/null 2>&1") != 0)
+    return "mpirun is not installed (Debian: openmpi-bin)";
+  const fs::path module =
+      fs::path(testing::TestOpenableExe()).parent_path().parent_path() / "modules" /
+      "libopenable_mpi.so";
+  if (!fs::exists(module))
+    return "this build has no MPI module (" + module.string() +
+           "; configure with libopenmpi-dev installed)";
+  return "";
+}
+
+// `program` run by mpirun with `processes` processes (0: run directly, one process).
+Outcome RunSpread(int processes, const std::string& program,
+                  const std::vector<std::string>& args, const std::string& dir) {
+  if (processes == 0) return RunProgram(program, args, dir);
+  // Root may run mpirun in containers and CI; --quiet keeps mpirun's own summary of a failed
+  // run out of the output, so that what is left is the program's.
+  std::vector<std::string> all = {"OMPI_ALLOW_RUN_AS_ROOT=1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1",
+                                  "OMPI_MCA_rmaps_base_oversubscribe=1", "mpirun", "--quiet",
+                                  "-np", std::to_string(processes), program};
+  all.insert(all.end(), args.begin(), args.end());
+  return RunProgram("/usr/bin/env", all, dir);
+}
+
+struct Case {
+  const char* name;
+  const char* descriptor;  // LDB: Hamming, HOG: L2
+  bool bounded;
+  bool two_traversals;
+  int sequence_length;
+};
+
+// `images`: the first traversal's folder (empty: the sample's summer frames).
+std::string ConfigOf(const std::string& dir, const Case& c, const std::string& images = "") {
+  const std::string path = dir + "/Config.txt";
+  std::ofstream f(path);
+  f << "%YAML:1.0\n"
+    << "Images_path: \"" << (images.empty() ? testing::SampleDir() + "/summer" : images)
+    << "\"\n"
+    << "Images_path_2: \"" << (c.two_traversals ? testing::SampleDir() + "/winter" : "")
+    << "\"\n"
+    << "Image_descriptor: " << c.descriptor << "\n"
+    << "Image_sequences: " << c.sequence_length << "\n"
+    << "Matrix_mode: " << (c.bounded ? 2 : 1) << "\n"
+    << "Best_matches: 5\n"
+    << "Exclusion: 20\n"
+    << "Threshold: 0.3\n"
+    << "Matches_name: \"out/matches.csv\"\n";
+  if (!c.bounded)
+    f << "Txt_name: \"out/matrix.txt\"\nNpy_name: \"out/matrix.npy\"\n"
+      << "Png_name: \"out/matrix.png\"\n";
+  return path;
+}
+
+// Lines of a matches CSV split at commas.
+std::vector<std::vector<std::string>> CsvRows(const std::string& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(ReadAll(path));
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::istringstream l(line);
+    std::string cell;
+    while (std::getline(l, cell, ',')) cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+// The matches of two runs: equal, or (L2) equal frames and ranks with values within 1e-6.
+void ExpectSameMatches(const std::string& a, const std::string& b, bool exact) {
+  if (exact) {
+    EXPECT_EQ(ReadAll(a), ReadAll(b)) << a << " and " << b << " differ";
+    return;
+  }
+  const auto ra = CsvRows(a), rb = CsvRows(b);
+  ASSERT_EQ(ra.size(), rb.size());
+  for (size_t i = 0; i < ra.size(); ++i) {
+    ASSERT_EQ(ra[i].size(), rb[i].size()) << "line " << i;
+    for (size_t k = 0; k < ra[i].size(); ++k) {
+      if (i > 0 && ra[i][k].find('.') != std::string::npos) {
+        EXPECT_NEAR(std::stod(ra[i][k]), std::stod(rb[i][k]), 1e-6) << "line " << i;
+      } else {
+        EXPECT_EQ(ra[i][k], rb[i][k]) << "line " << i;
+      }
+    }
+  }
+}
+
+class Spread : public ::testing::TestWithParam<Case> {};
+
+TEST_P(Spread, OneTwoAndThreeProcessesWriteTheSingleProcessOutputs) {
+  const std::string missing = MissingMpi();
+  if (!missing.empty()) GTEST_SKIP() << missing;
+  const Case& c = GetParam();
+  const bool hamming = std::string(c.descriptor) == "LDB";
+  const std::string single = testing::TempDir();
+  const Outcome one = RunProgram(testing::TestOpenableExe(), {ConfigOf(single, c), "--quiet"},
+                                 single);
+  ASSERT_EQ(one.status, 0) << one.err;
+  for (const int processes : {1, 2, 3}) {
+    SCOPED_TRACE(std::to_string(processes) + " processes");
+    const std::string dir = testing::TempDir();
+    const Outcome o =
+        RunSpread(processes, testing::TestOpenableExe(), {ConfigOf(dir, c), "--quiet"}, dir);
+    ASSERT_EQ(o.status, 0) << o.err << o.out;
+    if (processes > 1) {
+      EXPECT_NE(o.out.find("processes: " + std::to_string(processes)), std::string::npos)
+          << o.out;
+    }
+    ExpectSameMatches(single + "/out/matches.csv", dir + "/out/matches.csv", hamming);
+    if (c.bounded) {
+      EXPECT_FALSE(fs::exists(dir + "/out/matrix.npy"));
+      continue;
+    }
+    const cv::Mat1f a = ReadNpy(single + "/out/matrix.npy");
+    const cv::Mat1f b = ReadNpy(dir + "/out/matrix.npy");
+    ASSERT_EQ(a.size(), b.size());
+    ASSERT_FALSE(a.empty());
+    if (hamming) {
+      EXPECT_EQ(ReadAll(single + "/out/matrix.npy"), ReadAll(dir + "/out/matrix.npy"));
+      EXPECT_EQ(ReadAll(single + "/out/matrix.txt"), ReadAll(dir + "/out/matrix.txt"));
+      EXPECT_EQ(ReadAll(single + "/out/matrix.png"), ReadAll(dir + "/out/matrix.png"));
+    } else {
+      double worst = 0;
+      for (int i = 0; i < a.rows; ++i)
+        for (int j = 0; j < a.cols; ++j)
+          worst = std::max(worst, static_cast<double>(std::abs(a(i, j) - b(i, j))));
+      EXPECT_LE(worst, 1e-6);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Mpi, Spread,
+    ::testing::Values(Case{"LdbDenseOneL1", "LDB", false, false, 1},
+                      Case{"LdbDenseOneL10", "LDB", false, false, 10},
+                      Case{"LdbDenseTwoL1", "LDB", false, true, 1},
+                      Case{"LdbDenseTwoL10", "LDB", false, true, 10},
+                      Case{"LdbBoundedOneL1", "LDB", true, false, 1},
+                      Case{"LdbBoundedOneL10", "LDB", true, false, 10},
+                      Case{"LdbBoundedTwoL1", "LDB", true, true, 1},
+                      Case{"LdbBoundedTwoL10", "LDB", true, true, 10},
+                      Case{"HogDenseOneL1", "HOG", false, false, 1},
+                      Case{"HogDenseOneL10", "HOG", false, false, 10},
+                      Case{"HogDenseTwoL1", "HOG", false, true, 1},
+                      Case{"HogDenseTwoL10", "HOG", false, true, 10},
+                      Case{"HogBoundedOneL1", "HOG", true, false, 1},
+                      Case{"HogBoundedOneL10", "HOG", true, false, 10},
+                      Case{"HogBoundedTwoL1", "HOG", true, true, 1},
+                      Case{"HogBoundedTwoL10", "HOG", true, true, 10}),
+    [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
+
+// A frame that only process 1 reads is damaged: the run ends on every process, process 0 says
+// so in one line naming the frame and the process, and nothing is written.
+TEST(SpreadFailure, AFrameOfOneShareEndsTheRunInOneLineWithNoOutput) {
+  const std::string missing = MissingMpi();
+  if (!missing.empty()) GTEST_SKIP() << missing;
+  const std::string dir = testing::TempDir();
+  fs::create_directories(dir + "/frames");
+  std::vector<fs::path> images;
+  for (const auto& e : fs::directory_iterator(testing::SampleDir() + "/summer"))
+    images.push_back(e.path());
+  std::sort(images.begin(), images.end());
+  for (const fs::path& p : images) fs::copy_file(p, dir + "/frames/" + p.filename().string());
+  const std::string damaged = dir + "/frames/" + images.back().filename().string();
+  std::ofstream(damaged, std::ios::trunc) << "not an image";
+  const Case c{"", "LDB", false, false, 5};
+  const std::string config = ConfigOf(dir, c, dir + "/frames");
+  const Outcome o = RunSpread(2, testing::TestOpenableExe(), {config, "--quiet"}, dir);
+  EXPECT_EQ(o.status, 1) << o.err;
+  EXPECT_EQ(o.out, "");
+  EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+  EXPECT_NE(o.err.find("Test_OpenABLE: error: Images_path: image \"" + damaged), std::string::npos)
+      << o.err;
+  EXPECT_NE(o.err.find("(process 1 of 2)"), std::string::npos) << o.err;
+  EXPECT_FALSE(fs::exists(dir + "/out")) << "an output of the failed run was left";
+}
+
+// The other programs are not spread: under mpirun with several processes they say so.
+TEST(SpreadFailure, ProgramsThatDoNotSpreadRefuseSeveralProcesses) {
+  const std::string missing = MissingMpi();
+  if (!missing.empty()) GTEST_SKIP() << missing;
+  const std::string dir = testing::TempDir();
+  const Case c{"", "LDB", false, false, 1};
+  const Outcome o = RunSpread(2, testing::OpenableSweepExe(),
+                              {ConfigOf(dir, c), "--vary", "Image_sequences=1,2"}, dir);
+  EXPECT_EQ(o.status, 1) << o.err;
+  EXPECT_EQ(o.err,
+            "openable_sweep: error: openable_sweep runs as one process, but mpirun started 2; "
+            "expected one (Test_OpenABLE spreads a run over processes)\n");
+}
+
+}  // namespace
+}  // namespace openable
