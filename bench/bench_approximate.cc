@@ -1,18 +1,25 @@
-// Exact against approximate (FLANN) k-nearest search on real data: queries per second, speed-up
-// and recall of approximate search (matching/approximate.h), k = 10, all cores for both.
+// Exact against approximate k-nearest search on real data: queries per second, speed-up and
+// recall of each approximate engine (matching/approximate.h: FLANN, FAISS HNSW, FAISS IVF),
+// k = 10, all cores for every search.
 //
 // Data (../shared/datasets, skipped with a message when absent):
 //  - "nordland": references = Nordland trimmed summer, queries = winter (1788 + 1788 frames,
 //    frame-aligned: the same file name is the same place);
-//  - "nordland50k" and "nordland500k": the same queries against 50,000 and 500,000 references:
+//  - "nordland10k", "nordland100k" and "nordland1m": the same queries against 10,000, 100,000
+//    and 1,000,000 references:
 //    the 1788 summer frames plus distractors, each a perturbed copy (random crop of 80-100 % of
 //    the frame, gain 0.8-1.2, offset +-20 grey levels, Gaussian noise of deviation 3) of a
 //    summer frame or of a KITTI 00 frame (kitti00_first1700, 1700 frames), alternately, from
 //    fixed seeds. Summer copies keep their place (a copy of frame i is place i); KITTI copies
-//    are no place. The 500k set has LDB only (its HOG rows would take 3.5 GB).
+//    are no place. The 1m set has LDB only: its HOG rows would take 7.1 GB, held three times
+//    (the set, the index's copy for exact distances, FAISS's own copy) on a 23 GB machine.
 // Frames are read grey and resized to the 64 x 64 patch as the pipeline does (INTER_AREA when
 // shrinking both sides, INTER_LINEAR otherwise: Nordland's 64 x 32 frames are stretched), then
-// described with LDB (256 bits, Hamming; LSH) and HOG (1764 floats, L2; k-d trees).
+// described with LDB (256 bits, Hamming; LSH or binary FAISS indexes) and HOG (1764 floats, L2;
+// k-d trees or float FAISS indexes). An index is built once per set, descriptor and build
+// setting; the settings that differ only by their search budget (checks, ef_search, nprobe)
+// search the same index (ApproximateIndex::SetSearchBudget). FAISS settings are skipped with a
+// message in a build without FAISS.
 //
 // Counters: items_per_second = queries per second; speedup = exact time / approximate time for
 // the same queries; top1 and at_k as SearchRecall; place_top1 (approximate) and
@@ -122,8 +129,10 @@ struct SetSpec {
   int references;  // 0: the summer frames only
   bool hog;
 };
-constexpr SetSpec kSets[] = {
-    {"nordland", 0, true}, {"nordland50k", 50000, true}, {"nordland500k", 500000, false}};
+constexpr SetSpec kSets[] = {{"nordland", 0, true},
+                             {"nordland10k", 10000, true},
+                             {"nordland100k", 100000, true},
+                             {"nordland1m", 1000000, false}};
 
 // Describes patch(i) for i in [0, n) into rows of LDB and (when `hog`) HOG, in parallel.
 template <typename PatchOf>
@@ -214,12 +223,20 @@ DataSet Load(const SetSpec& spec) {
   return set;
 }
 
-// Sets are loaded on first use and kept; a set is released once a larger one is needed, to
-// bound memory (benchmarks run in registration order, smallest set first).
+// Indexes built so far, by set/descriptor/build setting, with their build time.
+struct BuiltIndex {
+  std::unique_ptr<ApproximateIndex> index;
+  double build_s = 0;
+};
+std::map<std::string, BuiltIndex> g_indexes;
+
+// Sets are loaded on first use and kept; a set (and its indexes) is released once a larger one
+// is needed, to bound memory (benchmarks run in registration order, smallest set first).
 const DataSet& Data(int which) {
   static std::map<int, std::unique_ptr<DataSet>> sets;
   auto& slot = sets[which];
   if (!slot) {
+    g_indexes.clear();
     for (auto& [other, set] : sets)
       if (other != which) set.reset();
     slot = std::make_unique<DataSet>();
@@ -308,7 +325,11 @@ void BM_Exact(benchmark::State& state, int which, bool hog) {
 }
 
 void BM_Approximate(benchmark::State& state, int which, bool hog, ApproximateOptions options,
-                    const std::string& setting) {
+                    const std::string& setting, const std::string& build_setting) {
+  if (options.engine != openable::ApproximateEngine::kFlann && !openable::FaissAvailable()) {
+    state.SkipWithError("this build has no FAISS (libfaiss-dev)");
+    return;
+  }
   const DataSet& d = Data(which);
   if (!d.error.empty()) {
     state.SkipWithError(d.error.c_str());
@@ -318,11 +339,17 @@ void BM_Approximate(benchmark::State& state, int which, bool hog, ApproximateOpt
   const cv::Mat& queries = Queries(d, hog);
   const Exact& exact = ExactOf(which, hog);
   options.k = kK;
-  Clock::time_point start = Clock::now();
-  const ApproximateIndex index(refs, options);
-  const double build_s = Seconds(start);
+  BuiltIndex& built = g_indexes[Key(which, hog) + "/" + build_setting];
+  if (!built.index) {
+    const Clock::time_point build_start = Clock::now();
+    built.index = std::make_unique<ApproximateIndex>(refs, options);
+    built.build_s = Seconds(build_start);
+  }
+  ApproximateIndex& index = *built.index;
+  index.SetSearchBudget(options);
+  const double build_s = built.build_s;
   CandidateLists lists;
-  start = Clock::now();
+  Clock::time_point start = Clock::now();
   for (auto _ : state) {
     lists = index.Search(queries);
     benchmark::DoNotOptimize(lists.data());
@@ -351,36 +378,63 @@ void BM_Approximate(benchmark::State& state, int which, bool hog, ApproximateOpt
   s.build_s = build_s;
 }
 
-// LSH settings for LDB (checks play no part in FLANN's LSH) and k-d tree settings for HOG.
+// Settings of each engine: LSH for LDB (checks play no part in FLANN's LSH), k-d trees for
+// HOG, HNSW and IVF for both. `build` names what the index is built from (settings with the
+// same `build` share one index).
 struct Setting {
-  std::string name;
+  std::string name, build;
   ApproximateOptions options;
 };
 
 std::vector<Setting> LshSettings() {
   std::vector<Setting> out;
-  for (const auto& [tables, bits, probe] : std::vector<std::tuple<int, int, int>>{
-           {12, 20, 2}, {12, 20, 1}, {12, 20, 0}, {24, 20, 2}, {12, 16, 2}, {12, 24, 2}}) {
+  for (const auto& [tables, bits, probe] :
+       std::vector<std::tuple<int, int, int>>{{12, 20, 2}, {12, 16, 2}}) {
     ApproximateOptions o;
     o.lsh_tables = tables;
     o.lsh_key_bits = bits;
     o.lsh_probe_level = probe;
-    out.push_back({"tables:" + std::to_string(tables) + "/key_bits:" + std::to_string(bits) +
-                       "/probe:" + std::to_string(probe),
-                   o});
+    const std::string name = "flann/tables:" + std::to_string(tables) +
+                             "/key_bits:" + std::to_string(bits) + "/probe:" + std::to_string(probe);
+    out.push_back({name, name, o});
   }
   return out;
 }
 
 std::vector<Setting> KdSettings() {
   std::vector<Setting> out;
-  for (const auto& [trees, checks] : std::vector<std::pair<int, int>>{
-           {4, 32}, {4, 128}, {4, 512}, {4, 2048}, {8, 512}, {8, 2048}}) {
+  for (const int checks : {512, 2048}) {
     ApproximateOptions o;
-    o.kd_trees = trees;
     o.checks = checks;
-    out.push_back({"trees:" + std::to_string(trees) + "/checks:" + std::to_string(checks), o});
+    out.push_back({"flann/trees:4/checks:" + std::to_string(checks), "flann/trees:4", o});
   }
+  return out;
+}
+
+std::vector<Setting> FaissSettings(const std::vector<int>& ef_searches,
+                                   const std::vector<int>& nprobes) {
+  std::vector<Setting> out;
+  for (const int ef : ef_searches) {
+    ApproximateOptions o;
+    o.engine = openable::ApproximateEngine::kHnsw;
+    o.ef_search = ef;
+    out.push_back({"hnsw/M:32/ef_search:" + std::to_string(ef), "hnsw/M:32", o});
+  }
+  for (const int nprobe : nprobes) {
+    ApproximateOptions o;
+    o.engine = openable::ApproximateEngine::kIvf;
+    o.nprobe = nprobe;
+    out.push_back({"ivf/nprobe:" + std::to_string(nprobe), "ivf", o});
+  }
+  return out;
+}
+
+std::vector<Setting> SettingsOf(bool hog) {
+  std::vector<Setting> out = hog ? KdSettings() : LshSettings();
+  const std::vector<Setting> faiss =
+      hog ? FaissSettings({32, 64, 128, 256}, {4, 16, 64})
+          : FaissSettings({16, 32, 64, 128, 256}, {4, 16, 64});
+  out.insert(out.end(), faiss.begin(), faiss.end());
   return out;
 }
 
@@ -392,9 +446,9 @@ void Register() {
       benchmark::RegisterBenchmark(("BM_Exact/" + base).c_str(), BM_Exact, which, hog)
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
-      for (const Setting& s : hog ? KdSettings() : LshSettings())
+      for (const Setting& s : SettingsOf(hog))
         benchmark::RegisterBenchmark(("BM_Approximate/" + base + "/" + s.name).c_str(),
-                                     BM_Approximate, which, hog, s.options, s.name)
+                                     BM_Approximate, which, hog, s.options, s.name, s.build)
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
     }
@@ -407,7 +461,7 @@ void PrintSummary() {
       "time / approximate time (search only, index built beforehand); place = first candidate "
       "within +-%d frames of the true place\n",
       kK, kPlaceTolerance);
-  std::printf("%-12s %-4s %-30s %7s %10s %10s %8s %6s %6s %11s %11s %8s\n", "set", "desc",
+  std::printf("%-12s %-4s %-34s %7s %10s %10s %8s %6s %6s %11s %11s %8s\n", "set", "desc",
               "setting", "refs", "exact q/s", "appr q/s", "speedup", "top1", "at_k", "place exact",
               "place appr", "build s");
   std::vector<const Summary*> rows;
@@ -418,7 +472,7 @@ void PrintSummary() {
   for (const Summary* s : rows) {
     const double exact_s = Median(g_exact[s->set + "/" + s->descriptor].seconds);
     const double approx_s = Median(s->seconds);
-    std::printf("%-12s %-4s %-30s %7d %10.0f %10.0f %8.2f %6.3f %6.3f %11.3f %11.3f %8.2f\n",
+    std::printf("%-12s %-4s %-34s %7d %10.0f %10.0f %8.2f %6.3f %6.3f %11.3f %11.3f %8.2f\n",
                 s->set.c_str(), s->descriptor.c_str(), s->setting.c_str(), s->references,
                 s->queries / exact_s, s->queries / approx_s, exact_s / approx_s, s->top1, s->at_k,
                 s->exact_place, s->place, s->build_s);

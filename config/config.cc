@@ -238,13 +238,23 @@ OptionTable ConfigTable(Config& c) {
         "int32, 1 = best, 0 = band only) or .csv. Frame numbers count from the start of their "
         "traversal. Required in bounded mode; optional in dense mode (taken from the matrix).");
   t.Add("Approximate_search", kScale, c.scale, c.scale.approximate_search,
-        "1: bounded mode finds the Best_matches candidates of each query with FLANN (LSH for "
-        "binary descriptors, k-d trees for vector ones) instead of comparing every pair, then "
-        "scores them with the sequence sum; faster on very large runs, recall below 1 "
-        "(docs/benchmarks.md). No band.");
+        "1: bounded mode finds the Best_matches candidates of each query with the index of "
+        "Approximate_engine instead of comparing every pair, then scores them with the sequence "
+        "sum; faster on very large runs, recall below 1 (docs/benchmarks.md). No band.");
+  t.AddEnumName("Approximate_engine", kScale, c.scale, c.scale.approximate_engine,
+        "Index of Approximate_search (docs/matching.md): hnsw, FAISS's HNSW graphs (binary for "
+        "LDB and other binary descriptors, float for SIFT and HOG); ivf, FAISS's inverted files "
+        "(k-means cells); flann, OpenCV's FLANN (LSH for binary descriptors, k-d trees for "
+        "vector ones). hnsw and ivf need a build with FAISS (libfaiss-dev).");
   t.Add("Approximate_checks", kScale, c.scale, c.scale.approximate_checks, 1, 100000,
-        "FLANN k-d trees (vector descriptors): references examined per query (more: better "
-        "recall, slower; LSH for binary descriptors ignores it).");
+        "Approximate_engine flann, k-d trees (vector descriptors): references examined per "
+        "query (more: better recall, slower; LSH for binary descriptors ignores it).");
+  t.Add("Approximate_ef_search", kScale, c.scale, c.scale.approximate_ef_search, 1, 100000,
+        "Approximate_engine hnsw: length of the candidate list while searching the graph "
+        "(efSearch; raised to Best_matches when smaller). More: better recall, slower.");
+  t.Add("Approximate_nprobe", kScale, c.scale, c.scale.approximate_nprobe, 1, 65536,
+        "Approximate_engine ivf: k-means cells scanned per query (nprobe; the index has about "
+        "2 sqrt(N) cells for N references). More: better recall, slower.");
   t.Add("Descriptor_cache", kScale, c.scale, c.scale.descriptor_cache,
         "Folder of the descriptor cache; empty = off. Each frame's descriptor row is kept under a"
         " hash of the image file's bytes and of every setting that changes the row "

@@ -62,10 +62,22 @@ std::string OutputOptions::ThresholdPngPath(bool thresholded) const {
 
 void OutputOptions::Check() const { CheckIntRange("Matrix_color", matrix_color, 0, 11); }
 
+ApproximateOptions ScaleOptions::Approximate() const {
+  ApproximateOptions o;
+  o.engine = approximate_engine;
+  o.checks = approximate_checks;
+  o.ef_search = approximate_ef_search;
+  o.nprobe = approximate_nprobe;
+  return o;
+}
+
 void ScaleOptions::Check() const {
   CheckNumberAtLeast("Memory_limit", memory_limit, 0);
   keep.Check();
   CheckIntRange("Approximate_checks", approximate_checks, 1, 100000);
+  CheckIntRange("Approximate_ef_search", approximate_ef_search, 1, 100000);
+  CheckIntRange("Approximate_nprobe", approximate_nprobe, 1, 65536);
+  if (approximate_search) CheckEngineAvailable(approximate_engine, "Approximate_engine");
   if (approximate_search && matrix_mode == MatrixMode::kDense)
     throw InputError("Approximate_search: 1 needs Matrix_mode 2 (bounded) or 0 (auto); "
                      "Matrix_mode is 1 (dense), which compares every pair");

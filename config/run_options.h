@@ -9,6 +9,7 @@
 #include "OpenABLE/base/enum_names.h"
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/metrics.h"
+#include "matching/approximate.h"
 #include "matching/bounded.h"
 
 namespace openable {
@@ -69,13 +70,19 @@ struct ScaleOptions {
   double memory_limit = 0.0;      // GiB the dense matrices may take, >= 0; 0: 3/4 of the RAM
   KeepRules keep;                 // Best_matches and Band_width (its exclusion: Exclusion)
   std::string matches_name;       // kept matches, .npy or .csv
-  bool approximate_search = false;  // FLANN candidates instead of every pair (bounded)
+  bool approximate_search = false;  // approximate candidates instead of every pair (bounded)
+  // The engine of the candidates (matching/approximate.h); hnsw and ivf need FAISS in the build.
+  ApproximateEngine approximate_engine = ApproximateEngine::kHnsw;
   int approximate_checks = 512;   // FLANN k-d trees: references examined per query, 1..100000
+  int approximate_ef_search = 128;  // hnsw: candidate list while searching, 1..100000
+  int approximate_nprobe = 16;     // ivf: cells scanned per query, 1..65536
   std::string descriptor_cache;   // folder of the descriptor cache; empty: off
 
   // Throws InputError naming the key: a value out of range, approximate search with the dense
   // mode, the bounded mode without Matches_name, a matches file that is not .npy or .csv.
   void Check() const;
+  // The options of the approximate index these keys give (k and threads left to the caller).
+  ApproximateOptions Approximate() const;
 };
 
 // The evaluation of a run (the Evaluation keys).

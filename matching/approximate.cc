@@ -12,8 +12,11 @@
 // why not Debian's libflann. (opencv2/flann.hpp: the cvflann headers need its includes first.)
 #include <opencv2/flann.hpp>
 
+#include "OpenABLE/base/error.h"
 #include "OpenABLE/base/threading.h"
+#include "OpenABLE/io/module_loader.h"
 #include "matching/distances.h"
+#include "matching/faiss_index.h"
 
 namespace openable {
 namespace {
@@ -129,7 +132,25 @@ class KnnUnique final : public cvflann::ResultSet<Distance> {
 
 }  // namespace
 
+bool FaissAvailable() {
+#ifdef OPENABLE_HAVE_FAISS
+  return true;
+#else
+  return false;
+#endif
+}
+
+void CheckEngineAvailable(ApproximateEngine engine, const std::string& key) {
+  if (engine != ApproximateEngine::kFlann && !FaissAvailable())
+    throw InputError(key + ": " + EnumName(engine) +
+                     " needs FAISS, which this build does not have (libfaiss-dev and OpenMP were "
+                     "not found when it was configured); expected flann");
+}
+
 void ApproximateOptions::Check() const {
+  if (static_cast<int>(engine) < 0 || static_cast<size_t>(engine) >= EnumNames<ApproximateEngine>().size())
+    Fail("ApproximateOptions::engine = " + std::to_string(static_cast<int>(engine)) +
+         ", expected one of " + EnumChoices<ApproximateEngine>());
   CheckField("k", k, 1, std::numeric_limits<int>::max());
   CheckField("checks", checks, 1, std::numeric_limits<int>::max());
   CheckField("lsh_tables", lsh_tables, 1, 64);
@@ -138,6 +159,11 @@ void ApproximateOptions::Check() const {
   // Level l probes sum_{i<=l} C(bits, i) keys per table: 1351 at level 3 with 20-bit keys.
   CheckField("lsh_probe_level", lsh_probe_level, 0, 3);
   CheckField("kd_trees", kd_trees, 1, 64);
+  CheckField("hnsw_m", hnsw_m, 4, 128);
+  CheckField("hnsw_ef_construction", hnsw_ef_construction, 8, 4096);
+  CheckField("ef_search", ef_search, 1, 100000);
+  CheckField("ivf_lists", ivf_lists, 0, std::numeric_limits<int>::max());
+  CheckField("nprobe", nprobe, 1, 65536);
   CheckField("threads", threads, 0, 4096);
 }
 
@@ -149,7 +175,38 @@ struct ApproximateIndex::Impl {
   cv::Mat references;  // owned copy, continuous: the FLANN indices point into it
   std::unique_ptr<Lsh> lsh;
   std::unique_ptr<KdTrees> kd;
+  std::unique_ptr<FaissIndex> faiss;  // hnsw, ivf (built in libopenable_faiss.so)
 };
+
+namespace {
+
+// openable_matching reaches the FAISS module through ModuleSymbol (openable_io, linked
+// PRIVATE: openable_io does not depend on this library, so there is no cycle) rather than a
+// table of functions handed in by its callers: every caller (the pipeline, the online
+// detector, the Python module, the benchmarks) then gets FAISS alike without wiring it.
+FaissSettings SettingsOf(const ApproximateOptions& o, const cv::Mat& refs) {
+  FaissSettings s;
+  s.hnsw = o.engine == ApproximateEngine::kHnsw;
+  s.binary = refs.depth() == CV_8U;
+  s.width = refs.cols;
+  s.hnsw_m = o.hnsw_m;
+  s.hnsw_ef_construction = o.hnsw_ef_construction;
+  s.ef_search = std::max(o.ef_search, o.k);
+  s.ivf_lists = o.ivf_lists;
+  s.nprobe = o.nprobe;
+  s.threads = o.threads;
+  s.seed = static_cast<int>(o.seed & 0x7FFFFFFFu);
+  return s;
+}
+
+std::unique_ptr<FaissIndex> BuildFaiss(const ApproximateOptions& o, const cv::Mat& refs) {
+  CheckEngineAvailable(o.engine, "ApproximateOptions::engine");
+  const auto build =
+      reinterpret_cast<OpenableFaissBuild>(ModuleSymbol("faiss", "openable_faiss_build"));
+  return std::unique_ptr<FaissIndex>(build(SettingsOf(o, refs), refs.data, refs.rows));
+}
+
+}  // namespace
 
 ApproximateIndex::ApproximateIndex(const cv::Mat& references, const ApproximateOptions& options)
     : impl_(std::make_unique<Impl>()) {
@@ -170,7 +227,9 @@ ApproximateIndex::ApproximateIndex(const cv::Mat& references, const ApproximateO
   } restore;
   cv::theRNG() = cv::RNG(options.seed);
 
-  if (refs.depth() == CV_8U) {
+  if (options.engine != ApproximateEngine::kFlann) {
+    impl_->faiss = BuildFaiss(options, refs);
+  } else if (refs.depth() == CV_8U) {
     // A key cannot have more bits than the descriptor (FLANN would read past its bit list).
     const int key_bits = std::min(options.lsh_key_bits, 8 * refs.cols);
     const cvflann::Matrix<unsigned char> data(refs.ptr<unsigned char>(), refs.rows, refs.cols);
@@ -191,6 +250,16 @@ ApproximateIndex& ApproximateIndex::operator=(ApproximateIndex&&) noexcept = def
 int ApproximateIndex::Size() const { return impl_->references.rows; }
 int ApproximateIndex::Width() const { return impl_->references.cols; }
 int ApproximateIndex::Type() const { return impl_->references.depth(); }
+const ApproximateOptions& ApproximateIndex::Options() const { return impl_->options; }
+
+void ApproximateIndex::SetSearchBudget(const ApproximateOptions& options) {
+  options.Check();
+  impl_->options.checks = options.checks;
+  impl_->options.ef_search = options.ef_search;
+  impl_->options.nprobe = options.nprobe;
+  if (impl_->faiss)
+    impl_->faiss->SetSearch(std::max(options.ef_search, impl_->options.k), options.nprobe);
+}
 
 CandidateLists ApproximateIndex::Search(const cv::Mat& queries_in) const {
   const cv::Mat& refs = impl_->references;
@@ -201,6 +270,27 @@ CandidateLists ApproximateIndex::Search(const cv::Mat& queries_in) const {
   // FLANN's k-d tree search insists on filling k slots, so k is capped at the set size.
   const int knn = std::min(impl_->options.k, refs.rows);
   const cvflann::SearchParams params(impl_->options.checks);
+
+  if (impl_->faiss) {
+    // FAISS spreads the queries over its OpenMP threads itself; only the exact distances are
+    // recomputed here, over OpenABLE's.
+    std::vector<std::int64_t> labels(static_cast<size_t>(queries.rows) * static_cast<size_t>(knn));
+    impl_->faiss->Search(queries.data, queries.rows, knn, labels.data());
+    ParallelBlocks(queries.rows, kQueryBlock, impl_->options.threads, [&](int q0, int q1) {
+      for (int q = q0; q < q1; ++q) {
+        std::vector<Candidate>& list = out[static_cast<size_t>(q)];
+        for (int i = 0; i < knn; ++i) {
+          const std::int64_t r = labels[static_cast<size_t>(q) * static_cast<size_t>(knn) +
+                                        static_cast<size_t>(i)];
+          if (r < 0 || r >= refs.rows) continue;
+          const int row = static_cast<int>(r);
+          list.push_back(Candidate{row, RowDistance(refs, row, queries, q)});
+        }
+        SortCandidates(list);
+      }
+    });
+    return out;
+  }
 
   // FLANN's search reads the index only (its k-d tree heaps are pooled per thread id), so
   // blocks of queries run in parallel on the one index, each thread with its own result set.

@@ -1,6 +1,6 @@
-// The bounded mode with approximate candidates (Approximate_search 1): FLANN (OpenCV's copy,
-// matching/approximate.h) finds the candidates of each query, LSH for binary descriptors and
-// randomised k-d trees for vector ones; each candidate is then scored by its exact sequence sum
+// The bounded mode with approximate candidates (Approximate_search 1): the index of
+// Approximate_engine (matching/approximate.h: FAISS HNSW or IVF, or OpenCV's FLANN) finds the
+// candidates of each query; each candidate is then scored by its exact sequence sum
 // (SequenceCellDistance). Declared in matching/bounded.h.
 #include <algorithm>
 #include <cmath>
@@ -13,13 +13,11 @@
 namespace openable {
 namespace {
 
-// Candidate lists (reference numbers) of every query, k per query: OpenCV's FLANN through
-// matching/approximate.h (seeded, so two runs give the same candidates; libflann cannot be).
+// Candidate lists (reference numbers) of every query, k per query, from the index of `options`
+// (deterministic, so two runs give the same candidates).
 std::vector<std::vector<int>> Candidates(const cv::Mat& refs, const cv::Mat& queries, int k,
-                                         int checks, int threads) {
-  ApproximateOptions options;
+                                         ApproximateOptions options, int threads) {
   options.k = k;
-  options.checks = checks;
   options.threads = threads;
   const ApproximateIndex index(refs, options);
   const CandidateLists lists = index.Search(queries);
@@ -33,12 +31,13 @@ std::vector<std::vector<int>> Candidates(const cv::Mat& refs, const cv::Mat& que
 
 std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlock& block,
                                       const KeepRules& rules, const BoundedOptions& options,
-                                      int checks, float& max_distance) {
+                                      const ApproximateOptions& approximate, float& max_distance) {
   const int L = options.sequence_length;
   const bool reverse = options.direction == SequenceDirection::kReverse;
   const bool both = options.direction == SequenceDirection::kBoth;
   const int m = block.reference_count;
-  // One sequence: the candidates must lie Exclusion frames back; ask FLANN for that many more.
+  // One sequence: the candidates must lie Exclusion frames back; ask the index for that many
+  // more.
   const int k = std::max(1, rules.best);
   const int asked = std::min(m, block.one_traversal ? k + 2 * rules.exclusion : k);
   const cv::Mat refs = descriptors.rowRange(block.reference_first, block.reference_first + m);
@@ -51,7 +50,7 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
                         ? block.query_count
                         : std::clamp(options.query_end, q_begin, block.query_count);
   const std::vector<std::vector<int>> cand =
-      Candidates(refs, queries.rowRange(q_begin, q_end), asked, checks, options.threads);
+      Candidates(refs, queries.rowRange(q_begin, q_end), asked, approximate, options.threads);
 
   auto score = [&](int q, int j, bool rev) {
     return SequenceCellDistance(queries, q, refs, j, L, rev, nullptr, options.partial);

@@ -23,6 +23,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "matching/approximate.h"
 #include "matching/distances.h"
 #include "matching/score.h"
 #include "matching/sequence.h"
@@ -103,13 +104,13 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
                                   float& max_distance,
                                   const std::function<void(int, int)>& progress = {});
 
-// Approximate_search: FLANN (LSH for CV_8U rows, 4 randomised k-d trees for CV_32F) gives
-// Best_matches candidates per query (with one traversal, Best_matches + 2 x Exclusion, of
-// which those Exclusion frames back are kept), each scored by its exact sequence sum; the
-// k best by that score are kept. Normalised by the largest score computed. `checks`: FLANN
-// leaves checked per query.
+// Approximate_search: the index of `approximate` (its engine and search budget; its k and
+// threads are set here: matching/approximate.h) gives Best_matches candidates per query (with
+// one traversal, Best_matches + 2 x Exclusion, of which those Exclusion frames back are kept),
+// each scored by its exact sequence sum; the k best by that score are kept. Normalised by the
+// largest score computed.
 std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlock& block,
                                       const KeepRules& rules, const BoundedOptions& options,
-                                      int checks, float& max_distance);
+                                      const ApproximateOptions& approximate, float& max_distance);
 
 }  // namespace openable

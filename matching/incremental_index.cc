@@ -16,7 +16,7 @@ struct IncrementalIndex::State {
   cv::Mat buffer;
   int size = 0;
 
-  // FLANN blocks over rows [first, first + count), contiguous and in order from row 0; counts
+  // Index blocks over rows [first, first + count), contiguous and in order from row 0; counts
   // are block_frames x 2^m, non-increasing along the vector.
   struct Block {
     int first = 0, count = 0;
@@ -148,12 +148,22 @@ int IncrementalIndex::Blocks() const { return static_cast<int>(state_->blocks.si
 std::int64_t IncrementalIndex::MemoryBytes() const {
   const State& s = *state_;
   std::int64_t bytes = static_cast<std::int64_t>(s.buffer.total()) * s.buffer.elemSize();
-  // Each index holds a copy of its rows plus its tables; counted as twice the rows (LSH: 12
-  // tables of one 4-byte id per row is less; k-d trees: 4 trees of nodes per row).
-  for (const auto& b : s.blocks)
-    bytes += 2 * static_cast<std::int64_t>(b.count) * s.width * s.buffer.elemSize();
-  if (s.merge)
-    bytes += 3 * static_cast<std::int64_t>(s.merge->count) * s.width * s.buffer.elemSize();
+  // Each index holds a copy of its rows (for the exact distances) plus its structure. FLANN:
+  // counted as one more copy of the rows (LSH: 12 tables of one 4-byte id per row is less;
+  // k-d trees: 4 trees of nodes per row). FAISS also keeps its own copy of the rows; HNSW adds
+  // its links, 2 M 4-byte ids per row on the bottom layer and about M more above; IVF an
+  // 8-byte id per row (the centroids are few).
+  const ApproximateOptions& a = s.options.approximate;
+  const std::int64_t row_bytes = s.width * static_cast<std::int64_t>(s.buffer.elemSize());
+  auto index_bytes = [&](std::int64_t rows) {
+    std::int64_t extra = 0;
+    if (a.engine == ApproximateEngine::kHnsw) extra = 3 * a.hnsw_m * 4 + 8;
+    if (a.engine == ApproximateEngine::kIvf) extra = 8;
+    return rows * (2 * row_bytes + extra);
+  };
+  for (const auto& b : s.blocks) bytes += index_bytes(b.count);
+  // A merge being built: its index and the copy of its rows handed to the build.
+  if (s.merge) bytes += index_bytes(s.merge->count) + s.merge->count * row_bytes;
   return bytes;
 }
 

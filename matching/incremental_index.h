@@ -2,8 +2,8 @@
 // online loop detector (OpenABLE/online/online.h).
 //
 // Rows are appended one by one. While the searchable rows number at most exact_limit, every
-// one is a candidate (an exact scan); beyond, rows are indexed by FLANN
-// (matching/approximate.h: LSH for binary rows, k-d trees for float rows) in blocks of
+// one is a candidate (an exact scan); beyond, rows are indexed by the engine of
+// options.approximate (matching/approximate.h: FAISS HNSW or IVF, or FLANN) in blocks of
 // block_frames rows merged as they grow (sizes block_frames x 2^m, at most one of each, like a
 // binary counter), and only the newest unindexed rows (fewer than block_frames) are scanned
 // exactly. Merges of two blocks are built on a background thread while the two old blocks go
@@ -21,8 +21,8 @@
 namespace openable {
 
 struct IncrementalIndexOptions {
-  int exact_limit = 20000;         // searchable rows scanned exactly before FLANN blocks, >= 0
-  int block_frames = 4096;         // rows of the smallest FLANN block, >= 16
+  int exact_limit = 20000;         // searchable rows scanned exactly before index blocks, >= 0
+  int block_frames = 4096;         // rows of the smallest index block, >= 16
   bool background_merges = true;   // build merges on a background thread (see above)
   ApproximateOptions approximate;  // its k is the candidate count of each block
 };
@@ -41,15 +41,15 @@ class IncrementalIndex {
   // `background` false builds every merge here (a map loaded all at once).
   void Update(int searchable, bool background = true);
   // The candidate rows for `row` among [0, searchable) (after Update(searchable)): every row
-  // while exact; else the FLANN candidates of each block plus the unindexed rows. `approximate`
-  // receives whether FLANN was used.
+  // while exact; else the approximate candidates of each block plus the unindexed rows.
+  // `approximate` receives whether the blocks were used.
   std::vector<int> Candidates(const cv::Mat& row, int searchable, bool* approximate) const;
   // Waits for a background merge to finish and installs its index.
   void FinishMerges();
 
   cv::Mat Rows() const;              // Size() x width, a view of the stored rows
   int Size() const;                  // rows appended
-  int Blocks() const;                // FLANN blocks in use (0 while exact)
+  int Blocks() const;                // index blocks in use (0 while exact)
   std::int64_t MemoryBytes() const;  // rows + indices held now (estimate, see the .cc)
 
  private:

@@ -60,6 +60,7 @@ void OnlineOptions::Check() const {
   } catch (const std::exception& e) {
     throw InputError("OnlineOptions.approximate: " + std::string(e.what()));
   }
+  CheckEngineAvailable(approximate.engine, "OnlineOptions.approximate.engine");
   Require(approximate.k >= candidates, "approximate.k", std::to_string(approximate.k),
           ">= candidates (" + std::to_string(candidates) + ")");
   if (verification.enabled) {

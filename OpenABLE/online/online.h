@@ -49,7 +49,7 @@ struct OnlineOptions {
   // The confidence of a candidate (matching/score.h, the key Match_score): its normalised
   // distance, or the ratio of its distance to the best candidate more than score_window
   // frames away from it (the rivals are the candidates the search scored: every searchable
-  // frame while exact, the FLANN candidates beyond).
+  // frame while exact, the approximate candidates beyond).
   MatchScore score = MatchScore::kDistance;
   int score_window = 10;  // >= 0
   // A candidate is accepted when its score is <= threshold (see LoopCandidate). Default, for
@@ -58,9 +58,10 @@ struct OnlineOptions {
   // docs/library.md). With the ratio score choose it anew (docs/library.md gives figures).
   double threshold = 0.13;
   // Search: exact (every earlier frame) while the searchable map holds at most exact_limit
-  // frames; beyond, frames are indexed by FLANN (LSH for binary rows, k-d trees for float
-  // rows) in blocks of block_frames merged as they grow (sizes block_frames x 2^m, at most one
-  // of each), and only the newest unindexed frames (< block_frames) are scanned exactly.
+  // frames; beyond, frames are indexed by approximate.engine (FAISS HNSW or IVF, or FLANN:
+  // matching/approximate.h) in blocks of block_frames merged as they grow (sizes block_frames x
+  // 2^m, at most one of each), and only the newest unindexed frames (< block_frames) are
+  // scanned exactly.
   int exact_limit = 20000;
   int block_frames = 4096;
   // Merges of two blocks into one are built on a background thread while the frames go on
@@ -68,7 +69,9 @@ struct OnlineOptions {
   // to 500,000 rows takes seconds). The candidates then depend on when a merge finishes: false
   // builds merges in AddFrame instead, for repeatable results (at the cost of those waits).
   bool background_merges = true;
-  ApproximateOptions approximate;  // its k is the per-block candidate count (>= candidates)
+  // The engine and settings of the blocks' indexes; its k is the per-block candidate count
+  // (>= candidates). Throws from Check() when the engine needs FAISS and the build has none.
+  ApproximateOptions approximate;
   // Geometric verification and temporal consistency (OpenABLE/verification/verification.h,
   // the Verification_* keys; verification.tolerance: the frames within which references
   // count as neighbours for the consistency). When enabled: each frame's local features are
@@ -111,7 +114,7 @@ struct OnlineResult {
   int frame = -1;                            // index of the frame just added (0, 1, ...)
   std::vector<LoopCandidate> candidates;     // best first (ties: earlier frame first); empty
                                              // while no frame is old enough
-  bool approximate = false;                  // the search used the FLANN blocks
+  bool approximate = false;                  // the search used the index blocks
   double describe_seconds = 0;               // AddFrame: describing the image
   double search_seconds = 0;                 // searching and bookkeeping (index builds too)
   double verify_seconds = 0;                 // verification: features of the frame and checks
@@ -119,8 +122,8 @@ struct OnlineResult {
 
 // Loop candidates frame by frame. Memory: the descriptor rows of every frame (row bytes x
 // frames: 32 B a frame for LDB 256 bits, 3.2 MB per 100,000 frames) plus, beyond exact_limit,
-// the FLANN indices (see MemoryBytes). Latency per frame: description, plus L distances per
-// searchable frame while exact (linear in the map up to exact_limit), then one FLANN query per
+// the approximate indices (see MemoryBytes). Latency per frame: description, plus L distances per
+// searchable frame while exact (linear in the map up to exact_limit), then one index query per
 // block (about log2(frames / block_frames) + 1 blocks; one more while a merge is built) plus
 // an exact scan of fewer than block_frames frames, plus L distances per candidate; every
 // block_frames frames one block of block_frames rows is indexed in AddFrame (milliseconds). Not
@@ -149,7 +152,7 @@ class OnlineDetector {
   int RowType() const;              // CV_8U (Hamming) or CV_32F (L2)
   cv::Mat Descriptors() const;      // Size() x RowWidth(), a view of the stored rows
   std::int64_t MemoryBytes() const; // rows + indices held now
-  int Blocks() const;               // FLANN blocks in use (0 while exact)
+  int Blocks() const;               // index blocks in use (0 while exact)
   // Waits for a background merge (background_merges) to finish and installs its index.
   void FinishMerges();
 

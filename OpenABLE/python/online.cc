@@ -77,7 +77,7 @@ OnlineOptions OnlineOptionsOf(const py::kwargs& kwargs);
 
 // openable.OnlineOptions: OnlineOptions with one property per keyword argument of
 // OnlineDetector, in the flat names of the Python API (grid as a pair, description by name,
-// the FLANN search's fields at the top level). The properties are the one list of options:
+// the approximate search's fields at the top level). The properties are the one list of options:
 // the constructor's keywords, its signature, options["name"], keys() and to_dict() read it.
 void BindOnlineOptions(py::module_& m) {
   using O = OnlineOptions;
@@ -127,12 +127,12 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
                      "choose another for the ratio (docs/library.md).")
       .def_readwrite("exact_limit", &O::exact_limit,
                      "Exact search while the searchable map holds at most this many frames.")
-      .def_readwrite("block_frames", &O::block_frames, "Frames per FLANN block beyond it.")
+      .def_readwrite("block_frames", &O::block_frames, "Frames per index block beyond it.")
       .def_readwrite("background_merges", &O::background_merges,
                      "Build merges of two blocks on a background thread (no frame waits for a "
                      "large index build; candidates then depend on when a merge finishes); "
                      "False builds them inside add_frame, for repeatable results.");
-  // Members of the nested option structs as top-level properties: the FLANN search
+  // Members of the nested option structs as top-level properties: the approximate search
   // (matching/approximate.h) and the verification (prefix verification_).
   const auto nested = [&c](const char* name, auto outer, auto member, const char* doc) {
     using T = std::remove_reference_t<decltype(std::declval<O&>().*outer.*member)>;
@@ -143,7 +143,15 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
   const auto flann = [&nested](const char* name, auto member, const char* doc) {
     nested(name, &O::approximate, member, doc);
   };
-  flann("approximate_k", &ApproximateOptions::k, "FLANN candidates per block (>= candidates).");
+  c.def_property(
+      "engine", [](const O& o) { return EnumName(o.approximate.engine); },
+      [](O& o, const std::string& v) {
+        o.approximate.engine = ParseEnum<ApproximateEngine>(v, "engine");
+      },
+      "Index of the blocks beyond exact_limit: \"hnsw\" or \"ivf\" (FAISS), \"flann\".");
+  flann("approximate_k", &ApproximateOptions::k, "Candidates per block (>= candidates).");
+  flann("ef_search", &ApproximateOptions::ef_search, "HNSW: candidate list while searching.");
+  flann("nprobe", &ApproximateOptions::nprobe, "IVF: cells scanned per query.");
   flann("checks", &ApproximateOptions::checks, "k-d trees: references examined per query.");
   flann("lsh_tables", &ApproximateOptions::lsh_tables, "LSH hash tables.");
   flann("lsh_key_bits", &ApproximateOptions::lsh_key_bits, "Bits of an LSH key.");
@@ -362,7 +370,7 @@ Returns:
 
 Loop candidates frame by frame, for a SLAM system: each frame added is described, searched
 among the earlier frames (exactly while the map holds at most exact_limit frames, then through
-FLANN blocks), and its best candidates are returned.
+index blocks of the engine), and its best candidates are returned.
 
 Args:
     **options: the properties of openable.OnlineOptions (help(openable.OnlineOptions) says
@@ -419,7 +427,7 @@ Returns:
     best first (ties: earlier frame first), each (earlier frame, raw sequence distance,
     normalised distance, accepted, score: the normalised distance or the ratio, as the option
     score says; accepted is score <= threshold), empty while no frame is old enough; timings
-    {"describe_seconds", "search_seconds", "approximate": whether FLANN blocks were used}.
+    {"describe_seconds", "search_seconds", "approximate": whether index blocks were used}.
 
 Raises:
     openable.InputError: an empty image, another type, or one smaller than the description
@@ -450,7 +458,7 @@ describe_images()) as the next frame; returns what add_frame() returns.)doc")
           },
           R"doc(finish_merges()
 
-Waits for a merge of FLANN blocks being built in the background (background_merges) and
+Waits for a merge of index blocks being built in the background (background_merges) and
 installs its index.)doc")
       .def_property_readonly(
           "size",
@@ -494,14 +502,14 @@ installs its index.)doc")
             std::lock_guard<std::mutex> lock(d.mutex);
             return d.detector->MemoryBytes();
           },
-          "Bytes held now: the rows plus, beyond exact_limit, the FLANN indices.")
+          "Bytes held now: the rows plus, beyond exact_limit, the index blocks.")
       .def_property_readonly(
           "blocks",
           [](Detector& d) {
             std::lock_guard<std::mutex> lock(d.mutex);
             return d.detector->Blocks();
           },
-          "FLANN blocks in use (0 while the search is exact).")
+          "Index blocks in use (0 while the search is exact).")
       .def_property_readonly(
           "options", [](Detector& d) { return d.detector->Options(); },
           "The options in effect (an openable.OnlineOptions; options[\"name\"] and "

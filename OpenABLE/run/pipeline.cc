@@ -439,7 +439,7 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
                      "Memory_limit)");
   if (scale.approximate_search && result.descriptors.front().metric == Metric::kL1)
     throw InputError("Approximate_search: 1 with Image_descriptor " + names.front() +
-                     " (L1 distance), which FLANN's LSH and k-d trees do not index; expected "
+                     " (L1 distance), which no approximate engine indexes; expected "
                      "Approximate_search 0 (the exact bounded mode) or another descriptor");
   if (check_only) return result;
 
@@ -503,8 +503,8 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     // as `share` says.
     const auto match_share = [&](const BoundedOptions& share, float& largest) {
       if (scale.approximate_search)
-        return ApproximateMatches(described.rows, block, rules, share,
-                                  scale.approximate_checks, largest);
+        return ApproximateMatches(described.rows, block, rules, share, scale.Approximate(),
+                                  largest);
       return BoundedMatches(described.rows, block, rules, share, largest,
                             [&](int done, int) { progress.Update(done); });
     };

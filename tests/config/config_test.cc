@@ -182,6 +182,47 @@ TEST(Config, OverridesUseTheSameBinding) {
             std::string::npos);
 }
 
+// Approximate_engine takes the three engine names (any case) and refuses others in one line
+// naming the key, the value and the names; hnsw and ivf with Approximate_search 1 need FAISS in
+// the build (else one line saying so, never FLANN in their place).
+TEST(Config, ApproximateEngineValues) {
+  Config c;
+  c.input.images_path = "x";
+  c.scale.matches_name = "m.csv";
+  ApplyOverride(c, "Approximate_engine=flann");
+  EXPECT_EQ(c.scale.approximate_engine, ApproximateEngine::kFlann);
+  ApplyOverride(c, "Approximate_engine=IVF");
+  EXPECT_EQ(c.scale.approximate_engine, ApproximateEngine::kIvf);
+  ApplyOverride(c, "Approximate_engine=hnsw");
+  EXPECT_EQ(c.scale.approximate_engine, ApproximateEngine::kHnsw);
+  EXPECT_EQ(ConfigValueText(c, "Approximate_engine"), "\"hnsw\"");
+  const std::string bad = ErrorOf([&] { ApplyOverride(c, "Approximate_engine=annoy"); });
+  EXPECT_NE(bad.find("Approximate_engine"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("annoy"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("flann, hnsw or ivf"), std::string::npos) << bad;
+  EXPECT_EQ(bad.find('\n'), std::string::npos) << bad;
+  EXPECT_EQ(c.scale.approximate_engine, ApproximateEngine::kHnsw);  // unchanged
+  // Read from a file as well.
+  const Config f = LoadConfig(WriteFile("%YAML:1.0\nApproximate_engine: ivf\n"
+                                        "Approximate_nprobe: 32\nApproximate_ef_search: 128\n"));
+  EXPECT_EQ(f.scale.approximate_engine, ApproximateEngine::kIvf);
+  EXPECT_EQ(f.scale.Approximate().nprobe, 32);
+  EXPECT_EQ(f.scale.Approximate().ef_search, 128);
+  EXPECT_EQ(f.scale.Approximate().engine, ApproximateEngine::kIvf);
+
+  c.scale.approximate_search = true;
+  for (const char* engine : {"flann", "hnsw", "ivf"}) {
+    ApplyOverride(c, std::string("Approximate_engine=") + engine);
+    if (FaissAvailable() || std::string(engine) == "flann") {
+      EXPECT_NO_THROW(CheckConfig(c)) << engine;
+    } else {
+      const std::string message = ErrorOf([&] { CheckConfig(c); });
+      EXPECT_EQ(message.rfind(std::string("Approximate_engine: ") + engine, 0), 0u) << message;
+      EXPECT_NE(message.find("expected flann"), std::string::npos) << message;
+    }
+  }
+}
+
 TEST(Config, CrossKeyChecks) {
   Config c;
   EXPECT_NE(ErrorOf([&] { CheckConfig(c); }).find("Images_path: empty"), std::string::npos);

@@ -7,8 +7,11 @@
 #include <limits>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
+
+#include "OpenABLE/base/error.h"
 
 namespace openable {
 namespace {
@@ -192,12 +195,19 @@ TEST(ExactNearest, ViewsAndEmptyQueries) {
 
 // ---------------------------------------------------------------- approximate search
 
+// FLANN's options (the default engine is HNSW).
+ApproximateOptions FlannOptions() {
+  ApproximateOptions o;
+  o.engine = ApproximateEngine::kFlann;
+  return o;
+}
+
 // 2000 random 256-bit references; queries are every 4th reference with 8 bits flipped (a
 // planted near-duplicate at distance 8, while other references lie around 128).
 TEST(ApproximateIndex, LshFindsPlantedNearDuplicates) {
   const cv::Mat refs = RandomBytes(2000, 32, 7);
   const cv::Mat queries = FlipBits(refs, EveryNth(2000, 4), 8, 8);
-  ApproximateOptions options;
+  ApproximateOptions options = FlannOptions();
   const ApproximateIndex index(refs, options);
   EXPECT_EQ(index.Size(), 2000);
   EXPECT_EQ(index.Width(), 32);
@@ -222,12 +232,12 @@ TEST(ApproximateIndex, LshOptionsChangeRecall) {
   const cv::Mat refs = RandomBytes(2000, 32, 11);
   const cv::Mat queries = FlipBits(refs, EveryNth(2000, 4), 40, 12);
   const CandidateLists exact = ExactNearest(refs, queries, 10);
-  ApproximateOptions weak;
+  ApproximateOptions weak = FlannOptions();
   weak.lsh_tables = 1;
   weak.lsh_probe_level = 0;
   const SearchRecall low = MeasureRecall(exact, ApproximateIndex(refs, weak).Search(queries));
   const SearchRecall high =
-      MeasureRecall(exact, ApproximateIndex(refs, ApproximateOptions()).Search(queries));
+      MeasureRecall(exact, ApproximateIndex(refs, FlannOptions()).Search(queries));
   // One table, no probing: found only when the 20 key bits avoid all 40 flipped bits
   // (probability 0.029; measured top1 0.032). Defaults, 12 tables probed at level 2: found
   // unless every key holds 3 or more (1 - 0.634^12 = 0.996; measured 0.998).
@@ -240,7 +250,7 @@ TEST(ApproximateIndex, LshOptionsChangeRecall) {
 TEST(ApproximateIndex, KdTreesFindPlantedNearDuplicates) {
   const cv::Mat refs = RandomFloats(2000, 64, 21);
   const cv::Mat queries = AddNoise(refs, EveryNth(2000, 4), 0.1f, 22);
-  ApproximateOptions options;
+  ApproximateOptions options = FlannOptions();
   options.checks = 128;
   const ApproximateIndex index(refs, options);
   EXPECT_EQ(index.Type(), CV_32F);
@@ -267,7 +277,7 @@ TEST(ApproximateIndex, DeterministicAcrossBuildsAndThreads) {
   const cv::Mat float_queries = AddNoise(floats, EveryNth(1000, 3), 0.5f, 34);
   for (const auto& [refs, queries] :
        {std::pair{bytes, byte_queries}, std::pair{floats, float_queries}}) {
-    ApproximateOptions one, two;
+    ApproximateOptions one = FlannOptions(), two = one;
     one.threads = 1;
     two.threads = 2;
     one.checks = two.checks = 32;
@@ -291,7 +301,7 @@ TEST(ApproximateIndex, ConcurrentSearchesAgree) {
   const cv::Mat floats = RandomFloats(1000, 32, 35);
   const cv::Mat bytes = RandomBytes(1000, 32, 36);
   for (const cv::Mat& refs : {floats, bytes}) {
-    ApproximateOptions options;
+    ApproximateOptions options = FlannOptions();
     options.threads = 2;
     const ApproximateIndex index(refs, options);
     const CandidateLists alone = index.Search(refs);
@@ -305,7 +315,7 @@ TEST(ApproximateIndex, ConcurrentSearchesAgree) {
 
 TEST(ApproximateIndex, KLargerThanReferences) {
   const cv::Mat refs = RandomFloats(5, 8, 41), queries = RandomFloats(3, 8, 42);
-  ApproximateOptions options;
+  ApproximateOptions options = FlannOptions();
   options.k = 10;
   const CandidateLists kd = ApproximateIndex(refs, options).Search(queries);
   ExpectSameLists(NaiveNearest(refs, queries, 10), kd);  // all 5, in order
@@ -323,7 +333,7 @@ TEST(ApproximateIndex, KLargerThanReferences) {
 TEST(ApproximateIndex, NarrowDescriptorsCapTheKey) {
   // 1-byte descriptors: a 20-bit key cannot be drawn from 8 bits; it is capped, not a crash.
   const cv::Mat refs = RandomBytes(200, 1, 51), queries = RandomBytes(20, 1, 52);
-  const CandidateLists approximate = ApproximateIndex(refs, ApproximateOptions()).Search(queries);
+  const CandidateLists approximate = ApproximateIndex(refs, FlannOptions()).Search(queries);
   ExpectExactDistances(refs, queries, approximate, 10);
   // An 8-bit key over 8-bit descriptors: each table's bucket holds the equal references, and
   // probing level 2 reaches every reference within 2 bits.
@@ -334,7 +344,7 @@ TEST(ApproximateIndex, NarrowDescriptorsCapTheKey) {
 TEST(ApproximateIndex, ViewsAndEmptyQueries) {
   const cv::Mat big = RandomFloats(60, 40, 61);
   const cv::Mat refs = big(cv::Rect(5, 0, 30, 50)), queries = big(cv::Rect(5, 50, 30, 10));
-  ApproximateOptions options;
+  ApproximateOptions options = FlannOptions();
   options.checks = 1000;  // more than the references: exact
   const ApproximateIndex index(refs, options);
   ExpectSameLists(NaiveNearest(refs, queries, 10), index.Search(queries));
@@ -344,7 +354,7 @@ TEST(ApproximateIndex, ViewsAndEmptyQueries) {
 
 TEST(ApproximateIndex, MovesKeepTheIndex) {
   const cv::Mat refs = RandomBytes(100, 32, 71);
-  ApproximateIndex a(refs, ApproximateOptions());
+  ApproximateIndex a(refs, FlannOptions());
   const CandidateLists before = a.Search(refs);
   ApproximateIndex b(std::move(a));
   EXPECT_TRUE(SameLists(before, b.Search(refs)));
@@ -355,7 +365,7 @@ TEST(ApproximateIndex, MovesKeepTheIndex) {
 TEST(ApproximateIndex, RejectsBadOptionsAndInputs) {
   const cv::Mat bytes = RandomBytes(10, 32, 81), floats = RandomFloats(10, 32, 82);
   auto with = [](auto change) {
-    ApproximateOptions o;
+    ApproximateOptions o = FlannOptions();
     change(o);
     return o;
   };
@@ -383,7 +393,7 @@ TEST(ApproximateIndex, RejectsBadOptionsAndInputs) {
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   }
 
-  const ApproximateOptions ok;
+  const ApproximateOptions ok = FlannOptions();
   EXPECT_THROW(ApproximateIndex(cv::Mat(), ok), std::invalid_argument);
   EXPECT_THROW(ApproximateIndex(cv::Mat(0, 32, CV_8U), ok), std::invalid_argument);
   EXPECT_THROW(ApproximateIndex(cv::Mat(10, 32, CV_16U, cv::Scalar(0)), ok), std::invalid_argument);
@@ -437,6 +447,188 @@ TEST(MeasureRecall, TiesCountAndAtKCounts) {
   EXPECT_EQ(MeasureRecall({}, {}).queries, 0);
   EXPECT_THROW(MeasureRecall(exact, {}), std::invalid_argument);
   EXPECT_THROW(MeasureRecall({{}}, {{}}), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------- FAISS engines
+
+// The FAISS engines of this build, with a message when there are none.
+#define SKIP_WITHOUT_FAISS() \
+  if (!FaissAvailable()) GTEST_SKIP() << "this build has no FAISS (libfaiss-dev)"
+
+ApproximateOptions EngineOptions(ApproximateEngine engine) {
+  ApproximateOptions o;
+  o.engine = engine;
+  return o;
+}
+
+// Share of queries whose first candidate is the planted reference (query i made from
+// reference source[i]).
+double PlantedFound(const CandidateLists& lists, const std::vector<int>& source) {
+  int found = 0;
+  for (size_t q = 0; q < lists.size(); ++q)
+    found += !lists[q].empty() && lists[q][0].reference == source[q];
+  return static_cast<double>(found) / static_cast<double>(lists.size());
+}
+
+// 4000 random 256-bit references; queries every 4th with 8 bits flipped (the planted row at 8
+// bits, every other ~128 away). Each engine must find the planted row, with exact distances.
+TEST(ApproximateIndex, FaissBinaryIndexesFindPlantedNearDuplicates) {
+  SKIP_WITHOUT_FAISS();
+  const cv::Mat refs = RandomBytes(4000, 32, 101);
+  const std::vector<int> source = EveryNth(4000, 4);
+  const cv::Mat queries = FlipBits(refs, source, 8, 102);
+  const CandidateLists exact = ExactNearest(refs, queries, 10);
+  for (const ApproximateEngine engine : {ApproximateEngine::kHnsw, ApproximateEngine::kIvf}) {
+    SCOPED_TRACE(EnumName(engine));
+    const ApproximateIndex index(refs, EngineOptions(engine));
+    EXPECT_EQ(index.Type(), CV_8U);
+    const CandidateLists approximate = index.Search(queries);
+    ExpectExactDistances(refs, queries, approximate, 10);
+    EXPECT_DOUBLE_EQ(PlantedFound(exact, source), 1.0);
+    // HNSW: the planted row is far nearer than any other, the graph search reaches it. IVF:
+    // cells are k-means of random bits; 8 flipped bits rarely move a query out of its
+    // source's nearest 16 cells (of 102).
+    EXPECT_GE(PlantedFound(approximate, source), 0.98);
+    EXPECT_GE(MeasureRecall(exact, approximate).top1, 0.98);
+  }
+}
+
+// 4000 float references of 64 unit Gaussians; queries every 4th plus noise of deviation 0.1.
+TEST(ApproximateIndex, FaissFloatIndexesFindPlantedNearDuplicates) {
+  SKIP_WITHOUT_FAISS();
+  const cv::Mat refs = RandomFloats(4000, 64, 111);
+  const std::vector<int> source = EveryNth(4000, 4);
+  const cv::Mat queries = AddNoise(refs, source, 0.1f, 112);
+  const CandidateLists exact = ExactNearest(refs, queries, 10);
+  for (const ApproximateEngine engine : {ApproximateEngine::kHnsw, ApproximateEngine::kIvf}) {
+    SCOPED_TRACE(EnumName(engine));
+    const ApproximateIndex index(refs, EngineOptions(engine));
+    EXPECT_EQ(index.Type(), CV_32F);
+    const CandidateLists approximate = index.Search(queries);
+    ExpectExactDistances(refs, queries, approximate, 10);
+    EXPECT_GE(PlantedFound(approximate, source), 0.98);
+    EXPECT_GE(MeasureRecall(exact, approximate).top1, 0.98);
+  }
+}
+
+// The search budget is used: a tiny IVF probe or HNSW list finds fewer of the exact 10 nearest
+// than a large one on unstructured rows (no planted neighbour).
+TEST(ApproximateIndex, FaissSearchBudgetChangesRecall) {
+  SKIP_WITHOUT_FAISS();
+  const cv::Mat refs = RandomFloats(4000, 32, 121), queries = RandomFloats(200, 32, 122);
+  const CandidateLists exact = ExactNearest(refs, queries, 10);
+  ApproximateOptions small = EngineOptions(ApproximateEngine::kIvf), large = small;
+  small.nprobe = 1;
+  large.nprobe = 1000;  // every cell: exact
+  EXPECT_LT(MeasureRecall(exact, ApproximateIndex(refs, small).Search(queries)).at_k, 0.8);
+  EXPECT_DOUBLE_EQ(MeasureRecall(exact, ApproximateIndex(refs, large).Search(queries)).at_k, 1.0);
+  small = large = EngineOptions(ApproximateEngine::kHnsw);
+  small.ef_search = 1;  // raised to k = 10
+  large.ef_search = 2000;
+  EXPECT_LT(MeasureRecall(exact, ApproximateIndex(refs, small).Search(queries)).at_k,
+            MeasureRecall(exact, ApproximateIndex(refs, large).Search(queries)).at_k);
+}
+
+TEST(ApproximateIndex, FaissDeterministicAcrossBuildsAndThreads) {
+  SKIP_WITHOUT_FAISS();
+  const cv::Mat bytes = RandomBytes(3000, 32, 131);
+  const cv::Mat byte_queries = FlipBits(bytes, EveryNth(3000, 3), 40, 132);
+  const cv::Mat floats = RandomFloats(3000, 32, 133);
+  const cv::Mat float_queries = AddNoise(floats, EveryNth(3000, 3), 0.5f, 134);
+  for (const auto& [refs, queries] :
+       {std::pair{bytes, byte_queries}, std::pair{floats, float_queries}}) {
+    for (const ApproximateEngine engine : {ApproximateEngine::kHnsw, ApproximateEngine::kIvf}) {
+      SCOPED_TRACE(EnumName(engine) + (refs.depth() == CV_8U ? " binary" : " float"));
+      ApproximateOptions one = EngineOptions(engine), two = one;
+      one.threads = 1;
+      two.threads = 2;
+      one.ef_search = two.ef_search = 16;
+      one.nprobe = two.nprobe = 2;
+      const CandidateLists a = ApproximateIndex(refs, one).Search(queries);
+      const CandidateLists b = ApproximateIndex(refs, two).Search(queries);
+      const CandidateLists c = ApproximateIndex(refs, two).Search(queries);
+      EXPECT_TRUE(SameLists(a, b));
+      EXPECT_TRUE(SameLists(b, c));
+      if (engine == ApproximateEngine::kIvf) {  // the k-means seed is used
+        ApproximateOptions other = one;
+        other.seed = 12345;
+        EXPECT_FALSE(SameLists(a, ApproximateIndex(refs, other).Search(queries)));
+      }
+    }
+  }
+}
+
+TEST(ApproximateIndex, FaissSmallSetsAndConcurrentSearches) {
+  SKIP_WITHOUT_FAISS();
+  for (const ApproximateEngine engine : {ApproximateEngine::kHnsw, ApproximateEngine::kIvf}) {
+    SCOPED_TRACE(EnumName(engine));
+    // Fewer references than k (IVF: one cell): every one, in order.
+    const cv::Mat refs = RandomFloats(5, 8, 141), queries = RandomFloats(3, 8, 142);
+    ExpectSameLists(NaiveNearest(refs, queries, 10),
+                    ApproximateIndex(refs, EngineOptions(engine)).Search(queries));
+    const cv::Mat bytes = RandomBytes(1000, 32, 143);
+    ApproximateOptions options = EngineOptions(engine);
+    options.threads = 2;
+    const ApproximateIndex index(bytes, options);
+    const CandidateLists alone = index.Search(bytes);
+    for (int q = 0; q < bytes.rows; ++q) EXPECT_EQ(alone[static_cast<size_t>(q)][0].distance, 0);
+    CandidateLists results[3];
+    std::vector<std::thread> threads;
+    for (auto& r : results) threads.emplace_back([&index, &bytes, &r] { r = index.Search(bytes); });
+    for (auto& t : threads) t.join();
+    for (const auto& r : results) EXPECT_TRUE(SameLists(alone, r));
+    EXPECT_TRUE(index.Search(cv::Mat(0, 32, CV_8U)).empty());
+    EXPECT_THROW(index.Search(RandomBytes(2, 16, 144)), std::invalid_argument);
+  }
+}
+
+TEST(ApproximateIndex, RejectsBadFaissOptions) {
+  const cv::Mat bytes = RandomBytes(10, 32, 151);
+  auto with = [](auto change) {
+    ApproximateOptions o = EngineOptions(ApproximateEngine::kHnsw);
+    change(o);
+    return o;
+  };
+  const std::pair<ApproximateOptions, const char*> bad[] = {
+      {with([](ApproximateOptions& o) { o.engine = static_cast<ApproximateEngine>(7); }),
+       "engine = 7, expected one of flann, hnsw or ivf"},
+      {with([](ApproximateOptions& o) { o.hnsw_m = 2; }), "hnsw_m = 2, expected 4..128"},
+      {with([](ApproximateOptions& o) { o.hnsw_ef_construction = 0; }),
+       "hnsw_ef_construction = 0"},
+      {with([](ApproximateOptions& o) { o.ef_search = 0; }), "ef_search = 0, expected 1..100000"},
+      {with([](ApproximateOptions& o) { o.ivf_lists = -1; }), "ivf_lists = -1"},
+      {with([](ApproximateOptions& o) { o.nprobe = 0; }), "nprobe = 0, expected 1..65536"},
+  };
+  for (const auto& [o, expected] : bad) {
+    try {
+      ApproximateIndex index(bytes, o);
+      ADD_FAILURE() << "accepted: " << expected;
+    } catch (const std::invalid_argument& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(expected), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  }
+}
+
+// A build without FAISS refuses its engines with one line naming the key; with FAISS they are
+// accepted. FLANN is always available.
+TEST(ApproximateIndex, FaissEnginesNeedFaissInTheBuild) {
+  EXPECT_NO_THROW(CheckEngineAvailable(ApproximateEngine::kFlann, "Approximate_engine"));
+  for (const ApproximateEngine engine : {ApproximateEngine::kHnsw, ApproximateEngine::kIvf}) {
+    if (FaissAvailable()) {
+      EXPECT_NO_THROW(CheckEngineAvailable(engine, "Approximate_engine"));
+      continue;
+    }
+    try {
+      CheckEngineAvailable(engine, "Approximate_engine");
+      ADD_FAILURE() << "accepted without FAISS";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("Approximate_engine: " + EnumName(engine), 0), 0u)
+          << e.what();
+    }
+    EXPECT_THROW(ApproximateIndex(RandomBytes(10, 32, 161), EngineOptions(engine)), InputError);
+  }
 }
 
 }  // namespace

@@ -164,8 +164,8 @@ TEST(BoundedMatches, VectorDescriptorsWithSequencesEqualTheDenseMatrix) {
   }
 }
 
-// FLANN candidates on planted near-duplicates: every query's duplicate found first, and every
-// kept distance is the exact one of its pair.
+// Approximate candidates on planted near-duplicates, with each engine of the build: every
+// query's duplicate found first, and every kept distance is the exact one of its pair.
 TEST(ApproximateMatches, FindsPlantedDuplicatesWithExactScores) {
   const int n = 2000;
   cv::Mat refs = RandomBinary(n, 32, 6);
@@ -182,16 +182,25 @@ TEST(ApproximateMatches, FindsPlantedDuplicatesWithExactScores) {
   KeepRules rules;
   rules.best = 3;
   rules.one_traversal = false;
-  float max_distance = 0;
-  const std::vector<Match> got = ApproximateMatches(d, block, rules, {}, 128, max_distance);
-  int found = 0;
-  for (const Match& m : got) {
-    const float exact = static_cast<float>(HammingDistance(d.ptr<std::uint8_t>(n + m.query),
-                                                           d.ptr<std::uint8_t>(m.reference), 32));
-    EXPECT_NEAR(m.distance * max_distance, exact, 1e-3);
-    if (m.rank == 1 && m.reference == m.query) ++found;
+  for (const ApproximateEngine engine :
+       {ApproximateEngine::kFlann, ApproximateEngine::kHnsw, ApproximateEngine::kIvf}) {
+    if (engine != ApproximateEngine::kFlann && !FaissAvailable()) continue;
+    SCOPED_TRACE(EnumName(engine));
+    ApproximateOptions approximate;
+    approximate.engine = engine;
+    approximate.checks = 128;
+    float max_distance = 0;
+    const std::vector<Match> got =
+        ApproximateMatches(d, block, rules, {}, approximate, max_distance);
+    int found = 0;
+    for (const Match& m : got) {
+      const float exact = static_cast<float>(HammingDistance(
+          d.ptr<std::uint8_t>(n + m.query), d.ptr<std::uint8_t>(m.reference), 32));
+      EXPECT_NEAR(m.distance * max_distance, exact, 1e-3);
+      if (m.rank == 1 && m.reference == m.query) ++found;
+    }
+    EXPECT_GE(found, 0.95 * n);
   }
-  EXPECT_GE(found, 0.95 * n);
 }
 
 

@@ -162,13 +162,17 @@ TEST(OnlineDetector, FloatDescriptorsMatchTheBruteForceToo) {
   }
 }
 
-TEST(OnlineDetector, SearchesFlannBlocksBeyondTheExactLimit) {
+// The index blocks of `engine` beyond the exact limit, against the exact detector.
+void SearchesBlocksBeyondTheExactLimit(ApproximateEngine engine) {
   OPENABLE_REQUIRE_PATH(KittiDir());
+  if (engine != ApproximateEngine::kFlann && !FaissAvailable())
+    GTEST_SKIP() << "this build has no FAISS (libfaiss-dev)";
   const std::vector<cv::Mat> frames = KittiFrames(2, 1699);  // 850 frames
   OnlineOptions exact_options;
   exact_options.exclusion = 50;
   exact_options.candidates = 1;
   OnlineOptions options = exact_options;
+  options.approximate.engine = engine;
   options.exact_limit = 100;
   options.block_frames = 64;
   options.background_merges = false;  // repeatable block counts
@@ -209,16 +213,27 @@ TEST(OnlineDetector, SearchesFlannBlocksBeyondTheExactLimit) {
     }
   }
   std::printf(
-      "approximate top-1 = exact top-1 for %d of %d frames; accepted loops found %d of %d\n", same,
-      queries, loops_found, loops);
+      "%s: approximate top-1 = exact top-1 for %d of %d frames; accepted loops found %d of %d\n",
+      EnumName(engine).c_str(), same, queries, loops_found, loops);
   // LSH misses many nearest neighbours that are far anyway (non-loops: ~25 % of the bits
-  // differ, so a 20-bit key rarely survives), but not the loops (~10 % differ).
-  EXPECT_GT(same, 0.5 * queries);
+  // differ, so a 20-bit key rarely survives), but not the loops (~10 % differ). HNSW and IVF
+  // find nearly all nearest neighbours.
+  EXPECT_GT(same, (engine == ApproximateEngine::kFlann ? 0.5 : 0.9) * queries);
   EXPECT_GT(loops, 20);
   EXPECT_GE(loops_found, 0.95 * loops);
   EXPECT_GT(approximate.MemoryBytes(), exact.MemoryBytes());
   background.FinishMerges();
   EXPECT_EQ(background.Blocks(), approximate.Blocks());
+}
+
+TEST(OnlineDetector, SearchesFlannBlocksBeyondTheExactLimit) {
+  SearchesBlocksBeyondTheExactLimit(ApproximateEngine::kFlann);
+}
+TEST(OnlineDetector, SearchesHnswBlocksBeyondTheExactLimit) {
+  SearchesBlocksBeyondTheExactLimit(ApproximateEngine::kHnsw);
+}
+TEST(OnlineDetector, SearchesIvfBlocksBeyondTheExactLimit) {
+  SearchesBlocksBeyondTheExactLimit(ApproximateEngine::kIvf);
 }
 
 TEST(OnlineDetector, DistanceMatrixIsTheNormalisedBruteForce) {

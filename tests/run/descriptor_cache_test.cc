@@ -49,7 +49,8 @@ const std::set<std::string> kNotDescription = {
     "Final_image", "Skip_unreadable", "Txt_name", "Npy_name", "Png_name", "Png_threshold_name",
     "Matrix_color", "Show_images", "Panorama_matching", "Image_sequences", "Threshold",
     "Threads", "Sequence_direction", "Matrix_mode", "Memory_limit", "Best_matches",
-    "Band_width", "Matches_name", "Approximate_search", "Approximate_checks",
+    "Band_width", "Matches_name", "Approximate_search", "Approximate_engine",
+    "Approximate_checks", "Approximate_ef_search", "Approximate_nprobe",
     "Descriptor_cache", "Sequence_partial", "Match_score", "Match_score_window",
     "Match_threshold", "Contrast_enhancement", "Contrast_window", "Fusion_weights",
     "Loops_name"};

@@ -1,0 +1,55 @@
+// The entry points of the run-time module libopenable_faiss.so (matching/faiss_module.cc), the
+// FAISS indexes of ApproximateIndex (matching/approximate.h). The module links FAISS, OpenMP
+// and BLAS and nothing of OpenABLE but this header, so that openable_matching reaches it
+// through ModuleSymbol (OpenABLE/io/module_loader.h) alone. Module and program come from the
+// same build, so C++ types and exceptions cross the boundary.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace openable {
+
+// What the module needs of ApproximateOptions, checked by ApproximateOptions::Check.
+struct FaissSettings {
+  bool hnsw = true;     // HNSW, else IVF
+  bool binary = true;   // Hamming on packed bits (IndexBinary*), else L2 on floats
+  int width = 0;        // bytes of a binary row, floats of a float row
+  int hnsw_m = 32, hnsw_ef_construction = 64, ef_search = 64;
+  int ivf_lists = 0;    // 0: automatic (see ApproximateOptions::ivf_lists)
+  int nprobe = 16;
+  int threads = 0;      // OpenMP threads of training and searches (0: all cores)
+  int seed = 0;         // IVF k-means seed
+};
+
+// One built FAISS index.
+class FaissIndex {
+ public:
+  virtual ~FaissIndex() = default;
+  // `labels` (n x k): the rows of the k approximate nearest references of each of the n
+  // queries (rows of the index's type and width, continuous), -1 where fewer were found.
+  // Reads the index only.
+  virtual void Search(const void* queries, int n, int k, std::int64_t* labels) const = 0;
+  // Sets ef_search (HNSW) or nprobe (IVF, capped at the cells) for later searches; not while
+  // a search runs.
+  virtual void SetSearch(int ef_search, int nprobe) = 0;
+  // The index in FAISS's serialisation (write_index / write_index_binary).
+  virtual std::vector<std::uint8_t> Serialize() const = 0;
+};
+
+}  // namespace openable
+
+// Builds the index of `settings` over `rows` (n rows, continuous). Throws std::runtime_error
+// with FAISS's message on failure.
+extern "C" openable::FaissIndex* openable_faiss_build(const openable::FaissSettings& settings,
+                                                      const void* rows, int n);
+using OpenableFaissBuild = openable::FaissIndex* (*)(const openable::FaissSettings&, const void*,
+                                                     int);
+// Reads an index written by FaissIndex::Serialize; `settings` gives the search parameters and
+// threads (the structure comes from the bytes). Throws std::runtime_error on bytes that FAISS
+// cannot read or that hold another kind of index.
+extern "C" openable::FaissIndex* openable_faiss_read(const openable::FaissSettings& settings,
+                                                     const std::uint8_t* bytes, std::size_t size);
+using OpenableFaissRead = openable::FaissIndex* (*)(const openable::FaissSettings&,
+                                                    const std::uint8_t*, std::size_t);
