@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "OpenABLE/OpenABLE.h"
+#include "OpenABLE/run/cluster.h"
 
 namespace {
 
@@ -73,6 +74,15 @@ const char* kUsage =
 
 int main(int argc, char** argv) {
   openable::InstallInterruptCleanup("openable_evaluate");  // signals remove the temporaries
+  // One process: started by mpirun with several, process 0 says so and every process stops.
+  if (const openable::Cluster& cluster = openable::Cluster::Get(); cluster.LaunchSize() > 1) {
+    if (cluster.LaunchRank() == 0)
+      std::cerr << "openable_evaluate: error: openable_evaluate runs as one process, but mpirun "
+                   "started "
+                << cluster.LaunchSize()
+                << "; expected one (Test_OpenABLE spreads a run over processes)\n";
+    return openable::kExitInputError;
+  }
   std::vector<openable::MatrixFile> matrices;
   std::vector<std::string> overrides;
   std::string config_path;

@@ -6,6 +6,7 @@
 //   openable_gui    OpenCV highgui (Show_images)
 //   openable_codecs OpenCV imgcodecs (PGM/PPM and BMP frames, matrix images other than PNG;
 //                   PNG and JPEG are decoded and PNG written in the program itself)
+//   openable_mpi    Open MPI, for runs spread over processes (OpenABLE/run/cluster.h)
 //
 // Debian's OpenImageIO and videoio pull in about 250 shared libraries each (FFmpeg, GDAL,
 // OpenVDB, Qt, ...), all bound at start-up (BIND_NOW): linking them into Test_OpenABLE cost

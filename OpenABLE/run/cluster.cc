@@ -75,6 +75,10 @@ void Cluster::Abort(int code) {
 }
 
 void Cluster::Agree(const std::function<void()>& step) {
+  if (!Distributed()) {  // one process: its errors as they are
+    step();
+    return;
+  }
   // Each process's outcome: a kind byte (0 fine, 1 InputError, 2 other) and its message.
   std::vector<char> mine(1, 0);
   try {
@@ -91,10 +95,6 @@ void Cluster::Agree(const std::function<void()>& step) {
     mine[0] = 2;
     const std::string m = e.what();
     mine.insert(mine.end(), m.begin(), m.end());
-  }
-  if (!Distributed()) {
-    if (mine[0] == 0) return;
-    throw ClusterFailure(std::string(mine.begin() + 1, mine.end()), mine[0] == 1);
   }
   std::vector<std::int64_t> sizes;
   const std::vector<char> all = AllGather(mine, &sizes);

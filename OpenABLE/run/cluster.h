@@ -71,7 +71,7 @@ class Cluster {
 
   // Runs `step` on every process; when it threw on any of them, throws ClusterFailure on every
   // process with the message of the lowest failing process, followed by the process's name.
-  // Collective.
+  // Collective. In one process, runs `step` and lets its exceptions through unchanged.
   void Agree(const std::function<void()>& step);
 
   // [first, last) of the share of `n` items of process `rank` (contiguous, in rank order, sizes

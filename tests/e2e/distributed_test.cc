@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -60,6 +61,9 @@ struct Case {
 };
 
 // `images`: the first traversal's folder (empty: the sample's summer frames).
+// Test names and failure messages show the case's name, not its bytes.
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
 std::string ConfigOf(const std::string& dir, const Case& c, const std::string& images = "") {
   const std::string path = dir + "/Config.txt";
   std::ofstream f(path);
@@ -218,6 +222,17 @@ TEST(SpreadFailure, ProgramsThatDoNotSpreadRefuseSeveralProcesses) {
   EXPECT_EQ(o.err,
             "openable_sweep: error: openable_sweep runs as one process, but mpirun started 2; "
             "expected one (Test_OpenABLE spreads a run over processes)\n");
+}
+
+TEST(SpreadFailure, OpenableEvaluateRefusesSeveralProcesses) {
+  const std::string missing = MissingMpi();
+  if (!missing.empty()) GTEST_SKIP() << missing;
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunSpread(2, testing::OpenableEvaluateExe(), {"--matrix", "m.npy"}, dir);
+  EXPECT_EQ(o.status, 1) << o.err;
+  EXPECT_EQ(o.err,
+            "openable_evaluate: error: openable_evaluate runs as one process, but mpirun "
+            "started 2; expected one (Test_OpenABLE spreads a run over processes)\n");
 }
 
 }  // namespace
