@@ -45,6 +45,9 @@ endforeach()
 # Run-time modules (OpenABLE/io/module_loader.h), where module_loader.cc looks for them.
 install(TARGETS openable_oiio openable_video openable_gui openable_codecs
   LIBRARY DESTINATION "${OPENABLE_INSTALL_MODULEDIR}")
+if(TARGET openable_mpi)  # runs over several processes (docs/distributed.md)
+  install(TARGETS openable_mpi LIBRARY DESTINATION "${OPENABLE_INSTALL_MODULEDIR}")
+endif()
 if(TARGET openable_faiss)
   install(TARGETS openable_faiss LIBRARY DESTINATION "${OPENABLE_INSTALL_MODULEDIR}")
 endif()
