@@ -58,6 +58,12 @@ extern "C" void openable_mpi_gather(const std::vector<char>& mine, int root,
                                     std::vector<char>& all, std::vector<std::int64_t>& sizes);
 using OpenableMpiGather = void (*)(const std::vector<char>&, int, std::vector<char>&,
                                    std::vector<std::int64_t>&);
+// The `bytes` at `mine` of every process, in rank order, into `into` on process 0, which holds
+// exactly the sum of the processes' counts, `capacity` (returns false, receiving nothing, when
+// the counts do not add up to it); the other processes pass nullptr. Collective.
+extern "C" bool openable_mpi_gather_into(const char* mine, std::int64_t bytes, char* into,
+                                         std::int64_t capacity);
+using OpenableMpiGatherInto = bool (*)(const char*, std::int64_t, char*, std::int64_t);
 // The largest of every process's `value`, on every process.
 extern "C" double openable_mpi_max(double value);
 using OpenableMpiMax = double (*)(double);

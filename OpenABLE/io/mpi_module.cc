@@ -78,6 +78,35 @@ extern "C" void openable_mpi_gather(const std::vector<char>& mine, int root,
               MPI_COMM_WORLD);
 }
 
+extern "C" bool openable_mpi_gather_into(const char* mine, std::int64_t bytes, char* into,
+                                         std::int64_t capacity) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  std::vector<std::int64_t> sizes(static_cast<size_t>(size), 0);
+  MPI_Allgather(&bytes, 1, MPI_INT64_T, sizes.data(), 1, MPI_INT64_T, MPI_COMM_WORLD);
+  std::int64_t total = 0;
+  for (const std::int64_t s : sizes) total += s;
+  // Every process sees the same counts, so all agree to skip the transfer when they do not
+  // add up to what process 0 holds.
+  std::int64_t expected = rank == 0 ? capacity : 0;
+  MPI_Bcast(&expected, 1, MPI_INT64_T, 0, MPI_COMM_WORLD);
+  if (total != expected) return false;
+  if (rank != 0) {
+    SendAll(mine, bytes, 0);
+    return true;
+  }
+  std::int64_t off = 0;
+  for (int r = 0; r < size; ++r) {
+    if (r == 0)
+      std::copy(mine, mine + bytes, into);
+    else
+      ReceiveAll(into + off, sizes[static_cast<size_t>(r)], r);
+    off += sizes[static_cast<size_t>(r)];
+  }
+  return true;
+}
+
 extern "C" double openable_mpi_max(double value) {
   double out = value;
   MPI_Allreduce(&value, &out, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);

@@ -1,6 +1,7 @@
 #include "OpenABLE/run/cluster.h"
 
 #include <cstdlib>
+#include <cstring>
 #include <string>
 
 #include "OpenABLE/base/error.h"
@@ -141,6 +142,18 @@ std::vector<char> Cluster::GatherToFirst(const std::vector<char>& mine,
   }
   if (sizes != nullptr) *sizes = counts;
   return all;
+}
+
+void Cluster::GatherInto(const char* mine, std::int64_t bytes, char* into,
+                         std::int64_t capacity) {
+  bool ok = true;
+  if (!Distributed()) {
+    ok = bytes == capacity;
+    if (ok && bytes > 0) std::memcpy(into, mine, static_cast<size_t>(bytes));
+  } else {
+    ok = Symbol<OpenableMpiGatherInto>("openable_mpi_gather_into")(mine, bytes, into, capacity);
+  }
+  if (!ok) throw std::logic_error("Cluster::GatherInto: the shares do not add up");
 }
 
 double Cluster::Max(double value) {

@@ -85,6 +85,10 @@ class Cluster {
                               std::vector<std::int64_t>* sizes = nullptr);
   std::vector<char> GatherToFirst(const std::vector<char>& mine,
                                   std::vector<std::int64_t>* sizes = nullptr);
+  // The `bytes` at `mine` of every process, in rank order, into the `capacity` bytes at `into`
+  // on process 0 (nullptr elsewhere), without an intermediate copy. Throws std::logic_error
+  // on every process when the counts do not add up to `capacity`. Collective.
+  void GatherInto(const char* mine, std::int64_t bytes, char* into, std::int64_t capacity);
   // The largest `value` of every process. Collective.
   double Max(double value);
 

@@ -168,17 +168,18 @@ std::vector<int> ShareRowStarts(const std::vector<int>& starts, const DenseShare
 
 cv::Mat1f GatherRows(Cluster& cluster, const cv::Mat1f& mine, int n, int cols) {
   if (!cluster.Distributed()) return mine;
-  std::vector<char> bytes;
-  for (int i = 0; i < mine.rows; ++i) AppendBytes(bytes, mine.ptr<float>(i), mine.cols);
-  const std::vector<char> all = cluster.GatherToFirst(bytes);
-  if (cluster.Rank() != 0) return cv::Mat1f();
-  cv::Mat1f out = LargeMatrix(n, cols);
-  if (static_cast<std::int64_t>(all.size()) !=
-      static_cast<std::int64_t>(n) * cols * static_cast<std::int64_t>(sizeof(float)))
-    throw std::logic_error("GatherRows: the shares do not make the matrix");
-  for (int i = 0; i < n; ++i)
-    std::memcpy(out.ptr<float>(i), all.data() + static_cast<std::size_t>(i) * cols * sizeof(float),
-                cols * sizeof(float));
+  // Straight into process 0's matrix: it holds the matrix once, as a single process does.
+  const cv::Mat1f rows = mine.isContinuous() ? mine : mine.clone();
+  cv::Mat1f out;
+  if (cluster.Rank() == 0) out = LargeMatrix(n, cols);
+  const std::int64_t bytes = static_cast<std::int64_t>(rows.total()) * sizeof(float);
+  const std::int64_t capacity =
+      cluster.Rank() == 0 ? static_cast<std::int64_t>(n) * cols * sizeof(float) : 0;
+  if (cluster.Rank() == 0 && !out.isContinuous())
+    throw std::logic_error("GatherRows: the matrix is not one block");
+  cluster.GatherInto(reinterpret_cast<const char*>(rows.data), bytes,
+                     cluster.Rank() == 0 ? reinterpret_cast<char*>(out.data) : nullptr,
+                     capacity);
   return out;
 }
 
