@@ -210,6 +210,36 @@ TEST(SpreadFailure, AFrameOfOneShareEndsTheRunInOneLineWithNoOutput) {
   EXPECT_FALSE(fs::exists(dir + "/out")) << "an output of the failed run was left";
 }
 
+// With Skip_unreadable, the damaged frame of the last share is skipped as in a single
+// process: the same matrix, the same frame listed as skipped.
+TEST(SpreadFailure, SkippedFramesOfAShareAreSkippedAsInOneProcess) {
+  const std::string missing = MissingMpi();
+  if (!missing.empty()) GTEST_SKIP() << missing;
+  const std::string dir = testing::TempDir();
+  fs::create_directories(dir + "/frames");
+  std::vector<fs::path> images;
+  for (const auto& e : fs::directory_iterator(testing::SampleDir() + "/summer"))
+    images.push_back(e.path());
+  std::sort(images.begin(), images.end());
+  for (const fs::path& p : images) fs::copy_file(p, dir + "/frames/" + p.filename().string());
+  std::ofstream(dir + "/frames/" + images.back().filename().string(), std::ios::trunc) << "x";
+  const Case c{"", "LDB", false, false, 5};
+  const std::string config = ConfigOf(dir, c, dir + "/frames");
+  std::ofstream(config, std::ios::app) << "Skip_unreadable: 1\n";
+  const Outcome one = RunProgram(testing::TestOpenableExe(), {config, "--quiet"}, dir);
+  ASSERT_EQ(one.status, 0) << one.err;
+  const std::string single = ReadAll(dir + "/out/matrix.npy");
+  fs::remove_all(dir + "/out");
+  const Outcome o = RunSpread(3, testing::TestOpenableExe(), {config, "--quiet"}, dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_EQ(ReadAll(dir + "/out/matrix.npy"), single);
+  EXPECT_NE(o.out.find("skipped: image \"" + dir + "/frames/" + images.back().filename().string()),
+            std::string::npos)
+      << o.out;
+  EXPECT_NE(o.out.find(std::to_string(images.size() - 1) + " frames of"), std::string::npos)
+      << o.out;
+}
+
 // The other programs are not spread: under mpirun with several processes they say so.
 TEST(SpreadFailure, ProgramsThatDoNotSpreadRefuseSeveralProcesses) {
   const std::string missing = MissingMpi();
