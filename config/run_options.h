@@ -75,7 +75,7 @@ struct ScaleOptions {
   ApproximateEngine approximate_engine = ApproximateEngine::kHnsw;
   int approximate_checks = 512;   // FLANN k-d trees: references examined per query, 1..100000
   int approximate_ef_search = 128;  // hnsw: candidate list while searching, 1..100000
-  int approximate_nprobe = 16;     // ivf: cells scanned per query, 1..65536
+  int approximate_nprobe = 64;     // ivf: cells scanned per query, 1..65536
   std::string descriptor_cache;   // folder of the descriptor cache; empty: off
 
   // Throws InputError naming the key: a value out of range, approximate search with the dense

@@ -92,7 +92,7 @@ struct ApproximateOptions {
   int ivf_lists = 0;
   // IVF: cells scanned per query (nprobe), 1..65536 (capped at the cells); more = better
   // recall, slower.
-  int nprobe = 16;
+  int nprobe = 64;
   int threads = 0;          // queries spread over this many threads, >= 0 (0 = all cores)
   // Seed of the index build: cv::RNG of FLANN ("FLAN"); FAISS's IVF k-means takes its low 31
   // bits (HNSW levels are drawn from FAISS's fixed seed, and its rows are added on one thread,
