@@ -61,7 +61,9 @@ DescribedSequence DescribeShared(Cluster& cluster, const FrameSource& source,
                                  const FrameDescriber& describer, const DescribeOptions& options,
                                  const std::function<void(int, int)>& progress) {
   if (!cluster.Distributed()) return DescribeSequence(source, describer, options, progress);
-  const auto [first, last] = cluster.Share(source.Size());
+  // Plain variables, not a structured binding: C++17 lambdas cannot capture bindings.
+  const std::pair<int, int> share_rows = cluster.Share(source.Size());
+  const int first = share_rows.first, last = share_rows.second;
   DescribedSequence mine;
   cluster.Agree([&] {
     if (last > first) {
