@@ -206,9 +206,32 @@ std::unique_ptr<FaissIndex> BuildFaiss(const ApproximateOptions& o, const cv::Ma
   return std::unique_ptr<FaissIndex>(build(SettingsOf(o, refs), refs.data, refs.rows));
 }
 
+// The index saved by Serialize(): FAISS's message (a damaged or foreign serialisation) and a
+// row count that is not the references' become std::invalid_argument.
+std::unique_ptr<FaissIndex> ReadFaiss(const ApproximateOptions& o, const cv::Mat& refs,
+                                      const std::vector<std::uint8_t>& saved) {
+  CheckEngineAvailable(o.engine, "ApproximateOptions::engine");
+  const auto read =
+      reinterpret_cast<OpenableFaissRead>(ModuleSymbol("faiss", "openable_faiss_read"));
+  std::unique_ptr<FaissIndex> index;
+  try {
+    index.reset(read(SettingsOf(o, refs), saved.data(), saved.size()));
+  } catch (const std::runtime_error& e) {
+    Fail(std::string("ApproximateIndex: the saved index cannot be read: ") + e.what());
+  }
+  if (index->Size() != refs.rows)
+    Fail("ApproximateIndex: the saved index holds " + std::to_string(index->Size()) +
+         " rows, expected " + std::to_string(refs.rows) + " (its references)");
+  return index;
+}
+
 }  // namespace
 
 ApproximateIndex::ApproximateIndex(const cv::Mat& references, const ApproximateOptions& options)
+    : ApproximateIndex(references, options, {}) {}
+
+ApproximateIndex::ApproximateIndex(const cv::Mat& references, const ApproximateOptions& options,
+                                   const std::vector<std::uint8_t>& saved)
     : impl_(std::make_unique<Impl>()) {
   options.Check();
   CheckRows(references, "ApproximateIndex");
@@ -227,7 +250,9 @@ ApproximateIndex::ApproximateIndex(const cv::Mat& references, const ApproximateO
   } restore;
   cv::theRNG() = cv::RNG(options.seed);
 
-  if (options.engine != ApproximateEngine::kFlann) {
+  if (options.engine != ApproximateEngine::kFlann && !saved.empty()) {
+    impl_->faiss = ReadFaiss(options, refs, saved);
+  } else if (options.engine != ApproximateEngine::kFlann) {
     impl_->faiss = BuildFaiss(options, refs);
   } else if (refs.depth() == CV_8U) {
     // A key cannot have more bits than the descriptor (FLANN would read past its bit list).
@@ -259,6 +284,10 @@ void ApproximateIndex::SetSearchBudget(const ApproximateOptions& options) {
   impl_->options.nprobe = options.nprobe;
   if (impl_->faiss)
     impl_->faiss->SetSearch(std::max(options.ef_search, impl_->options.k), options.nprobe);
+}
+
+std::vector<std::uint8_t> ApproximateIndex::Serialize() const {
+  return impl_->faiss ? impl_->faiss->Serialize() : std::vector<std::uint8_t>{};
 }
 
 CandidateLists ApproximateIndex::Search(const cv::Mat& queries_in) const {

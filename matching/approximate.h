@@ -113,6 +113,13 @@ class ApproximateIndex {
   // std::invalid_argument (a std::logic_error) on bad options, an empty set, another type, or
   // non-finite floats; InputError when a FAISS engine is asked of a build without FAISS.
   ApproximateIndex(const cv::Mat& references, const ApproximateOptions& options);
+  // The index of `references` from `saved`, bytes of Serialize() of an index built over the
+  // same references with the same options: FAISS's structure is read, not built again (a
+  // million-row HNSW graph takes minutes to build, a second to read); FLANN's, whose
+  // Serialize() is empty, is built (deterministic, so the same index). Throws
+  // std::invalid_argument when the bytes hold another kind of index or another row count.
+  ApproximateIndex(const cv::Mat& references, const ApproximateOptions& options,
+                   const std::vector<std::uint8_t>& saved);
   ~ApproximateIndex();
   ApproximateIndex(ApproximateIndex&&) noexcept;
   ApproximateIndex& operator=(ApproximateIndex&&) noexcept;
@@ -135,6 +142,10 @@ class ApproximateIndex {
   // those of the build) for later searches, to tune it without rebuilding the index. Not
   // while a Search runs. Throws std::invalid_argument on bad options.
   void SetSearchBudget(const ApproximateOptions& options);
+  // The index's structure for the constructor above: FAISS's serialisation of the index
+  // (write_index / write_index_binary, including FAISS's own copy of the rows); empty for
+  // FLANN, whose LSH tables and k-d trees are rebuilt from the rows in milliseconds to seconds.
+  std::vector<std::uint8_t> Serialize() const;
 
  private:
   struct Impl;

@@ -36,6 +36,8 @@ class FaissIndex {
   virtual void SetSearch(int ef_search, int nprobe) = 0;
   // The index in FAISS's serialisation (write_index / write_index_binary).
   virtual std::vector<std::uint8_t> Serialize() const = 0;
+  // Rows in the index (FAISS's ntotal).
+  virtual std::int64_t Size() const = 0;
 };
 
 }  // namespace openable

@@ -111,6 +111,7 @@ class Wrapped final : public FaissIndex {
     Write(index_.get(), &writer);
     return std::move(writer.data);
   }
+  std::int64_t Size() const override { return index_->ntotal; }
 
  private:
   std::unique_ptr<BaseIndex> index_;

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <future>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace openable {
@@ -139,6 +141,46 @@ std::vector<int> IncrementalIndex::Candidates(const cv::Mat& row, int searchable
 
 void IncrementalIndex::FinishMerges() {
   while (state_->merge) state_->FinishMerge(true);
+}
+
+std::vector<IncrementalIndex::SavedBlock> IncrementalIndex::SaveBlocks() {
+  FinishMerges();
+  std::vector<SavedBlock> out;
+  for (const auto& b : state_->blocks) out.push_back({b.first, b.count, b.index->Serialize()});
+  return out;
+}
+
+void IncrementalIndex::Restore(const cv::Mat& rows, const std::vector<SavedBlock>& blocks) {
+  State& s = *state_;
+  if (s.size != 0) throw std::invalid_argument("IncrementalIndex::Restore: the index is not empty");
+  if (!rows.empty() && (rows.cols != s.width || rows.depth() != s.type))
+    throw std::invalid_argument("IncrementalIndex::Restore: rows of another width or type");
+  // The layout this index would have built: contiguous from row 0, sizes block_frames x 2^m,
+  // strictly decreasing (two equal neighbours would have been merged).
+  int next = 0;
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    const SavedBlock& b = blocks[i];
+    int m = b.count / s.options.block_frames;
+    const bool power = b.count > 0 && b.count % s.options.block_frames == 0 && (m & (m - 1)) == 0;
+    if (b.first != next || !power || (i > 0 && b.count >= blocks[i - 1].count) ||
+        b.count > rows.rows - next)
+      throw std::invalid_argument(
+          "IncrementalIndex::Restore: block " + std::to_string(i) + " (rows " +
+          std::to_string(b.first) + ", " + std::to_string(b.count) + " of them) does not follow "
+          "the layout of blocks of " + std::to_string(s.options.block_frames) + " x 2^m rows");
+    next += b.count;
+  }
+  if (rows.rows > 0) {
+    s.buffer = cv::Mat(std::max(64, rows.rows), s.width, s.type);
+    rows.copyTo(s.buffer.rowRange(0, rows.rows));
+  }
+  s.size = rows.rows;
+  for (const SavedBlock& b : blocks)
+    s.blocks.push_back({b.first, b.count,
+                        std::make_unique<ApproximateIndex>(
+                            s.buffer.rowRange(b.first, b.first + b.count), s.options.approximate,
+                            b.index)});
+  s.indexed = next;
 }
 
 cv::Mat IncrementalIndex::Rows() const { return state_->buffer.rowRange(0, state_->size); }

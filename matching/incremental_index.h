@@ -47,6 +47,21 @@ class IncrementalIndex {
   // Waits for a background merge to finish and installs its index.
   void FinishMerges();
 
+  // One index block as a saved map holds it: rows [first, first + count) and the index's
+  // ApproximateIndex::Serialize() (empty for FLANN, rebuilt on Restore).
+  struct SavedBlock {
+    int first = 0, count = 0;
+    std::vector<std::uint8_t> index;
+  };
+  // The blocks in use, after waiting for a background merge (FinishMerges).
+  std::vector<SavedBlock> SaveBlocks();
+  // Appends `rows` to an empty index and installs `blocks` as its index blocks without
+  // building them (FAISS indexes are read; FLANN's are built). The blocks must tile rows
+  // [0, indexed) in order with sizes block_frames x 2^m, non-increasing, at most one of each,
+  // as this index builds them; otherwise std::invalid_argument. Empty `blocks` leaves the
+  // rows unindexed (Update indexes them).
+  void Restore(const cv::Mat& rows, const std::vector<SavedBlock>& blocks);
+
   cv::Mat Rows() const;              // Size() x width, a view of the stored rows
   int Size() const;                  // rows appended
   int Blocks() const;                // index blocks in use (0 while exact)
