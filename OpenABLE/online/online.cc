@@ -2,15 +2,19 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <mutex>
+#include <sstream>
 #include <utility>
 
 #include <opencv2/core/utility.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/threading.h"
+#include "OpenABLE/base/version.h"
 #include "OpenABLE/image/preprocess.h"
+#include "OpenABLE/online/map_file.h"
 #include "descriptors/registry.h"
 #include "matching/incremental_index.h"
 #include "matching/matrix.h"
@@ -331,6 +335,138 @@ OnlineResult OnlineDetector::State::Search(const cv::Mat& row) {
   }
   r.search_seconds = Seconds(start);
   return r;
+}
+
+// ---- Saved maps ----------------------------------------------------------------------------
+
+namespace {
+
+std::string Exact(double v) {
+  std::ostringstream out;
+  out.precision(17);
+  out << v;
+  return out.str();
+}
+
+// The settings that make the rows: a map made with others cannot be searched with this
+// detector's rows.
+std::vector<std::pair<std::string, std::string>> DescriptionSettings(const OnlineOptions& o) {
+  return {{"descriptor", o.descriptor},
+          {"description", EnumName(o.description)},
+          {"patch_size", std::to_string(o.patch_size)},
+          {"ldb_bits", std::to_string(o.ldb_bits)},
+          {"grid_x", std::to_string(o.grid_x)},
+          {"grid_y", std::to_string(o.grid_y)}};
+}
+
+// The settings that make the index blocks: with others, the saved blocks are rebuilt.
+std::vector<std::pair<std::string, std::string>> IndexSettings(const OnlineOptions& o) {
+  const ApproximateOptions& a = o.approximate;
+  return {{"exclusion", std::to_string(o.exclusion)},
+          {"exact_limit", std::to_string(o.exact_limit)},
+          {"block_frames", std::to_string(o.block_frames)},
+          {"engine", EnumName(a.engine)},
+          {"hnsw_m", std::to_string(a.hnsw_m)},
+          {"hnsw_ef_construction", std::to_string(a.hnsw_ef_construction)},
+          {"ivf_lists", std::to_string(a.ivf_lists)},
+          {"lsh_tables", std::to_string(a.lsh_tables)},
+          {"lsh_key_bits", std::to_string(a.lsh_key_bits)},
+          {"lsh_probe_level", std::to_string(a.lsh_probe_level)},
+          {"kd_trees", std::to_string(a.kd_trees)},
+          {"seed", std::to_string(a.seed)}};
+}
+
+std::vector<std::pair<std::string, std::string>> FeatureSettings(const OnlineOptions& o) {
+  if (!o.verification.enabled) return {{"features", "none"}};
+  return {{"features", EnumName(o.verification.features)},
+          {"max_features", std::to_string(o.verification.max_features)}};
+}
+
+}  // namespace
+
+void OnlineDetector::SaveMap(const std::string& path) {
+  State& s = *state_;
+  MapFile map;
+  map.settings = {{"openable", kVersion},
+                  {"frames", std::to_string(Size())},
+                  {"row_width", std::to_string(s.width)},
+                  {"row_type", s.type == CV_8U ? "CV_8U" : "CV_32F"},
+                  {"unit", Exact(s.unit)}};
+  for (const auto& list : {DescriptionSettings(s.options), IndexSettings(s.options),
+                           FeatureSettings(s.options)})
+    map.settings.insert(map.settings.end(), list.begin(), list.end());
+  map.blocks = s.map->SaveBlocks();
+  map.rows = s.map->Rows();
+  map.has_features = s.verifier != nullptr;
+  if (map.has_features) map.features = s.features;
+  WriteMapFile(path, map);
+}
+
+OnlineDetector::LoadedMap OnlineDetector::LoadMap(const std::string& path) {
+  State& s = *state_;
+  if (Size() != 0)
+    throw InputError("OnlineDetector::LoadMap(\"" + path + "\"): the detector holds " +
+                     std::to_string(Size()) + " frames; expected an empty detector (load the "
+                     "map before adding frames)");
+  MapFile map = ReadMapFile(path);
+  const std::string what = "the map was made with ";
+  for (const auto& [key, value] : DescriptionSettings(s.options))
+    if (map.Setting(key) != value)
+      throw InputError(path + ": " + what + key + " = " + map.Setting(key) +
+                       "; this detector has " + key + " = " + value +
+                       " (expected the same description settings: descriptor, description, "
+                       "patch_size, ldb_bits, grid_x, grid_y)");
+  if (map.rows.cols != s.width || map.rows.depth() != s.type)
+    throw InputError(path + ": the map's rows are " + std::to_string(map.rows.cols) + " " +
+                     map.Setting("row_type") + "; expected " + std::to_string(s.width) + " " +
+                     (s.type == CV_8U ? "CV_8U" : "CV_32F") + " (" +
+                     s.describer.descriptor->Name() + ")");
+  if (s.type == CV_32F && !cv::checkRange(map.rows))
+    throw InputError(path + ": the map's rows hold a value that is not finite");
+  if (s.verifier) {
+    for (const auto& [key, value] : FeatureSettings(s.options))
+      if (map.Setting(key) != value)
+        throw InputError(path + ": " + what + key + " = " + map.Setting(key) +
+                         "; this detector verifies with " + key + " = " + value +
+                         " (expected a map saved by a detector with the same verification "
+                         "features)");
+    if (!map.has_features || map.features.size() != static_cast<size_t>(map.rows.rows))
+      throw InputError(path + ": the map holds no local features; expected a map saved by a "
+                       "detector with verification enabled");
+  }
+  double unit = s.unit;
+  if (s.type == CV_32F) {
+    const std::string text = map.Setting("unit");
+    char* end = nullptr;
+    unit = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || !std::isfinite(unit) || unit < 0)
+      throw InputError(path + ": setting \"unit\" of the map is \"" + text +
+                       "\": expected a number >= 0");
+  }
+
+  LoadedMap out;
+  out.frames = map.rows.rows;
+  for (const auto& [key, value] : IndexSettings(s.options))
+    if (map.Setting(key) != value) {
+      out.rebuilt = true;
+      out.reason = what + key + " = " + map.Setting(key) + ", this detector has " + value;
+      break;
+    }
+  const int searchable = map.rows.rows - s.options.exclusion;
+  if (!out.rebuilt) {
+    try {
+      s.map->Restore(map.rows, map.blocks);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(path + ": " + e.what());
+    }
+  } else {
+    s.map->Restore(map.rows, {});
+    s.map->Update(searchable, /*background=*/false);
+  }
+  s.unit = unit;
+  if (s.verifier) s.features = std::move(map.features);
+  out.blocks = s.map->Blocks();
+  return out;
 }
 
 }  // namespace openable

@@ -156,6 +156,35 @@ class OnlineDetector {
   // Waits for a background merge (background_merges) to finish and installs its index.
   void FinishMerges();
 
+  // Saves the map to `path` so that a later session starts from it (LoadMap): the settings it
+  // was made with, every frame's descriptor row, the index blocks (FAISS's serialisation of
+  // each; FLANN's are rebuilt on loading) and, with verification, every frame's local
+  // features. Waits for a background merge first. Versioned and checksummed
+  // (docs/output_formats.md, "Saved maps"); written to a temporary file renamed into place
+  // when complete, so an interrupted save leaves the previous file. Throws InputError naming
+  // the path when it cannot be written.
+  void SaveMap(const std::string& path);
+
+  // What LoadMap did.
+  struct LoadedMap {
+    int frames = 0;        // frames read: they are frames 0 .. frames - 1 of this detector
+    int blocks = 0;        // index blocks in use after loading
+    bool rebuilt = false;  // the blocks were built from the rows instead of read
+    std::string reason;    // why they were rebuilt (the first index setting that differs)
+  };
+  // Loads a map written by SaveMap into this detector, which must be empty (Size() == 0).
+  // The next frame added is frame `frames`, and finds the loaded frames as candidates like
+  // any other: with the options of the detector that saved the map, the candidates of every
+  // later frame are those that detector would have given (the verification's temporal
+  // consistency starts anew: the first frame after loading has no previous streaks). The
+  // description settings (descriptor, description, patch_size, ldb_bits, grid_x, grid_y) must
+  // be the map's, and with verification enabled the map must hold features of the same kind.
+  // When an index setting differs (engine and its build settings, exact_limit, block_frames,
+  // exclusion), the saved blocks are set aside and the index built from the rows. Throws
+  // InputError beginning with the path: unreadable, not a map, another format version,
+  // damaged or truncated (checksum), or made with other description settings.
+  LoadedMap LoadMap(const std::string& path);
+
  private:
   struct State;
   std::unique_ptr<State> state_;

@@ -1,0 +1,271 @@
+// Saved maps of the online detector (OnlineDetector::SaveMap / LoadMap): a detector that
+// loads yesterday's map gives every later frame the candidates the detector that saved it
+// gives, on real KITTI 00 frames, with each index engine; the file is checked on loading.
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/online/online.h"
+#include "OpenABLE/run/exports.h"
+#include "tests/test_support.h"
+
+namespace openable {
+namespace {
+
+using testing::ExpectInputError;
+
+std::string KittiDir() { return testing::DatasetsDir() + "/kitti00_first1700/image_0"; }
+
+std::vector<cv::Mat> KittiFrames(int step, int last) {
+  std::vector<cv::Mat> frames;
+  for (int i = 0; i <= last; i += step) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/%06d.png", i);
+    frames.push_back(cv::imread(KittiDir() + name, cv::IMREAD_GRAYSCALE));
+    EXPECT_FALSE(frames.back().empty()) << name;
+  }
+  return frames;
+}
+
+// Options whose index blocks start early: 850 frames give blocks of 64 x 2^m rows.
+OnlineOptions BlockOptions(ApproximateEngine engine) {
+  OnlineOptions o;
+  o.exclusion = 50;
+  o.candidates = 3;
+  o.exact_limit = 100;
+  o.block_frames = 64;
+  o.background_merges = false;  // the same blocks at the same frames in every detector
+  o.approximate.engine = engine;
+  return o;
+}
+
+void ExpectSameCandidates(const OnlineResult& a, const OnlineResult& b) {
+  ASSERT_EQ(a.frame, b.frame);
+  EXPECT_EQ(a.approximate, b.approximate) << "frame " << a.frame;
+  ASSERT_EQ(a.candidates.size(), b.candidates.size()) << "frame " << a.frame;
+  for (size_t i = 0; i < a.candidates.size(); ++i) {
+    EXPECT_EQ(a.candidates[i].frame, b.candidates[i].frame) << "frame " << a.frame;
+    EXPECT_EQ(a.candidates[i].distance, b.candidates[i].distance) << "frame " << a.frame;
+    EXPECT_EQ(a.candidates[i].normalized, b.candidates[i].normalized) << "frame " << a.frame;
+    EXPECT_EQ(a.candidates[i].accepted, b.candidates[i].accepted) << "frame " << a.frame;
+  }
+}
+
+bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
+  return a.size() == b.size() && a.type() == b.type() &&
+         std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0;
+}
+
+// The detector that saved its map after `saved` frames and the one that loaded it are fed the
+// remaining frames: every candidate is the same.
+void SavedMapGivesTheSameCandidates(ApproximateEngine engine) {
+  OPENABLE_REQUIRE_PATH(KittiDir());
+  if (engine != ApproximateEngine::kFlann && !FaissAvailable())
+    GTEST_SKIP() << "this build has no FAISS (libfaiss-dev)";
+  const OnlineOptions options = BlockOptions(engine);
+  const cv::Mat rows = DescribeImages(KittiFrames(2, 1699), options);  // 850 frames
+  const int saved = 600;
+  OnlineDetector yesterday(options);
+  for (int q = 0; q < saved; ++q) yesterday.AddDescriptor(rows.row(q));
+  const std::string path = testing::TempDir() + "/kitti.map";
+  yesterday.SaveMap(path);
+
+  OnlineDetector today(options);
+  const OnlineDetector::LoadedMap loaded = today.LoadMap(path);
+  EXPECT_EQ(loaded.frames, saved);
+  EXPECT_FALSE(loaded.rebuilt) << loaded.reason;
+  // 600 - 50 = 550 searchable rows: 8 full blocks of 64 = one block of 512.
+  EXPECT_EQ(yesterday.Blocks(), 1);
+  EXPECT_EQ(today.Blocks(), yesterday.Blocks());
+  EXPECT_EQ(loaded.blocks, yesterday.Blocks());
+  EXPECT_EQ(today.Size(), saved);
+  EXPECT_TRUE(SameBytes(today.Descriptors(), yesterday.Descriptors()));
+
+  int approximate = 0;
+  for (int q = saved; q < rows.rows; ++q) {
+    const OnlineResult a = yesterday.AddDescriptor(rows.row(q));
+    const OnlineResult b = today.AddDescriptor(rows.row(q));
+    ExpectSameCandidates(a, b);
+    approximate += b.approximate;
+  }
+  EXPECT_EQ(approximate, rows.rows - saved);
+  EXPECT_EQ(today.Blocks(), yesterday.Blocks());
+}
+
+TEST(SavedMap, FlannMapGivesTheSameCandidatesAfterLoading) {
+  SavedMapGivesTheSameCandidates(ApproximateEngine::kFlann);
+}
+TEST(SavedMap, HnswMapGivesTheSameCandidatesAfterLoading) {
+  SavedMapGivesTheSameCandidates(ApproximateEngine::kHnsw);
+}
+TEST(SavedMap, IvfMapGivesTheSameCandidatesAfterLoading) {
+  SavedMapGivesTheSameCandidates(ApproximateEngine::kIvf);
+}
+
+// Another block size: the saved blocks are set aside and the index built from the rows, as a
+// detector with that block size given the same rows by AddToMap builds it.
+TEST(SavedMap, OtherIndexSettingsRebuildTheBlocks) {
+  OPENABLE_REQUIRE_PATH(KittiDir());
+  const OnlineOptions options = BlockOptions(ApproximateEngine::kFlann);
+  const cv::Mat rows = DescribeImages(KittiFrames(2, 1699), options);
+  const int saved = 600;
+  OnlineDetector yesterday(options);
+  for (int q = 0; q < saved; ++q) yesterday.AddDescriptor(rows.row(q));
+  const std::string path = testing::TempDir() + "/kitti.map";
+  yesterday.SaveMap(path);
+
+  OnlineOptions other = options;
+  other.block_frames = 128;
+  OnlineDetector today(other), reference(other);
+  const OnlineDetector::LoadedMap loaded = today.LoadMap(path);
+  EXPECT_TRUE(loaded.rebuilt);
+  EXPECT_NE(loaded.reason.find("block_frames = 64"), std::string::npos) << loaded.reason;
+  reference.AddToMap(rows.rowRange(0, saved));
+  // 550 searchable rows: 4 full blocks of 128 = one block of 512.
+  EXPECT_EQ(today.Blocks(), 1);
+  EXPECT_EQ(reference.Blocks(), 1);
+  for (int q = saved; q < rows.rows; ++q)
+    ExpectSameCandidates(reference.AddDescriptor(rows.row(q)), today.AddDescriptor(rows.row(q)));
+}
+
+// Float rows (HOG, exact search): the rows and the normalising unit (the largest single-frame
+// distance so far) come back exactly, so the normalised distances are equal too.
+TEST(SavedMap, FloatMapKeepsItsNormalisation) {
+  OPENABLE_REQUIRE_PATH(KittiDir());
+  OnlineOptions options;
+  options.descriptor = "HOG";
+  options.sequence_length = 3;
+  options.exclusion = 5;
+  const cv::Mat rows = DescribeImages(KittiFrames(20, 1699), options);  // 85 frames
+  OnlineDetector yesterday(options);
+  for (int q = 0; q < 60; ++q) yesterday.AddDescriptor(rows.row(q));
+  const std::string path = testing::TempDir() + "/hog.map";
+  yesterday.SaveMap(path);
+  OnlineDetector today(options);
+  EXPECT_EQ(today.LoadMap(path).frames, 60);
+  EXPECT_TRUE(SameBytes(today.Descriptors(), yesterday.Descriptors()));
+  for (int q = 60; q < rows.rows; ++q)
+    ExpectSameCandidates(yesterday.AddDescriptor(rows.row(q)), today.AddDescriptor(rows.row(q)));
+}
+
+// With verification, every frame's local features are saved: the loaded frames are verified
+// against later frames with the same features (the matches and inliers are equal).
+TEST(SavedMap, VerificationFeaturesAreSavedWithTheMap) {
+  OPENABLE_REQUIRE_PATH(KittiDir());
+  const std::vector<cv::Mat> frames = KittiFrames(10, 1699);  // 170 frames
+  OnlineOptions options;
+  options.exclusion = 50;
+  options.verification.enabled = true;
+  options.verification.candidates = 3;
+  OnlineDetector yesterday(options);
+  const int saved = 120;
+  for (int q = 0; q < saved; ++q) yesterday.AddFrame(frames[q]);
+  const std::string path = testing::TempDir() + "/verified.map";
+  yesterday.SaveMap(path);
+  OnlineDetector today(options);
+  EXPECT_EQ(today.LoadMap(path).frames, saved);
+  int verified = 0;
+  for (int q = saved; q < static_cast<int>(frames.size()); ++q) {
+    const OnlineResult a = yesterday.AddFrame(frames[q]);
+    const OnlineResult b = today.AddFrame(frames[q]);
+    ASSERT_EQ(a.candidates.size(), b.candidates.size());
+    for (size_t i = 0; i < a.candidates.size(); ++i) {
+      EXPECT_EQ(a.candidates[i].frame, b.candidates[i].frame);
+      EXPECT_EQ(a.candidates[i].distance, b.candidates[i].distance);
+      EXPECT_EQ(a.candidates[i].matches, b.candidates[i].matches) << "frame " << q;
+      EXPECT_EQ(a.candidates[i].inliers, b.candidates[i].inliers) << "frame " << q;
+      EXPECT_EQ(a.candidates[i].geometric, b.candidates[i].geometric) << "frame " << q;
+      verified += b.candidates[i].geometric;
+    }
+  }
+  // KITTI 00 revisits its start from about frame 1570 (every 10th: 157 on): some loops there.
+  EXPECT_GT(verified, 0);
+
+  // A detector without verification loads the rows and ignores the features; a map without
+  // features cannot serve a detector that verifies.
+  OnlineOptions plain = options;
+  plain.verification.enabled = false;
+  OnlineDetector rows_only(plain);
+  EXPECT_EQ(rows_only.LoadMap(path).frames, saved);
+  const std::string plain_path = testing::TempDir() + "/plain.map";
+  rows_only.SaveMap(plain_path);
+  OnlineDetector verifying(options);
+  ExpectInputError([&] { verifying.LoadMap(plain_path); },
+                   {plain_path, "features = none", "features = ORB", "same verification"});
+}
+
+// Every defect of a map file is one line naming the file, and leaves the detector empty.
+TEST(SavedMap, DefectsAreOneLineErrors) {
+  OnlineOptions options;
+  options.exclusion = 5;
+  OnlineDetector yesterday(options);
+  cv::Mat rows(40, 32, CV_8U);
+  cv::randu(rows, 0, 256);
+  for (int q = 0; q < rows.rows; ++q) yesterday.AddDescriptor(rows.row(q));
+  const std::string dir = testing::TempDir();
+  const std::string path = dir + "/good.map";
+  yesterday.SaveMap(path);
+  const std::string good = testing::ReadBytes(path);
+  ASSERT_GT(good.size(), 40u * 32u);
+  EXPECT_EQ(good.compare(0, 12, "OpenABLE-map"), 0);
+
+  auto load = [&](const std::string& p) {
+    OnlineDetector d(options);
+    try {
+      d.LoadMap(p);
+    } catch (...) {
+      EXPECT_EQ(d.Size(), 0);
+      throw;
+    }
+  };
+  ExpectInputError([&] { load(dir + "/absent.map"); },
+                   {dir + "/absent.map", "cannot read the map", "No such file"});
+  testing::WriteBytes(dir + "/text.map", "frames 40\n");
+  ExpectInputError([&] { load(dir + "/text.map"); }, {"text.map", "not an OpenABLE map"});
+  std::string newer = good;
+  newer[16] = 2;  // the format version, little-endian
+  testing::WriteBytes(dir + "/newer.map", newer);
+  ExpectInputError([&] { load(dir + "/newer.map"); },
+                   {"newer.map", "map format version 2", "expected version 1"});
+  std::string flipped = good;
+  flipped[good.size() / 2] ^= 0x10;
+  testing::WriteBytes(dir + "/flipped.map", flipped);
+  ExpectInputError([&] { load(dir + "/flipped.map"); }, {"flipped.map", "damaged or truncated"});
+  testing::WriteBytes(dir + "/short.map", good.substr(0, good.size() - 100));
+  ExpectInputError([&] { load(dir + "/short.map"); }, {"short.map", "damaged or truncated"});
+  testing::WriteBytes(dir + "/tiny.map", good.substr(0, 18));
+  ExpectInputError([&] { load(dir + "/tiny.map"); }, {"tiny.map", "truncated"});
+
+  OnlineOptions wider = options;
+  wider.ldb_bits = 512;
+  OnlineDetector other(wider);
+  ExpectInputError([&] { other.LoadMap(path); },
+                   {path, "ldb_bits = 256", "this detector has ldb_bits = 512"});
+  EXPECT_EQ(other.Size(), 0);
+  ExpectInputError([&] { yesterday.LoadMap(path); },
+                   {"holds 40 frames", "expected an empty detector"});
+
+  // Saving: a folder that cannot be made, then a save cut short (no space left): the earlier
+  // map is kept whole and no temporary file is left beside it.
+  testing::WriteBytes(dir + "/file", "x");
+  ExpectInputError([&] { yesterday.SaveMap(dir + "/file/sub.map"); }, {"file/sub.map"});
+  yesterday.AddDescriptor(rows.row(0));
+  FailStagedWritesAfterForTesting(100, ENOSPC);
+  ExpectInputError([&] { yesterday.SaveMap(path); }, {path, "No space left on device"});
+  FailStagedWritesAfterForTesting(-1, 0);
+  EXPECT_EQ(testing::ReadBytes(path), good);
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    files += entry.path().filename().string().find(".tmp-") != std::string::npos;
+  EXPECT_EQ(files, 0);
+}
+
+}  // namespace
+}  // namespace openable
