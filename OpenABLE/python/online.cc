@@ -450,6 +450,55 @@ Raises:
 Adds an already computed descriptor row (1-D, row_width elements of row_dtype, e.g. a row of
 describe_images()) as the next frame; returns what add_frame() returns.)doc")
       .def(
+          "save_map",
+          [](Detector& det, const std::string& path) {
+            py::gil_scoped_release release;
+            std::lock_guard<std::mutex> lock(det.mutex);
+            det.detector->SaveMap(path);
+          },
+          py::arg("path"),
+          R"doc(save_map(path)
+
+Saves the map (the settings it was made with, every frame's descriptor row, the index blocks,
+and with verification every frame's local features) to `path`, so that a later session starts
+from it with load_map(). Versioned and checksummed; written through a temporary file renamed
+into place when complete. Raises openable.InputError naming the path when it cannot be
+written.)doc")
+      .def(
+          "load_map",
+          [](Detector& det, const std::string& path) {
+            OnlineDetector::LoadedMap info;
+            {
+              py::gil_scoped_release release;
+              std::lock_guard<std::mutex> lock(det.mutex);
+              info = det.detector->LoadMap(path);
+            }
+            py::dict out;
+            out["frames"] = info.frames;
+            out["blocks"] = info.blocks;
+            out["rebuilt"] = info.rebuilt;
+            out["reason"] = info.reason;
+            return out;
+          },
+          py::arg("path"),
+          R"doc(load_map(path) -> dict
+
+Loads a map written by save_map() into this detector, which must be empty: its frames become
+frames 0 .. frames - 1, and later frames find them as candidates; with the options of the
+detector that saved it, every later frame gets the candidates that detector would give. The
+description options (descriptor, description, patch_size, ldb_bits, grid) must be the map's.
+When an index option differs (engine and its build settings, exact_limit, block_frames,
+exclusion), the index is built from the rows instead of read.
+
+Returns:
+    {"frames": frames loaded, "blocks": index blocks in use, "rebuilt": whether the blocks
+    were built rather than read, "reason": the option that differed}.
+
+Raises:
+    openable.InputError: one line beginning with the path: unreadable, not a map, another
+    format version, damaged or truncated, made with other description options, or the
+    detector is not empty.)doc")
+      .def(
           "finish_merges",
           [](Detector& det) {
             py::gil_scoped_release release;

@@ -134,6 +134,36 @@ class OnlineAgainstBatchTest(unittest.TestCase):
         self.assertGreater(d.blocks, 0)
         self.assertFalse(d.options["background_merges"])
 
+    def test_saved_map_gives_the_same_candidates(self):
+        import os
+        import tempfile
+        options = dict(sequence_length=L, exclusion=EXCLUSION, candidates=K, threshold=THRESHOLD,
+                       exact_limit=100, block_frames=64, background_merges=False)
+        yesterday = openable.OnlineDetector(**options)
+        for row in self.rows[:300]:
+            yesterday.add_descriptor(row)
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "kitti.map")
+            yesterday.save_map(path)
+            today = openable.OnlineDetector(**options)
+            info = today.load_map(path)
+            self.assertEqual(info["frames"], 300)
+            self.assertFalse(info["rebuilt"])
+            self.assertEqual(info["blocks"], yesterday.blocks)
+            self.assertGreater(today.blocks, 0)
+            np.testing.assert_array_equal(today.descriptors, yesterday.descriptors)
+            for row in self.rows[300:]:
+                self.assertEqual(today.add_descriptor(row)[1], yesterday.add_descriptor(row)[1])
+            # A damaged file: one line naming it, and the detector stays empty.
+            data = bytearray(open(path, "rb").read())
+            data[len(data) // 2] ^= 1
+            with open(path, "wb") as f:
+                f.write(data)
+            fresh = openable.OnlineDetector(**options)
+            with self.assertRaisesRegex(openable.InputError, "kitti.map: the map is damaged"):
+                fresh.load_map(path)
+            self.assertEqual(fresh.size, 0)
+
     def test_threads_share_a_detector(self):
         # add_descriptor releases the GIL; the detector's lock keeps frames whole.
         import threading
