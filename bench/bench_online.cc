@@ -9,9 +9,13 @@
 //                     [--block-frames N] [--foreground-merges] [--csv FILE]
 //                     [--verify] [--verify-candidates K] [--verify-consistency N]
 //                     [--verify-features ORB|SIFT] [--verify-max-features N]
+//                     [--engine hnsw|ivf|flann] [--save-map FILE]
 // --verify turns geometric verification on (OnlineOptions::verification, tolerance 3 frames):
 // the answer of a frame is then its first verified candidate, and the time of the checks is
 // reported apart ("verify": features of the frame and every candidate's check).
+// --save-map FILE saves the map at the end (OnlineDetector::SaveMap), loads it into a new
+// detector, and builds the same map from the rows (AddToMap) for comparison: the times of the
+// three and the file's size.
 // --prefill N adds N random rows before the frames (a map of N + 1700 frames, for the latency
 // of large maps only: random rows are never loop candidates of real frames in practice).
 #include <algorithm>
@@ -61,7 +65,7 @@ void Print(const char* what, const Stats& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string datasets = OPENABLE_DATASETS_DIR, csv;
+  std::string datasets = OPENABLE_DATASETS_DIR, csv, save_map;
   openable::OnlineOptions options;
   double heading_limit = -1;
   int prefill = 0;
@@ -88,6 +92,10 @@ int main(int argc, char** argv) {
     else if (a == "--block-frames") options.block_frames = std::stoi(next());
     else if (a == "--foreground-merges") options.background_merges = false;
     else if (a == "--csv") csv = next();
+    else if (a == "--engine")
+      options.approximate.engine =
+          openable::ParseEnum<openable::ApproximateEngine>(next(), "--engine");
+    else if (a == "--save-map") save_map = next();
     else if (a == "--verify") options.verification.enabled = true;
     else if (a == "--verify-candidates") options.verification.candidates = std::stoi(next());
     else if (a == "--verify-consistency") options.verification.consistency = std::stoi(next());
@@ -183,11 +191,12 @@ int main(int argc, char** argv) {
     const int positives = std::count(positive.begin(), positive.end(), 1);
     std::printf("OnlineDetector on KITTI 00 frames 0-1699: %s, L=%d, exclusion %d, score %s, "
                 "threshold %.3f, %d random rows before (map %d frames at the end), exact limit %d, %d "
-                "frames searched with FLANN blocks (%d blocks at the end, merges %s), memory "
+                "frames searched with %s index blocks (%d blocks at the end, merges %s), memory "
                 "%.1f MB\n",
                 options.descriptor.c_str(), options.sequence_length, options.exclusion,
                 openable::EnumName(options.score).c_str(), options.threshold, prefill, detector.Size(), options.exact_limit,
-                approximate_frames, detector.Blocks(),
+                approximate_frames, openable::EnumName(options.approximate.engine).c_str(),
+                detector.Blocks(),
                 options.background_merges ? "in the background" : "in AddFrame",
                 detector.MemoryBytes() / 1e6);
     Print("describe", Summarise(describe));
@@ -222,6 +231,27 @@ int main(int argc, char** argv) {
     }
     std::printf("  sweep of the top-1 threshold: max F1 %.3f at %.4f; recall at precision 1: "
                 "%.3f up to %.4f\n", best_f1, best_t, r100, t100);
+    if (!save_map.empty()) {
+      using Clock = std::chrono::steady_clock;
+      auto seconds = [](Clock::time_point t) {
+        return std::chrono::duration<double>(Clock::now() - t).count();
+      };
+      auto start = Clock::now();
+      detector.SaveMap(save_map);
+      const double save = seconds(start);
+      openable::OnlineDetector loaded(options);
+      start = Clock::now();
+      const auto info = loaded.LoadMap(save_map);
+      const double load = seconds(start);
+      openable::OnlineDetector rebuilt(options);
+      start = Clock::now();
+      rebuilt.AddToMap(detector.Descriptors());
+      const double build = seconds(start);
+      std::printf("  saved map: %d frames, %d blocks, %.1f MB; save %.2f s, load %.2f s "
+                  "(blocks %s), the same map built from its rows %.2f s\n",
+                  info.frames, info.blocks, std::filesystem::file_size(save_map) / 1e6, save,
+                  load, info.rebuilt ? "rebuilt" : "read", build);
+    }
   } catch (const openable::InputError& e) {
     std::fprintf(stderr, "bench_online: %s\n", e.what());
     return 1;
