@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 // OpenCV's FLANN (namespace cvflann): its index templates are used directly, not through the
@@ -140,6 +141,11 @@ bool FaissAvailable() {
 #endif
 }
 
+ApproximateEngine ResolvedEngine(ApproximateEngine engine, int depth) {
+  if (engine != ApproximateEngine::kAuto) return engine;
+  return depth == CV_8U ? ApproximateEngine::kIvf : ApproximateEngine::kHnsw;
+}
+
 void CheckEngineAvailable(ApproximateEngine engine, const std::string& key) {
   if (engine != ApproximateEngine::kFlann && !FaissAvailable())
     throw InputError(key + ": " + EnumName(engine) +
@@ -167,6 +173,20 @@ void ApproximateOptions::Check() const {
   CheckField("threads", threads, 0, 4096);
 }
 
+// Binary IVF: the cells FAISS trained and filled, scanned here with OpenABLE's Hamming
+// kernels rather than by FAISS's search. Debian's libfaiss is built for baseline x86-64: its
+// Hamming distances count bits without the POPCNT instruction (let alone AVX-512's
+// VPOPCNTQ), several times slower per row than the kernels of matching/distances.h that the
+// exact scan uses, which would eat most of what probing a few cells saves. The cells and the
+// probing rule (the rows of the nprobe cells whose centres are nearest the query) are those of
+// FAISS's IVF search; the distances are ours, exact, with ties broken by the lower cell and
+// the lower row.
+struct IvfCells {
+  std::unique_ptr<HammingReferences> centres;             // one row per cell
+  std::vector<std::unique_ptr<HammingReferences>> rows;   // each cell's rows (null: empty)
+  std::vector<std::vector<int>> ids;                      // their rows of `references`
+};
+
 struct ApproximateIndex::Impl {
   using Lsh = cvflann::LshIndex<LshHamming>;
   using KdTrees = cvflann::KDTreeIndex<cvflann::L2<float>>;
@@ -176,6 +196,8 @@ struct ApproximateIndex::Impl {
   std::unique_ptr<Lsh> lsh;
   std::unique_ptr<KdTrees> kd;
   std::unique_ptr<FaissIndex> faiss;  // hnsw, ivf (built in libopenable_faiss.so)
+
+  std::unique_ptr<IvfCells> cells;  // binary ivf: see IvfCells
 };
 
 namespace {
@@ -225,6 +247,43 @@ std::unique_ptr<FaissIndex> ReadFaiss(const ApproximateOptions& o, const cv::Mat
   return index;
 }
 
+// The cells of a binary IVF index (null for any other index), checked against the references:
+// a saved index whose cells name rows it does not have is refused.
+std::unique_ptr<IvfCells> CellsOf(const FaissIndex& index,
+                                                        const cv::Mat& refs) {
+  std::vector<std::uint8_t> centres;
+  std::vector<std::vector<std::int64_t>> cells;
+  if (refs.depth() != CV_8U || !index.BinaryCells(&centres, &cells) || cells.empty()) return {};
+  const std::size_t width = static_cast<std::size_t>(refs.cols);
+  if (centres.size() != cells.size() * width)
+    Fail("ApproximateIndex: the IVF index has " + std::to_string(centres.size()) +
+         " bytes of cell centres, expected " + std::to_string(cells.size() * width));
+  auto out = std::make_unique<IvfCells>();
+  const cv::Mat centre_rows(static_cast<int>(cells.size()), refs.cols, CV_8U, centres.data());
+  out->centres = std::make_unique<HammingReferences>(centre_rows);
+  out->rows.resize(cells.size());
+  out->ids.resize(cells.size());
+  std::int64_t total = 0;
+  for (std::size_t l = 0; l < cells.size(); ++l) {
+    const std::vector<std::int64_t>& ids = cells[l];
+    total += static_cast<std::int64_t>(ids.size());
+    if (ids.empty()) continue;
+    cv::Mat rows(static_cast<int>(ids.size()), refs.cols, CV_8U);
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      if (ids[i] < 0 || ids[i] >= refs.rows)
+        Fail("ApproximateIndex: the IVF index names row " + std::to_string(ids[i]) +
+             ", expected 0 to " + std::to_string(refs.rows - 1));
+      refs.row(static_cast<int>(ids[i])).copyTo(rows.row(static_cast<int>(i)));
+      out->ids[l].push_back(static_cast<int>(ids[i]));
+    }
+    out->rows[l] = std::make_unique<HammingReferences>(rows);
+  }
+  if (total != refs.rows)
+    Fail("ApproximateIndex: the IVF index's cells hold " + std::to_string(total) +
+         " rows, expected " + std::to_string(refs.rows));
+  return out;
+}
+
 }  // namespace
 
 ApproximateIndex::ApproximateIndex(const cv::Mat& references, const ApproximateOptions& options)
@@ -238,6 +297,7 @@ ApproximateIndex::ApproximateIndex(const cv::Mat& references, const ApproximateO
   if (references.rows < 1 || references.cols < 1)
     Fail("ApproximateIndex: the reference set is empty");
   impl_->options = options;
+  impl_->options.engine = ResolvedEngine(options.engine, references.depth());
   impl_->references = references.clone();
   cv::Mat& refs = impl_->references;
 
@@ -250,10 +310,13 @@ ApproximateIndex::ApproximateIndex(const cv::Mat& references, const ApproximateO
   } restore;
   cv::theRNG() = cv::RNG(options.seed);
 
-  if (options.engine != ApproximateEngine::kFlann && !saved.empty()) {
-    impl_->faiss = ReadFaiss(options, refs, saved);
-  } else if (options.engine != ApproximateEngine::kFlann) {
-    impl_->faiss = BuildFaiss(options, refs);
+  if (impl_->options.engine != ApproximateEngine::kFlann && !saved.empty()) {
+    impl_->faiss = ReadFaiss(impl_->options, refs, saved);
+  } else if (impl_->options.engine != ApproximateEngine::kFlann) {
+    impl_->faiss = BuildFaiss(impl_->options, refs);
+  }
+  if (impl_->faiss) {
+    impl_->cells = CellsOf(*impl_->faiss, refs);
   } else if (refs.depth() == CV_8U) {
     // A key cannot have more bits than the descriptor (FLANN would read past its bit list).
     const int key_bits = std::min(options.lsh_key_bits, 8 * refs.cols);
@@ -299,6 +362,52 @@ CandidateLists ApproximateIndex::Search(const cv::Mat& queries_in) const {
   // FLANN's k-d tree search insists on filling k slots, so k is capped at the set size.
   const int knn = std::min(impl_->options.k, refs.rows);
   const cvflann::SearchParams params(impl_->options.checks);
+
+  if (impl_->cells) {
+    // The nprobe cells whose centres are nearest the query (ties: the lower cell), then the k
+    // nearest of their rows (ties: the lower row), kept in a max-heap of k.
+    const IvfCells& cells = *impl_->cells;
+    const int lists = static_cast<int>(cells.ids.size());
+    const int probes = std::min(impl_->options.nprobe, lists);
+    const auto before = [](const Candidate& a, const Candidate& b) {
+      return a.distance < b.distance || (a.distance == b.distance && a.reference < b.reference);
+    };
+    ParallelBlocks(queries.rows, kQueryBlock, impl_->options.threads, [&](int q0, int q1) {
+      std::vector<float> centre(static_cast<size_t>(lists)), d;
+      std::vector<int> order(static_cast<size_t>(lists));
+      for (int q = q0; q < q1; ++q) {
+        const std::uint8_t* query = queries.ptr<std::uint8_t>(q);
+        cells.centres->Distances(query, centre.data());
+        std::iota(order.begin(), order.end(), 0);
+        std::partial_sort(order.begin(), order.begin() + probes, order.end(), [&](int a, int b) {
+          return centre[static_cast<size_t>(a)] < centre[static_cast<size_t>(b)] ||
+                 (centre[static_cast<size_t>(a)] == centre[static_cast<size_t>(b)] && a < b);
+        });
+        std::vector<Candidate>& heap = out[static_cast<size_t>(q)];
+        heap.reserve(static_cast<size_t>(knn));
+        for (int p = 0; p < probes; ++p) {
+          const int l = order[static_cast<size_t>(p)];
+          const std::vector<int>& ids = cells.ids[static_cast<size_t>(l)];
+          if (ids.empty()) continue;
+          d.resize(ids.size());
+          cells.rows[static_cast<size_t>(l)]->Distances(query, d.data());
+          for (std::size_t i = 0; i < ids.size(); ++i) {
+            const Candidate c{ids[i], d[i]};
+            if (static_cast<int>(heap.size()) < knn) {
+              heap.push_back(c);
+              std::push_heap(heap.begin(), heap.end(), before);
+            } else if (before(c, heap.front())) {
+              std::pop_heap(heap.begin(), heap.end(), before);
+              heap.back() = c;
+              std::push_heap(heap.begin(), heap.end(), before);
+            }
+          }
+        }
+        SortCandidates(heap);
+      }
+    });
+    return out;
+  }
 
   if (impl_->faiss) {
     // FAISS spreads the queries over its OpenMP threads itself; only the exact distances are

@@ -44,8 +44,14 @@
 namespace openable {
 
 // The engine of ApproximateIndex (the key Approximate_engine), see above.
-enum class ApproximateEngine { kFlann, kHnsw, kIvf };
-OPENABLE_ENUM_NAMES(ApproximateEngine, "flann", "hnsw", "ivf")
+// auto (the default): ivf for binary rows, hnsw for float rows, the faster for a given recall
+// on each kind in bench/bench_approximate (docs/matching.md, "Choosing an engine").
+enum class ApproximateEngine { kFlann, kHnsw, kIvf, kAuto };
+OPENABLE_ENUM_NAMES(ApproximateEngine, "flann", "hnsw", "ivf", "auto")
+
+// The engine `engine` stands for on rows of OpenCV depth `depth`: auto becomes ivf for CV_8U
+// and hnsw otherwise; the others are themselves.
+ApproximateEngine ResolvedEngine(ApproximateEngine engine, int depth);
 
 // Whether this build has FAISS (the hnsw and ivf engines): false when libfaiss-dev or OpenMP
 // was not found when the build was configured.
@@ -69,7 +75,7 @@ using CandidateLists = std::vector<std::vector<Candidate>>;
 // of queries; 4 k-d trees with 512 checks give HOG ~14x the speed of exact search while the
 // share of queries matched to the right place drops by ~2 points (128 checks: ~7 points).
 struct ApproximateOptions {
-  ApproximateEngine engine = ApproximateEngine::kHnsw;
+  ApproximateEngine engine = ApproximateEngine::kAuto;
   int k = 10;             // candidates per query, >= 1; more than the references gives them all
   int checks = 512;       // k-d trees: references examined per query (best bin first), >= 1; more =
                           // better recall, slower. LSH ignores it (it reads every probed bucket).

@@ -38,6 +38,11 @@ class FaissIndex {
   virtual std::vector<std::uint8_t> Serialize() const = 0;
   // Rows in the index (FAISS's ntotal).
   virtual std::int64_t Size() const = 0;
+  // A binary IVF index over a flat quantizer: its cells' centres (one row of the index's width
+  // per cell, cell after cell) and the rows of each cell, in FAISS's order; true. False for
+  // any other index, leaving both untouched.
+  virtual bool BinaryCells(std::vector<std::uint8_t>* centres,
+                           std::vector<std::vector<std::int64_t>>* cells) const = 0;
 };
 
 }  // namespace openable

@@ -87,6 +87,26 @@ void Write(const faiss::IndexBinary* index, faiss::IOWriter* writer) {
 }
 void Write(const faiss::Index* index, faiss::IOWriter* writer) { faiss::write_index(index, writer); }
 
+bool CellsOf(const faiss::IndexBinary* index, std::vector<std::uint8_t>* centres,
+             std::vector<std::vector<std::int64_t>>* cells) {
+  const auto* ivf = dynamic_cast<const faiss::IndexBinaryIVF*>(index);
+  if (ivf == nullptr) return false;
+  const auto* flat = dynamic_cast<const faiss::IndexBinaryFlat*>(ivf->quantizer);
+  if (flat == nullptr || flat->ntotal != static_cast<faiss::Index::idx_t>(ivf->nlist)) return false;
+  *centres = flat->xb;
+  cells->assign(ivf->nlist, {});
+  for (std::size_t l = 0; l < ivf->nlist; ++l) {
+    const std::size_t n = ivf->invlists->list_size(l);
+    faiss::InvertedLists::ScopedIds ids(ivf->invlists, l);
+    (*cells)[l].assign(ids.get(), ids.get() + n);
+  }
+  return true;
+}
+bool CellsOf(const faiss::Index*, std::vector<std::uint8_t>*,
+             std::vector<std::vector<std::int64_t>>*) {
+  return false;
+}
+
 // A binary (faiss::IndexBinary: uint8_t rows, int32_t distances) or float (faiss::Index)
 // index.
 template <typename BaseIndex, typename Element, typename Distance>
@@ -112,6 +132,10 @@ class Wrapped final : public FaissIndex {
     return std::move(writer.data);
   }
   std::int64_t Size() const override { return index_->ntotal; }
+  bool BinaryCells(std::vector<std::uint8_t>* centres,
+                   std::vector<std::vector<std::int64_t>>* cells) const override {
+    return CellsOf(index_.get(), centres, cells);
+  }
 
  private:
   std::unique_ptr<BaseIndex> index_;

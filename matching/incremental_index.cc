@@ -199,8 +199,9 @@ std::int64_t IncrementalIndex::MemoryBytes() const {
   const std::int64_t row_bytes = s.width * static_cast<std::int64_t>(s.buffer.elemSize());
   auto index_bytes = [&](std::int64_t rows) {
     std::int64_t extra = 0;
-    if (a.engine == ApproximateEngine::kHnsw) extra = 3 * a.hnsw_m * 4 + 8;
-    if (a.engine == ApproximateEngine::kIvf) extra = 8;
+    const ApproximateEngine engine = ResolvedEngine(a.engine, s.buffer.depth());
+    if (engine == ApproximateEngine::kHnsw) extra = 3 * a.hnsw_m * 4 + 8;
+    if (engine == ApproximateEngine::kIvf) extra = 8;
     return rows * (2 * row_bytes + extra);
   };
   for (const auto& b : s.blocks) bytes += index_bytes(b.count);

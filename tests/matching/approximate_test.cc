@@ -195,7 +195,7 @@ TEST(ExactNearest, ViewsAndEmptyQueries) {
 
 // ---------------------------------------------------------------- approximate search
 
-// FLANN's options (the default engine is HNSW).
+// FLANN's options (the default engine is auto: IVF or HNSW).
 ApproximateOptions FlannOptions() {
   ApproximateOptions o;
   o.engine = ApproximateEngine::kFlann;
@@ -529,6 +529,56 @@ TEST(ApproximateIndex, FaissSearchBudgetChangesRecall) {
             MeasureRecall(exact, ApproximateIndex(refs, large).Search(queries)).at_k);
 }
 
+TEST(ApproximateIndex, BinaryIvfScansItsCellsWithExactDistances) {
+  // The binary IVF index scans FAISS's cells itself (matching/approximate.cc, IvfCells):
+  // probing every cell must give the brute-force lists, ties included (2-byte rows: many equal
+  // distances; 13 bytes: a width that is not a multiple of the kernels' words), and probing one
+  // cell only true distances, each reference once, in order.
+  SKIP_WITHOUT_FAISS();
+  for (const int width : {2, 13, 32}) {
+    SCOPED_TRACE(width);
+    const cv::Mat refs = RandomBytes(3000, width, 150 + width);
+    const cv::Mat queries = FlipBits(refs, EveryNth(3000, 25), 4 * width / 8 + 1, 160 + width);
+    ApproximateOptions all = EngineOptions(ApproximateEngine::kIvf), one = all;
+    all.nprobe = 65536;
+    one.nprobe = 1;
+    ExpectSameLists(NaiveNearest(refs, queries, all.k), ApproximateIndex(refs, all).Search(queries));
+    const CandidateLists lists = ApproximateIndex(refs, one).Search(queries);
+    for (int q = 0; q < queries.rows; ++q) {
+      const std::vector<Candidate>& list = lists[static_cast<size_t>(q)];
+      ASSERT_FALSE(list.empty());
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        EXPECT_EQ(list[i].distance, cv::norm(queries.row(q), refs.row(list[i].reference),
+                                             cv::NORM_HAMMING));
+        if (i > 0) {
+          EXPECT_TRUE(list[i - 1].distance < list[i].distance ||
+                      (list[i - 1].distance == list[i].distance &&
+                       list[i - 1].reference < list[i].reference));
+        }
+      }
+    }
+  }
+}
+
+TEST(ApproximateIndex, AutoEngineIsIvfForBinaryRowsAndHnswForFloatRows) {
+  EXPECT_EQ(ResolvedEngine(ApproximateEngine::kAuto, CV_8U), ApproximateEngine::kIvf);
+  EXPECT_EQ(ResolvedEngine(ApproximateEngine::kAuto, CV_32F), ApproximateEngine::kHnsw);
+  EXPECT_EQ(ResolvedEngine(ApproximateEngine::kFlann, CV_8U), ApproximateEngine::kFlann);
+  EXPECT_EQ(ResolvedEngine(ApproximateEngine::kHnsw, CV_8U), ApproximateEngine::kHnsw);
+  SKIP_WITHOUT_FAISS();
+  // The index built with auto is the one built with the resolved engine: same candidates.
+  const cv::Mat bytes = RandomBytes(2000, 32, 171), floats = RandomFloats(2000, 16, 172);
+  for (const cv::Mat& refs : {bytes, floats}) {
+    const cv::Mat queries = refs.rowRange(0, 100);
+    ApproximateOptions automatic;
+    ApproximateOptions resolved = automatic;
+    resolved.engine = refs.depth() == CV_8U ? ApproximateEngine::kIvf : ApproximateEngine::kHnsw;
+    const ApproximateIndex index(refs, automatic);
+    EXPECT_EQ(index.Options().engine, resolved.engine);
+    EXPECT_TRUE(SameLists(index.Search(queries), ApproximateIndex(refs, resolved).Search(queries)));
+  }
+}
+
 TEST(ApproximateIndex, FaissDeterministicAcrossBuildsAndThreads) {
   SKIP_WITHOUT_FAISS();
   const cv::Mat bytes = RandomBytes(3000, 32, 131);
@@ -591,7 +641,7 @@ TEST(ApproximateIndex, RejectsBadFaissOptions) {
   };
   const std::pair<ApproximateOptions, const char*> bad[] = {
       {with([](ApproximateOptions& o) { o.engine = static_cast<ApproximateEngine>(7); }),
-       "engine = 7, expected one of flann, hnsw or ivf"},
+       "engine = 7, expected one of flann, hnsw, ivf or auto"},
       {with([](ApproximateOptions& o) { o.hnsw_m = 2; }), "hnsw_m = 2, expected 4..128"},
       {with([](ApproximateOptions& o) { o.hnsw_ef_construction = 0; }),
        "hnsw_ef_construction = 0"},
