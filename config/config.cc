@@ -242,10 +242,11 @@ OptionTable ConfigTable(Config& c) {
         "Approximate_engine instead of comparing every pair, then scores them with the sequence "
         "sum; faster on very large runs, recall below 1 (docs/benchmarks.md). No band.");
   t.AddEnumName("Approximate_engine", kScale, c.scale, c.scale.approximate_engine,
-        "Index of Approximate_search (docs/matching.md): hnsw, FAISS's HNSW graphs (binary for "
-        "LDB and other binary descriptors, float for SIFT and HOG); ivf, FAISS's inverted files "
+        "Index of Approximate_search (docs/matching.md): auto, ivf for binary descriptors (LDB, "
+        "ORB, ...) and hnsw for vector ones (SIFT, HOG), the faster at a given recall for each "
+        "in docs/benchmarks.md; hnsw, FAISS's HNSW graphs; ivf, FAISS's inverted files "
         "(k-means cells); flann, OpenCV's FLANN (LSH for binary descriptors, k-d trees for "
-        "vector ones). hnsw and ivf need a build with FAISS (libfaiss-dev).");
+        "vector ones). auto, hnsw and ivf need a build with FAISS (libfaiss-dev).");
   t.Add("Approximate_checks", kScale, c.scale, c.scale.approximate_checks, 1, 100000,
         "Approximate_engine flann, k-d trees (vector descriptors): references examined per "
         "query (more: better recall, slower; LSH for binary descriptors ignores it).");

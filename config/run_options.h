@@ -72,7 +72,7 @@ struct ScaleOptions {
   std::string matches_name;       // kept matches, .npy or .csv
   bool approximate_search = false;  // approximate candidates instead of every pair (bounded)
   // The engine of the candidates (matching/approximate.h); hnsw and ivf need FAISS in the build.
-  ApproximateEngine approximate_engine = ApproximateEngine::kHnsw;
+  ApproximateEngine approximate_engine = ApproximateEngine::kAuto;
   int approximate_checks = 512;   // FLANN k-d trees: references examined per query, 1..100000
   int approximate_ef_search = 128;  // hnsw: candidate list while searching, 1..100000
   int approximate_nprobe = 64;     // ivf: cells scanned per query, 1..65536

@@ -148,7 +148,8 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
       [](O& o, const std::string& v) {
         o.approximate.engine = ParseEnum<ApproximateEngine>(v, "engine");
       },
-      "Index of the blocks beyond exact_limit: \"hnsw\" or \"ivf\" (FAISS), \"flann\".");
+      "Index of the blocks beyond exact_limit: \"auto\" (default: \"ivf\" for binary "
+      "descriptors, \"hnsw\" for vector ones), \"hnsw\" or \"ivf\" (FAISS), \"flann\".");
   flann("approximate_k", &ApproximateOptions::k, "Candidates per block (>= candidates).");
   flann("ef_search", &ApproximateOptions::ef_search, "HNSW: candidate list while searching.");
   flann("nprobe", &ApproximateOptions::nprobe, "IVF: cells scanned per query.");

@@ -189,6 +189,7 @@ TEST(Config, ApproximateEngineValues) {
   Config c;
   c.input.images_path = "x";
   c.scale.matches_name = "m.csv";
+  EXPECT_EQ(c.scale.approximate_engine, ApproximateEngine::kAuto);  // the default
   ApplyOverride(c, "Approximate_engine=flann");
   EXPECT_EQ(c.scale.approximate_engine, ApproximateEngine::kFlann);
   ApplyOverride(c, "Approximate_engine=IVF");
@@ -199,7 +200,7 @@ TEST(Config, ApproximateEngineValues) {
   const std::string bad = ErrorOf([&] { ApplyOverride(c, "Approximate_engine=annoy"); });
   EXPECT_NE(bad.find("Approximate_engine"), std::string::npos) << bad;
   EXPECT_NE(bad.find("annoy"), std::string::npos) << bad;
-  EXPECT_NE(bad.find("flann, hnsw or ivf"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("flann, hnsw, ivf or auto"), std::string::npos) << bad;
   EXPECT_EQ(bad.find('\n'), std::string::npos) << bad;
   EXPECT_EQ(c.scale.approximate_engine, ApproximateEngine::kHnsw);  // unchanged
   // Read from a file as well.
@@ -211,7 +212,7 @@ TEST(Config, ApproximateEngineValues) {
   EXPECT_EQ(f.scale.Approximate().engine, ApproximateEngine::kIvf);
 
   c.scale.approximate_search = true;
-  for (const char* engine : {"flann", "hnsw", "ivf"}) {
+  for (const char* engine : {"flann", "hnsw", "ivf", "auto"}) {
     ApplyOverride(c, std::string("Approximate_engine=") + engine);
     if (FaissAvailable() || std::string(engine) == "flann") {
       EXPECT_NO_THROW(CheckConfig(c)) << engine;
