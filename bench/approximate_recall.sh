@@ -17,7 +17,7 @@ run() {  # name, extra settings...
     --set Image_sequences="$L" --set Best_matches=10 --set Matches_name="$out/$name.npy" "$@" > /dev/null
 }
 run exact --set Matrix_mode=2
-for c in "${checks[@]}"; do run "approx$c" --set Approximate_search=1 --set Approximate_checks="$c"; done
+for c in "${checks[@]}"; do run "approx$c" --set Approximate_search=1 --set Approximate_engine=flann --set Approximate_checks="$c"; done
 /usr/bin/python3 - "$out" "$desc" "$L" "${checks[@]}" <<'PY'
 import sys, numpy as np
 out, desc, L, checks = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]

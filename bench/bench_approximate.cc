@@ -391,6 +391,7 @@ std::vector<Setting> LshSettings() {
   for (const auto& [tables, bits, probe] :
        std::vector<std::tuple<int, int, int>>{{12, 20, 2}, {12, 16, 2}}) {
     ApproximateOptions o;
+    o.engine = openable::ApproximateEngine::kFlann;
     o.lsh_tables = tables;
     o.lsh_key_bits = bits;
     o.lsh_probe_level = probe;
@@ -405,6 +406,7 @@ std::vector<Setting> KdSettings() {
   std::vector<Setting> out;
   for (const int checks : {512, 2048}) {
     ApproximateOptions o;
+    o.engine = openable::ApproximateEngine::kFlann;
     o.checks = checks;
     out.push_back({"flann/trees:4/checks:" + std::to_string(checks), "flann/trees:4", o});
   }
@@ -433,7 +435,7 @@ std::vector<Setting> SettingsOf(bool hog) {
   std::vector<Setting> out = hog ? KdSettings() : LshSettings();
   const std::vector<Setting> faiss =
       hog ? FaissSettings({32, 64, 128, 256}, {4, 16, 64})
-          : FaissSettings({16, 32, 64, 128, 256}, {4, 16, 64});
+          : FaissSettings({16, 32, 64, 128, 256}, {4, 16, 32, 64, 128});
   out.insert(out.end(), faiss.begin(), faiss.end());
   return out;
 }
