@@ -135,7 +135,14 @@ std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
     for (const auto& s : t.skipped) out << "    skipped: " << s << "\n";
   }
   const auto& tm = r.timings;
-  out << "  mode: " << r.mode_reason << "\n";
+  out << "  mode: " << r.mode_reason;
+  if (c.scale.approximate_search && r.descriptors.size() == 1)
+    out << ", index "
+        << EnumName(ResolvedEngine(c.scale.approximate_engine,
+                                   r.descriptors.front().metric == Metric::kL2 ? CV_32F : CV_8U))
+        << (c.scale.approximate_engine == ApproximateEngine::kAuto ? " (Approximate_engine auto)"
+                                                                   : "");
+  out << "\n";
   const Cluster& cluster = Cluster::Get();
   if (cluster.Distributed())
     out << "  processes: " << cluster.Size() << " (mpirun; each described and matched its "

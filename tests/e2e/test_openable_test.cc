@@ -19,6 +19,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "config/config.h"
+#include "matching/approximate.h"
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
 
@@ -46,6 +47,37 @@ std::string SampleConfig(const std::string& dir, const std::string& extra = "") 
   return path;
 }
 
+
+// Approximate_search with the default engine, auto, builds the index it stands for (IVF for
+// binary rows, HNSW for float rows): the kept matches are those of a run naming that engine,
+// and the report names the index.
+TEST(TestOpenABLE, ApproximateRunWithTheAutoEngineUsesAndNamesTheResolvedIndex) {
+  if (!FaissAvailable()) GTEST_SKIP() << "this build has no FAISS (libfaiss-dev)";
+  for (const auto& [descriptor, resolved] :
+       {std::pair<std::string, std::string>{"LDB", "ivf"}, {"HOG", "hnsw"}}) {
+    SCOPED_TRACE(descriptor);
+    const std::string dir = testing::TempDir();
+    const std::string config = SampleConfig(dir);
+    const auto run = [&](const std::string& engine, const std::string& name) {
+      return RunProgram(testing::TestOpenableExe(),
+                        {config, "--set", "Image_descriptor=" + descriptor, "--set",
+                         "Approximate_search=1", "--set", "Approximate_engine=" + engine, "--set",
+                         "Matches_name=out/" + name + ".csv", "--set", "Txt_name=", "--set",
+                         "Npy_name=", "--set", "Png_name="},
+                        dir);
+    };
+    const Outcome automatic = run("auto", "auto"), named = run(resolved, "named");
+    ASSERT_EQ(automatic.status, 0) << automatic.err << automatic.out;
+    ASSERT_EQ(named.status, 0) << named.err << named.out;
+    EXPECT_NE(automatic.out.find("index " + resolved + " (Approximate_engine auto)"),
+              std::string::npos)
+        << automatic.out;
+    EXPECT_NE(named.out.find("index " + resolved + "\n"), std::string::npos) << named.out;
+    const std::string kept = ReadAll(dir + "/out/auto.csv");
+    EXPECT_GE(std::count(kept.begin(), kept.end(), '\n'), 3000);  // 10 for each of 300 queries
+    EXPECT_EQ(kept, ReadAll(dir + "/out/named.csv"));
+  }
+}
 
 TEST(TestOpenABLE, SampleRunWritesEveryOutputAndFindsTheSeasonDiagonal) {
   const std::string dir = testing::TempDir();
