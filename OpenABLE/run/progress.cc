@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <ostream>
+#include <utility>
 
 #include <unistd.h>
 
@@ -9,8 +10,13 @@ namespace openable {
 
 bool IsTerminal(int fd) { return ::isatty(fd) == 1; }
 
-ProgressReporter::ProgressReporter(std::ostream& out, bool enabled, bool terminal)
-    : out_(out), enabled_(enabled), terminal_(terminal) {}
+ProgressReporter::ProgressReporter(std::ostream& out, bool enabled, bool terminal,
+                                   std::chrono::milliseconds log_interval)
+    : out_(out), enabled_(enabled), terminal_(terminal), log_interval_(log_interval) {}
+
+void ProgressReporter::SetClock(std::function<Clock::time_point()> clock) {
+  clock_ = std::move(clock);
+}
 
 ProgressReporter::~ProgressReporter() {
   if (pending_) out_ << "\r\x1b[K" << std::flush;
@@ -21,24 +27,20 @@ void ProgressReporter::Begin(const std::string& what, std::int64_t total,
   what_ = what;
   unit_ = unit;
   total_ = total;
-  last_decile_ = -1;
-  start_ = last_print_ = std::chrono::steady_clock::now();
+  start_ = last_print_ = clock_();
 }
 
 void ProgressReporter::Update(std::int64_t done) {
   if (!enabled_ || total_ <= 0) return;
-  const auto now = std::chrono::steady_clock::now();
+  const auto now = clock_();
   if (terminal_) {
     if (now - last_print_ < std::chrono::milliseconds(100) && done < total_) return;
-    last_print_ = now;
-    Print(done, false);
   } else {
-    const int decile = static_cast<int>(done * 10 / total_);
-    if (decile <= last_decile_ || decile == 0 || done >= total_) return;
-    if (now - start_ < std::chrono::seconds(2)) return;  // short stages: final line only
-    last_decile_ = decile;
-    Print(done, false);
+    // End() writes the final line; in between, one line per interval.
+    if (done >= total_ || now - last_print_ < log_interval_) return;
   }
+  last_print_ = now;
+  Print(done, false);
 }
 
 void ProgressReporter::End() {
@@ -47,8 +49,7 @@ void ProgressReporter::End() {
 }
 
 void ProgressReporter::Print(std::int64_t done, bool final) {
-  const double elapsed =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const double elapsed = std::chrono::duration<double>(clock_() - start_).count();
   char line[256];
   const double percent = total_ > 0 ? 100.0 * static_cast<double>(done) / total_ : 100.0;
   int n = std::snprintf(line, sizeof line, "  %-11s %lld/%lld %s (%3.0f%%)  %.1f s",

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <string>
 
@@ -10,10 +11,15 @@ namespace openable {
 
 class ProgressReporter {
  public:
+  using Clock = std::chrono::steady_clock;
   // Writes to `out` when `enabled`. On a terminal the line is redrawn in place (at most
-  // 10 times a second); otherwise one line is written per 10% step, so logs stay short.
-  // Stages shorter than two seconds print only their final line in log mode.
-  ProgressReporter(std::ostream& out, bool enabled, bool terminal);
+  // 10 times a second). Otherwise (a log file, a pipe, a CI console) one line is written every
+  // `log_interval` (5 s) while a stage runs, then its final line: a stage shorter than that
+  // writes its final line only, and a long one a line every few seconds, never one per frame.
+  ProgressReporter(std::ostream& out, bool enabled, bool terminal,
+                   std::chrono::milliseconds log_interval = std::chrono::seconds(5));
+  // The clock the reporter reads (tests give a simulated one); steady_clock by default.
+  void SetClock(std::function<Clock::time_point()> clock);
   // Clears a line left half-drawn on a terminal (a stage that ended by an error), so the
   // error that follows stands on its own line.
   ~ProgressReporter();
@@ -30,10 +36,11 @@ class ProgressReporter {
   void Print(std::int64_t done, bool final);
   std::ostream& out_;
   bool enabled_, terminal_;
+  std::chrono::milliseconds log_interval_;
+  std::function<Clock::time_point()> clock_ = [] { return Clock::now(); };
   bool pending_ = false;  // a terminal line is drawn without its newline
   std::string what_, unit_;
   std::int64_t total_ = 0;
-  int last_decile_ = -1;
   std::chrono::steady_clock::time_point start_, last_print_;
 };
 
