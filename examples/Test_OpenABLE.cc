@@ -18,6 +18,8 @@ const char* kUsage =
     "Options:\n"
     "  --set Key=Value   override one key of Config.txt (repeatable; also without a file)\n"
     "  --quiet           no progress lines (errors and the final report are still printed)\n"
+    "  --json            print the final report as one JSON object on stdout (for scripts;\n"
+    "                    docs/output_formats.md, \"Reports as JSON\")\n"
     "  --print-config    print the configuration in effect (Config.txt format) and exit\n"
     "  --help-markdown   print the key reference as Markdown (docs/configuration.md)\n"
     "  --version         print the version\n"
@@ -41,12 +43,14 @@ int main(int argc, char** argv) {
   openable::KeepFrameBuffersOnTheHeap();
   return openable::RunConfigProgram(
       argc, argv, "Test_OpenABLE", kUsage, "OpenABLE " + std::string(openable::kVersion),
-      [](const openable::Config& config, const openable::CommandLine&,
+      [](const openable::Config& config, const openable::CommandLine& command_line,
          openable::ProgressReporter& progress) {
         const auto log = [](const std::string& line) {
           std::cerr << "Test_OpenABLE: " << line << "\n";
         };
-        std::cout << openable::FormatRunReport(config, openable::Run(config, progress, log));
+        const openable::RunOutcome outcome = openable::Run(config, progress, log);
+        std::cout << (command_line.json ? openable::EncodeRunJson(config, outcome)
+                                        : openable::FormatRunReport(config, outcome));
         return 0;
       },
       {}, /*spreads_over_processes=*/true);

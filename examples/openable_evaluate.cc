@@ -62,6 +62,7 @@ const char* kUsage =
     "  --config FILE           take the keys above from a Config.txt first\n"
     "  --set Key=Value         any evaluation key of Config.txt\n"
     "  --quiet                 print only errors and the list of files written\n"
+    "  --json                  print the evaluation as one JSON object on stdout (for scripts)\n"
     "  --help, --version\n"
     "\n"
     "Example (KITTI 00, loops within 5 m seen in the same direction):\n"
@@ -87,7 +88,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> overrides;
   std::string config_path;
   int reference_frames = 0;
-  bool quiet = false;
+  bool quiet = false, json = false;
   auto value_of = [&](int& i, const std::string& flag) -> std::string {
     if (i + 1 >= argc) throw std::invalid_argument(flag + " needs a value");
     return argv[++i];
@@ -125,6 +126,8 @@ int main(int argc, char** argv) {
         overrides.push_back(value_of(i, a));
       } else if (a == "--quiet" || a == "-q") {
         quiet = true;
+      } else if (a == "--json") {
+        json = true;
       } else {
         throw std::invalid_argument("unknown option \"" + a + "\"");
       }
@@ -149,10 +152,22 @@ int main(int argc, char** argv) {
     evaluation.settings = openable::EvaluationSettingsFrom(config);
     const std::vector<cv::Mat1f> loaded =
         openable::EvaluateMatrixFiles(evaluation, matrices, reference_frames);
-    if (!quiet) std::cout << openable::FormatEvaluationTable(evaluation.settings, evaluation.runs);
-    if (config.evaluation.name.empty()) return 0;
-    const std::vector<std::string> paths = openable::WriteEvaluation(
-        "Evaluation_name", config.evaluation.name, evaluation, loaded);
+    if (!quiet && !json)
+      std::cout << openable::FormatEvaluationTable(evaluation.settings, evaluation.runs);
+    const std::vector<std::string> paths =
+        config.evaluation.name.empty()
+            ? std::vector<std::string>{}
+            : openable::WriteEvaluation("Evaluation_name", config.evaluation.name, evaluation,
+                                        loaded);
+    if (json) {
+      std::cout << openable::ProgramJson(
+          "openable_evaluate",
+          {{"evaluation", openable::EncodeEvaluationJson(evaluation.settings, evaluation.runs,
+                                                         openable::kVersion)}},
+          paths);
+      return 0;
+    }
+    if (paths.empty()) return 0;
     std::cout << "Wrote:\n";
     for (const auto& p : paths) std::cout << "  " << p << "\n";
     return 0;

@@ -11,6 +11,7 @@
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/snaps/chain.h"
 #include "OpenABLE/run/command_line.h"
+#include "OpenABLE/run/run.h"
 
 namespace {
 
@@ -28,6 +29,7 @@ const char* const kUsage =
     "Options:\n"
     "  --set Key=Value   override one key (repeatable; also without a file)\n"
     "  --quiet           no progress lines\n"
+    "  --json            print the report as one JSON object on stdout (for scripts)\n"
     "  --print-config    print the configuration in effect and exit\n"
     "  -h, --help        this help (the SNAPS keys are in the group SNAPS below)\n"
     "\n"
@@ -54,6 +56,12 @@ int main(int argc, char** argv) {
           if (!cl.quiet) std::cerr << "  " << line << "\n";
         };
         const openable::snaps::ChainResult result = openable::snaps::RunChain(config, progress, say);
+        if (cl.json) {
+          const std::vector<std::string> paths = openable::snaps::WriteChainOutputs(config, result);
+          std::cout << openable::ProgramJson(
+              "openable_snaps", {{"snaps", openable::snaps::ChainJson(config, result)}}, paths);
+          return 0;
+        }
         std::cout << openable::snaps::FormatChainReport(config, result);
         const std::vector<std::string> paths = openable::snaps::WriteChainOutputs(config, result);
         if (!paths.empty()) {

@@ -34,6 +34,7 @@ const char* kUsage =
     "  --best N          runs drawn in the precision-recall figure (default 5)\n"
     "  --set Key=Value   override one key of Config.txt for every run (repeatable)\n"
     "  --quiet           no progress lines (errors and the table are still printed)\n"
+    "  --json            print the table as one JSON object on stdout (PREFIX.json's content)\n"
     "  --print-config    print the base configuration in effect and exit\n"
     "  --help-markdown   print the key reference as Markdown\n"
     "  --version         print the version\n"
@@ -96,6 +97,12 @@ int main(int argc, char** argv) {
         };
         const openable::SweepResult result = openable::RunSweep(config, options, progress, log);
         const std::vector<std::string> written = openable::WriteSweep(prefix, result);
+        if (command_line.json) {
+          std::cout << openable::ProgramJson(
+              "openable_sweep",
+              {{"sweep", openable::EncodeSweepJson(result, openable::kVersion)}}, written);
+          return 0;
+        }
         std::cout << openable::FormatSweepTable(result) << "Wrote:\n";
         for (const std::string& path : written) std::cout << "  " << path << "\n";
         return 0;

@@ -43,6 +43,8 @@ std::string ParseCommandLine(int argc, const char* const* argv, const std::strin
       out.overrides.push_back(a.substr(6));
     } else if (a == "--quiet" || a == "-q") {
       out.quiet = true;
+    } else if (a == "--json") {
+      out.json = true;
     } else if (a == "--print-config") {
       out.print_config = true;
     } else if (!a.empty() && a[0] == '-') {

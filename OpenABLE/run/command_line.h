@@ -1,5 +1,6 @@
 // The command line shared by the programs that read Config.txt (Test_OpenABLE,
-// openable_snaps): [Config.txt] [--set Key=Value ...] [--quiet] [--print-config] [--help]
+// openable_snaps, openable_sweep): [Config.txt] [--set Key=Value ...] [--quiet] [--json]
+// [--print-config] [--help]
 // [--help-markdown] [--version].
 #pragma once
 
@@ -17,6 +18,7 @@ struct CommandLine {
   std::string config_path;             // empty: defaults, then the overrides
   std::vector<std::string> overrides;  // "Key=Value" from --set, in order
   bool quiet = false;                  // --quiet, -q
+  bool json = false;                   // --json: the final report as one JSON object on stdout
   bool print_config = false;           // --print-config
   bool help = false;                   // -h, --help
   bool help_markdown = false;          // --help-markdown

@@ -5,6 +5,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "OpenABLE/run/evaluate.h"
@@ -38,5 +39,24 @@ VerifiedAnswers AnswersOf(const RunVerification& verification, const EvaluationL
 // The report Test_OpenABLE prints at the end: descriptor and camera, traversals, mode and
 // matrix, timings, the evaluation table, the files written.
 std::string FormatRunReport(const Config& config, const RunOutcome& outcome);
+
+// The same report as one JSON object (Test_OpenABLE --json), for scripts: {"program",
+// "openable_version", "descriptors": [{name, row_width, metric}], "camera", "traversals":
+// [{key, path, frames, first_row, frame_width, frame_height, skipped: [...]}], "mode",
+// "bounded", "index" (Approximate_search: the engine used, else null), "matches_kept"
+// (bounded) or "matrix": {rows, cols}, "max_distance", "empty_cells", "threshold_cells_below"
+// (Threshold set, else null), "accepted": {queries, answered, match_threshold} or null,
+// "verification": {queries, candidates_checked, geometric, answered, seconds} or null,
+// "timings": {total, description, matching, sequences, evaluation, export (seconds), frames,
+// pairs}, "evaluation" (EncodeEvaluationJson's object, or null), "notes", "written"}. Numbers
+// as in the evaluation JSON (docs/output_formats.md).
+std::string EncodeRunJson(const Config& config, const RunOutcome& outcome);
+
+// The --json report of the other programs: {"program": `program`, "openable_version", then
+// `members` in order (name, JSON value: an object written on several lines is re-indented),
+// then "written": the paths}. One object, ending with a newline.
+std::string ProgramJson(const std::string& program,
+                        const std::vector<std::pair<std::string, std::string>>& members,
+                        const std::vector<std::string>& written);
 
 }  // namespace openable
