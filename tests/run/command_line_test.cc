@@ -18,6 +18,11 @@ TEST(CommandLine, FileOverridesAndFlags) {
   EXPECT_TRUE(cl.quiet);
   EXPECT_TRUE(cl.print_config);
   EXPECT_FALSE(cl.help);
+  EXPECT_FALSE(cl.json);
+  CommandLine json;
+  EXPECT_EQ(Parse({"c.txt", "--json"}, json), "");
+  EXPECT_TRUE(json.json);
+  EXPECT_FALSE(json.quiet);
 }
 
 TEST(CommandLine, OverridesAloneOrHelpAloneAreEnough) {
