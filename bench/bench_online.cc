@@ -35,6 +35,7 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/online/online.h"
+#include "OpenABLE/run/progress.h"  // SecondsSince
 
 namespace {
 
@@ -233,20 +234,17 @@ int main(int argc, char** argv) {
                 "%.3f up to %.4f\n", best_f1, best_t, r100, t100);
     if (!save_map.empty()) {
       using Clock = std::chrono::steady_clock;
-      auto seconds = [](Clock::time_point t) {
-        return std::chrono::duration<double>(Clock::now() - t).count();
-      };
       auto start = Clock::now();
       detector.SaveMap(save_map);
-      const double save = seconds(start);
+      const double save = openable::SecondsSince(start);
       openable::OnlineDetector loaded(options);
       start = Clock::now();
       const auto info = loaded.LoadMap(save_map);
-      const double load = seconds(start);
+      const double load = openable::SecondsSince(start);
       openable::OnlineDetector rebuilt(options);
       start = Clock::now();
       rebuilt.AddToMap(detector.Descriptors());
-      const double build = seconds(start);
+      const double build = openable::SecondsSince(start);
       std::printf("  saved map: %d frames, %d blocks, %.1f MB; save %.2f s, load %.2f s "
                   "(blocks %s), the same map built from its rows %.2f s\n",
                   info.frames, info.blocks, std::filesystem::file_size(save_map) / 1e6, save,

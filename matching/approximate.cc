@@ -60,11 +60,12 @@ void CheckQueries(const cv::Mat& queries, int type, int width, const char* what)
 
 cv::Mat Continuous(const cv::Mat& m) { return m.isContinuous() ? m : m.clone(); }
 
-void SortCandidates(std::vector<Candidate>& c) {
-  std::sort(c.begin(), c.end(), [](const Candidate& a, const Candidate& b) {
-    return a.distance < b.distance || (a.distance == b.distance && a.reference < b.reference);
-  });
+// The order of CandidateLists: increasing distance, ties by increasing reference row.
+bool CandidateBefore(const Candidate& a, const Candidate& b) {
+  return a.distance < b.distance || (a.distance == b.distance && a.reference < b.reference);
 }
+
+void SortCandidates(std::vector<Candidate>& c) { std::sort(c.begin(), c.end(), CandidateBefore); }
 
 // Queries handed to one FLANN call (and one thread) at a time.
 constexpr int kQueryBlock = 32;
@@ -249,8 +250,7 @@ std::unique_ptr<FaissIndex> ReadFaiss(const ApproximateOptions& o, const cv::Mat
 
 // The cells of a binary IVF index (null for any other index), checked against the references:
 // a saved index whose cells name rows it does not have is refused.
-std::unique_ptr<IvfCells> CellsOf(const FaissIndex& index,
-                                                        const cv::Mat& refs) {
+std::unique_ptr<IvfCells> CellsOf(const FaissIndex& index, const cv::Mat& refs) {
   std::vector<std::uint8_t> centres;
   std::vector<std::vector<std::int64_t>> cells;
   if (refs.depth() != CV_8U || !index.BinaryCells(&centres, &cells) || cells.empty()) return {};
@@ -369,9 +369,6 @@ CandidateLists ApproximateIndex::Search(const cv::Mat& queries_in) const {
     const IvfCells& cells = *impl_->cells;
     const int lists = static_cast<int>(cells.ids.size());
     const int probes = std::min(impl_->options.nprobe, lists);
-    const auto before = [](const Candidate& a, const Candidate& b) {
-      return a.distance < b.distance || (a.distance == b.distance && a.reference < b.reference);
-    };
     ParallelBlocks(queries.rows, kQueryBlock, impl_->options.threads, [&](int q0, int q1) {
       std::vector<float> centre(static_cast<size_t>(lists)), d;
       std::vector<int> order(static_cast<size_t>(lists));
@@ -395,11 +392,11 @@ CandidateLists ApproximateIndex::Search(const cv::Mat& queries_in) const {
             const Candidate c{ids[i], d[i]};
             if (static_cast<int>(heap.size()) < knn) {
               heap.push_back(c);
-              std::push_heap(heap.begin(), heap.end(), before);
-            } else if (before(c, heap.front())) {
-              std::pop_heap(heap.begin(), heap.end(), before);
+              std::push_heap(heap.begin(), heap.end(), CandidateBefore);
+            } else if (CandidateBefore(c, heap.front())) {
+              std::pop_heap(heap.begin(), heap.end(), CandidateBefore);
               heap.back() = c;
-              std::push_heap(heap.begin(), heap.end(), before);
+              std::push_heap(heap.begin(), heap.end(), CandidateBefore);
             }
           }
         }

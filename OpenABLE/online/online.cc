@@ -410,12 +410,17 @@ OnlineDetector::LoadedMap OnlineDetector::LoadMap(const std::string& path) {
                      "map before adding frames)");
   MapFile map = ReadMapFile(path);
   const std::string what = "the map was made with ";
-  for (const auto& [key, value] : DescriptionSettings(s.options))
-    if (map.Setting(key) != value)
-      throw InputError(path + ": " + what + key + " = " + map.Setting(key) +
-                       "; this detector has " + key + " = " + value +
-                       " (expected the same description settings: descriptor, description, "
-                       "patch_size, ldb_bits, grid_x, grid_y)");
+  // Settings the map must share with this detector, else one line naming the first that differs.
+  const auto require_same = [&](const std::vector<std::pair<std::string, std::string>>& settings,
+                                const std::string& mine, const std::string& expected) {
+    for (const auto& [key, value] : settings)
+      if (map.Setting(key) != value)
+        throw InputError(path + ": " + what + key + " = " + map.Setting(key) + "; this detector " +
+                         mine + " " + key + " = " + value + " (" + expected + ")");
+  };
+  require_same(DescriptionSettings(s.options), "has",
+               "expected the same description settings: descriptor, description, patch_size, "
+               "ldb_bits, grid_x, grid_y");
   if (map.rows.cols != s.width || map.rows.depth() != s.type)
     throw InputError(path + ": the map's rows are " + std::to_string(map.rows.cols) + " " +
                      map.Setting("row_type") + "; expected " + std::to_string(s.width) + " " +
@@ -424,12 +429,8 @@ OnlineDetector::LoadedMap OnlineDetector::LoadMap(const std::string& path) {
   if (s.type == CV_32F && !cv::checkRange(map.rows))
     throw InputError(path + ": the map's rows hold a value that is not finite");
   if (s.verifier) {
-    for (const auto& [key, value] : FeatureSettings(s.options))
-      if (map.Setting(key) != value)
-        throw InputError(path + ": " + what + key + " = " + map.Setting(key) +
-                         "; this detector verifies with " + key + " = " + value +
-                         " (expected a map saved by a detector with the same verification "
-                         "features)");
+    require_same(FeatureSettings(s.options), "verifies with",
+                 "expected a map saved by a detector with the same verification features");
     if (!map.has_features || map.features.size() != static_cast<size_t>(map.rows.rows))
       throw InputError(path + ": the map holds no local features; expected a map saved by a "
                        "detector with verification enabled");

@@ -452,7 +452,8 @@ Adds an already computed descriptor row (1-D, row_width elements of row_dtype, e
 describe_images()) as the next frame; returns what add_frame() returns.)doc")
       .def(
           "save_map",
-          [](Detector& det, const std::string& path) {
+          [](Detector& det, const py::object& path_object) {
+            const std::string path = FileSystemPath(path_object, "save_map: path");
             py::gil_scoped_release release;
             std::lock_guard<std::mutex> lock(det.mutex);
             det.detector->SaveMap(path);
@@ -467,7 +468,8 @@ into place when complete. Raises openable.InputError naming the path when it can
 written.)doc")
       .def(
           "load_map",
-          [](Detector& det, const std::string& path) {
+          [](Detector& det, const py::object& path_object) {
+            const std::string path = FileSystemPath(path_object, "load_map: path");
             OnlineDetector::LoadedMap info;
             {
               py::gil_scoped_release release;

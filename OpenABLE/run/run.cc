@@ -95,6 +95,18 @@ VerifiedAnswers AnswersOf(const RunVerification& verification, const EvaluationL
   return out;
 }
 
+namespace {
+
+// The engine of the approximate index a run used (auto resolved by the rows' type), or empty
+// without Approximate_search (which runs on one descriptor).
+std::string IndexUsed(const Config& c, const RunResult& r) {
+  if (!c.scale.approximate_search || r.descriptors.size() != 1) return "";
+  const int depth = r.descriptors.front().metric == Metric::kL2 ? CV_32F : CV_8U;
+  return EnumName(ResolvedEngine(c.scale.approximate_engine, depth));
+}
+
+}  // namespace
+
 std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
   const RunResult& r = outcome.result;
   const Evaluation* evaluation = outcome.evaluation.get();
@@ -137,10 +149,8 @@ std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
   }
   const auto& tm = r.timings;
   out << "  mode: " << r.mode_reason;
-  if (c.scale.approximate_search && r.descriptors.size() == 1)
-    out << ", index "
-        << EnumName(ResolvedEngine(c.scale.approximate_engine,
-                                   r.descriptors.front().metric == Metric::kL2 ? CV_32F : CV_8U))
+  if (const std::string index = IndexUsed(c, r); !index.empty())
+    out << ", index " << index
         << (c.scale.approximate_engine == ApproximateEngine::kAuto ? " (Approximate_engine auto)"
                                                                    : "");
   out << "\n";
@@ -210,7 +220,6 @@ std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
   return out.str();
 }
 
-
 namespace {
 
 // "[a, b]" of JSON strings.
@@ -256,11 +265,8 @@ std::string EncodeRunJson(const Config& c, const RunOutcome& outcome) {
   }
   o << "],\n  \"mode\": " << JsonText(r.mode_reason) << ",\n  \"bounded\": "
     << (r.bounded ? "true" : "false") << ",\n  \"index\": ";
-  if (c.scale.approximate_search && r.descriptors.size() == 1)
-    o << JsonText(EnumName(ResolvedEngine(
-        c.scale.approximate_engine, r.descriptors.front().metric == Metric::kL2 ? CV_32F : CV_8U)));
-  else
-    o << "null";
+  const std::string index = IndexUsed(c, r);
+  o << (index.empty() ? "null" : JsonText(index));
   if (r.bounded)
     o << ",\n  \"matches_kept\": " << r.matches.size();
   else

@@ -136,6 +136,7 @@ class OnlineAgainstBatchTest(unittest.TestCase):
 
     def test_saved_map_gives_the_same_candidates(self):
         import os
+        import pathlib
         import tempfile
         options = dict(sequence_length=L, exclusion=EXCLUSION, candidates=K, threshold=THRESHOLD,
                        exact_limit=100, block_frames=64, background_merges=False)
@@ -146,7 +147,7 @@ class OnlineAgainstBatchTest(unittest.TestCase):
             path = os.path.join(folder, "kitti.map")
             yesterday.save_map(path)
             today = openable.OnlineDetector(**options)
-            info = today.load_map(path)
+            info = today.load_map(pathlib.Path(path))  # os.PathLike as well as str
             self.assertEqual(info["frames"], 300)
             self.assertFalse(info["rebuilt"])
             self.assertEqual(info["blocks"], yesterday.blocks)
