@@ -62,8 +62,9 @@ bool IsInside(const std::filesystem::path& file, const std::filesystem::path& fo
 
 // Where modules are searched, in order (docs/install.md): OPENABLE_MODULE_PATH; beside the
 // file holding this code as installed (<prefix>/bin/../lib/openable for a program,
-// <prefix>/lib/openable for a shared library, and <dir>/../../openable for the Python module in
-// <prefix>/lib/python3.X/dist-packages), whatever prefix it was installed to; then the
+// <prefix>/lib/openable for a shared library, and <dir>/../../../openable for the Python
+// extension in <prefix>/lib/python3.X/dist-packages/openable), whatever prefix it was
+// installed to; the modules/ folder of a package installed by pip; then the
 // build tree for a program of the build tree, the configured install folder for any other (so
 // an installed program never picks up the modules of a later build).
 std::vector<std::string> SearchFolders() {
@@ -85,10 +86,14 @@ std::vector<std::string> SearchFolders() {
     const char* relative =
         is_program ? OPENABLE_MODULE_DIR_FROM_BINDIR : OPENABLE_MODULE_DIR_FROM_LIBDIR;
     folders.push_back((own.parent_path() / relative).lexically_normal().string());
-    // A shared library two folders below <libdir>: the Python module, installed to
-    // <libdir>/python3.X/dist-packages (OPENABLE_PYTHON_INSTALL_DIR's default).
+    // The Python extension installed by cmake --install to
+    // <libdir>/python3.X/dist-packages/openable/ (OPENABLE_PYTHON_INSTALL_DIR's default).
     if (!is_program)
-      folders.push_back((own.parent_path() / "../../openable").lexically_normal().string());
+      folders.push_back((own.parent_path() / "../../../openable").lexically_normal().string());
+    // A package installed by pip (setup.py): the extension in openable/, the programs in
+    // openable/bin/, the modules in openable/modules/.
+    folders.push_back(
+        (own.parent_path() / (is_program ? "../modules" : "modules")).lexically_normal().string());
     in_build_tree = IsInside(own, OPENABLE_BUILD_TREE);
     installed = !in_build_tree;
   }

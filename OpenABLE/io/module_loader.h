@@ -14,7 +14,8 @@
 //
 // Modules are searched in the folders of the environment variable OPENABLE_MODULE_PATH
 // (colon-separated), then beside the program (or shared library) holding this code as
-// installed (<prefix>/lib/openable, whatever prefix it was installed to), then in the build
+// installed (<prefix>/lib/openable, whatever prefix it was installed to) or as pip installs
+// the Python package (openable/modules/ beside openable/bin/), then in the build
 // tree's modules/ for a program of the build tree, or in the configured prefix's lib/openable
 // for any other program (docs/install.md).
 #pragma once

@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <string>
 
+#include <opencv2/imgproc.hpp>
+
 namespace openable::python {
 namespace {
 
@@ -139,14 +141,43 @@ MatView Matrix2D(const py::handle& object, Elements elements, const char* what) 
   return Wrap(std::move(a), depth, 1, false);
 }
 
-MatView Image(const py::handle& object, const char* what) {
+bool IsRgbOrder(const std::string& color_order) {
+  if (color_order == "bgr" || color_order == "BGR") return false;
+  if (color_order == "rgb" || color_order == "RGB") return true;
+  throw py::value_error("color_order: '" + color_order +
+                        "'; expected 'bgr' (OpenCV's order, the default) or 'rgb' (matplotlib, "
+                        "PIL, imageio)");
+}
+
+namespace {
+
+// `v` with its three channels in BGR order: reordered into a new buffer when the array given
+// was RGB (never in place: the caller's array is left as it was).
+MatView ToBgr(MatView v, bool rgb) {
+  if (!rgb || v.mat.channels() != 3) return v;
+  cv::Mat bgr;
+  cv::cvtColor(v.mat, bgr, cv::COLOR_RGB2BGR);
+  return MatView{bgr, py::array(), true};
+}
+
+MatView ImageAsGiven(const py::handle& object, const char* what);
+
+}  // namespace
+
+MatView Image(const py::handle& object, const char* what, bool rgb) {
+  return ToBgr(ImageAsGiven(object, what), rgb);
+}
+
+namespace {
+
+MatView ImageAsGiven(const py::handle& object, const char* what) {
   py::array a = py::array::ensure(object);
   if (!a) throw py::value_error(std::string(what) + ": expected an image as a NumPy array");
   const bool shape_ok =
       a.ndim() == 2 || (a.ndim() == 3 && (a.shape(2) == 1 || a.shape(2) == 3));
   if (!shape_ok) {
     throw py::value_error(std::string(what) + ": array of shape " + ShapeText(a) +
-                          "; expected (H, W) grey or (H, W, 3) BGR");
+                          "; expected (H, W) grey or (H, W, 3) colour");
   }
   const int channels = a.ndim() == 3 ? static_cast<int>(a.shape(2)) : 1;
   int depth = -1;
@@ -170,7 +201,9 @@ MatView Image(const py::handle& object, const char* what) {
   return v;
 }
 
-std::vector<MatView> Images(const py::handle& sequence, const char* what) {
+}  // namespace
+
+std::vector<MatView> Images(const py::handle& sequence, const char* what, bool rgb) {
   std::vector<MatView> out;
   if (py::isinstance<py::array>(sequence)) {
     const py::array a = py::reinterpret_borrow<py::array>(sequence);
@@ -185,7 +218,7 @@ std::vector<MatView> Images(const py::handle& sequence, const char* what) {
   out.reserve(items.size());
   for (std::size_t i = 0; i < items.size(); ++i) {
     const std::string name = std::string(what) + "[" + std::to_string(i) + "]";
-    out.push_back(Image(items[i], name.c_str()));
+    out.push_back(Image(items[i], name.c_str(), rgb));
   }
   return out;
 }

@@ -37,12 +37,18 @@ enum class Elements {
 // A 2-D matrix (a 1-D array is one row). `what` names the argument in errors (ValueError).
 MatView Matrix2D(const py::handle& object, Elements elements, const char* what);
 
-// An image: (H, W) or (H, W, C) with C in {1, 3} (BGR), uint8 or float32 in [0, 1]; other real
-// types are converted to float32. A 3-D array becomes a multi-channel cv::Mat (CV_8UC3, ...).
-MatView Image(const py::handle& object, const char* what);
+// The `color_order` argument of the functions that take or return colour images: "bgr"
+// (OpenCV's order, the library's own) gives false, "rgb" (matplotlib, PIL, imageio) true;
+// anything else is a ValueError.
+bool IsRgbOrder(const std::string& color_order);
+
+// An image: (H, W) or (H, W, C) with C in {1, 3} (BGR, or RGB with `rgb`, then reordered to BGR
+// in a copy), uint8 or float32 in [0, 1]; other real types are converted to float32. A 3-D
+// array becomes a multi-channel cv::Mat (CV_8UC3, ...).
+MatView Image(const py::handle& object, const char* what, bool rgb = false);
 
 // Images of a Python sequence (list, tuple, or a 3-D/4-D array whose first axis is the image).
-std::vector<MatView> Images(const py::handle& sequence, const char* what);
+std::vector<MatView> Images(const py::handle& sequence, const char* what, bool rgb = false);
 
 // The cv::Mat `m` (CV_8U or CV_32F, any channel count) as a NumPy array over the same memory:
 // a capsule holds a cv::Mat header, so the buffer lives as long as the array. A matrix that

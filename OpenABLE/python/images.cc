@@ -1,5 +1,6 @@
 // Images and descriptor names: read_image, list_images, to_gray8, descriptor_names.
 #include <pybind11/stl.h>
+#include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/image/preprocess.h"
@@ -33,29 +34,34 @@ Descriptors of the original OpenABLE that this build cannot provide, each with t
 
   m.def(
       "read_image",
-      [](const py::object& path_object) {
+      [](const py::object& path_object, const std::string& color_order) {
         const std::string path = FileSystemPath(path_object, "path");
+        const bool rgb = IsRgbOrder(color_order);
         cv::Mat image;
         {
           py::gil_scoped_release release;
           image = ReadImageFile(path);
+          if (rgb && image.channels() == 3) cv::cvtColor(image, image, cv::COLOR_BGR2RGB);
         }
         return ToNumpy(image);
       },
-      py::arg("path"),
-      R"doc(read_image(path) -> numpy.ndarray
+      py::arg("path"), py::arg("color_order") = "bgr",
+      R"doc(read_image(path, color_order="bgr") -> numpy.ndarray
 
 Reads one image file exactly as Test_OpenABLE reads the frames of a folder (PNG, JPEG, PNM
 and BMP by OpenCV's codecs after OpenABLE's own integrity checks; TIFF and the rest by
 OpenImageIO).
 
 Args:
-    path (str | os.PathLike | bytes): the image file.
+    path (str | os.PathLike | bytes): the image file (a pathlib.Path is fine).
+    color_order (str): "bgr" (OpenCV's order, what the library uses) or "rgb" (for
+        matplotlib's imshow, PIL, imageio); only colour images are affected.
 
 Returns:
     numpy.ndarray: float32 in [0, 1] whatever the bit depth of the file, shape (H, W) for a
-    grey image or (H, W, 3) in BGR order for a colour one (alpha dropped). This is the form
-    describe(), describe_images() and OnlineDetector.add_frame() take.
+    grey image or (H, W, 3) in the order asked for a colour one (alpha dropped). This is the
+    form describe(), describe_images() and OnlineDetector.add_frame() take (give them the same
+    color_order).
 
 Raises:
     openable.InputError: one line naming the file when it is missing, corrupt, truncated or
@@ -90,8 +96,8 @@ Raises:
 
   m.def(
       "to_gray8",
-      [](const py::object& image) {
-        MatView v = Image(image, "image");
+      [](const py::object& image, const std::string& color_order) {
+        MatView v = Image(image, "image", IsRgbOrder(color_order));
         cv::Mat1b gray;
         {
           py::gil_scoped_release release;
@@ -101,14 +107,15 @@ Raises:
         }
         return ToNumpy(gray);
       },
-      py::arg("image"),
-      R"doc(to_gray8(image) -> numpy.ndarray
+      py::arg("image"), py::arg("color_order") = "bgr",
+      R"doc(to_gray8(image, color_order="bgr") -> numpy.ndarray
 
 The grey 8-bit image every monocular descriptor describes: OpenCV's luma weights
 (0.299 R + 0.587 G + 0.114 B) on the [0, 1] image, times 255, rounded.
 
 Args:
-    image (numpy.ndarray): (H, W) grey or (H, W, 3) BGR; uint8 (0-255) or float32 (0-1).
+    image (numpy.ndarray): (H, W) grey or (H, W, 3) colour; uint8 (0-255) or float32 (0-1).
+    color_order (str): channel order of a colour image, "bgr" (OpenCV's) or "rgb".
 
 Returns:
     numpy.ndarray: uint8, shape (H, W).)doc");

@@ -1,4 +1,5 @@
-// The Python module `openable` (docs/python.md).
+// The extension openable._openable (docs/python.md), whose contents the package openable
+// (OpenABLE/python/openable/__init__.py) re-exports.
 #include <stdexcept>
 
 #include <pybind11/eval.h>
@@ -24,8 +25,12 @@ void CheckPythonSignals() {
 
 }  // namespace
 
-PYBIND11_MODULE(openable, m) {
+PYBIND11_MODULE(_openable, m) {
   namespace py = pybind11;
+  // Classes, functions and messages name the package users import (openable.Curve, not
+  // openable._openable.Curve); set before anything is defined, since classes and the snaps
+  // submodule take their names from it.
+  m.attr("__name__") = "openable";
   // Every docstring starts with its own signature, written for readers (numpy.ndarray rather
   // than pybind11's "object"); pybind11's generated one would repeat it.
   py::options options;

@@ -239,7 +239,9 @@ const char* const kDescriptionArgs =
     ldb_bits (int): bits of LDB rows (1..1386; 256 = 32 bytes).
     grid (tuple[int, int]): (cells across, cells down) for description="grid".
     sad_patch (int): SAD: side of the normalised squares of its Patch_size x Patch_size/2
-        thumbnail, pixels (2..64).)doc";
+        thumbnail, pixels (2..64).
+    color_order (str): channel order of colour images, "bgr" (OpenCV's, as read_image()
+        gives them by default) or "rgb" (as matplotlib, PIL and imageio give them).)doc";
 
 }  // namespace
 
@@ -247,25 +249,26 @@ void RegisterOnline(py::module_& m) {
   m.def(
       "describe",
       [](const py::object& image, const std::string& descriptor, const std::string& description,
-         int patch_size, int ldb_bits, std::pair<int, int> grid, int sad_patch) {
+         int patch_size, int ldb_bits, std::pair<int, int> grid, int sad_patch,
+         const std::string& color_order) {
         const OnlineOptions o =
             DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid, sad_patch);
-        const cv::Mat rows = Describe({Image(image, "image")}, o, 1);
+        const cv::Mat rows = Describe({Image(image, "image", IsRgbOrder(color_order))}, o, 1);
         return ToNumpy(rows.row(0).clone(), true);
       },
       py::arg("image"), py::arg("descriptor") = "LDB", py::arg("description") = "global",
       py::arg("patch_size") = 64, py::arg("ldb_bits") = 256, py::arg("grid") = std::make_pair(1, 1),
-      py::arg("sad_patch") = 8,
+      py::arg("sad_patch") = 8, py::arg("color_order") = "bgr",
       (std::string(
            R"doc(describe(image, descriptor="LDB", description="global", patch_size=64,
-    ldb_bits=256, grid=(1, 1), sad_patch=8) -> numpy.ndarray
+    ldb_bits=256, grid=(1, 1), sad_patch=8, color_order="bgr") -> numpy.ndarray
 
 The descriptor row of one image, as Test_OpenABLE describes a frame (grey conversion, then
 global or grid description).
 
 Args:
-    image (numpy.ndarray): (H, W) grey or (H, W, 3) BGR; uint8 (0-255) or float32 (0-1, as
-        read_image() gives it). Read in place when contiguous.
+    image (numpy.ndarray): (H, W) grey or (H, W, 3) colour; uint8 (0-255) or float32 (0-1,
+        as read_image() gives it). Read in place when contiguous (and BGR).
 )doc") +
        kDescriptionArgs + R"doc(
 
@@ -279,17 +282,18 @@ Raises:
   m.def(
       "describe_images",
       [](const py::object& images, const std::string& descriptor, const std::string& description,
-         int patch_size, int ldb_bits, std::pair<int, int> grid, int sad_patch, int threads) {
+         int patch_size, int ldb_bits, std::pair<int, int> grid, int sad_patch, int threads,
+         const std::string& color_order) {
         const OnlineOptions o =
             DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid, sad_patch);
-        return ToNumpy(Describe(Images(images, "images"), o, threads));
+        return ToNumpy(Describe(Images(images, "images", IsRgbOrder(color_order)), o, threads));
       },
       py::arg("images"), py::arg("descriptor") = "LDB", py::arg("description") = "global",
       py::arg("patch_size") = 64, py::arg("ldb_bits") = 256, py::arg("grid") = std::make_pair(1, 1),
-      py::arg("sad_patch") = 8, py::arg("threads") = 0,
+      py::arg("sad_patch") = 8, py::arg("threads") = 0, py::arg("color_order") = "bgr",
       (std::string(
            R"doc(describe_images(images, descriptor="LDB", description="global", patch_size=64,
-    ldb_bits=256, grid=(1, 1), sad_patch=8, threads=0) -> numpy.ndarray
+    ldb_bits=256, grid=(1, 1), sad_patch=8, threads=0, color_order="bgr") -> numpy.ndarray
 
 One descriptor row per image, described in parallel (the GIL is released).
 
@@ -405,8 +409,8 @@ detector, saved with numpy.save) as the next n frames without searching for them
 earlier run, which later frames find as candidates like any other frame.)doc")
       .def(
           "add_frame",
-          [](Detector& d, const py::object& image) {
-            const MatView v = Image(image, "image");
+          [](Detector& d, const py::object& image, const std::string& color_order) {
+            const MatView v = Image(image, "image", IsRgbOrder(color_order));
             OnlineResult r;
             {
               py::gil_scoped_release release;
@@ -415,13 +419,14 @@ earlier run, which later frames find as candidates like any other frame.)doc")
             }
             return ResultTuple(r, d.detector->Options().verification.enabled);
           },
-          py::arg("image"),
-          R"doc(add_frame(image) -> tuple[int, list[tuple[int, float, float, bool, float]], dict]
+          py::arg("image"), py::arg("color_order") = "bgr",
+          R"doc(add_frame(image, color_order="bgr") -> tuple[int, list[tuple[int, float, float, bool, float]], dict]
 
 Describes `image` and adds it as the next frame (the GIL is released meanwhile).
 
 Args:
-    image (numpy.ndarray): (H, W) grey or (H, W, 3) BGR, uint8 or float32 in [0, 1].
+    image (numpy.ndarray): (H, W) grey or (H, W, 3) colour, uint8 or float32 in [0, 1].
+    color_order (str): channel order of a colour image, "bgr" (OpenCV's) or "rgb".
 
 Returns:
     (frame, candidates, timings): the index of the frame added (0, 1, ...); its candidates,

@@ -155,10 +155,15 @@ run_installed "$tmp/tiff" tiff LD_DEBUG=files || {
 loaded=$(grep -o "file=[^ ]*libopenable_oiio\.so" "$tmp/out/tiff.log" | head -n 1 | cut -d= -f2)
 [ "$loaded" = "$prefix/$libdir/openable/libopenable_oiio.so" ] ||
   fail "installed Test_OpenABLE loaded the OpenImageIO module from '$loaded', expected $prefix/$libdir/openable"
-# The installed Python module (when the build made one) imports from the prefix and reads a
-# TIFF through the prefix's OpenImageIO module, found two folders above its own file.
-python_dir=$(find "$prefix" -name 'openable.cpython-*.so' -printf '%h\n' 2> /dev/null | head -n 1)
+# The installed Python package (when the build made one) imports from the prefix and reads a
+# TIFF through the prefix's OpenImageIO module, found three folders above the extension
+# (<prefix>/lib/python3.X/dist-packages/openable/_openable.cpython-*.so).
+python_dir=$(find "$prefix" -name '_openable.cpython-*.so' -printf '%h\n' 2> /dev/null | head -n 1)
+if grep -q "^OPENABLE_BUILD_PYTHON:BOOL=ON" "$build/CMakeCache.txt" && [ -z "$python_dir" ]; then
+  fail "the build made the Python package but cmake --install did not install its extension"
+fi
 if [ -n "$python_dir" ]; then
+  python_dir=$(dirname "$python_dir")
   tiff=$(ls "$tmp/tiff"/* | head -n 1)
   (cd "$tmp" && LD_DEBUG=files PYTHONPATH="$python_dir" /usr/bin/python3 -c \
      "import openable, sys; a = openable.read_image(sys.argv[1]); assert a.ndim >= 2; print(openable.__file__)" \

@@ -7,7 +7,9 @@ import numpy as np
 
 import openable
 import openable.snaps
-from support import SOURCE_DIR, TempDirTestCase, run
+from support import DATASETS_DIR, SOURCE_DIR, TempDirTestCase, require, run
+
+GARDENS_POINT = DATASETS_DIR / "gardens_point"
 
 
 def public(obj):
@@ -112,3 +114,77 @@ def run_expect_failure(name, args, cwd):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class NotebookHabitsTest(TempDirTestCase):
+    """What a notebook user expects: pathlib paths, RGB images on request, readable results."""
+
+    def setUp(self):
+        from pathlib import Path
+        self.folder = Path(SOURCE_DIR) / "examples" / "data" / "nordland_sample" / "summer"
+        self.paths = sorted(p for p in self.folder.iterdir() if p.suffix == ".png")
+
+    def colour_frames(self):
+        """Real colour frames (the Nordland sample is grey in three equal channels)."""
+        folder = GARDENS_POINT / "day_left"
+        require(folder)
+        return [folder / ("Image%03d.jpg" % i) for i in range(4)]
+
+    def test_pathlib_paths(self):
+        listed = openable.list_images(self.folder)
+        self.assertEqual(listed, [str(p) for p in self.paths])  # names of equal width: sorted
+        np.testing.assert_array_equal(openable.read_image(self.paths[0]),
+                                      openable.read_image(str(self.paths[0])))
+
+    def test_rgb_order_on_request(self):
+        paths = self.colour_frames()
+        bgr = openable.read_image(paths[0])
+        rgb = openable.read_image(paths[0], color_order="rgb")
+        self.assertEqual(bgr.shape[2], 3)
+        self.assertFalse(np.array_equal(bgr, rgb))  # a real colour frame: channels differ
+        np.testing.assert_array_equal(rgb, bgr[..., ::-1])
+        rgb_before = rgb.copy()
+        # The same grey image and descriptor rows whichever order the image is given in.
+        np.testing.assert_array_equal(openable.to_gray8(rgb, color_order="rgb"),
+                                      openable.to_gray8(bgr))
+        # Luma by hand (OpenCV's weights on R, G, B) from the RGB array.
+        luma = 0.299 * rgb[..., 0] + 0.587 * rgb[..., 1] + 0.114 * rgb[..., 2]
+        self.assertLessEqual(np.abs(openable.to_gray8(rgb, color_order="rgb").astype(float) -
+                                    luma * 255).max(), 1.0)
+        np.testing.assert_array_equal(openable.describe(rgb, color_order="rgb"),
+                                      openable.describe(bgr))
+        stack = [openable.read_image(p, color_order="rgb") for p in paths]
+        np.testing.assert_array_equal(
+            openable.describe_images(stack, color_order="rgb"),
+            openable.describe_images([openable.read_image(p) for p in paths]))
+        a, b = openable.OnlineDetector(), openable.OnlineDetector()
+        for p in paths[:3]:
+            a.add_frame(openable.read_image(p, color_order="rgb"), color_order="rgb")
+            b.add_frame(openable.read_image(p))
+        np.testing.assert_array_equal(a.descriptors, b.descriptors)
+        np.testing.assert_array_equal(rgb, rgb_before)  # the caller's array is not reordered
+        # Grey images have no order: unchanged.
+        grey = openable.to_gray8(bgr)
+        np.testing.assert_array_equal(openable.describe(grey, color_order="rgb"),
+                                      openable.describe(grey))
+        with self.assertRaises(ValueError) as caught:
+            openable.read_image(paths[0], color_order="hsv")
+        self.assertIn("'hsv'", str(caught.exception))
+        self.assertEqual(len(str(caught.exception).splitlines()), 1)
+
+    def test_results_print_what_they_hold(self):
+        rng = np.random.default_rng(3)
+        m = rng.random((30, 30)).astype(np.float32)
+        result = openable.evaluate(m, aligned=True, reference_frames=15, tolerance=1)
+        text = repr(result)
+        self.assertTrue(text.startswith("<openable.EvaluationResult"), text)
+        self.assertIn("AUC %.4f" % result.auc, text)
+        self.assertIn("<openable.Curve", repr(result.curve))
+        detector = openable.OnlineDetector(sequence_length=2)
+        self.assertIn("L=2, 0 frames", repr(detector))
+        self.assertIn("'sequence_length': 2", repr(detector.options))
+        poses = np.tile(np.eye(4), (3, 1, 1))
+        self.assertIn("3 poses", repr(openable.snaps.Trajectory(poses)))
+        for obj in (result, result.curve, detector, detector.options,
+                    openable.snaps.Trajectory(poses)):
+            self.assertNotIn(" object at 0x", repr(obj))
