@@ -310,6 +310,14 @@ OptionTable ConfigTable(Config& c) {
   t.Add("Evaluation_label", kEvaluation, c.evaluation, c.evaluation.label,
         "Name of this run in the figure's legend and the JSON; empty: descriptor and L, e.g. "
         "\"LDB L=10\".");
+  t.Add("Report_name", kEvaluation, c.evaluation, c.evaluation.report_name,
+        "A self-contained HTML page of the evaluation (images embedded, opens offline in any "
+        "browser): the settings, the figures, the precision-recall figure, the matrix with the "
+        "ground truth, and the frames of the most confident wrong matches and of the misses "
+        "side by side (docs/output_formats.md). Needs Ground_truth_type. Empty: no report.");
+  t.Add("Report_examples", kEvaluation, c.evaluation, c.evaluation.report_examples, 0, 100,
+        "How many most confident wrong matches, and how many misses, the report shows with "
+        "their frames (0: none).");
   // Verification
   t.Add("Verification", kVerification, c.verification, c.verification.enabled,
         "1: check each query's Verification_candidates best candidates geometrically (local "

@@ -3,7 +3,9 @@
 # preset (config/presets/across_conditions.txt) on the bundled Nordland sample: 300 winter
 # frames matched against 300 summer frames, evaluated against their frame alignment. Outputs go
 # to ./results: the matrix (results/nordland_sample.{npy,png}), the precision-recall figure and
-# the ground truth drawn over the matrix (results/nordland_sample_eval_pr.png, _overlay.png).
+# the ground truth drawn over the matrix (results/nordland_sample_eval_pr.png, _overlay.png), and
+# all of it as one HTML page with the frames of the worst cases
+# (results/nordland_sample_report.html).
 # Extra arguments are passed to Test_OpenABLE (e.g. --set Image_sequences=20).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,4 +17,5 @@ bash examples/setup.sh
   --set Npy_name=results/nordland_sample.npy \
   --set Png_name=results/nordland_sample.png \
   --set Evaluation_name=results/nordland_sample_eval \
+  --set Report_name=results/nordland_sample_report.html \
   "$@"

@@ -9,6 +9,8 @@
 
 #include "OpenABLE/OpenABLE.h"
 #include "OpenABLE/run/cluster.h"
+#include "OpenABLE/run/html_report.h"
+#include "OpenABLE/run/pipeline.h"
 
 namespace {
 
@@ -20,8 +22,61 @@ const std::pair<const char*, const char*> kFlagKeys[] = {
     {"--min-gap", "Ground_truth_min_gap"},  {"--axes", "Ground_truth_axes"},
     {"--tolerance", "Tolerance"},           {"--exclusion", "Exclusion"},
     {"--vicinity", "Vicinity"},             {"--first-frame", "Initial_image"},
-    {"--output", "Evaluation_name"},
+    {"--output", "Evaluation_name"},        {"--report", "Report_name"},
+    {"--images", "Images_path"},            {"--images-2", "Images_path_2"},
+    {"--video", "Video_path_1"},
 };
+
+// The HTML report of the evaluation (Report_name), with the frames of the worst cases when the
+// command line says where the frames are (Images_path, Images_path_2, Video_path_1).
+std::string EncodeReport(const openable::Config& config, const openable::Evaluation& evaluation,
+                         const std::vector<const cv::Mat1f*>& matrices,
+                         const std::vector<openable::MatrixFile>& files) {
+  openable::ReportInput report;
+  report.program = "openable_evaluate";
+  std::string labels;
+  for (const auto& run : evaluation.runs) labels += (labels.empty() ? "" : " vs ") + run.label;
+  report.title = "OpenABLE report: " + labels;
+  report.settings = openable::ChangedSettings(config);
+  report.evaluation = &evaluation;
+  report.matrices = matrices;
+  report.examples = config.evaluation.report_examples;
+  const openable::InputOptions& input = config.input;
+  const bool video = input.frame_mode != openable::FrameMode::kImageFolders;
+  if (report.examples == 0) {
+    report.frames.missing = "Report_examples is 0";
+  } else if (video ? input.video_path_1.empty() : input.images_path.empty()) {
+    report.frames.missing =
+        "openable_evaluate was not told where the frames are (--images DIR, and --images-2 DIR "
+        "for a second traversal, or --video FILE with --set Frame_mode=1)";
+  } else {
+    std::vector<std::unique_ptr<openable::FrameSource>> sources =
+        openable::OpenFramesToShow(input);
+    const std::string key = video ? "Video_path_1 (--video)" : "Images_path (--images)";
+    int total = 0;
+    for (const auto& s : sources) total += s->Size();
+    bool non_square = false;
+    for (std::size_t i = 0; i < matrices.size(); ++i) {
+      const cv::Mat1f& m = *matrices[i];
+      non_square = m.rows != m.cols;
+      const bool fits = non_square ? sources.size() == 2 && m.rows == sources[1]->Size() &&
+                                         m.cols == sources[0]->Size()
+                                   : m.rows == total;
+      if (!fits)
+        throw openable::InputError(
+            key + ": " + std::to_string(total) + " frames" +
+            (sources.size() == 2 ? " (" + std::to_string(sources[0]->Size()) + " + " +
+                                       std::to_string(sources[1]->Size()) + ")"
+                                 : std::string()) +
+            ", but the matrix " + openable::Quoted(files[i].path) + " is " +
+            std::to_string(m.rows) + " x " + std::to_string(m.cols) +
+            "; expected the frames the matrix was computed from (a queries x references "
+            "matrix needs --images for the references and --images-2 for the queries)");
+    }
+    report.frames = openable::FramesFromSources(std::move(sources), non_square);
+  }
+  return openable::EncodeHtmlReport(report);
+}
 
 const char* kUsage =
     "Usage: openable_evaluate --matrix M.npy [--label NAME] [--matrix M2.npy --label NAME2 ...]\n"
@@ -59,6 +114,14 @@ const char* kUsage =
     "  --vicinity N            ABLE-P temporal vicinity (7) [Vicinity]\n"
     "  --first-frame N         frame number of row 0 in pairs and pose files [Initial_image]\n"
     "  --output PREFIX         write the files [Evaluation_name]\n"
+    "  --report FILE.html      one self-contained HTML page: settings, figures, PR figure, the\n"
+    "                          matrix with the ground truth, and the worst cases [Report_name];\n"
+    "                          their frames are shown when given by --images (and --images-2)\n"
+    "                          or --video, else only named [Report_examples: how many]\n"
+    "  --images DIR            the frames of the matrix (reference, or only, traversal)\n"
+    "                          [Images_path]\n"
+    "  --images-2 DIR          the frames of the query traversal [Images_path_2]\n"
+    "  --video FILE            the frames as one video [Video_path_1; with Frame_mode 1]\n"
     "  --config FILE           take the keys above from a Config.txt first\n"
     "  --set Key=Value         any evaluation key of Config.txt\n"
     "  --quiet                 print only errors and the list of files written\n"
@@ -154,11 +217,17 @@ int main(int argc, char** argv) {
         openable::EvaluateMatrixFiles(evaluation, matrices, reference_frames);
     if (!quiet && !json)
       std::cout << openable::FormatEvaluationTable(evaluation.settings, evaluation.runs);
-    const std::vector<std::string> paths =
-        config.evaluation.name.empty()
-            ? std::vector<std::string>{}
-            : openable::WriteEvaluation("Evaluation_name", config.evaluation.name, evaluation,
-                                        loaded);
+    openable::OutputBatch batch;
+    std::vector<const cv::Mat1f*> pointers;
+    for (const auto& m : loaded) pointers.push_back(&m);
+    if (!config.evaluation.name.empty())
+      openable::StageEvaluation(batch, "Evaluation_name", config.evaluation.name, evaluation,
+                                pointers);
+    if (!config.evaluation.report_name.empty())
+      batch.Stage("Report_name", config.evaluation.report_name,
+                  EncodeReport(config, evaluation, pointers, matrices));
+    const std::vector<std::string> paths = batch.Paths();
+    batch.Commit();
     if (json) {
       std::cout << openable::ProgramJson(
           "openable_evaluate",

@@ -3,7 +3,8 @@
 # builds it in ./build. Used by examples/demo.sh and tests/run_all.sh. clang and
 # libclang-rt-14-dev (libFuzzer) are only for the fuzzers of tests/fuzz/ (docs/robustness.md);
 # python3-dev and pybind11-dev for the Python module, python3-pip, -setuptools, -wheel and
-# -venv for pip install . (docs/python.md); Open MPI for runs over several processes
+# -venv for pip install . (docs/python.md); chromium to open the HTML report in the tests
+# (docs/output_formats.md); Open MPI for runs over several processes
 # (docs/distributed.md) and FAISS for approximate search (docs/matching.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,7 +13,7 @@ packages=(cmake g++ make pkg-config libopencv-dev libopencv-contrib-dev libeigen
           libpng-dev zlib1g-dev libjpeg-dev
           libopenimageio-dev openimageio-tools libgtest-dev libgmock-dev libbenchmark-dev
           python3-numpy python3-dev pybind11-dev python3-pip python3-setuptools python3-wheel
-          python3-venv clang libclang-rt-14-dev
+          python3-venv chromium clang libclang-rt-14-dev
           libopenmpi-dev openmpi-bin libfaiss-dev)
 missing=()
 for p in "${packages[@]}"; do

@@ -86,36 +86,22 @@ void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
                                                     : std::vector<cv::Point>());
 }
 
-void StageEvaluation(OutputBatch& batch, const std::string& key, const std::string& prefix,
-                     const Evaluation& evaluation, const std::vector<const cv::Mat1f*>& matrices) {
-  if (matrices.size() != evaluation.runs.size())
-    throw std::logic_error("StageEvaluation: one matrix per run expected");
-  const EvaluationSettings& s = evaluation.settings;
-  static_assert(std::size(kEvaluationSetSuffixes) == 2 && std::size(kEvaluationRunSuffixes) == 3,
-                "one suffix per file staged below");
-  batch.Stage(key, prefix + kEvaluationSetSuffixes[0],
-              EncodeEvaluationJson(s, evaluation.runs, kVersion));
+double OperatingThreshold(const EvaluatedRun& run) {
+  return run.per_query.has_operating_point ? run.per_query.operating_point.threshold
+                                           : run.per_query.max_f1_threshold;
+}
 
+cv::Mat3b RenderRunOverlay(const Evaluation& evaluation, std::size_t i, const cv::Mat1f& matrix) {
+  const EvaluatedRun& run = evaluation.runs.at(i);
+  return RenderOverlay(matrix, run.layout, evaluation.truths.at(i), run.per_query,
+                       OperatingThreshold(run),
+                       run.verified ? &evaluation.rejected.at(i) : nullptr);
+}
+
+cv::Mat3b RenderEvaluationPr(const Evaluation& evaluation) {
+  const EvaluationSettings& s = evaluation.settings;
   std::vector<PrSeries> series;
-  std::set<std::string> used;
-  for (std::size_t i = 0; i < evaluation.runs.size(); ++i) {
-    const EvaluatedRun& run = evaluation.runs[i];
-    std::string stem = prefix;
-    if (evaluation.runs.size() > 1) {
-      std::string part = FileSafe(run.label);
-      if (!used.insert(part).second) part += "_" + std::to_string(i + 1);
-      used.insert(part);
-      stem += "_" + part;
-    }
-    batch.Stage(key, stem + kEvaluationRunSuffixes[0], EncodeCurveCsv(run.per_query.curve));
-    batch.Stage(key, stem + kEvaluationRunSuffixes[1], EncodeCurveCsv(run.able_p.curve));
-    batch.Stage(key, stem + kEvaluationRunSuffixes[2],
-                EncodePng(RenderOverlay(*matrices[i], run.layout, evaluation.truths[i],
-                                        run.per_query,
-                                        run.per_query.has_operating_point
-                                            ? run.per_query.operating_point.threshold
-                                            : run.per_query.max_f1_threshold,
-                                        run.verified ? &evaluation.rejected[i] : nullptr)));
+  for (const EvaluatedRun& run : evaluation.runs) {
     // With verification: the matrix's answers (and its ABLE-P cells), then the verified ones.
     if (run.verified) {
       series.push_back({run.label + " unverified", run.per_query_unverified.curve,
@@ -130,8 +116,34 @@ void StageEvaluation(OutputBatch& batch, const std::string& key, const std::stri
   if (!evaluation.runs.empty() &&
       evaluation.runs[0].layout.kind == EvaluationLayout::Kind::kLoopClosure)
     title += ", exclusion " + std::to_string(s.options.exclusion);
-  batch.Stage(key, prefix + kEvaluationSetSuffixes[1],
-              EncodePng(RenderPrPlot(series, title, s.options.vicinity)));
+  return RenderPrPlot(series, title, s.options.vicinity);
+}
+
+void StageEvaluation(OutputBatch& batch, const std::string& key, const std::string& prefix,
+                     const Evaluation& evaluation, const std::vector<const cv::Mat1f*>& matrices) {
+  if (matrices.size() != evaluation.runs.size())
+    throw std::logic_error("StageEvaluation: one matrix per run expected");
+  const EvaluationSettings& s = evaluation.settings;
+  static_assert(std::size(kEvaluationSetSuffixes) == 2 && std::size(kEvaluationRunSuffixes) == 3,
+                "one suffix per file staged below");
+  batch.Stage(key, prefix + kEvaluationSetSuffixes[0],
+              EncodeEvaluationJson(s, evaluation.runs, kVersion));
+  std::set<std::string> used;
+  for (std::size_t i = 0; i < evaluation.runs.size(); ++i) {
+    const EvaluatedRun& run = evaluation.runs[i];
+    std::string stem = prefix;
+    if (evaluation.runs.size() > 1) {
+      std::string part = FileSafe(run.label);
+      if (!used.insert(part).second) part += "_" + std::to_string(i + 1);
+      used.insert(part);
+      stem += "_" + part;
+    }
+    batch.Stage(key, stem + kEvaluationRunSuffixes[0], EncodeCurveCsv(run.per_query.curve));
+    batch.Stage(key, stem + kEvaluationRunSuffixes[1], EncodeCurveCsv(run.able_p.curve));
+    batch.Stage(key, stem + kEvaluationRunSuffixes[2],
+                EncodePng(RenderRunOverlay(evaluation, i, *matrices[i])));
+  }
+  batch.Stage(key, prefix + kEvaluationSetSuffixes[1], EncodePng(RenderEvaluationPr(evaluation)));
 }
 
 cv::Mat1f DistancesForEvaluation(const cv::Mat1f& matrix, const std::string& what) {

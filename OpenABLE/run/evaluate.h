@@ -59,6 +59,15 @@ inline constexpr const char* kEvaluationSetSuffixes[] = {".json", "_pr.png"};
 inline constexpr const char* kEvaluationRunSuffixes[] = {"_per_query.csv", "_ablep.csv",
                                                          "_overlay.png"};
 
+// The figures of the evaluation's files, also shown by the HTML report (html_report.h): the
+// precision-recall figure of every run (<prefix>_pr.png), and run `i`'s ground truth and
+// answers over its matrix (<prefix>_overlay.png), answers marked at the run's operating point
+// (Match_threshold, else the max-F1 threshold).
+cv::Mat3b RenderEvaluationPr(const Evaluation& evaluation);
+cv::Mat3b RenderRunOverlay(const Evaluation& evaluation, std::size_t i, const cv::Mat1f& matrix);
+// The run's operating point: Match_threshold when set, else the max-F1 threshold.
+double OperatingThreshold(const EvaluatedRun& run);
+
 // Stages the evaluation's files under `prefix` into `batch` (key = the config key to name in
 // errors): <prefix>.json, <prefix>_pr.png, and per run <prefix>[_<label>]_per_query.csv,
 // <prefix>[_<label>]_ablep.csv and <prefix>[_<label>]_overlay.png (the label part only when

@@ -16,6 +16,7 @@
 #include "OpenABLE/run/descriptor_cache.h"
 #include "OpenABLE/run/distributed.h"
 #include "OpenABLE/run/evaluate.h"
+#include "OpenABLE/run/html_report.h"
 #include "OpenABLE/run/exports.h"
 #include "OpenABLE/run/verify.h"
 #include "OpenABLE/io/frame_source.h"
@@ -61,6 +62,28 @@ std::vector<SourceSpec> Sources(const InputOptions& c) {
   return {{"Video_path_1", c.video_path_1, SourceKind::kVideo},
           {"Video_path_2", c.video_path_2, SourceKind::kVideo}};
 }
+
+}  // namespace
+
+std::vector<std::unique_ptr<FrameSource>> OpenFramesToShow(const InputOptions& input) {
+  std::vector<std::unique_ptr<FrameSource>> sources;
+  for (const SourceSpec& spec : Sources(input)) {
+    sources.push_back(WithKey(spec.key, [&] {
+      switch (spec.kind) {
+        case SourceKind::kVideo:
+          return OpenVideo(spec.path, input.initial_image, input.final_image);
+        case SourceKind::kStereo:  // the left images, as they are stored
+        case SourceKind::kFolder:
+          break;
+      }
+      return OpenImageFolder(spec.path, input.images_format, input.initial_image,
+                             input.final_image);
+    }));
+  }
+  return sources;
+}
+
+namespace {
 
 double PhysicalMemoryBytes() {
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
@@ -719,6 +742,8 @@ std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& co
     for (const char* suffix : kEvaluationRunSuffixes)
       out.emplace_back("Evaluation_name", prefix + suffix);
   }
+  if (EvaluationRequested(config) && !config.evaluation.report_name.empty())
+    out.emplace_back("Report_name", config.evaluation.report_name);
   return out;
 }
 
@@ -796,6 +821,19 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
   if (evaluation != nullptr && !config.evaluation.name.empty())
     StageEvaluation(batch, "Evaluation_name", config.evaluation.name, *evaluation,
                     {&result.normalized});
+  if (evaluation != nullptr && !config.evaluation.report_name.empty()) {
+    ReportInput report;
+    report.program = "Test_OpenABLE";
+    report.title = "OpenABLE report: " + RunLabel(config);
+    report.settings = ChangedSettings(config);
+    report.all_settings = FormatConfig(config);
+    report.evaluation = evaluation;
+    report.matrices = {&result.normalized};
+    report.examples = config.evaluation.report_examples;
+    if (report.examples > 0)
+      report.frames = FramesFromSources(OpenFramesToShow(config.input), false);
+    batch.Stage("Report_name", config.evaluation.report_name, EncodeHtmlReport(report));
+  }
   const std::vector<std::string> paths = batch.Paths();
   batch.Commit();
   const double seconds = SecondsSince(t);

@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/evaluation/layout.h"
+#include "OpenABLE/io/frame_source.h"
 #include "matching/bounded.h"
 #include "matching/distances.h"
 #include "OpenABLE/run/progress.h"
@@ -139,5 +140,10 @@ std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& co
 // The thresholded image's path: Png_threshold_name, or Png_name with "_thresholded" before
 // its extension; empty when no threshold or no PNG is asked for.
 std::string ThresholdPngPath(const Config& config);
+
+// The frames of a run as images to look at (the left image of stereo pairs, as stored), one
+// source per traversal in the order of the matrix: the reference (or only) traversal, then the
+// second. For the HTML report's worst cases. Throws InputError naming the key, as a run does.
+std::vector<std::unique_ptr<FrameSource>> OpenFramesToShow(const InputOptions& input);
 
 }  // namespace openable

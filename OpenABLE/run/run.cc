@@ -56,8 +56,10 @@ RunOutcome Run(const Config& config, ProgressReporter& progress,
     result.timings.total_seconds += out.verification->seconds;
   }
   if (out.evaluation && result.bounded) {
-    log("note: Ground_truth_type: no evaluation in bounded mode (the protocols need the dense "
-        "matrix); evaluate Matches_name yourself or use Matrix_mode 1");
+    log(std::string("note: Ground_truth_type: no evaluation in bounded mode (the protocols "
+                    "need the dense matrix)") +
+        (config.evaluation.report_name.empty() ? "" : ", and so no Report_name") +
+        "; evaluate Matches_name yourself or use Matrix_mode 1");
     out.evaluation.reset();
   }
   if (out.evaluation) {
