@@ -36,7 +36,8 @@ OptionTable ConfigTable(Config& c) {
   t.AddEnumNumber("Frame_mode", kDatasets, c.input, c.input.frame_mode,
         "Input: 0 image folder(s) (Images_path, optionally Images_path_2), 1 one video "
         "(Video_path_1), 2 two videos matched as one concatenated sequence (Video_path_1, "
-        "Video_path_2).", false);
+        "Video_path_2), 3 a ROS 1 bag (Bag_path, Bag_topic; optionally Bag_topic_2 for a "
+        "second traversal).", false);
   t.Add("Images_path", kDatasets, c.input, c.input.images_path,
         "Folder of the image sequence (Frame_mode 0). Any file names: frames are taken in natural"
         " order (img2 before img10). PNG, JPEG, TIFF, PGM/PPM, BMP; 8 or 16 bit; grey or colour. "
@@ -62,6 +63,22 @@ OptionTable ConfigTable(Config& c) {
         "Video file read with OpenCV (Frame_mode 1 and 2).", false);
   t.Add("Video_path_2", kDatasets, c.input, c.input.video_path_2,
         "Second video file (Frame_mode 2), concatenated after Video_path_1.", false);
+  t.Add("Bag_path", kDatasets, c.input, c.input.bag_path,
+        "ROS 1 bag of Frame_mode 3 (rosbag record; EuRoC, TUM-VI, ...), read with Debian's "
+        "rosbag_storage. Frames keep their message header stamps (Ground_truth_type tum and "
+        "SNAPS associate by time; Timestamps_name writes them).");
+  t.Add("Bag_topic", kDatasets, c.input, c.input.bag_topic,
+        "Image topic of Bag_path (sensor_msgs/Image: mono8, mono16, bgr8, rgb8, bgra8, rgba8, "
+        "8UC1/3/4, 16UC1; or sensor_msgs/CompressedImage, JPEG or PNG), e.g. /cam0/image_raw; "
+        "the left camera's with Camera_type 1.");
+  t.Add("Bag_topic_right", kDatasets, c.input, c.input.bag_topic_right,
+        "Camera_type 1 with Frame_mode 3: the right camera's image topic; messages are paired "
+        "with the left topic's by position, as stereo folders are.");
+  t.Add("Bag_path_2", kDatasets, c.input, c.input.bag_path_2,
+        "Bag of a second traversal (Frame_mode 3, with Bag_topic_2); empty: Bag_path.");
+  t.Add("Bag_topic_2", kDatasets, c.input, c.input.bag_topic_2,
+        "Image topic of a second traversal (Frame_mode 3), in Bag_path_2 or else Bag_path: "
+        "matched against Bag_topic as Images_path_2 against Images_path. Empty: one traversal.");
   t.Add("Initial_image", kDatasets, c.input, c.input.initial_image, 0, kNoLimit,
         "First frame to process: a 0-based position in the natural order of the folder's images "
         "(or the video's frames). Applies to every folder or video of the run.", false);
@@ -79,6 +96,11 @@ OptionTable ConfigTable(Config& c) {
   t.Add("Npy_name", kRepresentation, c.output, c.output.npy_name,
         "Output: the normalised matrix M' (before any threshold) as a float32 NumPy .npy file "
         "(numpy.load reads it). Empty: not written.");
+  t.Add("Timestamps_name", kRepresentation, c.output, c.output.timestamps_name,
+        "Output: the time of every frame of the matrix (ROS bags, Frame_mode 3: message header "
+        "stamps), one line \"<row> <seconds>\" per row, for tools that associate frames by time "
+        "(Snaps_frame_times, TUM trajectories). Empty: not written; refused for frames without "
+        "times.");
   t.Add("Png_name", kRepresentation, c.output, c.output.png_name,
         "Output: the normalised matrix M' as a colour image, one pixel per pair of frames, "
         "coloured with Matrix_color. Empty: not written.", false);
@@ -290,6 +312,11 @@ OptionTable ConfigTable(Config& c) {
   t.Add("Ground_truth_min_gap", kEvaluation, c.evaluation, c.evaluation.min_frame_gap, -1, kNoLimit,
         "Poses, one sequence: only frames at least this many frames apart are loops; -1: "
         "Exclusion.");
+  t.Add("Ground_truth_time_tolerance", kEvaluation, c.evaluation,
+        c.evaluation.truth.time_tolerance, 0, kNoLimit,
+        "tum with frames that carry times (Frame_mode 3, ROS bags): each frame takes the pose "
+        "of the file with the nearest timestamp, which must be within this many seconds (else "
+        "the frame is named in an error). Frames without times take pose line i as frame i.");
   t.Add("Ground_truth_axes", kEvaluation, c.evaluation, c.evaluation.truth.axes,
         "Poses: axes of the distance and heading: xyz (3D), xz (the ground plane of KITTI's "
         "camera frame, y down) or xy.");
@@ -404,6 +431,11 @@ OptionTable ConfigTable(Config& c) {
         " below Snaps_matrix_threshold).");
   t.Add("Snaps_loops_file", kSnaps, c.snaps, c.snaps.loops_file,
         "Pairs file (Snaps_loops pairs) or saved matrix (Snaps_loops matrix).");
+  t.Add("Snaps_frame_times", kSnaps, c.snaps, c.snaps.frame_times,
+        "Snaps_loops matrix: the time of each matrix row, as Timestamps_name wrote it for a run "
+        "of a ROS bag; with a TUM trajectory, each row takes the pose nearest in time (within "
+        "Snaps_time_tolerance) instead of pose i for frame i. Snaps_loops openable on a bag "
+        "(Frame_mode 3) does the same by itself. Empty: by frame number.");
   t.Add("Snaps_keyframe_tolerance", kSnaps, c.snaps, c.snaps.keyframe_tolerance, 0, kNoLimit,
         "Snaps_loops pairs and matrix: a frame that is not a pose of the trajectory (keyframes) "
         "takes the nearest pose within this many frames; 0 keeps only frames that are poses.");
@@ -561,6 +593,11 @@ void CheckConfig(const Config& c) {
     throw InputError("Illumination_invariance: 1 with Camera_type 1 (stereo); expected 0: the "
                      "stereo pipeline describes grey rectified images, and Eq. 6 needs colour");
   c.output.Check();
+  if (!c.output.timestamps_name.empty() && c.input.frame_mode != FrameMode::kBag)
+    throw InputError("Timestamps_name: " + Quoted(c.output.timestamps_name) + " with Frame_mode " +
+                     std::to_string(static_cast<int>(c.input.frame_mode)) +
+                     "; expected Frame_mode 3 (ROS bags: the only frames that carry times), or "
+                     "Timestamps_name empty");
   c.matching.Check();
   c.scale.Check();
   CheckEvaluationConfig(c);

@@ -20,16 +20,27 @@ void InputOptions::Check() const {
   CheckIntAtLeast("Final_image", final_image, -1);
   const int mode = static_cast<int>(frame_mode);
   if (camera_type == CameraType::kStereo) {
-    if (frame_mode != FrameMode::kImageFolders)
+    if (frame_mode != FrameMode::kImageFolders && frame_mode != FrameMode::kBag)
       throw InputError("Frame_mode: " + std::to_string(mode) +
-                       " with Camera_type 1 (stereo); expected 0: stereo reads the image "
-                       "folders Images_path_left and Images_path_right, not videos");
+                       " with Camera_type 1 (stereo); expected 0 (the image folders "
+                       "Images_path_left and Images_path_right) or 3 (the topics Bag_topic and "
+                       "Bag_topic_right of a bag), not videos");
     if (!images_path_2.empty())
       throw InputError("Images_path_2: " + Quoted(images_path_2) +
                        " with Camera_type 1 (stereo); expected empty: a second stereo "
                        "traversal is not supported");
-    NeedPath(images_path_left, "Images_path_left", "Camera_type 1 reads a left image folder");
-    NeedPath(images_path_right, "Images_path_right", "Camera_type 1 reads a right image folder");
+    if (frame_mode == FrameMode::kBag) {
+      if (!bag_topic_2.empty())
+        throw InputError("Bag_topic_2: " + Quoted(bag_topic_2) +
+                         " with Camera_type 1 (stereo); expected empty: a second stereo "
+                         "traversal is not supported");
+      NeedPath(bag_topic_right, "Bag_topic_right",
+               "Camera_type 1 with Frame_mode 3 reads the right camera's image topic");
+    } else {
+      NeedPath(images_path_left, "Images_path_left", "Camera_type 1 reads a left image folder");
+      NeedPath(images_path_right, "Images_path_right",
+               "Camera_type 1 reads a right image folder");
+    }
     NeedPath(calibration_path, "Calibration_path", "Camera_type 1 needs a stereo calibration");
   }
   switch (frame_mode) {
@@ -43,6 +54,15 @@ void InputOptions::Check() const {
     case FrameMode::kTwoVideos:
       NeedPath(video_path_1, "Video_path_1", "Frame_mode 2 reads two videos");
       NeedPath(video_path_2, "Video_path_2", "Frame_mode 2 reads two videos");
+      break;
+    case FrameMode::kBag:
+      NeedPath(bag_path, "Bag_path", "Frame_mode 3 reads a ROS 1 bag");
+      if (bag_topic.empty())
+        throw InputError("Bag_topic: empty; expected the image topic to read from bag " +
+                         Quoted(bag_path) + " (e.g. /cam0/image_raw)");
+      if (!bag_path_2.empty() && bag_topic_2.empty())
+        throw InputError("Bag_topic_2: empty, but Bag_path_2 is " + Quoted(bag_path_2) +
+                         "; expected the image topic of the second traversal");
       break;
   }
   if (final_image != -1 && final_image <= initial_image)

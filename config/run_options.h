@@ -15,8 +15,8 @@
 namespace openable {
 
 // Frame_mode: image folders (Images_path, optionally Images_path_2), one video, two videos.
-enum class FrameMode { kImageFolders = 0, kVideo = 1, kTwoVideos = 2 };
-OPENABLE_ENUM_NAMES(FrameMode, "image folders", "video", "two videos")
+enum class FrameMode { kImageFolders = 0, kVideo = 1, kTwoVideos = 2, kBag = 3 };
+OPENABLE_ENUM_NAMES(FrameMode, "image folders", "video", "two videos", "ROS bag")
 
 // Camera_type: monocular (ABLE-M), stereo (ABLE-S), panoramic (ABLE-P).
 enum class CameraType { kMonocular = 0, kStereo = 1, kPanoramic = 2 };
@@ -37,6 +37,11 @@ struct InputOptions {
   std::string images_format;      // extension of the images taken; empty: every image type
   std::string video_path_1;       // video of Frame_mode 1 and 2
   std::string video_path_2;       // second video of Frame_mode 2
+  std::string bag_path;           // ROS 1 bag of Frame_mode 3
+  std::string bag_topic;          // its image topic (the left camera's with Camera_type 1)
+  std::string bag_topic_right;    // stereo: the right camera's image topic
+  std::string bag_path_2;         // bag of a second traversal; empty: Bag_path
+  std::string bag_topic_2;        // image topic of a second traversal; empty: one traversal
   int initial_image = 0;          // first position (natural order) processed, >= 0
   int final_image = -1;           // one past the last position; -1: to the end
   bool skip_unreadable = false;   // skip unreadable frames with a warning instead of stopping
@@ -54,6 +59,7 @@ struct OutputOptions {
   std::string png_name;            // M' as a colour image; empty: not written
   std::string png_threshold_name;  // M'' as an image; empty: Png_name + "_thresholded"
   std::string loops_name;          // verification: every candidate checked, CSV; empty: none
+  std::string timestamps_name;     // the time of every frame (ROS bags), text; empty: none
   int matrix_color = 0;            // colour map, 0..11 (docs/output_formats.md)
   bool show_images = false;        // show each frame while it is described
 

@@ -4,7 +4,8 @@
 # libclang-rt-14-dev (libFuzzer) are only for the fuzzers of tests/fuzz/ (docs/robustness.md);
 # python3-dev and pybind11-dev for the Python module, python3-pip, -setuptools, -wheel and
 # -venv for pip install . (docs/python.md); chromium to open the HTML report in the tests
-# (docs/output_formats.md); Open MPI for runs over several processes
+# (docs/output_formats.md); librosbag-dev and libsensor-msgs-dev for ROS 1 bags
+# (docs/cameras.md); Open MPI for runs over several processes
 # (docs/distributed.md) and FAISS for approximate search (docs/matching.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,7 +15,7 @@ packages=(cmake g++ make pkg-config libopencv-dev libopencv-contrib-dev libeigen
           libopenimageio-dev openimageio-tools libgtest-dev libgmock-dev libbenchmark-dev
           python3-numpy python3-dev pybind11-dev python3-pip python3-setuptools python3-wheel
           python3-venv chromium clang libclang-rt-14-dev
-          libopenmpi-dev openmpi-bin libfaiss-dev)
+          libopenmpi-dev openmpi-bin libfaiss-dev librosbag-dev libsensor-msgs-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

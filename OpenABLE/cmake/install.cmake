@@ -2,7 +2,7 @@
 #
 #   include/openable/{OpenABLE,descriptors,matching,config}/...h   every header, paths kept
 #   lib/libOpenABLE.a, lib/libopenable_*.a                          the static libraries
-#   lib/openable/libopenable_{oiio,video,gui}.so                    the run-time modules
+#   lib/openable/libopenable_{oiio,video,gui,codecs,...}.so          the run-time modules
 #   lib/cmake/OpenABLE/OpenABLE{Config,ConfigVersion,Targets*}.cmake
 #   bin/Test_OpenABLE, bin/openable_evaluate, bin/openable_snaps
 #
@@ -50,6 +50,9 @@ if(TARGET openable_mpi)  # runs over several processes (docs/distributed.md)
 endif()
 if(TARGET openable_faiss)
   install(TARGETS openable_faiss LIBRARY DESTINATION "${OPENABLE_INSTALL_MODULEDIR}")
+endif()
+if(TARGET openable_rosbag)  # ROS 1 bags (Frame_mode 3)
+  install(TARGETS openable_rosbag LIBRARY DESTINATION "${OPENABLE_INSTALL_MODULEDIR}")
 endif()
 
 # The command-line programs of examples/.

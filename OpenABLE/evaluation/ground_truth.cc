@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -128,6 +129,61 @@ std::vector<FramePose> PosesOfRun(const std::string& path, GroundTruthType type,
   return std::vector<FramePose>(poses.begin() + first, poses.begin() + needed);
 }
 
+// The poses of frames that carry times (`times`, one per frame of the traversal): each frame
+// takes the TUM pose with the nearest timestamp, which must be within `tolerance` seconds.
+std::vector<FramePose> PosesByTime(const std::string& path, const std::vector<double>& times,
+                                   double tolerance, const std::string& frames_what) {
+  const std::vector<PoseFileLine> lines =
+      ReadPoseFile(path, PoseFileFormat::kTum, PoseFileLabel(GroundTruthType::kTum));
+  if (lines.empty())
+    throw InputError(std::string(PoseFileLabel(GroundTruthType::kTum)) + " " + Quoted(path) +
+                     ": no pose; expected one per line");
+  std::vector<FramePose> poses;
+  poses.reserve(times.size());
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    // Timestamps increase (ReadPoseFile checks it): the nearest is beside the first >= t.
+    const auto after = std::lower_bound(
+        lines.begin(), lines.end(), times[i],
+        [](const PoseFileLine& line, double t) { return line.timestamp < t; });
+    auto nearest = after == lines.end() ? after - 1 : after;
+    if (after != lines.begin() && after != lines.end() &&
+        times[i] - (after - 1)->timestamp < after->timestamp - times[i])
+      nearest = after - 1;
+    const double gap = std::abs(nearest->timestamp - times[i]);
+    if (!(gap <= tolerance)) {
+      std::string frame = frames_what;  // "frames", "query frames": one of them
+      if (!frame.empty() && frame.back() == 's') frame.pop_back();
+      char text[240];
+      std::snprintf(text, sizeof text,
+                    ": no pose within %g s of %s %zu (time %.6f; the nearest, line %d, is %.6f "
+                    "s away); expected a ground truth that covers the frames, or a larger "
+                    "Ground_truth_time_tolerance",
+                    tolerance, frame.c_str(), i, times[i], nearest->line, gap);
+      throw InputError(std::string(PoseFileLabel(GroundTruthType::kTum)) + " " + Quoted(path) +
+                       text);
+    }
+    FramePose pose;
+    pose.position = nearest->translation;
+    pose.forward = nearest->rotation.col(2);
+    pose.has_forward = true;
+    poses.push_back(pose);
+  }
+  return poses;
+}
+
+// The poses of the frames of one traversal: by time when the frames carry times (tum), else
+// the lines [first, first + count) (PosesOfRun).
+std::vector<FramePose> TraversalPoses(const GroundTruthOptions& o, const std::string& path,
+                                      const std::vector<double>& times, int count,
+                                      const std::string& frames_what) {
+  if (o.type == GroundTruthType::kTum && !times.empty()) {
+    if (static_cast<int>(times.size()) != count)
+      throw std::logic_error("TraversalPoses: one time per frame expected");
+    return PosesByTime(path, times, o.time_tolerance, frames_what);
+  }
+  return PosesOfRun(path, o.type, o.first_frame, count, frames_what);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Loaders; each fills gt->matches (unsorted, maybe with duplicates) and gt->dropped.
 
@@ -221,7 +277,7 @@ void LoadPairs(const GroundTruthOptions& o, const EvaluationLayout& layout, Grou
 void LoadPoses(const GroundTruthOptions& o, const EvaluationLayout& layout, GroundTruth* gt) {
   if (layout.kind == EvaluationLayout::Kind::kLoopClosure) {
     const std::vector<FramePose> poses =
-        PosesOfRun(o.path, o.type, o.first_frame, layout.queries, "frames");
+        TraversalPoses(o, o.path, o.frame_times, layout.queries, "frames");
     gt->matches = PairsFromPoses(poses, {}, o);
     for (std::size_t q = 0; q < gt->matches.size(); ++q) {  // a gap of 0 lets (q, q) in
       auto& m = gt->matches[q];
@@ -239,9 +295,9 @@ void LoadPoses(const GroundTruthOptions& o, const EvaluationLayout& layout, Grou
   }
   if (layout.references == 0) return;  // an empty reference would mean loop closure below
   const std::vector<FramePose> reference =
-      PosesOfRun(o.path, o.type, o.first_frame, layout.references, "reference frames");
+      TraversalPoses(o, o.path, o.frame_times, layout.references, "reference frames");
   const std::vector<FramePose> queries =
-      PosesOfRun(o.path_2, o.type, o.first_frame, layout.queries, "query frames");
+      TraversalPoses(o, o.path_2, o.frame_times_2, layout.queries, "query frames");
   gt->matches = PairsFromPoses(queries, reference, o);
 }
 
@@ -270,6 +326,10 @@ void GroundTruthOptions::Check() const {
                      " is not valid; expected an integer >= 0");
   }
   CheckPoseOptions(*this);
+  if (!(time_tolerance >= 0) || !std::isfinite(time_tolerance)) {
+    throw InputError("Ground_truth_time_tolerance: " + FormatNumber(time_tolerance) +
+                     " is not valid; expected seconds >= 0");
+  }
   if (type == GroundTruthType::kPositions && heading_limit >= 0) {
     throw InputError("Ground_truth_heading: " + FormatNumber(heading_limit) +
                      " needs orientations, but positions have no orientation; expected -1 "

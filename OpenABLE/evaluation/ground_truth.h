@@ -73,6 +73,11 @@ struct GroundTruthOptions {
   int min_frame_gap = 100;  // poses, loop closure: only pairs with q - j >= min_frame_gap
   std::string axes = "xyz";  // poses: axes of the distance and heading: "xyz" (3D), "xz" (the
                              // ground plane of KITTI's camera frame), "xy"
+  // tum with frames that carry times (ROS bags): the time of each frame of the reference (or
+  // only) traversal and of the query traversal, in seconds; a frame takes the pose with the
+  // nearest timestamp, within time_tolerance seconds. Empty: pose line i is frame i.
+  std::vector<double> frame_times, frame_times_2;
+  double time_tolerance = 0.02;
 
   // Throws InputError naming the Config.txt key (Ground_truth_radius, ...) of a bad value.
   void Check() const;

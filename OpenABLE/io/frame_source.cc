@@ -537,4 +537,22 @@ std::unique_ptr<FrameSource> OpenVideo(const std::string& path, int first, int l
   return source;
 }
 
+std::unique_ptr<FrameSource> OpenBag(const std::string& path, const std::string& topic,
+                                     int first, int last, const std::string& key,
+                                     const std::string& topic_key) {
+  if (path.empty())
+    throw InputError(key + ": empty; expected the path of a ROS 1 bag (Frame_mode 3)");
+  if (topic.empty())
+    throw InputError(topic_key + ": empty; expected the image topic of bag " + Quoted(path) +
+                     " to read (e.g. /cam0/image_raw)");
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    throw InputError(key + ": bag " + Quoted(path) + " does not exist" +
+                     WorkingDirectoryNote(path) + " (expected a ROS 1 bag)");
+  std::unique_ptr<FrameSource> source;
+  reinterpret_cast<OpenableRosbagOpen>(ModuleSymbol("rosbag", "openable_rosbag_open"))(
+      path, topic, first, last, key, topic_key, source);
+  return source;
+}
+
 }  // namespace openable

@@ -6,6 +6,7 @@
 // later, in OpenABLE/image/preprocess.h.
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -57,6 +58,11 @@ class FrameSource {
   // True when Read may be called from several threads at once (image folders); false for
   // videos, which must be read in order from one thread.
   virtual bool ParallelReads() const = 0;
+  // The time frame i was taken, in seconds, when the source records it (a ROS bag: the
+  // message's header stamp), else NaN. Thread-safe. (Defined here: FrameSource has no key
+  // function, so the modules deriving from it, which do not link openable_io, get its type
+  // information inline.)
+  virtual double Timestamp(int /*i*/) const { return std::numeric_limits<double>::quiet_NaN(); }
 };
 
 // The images of `folder` (see ListImages), restricted to the positions [first, last) of the
@@ -72,5 +78,22 @@ std::unique_ptr<FrameSource> OpenImageFolder(const std::string& folder,
 // Not thread-safe: ParallelReads() is false. Throws InputError when the file cannot be opened,
 // holds no frame, or the range is outside it.
 std::unique_ptr<FrameSource> OpenVideo(const std::string& path, int first, int last);
+
+// The messages [first, last) of `topic` in the ROS 1 bag `path` (rosbag record: EuRoC, TUM-VI
+// and most recorded robot data), in the order of the bag (record time), read with Debian's
+// rosbag_storage in the module libopenable_rosbag.so. Topics of type sensor_msgs/Image
+// (encodings mono8, mono16, 8UC1, 16UC1, bgr8, rgb8, bgra8, rgba8, 8UC3, 8UC4) and
+// sensor_msgs/CompressedImage (JPEG or PNG). Frames are returned as every source returns them
+// (RGB reordered to BGR, alpha dropped, 16-bit scaled by 1/65535); Timestamp(i) is the
+// message's header stamp (its record time when the stamp is zero); FrameName(i) is
+// "<bag file name>:<topic>#<message index>". `key` and `topic_key` name the Config.txt keys in
+// messages (Bag_path, Bag_topic, ...). Throws InputError with one line naming the bag, the
+// topic and what was expected: a missing or unreadable file, a file that is not a bag or is
+// truncated (no index), a topic that is absent (the bag's image topics are listed) or of
+// another type, an empty range; Read(i) when a message cannot be decoded. Reads are
+// serialised (ParallelReads() is false).
+std::unique_ptr<FrameSource> OpenBag(const std::string& path, const std::string& topic,
+                                     int first, int last, const std::string& key,
+                                     const std::string& topic_key);
 
 }  // namespace openable

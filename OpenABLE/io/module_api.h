@@ -36,6 +36,16 @@ extern "C" void openable_video_open(const std::string& path, int first, int last
 using OpenableVideoOpen = void (*)(const std::string&, int, int,
                                    std::unique_ptr<openable::FrameSource>&);
 
+// libopenable_rosbag.so: the messages [first, last) of an image topic of a ROS 1 bag (see
+// OpenBag); `key` and `topic_key` name the Config.txt keys in messages.
+extern "C" void openable_rosbag_open(const std::string& path, const std::string& topic,
+                                     int first, int last, const std::string& key,
+                                     const std::string& topic_key,
+                                     std::unique_ptr<openable::FrameSource>& source);
+using OpenableRosbagOpen = void (*)(const std::string&, const std::string&, int, int,
+                                    const std::string&, const std::string&,
+                                    std::unique_ptr<openable::FrameSource>&);
+
 // libopenable_gui.so: shows a frame in the window "OpenABLE" (Show_images 1).
 extern "C" void openable_gui_show(const cv::Mat& frame);
 using OpenableGuiShow = void (*)(const cv::Mat&);

@@ -36,18 +36,31 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 
-enum class SourceKind { kFolder, kVideo, kStereo };
+enum class SourceKind { kFolder, kVideo, kStereo, kBag, kStereoBag };
 
 struct SourceSpec {
   std::string key, path;
   SourceKind kind;
+  std::string topic_key = {}, topic = {};  // bags: the topic and its key
 };
 
 std::vector<SourceSpec> Sources(const InputOptions& c) {
-  // Stereo (Camera_type 1): one pair of folders; CheckConfig rejects videos and Images_path_2.
+  // Stereo (Camera_type 1): one pair of folders or bag topics; CheckConfig rejects videos and
+  // second traversals.
+  if (c.camera_type == CameraType::kStereo && c.frame_mode == FrameMode::kBag)
+    return {{"Bag_path", c.bag_path, SourceKind::kStereoBag, "Bag_topic", c.bag_topic}};
   if (c.camera_type == CameraType::kStereo)
     return {{"Images_path_left", c.images_path_left, SourceKind::kStereo}};
   switch (c.frame_mode) {
+    case FrameMode::kBag: {
+      std::vector<SourceSpec> s = {
+          {"Bag_path", c.bag_path, SourceKind::kBag, "Bag_topic", c.bag_topic}};
+      if (!c.bag_topic_2.empty())
+        s.push_back({c.bag_path_2.empty() ? "Bag_path" : "Bag_path_2",
+                     c.bag_path_2.empty() ? c.bag_path : c.bag_path_2, SourceKind::kBag,
+                     "Bag_topic_2", c.bag_topic_2});
+      return s;
+    }
     case FrameMode::kImageFolders: {
       std::vector<SourceSpec> s = {{"Images_path", c.images_path, SourceKind::kFolder}};
       if (!c.images_path_2.empty())
@@ -72,6 +85,10 @@ std::vector<std::unique_ptr<FrameSource>> OpenFramesToShow(const InputOptions& i
       switch (spec.kind) {
         case SourceKind::kVideo:
           return OpenVideo(spec.path, input.initial_image, input.final_image);
+        case SourceKind::kBag:
+        case SourceKind::kStereoBag:  // the left images, as they are stored
+          return OpenBag(spec.path, spec.topic, input.initial_image, input.final_image,
+                         spec.key, spec.topic_key);
         case SourceKind::kStereo:  // the left images, as they are stored
         case SourceKind::kFolder:
           break;
@@ -142,8 +159,8 @@ Described DescribeSources(const Config& config, const FrameDescriber& describer,
   if (!scale.descriptor_cache.empty()) {
     if (specs.front().kind != SourceKind::kFolder) {
       out.notes.push_back("Descriptor_cache: not used: the cache keeps rows of image "
-                          "files (Frame_mode 0, Camera_type 0 or 2), not of videos or "
-                          "stereo pairs");
+                          "files (Frame_mode 0, Camera_type 0 or 2), not of videos, bags "
+                          "or stereo pairs");
     } else if (options.show_images) {
       out.notes.push_back("Descriptor_cache: not used with Show_images 1");
     } else if (options.preprocess.noise.Any()) {
@@ -169,7 +186,8 @@ Described DescribeSources(const Config& config, const FrameDescriber& describer,
   std::vector<cv::Mat> blocks;
   int row = 0;
   for (size_t s = 0; s < sources.size(); ++s) {
-    const bool stereo = specs[s].kind == SourceKind::kStereo;
+    const bool stereo =
+        specs[s].kind == SourceKind::kStereo || specs[s].kind == SourceKind::kStereoBag;
     options.key = stereo ? "" : specs[s].key;  // stereo read errors name their own key
     options.noise_stream = static_cast<int>(s);  // each traversal its own noise
     // Spread over processes: process 0's progress counts its share.
@@ -189,7 +207,12 @@ Described DescribeSources(const Config& config, const FrameDescriber& describer,
     tr.frames = seq.rows.rows;
     tr.skipped = seq.skipped;
     tr.frame_size = seq.frame_size;
-    for (int i : seq.kept) tr.names.push_back(sources[s]->FrameName(i));
+    for (int i : seq.kept) {
+      tr.names.push_back(sources[s]->FrameName(i));
+      tr.times.push_back(sources[s]->Timestamp(i));
+    }
+    if (std::any_of(tr.times.begin(), tr.times.end(), [](double t) { return std::isnan(t); }))
+      tr.times.clear();  // a source without times
     row += tr.frames;
     out.frames += sources[s]->Size();
     out.traversals.push_back(std::move(tr));
@@ -352,6 +375,24 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
   std::vector<std::unique_ptr<FrameSource>> sources;
   const std::vector<SourceSpec> specs = Sources(input);
   for (const auto& spec : specs) {
+    if (spec.kind == SourceKind::kStereoBag) {
+      StereoSourceOptions stereo_options;
+      stereo_options.compute_disparity = disparity;
+      const StereoCalibration calibration = WithKey(
+          "Calibration_path", [&] { return LoadStereoCalibration(input.calibration_path); });
+      sources.push_back(OpenStereoSources(
+          OpenBag(spec.path, spec.topic, input.initial_image, input.final_image, spec.key,
+                  spec.topic_key),
+          OpenBag(spec.path, input.bag_topic_right, input.initial_image, input.final_image,
+                  spec.key, "Bag_topic_right"),
+          calibration, stereo_options, "Bag_topic", "Bag_topic_right"));
+      continue;
+    }
+    if (spec.kind == SourceKind::kBag) {
+      sources.push_back(OpenBag(spec.path, spec.topic, input.initial_image, input.final_image,
+                                spec.key, spec.topic_key));
+      continue;
+    }
     if (spec.kind == SourceKind::kStereo) {
       // The stereo source's messages name their keys (Images_path_left, Images_path_right,
       // Calibration_path) themselves.
@@ -385,7 +426,10 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
 
   // Verification reads the candidates' frames again: checked now, before the long part.
   if (config.verification.enabled) {
-    const bool video = specs.front().kind == SourceKind::kVideo;
+    // Frames of videos and bags have no file to read again.
+    const SourceKind kind = specs.front().kind;
+    const bool video = kind == SourceKind::kVideo || kind == SourceKind::kBag ||
+                       kind == SourceKind::kStereoBag;
     const int query_frames = sources.back()->Size();
     const int queries = sources.size() > 1
                             ? query_frames
@@ -744,6 +788,7 @@ std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& co
   }
   if (EvaluationRequested(config) && !config.evaluation.report_name.empty())
     out.emplace_back("Report_name", config.evaluation.report_name);
+  if (!o.timestamps_name.empty()) out.emplace_back("Timestamps_name", o.timestamps_name);
   return out;
 }
 
@@ -818,6 +863,21 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
   }
   if (verification != nullptr && !out.loops_name.empty())
     batch.Stage("Loops_name", out.loops_name, EncodeLoops(*verification));
+  if (!out.timestamps_name.empty()) {
+    // "<row> <seconds>" per row, nanosecond resolution (the stamps of ROS messages).
+    std::string text = "# row seconds (frame times of the matrix's rows)\n";
+    for (const Traversal& tr : result.traversals) {
+      if (static_cast<int>(tr.times.size()) != tr.frames)
+        throw InputError("Timestamps_name: the frames of " + tr.key + " carry no times; "
+                         "expected frames of a ROS bag (Frame_mode 3)");
+      char line[64];
+      for (int i = 0; i < tr.frames; ++i) {
+        std::snprintf(line, sizeof line, "%d %.9f\n", tr.first_row + i, tr.times[i]);
+        text += line;
+      }
+    }
+    batch.Stage("Timestamps_name", out.timestamps_name, text);
+  }
   if (evaluation != nullptr && !config.evaluation.name.empty())
     StageEvaluation(batch, "Evaluation_name", config.evaluation.name, *evaluation,
                     {&result.normalized});

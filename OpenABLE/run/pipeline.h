@@ -28,6 +28,7 @@ struct Traversal {
   int first_row = 0;                // its first row (and column) in the matrix
   int frames = 0;                   // rows it holds
   std::vector<std::string> names;   // frame name of each row (file path or video#index)
+  std::vector<double> times;        // seconds of each row (ROS bags); empty: no times
   std::vector<std::string> skipped; // frames skipped as unreadable (Skip_unreadable 1)
   cv::Size frame_size;
 };

@@ -65,6 +65,10 @@ RunOutcome Run(const Config& config, ProgressReporter& progress,
   if (out.evaluation) {
     const auto start = std::chrono::steady_clock::now();
     const EvaluationLayout layout = LayoutOf(result);
+    // Frames that carry times (ROS bags) take their TUM poses by time.
+    GroundTruthOptions& truth = out.evaluation->settings.truth;
+    if (!result.traversals.empty()) truth.frame_times = result.traversals[0].times;
+    if (result.traversals.size() > 1) truth.frame_times_2 = result.traversals[1].times;
     if (out.verification) {
       const VerifiedAnswers answers = AnswersOf(*out.verification, layout);
       EvaluateMatrix(*out.evaluation, result.normalized, layout, RunLabel(config),

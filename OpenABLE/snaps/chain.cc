@@ -166,6 +166,9 @@ MatrixLoopOptions MatrixLoops(const Config& c) {
   m.exclusion = c.snaps.search.frame_distance;
   m.initial = c.input.initial_image;
   m.tolerance = c.snaps.keyframe_tolerance;
+  m.time_tolerance = c.snaps.time_tolerance;
+  if (c.snaps.loops == LoopSource::kMatrix && !c.snaps.frame_times.empty())
+    m.frame_times = ReadFrameTimes(c.snaps.frame_times, "Snaps_frame_times");
   return m;
 }
 
@@ -173,12 +176,20 @@ MatrixLoopOptions MatrixLoops(const Config& c) {
 // matching keys of the configuration, dense, one sequence, no output.
 Config OpenableRunOf(const Config& c) {
   Config run = c;
-  run.input.frame_mode = FrameMode::kImageFolders;
   run.input.camera_type = CameraType::kMonocular;
-  run.input.images_path = !c.snaps.images.empty()       ? c.snaps.images
-                          : !c.input.images_path.empty() ? c.input.images_path
-                                                         : c.input.images_path_left;
+  if (c.input.frame_mode == FrameMode::kBag && c.snaps.images.empty()) {
+    // The bag's (left) image topic: its frames carry times, and a TUM trajectory takes the
+    // loops by time.
+    run.input.bag_topic_2.clear();
+    run.input.bag_path_2.clear();
+  } else {
+    run.input.frame_mode = FrameMode::kImageFolders;
+    run.input.images_path = !c.snaps.images.empty()       ? c.snaps.images
+                            : !c.input.images_path.empty() ? c.input.images_path
+                                                           : c.input.images_path_left;
+  }
   run.input.images_path_2.clear();
+  run.output.timestamps_name.clear();
   run.output.txt_name.clear();
   run.output.npy_name.clear();
   run.output.png_name.clear();
@@ -245,11 +256,13 @@ ChainResult RunChain(const Config& c, ProgressReporter& progress,
       }
       if (s.middle_of_runs) r.loops = MiddleOfRuns(r.loops, r.input);
       break;
-    case LoopSource::kMatrix:
-      r.loops = WithKey("Snaps_loops_file", [&] {
-        return LoopsFromMatrix(s.loops_file, r.input, MatrixLoops(c), &r.pairs);
-      });
+    case LoopSource::kMatrix: {
+      const MatrixLoopOptions by = MatrixLoops(c);
+      r.loops_by_time = !by.frame_times.empty() && !r.input.timestamps.empty();
+      r.loops = WithKey("Snaps_loops_file",
+                        [&] { return LoopsFromMatrix(s.loops_file, r.input, by, &r.pairs); });
       break;
+    }
     case LoopSource::kOpenable: {
       const Config openable = OpenableRunOf(c);
       const RunResult run = ComputeRun(openable, progress);
@@ -261,8 +274,10 @@ ChainResult RunChain(const Config& c, ProgressReporter& progress,
           if (q.answer >= 0)
             answers.push_back({q.query, q.candidates[q.answer].reference,
                                q.candidates[q.answer].distance});
-        r.loops = LoopsFromMatches(answers, r.input, c.input.initial_image,
-                                   c.snaps.keyframe_tolerance, &r.pairs);
+        MatrixLoopOptions by = MatrixLoops(c);
+        by.frame_times = run.traversals.front().times;
+        r.loops_by_time = !by.frame_times.empty() && !r.input.timestamps.empty();
+        r.loops = LoopsFromMatches(answers, r.input, by, &r.pairs);
         r.verified_loops = true;
         say("OpenABLE: " + run.descriptor + ", L=" + std::to_string(c.matching.sequence_length) +
             ", " + std::to_string(run.normalized.rows) + " frames, " +
@@ -271,7 +286,10 @@ ChainResult RunChain(const Config& c, ProgressReporter& progress,
             FormatNumber(run.timings.total_seconds + verification.seconds) + " s");
         break;
       }
-      r.loops = LoopsFromMatrix(run.normalized, r.input, MatrixLoops(c), &r.pairs);
+      MatrixLoopOptions by = MatrixLoops(c);
+      by.frame_times = run.traversals.front().times;  // empty unless the frames carry times
+      r.loops_by_time = !by.frame_times.empty() && !r.input.timestamps.empty();
+      r.loops = LoopsFromMatrix(run.normalized, r.input, by, &r.pairs);
       say("OpenABLE: " + run.descriptor + ", L=" + std::to_string(c.matching.sequence_length) +
           ", " + std::to_string(run.normalized.rows) + " frames, " +
           FormatNumber(run.timings.total_seconds) + " s");
@@ -289,11 +307,15 @@ ChainResult RunChain(const Config& c, ProgressReporter& progress,
   }
   r.loop_seconds = Seconds(t);
   say(std::to_string(r.loops.size()) + " loop pairs (" + EnumName(s.loops) + ")" +
-      (r.pairs.associated > 0 ? ", " + std::to_string(r.pairs.associated) +
-                                    " pairs associated to the nearest pose within +-" +
-                                    std::to_string(s.keyframe_tolerance) +
-                                    (s.keyframe_tolerance == 1 ? " frame" : " frames")
-                              : std::string()) +
+      (r.pairs.associated == 0 ? std::string()
+       : r.loops_by_time
+           ? ", " + std::to_string(r.pairs.associated) +
+                 " pairs associated by time to the nearest pose within " +
+                 FormatNumber(s.time_tolerance) + " s"
+           : ", " + std::to_string(r.pairs.associated) +
+                 " pairs associated to the nearest pose within +-" +
+                 std::to_string(s.keyframe_tolerance) +
+                 (s.keyframe_tolerance == 1 ? " frame" : " frames")) +
       (r.pairs.dropped > 0 ? ", " + std::to_string(r.pairs.dropped) +
                                  " pairs with a frame that is not a pose dropped"
                            : std::string()) +

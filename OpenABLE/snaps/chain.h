@@ -45,6 +45,8 @@ struct ChainResult {
   std::vector<int> association;  // index in `truth` of each pose of `input`
   std::vector<LoopPair> loops;   // indices of `input`
   bool verified_loops = false;   // Snaps_loops openable with Verification 1: verified answers
+  // Matrix rows mapped to poses by time (frames with times and a TUM trajectory), not frame id.
+  bool loops_by_time = false;
   // Snaps_loops pairs, matrix, openable: the pairs of the file or the matrix's matches below the
   // threshold, on poses, associated to the nearest pose within Snaps_keyframe_tolerance, dropped
   // or (pairs file) outside the trajectory; `loops` is what remains after MiddleOfRuns (pairs)

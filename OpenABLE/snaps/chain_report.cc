@@ -86,7 +86,10 @@ std::string PairCountsLine(const Config& c, const ChainResult& r) {
     o << "matrix: " << n.Total() << " matches below " << Number(c.snaps.matrix_threshold)
       << ": ";
   o << n.on_poses << " on keyframes, " << n.associated;
-  if (tolerance > 0)
+  if (r.loops_by_time)
+    o << " associated by time (frames of a bag, Snaps_time_tolerance "
+      << Number(c.snaps.time_tolerance) << " s), ";
+  else if (tolerance > 0)
     o << " associated to the nearest keyframe within +-" << tolerance
       << (tolerance == 1 ? " frame, " : " frames, ");
   else

@@ -81,6 +81,77 @@ std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
   return out;
 }
 
+int IndexOfTime(const Trajectory& trajectory, double t, double tolerance) {
+  const auto& times = trajectory.timestamps;
+  if (times.empty()) return -1;
+  const auto after = std::lower_bound(times.begin(), times.end(), t);
+  auto nearest = after == times.end() ? after - 1 : after;
+  if (after != times.begin() && after != times.end() && t - *(after - 1) < *after - t)
+    nearest = after - 1;
+  return std::abs(*nearest - t) <= tolerance ? static_cast<int>(nearest - times.begin()) : -1;
+}
+
+std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
+                                       const Trajectory& trajectory,
+                                       const MatrixLoopOptions& options, PairCounts* counts) {
+  if (options.frame_times.empty() || trajectory.timestamps.empty())
+    return LoopsFromMatches(matches, trajectory, options.initial, options.tolerance, counts);
+  std::map<int, LoopPair> by_query;
+  PairCounts n;
+  for (const FrameMatch& match : matches) {
+    const double tq = options.frame_times.at(static_cast<std::size_t>(match.query));
+    const double tr = options.frame_times.at(static_cast<std::size_t>(match.reference));
+    const int qi = IndexOfTime(trajectory, tq, options.time_tolerance);
+    const int ri = IndexOfTime(trajectory, tr, options.time_tolerance);
+    if (qi < 0 || ri < 0 || ri >= qi) {
+      ++n.dropped;
+      continue;
+    }
+    const bool exact = std::abs(trajectory.timestamps[qi] - tq) < 1e-6 &&
+                       std::abs(trajectory.timestamps[ri] - tr) < 1e-6;
+    ++(exact ? n.on_poses : n.associated);
+    const LoopPair loop{qi, ri, 1.0 - match.distance};
+    auto [it, inserted] = by_query.emplace(qi, loop);
+    if (!inserted) {
+      ++n.merged;
+      if (loop.similarity > it->second.similarity) it->second = loop;
+    }
+  }
+  if (counts) *counts = n;
+  std::vector<LoopPair> out;
+  for (const auto& [q, loop] : by_query) out.push_back(loop);
+  return out;
+}
+
+std::vector<double> ReadFrameTimes(const std::string& path, const std::string& key) {
+  std::ifstream in(path);
+  if (!in)
+    throw InputError(key + ": frame times " + Quoted(path) +
+                     " cannot be opened (expected the file Timestamps_name wrote)");
+  std::vector<double> times;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    const std::size_t start = line.find_first_not_of(" \t\r");
+    if (start == std::string::npos || line[start] == '#') continue;
+    std::istringstream fields(line);
+    long row = -1;
+    double t = 0;
+    std::string rest;
+    if (!(fields >> row >> t) || (fields >> rest) || !std::isfinite(t) ||
+        row != static_cast<long>(times.size()))
+      throw InputError(key + ": frame times " + Quoted(path) + ":" + std::to_string(number) +
+                       ": " + Quoted(line) + "; expected \"" + std::to_string(times.size()) +
+                       " <seconds>\" (rows in order, as Timestamps_name writes them)");
+    times.push_back(t);
+  }
+  if (times.empty())
+    throw InputError(key + ": frame times " + Quoted(path) +
+                     " holds no line; expected one \"<row> <seconds>\" per matrix row");
+  return times;
+}
+
 std::vector<LoopPair> LoopsFromMatrix(cv::Mat1f m, const Trajectory& trajectory,
                                       const MatrixLoopOptions& options, PairCounts* counts) {
   if (m.rows != m.cols) throw std::invalid_argument("LoopsFromMatrix: matrix not square");
@@ -100,7 +171,11 @@ std::vector<LoopPair> LoopsFromMatrix(cv::Mat1f m, const Trajectory& trajectory,
     if (best_j < 0 || !(best < options.threshold)) continue;
     best_matches.push_back({q, best_j, best});
   }
-  return LoopsFromMatches(best_matches, trajectory, options.initial, options.tolerance, counts);
+  if (!options.frame_times.empty() && static_cast<int>(options.frame_times.size()) != m.rows)
+    throw InputError("Snaps_frame_times: " + std::to_string(options.frame_times.size()) +
+                     " frame times for a matrix of " + std::to_string(m.rows) +
+                     " rows; expected the times of the run that wrote the matrix");
+  return LoopsFromMatches(best_matches, trajectory, options, counts);
 }
 
 std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& trajectory,

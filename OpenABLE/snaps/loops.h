@@ -42,6 +42,11 @@ struct MatrixLoopOptions {
   // Frames whose id is not a pose of the trajectory map to the nearest pose within this many
   // frames; 0 keeps only frames that are poses (keyframes).
   long tolerance = 0;
+  // Frames that carry times (ROS bags: Timestamps_name, or the run of Snaps_loops openable):
+  // the time of each matrix row. With a trajectory that has timestamps (TUM), row i maps to the
+  // pose with the nearest timestamp within time_tolerance seconds instead of by frame id.
+  std::vector<double> frame_times;
+  double time_tolerance = 0.02;
 };
 
 // (a) Loops from an OpenABLE matrix of one sequence (ReadMatrixFile: .npy, .txt, image). For
@@ -75,6 +80,20 @@ struct FrameMatch {
 std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
                                        const Trajectory& trajectory, long initial,
                                        long tolerance, PairCounts* counts = nullptr);
+// The same with rows mapped by time when `times` holds one time per row and the trajectory has
+// timestamps (MatrixLoopOptions::frame_times); otherwise by frame id as above.
+std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
+                                       const Trajectory& trajectory,
+                                       const MatrixLoopOptions& options,
+                                       PairCounts* counts = nullptr);
+
+// The pose of `trajectory` (which has timestamps) nearest in time to `t`, -1 when none is
+// within `tolerance` seconds.
+int IndexOfTime(const Trajectory& trajectory, double t, double tolerance);
+
+// Frame times as Timestamps_name writes them ("<row> <seconds>" per line, '#' comments, rows
+// 0, 1, ... in order). Throws InputError naming `key`, the file and the line.
+std::vector<double> ReadFrameTimes(const std::string& path, const std::string& key);
 
 // (b) Loops from a file of pairs, read by ReadPairsFile (OpenABLE/evaluation/pairs_file.h): the
 // format and checks of the evaluation's ground-truth pairs (comma or blanks, '#' comments, a

@@ -34,6 +34,7 @@ struct SnapsOptions {
   double time_tolerance = 0.02;  // seconds, >= 0: TUM poses associated by timestamp
   LoopSource loops = LoopSource::kSearch;
   std::string loops_file;        // the pairs file or saved matrix of kPairs and kMatrix
+  std::string frame_times;       // kMatrix: the matrix rows' times (Timestamps_name); empty: none
   int keyframe_tolerance = 0;    // frames, >= 0: a frame that is not a pose takes the nearest
   bool middle_of_runs = true;    // pairs: keep the middle reference of each run of references
   bool drop_outside = false;     // pairs: drop pairs outside the trajectory instead of failing

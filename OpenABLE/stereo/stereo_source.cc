@@ -25,9 +25,12 @@ class StereoFolderSource final : public FrameSource {
  public:
   StereoFolderSource(std::unique_ptr<FrameSource> left, std::unique_ptr<FrameSource> right,
                      const StereoCalibration& calibration, const cv::Size& size,
-                     const StereoSourceOptions& options)
+                     const StereoSourceOptions& options, std::string left_key,
+                     std::string right_key)
       : left_(std::move(left)),
         right_(std::move(right)),
+        left_key_(std::move(left_key)),
+        right_key_(std::move(right_key)),
         size_(size),
         rectifier_(calibration, size, options.alpha),
         disparity_(DisparityOptions::ForWidth(size.width)),
@@ -35,19 +38,22 @@ class StereoFolderSource final : public FrameSource {
 
   int Size() const override { return left_->Size(); }
   std::string FrameName(int i) const override { return left_->FrameName(i); }
-  bool ParallelReads() const override { return true; }
+  bool ParallelReads() const override {
+    return left_->ParallelReads() && right_->ParallelReads();
+  }
+  double Timestamp(int i) const override { return left_->Timestamp(i); }
 
   cv::Mat Read(int i) const override {
-    const cv::Mat left = WithKey("Images_path_left", [&] { return Gray8(left_->Read(i)); });
-    const cv::Mat right = WithKey("Images_path_right", [&] { return Gray8(right_->Read(i)); });
+    const cv::Mat left = WithKey(left_key_, [&] { return Gray8(left_->Read(i)); });
+    const cv::Mat right = WithKey(right_key_, [&] { return Gray8(right_->Read(i)); });
     if (left.size() != right.size())
-      throw InputError("Images_path_left/Images_path_right: stereo pair " + std::to_string(i) +
+      throw InputError(left_key_ + "/" + right_key_ + ": stereo pair " + std::to_string(i) +
                        ": left image " + Quoted(left_->FrameName(i)) + " is " +
                        SizeText(left.size()) + " but right image " +
                        Quoted(right_->FrameName(i)) + " is " + SizeText(right.size()) +
                        " (expected both images of a pair to have one size)");
     if (left.size() != size_)
-      throw InputError("Images_path_left: image " + Quoted(left_->FrameName(i)) + " is " +
+      throw InputError(left_key_ + ": image " + Quoted(left_->FrameName(i)) + " is " +
                        SizeText(left.size()) + " but " + Quoted(left_->FrameName(0)) + " is " +
                        SizeText(size_) +
                        " (expected one size for every stereo pair: the rectification is "
@@ -70,6 +76,7 @@ class StereoFolderSource final : public FrameSource {
 
  private:
   std::unique_ptr<FrameSource> left_, right_;
+  std::string left_key_, right_key_;
   cv::Size size_;
   StereoRectifier rectifier_;
   DisparityOptions disparity_;
@@ -103,13 +110,28 @@ std::unique_ptr<FrameSource> OpenStereoFolders(const std::string& left, const st
                              [&] { return OpenImageFolder(left, extension, first, last); });
   auto right_source = WithKey("Images_path_right",
                               [&] { return OpenImageFolder(right, extension, first, last); });
-  const cv::Mat first_left = WithKey("Images_path_left", [&] { return left_source->Read(0); });
+  return OpenStereoSources(std::move(left_source), std::move(right_source), calibration, options,
+                           "Images_path_left", "Images_path_right");
+}
+
+std::unique_ptr<FrameSource> OpenStereoSources(std::unique_ptr<FrameSource> left,
+                                               std::unique_ptr<FrameSource> right,
+                                               const StereoCalibration& calibration,
+                                               const StereoSourceOptions& options,
+                                               const std::string& left_key,
+                                               const std::string& right_key) {
+  if (left->Size() != right->Size())
+    throw InputError(left_key + "/" + right_key + ": " + std::to_string(left->Size()) +
+                     " left images but " + std::to_string(right->Size()) +
+                     " right images (expected one right image per left image: pairs are "
+                     "matched by position)");
+  const cv::Mat first_left = WithKey(left_key, [&] { return left->Read(0); });
   WithKey("Calibration_path", [&] {
-    CheckCalibrationFits(calibration, first_left.size(), left_source->FrameName(0));
+    CheckCalibrationFits(calibration, first_left.size(), left->FrameName(0));
     return 0;
   });
-  return std::make_unique<StereoFolderSource>(std::move(left_source), std::move(right_source),
-                                              calibration, first_left.size(), options);
+  return std::make_unique<StereoFolderSource>(std::move(left), std::move(right), calibration,
+                                              first_left.size(), options, left_key, right_key);
 }
 
 }  // namespace openable

@@ -44,6 +44,17 @@ std::unique_ptr<FrameSource> OpenStereoFolders(const std::string& left, const st
                                                const StereoCalibration& calibration,
                                                const StereoSourceOptions& options = {});
 
+// The same over any two frame sources of one size (e.g. two image topics of a ROS bag,
+// OpenBag): pairs by position, which must hold as many frames. `left_key` and `right_key` name
+// the Config.txt keys in messages. Reads are thread-safe when both sources' are; Timestamp(i)
+// is the left frame's.
+std::unique_ptr<FrameSource> OpenStereoSources(std::unique_ptr<FrameSource> left,
+                                               std::unique_ptr<FrameSource> right,
+                                               const StereoCalibration& calibration,
+                                               const StereoSourceOptions& options,
+                                               const std::string& left_key,
+                                               const std::string& right_key);
+
 // The parts of one stereo pair, for tests and tools: the pair rectified and its disparity.
 struct StereoPair {
   cv::Mat left_rectified, right_rectified;  // CV_8UC1

@@ -53,7 +53,8 @@ const std::set<std::string> kNotDescription = {
     "Approximate_checks", "Approximate_ef_search", "Approximate_nprobe",
     "Descriptor_cache", "Sequence_partial", "Match_score", "Match_score_window",
     "Match_threshold", "Contrast_enhancement", "Contrast_window", "Fusion_weights",
-    "Loops_name"};
+    "Loops_name", "Bag_path", "Bag_topic", "Bag_topic_right", "Bag_path_2", "Bag_topic_2",
+    "Timestamps_name"};
 
 bool Perturb(Config& c, const std::string& key) {
   const std::string v = ConfigValueText(c, key);

@@ -1,0 +1,389 @@
+// ROS 1 bags as input (Frame_mode 3, OpenBag): bags written here with Debian's rosbag_storage
+// from real frames of ../shared/datasets, read back by Test_OpenABLE and compared with the same
+// frames read from their folders.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <rosbag/bag.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <sensor_msgs/Image.h>
+#include <std_msgs/String.h>
+
+#include "OpenABLE/io/frame_source.h"
+#include "tests/e2e/e2e_support.h"
+
+namespace openable {
+namespace {
+
+using e2e::Outcome;
+using e2e::ReadAll;
+using e2e::RunProgram;
+namespace fs = std::filesystem;
+
+std::string Kitti() { return testing::DatasetsDir() + "/kitti00_first1700"; }
+std::string Sample() { return testing::SampleDir(); }
+
+bool OneLine(const std::string& s) { return !s.empty() && s.find('\n') == s.size() - 1; }
+
+// The images of `folder` in natural order, [0, count).
+std::vector<std::string> Frames(const std::string& folder, int count) {
+  std::vector<std::string> paths = ListImages(folder, "");
+  if (static_cast<int>(paths.size()) > count) paths.resize(count);
+  return paths;
+}
+
+// A sensor_msgs/Image of `image` (8-bit grey or BGR) in `encoding`.
+sensor_msgs::Image ImageMessage(const cv::Mat& image, const std::string& encoding, double t) {
+  cv::Mat pixels = image;
+  if (encoding == "rgb8") cv::cvtColor(image, pixels, cv::COLOR_BGR2RGB);
+  if (encoding == "mono16") image.convertTo(pixels, CV_16U, 257.0);  // v -> v * 257
+  sensor_msgs::Image m;
+  m.header.stamp = ros::Time(t);
+  m.header.frame_id = "cam0";
+  m.height = pixels.rows;
+  m.width = pixels.cols;
+  m.encoding = encoding;
+  m.is_bigendian = 0;
+  m.step = static_cast<std::uint32_t>(pixels.cols * pixels.elemSize());
+  m.data.resize(static_cast<std::size_t>(m.step) * m.height);
+  for (int r = 0; r < pixels.rows; ++r)
+    std::memcpy(m.data.data() + r * m.step, pixels.ptr(r), m.step);
+  return m;
+}
+
+// Writes `frames` to `topic` of `bag` as `encoding` ("compressed": the PNG file's own bytes as
+// a sensor_msgs/CompressedImage), stamped times[i]; recorded 5 ms after each stamp.
+void WriteTopic(rosbag::Bag& bag, const std::string& topic, const std::vector<std::string>& frames,
+                const std::string& encoding, const std::vector<double>& times) {
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const ros::Time record(times[i] + 0.005);
+    if (encoding == "compressed") {
+      sensor_msgs::CompressedImage m;
+      m.header.stamp = ros::Time(times[i]);
+      m.format = "png";
+      const std::string bytes = ReadAll(frames[i]);
+      m.data.assign(bytes.begin(), bytes.end());
+      bag.write(topic, record, m);
+      continue;
+    }
+    const bool grey = encoding == "mono8" || encoding == "mono16";
+    const cv::Mat image = cv::imread(frames[i], grey ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+    ASSERT_FALSE(image.empty()) << frames[i];
+    bag.write(topic, record, ImageMessage(image, encoding, times[i]));
+  }
+}
+
+std::vector<double> KittiTimes(int count) {
+  std::ifstream in(Kitti() + "/times.txt");
+  std::vector<double> t;
+  double v;
+  while (static_cast<int>(t.size()) < count && in >> v) t.push_back(1.4e9 + v);  // a ROS epoch
+  return t;
+}
+
+std::string Written(const std::string& dir, const std::vector<std::string>& args) {
+  const Outcome o = RunProgram(testing::TestOpenableExe(), args, dir);
+  EXPECT_EQ(o.status, 0) << o.err;
+  return o.err;
+}
+
+// The bar: KITTI 00 frames 0-299 from a bag give the matrix of the image folder, bit for bit,
+// whether stored raw (mono8) or as the PNG files themselves (CompressedImage).
+TEST(RosBag, Kitti300FramesGiveTheFolderMatrixBitForBit) {
+  OPENABLE_REQUIRE_PATH(Kitti());
+  const std::string dir = testing::TempDir();
+  const std::vector<std::string> frames = Frames(Kitti() + "/image_0", 300);
+  ASSERT_EQ(frames.size(), 300u);
+  const std::vector<double> times = KittiTimes(300);
+  {
+    rosbag::Bag bag(dir + "/kitti.bag", rosbag::bagmode::Write);
+    WriteTopic(bag, "/kitti/camera_gray_left/image_raw", frames, "mono8", times);
+    WriteTopic(bag, "/kitti/camera_gray_left/image_png", frames, "compressed", times);
+  }
+  const std::vector<std::string> common = {"--set", "Image_sequences=10", "--set", "Png_name=",
+                                           "--set", "Ground_truth_type="};
+  auto run = [&](const std::string& npy, std::vector<std::string> args) {
+    args.insert(args.end(), common.begin(), common.end());
+    args.push_back("--set");
+    args.push_back("Npy_name=" + npy);
+    Written(dir, args);
+    return ReadAll(dir + "/" + npy);
+  };
+  const std::string folder = run("folder.npy", {"--set", "Images_path=" + Kitti() + "/image_0",
+                                                "--set", "Final_image=300"});
+  const std::string raw = run("raw.npy", {"--set", "Frame_mode=3", "--set",
+                                          "Bag_path=kitti.bag", "--set",
+                                          "Bag_topic=/kitti/camera_gray_left/image_raw",
+                                          "--set", "Timestamps_name=times.txt"});
+  const std::string png = run("png.npy", {"--set", "Frame_mode=3", "--set", "Bag_path=kitti.bag",
+                                          "--set", "Bag_topic=/kitti/camera_gray_left/image_png"});
+  ASSERT_GT(folder.size(), 300u * 300u * 4u);
+  EXPECT_TRUE(folder == raw) << "mono8 bag differs from the folder";
+  EXPECT_TRUE(folder == png) << "CompressedImage bag differs from the folder";
+  // The frames kept their message stamps.
+  std::ifstream in(dir + "/times.txt");
+  std::string header;
+  std::getline(in, header);
+  for (int i = 0; i < 300; ++i) {
+    int row = -1;
+    double t = 0;
+    ASSERT_TRUE(in >> row >> t) << i;
+    EXPECT_EQ(row, i);
+    EXPECT_NEAR(t, times[i], 1e-6) << i;
+  }
+}
+
+// Colour encodings give the folder's frames: bgr8 and rgb8 as stored, mono16 scaled.
+TEST(RosBag, EncodingsDecodeToTheFramesOfTheFiles) {
+  OPENABLE_REQUIRE_PATH(testing::DatasetsDir() + "/gardens_point");
+  const std::string dir = testing::TempDir();
+  const std::vector<std::string> colour =
+      Frames(testing::DatasetsDir() + "/gardens_point/day_left", 3);
+  const std::vector<double> times = {10.0, 10.5, 11.0};
+  {
+    rosbag::Bag bag(dir + "/c.bag", rosbag::bagmode::Write);
+    WriteTopic(bag, "/bgr", colour, "bgr8", times);
+    WriteTopic(bag, "/rgb", colour, "rgb8", times);
+    WriteTopic(bag, "/mono16", colour, "mono16", times);
+  }
+  for (const std::string topic : {"/bgr", "/rgb"}) {
+    const auto source = OpenBag(dir + "/c.bag", topic, 0, -1, "Bag_path", "Bag_topic");
+    ASSERT_EQ(source->Size(), 3);
+    for (int i = 0; i < 3; ++i) {
+      // The pixels written (OpenCV's decoding of the JPEG file), as a frame: BGR in [0, 1].
+      cv::Mat expected;
+      cv::imread(colour[i], cv::IMREAD_COLOR).convertTo(expected, CV_32F, 1.0 / 255.0);
+      EXPECT_EQ(cv::norm(source->Read(i), expected, cv::NORM_INF), 0.0) << topic << " " << i;
+      EXPECT_NEAR(source->Timestamp(i), times[i], 1e-9);
+    }
+    EXPECT_EQ(source->FrameName(1), "c.bag:" + topic + "#1");
+  }
+  const auto mono16 = OpenBag(dir + "/c.bag", "/mono16", 1, 3, "Bag_path", "Bag_topic");
+  ASSERT_EQ(mono16->Size(), 2);
+  const cv::Mat grey = cv::imread(colour[1], cv::IMREAD_GRAYSCALE);
+  cv::Mat expected;
+  grey.convertTo(expected, CV_32F, 1.0 / 255.0);  // v * 257 / 65535 = v / 255
+  EXPECT_LT(cv::norm(mono16->Read(0), expected, cv::NORM_INF), 1e-6);
+  EXPECT_NEAR(mono16->Timestamp(1), times[2], 1e-9);  // the range starts at message 1
+}
+
+// A second traversal from a second topic gives the matrix of two folders.
+TEST(RosBag, SecondTraversalFromATopicOrABag) {
+  const std::string dir = testing::TempDir();
+  const std::vector<std::string> summer = Frames(Sample() + "/summer", 60);
+  const std::vector<std::string> winter = Frames(Sample() + "/winter", 60);
+  std::vector<double> times(60);
+  for (int i = 0; i < 60; ++i) times[i] = 100 + i;
+  {
+    rosbag::Bag bag(dir + "/both.bag", rosbag::bagmode::Write);
+    WriteTopic(bag, "/summer", summer, "bgr8", times);
+    WriteTopic(bag, "/winter", winter, "bgr8", times);
+    rosbag::Bag other(dir + "/winter.bag", rosbag::bagmode::Write);
+    WriteTopic(other, "/cam", winter, "bgr8", times);
+  }
+  const std::vector<std::string> common = {"--set", "Image_sequences=5", "--set", "Png_name=",
+                                           "--set", "Final_image=60", "--set",
+                                           "Ground_truth_type="};
+  auto run = [&](const std::string& npy, std::vector<std::string> args) {
+    args.insert(args.end(), common.begin(), common.end());
+    args.insert(args.end(), {"--set", "Npy_name=" + npy});
+    Written(dir, args);
+    return ReadAll(dir + "/" + npy);
+  };
+  const std::string folders =
+      run("folders.npy", {"--set", "Images_path=" + Sample() + "/summer", "--set",
+                          "Images_path_2=" + Sample() + "/winter"});
+  const std::string topics =
+      run("topics.npy", {"--set", "Frame_mode=3", "--set", "Bag_path=both.bag", "--set",
+                         "Bag_topic=/summer", "--set", "Bag_topic_2=/winter"});
+  const std::string bags =
+      run("bags.npy", {"--set", "Frame_mode=3", "--set", "Bag_path=both.bag", "--set",
+                       "Bag_topic=/summer", "--set", "Bag_path_2=winter.bag", "--set",
+                       "Bag_topic_2=/cam"});
+  ASSERT_GT(folders.size(), 120u * 120u * 4u);
+  EXPECT_TRUE(folders == topics);
+  EXPECT_TRUE(folders == bags);
+}
+
+// TUM ground truth is associated by time: KITTI's poses written as a TUM file with stamps 4 ms
+// off the frames' give the evaluation of the same poses in KITTI's format read line by line.
+// Every 10th frame of 0-1699, so that the loops of KITTI 00 (frames 1570 on) are in.
+TEST(RosBag, TumGroundTruthAssociatesByTime) {
+  OPENABLE_REQUIRE_PATH(Kitti());
+  const std::string dir = testing::TempDir();
+  const int stride = 10, n = 170;
+  const std::vector<std::string> all = Frames(Kitti() + "/image_0", n * stride);
+  const std::vector<double> all_times = KittiTimes(n * stride);
+  ASSERT_EQ(all.size(), static_cast<std::size_t>(n * stride));
+  std::vector<std::string> frames;
+  std::vector<double> times;
+  for (int i = 0; i < n; ++i) {
+    frames.push_back(all[i * stride]);
+    times.push_back(all_times[i * stride]);
+  }
+  {
+    rosbag::Bag bag(dir + "/kitti.bag", rosbag::bagmode::Write);
+    WriteTopic(bag, "/cam", frames, "mono8", times);
+  }
+  // 3x4 camera-to-world per line -> "t tx ty tz qx qy qz qw" for every frame (read line by line,
+  // its first 170 lines would be the wrong poses), and the bag's frames' poses as KITTI.
+  std::ifstream kitti(Kitti() + "/poses/00_first1700.txt");
+  std::ofstream tum(dir + "/truth_tum.txt");
+  tum.precision(17);
+  std::ofstream head(dir + "/truth_kitti.txt");
+  head.precision(17);
+  for (int i = 0; i < n * stride; ++i) {
+    cv::Matx34d p;
+    for (int k = 0; k < 12; ++k) ASSERT_TRUE(kitti >> p.val[k]);
+    if (i % stride == 0)
+      for (int k = 0; k < 12; ++k) head << p.val[k] << (k == 11 ? "\n" : " ");
+    Eigen::Matrix3d r;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) r(a, b) = p(a, b);
+    const Eigen::Quaterniond q(r);
+    const double x = q.x(), y = q.y(), z = q.z(), w = q.w();
+    tum << all_times[i] + 0.004 << " " << p(0, 3) << " " << p(1, 3) << " " << p(2, 3) << " "
+        << x << " " << y << " " << z << " " << w << "\n";
+  }
+  tum.close();
+  head.close();
+  const std::vector<std::string> common = {
+      "--set", "Frame_mode=3", "--set", "Bag_path=kitti.bag", "--set", "Bag_topic=/cam",
+      "--set", "Image_sequences=3", "--set", "Png_name=", "--set", "Exclusion=5",
+      "--set", "Ground_truth_radius=5", "--set", "Ground_truth_axes=xz"};
+  auto evaluate = [&](const std::string& name, const std::vector<std::string>& truth) {
+    std::vector<std::string> args = common;
+    args.insert(args.end(), truth.begin(), truth.end());
+    args.insert(args.end(), {"--set", "Evaluation_name=" + name});
+    Written(dir, args);
+    return ReadAll(dir + "/" + name + "_per_query.csv");
+  };
+  const std::string by_line = evaluate("line", {"--set", "Ground_truth_type=kitti", "--set",
+                                                "Ground_truth=truth_kitti.txt"});
+  const std::string by_time = evaluate("time", {"--set", "Ground_truth_type=tum", "--set",
+                                                "Ground_truth=truth_tum.txt"});
+  EXPECT_EQ(by_line, by_time);
+  // Not vacuous: the loops of KITTI 00 are there.
+  const std::string json = ReadAll(dir + "/time.json");
+  const std::size_t positive = json.find("\"positive_queries\": ");
+  ASSERT_NE(positive, std::string::npos);
+  EXPECT_GT(std::stoi(json.substr(positive + 20)), 5) << json.substr(positive, 40);
+  // SNAPS on the TUM trajectory of every frame: the loops of the bag's saved matrix map to the
+  // poses by time through Timestamps_name (pose 10 i for row i), not to pose i.
+  Written(dir, {"--set", "Frame_mode=3", "--set", "Bag_path=kitti.bag", "--set",
+                "Bag_topic=/cam", "--set", "Image_sequences=3", "--set", "Png_name=", "--set",
+                "Npy_name=m.npy", "--set", "Timestamps_name=times.txt"});
+  auto snaps_loops = [&](const std::string& prefix, bool by_time) {
+    std::vector<std::string> args = {
+        "--set", "Snaps_trajectory=truth_tum.txt", "--set", "Snaps_trajectory_format=tum",
+        "--set", "Snaps_loops=matrix", "--set", "Snaps_loops_file=m.npy", "--set",
+        "Snaps_matrix_threshold=0.6", "--set", "Snaps_frame_distance=50", "--set",
+        "Snaps_corrector=discounted", "--set", "Snaps_output_name=" + prefix};
+    if (by_time) args.insert(args.end(), {"--set", "Snaps_frame_times=times.txt"});
+    const Outcome o = RunProgram(testing::OpenableSnapsExe(), args, dir);
+    EXPECT_EQ(o.status, 0) << o.err;
+    std::vector<std::pair<int, int>> loops;
+    std::ifstream in(dir + "/" + prefix + "_loops.csv");
+    std::string line;
+    while (std::getline(in, line)) {
+      int q = 0, r = 0;
+      if (line.empty() || line[0] == '#' || std::sscanf(line.c_str(), "%d,%d", &q, &r) != 2)
+        continue;
+      loops.emplace_back(q, r);
+    }
+    return loops;
+  };
+  const auto loops_by_time = snaps_loops("snaps_time", true);
+  const auto loops_by_row = snaps_loops("snaps_row", false);
+  ASSERT_GT(loops_by_time.size(), 5u);
+  ASSERT_EQ(loops_by_time.size(), loops_by_row.size());
+  for (std::size_t k = 0; k < loops_by_time.size(); ++k) {
+    EXPECT_EQ(loops_by_time[k].first, stride * loops_by_row[k].first) << k;  // row i: pose 10 i
+    EXPECT_EQ(loops_by_time[k].second, stride * loops_by_row[k].second) << k;
+  }
+
+  // 4 ms off is outside a 3 ms tolerance: the frame is named.
+  const Outcome o = RunProgram(
+      testing::TestOpenableExe(),
+      {"--set", "Frame_mode=3", "--set", "Bag_path=kitti.bag", "--set", "Bag_topic=/cam",
+       "--set", "Ground_truth_type=tum", "--set", "Ground_truth=truth_tum.txt", "--set",
+       "Ground_truth_time_tolerance=0.003", "--set", "Npy_name=out/m.npy"},
+      dir);
+  EXPECT_EQ(o.status, 1);
+  // The frames' times are known once they are read: progress lines come first, then the one
+  // error line, last.
+  const std::size_t error = o.err.find("Test_OpenABLE: error: ");
+  ASSERT_NE(error, std::string::npos) << o.err;
+  EXPECT_TRUE(OneLine(o.err.substr(error))) << o.err;
+  EXPECT_NE(o.err.find("no pose within 0.003 s of frame 0 (time "), std::string::npos) << o.err;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+}
+
+// Bad bags: one line naming the bag, the topic and what was expected; nothing written.
+TEST(RosBag, BadBagsAreOneLineNamingBagAndTopic) {
+  const std::string dir = testing::TempDir();
+  const std::vector<std::string> frames = Frames(Sample() + "/summer", 20);
+  std::vector<double> times(20);
+  for (int i = 0; i < 20; ++i) times[i] = 1 + i;
+  {
+    rosbag::Bag bag(dir + "/good.bag", rosbag::bagmode::Write);
+    WriteTopic(bag, "/cam0/image_raw", frames, "bgr8", times);
+    std_msgs::String text;
+    text.data = "not an image";
+    bag.write("/status", ros::Time(1), text);
+  }
+  // Truncated: the first half of the file (a recording cut short: no index).
+  const std::string good = ReadAll(dir + "/good.bag");
+  std::ofstream(dir + "/cut.bag", std::ios::binary) << good.substr(0, good.size() / 2);
+  std::ofstream(dir + "/text.bag") << "#ROSBAG V2.0\nnot really\n";
+  struct Case {
+    std::string bag, topic, expected;
+  };
+  const std::vector<Case> cases = {
+      {"good.bag", "/cam1/image_raw",
+       "Bag_topic: topic \"/cam1/image_raw\" is not in bag \"good.bag\"; expected an image topic "
+       "of the bag: /cam0/image_raw (sensor_msgs/Image); other topics: /status "
+       "(std_msgs/String)"},
+      {"good.bag", "/status",
+       "Bag_topic: topic \"/status\" of bag \"good.bag\" holds std_msgs/String; expected "
+       "sensor_msgs/Image or sensor_msgs/CompressedImage"},
+      {"cut.bag", "/cam0/image_raw", "Bag_path: bag \"cut.bag\" cannot be read ("},
+      {"text.bag", "/cam0/image_raw", "Bag_path: bag \"text.bag\" cannot be read ("},
+      {"absent.bag", "/cam0/image_raw", "Bag_path: bag \"absent.bag\" does not exist"},
+  };
+  for (const Case& c : cases) {
+    const Outcome o = RunProgram(testing::TestOpenableExe(),
+                                 {"--set", "Frame_mode=3", "--set", "Bag_path=" + c.bag, "--set",
+                                  "Bag_topic=" + c.topic, "--set", "Npy_name=out/m.npy", "--set",
+                                  "Ground_truth_type="},
+                                 dir);
+    EXPECT_EQ(o.status, 1) << c.bag << " " << o.err;
+    EXPECT_TRUE(OneLine(o.err)) << o.err;
+    EXPECT_NE(o.err.find(c.expected), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(dir + "/out")) << c.bag;
+  }
+  // Keys that need each other.
+  const Outcome o = RunProgram(testing::TestOpenableExe(),
+                               {"--set", "Frame_mode=3", "--set", "Bag_path=good.bag"}, dir);
+  EXPECT_EQ(o.status, 1);
+  EXPECT_NE(o.err.find("Bag_topic: empty; expected the image topic"), std::string::npos) << o.err;
+  const Outcome t = RunProgram(testing::TestOpenableExe(),
+                               {"--set", "Images_path=" + Sample() + "/summer", "--set",
+                                "Timestamps_name=t.txt", "--set", "Ground_truth_type="},
+                               dir);
+  EXPECT_EQ(t.status, 1);
+  EXPECT_NE(t.err.find("Timestamps_name: \"t.txt\" with Frame_mode 0"), std::string::npos)
+      << t.err;
+}
+
+}  // namespace
+}  // namespace openable
