@@ -20,6 +20,7 @@
 
 #include "OpenABLE/io/frame_source.h"
 #include "tests/e2e/e2e_support.h"
+#include "tests/tools/euroc_calibration.h"
 
 namespace openable {
 namespace {
@@ -212,6 +213,59 @@ TEST(RosBag, SecondTraversalFromATopicOrABag) {
   ASSERT_GT(folders.size(), 120u * 120u * 4u);
   EXPECT_TRUE(folders == topics);
   EXPECT_TRUE(folders == bags);
+}
+
+// Stereo from two topics (Camera_type 1, Bag_topic_right) gives the matrix of the two folders.
+TEST(RosBag, StereoPairsFromTwoTopicsGiveTheFoldersMatrix) {
+  const std::string euroc = testing::DatasetsDir() + "/euroc_stereo_pairs";
+  OPENABLE_REQUIRE_PATH(euroc);
+  const std::string dir = testing::TempDir();
+  std::vector<std::string> left, right;
+  fs::create_directories(dir + "/left");
+  fs::create_directories(dir + "/right");
+  for (int i = 0; i < 4; ++i) {
+    left.push_back(dir + "/left/left_img_" + std::to_string(i) + ".png");
+    right.push_back(dir + "/right/right_img_" + std::to_string(i) + ".png");
+    fs::copy_file(euroc + "/left_img_" + std::to_string(i) + ".png", left.back());
+    fs::copy_file(euroc + "/right_img_" + std::to_string(i) + ".png", right.back());
+  }
+  ASSERT_TRUE(testing::WriteEurocCalibration(euroc, dir + "/calibration.yaml"));
+  const std::vector<double> times = {5.0, 5.05, 5.1, 5.15};
+  {
+    rosbag::Bag bag(dir + "/stereo.bag", rosbag::bagmode::Write);
+    WriteTopic(bag, "/cam0/image_raw", left, "mono8", times);
+    WriteTopic(bag, "/cam1/image_raw", right, "mono8", times);
+    WriteTopic(bag, "/cam1/short", std::vector<std::string>(right.begin(), right.begin() + 3),
+               "mono8", times);
+  }
+  const std::vector<std::string> common = {
+      "--set", "Camera_type=1", "--set", "Calibration_path=calibration.yaml", "--set",
+      "Image_descriptor=D-LDB", "--set", "Ldb_bits=1386", "--set", "Png_name=", "--set",
+      "Ground_truth_type="};
+  auto run = [&](const std::string& npy, std::vector<std::string> args) {
+    args.insert(args.end(), common.begin(), common.end());
+    args.insert(args.end(), {"--set", "Npy_name=" + npy});
+    Written(dir, args);
+    return ReadAll(dir + "/" + npy);
+  };
+  const std::string folders = run("folders.npy", {"--set", "Images_path_left=left", "--set",
+                                                  "Images_path_right=right"});
+  const std::string topics =
+      run("topics.npy", {"--set", "Frame_mode=3", "--set", "Bag_path=stereo.bag", "--set",
+                         "Bag_topic=/cam0/image_raw", "--set", "Bag_topic_right=/cam1/image_raw"});
+  ASSERT_GT(folders.size(), 4u * 4u * 4u);
+  EXPECT_TRUE(folders == topics);
+  const Outcome o = RunProgram(
+      testing::TestOpenableExe(),
+      {"--set", "Camera_type=1", "--set", "Calibration_path=calibration.yaml", "--set",
+       "Frame_mode=3", "--set", "Bag_path=stereo.bag", "--set", "Bag_topic=/cam0/image_raw",
+       "--set", "Bag_topic_right=/cam1/short", "--set", "Npy_name=out/m.npy"},
+      dir);
+  EXPECT_EQ(o.status, 1);
+  EXPECT_TRUE(OneLine(o.err)) << o.err;
+  EXPECT_NE(o.err.find("Bag_topic/Bag_topic_right: 4 left images but 3 right images"),
+            std::string::npos)
+      << o.err;
 }
 
 // TUM ground truth is associated by time: KITTI's poses written as a TUM file with stamps 4 ms
