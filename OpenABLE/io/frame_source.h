@@ -91,7 +91,7 @@ std::unique_ptr<FrameSource> OpenVideo(const std::string& path, int first, int l
 // topic and what was expected: a missing or unreadable file, a file that is not a bag or is
 // truncated (no index), a topic that is absent (the bag's image topics are listed) or of
 // another type, an empty range; Read(i) when a message cannot be decoded. Reads are
-// serialised (ParallelReads() is false).
+// thread-safe: the bag is read under a lock, messages are decoded outside it.
 std::unique_ptr<FrameSource> OpenBag(const std::string& path, const std::string& topic,
                                      int first, int last, const std::string& key,
                                      const std::string& topic_key);

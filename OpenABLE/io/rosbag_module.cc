@@ -139,42 +139,62 @@ class BagSource final : public FrameSource {
   }
 
   int Size() const override { return static_cast<int>(messages_.size()); }
-  bool ParallelReads() const override { return false; }
+  // The bag is read under a lock (rosbag::Bag is not thread-safe); messages are decoded
+  // outside it, so a run decodes compressed frames on every core.
+  bool ParallelReads() const override { return true; }
 
   std::string FrameName(int i) const override {
     return name_ + ":" + topic_ + "#" + std::to_string(first_ + i);
   }
 
   cv::Mat Read(int i) const override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return ReadLocked(i);
+    const std::string what = "bag " + Quoted(path_) + ", topic " + Quoted(topic_) +
+                             ", message " + std::to_string(first_ + i);
+    Message message = Load(i, what);
+    try {
+      if (compressed_) {
+        const sensor_msgs::CompressedImage& m = *message.compressed;
+        const std::string bytes(m.data.begin(), m.data.end());
+        return DecodeImageBytes(bytes, what + " (" + m.format + ")");
+      }
+      return DecodeImage(*message.image, what);
+    } catch (const ros::Exception& e) {
+      throw InputError(what + " cannot be decoded (" + e.what() + ")");
+    }
   }
 
   double Timestamp(int i) const override {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!std::isnan(stamps_.at(i))) return stamps_[i];
+    }
+    Load(i, "bag " + Quoted(path_) + ", topic " + Quoted(topic_) + ", message " +
+                std::to_string(first_ + i));
     std::lock_guard<std::mutex> lock(mutex_);
-    if (std::isnan(stamps_.at(i))) ReadLocked(i);
     return stamps_[i];
   }
 
  private:
-  cv::Mat ReadLocked(int i) const {
+  struct Message {
+    boost::shared_ptr<sensor_msgs::Image> image;
+    boost::shared_ptr<sensor_msgs::CompressedImage> compressed;
+  };
+
+  // Reads and deserialises message i (under the lock) and records its stamp.
+  Message Load(int i, const std::string& what) const {
+    std::lock_guard<std::mutex> lock(mutex_);
     const rosbag::MessageInstance& m = messages_.at(i);
-    const std::string what = "bag " + Quoted(path_) + ", topic " + Quoted(topic_) +
-                             ", message " + std::to_string(first_ + i);
+    Message out;
     ros::Time stamp;
-    cv::Mat frame;
     try {
       if (compressed_) {
-        const auto message = m.instantiate<sensor_msgs::CompressedImage>();
-        if (!message) throw InputError(what + ": not a " + std::string(kCompressed));
-        stamp = message->header.stamp;
-        const std::string bytes(message->data.begin(), message->data.end());
-        frame = DecodeImageBytes(bytes, what + " (" + message->format + ")");
+        out.compressed = m.instantiate<sensor_msgs::CompressedImage>();
+        if (!out.compressed) throw InputError(what + ": not a " + std::string(kCompressed));
+        stamp = out.compressed->header.stamp;
       } else {
-        const auto message = m.instantiate<sensor_msgs::Image>();
-        if (!message) throw InputError(what + ": not a " + std::string(kImage));
-        stamp = message->header.stamp;
-        frame = DecodeImage(*message, what);
+        out.image = m.instantiate<sensor_msgs::Image>();
+        if (!out.image) throw InputError(what + ": not a " + std::string(kImage));
+        stamp = out.image->header.stamp;
       }
     } catch (const rosbag::BagException& e) {
       throw InputError(what + " cannot be read (" + e.what() +
@@ -185,7 +205,7 @@ class BagSource final : public FrameSource {
     }
     if (stamp.isZero()) stamp = m.getTime();  // no header stamp: the record time
     stamps_[i] = stamp.toSec();
-    return frame;
+    return out;
   }
 
   std::string path_, topic_, name_;
@@ -193,7 +213,7 @@ class BagSource final : public FrameSource {
   std::vector<rosbag::MessageInstance> messages_;
   bool compressed_ = false;
   int first_ = 0;
-  mutable std::mutex mutex_;  // rosbag::Bag reads are not thread-safe
+  mutable std::mutex mutex_;  // rosbag::Bag reads are not thread-safe; guards stamps_ too
   mutable std::vector<double> stamps_;
 };
 
