@@ -345,30 +345,34 @@ std::string EncodeHtmlReport(const ReportInput& input) {
       frames.read ? ""
                   : "<p class=\"note\">Frames are named, not shown: " + Escape(frames.missing) +
                         "</p>\n";
-  h += "<section id=\"wrong-matches\">\n<h2>Most confident wrong matches</h2>\n<p class=\"note\">"
-       "Queries whose best match is not a true place (outside the tolerance), lowest score "
-       "first: the wrong loops a threshold would accept first. Beside each, the true place: "
-       "the query's ground-truth candidate with the smallest distance.</p>\n" + no_images;
-  for (std::size_t i = 0; i < evaluation.runs.size(); ++i) {
-    const EvaluatedRun& run = evaluation.runs[i];
-    h += cases_table(run, *input.matrices[i],
-                     ConfidentWrongMatches(run, evaluation.truths[i], *input.matrices[i],
-                                           exclusion, input.examples),
-                     "wrong");
-  }
-  h += "</section>\n";
-  h += "<section id=\"misses\">\n<h2>Misses</h2>\n<p class=\"note\">Queries with a true place "
-       "that the run does not find at its operating point (Match_threshold, else the max-F1 "
-       "threshold): no answer, a wrong answer, or a right one with a score above the "
-       "threshold; least confident first.</p>\n" + no_images;
-  for (std::size_t i = 0; i < evaluation.runs.size(); ++i) {
-    const EvaluatedRun& run = evaluation.runs[i];
-    h += cases_table(run, *input.matrices[i],
-                     Misses(run, evaluation.truths[i], *input.matrices[i], exclusion,
-                            OperatingThreshold(run), input.examples),
-                     "miss");
-  }
-  h += "</section>\n";
+  // One section per kind of worst case, one table per run.
+  const auto cases_section = [&](const std::string& id, const std::string& title,
+                                 const std::string& note, const std::string& kind,
+                                 const auto& select) {
+    std::string section = "<section id=\"" + id + "\">\n<h2>" + title +
+                          "</h2>\n<p class=\"note\">" + note + "</p>\n" + no_images;
+    for (std::size_t i = 0; i < evaluation.runs.size(); ++i)
+      section += cases_table(evaluation.runs[i], *input.matrices[i],
+                             select(evaluation.runs[i], evaluation.truths[i], *input.matrices[i]),
+                             kind);
+    return section + "</section>\n";
+  };
+  h += cases_section(
+      "wrong-matches", "Most confident wrong matches",
+      "Queries whose best match is not a true place (outside the tolerance), lowest score "
+      "first: the wrong loops a threshold would accept first. Beside each, the true place: the "
+      "query's ground-truth candidate with the smallest distance.",
+      "wrong", [&](const EvaluatedRun& run, const GroundTruth& truth, const cv::Mat1f& m) {
+        return ConfidentWrongMatches(run, truth, m, exclusion, input.examples);
+      });
+  h += cases_section(
+      "misses", "Misses",
+      "Queries with a true place that the run does not find at its operating point "
+      "(Match_threshold, else the max-F1 threshold): no answer, a wrong answer, or a right one "
+      "with a score above the threshold; least confident first.",
+      "miss", [&](const EvaluatedRun& run, const GroundTruth& truth, const cv::Mat1f& m) {
+        return Misses(run, truth, m, exclusion, OperatingThreshold(run), input.examples);
+      });
 
   // Every embedded image must decode: the console names any that did not (a damaged or
   // truncated page), and the page records the count (data-images-loaded) for tests.

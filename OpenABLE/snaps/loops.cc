@@ -54,20 +54,24 @@ std::vector<LoopPair> LoopsFromMatrix(const std::string& path, const Trajectory&
   return LoopsFromMatrix(m, trajectory, options, counts);
 }
 
-std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
-                                       const Trajectory& trajectory, long initial,
-                                       long tolerance, PairCounts* counts) {
+namespace {
+
+// Loops from matches whose frames `pose_of(match)` maps to trajectory indices (query,
+// reference, and whether both frames are poses exactly), -1 for a frame without a pose: pairs
+// that map to no pose or not to query > reference are dropped, one loop per query pose (the
+// most similar), every pair counted once.
+template <class PoseOf>
+std::vector<LoopPair> CollectLoops(const std::vector<FrameMatch>& matches, PoseOf pose_of,
+                                   PairCounts* counts) {
   std::map<int, LoopPair> by_query;
   PairCounts n;
   for (const FrameMatch& match : matches) {
-    const long query_frame = initial + match.query, reference_frame = initial + match.reference;
-    const int qi = IndexOfFrame(trajectory, query_frame, tolerance);
-    const int ri = IndexOfFrame(trajectory, reference_frame, tolerance);
+    const auto [qi, ri, exact] = pose_of(match);
     if (qi < 0 || ri < 0 || ri >= qi) {
       ++n.dropped;
       continue;
     }
-    ++(OnPoses(trajectory, qi, query_frame, ri, reference_frame) ? n.on_poses : n.associated);
+    ++(exact ? n.on_poses : n.associated);
     const LoopPair loop{qi, ri, 1.0 - match.distance};
     auto [it, inserted] = by_query.emplace(qi, loop);
     if (!inserted) {
@@ -79,6 +83,30 @@ std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
   std::vector<LoopPair> out;
   for (const auto& [q, loop] : by_query) out.push_back(loop);
   return out;
+}
+
+struct Mapped {
+  int query, reference;
+  bool exact;
+};
+
+}  // namespace
+
+std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
+                                       const Trajectory& trajectory, long initial,
+                                       long tolerance, PairCounts* counts) {
+  return CollectLoops(
+      matches,
+      [&](const FrameMatch& match) {
+        const long query_frame = initial + match.query;
+        const long reference_frame = initial + match.reference;
+        const int qi = IndexOfFrame(trajectory, query_frame, tolerance);
+        const int ri = IndexOfFrame(trajectory, reference_frame, tolerance);
+        const bool exact =
+            qi >= 0 && ri >= 0 && OnPoses(trajectory, qi, query_frame, ri, reference_frame);
+        return Mapped{qi, ri, exact};
+      },
+      counts);
 }
 
 int IndexOfTime(const Trajectory& trajectory, double t, double tolerance) {
@@ -96,31 +124,19 @@ std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
                                        const MatrixLoopOptions& options, PairCounts* counts) {
   if (options.frame_times.empty() || trajectory.timestamps.empty())
     return LoopsFromMatches(matches, trajectory, options.initial, options.tolerance, counts);
-  std::map<int, LoopPair> by_query;
-  PairCounts n;
-  for (const FrameMatch& match : matches) {
-    const double tq = options.frame_times.at(static_cast<std::size_t>(match.query));
-    const double tr = options.frame_times.at(static_cast<std::size_t>(match.reference));
-    const int qi = IndexOfTime(trajectory, tq, options.time_tolerance);
-    const int ri = IndexOfTime(trajectory, tr, options.time_tolerance);
-    if (qi < 0 || ri < 0 || ri >= qi) {
-      ++n.dropped;
-      continue;
-    }
-    const bool exact = std::abs(trajectory.timestamps[qi] - tq) < 1e-6 &&
-                       std::abs(trajectory.timestamps[ri] - tr) < 1e-6;
-    ++(exact ? n.on_poses : n.associated);
-    const LoopPair loop{qi, ri, 1.0 - match.distance};
-    auto [it, inserted] = by_query.emplace(qi, loop);
-    if (!inserted) {
-      ++n.merged;
-      if (loop.similarity > it->second.similarity) it->second = loop;
-    }
-  }
-  if (counts) *counts = n;
-  std::vector<LoopPair> out;
-  for (const auto& [q, loop] : by_query) out.push_back(loop);
-  return out;
+  return CollectLoops(
+      matches,
+      [&](const FrameMatch& match) {
+        const double tq = options.frame_times.at(static_cast<std::size_t>(match.query));
+        const double tr = options.frame_times.at(static_cast<std::size_t>(match.reference));
+        const int qi = IndexOfTime(trajectory, tq, options.time_tolerance);
+        const int ri = IndexOfTime(trajectory, tr, options.time_tolerance);
+        const bool exact = qi >= 0 && ri >= 0 &&
+                           std::abs(trajectory.timestamps[qi] - tq) < 1e-6 &&
+                           std::abs(trajectory.timestamps[ri] - tr) < 1e-6;
+        return Mapped{qi, ri, exact};
+      },
+      counts);
 }
 
 std::vector<double> ReadFrameTimes(const std::string& path, const std::string& key) {
