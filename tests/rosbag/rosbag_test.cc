@@ -97,6 +97,15 @@ std::string Written(const std::string& dir, const std::vector<std::string>& args
   return o.err;
 }
 
+// The bytes of the .npy a run of Test_OpenABLE with `args` then `common` writes to `npy`.
+std::string MatrixOf(const std::string& dir, std::vector<std::string> args,
+                     const std::vector<std::string>& common, const std::string& npy) {
+  args.insert(args.end(), common.begin(), common.end());
+  args.insert(args.end(), {"--set", "Npy_name=" + npy});
+  Written(dir, args);
+  return ReadAll(dir + "/" + npy);
+}
+
 // The bar: KITTI 00 frames 0-299 from a bag give the matrix of the image folder, bit for bit,
 // whether stored raw (mono8) or as the PNG files themselves (CompressedImage).
 TEST(RosBag, Kitti300FramesGiveTheFolderMatrixBitForBit) {
@@ -112,12 +121,8 @@ TEST(RosBag, Kitti300FramesGiveTheFolderMatrixBitForBit) {
   }
   const std::vector<std::string> common = {"--set", "Image_sequences=10", "--set", "Png_name=",
                                            "--set", "Ground_truth_type="};
-  auto run = [&](const std::string& npy, std::vector<std::string> args) {
-    args.insert(args.end(), common.begin(), common.end());
-    args.push_back("--set");
-    args.push_back("Npy_name=" + npy);
-    Written(dir, args);
-    return ReadAll(dir + "/" + npy);
+  auto run = [&](const std::string& npy, const std::vector<std::string>& args) {
+    return MatrixOf(dir, args, common, npy);
   };
   const std::string folder = run("folder.npy", {"--set", "Images_path=" + Kitti() + "/image_0",
                                                 "--set", "Final_image=300"});
@@ -194,11 +199,8 @@ TEST(RosBag, SecondTraversalFromATopicOrABag) {
   const std::vector<std::string> common = {"--set", "Image_sequences=5", "--set", "Png_name=",
                                            "--set", "Final_image=60", "--set",
                                            "Ground_truth_type="};
-  auto run = [&](const std::string& npy, std::vector<std::string> args) {
-    args.insert(args.end(), common.begin(), common.end());
-    args.insert(args.end(), {"--set", "Npy_name=" + npy});
-    Written(dir, args);
-    return ReadAll(dir + "/" + npy);
+  auto run = [&](const std::string& npy, const std::vector<std::string>& args) {
+    return MatrixOf(dir, args, common, npy);
   };
   const std::string folders =
       run("folders.npy", {"--set", "Images_path=" + Sample() + "/summer", "--set",
@@ -242,11 +244,8 @@ TEST(RosBag, StereoPairsFromTwoTopicsGiveTheFoldersMatrix) {
       "--set", "Camera_type=1", "--set", "Calibration_path=calibration.yaml", "--set",
       "Image_descriptor=D-LDB", "--set", "Ldb_bits=1386", "--set", "Png_name=", "--set",
       "Ground_truth_type="};
-  auto run = [&](const std::string& npy, std::vector<std::string> args) {
-    args.insert(args.end(), common.begin(), common.end());
-    args.insert(args.end(), {"--set", "Npy_name=" + npy});
-    Written(dir, args);
-    return ReadAll(dir + "/" + npy);
+  auto run = [&](const std::string& npy, const std::vector<std::string>& args) {
+    return MatrixOf(dir, args, common, npy);
   };
   const std::string folders = run("folders.npy", {"--set", "Images_path_left=left", "--set",
                                                   "Images_path_right=right"});
