@@ -23,7 +23,7 @@ COMMANDS = {
 USAGE = """usage: python3 -m openable COMMAND [ARGS...]   (or: openable COMMAND [ARGS...])
        python3 -m openable COMMAND --help
 
-The command-line programs of OpenABLE (docs/python.md, "Command line"):
+The command-line programs of OpenABLE (docs/python.md, "Command line from Python"):
 
 {commands}
 
