@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdint>
 #include <cstddef>
@@ -13,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -32,6 +34,32 @@ namespace {
 // do the same but also offer the file to the FFmpeg (video) reader, which a damaged image can
 // drive into an exception or a leak (found by the image fuzzer); frames here are still images,
 // and videos go through OpenCV's videoio instead.
+// The OpenImageIO format whose readers claim the extension of `file` ("tif" -> "tiff"), from
+// its "extension_list" attribute ("tiff:tif,tiff;jpeg:jpg,jpe,jpeg;..."); empty when none
+// does. ImageInput::create given a file name instead would, for an unknown extension, open
+// the file with every reader, FFmpeg's included, which leaks its codec context on bytes that
+// are not a video (found by the image fuzzer: 944 bytes from avcodec_alloc_context3).
+std::string FormatOfExtension(const std::string& file) {
+  std::string extension = std::filesystem::path(file).extension().string();
+  if (extension.size() < 2) return "";
+  extension = extension.substr(1);
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string list = OIIO::get_string_attribute("extension_list");
+  std::size_t begin = 0;
+  while (begin < list.size()) {
+    const std::size_t end = std::min(list.find(';', begin), list.size());
+    const std::string entry = list.substr(begin, end - begin);
+    const std::size_t colon = entry.find(':');
+    if (colon != std::string::npos) {
+      const std::string extensions = "," + entry.substr(colon + 1) + ",";
+      if (extensions.find("," + extension + ",") != std::string::npos)
+        return entry.substr(0, colon);
+    }
+    begin = end + 1;
+  }
+  return "";
+}
+
 std::unique_ptr<OIIO::ImageInput> OpenImageReader(const std::string& file,
                                                   const OIIO::ImageSpec& config,
                                                   std::string& error) {
@@ -48,7 +76,8 @@ std::unique_ptr<OIIO::ImageInput> OpenImageReader(const std::string& file,
     if (error.empty()) error = in->geterror();  // the file's own reader, failing on it
     return nullptr;
   };
-  if (auto in = try_reader(file)) return in;  // the reader of the extension, if there is one
+  // The reader of the extension, if there is one.
+  if (auto in = try_reader(FormatOfExtension(file))) return in;
   const std::string formats = OIIO::get_string_attribute("input_format_list");
   for (std::size_t begin = 0; begin < formats.size();) {
     const std::size_t end = std::min(formats.find(',', begin), formats.size());
