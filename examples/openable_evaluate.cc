@@ -55,10 +55,18 @@ std::string EncodeReport(const openable::Config& config, const openable::Evaluat
     const std::string key = video ? "Video_path_1 (--video)" : "Images_path (--images)";
     int total = 0;
     for (const auto& s : sources) total += s->Size();
-    bool non_square = false;
+    // One mapping of rows and columns to frames serves every matrix: they must share a shape.
+    const cv::Mat1f& first = *matrices.front();
+    const bool non_square = first.rows != first.cols;
     for (std::size_t i = 0; i < matrices.size(); ++i) {
       const cv::Mat1f& m = *matrices[i];
-      non_square = m.rows != m.cols;
+      if (m.size() != first.size())
+        throw openable::InputError(
+            key + ": one set of frames for matrices of different sizes (" +
+            openable::Quoted(files.front().path) + " is " + std::to_string(first.rows) + " x " +
+            std::to_string(first.cols) + ", " + openable::Quoted(files[i].path) + " is " +
+            std::to_string(m.rows) + " x " + std::to_string(m.cols) +
+            "); expected matrices of the same frames, or a report per matrix");
       const bool fits = non_square ? sources.size() == 2 && m.rows == sources[1]->Size() &&
                                          m.cols == sources[0]->Size()
                                    : m.rows == total;

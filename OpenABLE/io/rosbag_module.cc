@@ -4,7 +4,6 @@
 // bz2 and the ROS plugin loader, which a run without bags does not load.
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -63,13 +62,8 @@ cv::Mat DecodeImage(const sensor_msgs::Image& m, const std::string& what) {
                  const_cast<unsigned char*>(m.data.data()), m.step);
   pixels = pixels.clone();
   // 16-bit data in the other byte order than this machine's.
-  const bool little = [] {
-    const std::uint16_t one = 1;
-    unsigned char first;
-    std::memcpy(&first, &one, 1);
-    return first == 1;
-  }();
-  if (pixels.depth() == CV_16U && (m.is_bigendian != 0) == little) {
+  constexpr bool kLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
+  if (pixels.depth() == CV_16U && (m.is_bigendian != 0) == kLittleEndian) {
     for (int r = 0; r < pixels.rows; ++r) {
       auto* p = pixels.ptr<std::uint16_t>(r);
       for (int c = 0; c < pixels.cols * pixels.channels(); ++c)

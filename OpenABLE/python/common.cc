@@ -160,16 +160,7 @@ MatView ToBgr(MatView v, bool rgb) {
   return MatView{bgr, py::array(), true};
 }
 
-MatView ImageAsGiven(const py::handle& object, const char* what);
-
-}  // namespace
-
-MatView Image(const py::handle& object, const char* what, bool rgb) {
-  return ToBgr(ImageAsGiven(object, what), rgb);
-}
-
-namespace {
-
+// The image as given (channels in the caller's order).
 MatView ImageAsGiven(const py::handle& object, const char* what) {
   py::array a = py::array::ensure(object);
   if (!a) throw py::value_error(std::string(what) + ": expected an image as a NumPy array");
@@ -202,6 +193,10 @@ MatView ImageAsGiven(const py::handle& object, const char* what) {
 }
 
 }  // namespace
+
+MatView Image(const py::handle& object, const char* what, bool rgb) {
+  return ToBgr(ImageAsGiven(object, what), rgb);
+}
 
 std::vector<MatView> Images(const py::handle& sequence, const char* what, bool rgb) {
   std::vector<MatView> out;

@@ -76,27 +76,32 @@ std::vector<SourceSpec> Sources(const InputOptions& c) {
           {"Video_path_2", c.video_path_2, SourceKind::kVideo}};
 }
 
+// One traversal's frames as they are stored (a stereo camera's left images, unrectified).
+// Bag errors name their own keys; folder and video errors get the key of the source.
+std::unique_ptr<FrameSource> OpenStoredFrames(const SourceSpec& spec, const InputOptions& input) {
+  switch (spec.kind) {
+    case SourceKind::kBag:
+    case SourceKind::kStereoBag:
+      return OpenBag(spec.path, spec.topic, input.initial_image, input.final_image, spec.key,
+                     spec.topic_key);
+    case SourceKind::kVideo:
+      return WithKey(spec.key,
+                     [&] { return OpenVideo(spec.path, input.initial_image, input.final_image); });
+    case SourceKind::kStereo:
+    case SourceKind::kFolder:
+      break;
+  }
+  return WithKey(spec.key, [&] {
+    return OpenImageFolder(spec.path, input.images_format, input.initial_image,
+                           input.final_image);
+  });
+}
+
 }  // namespace
 
 std::vector<std::unique_ptr<FrameSource>> OpenFramesToShow(const InputOptions& input) {
   std::vector<std::unique_ptr<FrameSource>> sources;
-  for (const SourceSpec& spec : Sources(input)) {
-    sources.push_back(WithKey(spec.key, [&] {
-      switch (spec.kind) {
-        case SourceKind::kVideo:
-          return OpenVideo(spec.path, input.initial_image, input.final_image);
-        case SourceKind::kBag:
-        case SourceKind::kStereoBag:  // the left images, as they are stored
-          return OpenBag(spec.path, spec.topic, input.initial_image, input.final_image,
-                         spec.key, spec.topic_key);
-        case SourceKind::kStereo:  // the left images, as they are stored
-        case SourceKind::kFolder:
-          break;
-      }
-      return OpenImageFolder(spec.path, input.images_format, input.initial_image,
-                             input.final_image);
-    }));
-  }
+  for (const SourceSpec& spec : Sources(input)) sources.push_back(OpenStoredFrames(spec, input));
   return sources;
 }
 
@@ -380,17 +385,12 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
       stereo_options.compute_disparity = disparity;
       const StereoCalibration calibration = WithKey(
           "Calibration_path", [&] { return LoadStereoCalibration(input.calibration_path); });
-      sources.push_back(OpenStereoSources(
-          OpenBag(spec.path, spec.topic, input.initial_image, input.final_image, spec.key,
-                  spec.topic_key),
-          OpenBag(spec.path, input.bag_topic_right, input.initial_image, input.final_image,
-                  spec.key, "Bag_topic_right"),
-          calibration, stereo_options, "Bag_topic", "Bag_topic_right"));
-      continue;
-    }
-    if (spec.kind == SourceKind::kBag) {
-      sources.push_back(OpenBag(spec.path, spec.topic, input.initial_image, input.final_image,
-                                spec.key, spec.topic_key));
+      SourceSpec right = spec;
+      right.topic_key = "Bag_topic_right";
+      right.topic = input.bag_topic_right;
+      sources.push_back(OpenStereoSources(OpenStoredFrames(spec, input),
+                                          OpenStoredFrames(right, input), calibration,
+                                          stereo_options, "Bag_topic", "Bag_topic_right"));
       continue;
     }
     if (spec.kind == SourceKind::kStereo) {
@@ -405,12 +405,7 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
                                           input.final_image, calibration, stereo_options));
       continue;
     }
-    sources.push_back(WithKey(spec.key, [&] {
-      return spec.kind == SourceKind::kVideo
-                 ? OpenVideo(spec.path, input.initial_image, input.final_image)
-                 : OpenImageFolder(spec.path, input.images_format, input.initial_image,
-                                   input.final_image);
-    }));
+    sources.push_back(OpenStoredFrames(spec, input));  // folders, videos, bags
   }
 
   // The ratio score needs rivals: its window must leave references outside it.

@@ -233,6 +233,19 @@ class EvaluateReport(support.TempDirTestCase):
         self.assertIn("600 x 600", done.stderr)
         self.assertFalse(out.exists())
 
+    def test_matrices_of_different_sizes_cannot_share_the_frames(self):
+        other = self.tmp / "other.npy"
+        np.save(other, np.random.default_rng(2).random((40, 20)).astype(np.float32))
+        out = self.tmp / "two.html"
+        done = self.evaluate("--matrix", other, "--report", out, "--images",
+                             support.SAMPLE / "summer", "--images-2", support.SAMPLE / "winter")
+        self.assertEqual(done.returncode, 1)
+        self.assertEqual(len(done.stderr.strip().splitlines()), 1, done.stderr)
+        self.assertIn("matrices of different sizes", done.stderr)
+        self.assertIn("600 x 600", done.stderr)
+        self.assertIn("40 x 20", done.stderr)
+        self.assertFalse(out.exists())
+
     def test_report_needs_ground_truth(self):
         out = self.tmp / "none.html"
         done = subprocess.run([support.program("Test_OpenABLE"),
