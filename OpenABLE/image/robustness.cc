@@ -164,4 +164,59 @@ cv::Mat AddNoise(const cv::Mat& frame, const NoiseOptions& o, uint64_t state) {
   return out;
 }
 
+cv::Mat MakeNightLike(const cv::Mat& frame, const NightOptions& o, uint64_t state) {
+  const int type = frame.type();
+  if (type != CV_32FC1 && type != CV_32FC3)
+    throw std::logic_error("MakeNightLike: expected CV_32FC1 or CV_32FC3, got " +
+                           cv::typeToString(type));
+  cv::RNG rng(state);
+  const int w = frame.cols, h = frame.rows, cn = frame.channels();
+  // 1. Viewpoint: scale >= 1 so that the reflected border stays small.
+  const double scale = 1.0 + rng.uniform(0.0, o.zoom);
+  const double angle = rng.uniform(-o.rotation, o.rotation);
+  const double dx = rng.uniform(-o.shift, o.shift) * w, dy = rng.uniform(-o.shift, o.shift) * h;
+  cv::Mat m = cv::getRotationMatrix2D(cv::Point2f(w / 2.0f, h / 2.0f), angle, scale);
+  m.at<double>(0, 2) += dx;
+  m.at<double>(1, 2) += dy;
+  cv::Mat moved;
+  cv::warpAffine(frame, moved, m, frame.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT_101);
+  // 2-4. Light field, tone curve, colour cast.
+  const double gains[3] = {o.gain_b, o.gain_g, o.gain_r};
+  cv::Mat out(frame.size(), type);
+  double total = 0;
+  for (int y = 0; y < h; ++y) {
+    const double top = o.sky_height * h;  // t: 1 above top / 2, 0 below top
+    const double t = top > 0 ? std::min(1.0, std::max(0.0, 2.0 * (1.0 - y / top))) : 0.0;
+    const float* in = moved.ptr<float>(y);
+    float* px = out.ptr<float>(y);
+    for (int x = 0; x < w; ++x) {
+      double u = w > 1 ? static_cast<double>(x) / (w - 1) : 1.0;
+      if (o.from_left) u = 1.0 - u;
+      const double light = o.ambient + (1.0 - o.ambient) * ((1.0 - o.side) + o.side * u);
+      for (int c = 0; c < cn; ++c) {
+        const double day = std::min(1.0, std::max(0.0, static_cast<double>(in[x * cn + c])));
+        const double sky = 1.0 - (1.0 - o.sky_floor) * t * day;
+        double v = std::pow(day * light * sky, o.gamma);
+        if (cn == 3) v *= gains[c];
+        px[x * cn + c] = static_cast<float>(v);
+        total += v;
+      }
+    }
+  }
+  // 5-7. Automatic gain, noise, glare, clipping.
+  const double mean = total / (static_cast<double>(w) * h * cn);
+  const double gain = mean > 1e-12 ? o.target_mean / mean : 1.0;
+  const double floor = o.glare * o.target_mean;
+  for (int y = 0; y < h; ++y) {
+    float* px = out.ptr<float>(y);
+    for (int i = 0; i < w * cn; ++i) {
+      const double v = px[i] * gain;
+      const double sd = std::sqrt(o.shot * o.shot * v / o.target_mean + o.read * o.read);
+      const double noisy = v + rng.gaussian(1.0) * sd;
+      px[i] = static_cast<float>(std::min(1.0, std::max(0.0, (noisy + floor) / (1.0 + o.glare))));
+    }
+  }
+  return out;
+}
+
 }  // namespace openable

@@ -70,4 +70,47 @@ uint64_t NoiseState(int seed, int stream, int frame);
 // std::logic_error on a type other than CV_32FC1/2/3.
 cv::Mat AddNoise(const cv::Mat& frame, const NoiseOptions& options, uint64_t state);
 
+// A synthetic night-like version of a day frame, for development and tests of settings meant
+// to work from day to night (there is no night traversal among the shared datasets). It models
+// what changes between a day image and a night image of the same place, in this order:
+//   1. a small change of viewpoint (the camera is never in the same place twice): a random
+//      similarity transform, scale up to 1 + `zoom`, shift up to `shift` of the frame's size,
+//      rotation up to `rotation` degrees (border reflected);
+//   2. light from elsewhere: the scene's reflectance (the day image) under artificial light,
+//      E(x, y) = ambient + (1 - ambient) * ((1 - side) + side * u), u in [0, 1] rising towards
+//      the lit side (the right, or the left when `from_left`); and a dark sky: the sky is the
+//      brightest region by day and the darkest by night, so a pixel of the upper part of the
+//      frame is darkened the more the brighter it was by day, by 1 - (1 - sky_floor) t v
+//      (v its day intensity, t = 1 above half of `sky_height` of the frame's height, falling
+//      linearly to 0 at `sky_height`);
+//   3. a tone curve v -> v^gamma (gamma > 1: low light crushes the darker tones);
+//   4. a colour cast (sodium or tungsten light): channel gains B, G, R (colour frames only);
+//   5. the camera's automatic gain: the frame scaled so that its mean is `target_mean`;
+//   6. sensor noise, as little light leaves it after that gain: shot noise of standard deviation
+//      shot * sqrt(v / target_mean) and read noise of deviation `read` (on [0, 1]);
+//   7. veiling glare: a fraction `glare` of the mean added everywhere (lower contrast), then
+//      the frame rescaled by 1 / (1 + glare) and clipped to [0, 1].
+// The defaults give a frame clearly darker in its upper part, lit from the right, noisy and of
+// low contrast; `Strong()` a harder night. The result depends only on the frame and `state`.
+struct NightOptions {
+  double zoom = 0.04, shift = 0.02, rotation = 1.5;   // viewpoint
+  double ambient = 0.25, side = 0.7;                   // light field
+  bool from_left = false;
+  double sky_floor = 0.1, sky_height = 0.5;
+  double gamma = 1.6;
+  double gain_b = 0.55, gain_g = 0.8, gain_r = 1.0;    // sodium-like cast
+  double target_mean = 0.3, shot = 0.04, read = 0.02, glare = 0.25;
+  static NightOptions Strong() {
+    NightOptions o;
+    o.zoom = 0.06, o.shift = 0.03, o.rotation = 2.5;
+    o.ambient = 0.15, o.side = 0.85, o.sky_floor = 0.05, o.gamma = 2.0;
+    o.shot = 0.07, o.read = 0.035, o.glare = 0.4;
+    return o;
+  }
+};
+
+// `frame` (CV_32FC1 or CV_32FC3 in [0, 1], as a FrameSource gives it) made night-like; a new
+// image of the same size and type. Throws std::logic_error on another type.
+cv::Mat MakeNightLike(const cv::Mat& frame, const NightOptions& options, uint64_t state);
+
 }  // namespace openable
