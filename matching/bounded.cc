@@ -213,20 +213,63 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
   std::vector<float> range_max(static_cast<std::size_t>(ranges), 0.0f);
   std::atomic<int> rows_done{0};
   std::mutex progress_mutex;
+  // Sequence_partial ahead: a cell with fewer than L terms takes the cell AheadShift steps
+  // forward along its diagonal, which lies in one of the next L - 1 rows. Each range then
+  // computes L - 1 rows past its end (as it computes L - 1 rows before its start), keeps its
+  // last L rows of sums (each direction apart, before the smaller of the two is taken) and
+  // finishes row i once row i + L - 1 is summed.
+  const bool ahead = L > 1 && options.partial == SequencePartial::kAhead;
+  const int look = ahead ? L - 1 : 0;
   ParallelFor(ranges, threads, [&](int c) {
     const int r0 = q_begin + c * range_rows, r1 = std::min(q_end, r0 + range_rows);
     const int h0 = std::max(0, r0 - (L - 1));  // first row summed
+    const int rows_end = std::min(block.query_count, r1 + look);  // one past the last summed
     const int slots = L + 1;  // ring: rows i - L .. i of D
     const std::size_t width = static_cast<std::size_t>(std::max(m, 1));
     std::vector<float> ring(static_cast<std::size_t>(L > 1 ? slots : 1) * width);
     std::vector<double> prev_f(forward && L > 1 ? width : 0), cur_f(prev_f.size());
     std::vector<double> prev_r(backward && L > 1 ? width : 0), cur_r(prev_r.size());
     std::vector<float> sum_f(L > 1 ? width : 0), sum_r(L > 1 && backward && forward ? width : 0);
+    // ahead: the last L rows of sums of each direction, and the finished row(s).
+    std::vector<float> sums_f(ahead && forward ? L * width : 0);
+    std::vector<float> sums_r(ahead && backward ? L * width : 0);
+    std::vector<float> done_f(ahead ? width : 0), done_r(ahead && forward && backward ? width : 0);
     cv::Mat1f computed;
     float largest = 0.0f;
     std::vector<Match>& out = kept[static_cast<std::size_t>(c)];
-    for (int b0 = h0; b0 < r1; b0 += block_rows) {
-      const int b1 = std::min(r1, b0 + block_rows);
+    const auto keep = [&](int i, const float* s) {
+      largest = LargestFinite(s, m, largest);
+      KeepRow(s, m, i, rules, out);
+    };
+    // Row e of one direction with its early cells taken from the rows ahead (kept in `sums`).
+    const auto finish = [&](int e, const std::vector<float>& sums, bool rev, float* into) {
+      const float* own = &sums[static_cast<std::size_t>(e % L) * width];
+      const int forward_rows = block.query_count - 1 - e;
+      const auto cell = [&](int j) {
+        const int t = std::min(e, rev ? m - 1 - j : j);
+        if (t >= L - 1) return own[j];
+        const int shift = AheadShift(L, t, std::min(forward_rows, rev ? j : m - 1 - j));
+        if (shift < 0) return std::numeric_limits<float>::infinity();
+        return sums[static_cast<std::size_t>((e + shift) % L) * width +
+                    static_cast<std::size_t>(rev ? j - shift : j + shift)];
+      };
+      if (e < L - 1) {
+        for (int j = 0; j < m; ++j) into[j] = cell(j);
+        return;
+      }
+      std::copy_n(own, m, into);
+      const int e0 = rev ? std::max(0, m - (L - 1)) : 0, e1 = rev ? m : std::min(m, L - 1);
+      for (int j = e0; j < e1; ++j) into[j] = cell(j);
+    };
+    const auto keep_ahead = [&](int e) {
+      if (forward) finish(e, sums_f, false, done_f.data());
+      if (backward) finish(e, sums_r, true, forward ? done_r.data() : done_f.data());
+      if (forward && backward)
+        for (int j = 0; j < m; ++j) done_f[j] = std::min(done_f[j], done_r[j]);
+      keep(e, done_f.data());
+    };
+    for (int b0 = h0; b0 < rows_end; b0 += block_rows) {
+      const int b1 = std::min(rows_end, b0 + block_rows);
       if (!packed) {
         computed = Distances(descriptors.rowRange(block.query_first + b0, block.query_first + b1),
                              references, metric, 1);
@@ -246,23 +289,29 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
             SequenceRow(d, old, prev_f.data(), cur_f.data(), sum_f.data(), m, steps, L, false,
                         options.partial);
             std::swap(prev_f, cur_f);
+            if (ahead)
+              std::copy_n(sum_f.data(), m, &sums_f[static_cast<std::size_t>(i % L) * width]);
           }
           if (backward) {
             float* into = forward ? sum_r.data() : sum_f.data();
             SequenceRow(d, old, prev_r.data(), cur_r.data(), into, m, steps, L, true,
                         options.partial);
             std::swap(prev_r, cur_r);
-            if (forward)  // both directions: the smaller of the two sums
+            if (ahead)
+              std::copy_n(into, m, &sums_r[static_cast<std::size_t>(i % L) * width]);
+            if (forward && !ahead)  // both directions: the smaller of the two sums
               for (int j = 0; j < m; ++j) sum_f[j] = std::min(sum_f[j], sum_r[j]);
           }
           s = sum_f.data();
         }
-        if (i >= r0) {
-          largest = LargestFinite(s, m, largest);
-          KeepRow(s, m, i, rules, out);
+        if (ahead) {
+          if (i - look >= r0 && i - look < r1) keep_ahead(i - look);
+        } else if (i >= r0 && i < r1) {
+          keep(i, s);
         }
       }
     }
+    for (int e = std::max(r0, rows_end - look); ahead && e < r1; ++e) keep_ahead(e);
     range_max[static_cast<std::size_t>(c)] = largest;
     rows_done += r1 - r0;
     // Progress from whichever thread gets the lock (the reporter is not thread-safe); the count
@@ -283,6 +332,24 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
   max_distance = max_seen;
   if (options.normalize) NormalizeMatches(all, max_seen, rules.score);
   return all;
+}
+
+std::vector<std::uint8_t> AcceptedMatches(const std::vector<Match>& matches, int queries,
+                                          double threshold,
+                                          const AgreementOptions* consistency) {
+  std::vector<int> best(static_cast<std::size_t>(std::max(queries, 0)), -1);
+  std::vector<float> score(best.size(), 0.0f);
+  for (const Match& m : matches)
+    if (m.rank == 1 && m.query >= 0 && m.query < queries) {
+      best[static_cast<std::size_t>(m.query)] = m.reference;
+      score[static_cast<std::size_t>(m.query)] = m.score;
+    }
+  std::vector<std::uint8_t> out(best.size(), 0);
+  const std::vector<std::uint8_t> agree =
+      consistency != nullptr ? AgreeingAnswers(best, *consistency) : std::vector<std::uint8_t>();
+  for (std::size_t q = 0; q < best.size(); ++q)
+    out[q] = best[q] >= 0 && score[q] <= threshold && (agree.empty() || agree[q]) ? 1 : 0;
+  return out;
 }
 
 void NormalizeMatches(std::vector<Match>& matches, float max_distance, MatchScore score) {

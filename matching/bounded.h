@@ -23,6 +23,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "matching/agreement.h"
 #include "matching/approximate.h"
 #include "matching/distances.h"
 #include "matching/score.h"
@@ -71,12 +72,20 @@ void KeepRow(const float* s, int references, int q, const KeepRules& rules,
 std::vector<Match> MatchesFromMatrix(const cv::Mat1f& normalized, const MatchBlock& block,
                                      const KeepRules& rules);
 
+// Per query 0 .. queries - 1, whether its best match (the match of rank 1 in `matches`, which
+// may hold others) is accepted: its score is <= `threshold` and, when `consistency` is given,
+// the best matches of consistency->partners independent queries agree with it
+// (matching/agreement.h; a query without a best match is never accepted nor a partner).
+std::vector<std::uint8_t> AcceptedMatches(const std::vector<Match>& matches, int queries,
+                                          double threshold,
+                                          const AgreementOptions* consistency = nullptr);
+
 struct BoundedOptions {
   // The metric of the descriptor rows; none: by their type (Hamming for CV_8U, L2 for CV_32F).
   std::optional<Metric> metric;
   int sequence_length = 1;
   SequenceDirection direction = SequenceDirection::kForward;
-  SequencePartial partial = SequencePartial::kScale;
+  SequencePartial partial = SequencePartial::kAhead;
   int threads = 0;
   // Query rows per range of the fused pipeline (each thread takes ranges in turn); 0 chooses
   // from the rows and threads (64 to 1024). Tests set a few rows to cross many range starts.

@@ -21,8 +21,18 @@ void MatchingOptions::Check() const {
   if (match_threshold != -1.0 && !(match_threshold >= 0.0 && match_threshold <= 1.0))
     throw InputError("Match_threshold: " + FormatNumber(match_threshold) +
                      " is not valid; expected -1 (none) or a number in [0, 1]");
+  CheckIntRange("Match_consistency", match_consistency, 0, 1000);
   CheckIntRange("Contrast_window", contrast_window, 1, 100000);
   if (!fusion_weights.empty()) FusionWeights(-1);
+}
+
+AgreementOptions AgreementOf(const MatchingOptions& options) {
+  AgreementOptions a;
+  a.sequence_length = options.sequence_length;
+  a.partial = options.partial;
+  a.direction = options.direction;
+  a.partners = options.match_consistency > 0 ? options.match_consistency : 1;
+  return a;
 }
 
 std::vector<double> MatchingOptions::FusionWeights(int descriptors) const {

@@ -8,6 +8,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "matching/agreement.h"
 #include "matching/distances.h"
 #include "matching/panorama.h"
 #include "matching/score.h"
@@ -20,7 +21,7 @@ namespace openable {
 struct MatchingOptions {
   int sequence_length = 1;  // L: single-frame distances summed along a diagonal, 1..100000
   SequenceDirection direction = SequenceDirection::kForward;  // diagonals, anti-diagonals, both
-  SequencePartial partial = SequencePartial::kScale;  // cells with fewer than L terms
+  SequencePartial partial = SequencePartial::kAhead;  // cells with fewer than L terms
   PanoramaMatching panorama_matching = PanoramaMatching::kCrossCorrelation;  // panoramic frames
   double threshold = -1.0;  // theta of Eq. 9: -1 (no thresholded matrix) or a number in [0, 1]
   int threads = 0;          // worker threads for description and matching, 0..1024, 0 = all
@@ -29,6 +30,9 @@ struct MatchingOptions {
   int score_window = 10;
   // A query's best match is accepted when its score is <= this; -1: no threshold (in [0, 1]).
   double match_threshold = -1.0;
+  // n: an accepted best match also needs the best matches of n independent queries (one
+  // sequence apart, matching/agreement.h) to agree with it; 0: the score alone (0..1000).
+  int match_consistency = 0;
   // SeqSLAM's local contrast enhancement of the single-frame matrix (contrast.h), over
   // +-contrast_window references (1..100000).
   bool contrast_enhancement = false;
@@ -44,6 +48,10 @@ struct MatchingOptions {
   // Throws InputError naming the key of a value out of range.
   void Check() const;
 };
+
+// The agreement of best matches under these options (matching/agreement.h): L, Sequence_partial
+// and Sequence_direction, and Match_consistency partners (at least 1).
+AgreementOptions AgreementOf(const MatchingOptions& options);
 
 // Every row of `rows` against every row with `metric` (Distances), or, with strips > 1
 // (panoramic frames), PanoramaDistances with `mode`.
@@ -64,6 +72,6 @@ cv::Mat1f NormalizedDistanceMatrix(const cv::Mat& rows, int sequence_length,
                                    const std::vector<int>& traversal_starts, int threads,
                                    float* max_distance = nullptr,
                                    std::optional<Metric> metric = {},
-                                   SequencePartial partial = SequencePartial::kScale);
+                                   SequencePartial partial = SequencePartial::kAhead);
 
 }  // namespace openable

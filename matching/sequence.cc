@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <limits>
 #include <stdexcept>
 #include <thread>
 
@@ -113,7 +114,48 @@ void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, 
   });
 }
 
+// FillAheadCells on known traversals.
+void FillAhead(cv::Mat1f& s, int L, const Traversals& rows, const Traversals& cols,
+               bool reverse) {
+  if (L <= 1) return;
+  const int n = s.rows, m = s.cols;
+  // Columns that can go fewer than L - 1 steps back: the first L - 1 of each traversal along
+  // diagonals, the last L - 1 along anti-diagonals.
+  std::vector<int> edge;
+  for (int j = 0; j < m; ++j) {
+    const int tj = reverse ? cols.last[static_cast<size_t>(j)] - j
+                           : j - cols.first[static_cast<size_t>(j)];
+    if (tj < L - 1) edge.push_back(j);
+  }
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int i = 0; i < n; ++i) {
+    const int ti = i - rows.first[static_cast<size_t>(i)];
+    const int fi = rows.last[static_cast<size_t>(i)] - i;
+    auto fill = [&](int j) {
+      const int first = cols.first[static_cast<size_t>(j)];
+      const int last = cols.last[static_cast<size_t>(j)];
+      const int t = std::min(ti, reverse ? last - j : j - first);
+      if (t >= L - 1) return;
+      const int f = std::min(fi, reverse ? j - first : last - j);
+      const int shift = AheadShift(L, t, f);
+      s(i, j) = shift < 0 ? inf : s(i + shift, reverse ? j - shift : j + shift);
+    };
+    if (ti < L - 1) {
+      for (int j = 0; j < m; ++j) fill(j);
+    } else {
+      for (const int j : edge) fill(j);
+    }
+  }
+}
+
 }  // namespace
+
+void FillAheadCells(cv::Mat1f& s, int sequence_length, const std::vector<int>& row_starts,
+                    const std::vector<int>& col_starts, bool reverse) {
+  if (sequence_length < 1) throw std::logic_error("FillAheadCells: sequence length < 1");
+  FillAhead(s, sequence_length, Bounds(row_starts, s.rows, "row"),
+            Bounds(col_starts, s.cols, "column"), reverse);
+}
 
 void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length,
                               const std::vector<int>& row_starts,
@@ -124,16 +166,22 @@ void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length,
   const Traversals cols = Bounds(col_starts, d.cols, "column");
   if (sequence_length == 1 || d.empty()) return;
   threads = EffectiveThreads(threads);
+  const bool ahead = partial == SequencePartial::kAhead;
   if (direction == SequenceDirection::kBoth) {
     cv::Mat1f reverse = LargeMatrix(d.rows, d.cols);
     d.copyTo(reverse);
     Sweep(d, sequence_length, rows, cols, false, threads, partial);
     Sweep(reverse, sequence_length, rows, cols, true, threads, partial);
+    if (ahead) {
+      FillAhead(d, sequence_length, rows, cols, false);
+      FillAhead(reverse, sequence_length, rows, cols, true);
+    }
     cv::min(cv::InputArray(d), cv::InputArray(reverse), cv::OutputArray(d));
     return;
   }
-  Sweep(d, sequence_length, rows, cols, direction == SequenceDirection::kReverse, threads,
-        partial);
+  const bool reverse = direction == SequenceDirection::kReverse;
+  Sweep(d, sequence_length, rows, cols, reverse, threads, partial);
+  if (ahead) FillAhead(d, sequence_length, rows, cols, reverse);
 }
 
 cv::Mat1f SequenceDistances(const cv::Mat1f& d, int sequence_length,
@@ -150,7 +198,16 @@ cv::Mat1f SequenceDistances(const cv::Mat1f& d, int sequence_length,
 float SequenceCellDistance(const cv::Mat& queries, int q, const cv::Mat& references, int j,
                            int sequence_length, bool reverse, double* largest_term,
                            SequencePartial partial) {
-  const int steps_back = std::min(q, reverse ? references.rows - 1 - j : j);
+  int steps_back = std::min(q, reverse ? references.rows - 1 - j : j);
+  if (partial == SequencePartial::kAhead && steps_back < sequence_length - 1) {
+    const int steps_forward =
+        std::min(queries.rows - 1 - q, reverse ? j : references.rows - 1 - j);
+    const int shift = AheadShift(sequence_length, steps_back, steps_forward);
+    if (shift < 0) return std::numeric_limits<float>::infinity();
+    q += shift;
+    j += reverse ? -shift : shift;
+    steps_back += shift;
+  }
   const int terms = SequenceTerms(sequence_length, steps_back);
   double sum = 0;
   for (int k = 0; k < terms; ++k) {

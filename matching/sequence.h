@@ -14,10 +14,17 @@
 //
 // Early frames: where only c < L terms exist (the first L - 1 frames of a traversal; for
 // anti-diagonals, also the last L - 1 frames of the reference traversal), SequencePartial says
-// what the cell holds: kScale (the default) scales the sum of the c terms by L / c, i.e. the
-// mean distance along the available part of the diagonal times L (leaving the short sums
-// unscaled would make early frames look similar to everything); kSkip, the rule of
-// OpenSeqSLAM, makes the cell +inf: it is no candidate at all (docs/matching.md).
+// what the cell holds: kAhead (the default) takes the window of L frames that starts where the
+// diagonal enters both traversals, i.e. the cell L - 1 - c steps further along the diagonal,
+// looking ahead where it cannot look back (a centred window at a traversal's start, as SeqSLAM's
+// centred sequences), so every cell is a sum of L terms and none wins more often for having
+// fewer; a diagonal holding fewer than L frames in all has no such window and its cells are
+// +inf. kScale scales the sum of the c terms by L / c, i.e. the mean distance along the
+// available part of the diagonal times L (leaving the short sums unscaled would make early
+// frames look similar to everything; scaled, their few terms still make them noisier than the
+// rest, and some become attractors). kSkip, the rule of OpenSeqSLAM, makes the cell +inf: it
+// is no candidate at all, and the first L - 1 queries of a traversal get no answer
+// (docs/matching.md compares the three).
 //
 // Cost: one pass over the matrix whatever L is. Row i is obtained from row i - 1 by the running
 // sum S(i, j) = S(i - 1, j -+ 1) + D(i, j) - D(i - L, j -+ L), kept in double precision, with
@@ -42,9 +49,10 @@ OPENABLE_ENUM_NAMES(SequenceDirection, "forward", "reverse", "both")
 // ..." otherwise (a ValueError in Python); `what` names the argument ("traversal_starts").
 void CheckTraversalStarts(const std::vector<int>& starts, int n, const char* what);
 
-// A cell with fewer than L terms (see above): scaled up to L terms, or skipped (+inf).
-enum class SequencePartial { kScale, kSkip };
-OPENABLE_ENUM_NAMES(SequencePartial, "scale", "skip")
+// A cell with fewer than L terms (see above): scaled up to L terms, skipped (+inf), or the
+// window of L frames ahead of it along its diagonal.
+enum class SequencePartial { kScale, kSkip, kAhead };
+OPENABLE_ENUM_NAMES(SequencePartial, "scale", "skip", "ahead")
 
 // The terms of S(i, j) that exist: min(L, t + 1), t being the steps the diagonal can go back
 // from (i, j) without leaving the traversal of i or that of j.
@@ -53,26 +61,46 @@ inline int SequenceTerms(int sequence_length, int steps_back) {
 }
 
 // The sum of `terms` single-frame distances scaled to L terms (L / terms, when terms < L) and
-// rounded to float, or +inf for a partial sum with kSkip: how every sequence distance is
-// finished, in the matrix sweep below and in SequenceCellDistance.
+// rounded to float, or +inf for a partial sum with kSkip and kAhead (kAhead then replaces the
+// cell by AheadShift's): how every sequence distance is finished, in the matrix sweep below
+// and in SequenceCellDistance.
 inline float ScaleSequenceSum(double sum, int terms, int sequence_length,
-                              SequencePartial partial = SequencePartial::kScale) {
+                              SequencePartial partial) {
   if (terms == sequence_length) return static_cast<float>(sum);
-  if (partial == SequencePartial::kSkip) return std::numeric_limits<float>::infinity();
+  if (partial != SequencePartial::kScale) return std::numeric_limits<float>::infinity();
   return static_cast<float>(sum * sequence_length / terms);
 }
 
+// kAhead: a cell whose diagonal can go `steps_back` steps back and `steps_forward` steps
+// forward without leaving the traversal of its row or that of its column takes the sum of the
+// cell this many steps forward along the diagonal (0: the cell has its L terms itself); -1
+// when the diagonal holds fewer than L frames in all (the cell is +inf).
+inline int AheadShift(int sequence_length, int steps_back, int steps_forward) {
+  if (steps_back >= sequence_length - 1) return 0;
+  if (steps_back + steps_forward + 1 < sequence_length) return -1;
+  return sequence_length - 1 - steps_back;
+}
+
 // S(q, j) of one cell, straight from descriptor rows, for searches that score a few cells
-// (approximate candidates, the online detector): `queries` holds the query traversal from its
-// first frame (row q is frame q) and `references` the reference traversal (row j is frame j);
-// the terms are RowDistance (matching/distances.h) of (q - k, j - k), or (q - k, j + k) when
-// `reverse`, for as many k < L as both traversals hold, summed in double and scaled by
-// ScaleSequenceSum. Equal to the cell of SequenceDistances up to float rounding (exactly for
-// Hamming rows). `largest_term`, when given, is raised to the largest single-frame distance
-// summed.
+// (approximate candidates, the online detector): `queries` holds the query traversal (row q is
+// frame q; with kAhead all of it, since an early cell reads frames after q) and `references`
+// the reference traversal (row j is frame j); the terms are RowDistance
+// (matching/distances.h) of (q - k, j - k), or (q - k, j + k) when `reverse`, for as many
+// k < L as both traversals hold, summed in double and finished by ScaleSequenceSum (kAhead:
+// the cell AheadShift steps forward). Equal to the cell of SequenceDistances up to float
+// rounding (exactly for Hamming rows). `largest_term`, when given, is raised to the largest
+// single-frame distance summed.
 float SequenceCellDistance(const cv::Mat& queries, int q, const cv::Mat& references, int j,
                            int sequence_length, bool reverse, double* largest_term = nullptr,
-                           SequencePartial partial = SequencePartial::kScale);
+                           SequencePartial partial = SequencePartial::kAhead);
+
+// kAhead after a sweep that left every cell with fewer than L terms +inf (kSkip): each such
+// cell takes the value of the cell AheadShift steps forward along its diagonal (a cell with L
+// terms, never changed here), or stays +inf. `row_starts`/`col_starts` and `reverse` as for
+// SequenceDistancesInPlace. Used by it, and by a run spread over processes on the gathered
+// matrix (normalised cells are copied as they are).
+void FillAheadCells(cv::Mat1f& s, int sequence_length, const std::vector<int>& row_starts,
+                    const std::vector<int>& col_starts, bool reverse);
 
 // D: N x M single-frame distances (rows: frames i, columns: frames j), replaced by S.
 // `row_starts` and `col_starts` are the first frame of each traversal along the rows and the
@@ -84,7 +112,7 @@ void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length,
                               const std::vector<int>& col_starts = {},
                               SequenceDirection direction = SequenceDirection::kForward,
                               int threads = 0,
-                              SequencePartial partial = SequencePartial::kScale);
+                              SequencePartial partial = SequencePartial::kAhead);
 
 // The same, returning S in a new matrix and leaving D as it is.
 cv::Mat1f SequenceDistances(const cv::Mat1f& d, int sequence_length,
@@ -92,6 +120,6 @@ cv::Mat1f SequenceDistances(const cv::Mat1f& d, int sequence_length,
                             const std::vector<int>& col_starts = {},
                             SequenceDirection direction = SequenceDirection::kForward,
                             int threads = 0,
-                            SequencePartial partial = SequencePartial::kScale);
+                            SequencePartial partial = SequencePartial::kAhead);
 
 }  // namespace openable

@@ -297,13 +297,18 @@ OnlineResult OnlineDetector::State::Search(const cv::Mat& row) {
   const int searchable = q - s.options.exclusion + 1;  // frames j <= q - exclusion
   if (searchable > 0) {
     s.map->Update(searchable);
-    // Each candidate frame is scored by its exact sequence sum (one traversal, forward).
+    // Each candidate frame is scored by its exact sequence sum (one traversal, forward). The
+    // frames after the query are not known yet, so a candidate among the first L - 1 frames
+    // (a sum with fewer than L terms) is scaled up to L terms (Sequence_partial scale): the
+    // batch run's default, ahead, would read frames the detector has not seen.
     const cv::Mat rows = s.map->Rows();
     double* largest = s.type == CV_32F ? &s.unit : nullptr;
     std::vector<std::pair<double, int>> scored;
     for (const int j : s.map->Candidates(row, searchable, &r.approximate))
       scored.emplace_back(
-          SequenceCellDistance(rows, q, rows, j, s.options.sequence_length, false, largest), j);
+          SequenceCellDistance(rows, q, rows, j, s.options.sequence_length, false, largest,
+                               SequencePartial::kScale),
+          j);
     // The candidates returned: the k best, or with verification the k best at distinct places
     // (the choice of Test_OpenABLE's verification, DistinctBest).
     std::vector<std::size_t> chosen;

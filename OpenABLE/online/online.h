@@ -43,7 +43,10 @@ struct OnlineOptions {
   int sad_patch = 8;  // SAD (DescribeImages only): side of the normalised squares (Sad_patch)
   int grid_x = 1, grid_y = 1;
   // Matching.
-  int sequence_length = 1;  // L (the key Image_sequences): frames summed along the diagonal
+  // L (the key Image_sequences): frames summed along the diagonal. A candidate among the first
+  // L - 1 frames has fewer terms, scaled up to L (Sequence_partial scale): the frames after a
+  // query, which a batch run's default (ahead) reads, are not known yet.
+  int sequence_length = 1;
   int exclusion = 100;      // frame q's candidates are frames j <= q - exclusion (>= 1)
   int candidates = 5;       // candidates returned per frame (the k best), >= 1
   // The confidence of a candidate (matching/score.h, the key Match_score): its normalised
@@ -212,6 +215,6 @@ cv::Mat1f DistanceMatrix(const cv::Mat& rows, int sequence_length = 1,
                          SequenceDirection direction = SequenceDirection::kForward,
                          const std::vector<int>& traversal_starts = {}, int threads = 0,
                          float* max_distance = nullptr, std::optional<Metric> metric = {},
-                         SequencePartial partial = SequencePartial::kScale);
+                         SequencePartial partial = SequencePartial::kAhead);
 
 }  // namespace openable

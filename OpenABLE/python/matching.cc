@@ -164,17 +164,18 @@ Raises:
       },
       py::arg("d"), py::arg("sequence_length"), py::arg("direction") = "forward",
       py::arg("row_starts") = py::none(), py::arg("col_starts") = py::none(),
-      py::arg("threads") = 0, py::arg("in_place") = false, py::arg("partial") = "scale",
+      py::arg("threads") = 0, py::arg("in_place") = false, py::arg("partial") = "ahead",
       R"doc(sequence_distances(d, sequence_length, direction="forward", row_starts=None,
-    col_starts=None, threads=0, in_place=False, partial="scale") -> numpy.ndarray
+    col_starts=None, threads=0, in_place=False, partial="ahead") -> numpy.ndarray
 
 Sequence matching (ABLE, after SeqSLAM): the distance of the places of frames i and j is the
 sum of the L single-frame distances along the diagonal ending at (i, j):
 forward S(i, j) = sum_k D(i-k, j-k), reverse S(i, j) = sum_k D(i-k, j+k) (the reference
 route driven the other way), both = the smaller of the two; k = 0 .. L-1. Where fewer than L
-terms exist (the first frames of a traversal) the available terms are scaled to L
-(partial="scale") or the cell holds +inf (partial="skip", OpenSeqSLAM's rule). Sums never
-cross from one traversal into another. One pass whatever L.
+terms exist (the first frames of a traversal) the cell takes the L frames ahead of it along
+its diagonal (partial="ahead"; +inf when the whole diagonal is shorter than L), the available
+terms are scaled to L (partial="scale") or the cell holds +inf (partial="skip", OpenSeqSLAM's
+rule). Sums never cross from one traversal into another. One pass whatever L.
 
 Args:
     d (numpy.ndarray): shape (N, M) single-frame distances (float32 is read in place; other
@@ -187,7 +188,7 @@ Args:
     threads (int): threads; 0 = all cores.
     in_place (bool): overwrite `d` (a writable float32 array with contiguous rows) and return
         it, instead of returning a new matrix.
-    partial (str): "scale" or "skip" (Sequence_partial).
+    partial (str): "ahead", "scale" or "skip" (Sequence_partial).
 
 Returns:
     numpy.ndarray: float32, shape (N, M).

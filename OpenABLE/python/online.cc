@@ -338,9 +338,9 @@ Raises:
       py::arg("rows"), py::arg("sequence_length") = 1, py::arg("direction") = "forward",
       py::arg("traversal_starts") = py::none(), py::arg("threads") = 0,
       py::arg("return_max") = false, py::arg("metric") = py::none(),
-      py::arg("partial") = "scale",
+      py::arg("partial") = "ahead",
       R"doc(distance_matrix(rows, sequence_length=1, direction="forward", traversal_starts=None,
-    threads=0, return_max=False, metric=None, partial="scale") -> numpy.ndarray
+    threads=0, return_max=False, metric=None, partial="ahead") -> numpy.ndarray
 
 The normalised matrix M' of Test_OpenABLE over descriptor rows: distances between all rows
 (Hamming for uint8 rows, L2 for float32, or `metric`), summed along sequences of L frames
@@ -357,11 +357,12 @@ Args:
     return_max (bool): also return the divisor max(M).
     metric (str | None): "hamming" or "l1" (uint8 rows; l1 for SAD's rows) or "l2" (float32
         rows); None: by the rows' type.
-    partial (str): "scale" or "skip" (Sequence_partial): cells with fewer than L frames
-        before them are scaled up, or hold +inf (never a best match).
+    partial (str): "ahead", "scale" or "skip" (Sequence_partial): cells with fewer than L
+        frames before them take the L frames ahead of them on their diagonal, are scaled
+        up, or hold +inf (never a best match).
 
 Returns:
-    numpy.ndarray: float32 (N, N) in [0, 1] (+inf for skipped cells), owning the C++ result
+    numpy.ndarray: float32 (N, N) in [0, 1] (+inf for cells without a value), owning the C++ result
     (no copy); or (matrix, max) with return_max=True.)doc");
 
   BindOnlineOptions(m);

@@ -71,14 +71,18 @@ inline cv::Mat1f ReadNpy(const std::string& path) {
 }
 
 // Share of query rows [q0, q0+n) whose smallest distance among reference columns
-// [r0, r0+m) lies within `tol` frames of the aligned frame (frame-aligned traversals).
+// [r0, r0+m) lies within `tol` frames of the aligned frame (frame-aligned traversals). Cells
+// without a value (NaN in a saved .npy, +inf in memory) are never the smallest; a row without
+// any value is a miss.
 inline double AlignedRecallAt1(const cv::Mat1f& d, int q0, int r0, int n, int tol) {
   int hits = 0;
   for (int q = 0; q < n; ++q) {
-    int best = 0;
-    for (int r = 1; r < n; ++r)
-      if (d(q0 + q, r0 + r) < d(q0 + q, r0 + best)) best = r;
-    hits += std::abs(best - q) <= tol;
+    int best = -1;
+    for (int r = 0; r < n; ++r) {
+      const float v = d(q0 + q, r0 + r);
+      if (std::isfinite(v) && (best < 0 || v < d(q0 + q, r0 + best))) best = r;
+    }
+    hits += best >= 0 && std::abs(best - q) <= tol;
   }
   return static_cast<double>(hits) / n;
 }
@@ -86,18 +90,20 @@ inline double AlignedRecallAt1(const cv::Mat1f& d, int q0, int r0, int n, int to
 // Brute force over two traversals of `n` frames each (references rows/columns 0..n-1, queries
 // rows first_query..first_query+n-1): the queries whose best reference (smallest distance,
 // lowest column on ties) has a ratio to the smallest distance more than `window` columns away
-// (1 without such a rival, or when it is 0) of at most `threshold`.
+// (1 without such a rival, or when it is 0) of at most `threshold`. Cells without a value (NaN,
+// +inf) are neither best matches nor rivals.
 inline int AcceptedByRatio(const cv::Mat1f& m, int first_query, int n, int window,
                            float threshold) {
   int accepted = 0;
   for (int q = first_query; q < first_query + n; ++q) {
-    int best = 0;
-    for (int c = 1; c < n; ++c)
-      if (m(q, c) < m(q, best)) best = c;
+    int best = -1;
+    for (int c = 0; c < n; ++c)
+      if (std::isfinite(m(q, c)) && (best < 0 || m(q, c) < m(q, best))) best = c;
+    if (best < 0) continue;
     float rival = std::numeric_limits<float>::infinity();
     for (int c = 0; c < n; ++c)
-      if (std::abs(c - best) > window) rival = std::min(rival, m(q, c));
-    accepted += (rival > 0 ? m(q, best) / rival : 1.0f) <= threshold;
+      if (std::abs(c - best) > window && std::isfinite(m(q, c))) rival = std::min(rival, m(q, c));
+    accepted += (std::isfinite(rival) && rival > 0 ? m(q, best) / rival : 1.0f) <= threshold;
   }
   return accepted;
 }

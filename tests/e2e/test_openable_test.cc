@@ -74,7 +74,10 @@ TEST(TestOpenABLE, ApproximateRunWithTheAutoEngineUsesAndNamesTheResolvedIndex) 
         << automatic.out;
     EXPECT_NE(named.out.find("index " + resolved + "\n"), std::string::npos) << named.out;
     const std::string kept = ReadAll(dir + "/out/auto.csv");
-    EXPECT_GE(std::count(kept.begin(), kept.end(), '\n'), 3000);  // 10 for each of 300 queries
+    // 10 for each of 300 queries, but for the last queries' candidates among the first
+    // references: their diagonals hold fewer than L = 10 frames (no value, Sequence_partial
+    // ahead), at most 9 such cells per query over the last 9 queries.
+    EXPECT_GE(std::count(kept.begin(), kept.end(), '\n'), 3000 - 45);
     EXPECT_EQ(kept, ReadAll(dir + "/out/named.csv"));
   }
 }

@@ -23,19 +23,21 @@ cv::Mat RandomBinary(int rows, int cols, unsigned seed) {
   return m;
 }
 
-// Brute force: every cell, sorted by (distance, reference), the first k kept.
+// Brute force: every cell with a value, sorted by (distance, reference), the first k kept.
 std::vector<Match> SortedRow(const cv::Mat1f& s, int row, int q, int first, int count,
                              const KeepRules& rules) {
   std::vector<std::pair<float, int>> all;
   for (int j = 0; j < count; ++j)
-    if (!rules.one_traversal || j <= q - rules.exclusion) all.emplace_back(s(row, first + j), j);
+    if ((!rules.one_traversal || j <= q - rules.exclusion) && std::isfinite(s(row, first + j)))
+      all.emplace_back(s(row, first + j), j);
   std::sort(all.begin(), all.end());
   std::vector<Match> out;
   for (int r = 0; r < std::min<int>(rules.best, static_cast<int>(all.size())); ++r)
     out.push_back({q, all[r].second, all[r].first, r + 1});
   for (int j = std::max(0, q - rules.band);
        rules.band >= 0 && j <= std::min(count - 1, q + rules.band); ++j)
-    if (std::none_of(out.begin(), out.end(),
+    if (std::isfinite(s(row, first + j)) &&
+        std::none_of(out.begin(), out.end(),
                      [&](const Match& m) { return m.rank > 0 && m.reference == j; }))
       out.push_back({q, j, s(row, first + j), 0});
   return out;
@@ -52,10 +54,12 @@ void ExpectSame(const std::vector<Match>& a, const std::vector<Match>& b, float 
 }
 
 // The fused run against the dense matrix computed by the separate, tested pieces, then
-// selected by brute force: one traversal (exclusion) and two (cross block), several L and
-// every direction, with ranges of a few rows so that many range starts are crossed.
+// selected by brute force: one traversal (exclusion) and two (cross block), several L, every
+// direction, Sequence_partial scale and ahead, with ranges of a few rows so that many range
+// starts (and ends, which ahead reads past) are crossed.
 TEST(BoundedMatches, EqualsBruteForceSelectionOfTheDenseMatrix) {
   const cv::Mat d = RandomBinary(150, 32, 3);
+  for (const SequencePartial partial : {SequencePartial::kScale, SequencePartial::kAhead})
   for (int traversals : {1, 2}) {
     const std::vector<int> starts = traversals == 1 ? std::vector<int>{0} : std::vector<int>{0, 70};
     const MatchBlock block = BlockOf(starts, d.rows);
@@ -68,16 +72,18 @@ TEST(BoundedMatches, EqualsBruteForceSelectionOfTheDenseMatrix) {
       for (auto dir : {SequenceDirection::kForward, SequenceDirection::kReverse,
                        SequenceDirection::kBoth}) {
         SCOPED_TRACE("traversals " + std::to_string(traversals) + " L " + std::to_string(L) +
-                     " direction " + std::to_string(static_cast<int>(dir)));
+                     " direction " + std::to_string(static_cast<int>(dir)) + " partial " +
+                     EnumName(partial));
         // Dense: the block of the full matrix, with sums restricted to the block's traversals.
         cv::Mat1f full = HammingDistances(d);
-        SequenceDistancesInPlace(full, L, starts, starts, dir);
+        SequenceDistancesInPlace(full, L, starts, starts, dir, 0, partial);
         std::vector<Match> expected;
         float block_max = 0;
         for (int q = 0; q < block.query_count; ++q) {
           const int row = block.query_first + q;
           for (int j = 0; j < block.reference_count; ++j)
-            block_max = std::max(block_max, full(row, block.reference_first + j));
+            if (std::isfinite(full(row, block.reference_first + j)))
+              block_max = std::max(block_max, full(row, block.reference_first + j));
           for (const Match& m : SortedRow(full, row, q, block.reference_first,
                                           block.reference_count, rules))
             expected.push_back(m);
@@ -85,6 +91,7 @@ TEST(BoundedMatches, EqualsBruteForceSelectionOfTheDenseMatrix) {
         BoundedOptions options;
         options.sequence_length = L;
         options.direction = dir;
+        options.partial = partial;
         options.range_rows = 7;  // many ranges, each starting L - 1 rows early
         float max_distance = 0;
         const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
@@ -93,6 +100,28 @@ TEST(BoundedMatches, EqualsBruteForceSelectionOfTheDenseMatrix) {
       }
     }
   }
+}
+
+// The hand-worked example of Match_consistency (tests/evaluation/metrics_test.cc) on the
+// matches of rank 1: 30 queries answering reference q + 100 at score 0.5, but query 15 (900,
+// 0.2) and query 25 (125, 0.95); threshold 0.9, L = 1, scale: the score alone accepts all but
+// 25; one partner (10 queries apart) also refuses 15 and 5 (whose partner is 15).
+TEST(AcceptedMatches, ConsistencyByHand) {
+  std::vector<Match> matches;
+  for (int q = 0; q < 30; ++q) {
+    matches.push_back({q, q == 15 ? 900 : q + 100, 0.5f, 1, q == 15 ? 0.2f : 0.5f});
+    matches.push_back({q, 400 + q, 0.7f, 2, 0.7f});  // rank 2: never an answer
+  }
+  matches[50].score = 0.95f;  // query 25's rank-1 match
+  const std::vector<std::uint8_t> alone = AcceptedMatches(matches, 30, 0.9);
+  EXPECT_EQ(std::count(alone.begin(), alone.end(), 1), 29);
+  EXPECT_EQ(alone[25], 0);
+  AgreementOptions a;
+  a.sequence_length = 1;
+  a.partial = SequencePartial::kScale;
+  const std::vector<std::uint8_t> confirmed = AcceptedMatches(matches, 30, 0.9, &a);
+  EXPECT_EQ(std::count(confirmed.begin(), confirmed.end(), 1), 27);
+  for (int q : {5, 15, 25}) EXPECT_EQ(confirmed[q], 0) << q;
 }
 
 TEST(MatchesFromMatrix, SameSelectionAsBoundedOnOneTraversal) {
@@ -149,7 +178,7 @@ TEST(BoundedMatches, VectorDescriptorsWithSequencesEqualTheDenseMatrix) {
     for (int q = 0; q < block.query_count; ++q) {
       const int row = block.query_first + q;
       for (int j = 0; j < block.reference_count; ++j)
-        block_max = std::max(block_max, full(row, j));
+        if (std::isfinite(full(row, j))) block_max = std::max(block_max, full(row, j));
       for (const Match& m : SortedRow(full, row, q, 0, block.reference_count, rules))
         expected.push_back(m);
     }
@@ -204,11 +233,13 @@ TEST(ApproximateMatches, FindsPlantedDuplicatesWithExactScores) {
 }
 
 
-// Sequence_partial skip, the ratio score and the L1 distance of SAD rows: the fused run against
-// the dense matrix of the tested pieces, selected and scored by brute force (empty cells never
-// kept; the ratio of a kept match over the best finite candidate more than the window away).
-TEST(BoundedMatches, SkipCellsAndRatioScoresEqualBruteForce) {
+// Sequence_partial skip and ahead, the ratio score and the L1 distance of SAD rows: the fused
+// run against the dense matrix of the tested pieces, selected and scored by brute force (empty
+// cells never kept; the ratio of a kept match over the best finite candidate more than the
+// window away). Ahead's early cells come from rows a range computes past its end.
+TEST(BoundedMatches, SkipAndAheadCellsAndRatioScoresEqualBruteForce) {
   const cv::Mat d = RandomBinary(120, 64, 9);
+  for (const SequencePartial partial : {SequencePartial::kSkip, SequencePartial::kAhead})
   for (int traversals : {1, 2}) {
     const std::vector<int> starts =
         traversals == 1 ? std::vector<int>{0} : std::vector<int>{0, 50};
@@ -219,11 +250,13 @@ TEST(BoundedMatches, SkipCellsAndRatioScoresEqualBruteForce) {
     rules.one_traversal = block.one_traversal;
     rules.score = MatchScore::kRatio;
     rules.score_window = 4;
-    for (auto dir : {SequenceDirection::kForward, SequenceDirection::kReverse}) {
+    for (auto dir : {SequenceDirection::kForward, SequenceDirection::kReverse,
+                     SequenceDirection::kBoth}) {
       const int L = 6;
-      SCOPED_TRACE("traversals " + std::to_string(traversals));
+      SCOPED_TRACE("traversals " + std::to_string(traversals) + " partial " +
+                   EnumName(partial) + " direction " + std::to_string(static_cast<int>(dir)));
       cv::Mat1f full = L1Distances(d);
-      SequenceDistancesInPlace(full, L, starts, starts, dir, 0, SequencePartial::kSkip);
+      SequenceDistancesInPlace(full, L, starts, starts, dir, 0, partial);
       float block_max = 0;
       std::vector<Match> expected;
       for (int q = 0; q < block.query_count; ++q) {
@@ -249,7 +282,7 @@ TEST(BoundedMatches, SkipCellsAndRatioScoresEqualBruteForce) {
       options.metric = Metric::kL1;
       options.sequence_length = L;
       options.direction = dir;
-      options.partial = SequencePartial::kSkip;
+      options.partial = partial;
       options.range_rows = 7;
       float max_distance = 0;
       const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
@@ -259,7 +292,12 @@ TEST(BoundedMatches, SkipCellsAndRatioScoresEqualBruteForce) {
         EXPECT_NEAR(got[k].score, expected[k].score, 1e-5) << k;
       // The first L - 1 queries of a traversal have no complete sequence along diagonals.
       if (dir == SequenceDirection::kForward && traversals == 2) {
-        for (const Match& m : got) EXPECT_GE(m.query, L - 1);
+        const auto first = std::min_element(got.begin(), got.end(), [](auto& a, auto& b) {
+          return a.query < b.query;
+        });
+        ASSERT_NE(first, got.end());
+        // skip: none before L - 1; ahead: the first query is answered.
+        EXPECT_EQ(first->query, partial == SequencePartial::kSkip ? L - 1 : 0);
       }
     }
   }

@@ -58,7 +58,8 @@ TEST(SequenceDistances, LengthOneIsTheInput) {
 
 TEST(SequenceDistances, HandWorkedThreeByThree) {
   cv::Mat1f d = (cv::Mat1f(3, 3) << 1, 2, 3, 4, 5, 6, 7, 8, 9);
-  const cv::Mat1f s = SequenceDistances(d, 2);
+  const cv::Mat1f s = SequenceDistances(d, 2, {}, {}, SequenceDirection::kForward, 0,
+                                        SequencePartial::kScale);
   // (2,2): d(2,2) + d(1,1) = 9 + 5; (1,2): 6 + 2; (2,1): 8 + 4;
   // (0,0): one term, 1 scaled by 2/1; (2,0): 7 * 2.
   EXPECT_FLOAT_EQ(s(2, 2), 14.f);
@@ -71,7 +72,8 @@ TEST(SequenceDistances, HandWorkedThreeByThree) {
 TEST(SequenceDistances, MatchesNaiveLoopForSeveralLengths) {
   const cv::Mat1f d = Random(41, 33, 3);
   for (int L : {1, 2, 3, 5, 10, 40, 60}) {
-    const cv::Mat1f fast = SequenceDistances(d, L);
+    const cv::Mat1f fast = SequenceDistances(d, L, {}, {}, SequenceDirection::kForward, 0,
+                                             SequencePartial::kScale);
     const cv::Mat1f slow = NaiveSequence(d, L, {0}, {0});
     for (int i = 0; i < d.rows; ++i)
       for (int j = 0; j < d.cols; ++j)
@@ -84,7 +86,8 @@ TEST(SequenceDistances, SumsNeverCrossTraversals) {
   const cv::Mat1f d = Random(45, 45, 4);
   const std::vector<int> starts = {0, 20};
   for (int L : {1, 4, 10, 25}) {
-    const cv::Mat1f fast = SequenceDistances(d, L, starts, starts);
+    const cv::Mat1f fast = SequenceDistances(d, L, starts, starts, SequenceDirection::kForward,
+                                             0, SequencePartial::kScale);
     const cv::Mat1f slow = NaiveSequence(d, L, starts, starts);
     for (int i = 0; i < d.rows; ++i)
       for (int j = 0; j < d.cols; ++j)
@@ -105,13 +108,17 @@ TEST(SequenceDistances, ReverseAndBothMatchNaiveLoops) {
       for (int j = 0; j < d.cols; ++j) both(i, j) = std::min(fwd(i, j), rev(i, j));
     for (int threads : {1, 2, 3}) {
       cv::Mat1f in_place = d.clone();
-      SequenceDistancesInPlace(in_place, L, rows, cols, SequenceDirection::kReverse, threads);
+      const SequencePartial scale = SequencePartial::kScale;
+      SequenceDistancesInPlace(in_place, L, rows, cols, SequenceDirection::kReverse, threads,
+                               scale);
       EXPECT_LE(cv::norm(in_place, rev, cv::NORM_INF), 1e-3) << "L=" << L << " t=" << threads;
-      EXPECT_LE(cv::norm(SequenceDistances(d, L, rows, cols, SequenceDirection::kForward, threads),
+      EXPECT_LE(cv::norm(SequenceDistances(d, L, rows, cols, SequenceDirection::kForward, threads,
+                                           scale),
                          fwd, cv::NORM_INF),
                 1e-3)
           << "L=" << L << " t=" << threads;
-      EXPECT_LE(cv::norm(SequenceDistances(d, L, rows, cols, SequenceDirection::kBoth, threads),
+      EXPECT_LE(cv::norm(SequenceDistances(d, L, rows, cols, SequenceDirection::kBoth, threads,
+                                           scale),
                          both, cv::NORM_INF),
                 1e-3)
           << "L=" << L << " t=" << threads;
@@ -160,6 +167,122 @@ TEST(SequenceDistances, SkipLeavesExactlyTheIncompleteCellsEmpty) {
         EXPECT_NE(r(L - 1, 120 - L), inf);
       }
     }
+  }
+}
+
+// Naive definition of Sequence_partial ahead, written from the rule and not from AheadShift:
+// list the cells of (i, j)'s diagonal that lie in the traversal of i and in that of j, in order;
+// with fewer than L of them the cell is +inf; at position p >= L - 1 it sums cells p - L + 1 ..
+// p, and before that the first L cells of the diagonal.
+cv::Mat1f NaiveAhead(const cv::Mat1f& d, int L, const std::vector<int>& rs,
+                     const std::vector<int>& cs, bool reverse = false) {
+  cv::Mat1f out(d.size());
+  for (int i = 0; i < d.rows; ++i)
+    for (int j = 0; j < d.cols; ++j) {
+      const int r0 = StartOf(rs, i), r1 = EndOf(rs, i, d.rows);
+      const int c0 = StartOf(cs, j), c1 = EndOf(cs, j, d.cols);
+      const int dj = reverse ? -1 : 1;  // the column's step as the row goes forward
+      int a = i, b = j;                 // walk back to where the diagonal enters
+      while (a - 1 >= r0 && b - dj >= c0 && b - dj < c1) --a, b -= dj;
+      std::vector<std::pair<int, int>> cells;
+      for (int x = a, y = b; x < r1 && y >= c0 && y < c1; ++x, y += dj) cells.emplace_back(x, y);
+      const int p = i - a;
+      if (static_cast<int>(cells.size()) < L) {
+        out(i, j) = std::numeric_limits<float>::infinity();
+        continue;
+      }
+      const int first = p >= L - 1 ? p - L + 1 : 0;
+      double sum = 0;
+      for (int k = first; k < first + L; ++k) sum += d(cells[k].first, cells[k].second);
+      out(i, j) = static_cast<float>(sum);
+    }
+  return out;
+}
+
+// Sequence_partial ahead: every cell against the naive rule, along diagonals, anti-diagonals
+// and both, with two traversals along rows and three along columns, on 1-3 threads; cells of
+// diagonals shorter than L are +inf, and no finite cell sums fewer than L terms.
+TEST(SequenceDistances, AheadMatchesTheNaiveRule) {
+  const cv::Mat1f d = Random(45, 300, 12);
+  const std::vector<int> rows = {0, 20}, cols = {0, 120, 250};
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int L : {1, 2, 3, 10, 25, 60}) {
+    const cv::Mat1f fwd = NaiveAhead(d, L, rows, cols);
+    const cv::Mat1f rev = NaiveAhead(d, L, rows, cols, true);
+    for (int threads : {1, 2, 3}) {
+      const auto got = [&](SequenceDirection dir) {
+        return SequenceDistances(d, L, rows, cols, dir, threads, SequencePartial::kAhead);
+      };
+      const cv::Mat1f f = got(SequenceDirection::kForward), r = got(SequenceDirection::kReverse),
+                      b = got(SequenceDirection::kBoth);
+      for (int i = 0; i < d.rows; ++i)
+        for (int j = 0; j < d.cols; ++j) {
+          const float both = std::min(fwd(i, j), rev(i, j));
+          ASSERT_EQ(f(i, j) == inf, fwd(i, j) == inf) << "L=" << L << " at " << i << "," << j;
+          ASSERT_EQ(r(i, j) == inf, rev(i, j) == inf) << "L=" << L << " at " << i << "," << j;
+          ASSERT_EQ(b(i, j) == inf, both == inf) << "L=" << L << " at " << i << "," << j;
+          if (fwd(i, j) != inf) {
+            ASSERT_NEAR(f(i, j), fwd(i, j), 1e-3) << L << " " << i << "," << j;
+          }
+          if (rev(i, j) != inf) {
+            ASSERT_NEAR(r(i, j), rev(i, j), 1e-3) << L << " " << i << "," << j;
+          }
+          if (both != inf) {
+            ASSERT_NEAR(b(i, j), both, 1e-3) << L << " " << i << "," << j;
+          }
+        }
+    }
+  }
+  // By hand, L = 3 on one 4 x 4 traversal: (0, 1) sums (0,1), (1,2), (2,3) = 2 + 7 + 12;
+  // (1, 0) sums (1,0), (2,1), (3,2) = 5 + 10 + 15; (0, 2) has a diagonal of two cells: +inf;
+  // (3, 3) sums its own three.
+  const cv::Mat1f h = (cv::Mat1f(4, 4) << 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16);
+  const cv::Mat1f s = SequenceDistances(h, 3, {}, {}, SequenceDirection::kForward, 1,
+                                        SequencePartial::kAhead);
+  EXPECT_FLOAT_EQ(s(0, 1), 21.f);
+  EXPECT_FLOAT_EQ(s(1, 0), 30.f);
+  EXPECT_EQ(s(0, 2), inf);
+  EXPECT_FLOAT_EQ(s(3, 3), 16.f + 11.f + 6.f);
+  EXPECT_FLOAT_EQ(s(0, 0), s(2, 2));
+}
+
+// FillAheadCells on a matrix swept with skip gives the ahead matrix (what a run over several
+// processes does once it has gathered its rows).
+TEST(SequenceDistances, FillAheadCellsCompletesASkipSweep) {
+  const cv::Mat1f d = Random(45, 300, 13);
+  const std::vector<int> rows = {0, 20}, cols = {0, 120, 250};
+  for (const bool reverse : {false, true}) {
+    const SequenceDirection dir = reverse ? SequenceDirection::kReverse
+                                          : SequenceDirection::kForward;
+    cv::Mat1f skip = SequenceDistances(d, 10, rows, cols, dir, 2, SequencePartial::kSkip);
+    FillAheadCells(skip, 10, rows, cols, reverse);
+    const cv::Mat1f ahead = SequenceDistances(d, 10, rows, cols, dir, 2, SequencePartial::kAhead);
+    EXPECT_EQ(cv::norm(skip != ahead, cv::NORM_L1), 0.0) << reverse;
+  }
+}
+
+// SequenceCellDistance with ahead gives the matrix's cell, for early cells too (queries and
+// references as separate traversals).
+TEST(SequenceDistances, CellDistanceAheadEqualsTheMatrix) {
+  cv::RNG rng(14);
+  cv::Mat queries(30, 8, CV_8U), references(25, 8, CV_8U);
+  rng.fill(queries, cv::RNG::UNIFORM, 0, 256);
+  rng.fill(references, cv::RNG::UNIFORM, 0, 256);
+  cv::Mat1f single(30, 25);
+  for (int q = 0; q < 30; ++q)
+    for (int j = 0; j < 25; ++j)
+      single(q, j) = static_cast<float>(cv::norm(queries.row(q), references.row(j),
+                                                 cv::NORM_HAMMING));
+  for (const bool reverse : {false, true}) {
+    const cv::Mat1f s = SequenceDistances(
+        single, 7, {}, {}, reverse ? SequenceDirection::kReverse : SequenceDirection::kForward, 1,
+        SequencePartial::kAhead);
+    for (int q = 0; q < 30; ++q)
+      for (int j = 0; j < 25; ++j)
+        ASSERT_EQ(SequenceCellDistance(queries, q, references, j, 7, reverse, nullptr,
+                                       SequencePartial::kAhead),
+                  s(q, j))
+            << reverse << " " << q << "," << j;
   }
 }
 

@@ -87,10 +87,11 @@ TEST(OnlineDetector, GivesTheBruteForceCandidatesOnRealKittiFrames) {
   OnlineDetector detector(options);
   const cv::Mat batch_rows = DescribeImages(frames, options);
   // The batch path of Test_OpenABLE: the normalised sequence matrix and its kept matches (the
-  // k best of each query among frames at least `exclusion` earlier).
+  // k best of each query among frames at least `exclusion` earlier), with Sequence_partial
+  // scale, the rule of a detector that has not seen the frames after its query yet.
   float max_distance = 0;
   const cv::Mat1f matrix = DistanceMatrix(batch_rows, 5, SequenceDirection::kForward, {}, 0,
-                                          &max_distance);
+                                          &max_distance, {}, SequencePartial::kScale);
   const int n = static_cast<int>(frames.size());
   KeepRules rules;
   rules.best = 4;
@@ -242,7 +243,8 @@ TEST(OnlineDetector, DistanceMatrixIsTheNormalisedBruteForce) {
   OnlineOptions options;
   const cv::Mat rows = DescribeImages(frames, options);
   float max_distance = 0;
-  const cv::Mat1f m = DistanceMatrix(rows, 3, SequenceDirection::kForward, {}, 0, &max_distance);
+  const cv::Mat1f m = DistanceMatrix(rows, 3, SequenceDirection::kForward, {}, 0, &max_distance,
+                                     {}, SequencePartial::kScale);
   double largest = 0;
   for (int i = 0; i < rows.rows; ++i)
     for (int j = 0; j < rows.rows; ++j) {

@@ -14,9 +14,11 @@ def hamming_reference(a, b):
     return out
 
 
-def sequence_reference(d, length, direction, row_starts=(0,), col_starts=(0,), skip=False):
+def sequence_reference(d, length, direction, row_starts=(0,), col_starts=(0,), skip=False,
+                       ahead=False):
     """S of matching/sequence.h written out term by term in float64 (skip: +inf where fewer
-    than L terms exist)."""
+    than L terms exist; ahead: such a cell sums the first L cells of its diagonal, +inf when
+    the diagonal holds fewer than L cells)."""
     n, m = d.shape
     row_starts, col_starts = list(row_starts), list(col_starts)
     row_bounds = [(s, e) for s, e in zip(row_starts, row_starts[1:] + [n])]
@@ -28,9 +30,25 @@ def sequence_reference(d, length, direction, row_starts=(0,), col_starts=(0,), s
     def one(step):
         s = np.zeros((n, m))
         for i in range(n):
-            r0, _ = bounds(row_bounds, i)
+            r0, r1 = bounds(row_bounds, i)
             for j in range(m):
                 c0, c1 = bounds(col_bounds, j)
+                if ahead:
+                    # The cells of the diagonal through (i, j) inside both traversals, in order.
+                    a, b = i, j
+                    while a - 1 >= r0 and c0 <= b + step < c1:
+                        a, b = a - 1, b + step
+                    cells = []
+                    while a < r1 and c0 <= b < c1:
+                        cells.append((a, b))
+                        a, b = a + 1, b - step
+                    p = i - cells[0][0]
+                    if len(cells) < length:
+                        s[i, j] = np.inf
+                        continue
+                    first = p - length + 1 if p >= length - 1 else 0
+                    s[i, j] = sum(d[x, y] for x, y in cells[first:first + length])
+                    continue
                 total, count = 0.0, 0
                 for k in range(length):
                     ii, jj = i - k, j + step * k
@@ -113,11 +131,15 @@ class SequenceTest(unittest.TestCase):
             (5, "reverse", [0, 12], [0, 10]),
         ]
         for length, direction, rows, cols in cases:
-            with self.subTest(L=length, direction=direction, starts=rows):
-                got = openable.sequence_distances(d, length, direction, rows, cols)
-                ref = sequence_reference(d.astype(np.float64), length, direction,
-                                         rows or [0], cols or [0])
-                np.testing.assert_allclose(got, ref, rtol=2e-6, atol=1e-4)
+            for partial in ("ahead", "scale"):  # the default first
+                with self.subTest(L=length, direction=direction, starts=rows, partial=partial):
+                    got = (openable.sequence_distances(d, length, direction, rows, cols)
+                           if partial == "ahead" else
+                           openable.sequence_distances(d, length, direction, rows, cols,
+                                                       partial=partial))
+                    ref = sequence_reference(d.astype(np.float64), length, direction,
+                                             rows or [0], cols or [0], ahead=partial == "ahead")
+                    np.testing.assert_allclose(got, ref, rtol=2e-6, atol=1e-4)
 
     def test_in_place_writes_into_the_given_array(self):
         rng = np.random.default_rng(5)

@@ -22,9 +22,13 @@ class OnlineAgainstBatchTest(unittest.TestCase):
             rows.append(openable.describe_images(
                 [openable.read_image(p) for p in cls.paths[i:i + 140]]))
         cls.rows = np.vstack(rows)
-        # The batch matrix M' and its divisor: M' x max = S, the raw sequence distances.
-        cls.matrix, cls.peak = openable.distance_matrix(cls.rows, L, return_max=True)
-        cls.sums = openable.sequence_distances(openable.hamming_distances(cls.rows), L)
+        # The batch matrix M' and its divisor: M' x max = S, the raw sequence distances; with
+        # partial="scale", the rule of the detector, which has not seen the frames after a
+        # query yet.
+        cls.matrix, cls.peak = openable.distance_matrix(cls.rows, L, return_max=True,
+                                                        partial="scale")
+        cls.sums = openable.sequence_distances(openable.hamming_distances(cls.rows), L,
+                                               partial="scale")
         cls.sums = cls.sums.astype(np.float64)
         cls.detector = openable.OnlineDetector(sequence_length=L, exclusion=EXCLUSION,
                                                candidates=K, threshold=THRESHOLD)

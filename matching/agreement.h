@@ -1,0 +1,66 @@
+// Whether a query's best match is confirmed by the best match of another query whose sequence
+// shares no frame with it: the evidence, without ground truth, that the answer follows the
+// route. Two traversals of a route (or one traversal revisiting a stretch) give best matches
+// that advance with the queries: if query q's answer is reference b(q), query p's should be
+// near b(q) - (q - p) (b(q) + (q - p) when the reference was driven the other way). A wrong
+// answer rarely has such a partner: the best matches of unrelated sequences fall anywhere.
+//
+// Independence matters. With sequences of L frames, consecutive queries share L - 1 of their
+// L single-frame distances, so their best matches move together whether right or wrong; only
+// a partner whose window of frames is disjoint from q's is evidence. Query q's window is frames
+// q - L + 1 .. q (clipped at its traversal's start), or, for the first L - 1 queries with
+// Sequence_partial ahead, frames 0 .. L - 1 (matching/sequence.h). The partner of q is the
+// nearest query at least Gap() frames back whose window ends before q's starts; a query
+// without one (the first ones of a traversal) takes the nearest such query forward instead.
+// A pair agrees when their answers differ by the frames between them within +-Tolerance().
+//
+// Used by the criteria that rank settings without ground truth
+// (OpenABLE/evaluation/unsupervised.h: consistency is the share of queries whose answer agrees
+// with its partner's) and by the acceptance of best matches (Match_consistency: an accepted
+// match needs its partners to agree), in the same way, so that a run's accepted matches are
+// the answers the criterion counted as confirmed.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "matching/sequence.h"
+
+namespace openable {
+
+struct AgreementOptions {
+  int sequence_length = 1;  // L of the matrix whose answers are compared (>= 1)
+  SequencePartial partial = SequencePartial::kAhead;  // the window of the first L - 1 queries
+  // The step of the answers as the queries advance: +1 along diagonals, -1 along
+  // anti-diagonals, either with kBoth.
+  SequenceDirection direction = SequenceDirection::kForward;
+  // n: partners that must agree, the nearest first: back from q as far as the traversal
+  // allows, then forward (each partner's partner in turn); >= 1.
+  int partners = 1;
+
+  // Frames between a query and its partner, at least: L, and never fewer than 10, so that an
+  // answer stuck on one place (the same reference for every query) cannot agree with itself
+  // within the tolerance.
+  int Gap() const { return sequence_length > kMinGap ? sequence_length : kMinGap; }
+  // Frames of disagreement allowed: 3, or a tenth of the gap for long sequences (two
+  // traversals at slightly different speeds drift apart along a long gap).
+  int Tolerance() const {
+    const int tenth = (Gap() + 5) / 10;
+    return tenth > 3 ? tenth : 3;
+  }
+  static constexpr int kMinGap = 10;
+};
+
+// best[q]: the answer of query q (its best reference frame, counted from the reference
+// traversal's first frame), -1 without one; q counts the frames of the query traversal from
+// its first. Returns, per query, 1 when it has an answer and `options.partners` partners that
+// have answers agreeing with it, else 0. Throws std::logic_error when sequence_length or
+// partners is below 1.
+std::vector<std::uint8_t> AgreeingAnswers(const std::vector<int>& best,
+                                          const AgreementOptions& options);
+
+// The partner of query q among `queries` queries (see above), or -1 when there is none: the
+// nearest p <= q - Gap() whose window ends before q's starts, else the nearest such p forward.
+int AgreementPartner(int q, int queries, const AgreementOptions& options);
+
+}  // namespace openable
