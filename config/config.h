@@ -30,6 +30,7 @@ struct Config {
   PreprocessOptions preprocess;     // Illumination_invariance, Alpha, Lambda_*, Robustness
   MatchingOptions matching;         // Image_sequences, Sequence_direction, Panorama_matching,
                                     // Threshold, Threads
+  AutoOptions automatic;            // Auto
   ScaleOptions scale;               // Scale
   EvaluationConfig evaluation;      // Evaluation
   VerificationOptions verification;  // Verification

@@ -4,6 +4,7 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/option_checks.h"
+#include "OpenABLE/base/strings.h"
 
 namespace openable {
 namespace {
@@ -111,6 +112,12 @@ void ScaleOptions::Check() const {
       throw InputError("Matches_name: " + Quoted(matches_name) + " has extension " +
                        (ext.empty() ? std::string("(none)") : ext) + "; expected .npy or .csv");
   }
+}
+
+void AutoOptions::Check() const {
+  if (!(min_consistency >= 0.0 && min_consistency <= 1.0))
+    throw InputError("Auto_min_consistency: " + FormatNumber(min_consistency) +
+                     " is not valid; expected a share of the queries in [0, 1]");
 }
 
 void EvaluationConfig::Check() const {

@@ -91,6 +91,29 @@ struct ScaleOptions {
   ApproximateOptions Approximate() const;
 };
 
+// The auto mode (the Auto keys, config/presets/auto.txt): the description and matching
+// settings of a run of two traversals chosen from the data, without ground truth
+// (OpenABLE/run/auto.h; docs/evaluation.md, "Without ground truth").
+struct AutoOptions {
+  bool enabled = false;  // Auto
+  // Auto_candidates: groups separated by '|', each a product of axes "Key=v1,v2" separated by
+  // spaces (values as openable_sweep's --vary takes them).
+  std::string candidates = kDefaultCandidates;
+  // Auto_min_consistency: the chosen setting is trusted when at least this share of the best
+  // matches are confirmed by an independent query's (consistency), in [0, 1].
+  double min_consistency = 0.5;
+
+  // The candidates measured across the shared datasets (docs/benchmarks.md, "Settings chosen
+  // from the data").
+  static constexpr const char* kDefaultCandidates =
+      "Image_descriptor=HOG,SIFT,LDB,HOG+LDB Image_sequences=10,20,40 | "
+      "Image_descriptor=SAD Contrast_enhancement=1 Image_sequences=10,20,40";
+
+  // Throws InputError naming the key of a bad value (the candidates' own checks are the auto
+  // mode's, OpenABLE/run/auto.h).
+  void Check() const;
+};
+
 // The evaluation of a run (the Evaluation keys).
 struct EvaluationConfig {
   GroundTruthOptions truth;  // the ground truth (its frame gap, first frame and range: below)

@@ -144,14 +144,32 @@ void Summarize(PerQueryResult& r, const std::vector<std::uint8_t>& has_candidate
   }
   r.auc = CurveArea(r.curve);
   if (options.accept_threshold >= 0) {
+    // The answers accepted: score <= threshold, and, with Match_consistency, confirmed by
+    // their partners; counted over the queries with candidates, as the curve counts them.
     r.has_operating_point = true;
-    r.operating_point.threshold = options.accept_threshold;
-    r.operating_point.precision = 1.0;
-    for (const CurvePoint& p : r.curve)
-      if (p.threshold <= options.accept_threshold) {
-        r.operating_point = p;
-        r.operating_point.threshold = options.accept_threshold;
-      }
+    r.accepted.assign(static_cast<std::size_t>(nq), 0);
+    std::vector<std::uint8_t> agree;
+    if (options.accept_consistency > 0) {
+      AgreementOptions a = options.agreement;
+      a.partners = options.accept_consistency;
+      agree = AgreeingAnswers(r.best, a);
+    }
+    CurvePoint& p = r.operating_point;
+    p.threshold = options.accept_threshold;
+    for (int q = 0; q < nq; ++q) {
+      if (!has_candidates[q] || r.best[q] < 0 || options.accept_none) continue;
+      if (!(r.score[q] <= options.accept_threshold)) continue;
+      if (!agree.empty() && !agree[q]) continue;
+      r.accepted[q] = 1;
+      if (r.correct[q])
+        ++p.tp;
+      else
+        ++p.fp;
+    }
+    p.precision = p.tp + p.fp > 0 ? static_cast<double>(p.tp) / static_cast<double>(p.tp + p.fp)
+                                  : 1.0;
+    p.recall = positives > 0 ? static_cast<double>(p.tp) / positives : 0.0;
+    p.f1 = F1(p.precision, p.recall);
   }
   for (const CurvePoint& p : r.curve) {
     if (p.fp == 0 && p.tp > 0) r.recall_at_100p = p.recall;

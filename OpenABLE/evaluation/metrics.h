@@ -10,6 +10,7 @@
 
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/layout.h"
+#include "matching/agreement.h"
 #include "matching/score.h"
 
 namespace openable {
@@ -26,6 +27,13 @@ struct EvaluationOptions {
   // Per-query protocol: the operating point a user chose (Match_threshold): answers with a
   // score <= accept_threshold are accepted; -1: none.
   double accept_threshold = -1.0;
+  // Match_consistency n: an answer is accepted only when n partners agree with it
+  // (matching/agreement.h, with the L, Sequence_partial and Sequence_direction of `agreement`);
+  // 0: the score alone decides.
+  int accept_consistency = 0;
+  AgreementOptions agreement;
+  // The auto mode found no setting it could trust (Auto_min_consistency): nothing is accepted.
+  bool accept_none = false;
 
   // Throws InputError naming Tolerance, Exclusion, Vicinity or Match_score_window.
   void Check() const;
@@ -56,10 +64,13 @@ struct PerQueryResult {
   double max_f1 = 0;
   double max_f1_threshold = 0;
   double max_f1_precision = 0, max_f1_recall = 0;
-  // At EvaluationOptions::accept_threshold (when >= 0): the answers accepted, and their
-  // precision (1 when none is accepted) and recall.
+  // At EvaluationOptions::accept_threshold (when >= 0): the answers accepted (score <= the
+  // threshold, agreeing with their partners under accept_consistency, none under
+  // accept_none), and their precision (1 when none is accepted) and recall; `accepted` marks
+  // them per query row.
   bool has_operating_point = false;
   CurvePoint operating_point;
+  std::vector<std::uint8_t> accepted;
   // R@N for N = 1, 5, 10: share of positive queries with a correct match among the N best
   // candidates (ties broken by lower column index).
   double recall_at_1 = 0, recall_at_5 = 0, recall_at_10 = 0;

@@ -336,7 +336,12 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
     for (int q = 0; q < marked; ++q) {
       const int c = result.best[q];
       const float d = result.score[q];
-      if (c < 0 || c >= cols || !(d <= accept_threshold)) continue;
+      // At the operating point, the answers it accepted (Match_consistency may refuse some
+      // below its threshold); else those with a score within the threshold given.
+      const bool accepted = result.has_operating_point && q < static_cast<int>(result.accepted.size())
+                                ? result.accepted[q] != 0
+                                : d <= accept_threshold;
+      if (c < 0 || c >= cols || !accepted) continue;
       const bool correct = result.correct[q] != 0;
       if (correct != (pass == 0)) continue;
       const cv::Rect mark =

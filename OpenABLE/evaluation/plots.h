@@ -30,8 +30,9 @@ cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& t
                        int vicinity);
 
 // The evaluated block of `matrix` (normalised) in grey (dark = small distance), with the ground
-// truth tinted blue, and each query's best match marked where its score is <= accept
-// threshold: green when correct, red when wrong. Queries are rows, references columns. Small
+// truth tinted blue, and each query's best match marked where it is accepted (at the operating
+// point: `result.accepted`, which Match_consistency may make stricter than the threshold; without
+// one, where its score is <= accept_threshold): green when correct, red when wrong. Queries are rows, references columns. Small
 // blocks are enlarged by an integer factor (nearest neighbour) to at least 600 pixels on the
 // longer side; marks are at least 3 x 3 output pixels. A legend strip below the image names the
 // colours. With `rejected` (geometric verification: cells (x = reference column, y = query row)

@@ -74,6 +74,9 @@ std::string EncodeEvaluationSettingsJson(const EvaluationSettings& s, const std:
     << in << "\"vicinity\": " << s.options.vicinity << ",\n"
     << in << "\"match_score\": " << JsonString(EnumName(s.options.score)) << ",\n"
     << in << "\"match_score_window\": " << s.options.score_window << ",\n"
+    << in << "\"match_threshold\": " << Number(s.options.accept_threshold) << ",\n"
+    << in << "\"match_consistency\": " << s.options.accept_consistency << ",\n"
+    << in << "\"accept_none\": " << (s.options.accept_none ? "true" : "false") << ",\n"
     << in << "\"able_thresholds\": " << s.options.able_thresholds << "\n"
     << indent << "}";
   return o.str();
@@ -194,12 +197,23 @@ std::string FormatEvaluationTable(const EvaluationSettings& s,
                     "misses)\n");
       if (q.has_operating_point) {
         const CurvePoint& p = q.operating_point;
-        const std::string at = std::isfinite(p.threshold)
-                                   ? "accepted at score <= " + FormatNumber(p.threshold)
-                                   : std::string("accepted (every verified answer)");
-        std::snprintf(line, sizeof line, "    %s: %lld answers, precision %.3f, recall %.3f\n",
-                      at.c_str(), static_cast<long long>(p.tp + p.fp), p.precision, p.recall);
-        o << line;
+        std::string at = std::isfinite(p.threshold)
+                             ? "accepted at score <= " + FormatNumber(p.threshold)
+                             : std::string("accepted (every verified answer)");
+        if (s.options.accept_consistency > 0)
+          at += std::string(" and confirmed by ") +
+                (s.options.accept_consistency == 1
+                     ? "a partner"
+                     : std::to_string(s.options.accept_consistency) + " partners") +
+                " (Match_consistency)";
+        if (s.options.accept_none) {
+          o << "    accepted: none (the auto mode found no setting consistent enough to trust, "
+               "Auto_min_consistency)\n";
+        } else {
+          std::snprintf(line, sizeof line, "    %s: %lld answers, precision %.3f, recall %.3f\n",
+                        at.c_str(), static_cast<long long>(p.tp + p.fp), p.precision, p.recall);
+          o << line;
+        }
       }
     }
   }

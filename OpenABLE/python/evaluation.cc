@@ -13,6 +13,7 @@
 #include "OpenABLE/evaluation/layout.h"
 #include "OpenABLE/evaluation/metrics.h"
 #include "OpenABLE/evaluation/report.h"
+#include "OpenABLE/evaluation/unsupervised.h"
 #include "OpenABLE/python/common.h"
 #include "OpenABLE/run/evaluate.h"
 #include "matching/normalize.h"
@@ -421,7 +422,8 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
          int exclusion, int vicinity, int able_thresholds, double radius, double heading_limit,
          const py::object& min_frame_gap, const std::string& axes, bool normalize,
          const std::string& label, const std::string& score, int score_window,
-         const py::object& accept_threshold) {
+         const py::object& accept_threshold, int accept_consistency, int sequence_length,
+         const std::string& partial, const std::string& direction) {
         const MatView view = Matrix2D(matrix, Elements::kFloat32, "matrix");
         const int full_rows = view.mat.rows, full_cols = view.mat.cols;
         Result result;
@@ -437,6 +439,13 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
           if (!(s.options.accept_threshold >= 0))
             throw py::value_error("accept_threshold: expected None or a number >= 0");
         }
+        if (accept_consistency < 0)
+          throw py::value_error("accept_consistency: expected a number of partners >= 0");
+        if (sequence_length < 1) throw py::value_error("sequence_length: expected >= 1");
+        s.options.accept_consistency = accept_consistency;
+        s.options.agreement.sequence_length = sequence_length;
+        s.options.agreement.partial = ParseEnum<SequencePartial>(partial, "partial");
+        s.options.agreement.direction = ParseEnum<SequenceDirection>(direction, "direction");
         if (able_thresholds < 2) throw py::value_error("able_thresholds: expected >= 2");
         WithArgumentNames([&] { s.options.Check(); });
         const EvaluationLayout layout =
@@ -570,13 +579,16 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
       py::arg("radius") = 5.0, py::arg("heading_limit") = -1.0,
       py::arg("min_frame_gap") = py::none(), py::arg("axes") = "xyz", py::arg("normalize") = true,
       py::arg("label") = "python", py::arg("score") = "distance", py::arg("score_window") = 10,
-      py::arg("accept_threshold") = py::none(),
+      py::arg("accept_threshold") = py::none(), py::arg("accept_consistency") = 0,
+      py::arg("sequence_length") = 1, py::arg("partial") = "ahead",
+      py::arg("direction") = "forward",
       R"doc(evaluate(matrix, *, truth_matrix=None, pairs=None, poses=None, reference_poses=None,
     aligned=False, truth_file=None, truth_type=None, truth_file_2="", base=-1, first_frame=0,
     range_selected=False, layout=None, reference_frames=None, tolerance=2, exclusion=100,
     vicinity=7, able_thresholds=100, radius=5.0, heading_limit=-1.0, min_frame_gap=None, axes="xyz",
     normalize=True, label="python", score="distance", score_window=10,
-    accept_threshold=None) -> EvaluationResult
+    accept_threshold=None, accept_consistency=0, sequence_length=1, partial="ahead",
+    direction="forward") -> EvaluationResult
 
 Evaluates a distance matrix against ground truth with both protocols of docs/evaluation.md,
 exactly as Test_OpenABLE (Ground_truth_type) and openable_evaluate do.
@@ -623,6 +635,10 @@ Args:
         smaller than the references).
     accept_threshold (float | None): an operating point (Match_threshold): operating_point
         gives the precision and recall of the answers whose score is <= it.
+    accept_consistency (int): Match_consistency n: an answer is accepted only when the
+        answers of n independent queries (one sequence apart) agree with it (0: the score
+        alone); sequence_length, partial and direction are those of the matrix (L,
+        Sequence_partial, Sequence_direction), which say which queries are independent.
 
 Returns:
     EvaluationResult: figures (auc, recall_at_100p, max_f1, recall_at_1/5/10,
@@ -630,6 +646,74 @@ Returns:
 
 Raises:
     ValueError (openable.InputError for files and options): one line naming the argument.)doc");
+
+  m.def(
+      "unsupervised_criteria",
+      [](const py::object& matrix, const py::object& layout_name,
+         const py::object& reference_frames, int sequence_length, const std::string& partial,
+         const std::string& direction, int exclusion, int score_window) {
+        const MatView view = Matrix2D(matrix, Elements::kFloat32, "matrix");
+        const EvaluationLayout layout =
+            LayoutOf(layout_name, reference_frames, view.mat.rows, view.mat.cols);
+        if (sequence_length < 1) throw py::value_error("sequence_length: expected >= 1");
+        if (exclusion < 1) throw py::value_error("exclusion: expected >= 1");
+        if (score_window < 0) throw py::value_error("score_window: expected >= 0");
+        UnsupervisedOptions o;
+        o.agreement.sequence_length = sequence_length;
+        o.agreement.partial = ParseEnum<SequencePartial>(partial, "partial");
+        o.agreement.direction = ParseEnum<SequenceDirection>(direction, "direction");
+        o.exclusion = exclusion;
+        o.score_window = score_window;
+        UnsupervisedFigures f;
+        {
+          py::gil_scoped_release release;
+          f = UnsupervisedCriteria(cv::Mat1f(view.mat), layout, o);
+        }
+        py::dict d;
+        d["consistency"] = f.consistency;
+        d["distinctiveness"] = f.distinctiveness;
+        d["agreement"] = f.agreement;
+        d["queries"] = f.queries;
+        d["answered"] = f.answered;
+        d["agreeing"] = f.agreeing;
+        d["gap"] = f.gap;
+        d["tolerance"] = f.tolerance;
+        d["best"] = py::array_t<int>(static_cast<py::ssize_t>(f.best.size()), f.best.data());
+        d["ratio"] = py::array_t<float>(static_cast<py::ssize_t>(f.ratio.size()), f.ratio.data());
+        std::vector<bool> agrees(f.agrees.begin(), f.agrees.end());
+        py::array_t<bool> a(static_cast<py::ssize_t>(agrees.size()));
+        for (std::size_t i = 0; i < agrees.size(); ++i) a.mutable_data()[i] = agrees[i];
+        d["agrees"] = a;
+        return d;
+      },
+      py::arg("matrix"), py::kw_only(), py::arg("layout") = py::none(),
+      py::arg("reference_frames") = py::none(), py::arg("sequence_length") = 1,
+      py::arg("partial") = "ahead", py::arg("direction") = "forward", py::arg("exclusion") = 100,
+      py::arg("score_window") = 10,
+      R"doc(unsupervised_criteria(matrix, *, layout=None, reference_frames=None,
+    sequence_length=1, partial="ahead", direction="forward", exclusion=100,
+    score_window=10) -> dict
+
+The criteria openable_sweep --rank-by and the auto mode (Auto 1) judge a matrix by, with no
+ground truth (docs/evaluation.md, "Without ground truth"): each query's best match (answer)
+and its ratio to the best rival beyond score_window frames; an answer agrees when the answer
+of the nearest query whose sequence shares no frame with it (at least max(L, 10) frames away,
+back or else forward) lies where the route says, within max(3, gap / 10) frames.
+
+Args:
+    matrix (numpy.ndarray): distances (small = similar), as for evaluate; +inf and NaN cells
+        are never answers.
+    layout, reference_frames, exclusion: the evaluated block and its candidates, as for
+        evaluate.
+    sequence_length (int), partial (str), direction (str): the matrix's L, Sequence_partial
+        and Sequence_direction (which queries are independent, and which way answers move).
+    score_window (int): Match_score_window of the ratio.
+
+Returns:
+    dict: consistency (share of the queries whose answer agrees), distinctiveness (mean of 1 -
+    ratio, 0 for a query without answer), agreement ((10 consistency + distinctiveness) / 11),
+    queries, answered, agreeing, gap and tolerance (frames), and per query row of the block
+    best (column, -1 none), ratio and agrees (bool).)doc");
 }
 
 }  // namespace openable::python

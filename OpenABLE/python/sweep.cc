@@ -32,16 +32,24 @@ py::dict RunDict(const SweepResult& r, std::size_t i) {
   d["rank"] = i + 1;
   d["settings"] = settings;
   d["label"] = run.label;
-  d["auc"] = q.auc;
-  d["recall_at_100p"] = q.recall_at_100p;
-  d["max_f1"] = q.max_f1;
-  d["max_f1_threshold"] = q.max_f1_threshold;
-  d["recall_at_1"] = q.recall_at_1;
-  d["recall_at_5"] = q.recall_at_5;
-  d["recall_at_10"] = q.recall_at_10;
-  d["average_precision"] = run.evaluation.able_p.average_precision;
-  d["queries"] = q.queries;
-  d["unanswered_queries"] = q.unanswered;
+  d["consistency"] = run.unsupervised.consistency;
+  d["distinctiveness"] = run.unsupervised.distinctiveness;
+  d["agreement"] = run.unsupervised.agreement;
+  // The figures of the evaluation: None without ground truth.
+  const auto figure = [&](double v) -> py::object {
+    return r.evaluated ? py::cast(v) : py::none();
+  };
+  d["auc"] = figure(q.auc);
+  d["recall_at_100p"] = figure(q.recall_at_100p);
+  d["max_f1"] = figure(q.max_f1);
+  d["max_f1_threshold"] = figure(q.max_f1_threshold);
+  d["recall_at_1"] = figure(q.recall_at_1);
+  d["recall_at_5"] = figure(q.recall_at_5);
+  d["recall_at_10"] = figure(q.recall_at_10);
+  d["average_precision"] = figure(run.evaluation.able_p.average_precision);
+  d["queries"] = r.evaluated ? q.queries : run.unsupervised.queries;
+  d["unanswered_queries"] =
+      r.evaluated ? q.unanswered : run.unsupervised.queries - run.unsupervised.answered;
   d["seconds"] = run.seconds;
   d["described"] = run.described;
   return d;
@@ -55,8 +63,10 @@ files written.
 
 Attributes:
     runs (list[dict]): one dict per combination, best first: rank, settings ({key: value} of
-        the varied keys), label, auc, recall_at_100p, max_f1, max_f1_threshold, recall_at_1,
-        recall_at_5, recall_at_10, average_precision (ABLE-P, percent), queries,
+        the varied keys), label, the criteria without ground truth consistency,
+        distinctiveness and agreement (docs/evaluation.md), then the figures of the
+        evaluation, None without ground truth: auc, recall_at_100p, max_f1, max_f1_threshold,
+        recall_at_1, recall_at_5, recall_at_10, average_precision (ABLE-P, percent); queries,
         unanswered_queries, seconds, described (False: the run took the single-frame matrices
         of an earlier run).
     rank_by (str): the figure runs are ranked by.
@@ -159,7 +169,9 @@ Args:
     vary (dict): {key: [values]} (or {key: "v1,v2"} as --vary takes it), e.g.
         {"Image_descriptor": ["LDB", "HOG", "HOG+LDB"], "Image_sequences": [1, 10, 30]}.
     settings (dict | None): keys set over the configuration for every run, as --set does.
-    rank_by (str): auc, recall_at_100p, recall_at_1, max_f1 or average_precision.
+    rank_by (str): auc, recall_at_100p, recall_at_1, max_f1 or average_precision (ground
+        truth needed), or agreement, consistency or distinctiveness (computed from each run's
+        matrix alone; the configuration needs no Ground_truth_type).
     best (int): runs drawn in the precision-recall figure.
     output (str | None): also write <output>.csv, <output>.json and <output>_pr.png.
     quiet (bool): no progress lines on stderr.

@@ -44,6 +44,8 @@ EvaluationSettings EvaluationSettingsFrom(const Config& c) {
   s.options.score = c.matching.score;
   s.options.score_window = c.matching.score_window;
   s.options.accept_threshold = c.matching.match_threshold;
+  s.options.accept_consistency = c.matching.match_consistency;
+  s.options.agreement = AgreementOf(c.matching);
   s.truth.Check();
   s.options.Check();
   return s;

@@ -150,7 +150,12 @@ std::vector<ReportCase> Misses(const EvaluatedRun& run, const GroundTruth& truth
   std::vector<ReportCase> all;
   for (int q = 0; q < static_cast<int>(p.best.size()); ++q) {
     if (!p.positive[q]) continue;
-    const bool found = p.best[q] >= 0 && p.correct[q] && p.score[q] <= threshold;
+    // At the operating point, the answers it accepted (Match_consistency may refuse some
+    // below the threshold; an untrusted auto run accepts none).
+    const bool accepted = p.has_operating_point && q < static_cast<int>(p.accepted.size())
+                              ? p.accepted[q] != 0
+                              : p.score[q] <= threshold;
+    const bool found = p.best[q] >= 0 && p.correct[q] && accepted;
     if (!found) all.push_back(CaseOf(run, truth, matrix, exclusion, q));
   }
   // Unanswered first (score +inf), then the least confident.
@@ -223,7 +228,11 @@ std::string EncodeHtmlReport(const ReportInput& input) {
   h += "<h1>" + Escape(input.title) + "</h1>\n";
   h += "<p class=\"note\">Written by " + Escape(input.program) + " (OpenABLE " + kVersion +
        "). Figures and protocols: docs/evaluation.md; this page: docs/output_formats.md.</p>\n";
-  h += "<nav><a href=\"#settings\">Settings</a> &middot; <a href=\"#figures\">Figures</a> "
+  std::string extra_links;
+  for (const ReportTable& t : input.tables)
+    extra_links += "<a href=\"#" + Escape(t.id) + "\">" + Escape(t.title) + "</a> &middot; ";
+  h += "<nav><a href=\"#settings\">Settings</a> &middot; " + extra_links +
+       "<a href=\"#figures\">Figures</a> "
        "&middot; <a href=\"#pr\">Precision-recall</a> &middot; <a href=\"#matrix\">Matrix</a> "
        "&middot; <a href=\"#wrong-matches\">Wrong matches</a> &middot; "
        "<a href=\"#misses\">Misses</a></nav>\n";
@@ -255,6 +264,24 @@ std::string EncodeHtmlReport(const ReportInput& input) {
     h += "<details><summary>Every key</summary>\n<pre>" + Escape(input.all_settings) +
          "</pre>\n</details>\n";
   h += "</section>\n";
+
+  // Tables of the run (the auto mode's candidates).
+  for (const ReportTable& t : input.tables) {
+    h += "<section id=\"" + Escape(t.id) + "\">\n<h2>" + Escape(t.title) + "</h2>\n<table id=\"" +
+         Escape(t.id) + "-table\">\n<tr>";
+    for (const std::string& c : t.header) h += "<th>" + Escape(c) + "</th>";
+    h += "</tr>\n";
+    for (size_t r = 0; r < t.rows.size(); ++r) {
+      h += static_cast<int>(r) == t.highlight ? "<tr style=\"font-weight:bold\">" : "<tr>";
+      for (size_t c = 0; c < t.rows[r].size(); ++c)
+        h += std::string(c < t.numeric.size() && t.numeric[c] ? "<td class=\"n\">" : "<td>") +
+             Escape(t.rows[r][c]) + "</td>";
+      h += "</tr>\n";
+    }
+    h += "</table>\n";
+    if (!t.note.empty()) h += "<p class=\"note\">" + Escape(t.note) + "</p>\n";
+    h += "</section>\n";
+  }
 
   // Figures.
   h += "<section id=\"figures\">\n<h2>Figures</h2>\n<table id=\"figures-table\">\n<tr><th>run"

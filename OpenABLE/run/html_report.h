@@ -67,6 +67,16 @@ struct ReportFrames {
 ReportFrames FramesFromSources(std::vector<std::unique_ptr<FrameSource>> sources,
                                bool rows_are_second);
 
+// A table of its own on the page, after the settings (the auto mode's candidates).
+struct ReportTable {
+  std::string id, title;                       // HTML id and heading
+  std::string note;                            // a sentence under the table; may be empty
+  std::vector<std::string> header;             // column titles
+  std::vector<std::vector<std::string>> rows;  // cells, as text (escaped by the report)
+  std::vector<bool> numeric;                   // per column: right-aligned numbers
+  int highlight = -1;                          // a row shown in bold, -1 none
+};
+
 struct ReportInput {
   std::string program;  // "Test_OpenABLE" or "openable_evaluate"
   std::string title;    // heading of the page
@@ -77,6 +87,7 @@ struct ReportInput {
   std::vector<const cv::Mat1f*> matrices;  // the normalised matrix of each run
   int examples = 6;                        // Report_examples
   ReportFrames frames;
+  std::vector<ReportTable> tables;         // shown after the settings
 };
 
 // The page. Throws InputError naming the frame when a frame of a worst case cannot be read.

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <unistd.h>
+#include <functional>
 #include <future>
 #include <iostream>
 #include <limits>
@@ -12,6 +13,7 @@
 #include <filesystem>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/run/auto.h"
 #include "OpenABLE/run/describe.h"
 #include "OpenABLE/run/descriptor_cache.h"
 #include "OpenABLE/run/distributed.h"
@@ -235,6 +237,24 @@ Described DescribeSources(const Config& config, const FrameDescriber& describer,
   return out;
 }
 
+// The best matches a run answered and accepted (Match_threshold, Match_consistency), from its
+// matches of rank 1.
+void CountAccepted(RunResult& result, const MatchingOptions& matching,
+                   const std::vector<Match>& matches) {
+  int queries = 0;
+  result.answered_queries = 0;
+  for (const Match& m : matches)
+    if (m.rank == 1) {
+      ++result.answered_queries;
+      queries = std::max(queries, m.query + 1);
+    }
+  const AgreementOptions agreement = AgreementOf(matching);
+  const std::vector<std::uint8_t> accepted =
+      AcceptedMatches(matches, queries, matching.match_threshold,
+                      matching.match_consistency > 0 ? &agreement : nullptr);
+  result.accepted_queries = static_cast<int>(std::count(accepted.begin(), accepted.end(), 1));
+}
+
 // Adds `more` to `all`, each line once.
 void AddLines(std::vector<std::string>& all, const std::vector<std::string>& more) {
   for (const std::string& line : more)
@@ -265,6 +285,7 @@ std::string SingleFrameKey(const Config& config, const std::string& name) {
   c.matching.panorama_matching = panorama;
   c.output = OutputOptions();
   c.scale = ScaleOptions();
+  c.automatic = AutoOptions();
   c.evaluation = EvaluationConfig();
   c.snaps = snaps::SnapsOptions();
   c.odometry = odometry::OdometryOptions();
@@ -274,10 +295,39 @@ std::string SingleFrameKey(const Config& config, const std::string& name) {
 
 namespace {
 
-// ComputeRun, or with `check_only` its checks alone: it returns before the first frame is
-// described, once the configuration, the descriptors, the sources and the mode are checked.
+// Where ComputeOrCheckRun stops: after its checks (before the first frame is described, once
+// the configuration, the descriptors, the sources and the mode are checked), once the store
+// holds the run's single-frame matrices, or at the end of the run.
+enum class StopAfter { kChecks, kSingleFrames, kRun };
+
+// Steps 2 and 3 of a dense run (docs/architecture.md): the single-frame matrices of several
+// descriptors each divided by its largest value (`largest_of` gives it over every process) and
+// summed with their weights, then contrast enhancement. One matrix is used as it is, copied
+// when `copy`.
+cv::Mat1f FusedSingleFrame(const std::vector<const cv::Mat1f*>& singles,
+                           const std::vector<double>& weights, const MatchingOptions& matching,
+                           const std::vector<int>& starts, bool copy,
+                           const std::function<double(double)>& largest_of) {
+  cv::Mat1f distances;
+  if (singles.size() == 1) {
+    distances = copy ? singles.front()->clone() : *singles.front();
+  } else {
+    distances = cv::Mat1f::zeros(singles.front()->size());
+    for (size_t k = 0; k < singles.size(); ++k) {
+      double largest = 0;
+      if (!singles[k]->empty()) cv::minMaxLoc(*singles[k], nullptr, &largest);
+      largest = largest_of(largest);
+      // A descriptor whose frames are all alike (largest 0) adds nothing.
+      if (largest > 0) cv::scaleAdd(*singles[k], weights[k] / largest, distances, distances);
+    }
+  }
+  if (matching.contrast_enhancement)
+    EnhanceContrast(distances, matching.contrast_window, starts, matching.threads);
+  return distances;
+}
+
 RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
-                            SingleFrameStore* store, bool check_only) {
+                            SingleFrameStore* store, StopAfter stop) {
   CheckConfig(config);
   const auto run_start = Clock::now();
   RunResult result;
@@ -476,6 +526,17 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
                      (scale.memory_limit > 0 ? "Memory_limit" : "3/4 of the RAM") +
                      "; expected a smaller Patch_size or grid");
   }
+  // Over processes, the dense matrix's ahead cells are filled once gathered, from the sums of
+  // one direction; with both directions each direction's sums would be needed apart.
+  if (!result.bounded && Cluster::Get().Distributed() && matching.sequence_length > 1 &&
+      direction == SequenceDirection::kBoth && matching.partial == SequencePartial::kAhead)
+    throw InputError("Sequence_partial: ahead with Sequence_direction 2 is not computed over "
+                     "several processes (mpirun) in dense mode; expected Sequence_partial scale "
+                     "or skip, Sequence_direction 0 or 1, or one process");
+  if (result.bounded && stop == StopAfter::kSingleFrames)
+    throw InputError("Auto: 1 compares dense matrices, but the run would be " +
+                     result.mode_reason + "; expected a larger Memory_limit, or fewer frames "
+                     "(the auto mode keeps one single-frame matrix per candidate descriptor)");
   if (result.bounded && scale.matches_name.empty())
     throw InputError("Matches_name: empty, but the run is " + result.mode_reason +
                      " and keeps only matches; expected a .npy or .csv path (or a larger "
@@ -503,7 +564,7 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     throw InputError("Approximate_search: 1 with Image_descriptor " + names.front() +
                      " (L1 distance), which no approximate engine indexes; expected "
                      "Approximate_search 0 (the exact bounded mode) or another descriptor");
-  if (check_only) return result;
+  if (stop == StopAfter::kChecks) return result;
 
   std::vector<int> starts;  // set from the first description
   auto set_traversals = [&](const std::vector<Traversal>& traversals) {
@@ -575,14 +636,7 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     progress.End();
     cluster.Release();
     result.timings.match_seconds = SecondsSince(t);
-    if (matching.match_threshold >= 0.0) {
-      result.accepted_queries = 0;
-      for (const Match& m : result.matches) {
-        if (m.rank != 1) continue;
-        ++result.answered_queries;
-        if (m.score <= matching.match_threshold) ++result.accepted_queries;
-      }
-    }
+    if (matching.match_threshold >= 0.0) CountAccepted(result, matching, result.matches);
     result.timings.total_seconds = SecondsSince(run_start);
     return result;
   }
@@ -655,29 +709,18 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     result.timings.pairs = f->pairs;
   }
 
+  if (stop == StopAfter::kSingleFrames) return result;
+
   // Fusion (each matrix over its largest value, weighted), contrast enhancement, sequences,
   // Eq. 5, Eq. 9.
   const auto t = Clock::now();
-  cv::Mat1f distances;
-  if (!fused) {
-    // The store keeps its matrix for the next run; without one, the matrix is taken over.
-    distances = store ? singles.front()->distances.clone() : singles.front()->distances;
-    if (!store) computed.front().distances.release();
-  } else {
-    distances = cv::Mat1f::zeros(singles.front()->distances.size());
-    for (size_t k = 0; k < singles.size(); ++k) {
-      double largest = 0;
-      if (!singles[k]->distances.empty())
-        cv::minMaxLoc(singles[k]->distances, nullptr, &largest);
-      largest = cluster.Max(largest);  // over every process's rows
-      // A descriptor whose frames are all alike (largest 0) adds nothing.
-      if (largest > 0)
-        cv::scaleAdd(singles[k]->distances, result.fusion_weights[k] / largest, distances,
-                     distances);
-    }
-  }
-  if (matching.contrast_enhancement)
-    EnhanceContrast(distances, matching.contrast_window, starts, matching.threads);
+  std::vector<const cv::Mat1f*> matrices;
+  for (const SingleFrame* f : singles) matrices.push_back(&f->distances);
+  // The store keeps its matrix for the next run; without one, the matrix is taken over.
+  cv::Mat1f distances =
+      FusedSingleFrame(matrices, result.fusion_weights, matching, starts, store != nullptr,
+                       [&](double largest) { return cluster.Max(largest); });
+  if (!store && !fused) computed.front().distances.release();
   if (!cluster.Distributed()) {
     SequenceDistancesInPlace(distances, matching.sequence_length, starts, starts, direction,
                              matching.threads, matching.partial);
@@ -692,10 +735,14 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     const DenseShare share = DenseShareOf(cluster, n, matching.sequence_length);
     cv::Mat1f rows;
     float largest = 0.0f;
+    // Sequence_partial ahead reads cells of later rows, which may belong to the next share:
+    // each process leaves its early cells without a value (skip; they never set the largest
+    // value, which ahead only copies) and process 0 fills them in the gathered matrix.
+    const bool ahead = matching.partial == SequencePartial::kAhead;
     cluster.Agree([&] {
       SequenceDistancesInPlace(distances, matching.sequence_length,
                                ShareRowStarts(starts, share), starts, direction,
-                               matching.threads, matching.partial);
+                               matching.threads, ahead ? SequencePartial::kSkip : matching.partial);
       rows = distances.rowRange(share.first - share.history, share.last - share.history);
       largest = LargestFiniteEntry(rows);
     });
@@ -705,8 +752,12 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     distances.release();
     cluster.Release();
     if (cluster.Rank() != 0) return result;  // process 0 keeps the matrix and goes on
+    if (ahead && matching.sequence_length > 1) {
+      FillAheadCells(result.normalized, matching.sequence_length, starts, starts,
+                     direction == SequenceDirection::kReverse);
+    }
   }
-  if (matching.partial == SequencePartial::kSkip)
+  if (matching.partial != SequencePartial::kScale)
     result.empty_cells = static_cast<std::int64_t>(result.normalized.total()) -
                          cv::countNonZero(result.normalized <= 1.0f);
   if (matching.threshold >= 0.0)
@@ -724,11 +775,7 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     KeepRules best = rules;
     best.best = 1;
     best.band = -1;
-    result.accepted_queries = 0;
-    for (const Match& m : MatchesFromMatrix(result.normalized, block, best)) {
-      ++result.answered_queries;
-      if (m.score <= matching.match_threshold) ++result.accepted_queries;
-    }
+    CountAccepted(result, matching, MatchesFromMatrix(result.normalized, block, best));
   }
   result.timings.sequence_seconds = SecondsSince(t);
   result.timings.total_seconds = SecondsSince(run_start);
@@ -738,12 +785,36 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
 }  // namespace
 
 RunResult ComputeRun(const Config& config, ProgressReporter& progress, SingleFrameStore* store) {
-  return ComputeOrCheckRun(config, progress, store, false);
+  return ComputeOrCheckRun(config, progress, store, StopAfter::kRun);
 }
 
 void CheckRun(const Config& config) {
   ProgressReporter silent(std::cerr, false, false);
-  ComputeOrCheckRun(config, silent, nullptr, true);
+  ComputeOrCheckRun(config, silent, nullptr, StopAfter::kChecks);
+}
+
+RunResult ComputeSingleFrames(const Config& config, ProgressReporter& progress,
+                              SingleFrameStore& store) {
+  if (config.scale.matrix_mode == MatrixMode::kBounded || config.scale.approximate_search)
+    throw std::logic_error("ComputeSingleFrames: a dense run expected");
+  return ComputeOrCheckRun(config, progress, &store, StopAfter::kSingleFrames);
+}
+
+cv::Mat1f SingleFrameMatrix(const Config& config, const SingleFrameStore& store,
+                            const std::vector<int>& starts) {
+  const std::vector<std::string> names = DescriptorList(config.descriptor.name);
+  std::vector<const cv::Mat1f*> matrices;
+  for (const std::string& name : names) {
+    const SingleFrame* kept = store.Find(SingleFrameKey(config, name));
+    if (kept == nullptr)
+      throw std::logic_error("SingleFrameMatrix: no single-frame matrix of " + name);
+    matrices.push_back(&kept->distances);
+  }
+  const std::vector<double> weights =
+      names.size() > 1 ? config.matching.FusionWeights(static_cast<int>(names.size()))
+                       : std::vector<double>{1.0};
+  return FusedSingleFrame(matrices, weights, config.matching, starts, true,
+                          [](double largest) { return largest; });
 }
 
 EvaluationLayout LayoutOf(const RunResult& result) {
@@ -789,7 +860,8 @@ std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& co
 
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
                                       const Evaluation* evaluation,
-                                      const RunVerification* verification) {
+                                      const RunVerification* verification,
+                                      const AutoChoice* automatic) {
   const auto t = Clock::now();
   // The encodings are independent; the two PNG images dominate (OpenCV's PNG encoder is
   // single-threaded), so each is encoded on its own thread while the .npy and the text are
@@ -885,6 +957,7 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
     report.evaluation = evaluation;
     report.matrices = {&result.normalized};
     report.examples = config.evaluation.report_examples;
+    if (automatic != nullptr) report.tables.push_back(AutoReportTable(*automatic));
     if (report.examples > 0)
       report.frames = FramesFromSources(OpenFramesToShow(config.input), false);
     batch.Stage("Report_name", config.evaluation.report_name, EncodeHtmlReport(report));

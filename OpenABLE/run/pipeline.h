@@ -20,6 +20,7 @@ namespace openable {
 
 struct Evaluation;       // OpenABLE/run/evaluate.h
 struct RunVerification;  // OpenABLE/run/verify.h
+struct AutoChoice;       // OpenABLE/run/auto.h
 
 // One traversal of the run (a folder or a video) and the rows it holds in the matrix.
 struct Traversal {
@@ -112,6 +113,21 @@ std::string SingleFrameKey(const Config& config, const std::string& name);
 RunResult ComputeRun(const Config& config, ProgressReporter& progress,
                      SingleFrameStore* store = nullptr);
 
+// The first part of a dense ComputeRun alone: the single-frame matrix of each descriptor of
+// `config`, kept in `store` (described and compared unless the store holds it already). The
+// result carries the traversals, timings, notes and warnings; no matrix. For runs that build
+// several matrices from the same descriptions (the auto mode). Throws InputError as ComputeRun
+// does; std::logic_error for a bounded configuration.
+RunResult ComputeSingleFrames(const Config& config, ProgressReporter& progress,
+                              SingleFrameStore& store);
+
+// The single-frame matrix of a dense run of `config` from the matrices `store` holds (its
+// descriptors' matrices fused with Fusion_weights, then contrast-enhanced): the matrix
+// ComputeRun sums sequences over, on one process. `starts` are the traversals' first rows.
+// Throws std::logic_error when the store lacks a descriptor's matrix.
+cv::Mat1f SingleFrameMatrix(const Config& config, const SingleFrameStore& store,
+                            const std::vector<int>& starts);
+
 // The checks of ComputeRun that come before its first frame is described: the
 // configuration, the descriptors and their fusion, the sources (folders, videos, calibration
 // are opened, not read), the ratio window, the mode. Throws InputError as ComputeRun does.
@@ -123,14 +139,16 @@ EvaluationLayout LayoutOf(const RunResult& result);
 
 // Writes the outputs the configuration asks for (Txt_name, Npy_name, Png_name,
 // Png_threshold_name, Loops_name when `verification` is given, and the files of
-// Evaluation_name when `evaluation` is given)
+// Evaluation_name and Report_name when `evaluation` is given; the report lists the auto
+// mode's candidates when `automatic` is given)
 // all-or-nothing. Cells without a value (+inf, Sequence_partial skip) are written as the
 // largest finite value in Txt_name and the PNG images and as NaN in Npy_name. Returns the
 // paths written. Adds the time spent to result.timings.export_seconds. Throws InputError
 // naming the key and path on failure.
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
                                       const Evaluation* evaluation = nullptr,
-                                      const RunVerification* verification = nullptr);
+                                      const RunVerification* verification = nullptr,
+                                      const AutoChoice* automatic = nullptr);
 
 // Every file a run of `config` may write, as (key, path): the matrix files, the thresholded
 // image, the matches, the loops (Verification) and, when Ground_truth_type and

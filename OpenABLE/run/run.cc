@@ -13,9 +13,9 @@
 
 namespace openable {
 
-RunOutcome Run(const Config& config, ProgressReporter& progress,
+RunOutcome Run(const Config& base, ProgressReporter& progress,
                const std::function<void(const std::string&)>& log) {
-  if (config.output.show_images && std::getenv("DISPLAY") == nullptr &&
+  if (base.output.show_images && std::getenv("DISPLAY") == nullptr &&
       std::getenv("WAYLAND_DISPLAY") == nullptr)
     log("warning: Show_images is 1 but there is no display (DISPLAY is not set); frames are "
         "not shown");
@@ -26,28 +26,51 @@ RunOutcome Run(const Config& config, ProgressReporter& progress,
   Cluster& cluster = Cluster::Get();
   if (cluster.Distributed())
     cluster.Agree([&] {
-      CheckDistinctOutputs(PlannedOutputs(config));
-      if (EvaluationRequested(config)) {
-        CheckOutputPrefix("Evaluation_name", config.evaluation.name);
-        (void)EvaluationSettingsFrom(config);
+      CheckDistinctOutputs(PlannedOutputs(base));
+      if (EvaluationRequested(base)) {
+        CheckOutputPrefix("Evaluation_name", base.evaluation.name);
+        (void)EvaluationSettingsFrom(base);
       }
-      CheckRun(config);
+      CheckRun(base);
     });
   // Outputs are checked before the long part of the run: no two at one file, no prefix that
   // is a folder.
-  CheckDistinctOutputs(PlannedOutputs(config));
-  if (EvaluationRequested(config)) CheckOutputPrefix("Evaluation_name", config.evaluation.name);
+  CheckDistinctOutputs(PlannedOutputs(base));
+  if (EvaluationRequested(base)) CheckOutputPrefix("Evaluation_name", base.evaluation.name);
   // Evaluation settings are checked before the long part of the run.
-  if (EvaluationRequested(config)) {
+  if (EvaluationRequested(base)) {
     out.evaluation = std::make_unique<Evaluation>();
-    out.evaluation->settings = EvaluationSettingsFrom(config);
+    out.evaluation->settings = EvaluationSettingsFrom(base);
   }
-  if (!config.verification.enabled && !config.output.loops_name.empty())
+  if (!base.verification.enabled && !base.output.loops_name.empty())
     log("note: Loops_name: not written: Verification is 0 (no candidate is checked)");
-  out.result = ComputeRun(config, progress);
+  // Auto 1: the settings chosen from the data; the run goes on as a run of the chosen
+  // configuration, from the single-frame matrices the choice computed.
+  SingleFrameStore store;
+  const Config* chosen = &base;
+  if (base.automatic.enabled) {
+    out.automatic = std::make_unique<AutoChoice>(ChooseSettings(base, progress, store, log));
+    chosen = &out.automatic->config;
+    if (!out.automatic->reliable)
+      log("warning: Auto: no candidate is consistent enough to be trusted (the best confirms " +
+          FormatFixed(100.0 * out.automatic->candidates[out.automatic->chosen].figures
+                                  .consistency,
+                      1) +
+          " % of its best matches, Auto_min_consistency " +
+          FormatNumber(100.0 * base.automatic.min_consistency) +
+          " %): the outputs are written, but no match is accepted");
+    if (out.evaluation) {
+      out.evaluation->settings = EvaluationSettingsFrom(*chosen);
+      out.evaluation->settings.options.accept_none = !out.automatic->reliable;
+    }
+  }
+  const Config& config = *chosen;
+  out.result = ComputeRun(config, progress, out.automatic ? &store : nullptr);
   // Process 0 evaluates, verifies and writes; the others have given it their shares.
   if (cluster.Distributed() && cluster.Rank() != 0) return out;
   RunResult& result = out.result;
+  if (out.automatic && !out.automatic->reliable && result.accepted_queries > 0)
+    result.accepted_queries = 0;
   for (const std::string& w : result.warnings) log("warning: " + w);
   for (const std::string& note : result.notes) log("note: " + note);
   if (config.verification.enabled) {
@@ -81,7 +104,9 @@ RunOutcome Run(const Config& config, ProgressReporter& progress,
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.timings.total_seconds += result.timings.evaluate_seconds;
   }
-  out.written = WriteOutputs(config, result, out.evaluation.get(), out.verification.get());
+  if (out.automatic) result.timings.total_seconds += out.automatic->seconds;
+  out.written = WriteOutputs(config, result, out.evaluation.get(), out.verification.get(),
+                             out.automatic.get());
   return out;
 }
 
@@ -113,7 +138,8 @@ std::string IndexUsed(const Config& c, const RunResult& r) {
 
 }  // namespace
 
-std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
+std::string FormatRunReport(const Config& config, const RunOutcome& outcome) {
+  const Config& c = outcome.automatic ? outcome.automatic->config : config;
   const RunResult& r = outcome.result;
   const Evaluation* evaluation = outcome.evaluation.get();
   const int patch = c.descriptor.patch_size;
@@ -135,8 +161,8 @@ std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
               : std::to_string(d.grid_x) + "x" + std::to_string(d.grid_y) + " cells of " +
                     std::to_string(patch) + "x" + std::to_string(patch))
       << ", sequence length " << c.matching.sequence_length
-      << (c.matching.sequence_length > 1 && c.matching.partial == SequencePartial::kSkip
-              ? " (skip partial)" : "")
+      << (c.matching.sequence_length > 1 && c.matching.partial != SequencePartial::kAhead
+              ? std::string(" (") + EnumName(c.matching.partial) + " partial)" : std::string())
       << (c.matching.contrast_enhancement
               ? ", contrast enhancement +-" + std::to_string(c.matching.contrast_window)
               : std::string())
@@ -173,15 +199,25 @@ std::string FormatRunReport(const Config& c, const RunOutcome& outcome) {
         << r.max_distance << " (Eq. 5 divisor)";
   }
   if (r.empty_cells > 0)
-    out << ", " << r.empty_cells << " cells without a value (Sequence_partial skip)";
+    out << ", " << r.empty_cells << " cells without a value (Sequence_partial "
+        << EnumName(c.matching.partial) << ")";
   if (!r.thresholded.empty())
     out << ", threshold " << c.matching.threshold << ": "
         << r.thresholded.total() - static_cast<size_t>(cv::countNonZero(r.thresholded))
         << " cells below";
-  if (r.accepted_queries >= 0)
+  if (r.accepted_queries >= 0) {
     out << "\n  accepted: " << r.accepted_queries << " of " << r.answered_queries
         << " best matches with " << EnumName(c.matching.score) << " score <= "
         << c.matching.match_threshold << " (Match_threshold)";
+    if (c.matching.match_consistency > 0)
+      out << " confirmed by " << c.matching.match_consistency
+          << (c.matching.match_consistency == 1 ? " independent query" : " independent queries")
+          << " (Match_consistency)";
+  }
+  if (outcome.automatic) {
+    const std::string lines = FormatAutoReport(*outcome.automatic);
+    out << "\n" << lines.substr(0, lines.size() - 1);  // each line ends the one before
+  }
   if (const RunVerification* v = outcome.verification.get()) {
     const VerificationOptions& o = v->options;
     out << "\n  verification: " << EnumName(o.features) << " (" << o.max_features
@@ -248,7 +284,8 @@ std::string Indented(const std::string& object) {
 
 }  // namespace
 
-std::string EncodeRunJson(const Config& c, const RunOutcome& outcome) {
+std::string EncodeRunJson(const Config& config, const RunOutcome& outcome) {
+  const Config& c = outcome.automatic ? outcome.automatic->config : config;
   const RunResult& r = outcome.result;
   const RunTimings& tm = r.timings;
   std::ostringstream o;
@@ -287,7 +324,8 @@ std::string EncodeRunJson(const Config& c, const RunOutcome& outcome) {
   o << ",\n  \"accepted\": ";
   if (r.accepted_queries >= 0)
     o << "{\"queries\": " << r.accepted_queries << ", \"answered\": " << r.answered_queries
-      << ", \"match_threshold\": " << JsonNumber(c.matching.match_threshold) << "}";
+      << ", \"match_threshold\": " << JsonNumber(c.matching.match_threshold)
+      << ", \"match_consistency\": " << c.matching.match_consistency << "}";
   else
     o << "null";
   o << ",\n  \"verification\": ";
@@ -308,6 +346,8 @@ std::string EncodeRunJson(const Config& c, const RunOutcome& outcome) {
     o << Indented(EncodeEvaluationJson(e->settings, e->runs, kVersion));
   else
     o << "null";
+  o << ",\n  \"auto\": "
+    << (outcome.automatic ? EncodeAutoJson(*outcome.automatic, "  ") : std::string("null"));
   o << ",\n  \"notes\": " << JsonList(r.notes) << ",\n  \"written\": " << JsonList(outcome.written)
     << "\n}\n";
   return o.str();

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "OpenABLE/run/auto.h"
 #include "OpenABLE/run/evaluate.h"
 #include "OpenABLE/run/pipeline.h"
 #include "OpenABLE/run/progress.h"
@@ -18,14 +19,20 @@ namespace openable {
 
 struct RunOutcome {
   RunResult result;
+  // Auto 1: the candidates, their criteria and the choice; `config` there is the configuration
+  // the run went on with.
+  std::unique_ptr<AutoChoice> automatic;
   std::unique_ptr<RunVerification> verification;  // when Verification is 1
   std::unique_ptr<Evaluation> evaluation;  // when Ground_truth_type is set (not bounded)
   std::vector<std::string> written;        // the paths of the outputs
 };
 
-// Checks the evaluation settings, computes the run (ComputeRun), verifies its candidates when
-// Verification is 1 (VerifyRun), evaluates its matrix (and the verified answers) when
-// Ground_truth_type is set, and writes the outputs (WriteOutputs). `log` receives, as they
+// Checks the evaluation settings, chooses the settings from the data when Auto is 1
+// (ChooseSettings, auto.h: the run then goes on with the chosen configuration, from the
+// single-frame matrices the choice computed; an untrusted choice accepts no match), computes
+// the run (ComputeRun), verifies its candidates when Verification is 1 (VerifyRun), evaluates
+// its matrix (and the verified answers) when Ground_truth_type is set, and writes the outputs
+// (WriteOutputs). `log` receives, as they
 // arise, lines "warning: ..." (a problem that only costs time or a feature unavailable here)
 // and "note: ..." (an output or evaluation this mode cannot give). Throws InputError naming
 // the key, file or value.
@@ -37,7 +44,8 @@ RunOutcome Run(const Config& config, ProgressReporter& progress,
 VerifiedAnswers AnswersOf(const RunVerification& verification, const EvaluationLayout& layout);
 
 // The report Test_OpenABLE prints at the end: descriptor and camera, traversals, mode and
-// matrix, timings, the evaluation table, the files written.
+// matrix, the auto mode's candidates and choice, timings, the evaluation table, the files
+// written. With Auto 1 the run is described by the chosen configuration, not `config`.
 std::string FormatRunReport(const Config& config, const RunOutcome& outcome);
 
 // The same report as one JSON object (Test_OpenABLE --json), for scripts: {"program",
@@ -48,7 +56,8 @@ std::string FormatRunReport(const Config& config, const RunOutcome& outcome);
 // (Threshold set, else null), "accepted": {queries, answered, match_threshold} or null,
 // "verification": {queries, candidates_checked, geometric, answered, seconds} or null,
 // "timings": {total, description, matching, sequences, evaluation, export (seconds), frames,
-// pairs}, "evaluation" (EncodeEvaluationJson's object, or null), "notes", "written"}. Numbers
+// pairs}, "evaluation" (EncodeEvaluationJson's object, or null), "auto" (EncodeAutoJson's
+// object with Auto 1, else null), "notes", "written"}. Numbers
 // as in the evaluation JSON (docs/output_formats.md).
 std::string EncodeRunJson(const Config& config, const RunOutcome& outcome);
 

@@ -49,13 +49,17 @@ std::vector<std::string> SplitValues(const std::string& text) {
   return values;
 }
 
-double RankFigure(const EvaluatedRun& run, SweepRank rank) {
+double RankFigure(const SweepRun& run, SweepRank rank) {
+  const PerQueryResult& q = run.evaluation.per_query;
   switch (rank) {
-    case SweepRank::kAuc: return run.per_query.auc;
-    case SweepRank::kRecallAt100p: return run.per_query.recall_at_100p;
-    case SweepRank::kRecallAt1: return run.per_query.recall_at_1;
-    case SweepRank::kMaxF1: return run.per_query.max_f1;
-    case SweepRank::kAveragePrecision: return run.able_p.average_precision;
+    case SweepRank::kAuc: return q.auc;
+    case SweepRank::kRecallAt100p: return q.recall_at_100p;
+    case SweepRank::kRecallAt1: return q.recall_at_1;
+    case SweepRank::kMaxF1: return q.max_f1;
+    case SweepRank::kAveragePrecision: return run.evaluation.able_p.average_precision;
+    case SweepRank::kDistinctiveness: return run.unsupervised.distinctiveness;
+    case SweepRank::kConsistency: return run.unsupervised.consistency;
+    case SweepRank::kAgreement: return run.unsupervised.agreement;
   }
   return 0;
 }
@@ -67,8 +71,28 @@ const char* RankTitle(SweepRank rank) {
     case SweepRank::kRecallAt1: return "recall at 1";
     case SweepRank::kMaxF1: return "max F1";
     case SweepRank::kAveragePrecision: return "ABLE-P average precision";
+    case SweepRank::kDistinctiveness: return "distinctiveness (no ground truth)";
+    case SweepRank::kConsistency: return "consistency (no ground truth)";
+    case SweepRank::kAgreement: return "agreement (no ground truth)";
   }
   return "";
+}
+
+// Each run's rank (1 = best) by `rank`, ties keeping the order of the runs.
+std::vector<int> RanksBy(const std::vector<SweepRun>& runs, SweepRank rank) {
+  std::vector<int> order(runs.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return RankFigure(runs[a], rank) > RankFigure(runs[b], rank);
+  });
+  std::vector<int> out(runs.size());
+  for (size_t r = 0; r < order.size(); ++r) out[order[r]] = static_cast<int>(r + 1);
+  return out;
+}
+
+// The other kind of ranking the table shows beside the chosen one.
+SweepRank Counterpart(SweepRank rank) {
+  return Unsupervised(rank) ? SweepRank::kAuc : SweepRank::kAgreement;
 }
 
 // The combination's label: descriptor and sequence length (always, as Test_OpenABLE labels a
@@ -170,9 +194,13 @@ SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressRe
   if (options.best < 1)
     throw InputError("--best: " + std::to_string(options.best) +
                      " is not valid; expected the number of runs to draw, >= 1");
-  if (!EvaluationRequested(base))
+  if (!EvaluationRequested(base) && !Unsupervised(options.rank_by))
     throw InputError("Ground_truth_type: empty; expected the ground truth the sweep ranks its "
-                     "runs by (docs/evaluation.md)");
+                     "runs by (--rank-by " + EnumName(options.rank_by) + ", docs/evaluation.md), "
+                     "or --rank-by agreement, consistency or distinctiveness, which need none");
+  if (base.automatic.enabled)
+    throw InputError("Auto: 1: a sweep runs each combination as given; expected Auto 0 "
+                     "(--rank-by agreement ranks settings without ground truth as Auto does)");
   if (base.scale.matrix_mode == MatrixMode::kBounded || base.scale.approximate_search)
     throw InputError(std::string(base.scale.approximate_search ? "Approximate_search: 1"
                                                                 : "Matrix_mode: 2") +
@@ -190,7 +218,7 @@ SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressRe
     try {
       configs.push_back(SweepRunConfig(base, options.axes, values));
       CheckRun(configs.back());
-      EvaluationSettingsFrom(configs.back());
+      if (EvaluationRequested(configs.back())) EvaluationSettingsFrom(configs.back());
     } catch (const InputError& e) {
       throw InputError("with " + where + ": " + e.what());
     }
@@ -200,7 +228,8 @@ SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressRe
   out.axes = options.axes;
   out.rank_by = options.rank_by;
   out.best = options.best;
-  out.settings = EvaluationSettingsFrom(base);
+  out.evaluated = EvaluationRequested(base);
+  if (out.evaluated) out.settings = EvaluationSettingsFrom(base);
   const auto start = Clock::now();
   SingleFrameStore store;
   std::set<std::string> said;
@@ -221,26 +250,45 @@ SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressRe
       if (said.insert("warning: " + w).second) log("warning: " + w);
     for (const std::string& note : result.notes)
       if (said.insert("note: " + note).second) log("note: " + note);
-    Evaluation evaluation;
-    evaluation.settings = EvaluationSettingsFrom(config);
-    if (config.verification.enabled) {
-      // Verified answers rank the run (per_query), the matrix's best matches beside them.
-      const RunVerification verification = VerifyRun(config, result, progress);
-      const VerifiedAnswers answers = AnswersOf(verification, LayoutOf(result));
-      EvaluateMatrix(evaluation, result.normalized, LayoutOf(result), run.label,
-                     "openable_sweep run", &answers);
-    } else {
-      EvaluateMatrix(evaluation, result.normalized, LayoutOf(result), run.label,
-                     "openable_sweep run");
+    // The criteria without ground truth, from the matrix alone.
+    const EvaluationLayout layout = LayoutOf(result);
+    UnsupervisedOptions unsupervised;
+    unsupervised.agreement = AgreementOf(config.matching);
+    unsupervised.agreement.partners = 1;
+    unsupervised.exclusion = config.evaluation.protocol.exclusion;
+    unsupervised.score_window = config.matching.score_window;
+    run.unsupervised = UnsupervisedCriteria(result.normalized, layout, unsupervised);
+    run.unsupervised.best.clear();
+    run.unsupervised.ratio.clear();
+    run.unsupervised.agrees.clear();
+    if (Unsupervised(options.rank_by) && run.unsupervised.queries < 2)
+      throw InputError("--rank-by " + EnumName(options.rank_by) + ": the run " + run.label +
+                       " has " + std::to_string(run.unsupervised.queries) +
+                       (run.unsupervised.queries == 1 ? " query" : " queries") +
+                       " with candidates (" + std::to_string(result.normalized.rows) +
+                       " frames); expected at least two, whose best matches can be compared "
+                       "(more frames, or a smaller Exclusion in one traversal)");
+    if (out.evaluated) {
+      Evaluation evaluation;
+      evaluation.settings = EvaluationSettingsFrom(config);
+      if (config.verification.enabled) {
+        // Verified answers rank the run (per_query), the matrix's best matches beside them.
+        const RunVerification verification = VerifyRun(config, result, progress);
+        const VerifiedAnswers answers = AnswersOf(verification, layout);
+        EvaluateMatrix(evaluation, result.normalized, layout, run.label, "openable_sweep run",
+                       &answers);
+      } else {
+        EvaluateMatrix(evaluation, result.normalized, layout, run.label, "openable_sweep run");
+      }
+      run.evaluation = std::move(evaluation.runs.front());
     }
-    run.evaluation = std::move(evaluation.runs.front());
     run.seconds = SecondsSince(t);
     out.runs.push_back(std::move(run));
   }
   out.descriptions = store.Size();
   out.seconds = SecondsSince(start);
   std::stable_sort(out.runs.begin(), out.runs.end(), [&](const SweepRun& a, const SweepRun& b) {
-    return RankFigure(a.evaluation, options.rank_by) > RankFigure(b.evaluation, options.rank_by);
+    return RankFigure(a, options.rank_by) > RankFigure(b, options.rank_by);
   });
   return out;
 }
@@ -253,31 +301,50 @@ std::string FormatSweepTable(const SweepResult& r) {
     << RankTitle(r.rank_by) << "; frames described " << r.descriptions
     << (r.descriptions == 1 ? " time" : " times") << " (once per description setting), "
     << FormatFixed(r.seconds, 1) << " s\n";
-  const EvaluationSettings& s = r.settings;
-  o << "Evaluation against " << GroundTruthTypeName(s.truth.type) << " ground truth"
-    << (s.truth.path.empty() ? "" : " \"" + s.truth.path + "\"") << ": tolerance +-"
-    << s.options.tolerance << " frames";
-  if (!r.runs.empty() && r.runs[0].evaluation.layout.kind == EvaluationLayout::Kind::kLoopClosure)
-    o << ", candidates at least " << s.options.exclusion << " frames back";
-  o << "; ABLE-P vicinity " << s.options.vicinity << "\n";
+  const bool loop = !r.runs.empty() && r.runs[0].evaluation.layout.kind ==
+                                           EvaluationLayout::Kind::kLoopClosure;
+  if (r.evaluated) {
+    const EvaluationSettings& s = r.settings;
+    o << "Evaluation against " << GroundTruthTypeName(s.truth.type) << " ground truth"
+      << (s.truth.path.empty() ? "" : " \"" + s.truth.path + "\"") << ": tolerance +-"
+      << s.options.tolerance << " frames";
+    if (loop) o << ", candidates at least " << s.options.exclusion << " frames back";
+    o << "; ABLE-P vicinity " << s.options.vicinity << "\n";
+  } else {
+    o << "No ground truth (Ground_truth_type empty): the criteria of the matrices alone "
+         "(docs/evaluation.md, \"Without ground truth\")\n";
+  }
 
   // Columns as wide as their longest entry.
+  const bool both = r.evaluated;
+  const SweepRank other = Counterpart(r.rank_by);
+  const std::vector<int> other_rank = both ? RanksBy(r.runs, other) : std::vector<int>();
   std::vector<std::string> header = {"rank"};
   for (const SweepAxis& a : r.axes) header.push_back(a.key);
-  for (const char* h : {"AUC", "R@100P", "max F1", "R@1", "R@5", "AP %", "seconds", ""})
-    header.push_back(h);
+  for (const char* h : {"consist.", "distinct.", "agreement"}) header.push_back(h);
+  if (both)
+    for (const char* h : {"AUC", "R@100P", "max F1", "R@1", "R@5", "AP %"}) header.push_back(h);
+  if (both) header.push_back(Unsupervised(r.rank_by) ? "AUC rank" : "agr. rank");
+  header.push_back("seconds");
+  header.push_back("");
   std::vector<std::vector<std::string>> rows = {header};
   for (size_t i = 0; i < r.runs.size(); ++i) {
     const SweepRun& run = r.runs[i];
     const PerQueryResult& q = run.evaluation.per_query;
     std::vector<std::string> row = {std::to_string(i + 1)};
     for (const std::string& v : run.values) row.push_back(v);
-    row.push_back(FormatFixed(q.auc, 3));
-    row.push_back(FormatFixed(q.recall_at_100p, 3));
-    row.push_back(FormatFixed(q.max_f1, 3));
-    row.push_back(FormatFixed(q.recall_at_1, 3));
-    row.push_back(FormatFixed(q.recall_at_5, 3));
-    row.push_back(FormatFixed(run.evaluation.able_p.average_precision, 1));
+    row.push_back(FormatFixed(run.unsupervised.consistency, 3));
+    row.push_back(FormatFixed(run.unsupervised.distinctiveness, 3));
+    row.push_back(FormatFixed(run.unsupervised.agreement, 3));
+    if (both) {
+      row.push_back(FormatFixed(q.auc, 3));
+      row.push_back(FormatFixed(q.recall_at_100p, 3));
+      row.push_back(FormatFixed(q.max_f1, 3));
+      row.push_back(FormatFixed(q.recall_at_1, 3));
+      row.push_back(FormatFixed(q.recall_at_5, 3));
+      row.push_back(FormatFixed(run.evaluation.able_p.average_precision, 1));
+      row.push_back(std::to_string(other_rank[i]));
+    }
     row.push_back(FormatFixed(run.seconds, 3));
     row.push_back(run.described ? "" : "*");
     rows.push_back(row);
@@ -296,6 +363,14 @@ std::string FormatSweepTable(const SweepResult& r) {
     o << line.substr(0, line.find_last_not_of(' ') + 1) << "\n";
   }
   o << "  (*: the run took the single-frame matrices of an earlier run; no frame described)\n";
+  if (both && !r.runs.empty() && Unsupervised(r.rank_by)) {
+    double best_auc = 0;
+    for (const SweepRun& run : r.runs) best_auc = std::max(best_auc, run.evaluation.per_query.auc);
+    o << "  The first by " << EnumName(r.rank_by) << ", chosen without ground truth, has AUC "
+      << FormatFixed(r.runs[0].evaluation.per_query.auc, 3) << ": rank " << other_rank[0]
+      << " of " << r.runs.size() << " by AUC (the best AUC is " << FormatFixed(best_auc, 3)
+      << ")\n";
+  }
   return o.str();
 }
 
@@ -303,19 +378,29 @@ std::string EncodeSweepCsv(const SweepResult& r) {
   std::string out = "rank";
   for (const SweepAxis& a : r.axes) out += "," + CsvField(a.key);
   out += ",label,auc,recall_at_100p,max_f1,max_f1_threshold,recall_at_1,recall_at_5,"
-         "recall_at_10,average_precision_percent,queries,unanswered_queries,seconds,described\n";
+         "recall_at_10,average_precision_percent,queries,unanswered_queries,consistency,"
+         "distinctiveness,agreement,seconds,described\n";
   for (size_t i = 0; i < r.runs.size(); ++i) {
     const SweepRun& run = r.runs[i];
     const PerQueryResult& q = run.evaluation.per_query;
+    const UnsupervisedFigures& u = run.unsupervised;
     out += std::to_string(i + 1);
     for (const std::string& v : run.values) out += "," + CsvField(v);
-    out += "," + CsvField(run.label) + "," + JsonNumber(q.auc) + "," +
-           JsonNumber(q.recall_at_100p) + "," + JsonNumber(q.max_f1) + "," +
-           JsonNumber(q.max_f1_threshold) + "," + JsonNumber(q.recall_at_1) + "," +
-           JsonNumber(q.recall_at_5) + "," + JsonNumber(q.recall_at_10) + "," +
-           JsonNumber(run.evaluation.able_p.average_precision) + "," +
-           std::to_string(q.queries) + "," + std::to_string(q.unanswered) + "," +
-           JsonNumber(run.seconds) + "," + (run.described ? "1" : "0") + "\n";
+    out += "," + CsvField(run.label);
+    if (r.evaluated) {
+      out += "," + JsonNumber(q.auc) + "," + JsonNumber(q.recall_at_100p) + "," +
+             JsonNumber(q.max_f1) + "," + JsonNumber(q.max_f1_threshold) + "," +
+             JsonNumber(q.recall_at_1) + "," + JsonNumber(q.recall_at_5) + "," +
+             JsonNumber(q.recall_at_10) + "," +
+             JsonNumber(run.evaluation.able_p.average_precision) + "," +
+             std::to_string(q.queries) + "," + std::to_string(q.unanswered);
+    } else {  // no ground truth: the figures are empty; queries from the criteria
+      out += ",,,,,,,,," + std::to_string(u.queries) + "," +
+             std::to_string(u.queries - u.answered);
+    }
+    out += "," + JsonNumber(u.consistency) + "," + JsonNumber(u.distinctiveness) + "," +
+           JsonNumber(u.agreement) + "," + JsonNumber(run.seconds) + "," +
+           (run.described ? "1" : "0") + "\n";
   }
   return out;
 }
@@ -333,16 +418,32 @@ std::string EncodeSweepJson(const SweepResult& r, const std::string& version) {
   }
   o << "],\n  \"descriptions\": " << r.descriptions << ",\n"
     << "  \"seconds\": " << JsonNumber(r.seconds) << ",\n"
-    << "  \"evaluation\": " << EncodeEvaluationSettingsJson(r.settings, "  ") << ",\n"
-    << "  \"runs\": [";
+    << "  \"evaluation\": "
+    << (r.evaluated ? EncodeEvaluationSettingsJson(r.settings, "  ") : std::string("null"))
+    << ",\n  \"runs\": [";
+  const std::vector<int> by_auc =
+      r.evaluated ? RanksBy(r.runs, SweepRank::kAuc) : std::vector<int>();
+  const std::vector<int> by_agreement = RanksBy(r.runs, SweepRank::kAgreement);
   for (size_t i = 0; i < r.runs.size(); ++i) {
     const SweepRun& run = r.runs[i];
+    const UnsupervisedFigures& u = run.unsupervised;
     o << (i ? ",\n" : "\n") << "    {\n      \"rank\": " << i + 1 << ",\n      \"settings\": {";
     for (size_t a = 0; a < r.axes.size(); ++a)
       o << (a ? ", " : "") << JsonText(r.axes[a].key) << ": " << JsonText(run.values[a]);
     o << "},\n      \"seconds\": " << JsonNumber(run.seconds) << ",\n"
       << "      \"described\": " << (run.described ? "true" : "false") << ",\n"
-      << EncodeEvaluatedRunFieldsJson(run.evaluation, "      ") << "\n    }";
+      << "      \"unsupervised\": {\"consistency\": " << JsonNumber(u.consistency)
+      << ", \"distinctiveness\": " << JsonNumber(u.distinctiveness)
+      << ", \"agreement\": " << JsonNumber(u.agreement) << ", \"queries\": " << u.queries
+      << ", \"answered\": " << u.answered << ", \"agreeing\": " << u.agreeing
+      << ", \"gap\": " << u.gap << ", \"tolerance\": " << u.tolerance
+      << ", \"rank_by_agreement\": " << by_agreement[i] << "}";
+    if (r.evaluated)
+      o << ",\n      \"rank_by_auc\": " << by_auc[i] << ",\n"
+        << EncodeEvaluatedRunFieldsJson(run.evaluation, "      ");
+    else
+      o << ",\n      \"label\": " << JsonText(run.label);
+    o << "\n    }";
   }
   o << "\n  ]\n}\n";
   return o.str();
@@ -352,6 +453,11 @@ std::vector<std::string> WriteSweep(const std::string& prefix, const SweepResult
   OutputBatch batch;
   batch.Stage("--output", prefix + ".csv", EncodeSweepCsv(r));
   batch.Stage("--output", prefix + ".json", EncodeSweepJson(r, kVersion));
+  if (!r.evaluated) {  // no ground truth, no precision-recall curve
+    const std::vector<std::string> paths = batch.Paths();
+    batch.Commit();
+    return paths;
+  }
   std::vector<PrSeries> series;
   const size_t shown = std::min(r.runs.size(), static_cast<size_t>(r.best));
   for (size_t i = 0; i < shown; ++i)

@@ -63,6 +63,48 @@ TEST(PerQuery, HandWorkedQueryReferenceExample) {
   EXPECT_NEAR(r.recall_at_10, 1.0, 1e-12);
 }
 
+// Match_consistency by hand: 30 queries, query q's true place is reference q + 100. Every
+// answer is right (distance 0.5) but for query 15, whose best match is reference 900 (0.2,
+// wrong), and query 25, right but at 0.95, above the threshold 0.9. With L = 1 (partners 10
+// queries apart, tolerance 3; queries 0-9 take the query 10 after them): the score alone
+// accepts 29 answers, one wrong (15); with one partner, 5 (its partner 15 is wrong) and 15
+// lose too: 27 accepted, all right.
+TEST(PerQuery, ConsistencyAcceptanceByHand) {
+  cv::Mat1f m(30, 1000, 1.0f);
+  std::vector<std::vector<int>> truth(30);
+  for (int q = 0; q < 30; ++q) {
+    m(q, q + 100) = 0.5f;
+    truth[q] = {q + 100};
+  }
+  m(15, 900) = 0.2f;
+  m(25, 125) = 0.95f;
+  EvaluationOptions o;
+  o.tolerance = 2;
+  o.accept_threshold = 0.9;
+  const auto layout = EvaluationLayout::QueryReference(30, 1000);
+  const PerQueryResult alone = EvaluatePerQuery(m, layout, Truth(truth, 1000), o);
+  EXPECT_EQ(alone.operating_point.tp, 28);
+  EXPECT_EQ(alone.operating_point.fp, 1);
+  EXPECT_NEAR(alone.operating_point.precision, 28.0 / 29, 1e-12);
+  o.accept_consistency = 1;
+  o.agreement.sequence_length = 1;
+  o.agreement.partial = SequencePartial::kScale;
+  const PerQueryResult confirmed = EvaluatePerQuery(m, layout, Truth(truth, 1000), o);
+  EXPECT_EQ(confirmed.operating_point.tp, 27);
+  EXPECT_EQ(confirmed.operating_point.fp, 0);
+  EXPECT_DOUBLE_EQ(confirmed.operating_point.precision, 1.0);
+  EXPECT_NEAR(confirmed.operating_point.recall, 27.0 / 30, 1e-12);
+  for (int q : {5, 15, 25}) EXPECT_EQ(confirmed.accepted[q], 0) << q;
+  EXPECT_EQ(confirmed.accepted[6], 1);
+  // The curve does not change: the consistency only decides the operating point.
+  EXPECT_EQ(confirmed.auc, alone.auc);
+  // An untrusted auto run accepts nothing.
+  o.accept_none = true;
+  const PerQueryResult none = EvaluatePerQuery(m, layout, Truth(truth, 1000), o);
+  EXPECT_EQ(none.operating_point.tp + none.operating_point.fp, 0);
+  EXPECT_DOUBLE_EQ(none.operating_point.precision, 1.0);
+}
+
 TEST(PerQuery, ToleranceZeroAndTwoChangeOnlyTheAmbiguousQuery) {
   EvaluationOptions o;
   o.tolerance = 0;

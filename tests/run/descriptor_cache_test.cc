@@ -52,7 +52,8 @@ const std::set<std::string> kNotDescription = {
     "Band_width", "Matches_name", "Approximate_search", "Approximate_engine",
     "Approximate_checks", "Approximate_ef_search", "Approximate_nprobe",
     "Descriptor_cache", "Sequence_partial", "Match_score", "Match_score_window",
-    "Match_threshold", "Contrast_enhancement", "Contrast_window", "Fusion_weights",
+    "Match_threshold", "Match_consistency", "Auto", "Auto_candidates", "Auto_min_consistency",
+    "Contrast_enhancement", "Contrast_window", "Fusion_weights",
     "Loops_name", "Bag_path", "Bag_topic", "Bag_topic_right", "Bag_path_2", "Bag_topic_2",
     "Timestamps_name"};
 
