@@ -45,8 +45,11 @@ int main(int argc, char** argv) {
       argc, argv, "Test_OpenABLE", kUsage, "OpenABLE " + std::string(openable::kVersion),
       [](const openable::Config& config, const openable::CommandLine& command_line,
          openable::ProgressReporter& progress) {
-        const auto log = [](const std::string& line) {
-          std::cerr << "Test_OpenABLE: " << line << "\n";
+        // --quiet leaves out the auto mode's line per candidate (the report lists them all).
+        const bool quiet = command_line.quiet;
+        const auto log = [quiet](const std::string& line) {
+          if (!quiet || line.rfind("auto: ", 0) != 0)
+            std::cerr << "Test_OpenABLE: " << line << "\n";
         };
         const openable::RunOutcome outcome = openable::Run(config, progress, log);
         std::cout << (command_line.json ? openable::EncodeRunJson(config, outcome)

@@ -231,11 +231,10 @@ void CheckAuto(const Config& config) {
     throw InputError("Auto: 1 runs on one process; expected Test_OpenABLE without mpirun (the "
                      "chosen settings can then be run over processes with Auto 0)");
   for (const AutoSettings& candidate : ParseAutoCandidates(config.automatic.candidates)) {
-    const AutoSettings settings = Completed(config, candidate);
     try {
-      CheckRun(AutoCandidateConfig(config, settings));
+      CheckRun(AutoCandidateConfig(config, Completed(config, candidate)));
     } catch (const InputError& e) {
-      throw InputError(std::string(kKey) + ": with " + AutoSettingsText(settings) + ": " +
+      throw InputError(std::string(kKey) + ": with " + AutoSettingsText(candidate) + ": " +
                        e.what());
     }
   }

@@ -90,12 +90,14 @@ inline double AlignedRecallAt1(const cv::Mat1f& d, int q0, int r0, int n, int to
 // Brute force over two traversals of `n` frames each (references rows/columns 0..n-1, queries
 // rows first_query..first_query+n-1): the queries whose best reference (smallest distance,
 // lowest column on ties) has a ratio to the smallest distance more than `window` columns away
-// (1 without such a rival, or when it is 0) of at most `threshold`. Cells without a value (NaN,
-// +inf) are neither best matches nor rivals.
+// (1 without such a rival, or when it is 0) of at most `threshold`, and, when `confirmed` is
+// given, confirmed (Match_consistency: AgreeingByBruteForce). Cells without a value (NaN, +inf)
+// are neither best matches nor rivals.
 inline int AcceptedByRatio(const cv::Mat1f& m, int first_query, int n, int window,
-                           float threshold) {
+                           float threshold, const std::vector<bool>* confirmed = nullptr) {
   int accepted = 0;
   for (int q = first_query; q < first_query + n; ++q) {
+    if (confirmed != nullptr && !(*confirmed)[q - first_query]) continue;
     int best = -1;
     for (int c = 0; c < n; ++c)
       if (std::isfinite(m(q, c)) && (best < 0 || m(q, c) < m(q, best))) best = c;
@@ -106,6 +108,39 @@ inline int AcceptedByRatio(const cv::Mat1f& m, int first_query, int n, int windo
     accepted += (std::isfinite(rival) && rival > 0 ? m(q, best) / rival : 1.0f) <= threshold;
   }
   return accepted;
+}
+
+// Per query of the query-reference block (rows first_query.., columns 0..references-1) of a
+// written matrix, whether its best match is confirmed, from the rule of docs/evaluation.md
+// written out here: the answer (smallest finite cell, lowest column on ties) of query q agrees
+// when the answer of its partner (the nearest query at least max(L, 10) frames back whose
+// window of frames is disjoint from q's, else the nearest such forward; windows q - L + 1 .. q,
+// the first L - 1 queries 0 .. L - 1 with Sequence_partial ahead) differs from it by the
+// queries between them within max(3, gap / 10).
+inline std::vector<bool> AgreeingByBruteForce(const cv::Mat1f& m, int first_query, int queries,
+                                              int references, int L, bool ahead = true) {
+  std::vector<int> best(queries, -1);
+  for (int q = 0; q < queries; ++q)
+    for (int j = 0; j < references; ++j) {
+      const float v = m(first_query + q, j);
+      if (std::isfinite(v) && (best[q] < 0 || v < m(first_query + q, best[q]))) best[q] = j;
+    }
+  const auto window = [L, ahead](int q) {
+    const int end = ahead && q < L - 1 ? L - 1 : q;
+    return std::make_pair(std::max(0, end - L + 1), end);
+  };
+  const int gap = std::max(L, 10), tolerance = std::max(3, (gap + 5) / 10);
+  std::vector<bool> out(queries, false);
+  for (int q = 0; q < queries; ++q) {
+    int partner = -1;
+    for (int p = q - gap; p >= 0 && partner < 0; --p)
+      if (window(p).second < window(q).first) partner = p;
+    for (int p = q + gap; p < queries && partner < 0; ++p)
+      if (window(p).first > window(q).second) partner = p;
+    if (best[q] < 0 || partner < 0 || best[partner] < 0) continue;
+    out[q] = std::abs((best[q] - best[partner]) - (q - partner)) <= tolerance;
+  }
+  return out;
 }
 
 // True when `s` is exactly one line.

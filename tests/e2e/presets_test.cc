@@ -22,7 +22,7 @@ std::string Preset(const std::string& name) {
 // Two traversals of 300 frames (summer reference, winter queries) with the frame alignment as
 // ground truth: the settings the preset's comment announces are in effect, R@1 of the report is
 // that of the written matrix, and the accepted best matches are those whose ratio to the best
-// match outside +-10 frames is at most 0.9.
+// match outside +-10 frames is at most 0.9 and that an independent query confirms.
 TEST(Presets, AcrossConditionsRunsOnTheSample) {
   const std::string dir = testing::TempDir();
   const Outcome o = RunProgram(
@@ -44,10 +44,14 @@ TEST(Presets, AcrossConditionsRunsOnTheSample) {
   ASSERT_EQ(m.size(), cv::Size(600, 600));
   const std::string json = ReadAll(dir + "/eval.json");
   EXPECT_NEAR(JsonNumber(json, "recall_at_1"), AlignedRecallAt1(m, 300, 0, 300, 2), 1e-9);
-  const int accepted = AcceptedByRatio(m, 300, 300, 10, 0.9f);
+  // Accepted: ratio <= 0.9 and confirmed by an independent query's best match
+  // (Match_consistency 1, L = 40); the confirmation refuses some the ratio alone accepts.
+  const std::vector<bool> confirmed = AgreeingByBruteForce(m, 300, 300, 300, 40);
+  const int accepted = AcceptedByRatio(m, 300, 300, 10, 0.9f, &confirmed);
   EXPECT_NE(o.out.find("accepted: " + std::to_string(accepted) + " of 300 best matches"),
             std::string::npos)
       << o.out;
+  EXPECT_LT(accepted, AcceptedByRatio(m, 300, 300, 10, 0.9f));
   // On the sample as on the datasets it was chosen on, what it accepts is right.
   EXPECT_EQ(JsonNumber(json, "precision", json.find("\"accepted\"")), 1.0) << json;
   EXPECT_GT(accepted, 100);
@@ -82,6 +86,7 @@ TEST(Presets, LoopClosureRunsOnTheSample) {
 // holds every key the program knows, with the value in effect (no key missing or unknown).
 TEST(Presets, AreCompleteConfigurations) {
   for (const std::string& name : {Preset("across_conditions"), Preset("loop_closure"),
+                                  Preset("auto"),
                                   testing::SourceDir() + "/config/Config.txt"}) {
     const Outcome o =
         RunProgram(testing::TestOpenableExe(), {name, "--print-config"}, testing::TempDir());
