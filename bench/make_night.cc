@@ -11,12 +11,11 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/image/robustness.h"
 #include "OpenABLE/io/frame_source.h"
@@ -51,9 +50,10 @@ int main(int argc, char** argv) {
       }
     }
     if (folders.size() != 2) {
-      std::fprintf(stderr, "usage: make_night <input folder> <output folder> [--strong] "
-                           "[--from-left] [--seed N] [--zoom Z] [--shift S] [--rotation DEG] "
-                           "[--noise K]\n");
+      std::fprintf(stderr,
+                   "usage: make_night <input folder> <output folder> [--strong] "
+                   "[--from-left] [--seed N] [--zoom Z] [--shift S] [--rotation DEG] "
+                   "[--noise K]\n");
       return 2;
     }
     std::filesystem::create_directories(folders[1]);

@@ -38,9 +38,12 @@ bool Agree(int qa, int a, int qb, int b, const AgreementOptions& o) {
   const bool forward = std::abs(moved - steps) <= tolerance;
   const bool reverse = std::abs(moved + steps) <= tolerance;
   switch (o.direction) {
-    case SequenceDirection::kForward: return forward;
-    case SequenceDirection::kReverse: return reverse;
-    case SequenceDirection::kBoth: break;
+    case SequenceDirection::kForward:
+      return forward;
+    case SequenceDirection::kReverse:
+      return reverse;
+    case SequenceDirection::kBoth:
+      break;
   }
   return forward || reverse;
 }
@@ -70,8 +73,7 @@ std::vector<std::uint8_t> AgreeingAnswers(const std::vector<int>& best,
       found += agree ? 1 : 0;
     }
     for (int from = q, p = ForwardPartner(q, n, options);
-         agree && found < options.partners && p >= 0;
-         from = p, p = ForwardPartner(p, n, options)) {
+         agree && found < options.partners && p >= 0; from = p, p = ForwardPartner(p, n, options)) {
       agree = Agree(from, best[from], p, best[p], options);
       found += agree ? 1 : 0;
     }

@@ -30,6 +30,16 @@ std::string Trim(std::string_view s) {
   return std::string(s.substr(b, e - b + 1));
 }
 
+std::vector<std::string> SplitTrimmed(std::string_view s, char separator) {
+  std::vector<std::string> pieces;
+  for (std::size_t start = 0;;) {
+    const std::size_t end = s.find(separator, start);
+    pieces.push_back(Trim(s.substr(start, end == std::string_view::npos ? end : end - start)));
+    if (end == std::string_view::npos) return pieces;
+    start = end + 1;
+  }
+}
+
 std::string FormatNumber(double value) {
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
   std::ostringstream os;

@@ -3,6 +3,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace openable {
 
@@ -13,6 +14,10 @@ std::string Upper(std::string_view s);
 
 // `s` without leading and trailing spaces, tabs, CR and LF.
 std::string Trim(std::string_view s);
+
+// The pieces of `s` between `separator`s, each trimmed (an empty piece stays: "a,,b" gives
+// "a", "", "b"; "" gives one empty piece).
+std::vector<std::string> SplitTrimmed(std::string_view s, char separator);
 
 // A number as users read it in messages and in Config.txt: the shortest of printf's %g with
 // six significant digits ("0.47", "2500", "1e+06"), "inf" for infinity.

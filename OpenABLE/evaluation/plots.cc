@@ -338,9 +338,9 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
       const float d = result.score[q];
       // At the operating point, the answers it accepted (Match_consistency may refuse some
       // below its threshold); else those with a score within the threshold given.
-      const bool accepted = result.has_operating_point && q < static_cast<int>(result.accepted.size())
-                                ? result.accepted[q] != 0
-                                : d <= accept_threshold;
+      const bool at_operating_point =
+          result.has_operating_point && q < static_cast<int>(result.accepted.size());
+      const bool accepted = at_operating_point ? result.accepted[q] != 0 : d <= accept_threshold;
       if (c < 0 || c >= cols || !accepted) continue;
       const bool correct = result.correct[q] != 0;
       if (correct != (pass == 0)) continue;

@@ -31,13 +31,14 @@ cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& t
 
 // The evaluated block of `matrix` (normalised) in grey (dark = small distance), with the ground
 // truth tinted blue, and each query's best match marked where it is accepted (at the operating
-// point: `result.accepted`, which Match_consistency may make stricter than the threshold; without
-// one, where its score is <= accept_threshold): green when correct, red when wrong. Queries are rows, references columns. Small
-// blocks are enlarged by an integer factor (nearest neighbour) to at least 600 pixels on the
-// longer side; marks are at least 3 x 3 output pixels. A legend strip below the image names the
-// colours. With `rejected` (geometric verification: cells (x = reference column, y = query row)
-// of candidates that verification rejected), those are marked in magenta under the answers,
-// and the answers are labelled "verified".
+// point: `result.accepted`, which Match_consistency may make stricter than the threshold;
+// without one, where its score is <= accept_threshold): green when correct, red when wrong.
+// Queries are rows, references columns. Small blocks are enlarged by an integer factor
+// (nearest neighbour) to at least 600 pixels on the longer side; marks are at least 3 x 3
+// output pixels. A legend strip below the image names the colours. With `rejected` (geometric
+// verification: cells (x = reference column, y = query row) of candidates that verification
+// rejected), those are marked in magenta under the answers, and the answers are labelled
+// "verified".
 cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                         const GroundTruth& truth, const PerQueryResult& result,
                         double accept_threshold,

@@ -21,9 +21,8 @@
 #pragma once
 
 #include <cstdint>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "OpenABLE/base/enum_names.h"
 #include "OpenABLE/evaluation/layout.h"
@@ -54,9 +53,12 @@ struct UnsupervisedFigures {
 
   double Value(UnsupervisedCriterion c) const {
     switch (c) {
-      case UnsupervisedCriterion::kDistinctiveness: return distinctiveness;
-      case UnsupervisedCriterion::kConsistency: return consistency;
-      case UnsupervisedCriterion::kAgreement: break;
+      case UnsupervisedCriterion::kDistinctiveness:
+        return distinctiveness;
+      case UnsupervisedCriterion::kConsistency:
+        return consistency;
+      case UnsupervisedCriterion::kAgreement:
+        break;
     }
     return agreement;
   }

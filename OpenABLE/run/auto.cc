@@ -22,29 +22,21 @@ constexpr const char* kKey = "Auto_candidates";
 
 // Keys of these groups may change the matrix a candidate is judged by.
 bool ChangesTheMatrix(const OptionBinding& b) {
-  static const std::set<std::string> after = {
-      "Threads",          "Threshold",          "Match_score", "Match_score_window",
-      "Match_threshold",  "Match_consistency",  "Noise_gaussian", "Noise_salt_pepper",
-      "Noise_overexposure", "Noise_seed"};
+  static const std::set<std::string> after = {"Threads",
+                                              "Threshold",
+                                              "Match_score",
+                                              "Match_score_window",
+                                              "Match_threshold",
+                                              "Match_consistency",
+                                              "Noise_gaussian",
+                                              "Noise_salt_pepper",
+                                              "Noise_overexposure",
+                                              "Noise_seed"};
   return (b.group == "Description and matching" || b.group == "Robustness") &&
          after.count(b.key) == 0;
 }
 
 std::string Example() { return std::string(AutoOptions::kDefaultCandidates); }
-
-std::vector<std::string> Split(const std::string& text, char separator) {
-  std::vector<std::string> out;
-  std::string current;
-  for (const char c : text + separator) {
-    if (c == separator) {
-      out.push_back(Trim(current));
-      current.clear();
-    } else {
-      current += c;
-    }
-  }
-  return out;
-}
 
 std::vector<std::string> Words(const std::string& text) {
   std::vector<std::string> out;
@@ -63,23 +55,27 @@ Axis ParseAxis(const std::string& text) {
   if (eq == std::string::npos || eq == 0)
     throw InputError(std::string(kKey) + ": " + Quoted(text) +
                      " is not of the form Key=v1,v2,...; expected axes separated by spaces and "
-                     "groups by |, e.g. " + Quoted(Example()));
+                     "groups by |, e.g. " +
+                     Quoted(Example()));
   Axis axis;
   axis.key = Trim(text.substr(0, eq));
   Config probe;
   const OptionTable table = ConfigTable(probe);
   const OptionBinding& b = table.Lookup(axis.key, kKey);
   if (b.key == "Exclusion" || b.key == "Ground_truth_min_gap")
-    throw InputError(std::string(kKey) + ": " + b.key + " is a setting of runs of one traversal "
+    throw InputError(std::string(kKey) + ": " + b.key +
+                     " is a setting of runs of one traversal "
                      "(loop closure: candidates frames back), while Auto chooses settings for "
                      "two traversals; expected keys of the Description and matching or "
                      "Robustness groups");
   if (b.group == "Datasets")
-    throw InputError(std::string(kKey) + ": " + b.key + " changes which frames are matched; "
+    throw InputError(std::string(kKey) + ": " + b.key +
+                     " changes which frames are matched; "
                      "every candidate is judged on the run's frames; expected keys of the "
                      "Description and matching or Robustness groups");
   if (!ChangesTheMatrix(b))
-    throw InputError(std::string(kKey) + ": " + b.key + " (" + b.group + ") does not change "
+    throw InputError(std::string(kKey) + ": " + b.key + " (" + b.group +
+                     ") does not change "
                      "the matrix a candidate is judged by; set it for the run instead; "
                      "expected keys of the Description and matching or Robustness groups that "
                      "change the matrix (Image_descriptor, Image_sequences, Contrast_enhancement, "
@@ -87,7 +83,7 @@ Axis ParseAxis(const std::string& text) {
   const std::string list = text.substr(eq + 1);
   const char separator = list.find(';') != std::string::npos ? ';' : ',';
   std::set<std::string> seen;
-  for (const std::string& value : Split(list, separator)) {
+  for (const std::string& value : SplitTrimmed(list, separator)) {
     if (value.empty())
       throw InputError(std::string(kKey) + ": " + axis.key + "=" + list +
                        " has an empty value; expected values separated by commas (or by "
@@ -145,10 +141,14 @@ AutoSettings Completed(const Config& config, AutoSettings settings) {
 
 int Traversals(const InputOptions& in) {
   switch (in.frame_mode) {
-    case FrameMode::kImageFolders: return in.images_path_2.empty() ? 1 : 2;
-    case FrameMode::kVideo: return 1;
-    case FrameMode::kTwoVideos: return 2;
-    case FrameMode::kBag: return in.bag_topic_2.empty() ? 1 : 2;
+    case FrameMode::kImageFolders:
+      return in.images_path_2.empty() ? 1 : 2;
+    case FrameMode::kVideo:
+      return 1;
+    case FrameMode::kTwoVideos:
+      return 2;
+    case FrameMode::kBag:
+      return in.bag_topic_2.empty() ? 1 : 2;
   }
   return 1;
 }
@@ -169,15 +169,18 @@ std::vector<int> Ranking(const AutoChoice& c) {
 
 std::vector<AutoSettings> ParseAutoCandidates(const std::string& text) {
   if (Trim(text).empty())
-    throw InputError(std::string(kKey) + ": empty; expected groups of Key=v1,v2 axes separated "
-                     "by |, e.g. " + Quoted(Example()));
-  const std::vector<std::string> groups = Split(text, '|');
+    throw InputError(std::string(kKey) +
+                     ": empty; expected groups of Key=v1,v2 axes separated "
+                     "by |, e.g. " +
+                     Quoted(Example()));
+  const std::vector<std::string> groups = SplitTrimmed(text, '|');
   std::vector<AutoSettings> out;
   std::set<AutoSettings> seen;
   for (size_t g = 0; g < groups.size(); ++g) {
     if (groups[g].empty())
       throw InputError(std::string(kKey) + ": group " + std::to_string(g + 1) + " of " +
-                       std::to_string(groups.size()) + " is empty; expected Key=v1,v2 axes "
+                       std::to_string(groups.size()) +
+                       " is empty; expected Key=v1,v2 axes "
                        "separated by spaces between the |");
     std::vector<Axis> axes;
     std::set<std::string> keys;
@@ -185,7 +188,8 @@ std::vector<AutoSettings> ParseAutoCandidates(const std::string& text) {
       axes.push_back(ParseAxis(word));
       if (!keys.insert(axes.back().key).second)
         throw InputError(std::string(kKey) + ": " + axes.back().key + " is given twice in " +
-                         Quoted(groups[g]) + "; expected each key once per group, with all its "
+                         Quoted(groups[g]) +
+                         "; expected each key once per group, with all its "
                          "values");
     }
     for (AutoSettings& candidate : Combinations(axes)) {
@@ -193,7 +197,8 @@ std::vector<AutoSettings> ParseAutoCandidates(const std::string& text) {
       std::sort(sorted.begin(), sorted.end());
       if (!seen.insert(sorted).second)
         throw InputError(std::string(kKey) + ": the candidate " +
-                         Quoted(AutoSettingsText(candidate)) + " is given twice; expected each "
+                         Quoted(AutoSettingsText(candidate)) +
+                         " is given twice; expected each "
                          "setting once");
       out.push_back(std::move(candidate));
     }
@@ -217,19 +222,21 @@ Config AutoCandidateConfig(const Config& config, const AutoSettings& candidate) 
 void CheckAuto(const Config& config) {
   const int traversals = Traversals(config.input);
   if (traversals != 2)
-    throw InputError("Auto: 1 chooses settings for two traversals of a route (Images_path and "
-                     "Images_path_2, Frame_mode 2, or Bag_topic_2), but this run has one; for "
-                     "loop closure in one traversal start from config/presets/loop_closure.txt "
-                     "(openable_sweep --rank-by agreement ranks settings of one traversal "
-                     "without ground truth)");
+    throw InputError(
+        "Auto: 1 chooses settings for two traversals of a route (Images_path and "
+        "Images_path_2, Frame_mode 2, or Bag_topic_2), but this run has one; for "
+        "loop closure in one traversal start from config/presets/loop_closure.txt "
+        "(openable_sweep --rank-by agreement ranks settings of one traversal "
+        "without ground truth)");
   if (config.scale.matrix_mode == MatrixMode::kBounded || config.scale.approximate_search)
     throw InputError(std::string("Auto: 1 compares dense matrices, but ") +
                      (config.scale.approximate_search ? "Approximate_search is 1"
                                                       : "Matrix_mode is 2 (bounded)") +
                      "; expected Matrix_mode 0 or 1 and Approximate_search 0");
   if (Cluster::Get().Distributed())
-    throw InputError("Auto: 1 runs on one process; expected Test_OpenABLE without mpirun (the "
-                     "chosen settings can then be run over processes with Auto 0)");
+    throw InputError(
+        "Auto: 1 runs on one process; expected Test_OpenABLE without mpirun (the "
+        "chosen settings can then be run over processes with Auto 0)");
   for (const AutoSettings& candidate : ParseAutoCandidates(config.automatic.candidates)) {
     try {
       CheckRun(AutoCandidateConfig(config, Completed(config, candidate)));
@@ -240,8 +247,7 @@ void CheckAuto(const Config& config) {
   }
 }
 
-AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress,
-                          SingleFrameStore& store,
+AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress, SingleFrameStore& store,
                           const std::function<void(const std::string&)>& log) {
   const auto start = std::chrono::steady_clock::now();
   CheckAuto(config);
@@ -277,14 +283,13 @@ AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress,
     CheckForInterrupt();
     const Config& c = configs[i];
     const MatchingOptions& m = c.matching;
-    const std::string key = SingleFrameKey(c, c.descriptor.name) + "\n" + m.fusion_weights +
-                            "\n" + std::to_string(m.contrast_enhancement) + " " +
+    const std::string key = SingleFrameKey(c, c.descriptor.name) + "\n" + m.fusion_weights + "\n" +
+                            std::to_string(m.contrast_enhancement) + " " +
                             std::to_string(m.contrast_window);
     auto it = blocks.find(key);
     if (it == blocks.end()) {
       const cv::Mat1f single = SingleFrameMatrix(c, store, starts);
-      it = blocks.emplace(key, single(cv::Rect(0, references, references, queries)).clone())
-               .first;
+      it = blocks.emplace(key, single(cv::Rect(0, references, references, queries)).clone()).first;
     }
     cv::Mat1f sums = it->second.clone();
     SequenceDistancesInPlace(sums, m.sequence_length, {}, {}, m.direction, m.threads, m.partial);
@@ -327,12 +332,12 @@ std::string FormatAutoReport(const AutoChoice& c) {
     char line[96];
     std::snprintf(line, sizeof line, "    %4zu  %11.3f  %15.3f  %9.3f  ", r + 1,
                   a.figures.consistency, a.figures.distinctiveness, a.figures.agreement);
-    o << line << AutoSettingsText(a.settings)
-      << (order[r] == c.chosen ? "  <- chosen" : "") << "\n";
+    o << line << AutoSettingsText(a.settings) << (order[r] == c.chosen ? "  <- chosen" : "")
+      << "\n";
   }
   if (c.reliable) {
-    o << "    chosen: " << AutoSettingsText(chosen.settings) << "; reliable: "
-      << FormatFixed(100.0 * chosen.figures.consistency, 1)
+    o << "    chosen: " << AutoSettingsText(chosen.settings)
+      << "; reliable: " << FormatFixed(100.0 * chosen.figures.consistency, 1)
       << " % of its best matches agree with an independent query's (Auto_min_consistency "
       << FormatNumber(c.min_consistency) << ")\n";
   } else {
@@ -354,11 +359,10 @@ ReportTable AutoReportTable(const AutoChoice& c) {
   const std::vector<int> order = Ranking(c);
   for (size_t r = 0; r < order.size(); ++r) {
     const AutoCandidate& a = c.candidates[order[r]];
-    t.rows.push_back({std::to_string(r + 1), AutoSettingsText(a.settings),
-                      Fixed(a.figures.consistency, 3), Fixed(a.figures.distinctiveness, 3),
-                      Fixed(a.figures.agreement, 3),
-                      std::to_string(a.figures.answered) + " of " +
-                          std::to_string(a.figures.queries)});
+    t.rows.push_back(
+        {std::to_string(r + 1), AutoSettingsText(a.settings), Fixed(a.figures.consistency, 3),
+         Fixed(a.figures.distinctiveness, 3), Fixed(a.figures.agreement, 3),
+         std::to_string(a.figures.answered) + " of " + std::to_string(a.figures.queries)});
     if (order[r] == c.chosen) t.highlight = static_cast<int>(r);
   }
   const double consistency = c.candidates.at(c.chosen).figures.consistency;
@@ -395,10 +399,11 @@ std::string EncodeAutoJson(const AutoChoice& c, const std::string& indent) {
   for (size_t r = 0; r < order.size(); ++r) rank[order[r]] = static_cast<int>(r + 1);
   for (size_t i = 0; i < c.candidates.size(); ++i) {
     const UnsupervisedFigures& f = c.candidates[i].figures;
-    o << (i ? ",\n" : "\n") << in << "  {\"settings\": "
-      << JsonText(AutoSettingsText(c.candidates[i].settings)) << ", \"rank\": " << rank[i]
-      << ", \"queries\": " << f.queries << ", \"answered\": " << f.answered
-      << ", \"agreeing\": " << f.agreeing << ", \"consistency\": " << JsonNumber(f.consistency)
+    o << (i ? ",\n" : "\n") << in
+      << "  {\"settings\": " << JsonText(AutoSettingsText(c.candidates[i].settings))
+      << ", \"rank\": " << rank[i] << ", \"queries\": " << f.queries
+      << ", \"answered\": " << f.answered << ", \"agreeing\": " << f.agreeing
+      << ", \"consistency\": " << JsonNumber(f.consistency)
       << ", \"distinctiveness\": " << JsonNumber(f.distinctiveness)
       << ", \"agreement\": " << JsonNumber(f.agreement) << ", \"gap\": " << f.gap
       << ", \"tolerance\": " << f.tolerance << "}";

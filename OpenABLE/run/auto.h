@@ -52,9 +52,9 @@ struct AutoChoice {
   int chosen = -1;                        // index of the chosen candidate
   bool reliable = false;                  // its consistency >= min_consistency
   double min_consistency = 0.5;
-  Config config;                          // the run's configuration with the chosen settings
-  int descriptions = 0;                   // single-frame matrices computed
-  double seconds = 0;                     // describing, matching and judging the candidates
+  Config config;         // the run's configuration with the chosen settings
+  int descriptions = 0;  // single-frame matrices computed
+  double seconds = 0;    // describing, matching and judging the candidates
 };
 
 // Checks what the auto mode needs before any frame is read: two traversals, a dense matrix on
@@ -64,8 +64,7 @@ void CheckAuto(const Config& config);
 // Describes the frames once per candidate descriptor into `store`, judges every candidate and
 // chooses (CheckAuto first). `log` receives one line per candidate ("auto: 3 of 15: HOG
 // Image_sequences=20: consistency 0.912, ..."). Throws InputError as ComputeRun does.
-AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress,
-                          SingleFrameStore& store,
+AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress, SingleFrameStore& store,
                           const std::function<void(const std::string&)>& log);
 
 // The lines of the run report: the candidates with their criteria, ranked, and the choice, or

@@ -742,7 +742,8 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     cluster.Agree([&] {
       SequenceDistancesInPlace(distances, matching.sequence_length,
                                ShareRowStarts(starts, share), starts, direction,
-                               matching.threads, ahead ? SequencePartial::kSkip : matching.partial);
+                               matching.threads,
+                               ahead ? SequencePartial::kSkip : matching.partial);
       rows = distances.rowRange(share.first - share.history, share.last - share.history);
       largest = LargestFiniteEntry(rows);
     });

@@ -34,19 +34,9 @@ bool IsFixedKey(const std::string& key) {
   return key == "Evaluation_name" || key == "Evaluation_label";
 }
 
+// Values separated by commas, or by semicolons when a value holds commas.
 std::vector<std::string> SplitValues(const std::string& text) {
-  const char separator = text.find(';') != std::string::npos ? ';' : ',';
-  std::vector<std::string> values;
-  std::string current;
-  for (const char c : text + separator) {
-    if (c == separator) {
-      values.push_back(Trim(current));
-      current.clear();
-    } else {
-      current += c;
-    }
-  }
-  return values;
+  return SplitTrimmed(text, text.find(';') != std::string::npos ? ';' : ',');
 }
 
 double RankFigure(const SweepRun& run, SweepRank rank) {

@@ -88,8 +88,9 @@ Config SweepRunConfig(const Config& base, const std::vector<SweepAxis>& axes,
 // when the configuration has Ground_truth_type, its evaluation; ranking by a figure of the
 // evaluation needs the ground truth. Refuses Matrix_mode 2 and Approximate_search 1 (no dense
 // matrix to evaluate), Auto 1, and an unsupervised ranking of runs with fewer than two queries.
-// Throws InputError naming the key and value. `log` receives "run 3 of 32: HOG L=10" before each run and each distinct warning or
-// note of the runs ("warning: ...", "note: ..."); each run's stages go to `progress`.
+// Throws InputError naming the key and value. `log` receives "run 3 of 32: HOG L=10" before
+// each run and each distinct warning or note of the runs ("warning: ...", "note: ..."); each
+// run's stages go to `progress`.
 SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressReporter& progress,
                      const std::function<void(const std::string&)>& log);
 

@@ -4,16 +4,16 @@
 // unreliable and nothing is accepted; bad candidate lists are one line before any work; on a
 // night-like pair of real frames the choice is within 0.02 of the best AUC a sweep finds with
 // ground truth, and every match it accepts is right.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/image/robustness.h"
 #include "OpenABLE/io/frame_source.h"
@@ -46,19 +46,27 @@ std::vector<std::string> Words(const std::string& s) {
 // The consistency of a written matrix's query-reference block by brute force
 // (AgreeingByBruteForce, e2e_support.h).
 double BruteConsistency(const cv::Mat1f& m, int references, int L) {
-  const std::vector<bool> a = AgreeingByBruteForce(m, references, m.rows - references,
-                                                   references, L);
+  const std::vector<bool> a =
+      AgreeingByBruteForce(m, references, m.rows - references, references, L);
   return static_cast<double>(std::count(a.begin(), a.end(), true)) / a.size();
 }
 
 std::vector<std::string> SampleArgs() {
-  return {"--quiet",      "--set", "Images_path=" + testing::SampleDir() + "/summer",
-          "--set",        "Images_path_2=" + testing::SampleDir() + "/winter",
-          "--set",        "Ground_truth_type=aligned",
-          "--set",        "Npy_name=out/m.npy",
-          "--set",        "Png_name=out/m.png",
-          "--set",        "Txt_name=out/m.txt",
-          "--set",        "Evaluation_name=out/eval"};
+  return {"--quiet",
+          "--set",
+          "Images_path=" + testing::SampleDir() + "/summer",
+          "--set",
+          "Images_path_2=" + testing::SampleDir() + "/winter",
+          "--set",
+          "Ground_truth_type=aligned",
+          "--set",
+          "Npy_name=out/m.npy",
+          "--set",
+          "Png_name=out/m.png",
+          "--set",
+          "Txt_name=out/m.txt",
+          "--set",
+          "Evaluation_name=out/eval"};
 }
 
 TEST(Auto, TheRunOfTheChoiceIsThePlainRunOfItsSettingsByteForByte) {
@@ -121,11 +129,11 @@ TEST(Auto, UnrelatedTraversalsAreUnreliableAndAcceptNothing) {
     fs::copy_file(summer[i], dir + "/a/" + fs::path(summer[i]).filename().string());
     fs::copy_file(winter[150 + i], dir + "/b/" + fs::path(winter[150 + i]).filename().string());
   }
-  const Outcome o = RunProgram(testing::TestOpenableExe(),
-                               {AutoPreset(), "--quiet", "--set", "Images_path=a", "--set",
-                                "Images_path_2=b", "--set", "Npy_name=out/m.npy", "--set",
-                                "Png_name=", "--json"},
-                               dir);
+  const Outcome o =
+      RunProgram(testing::TestOpenableExe(),
+                 {AutoPreset(), "--quiet", "--set", "Images_path=a", "--set", "Images_path_2=b",
+                  "--set", "Npy_name=out/m.npy", "--set", "Png_name=", "--json"},
+                 dir);
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_NE(o.out.find("\"reliable\": false"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("\"accepted\": {\"queries\": 0,"), std::string::npos) << o.out;
@@ -158,8 +166,8 @@ TEST(Auto, BadCandidatesAndRunsAreOneLineBeforeAnyWork) {
       {{"Auto_candidates="}, {"Auto_candidates", "empty"}},
       {{"Auto_candidates=Image_descriptor=HOG | "}, {"Auto_candidates", "group 2 of 2", "empty"}},
       {{"Auto_candidates=Image_descriptor=HOG,FOO"}, {"Auto_candidates", "FOO"}},
-      {{"Auto_candidates=Imge_descriptor=HOG"}, {"Auto_candidates", "Imge_descriptor",
-                                                  "Image_descriptor"}},
+      {{"Auto_candidates=Imge_descriptor=HOG"},
+       {"Auto_candidates", "Imge_descriptor", "Image_descriptor"}},
       {{"Auto_candidates=Image_descriptor=HOG Exclusion=50"},
        {"Auto_candidates", "Exclusion", "one traversal"}},
       {{"Auto_candidates=Image_descriptor=HOG Match_threshold=0.5"},
@@ -172,10 +180,12 @@ TEST(Auto, BadCandidatesAndRunsAreOneLineBeforeAnyWork) {
   };
   for (const Case& c : cases) {
     const std::string dir = testing::TempDir();
-    std::vector<std::string> args = {AutoPreset(), "--quiet", "--set",
-                                     "Images_path=" + testing::SampleDir() + "/summer", "--set",
-                                     "Images_path_2=" + testing::SampleDir() + "/winter", "--set",
-                                     "Npy_name=out/m.npy", "--set", "Png_name=out/m.png"};
+    std::vector<std::string> args = {
+        AutoPreset(), "--quiet",
+        "--set",      "Images_path=" + testing::SampleDir() + "/summer",
+        "--set",      "Images_path_2=" + testing::SampleDir() + "/winter",
+        "--set",      "Npy_name=out/m.npy",
+        "--set",      "Png_name=out/m.png"};
     for (const std::string& s : c.sets) args.insert(args.end(), {"--set", s});
     const Outcome o = RunProgram(testing::TestOpenableExe(), args, dir);
     EXPECT_EQ(o.status, 1) << c.sets.front() << ": " << o.err;
@@ -202,21 +212,32 @@ TEST(Auto, NightLikeGardensPointIsWithinTheBestOfTheSweep) {
   int frame = 0;
   for (const std::string& file : ListImages(gp + "/day_left", "")) {
     cv::Mat half;
-    cv::resize(cv::imread(file, cv::IMREAD_COLOR), half, cv::Size(480, 270), 0, 0,
-               cv::INTER_AREA);
+    cv::resize(cv::imread(file, cv::IMREAD_COLOR), half, cv::Size(480, 270), 0, 0, cv::INTER_AREA);
     ASSERT_TRUE(cv::imwrite(dir + "/day/" + fs::path(file).filename().string(), half));
   }
   for (const std::string& file : ListImages(gp + "/day_right", "")) {
     cv::Mat half, f, out;
-    cv::resize(cv::imread(file, cv::IMREAD_COLOR), half, cv::Size(480, 270), 0, 0,
-               cv::INTER_AREA);
+    cv::resize(cv::imread(file, cv::IMREAD_COLOR), half, cv::Size(480, 270), 0, 0, cv::INTER_AREA);
     half.convertTo(f, CV_32FC3, 1.0 / 255);
-    MakeNightLike(f, NightOptions::Strong(), NoiseState(2, 7, frame++)).convertTo(out, CV_8UC3, 255);
+    MakeNightLike(f, NightOptions::Strong(), NoiseState(2, 7, frame++))
+        .convertTo(out, CV_8UC3, 255);
     ASSERT_TRUE(cv::imwrite(dir + "/night/" + fs::path(file).filename().string(), out));
   }
-  const std::vector<std::string> pair = {
-      "--quiet", "--set", "Images_path=day", "--set", "Images_path_2=night", "--set", "Ground_truth_type=aligned", "--set",
-      "Tolerance=2", "--set", "Npy_name=", "--set", "Png_name=", "--set", "Evaluation_name="};
+  const std::vector<std::string> pair = {"--quiet",
+                                         "--set",
+                                         "Images_path=day",
+                                         "--set",
+                                         "Images_path_2=night",
+                                         "--set",
+                                         "Ground_truth_type=aligned",
+                                         "--set",
+                                         "Tolerance=2",
+                                         "--set",
+                                         "Npy_name=",
+                                         "--set",
+                                         "Png_name=",
+                                         "--set",
+                                         "Evaluation_name="};
   std::vector<std::string> args = {AutoPreset()};
   args.insert(args.end(), pair.begin(), pair.end());
   args.push_back("--json");
@@ -230,10 +251,18 @@ TEST(Auto, NightLikeGardensPointIsWithinTheBestOfTheSweep) {
 
   // Every candidate, and more (SAD without contrast enhancement, the others with it), in one
   // sweep with the ground truth: the best AUC among them.
-  std::vector<std::string> sweep = {AutoPreset(), "--set", "Auto=0", "--set",
-                                    "Fusion_weights=1,1", "--output", "s", "--vary",
-                                    "Image_descriptor=HOG,SIFT,LDB,HOG+LDB,SAD", "--vary",
-                                    "Contrast_enhancement=0,1", "--vary",
+  std::vector<std::string> sweep = {AutoPreset(),
+                                    "--set",
+                                    "Auto=0",
+                                    "--set",
+                                    "Fusion_weights=1,1",
+                                    "--output",
+                                    "s",
+                                    "--vary",
+                                    "Image_descriptor=HOG,SIFT,LDB,HOG+LDB,SAD",
+                                    "--vary",
+                                    "Contrast_enhancement=0,1",
+                                    "--vary",
                                     "Image_sequences=10,20,40"};
   sweep.insert(sweep.end(), pair.begin(), pair.end());
   const Outcome s = RunProgram(testing::OpenableSweepExe(), sweep, dir);
@@ -276,12 +305,12 @@ TEST(Auto, SweepRanksWithoutGroundTruthAndRefusesOneFrame) {
   const std::vector<std::string> summer = ListImages(testing::SampleDir() + "/summer", "");
   fs::copy_file(summer[0], dir + "/one_a/a.png");
   fs::copy_file(summer[1], dir + "/one_b/b.png");
-  const Outcome one = RunProgram(
-      testing::OpenableSweepExe(),
-      {AutoPreset(), "--quiet", "--set", "Auto=0", "--set", "Images_path=one_a", "--set",
-       "Images_path_2=one_b", "--set", "Match_score=distance", "--vary",
-       "Image_sequences=1,2", "--rank-by", "consistency", "--output", "out2/s"},
-      dir);
+  const Outcome one =
+      RunProgram(testing::OpenableSweepExe(),
+                 {AutoPreset(), "--quiet", "--set", "Auto=0", "--set", "Images_path=one_a", "--set",
+                  "Images_path_2=one_b", "--set", "Match_score=distance", "--vary",
+                  "Image_sequences=1,2", "--rank-by", "consistency", "--output", "out2/s"},
+                 dir);
   EXPECT_EQ(one.status, 1) << one.err;
   EXPECT_TRUE(OneLine(one.err)) << one.err;
   EXPECT_NE(one.err.find("--rank-by consistency"), std::string::npos) << one.err;

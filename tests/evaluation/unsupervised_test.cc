@@ -1,12 +1,12 @@
 #include "OpenABLE/evaluation/unsupervised.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <random>
-
-#include <gtest/gtest.h>
 
 namespace openable {
 namespace {
@@ -40,7 +40,8 @@ Brute BruteForce(const cv::Mat1f& m, int L, int window) {
     if (best[q] < 0) continue;
     float rival = std::numeric_limits<float>::infinity();
     for (int j = 0; j < nr; ++j)
-      if (std::abs(j - best[q]) > window && std::isfinite(m(q, j))) rival = std::min(rival, m(q, j));
+      if (std::abs(j - best[q]) > window && std::isfinite(m(q, j)))
+        rival = std::min(rival, m(q, j));
     const double ratio = std::isfinite(rival) && rival > 0 ? m(q, best[q]) / rival : 1.0;
     margin += 1.0 - ratio;
   }

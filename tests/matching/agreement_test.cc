@@ -1,10 +1,10 @@
 #include "matching/agreement.h"
 
+#include <gtest/gtest.h>
+
 #include <cstdlib>
 #include <random>
 #include <set>
-
-#include <gtest/gtest.h>
 
 namespace openable {
 namespace {
