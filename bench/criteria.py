@@ -42,8 +42,17 @@ def pairs(work):
         ("*Nordland extreme night-like", nl + "/summer", night + "/nord_winter_night_extreme"),
     ]
     unrelated = [
-        ("Unrelated: Nordland 1100-1699 vs 0-599", parts + "/nord_summer_a", parts + "/nord_winter_b"),
-        ("Unrelated: Nordland 1100-1299 vs Gardens Point", gp + "/day_left", parts + "/nord_winter_c"),
+        ("Nordland winter 1100-1699 vs summer 0-599", parts + "/nord_summer_a",
+         parts + "/nord_winter_b"),
+        ("Nordland winter 1100-1299 vs Gardens Point", gp + "/day_left", parts + "/nord_winter_c"),
+        ("Nordland winter 1100-1699 vs Gardens Point", gp + "/day_left", parts + "/nord_winter_b"),
+        ("KITTI 00 1500-1699 vs Gardens Point", gp + "/day_left", parts + "/kitti_qry"),
+        ("Nordland winter 1100-1299 vs KITTI 00 40-260", parts + "/kitti_ref",
+         parts + "/nord_winter_c"),
+        ("Nordland winter 600-899 vs summer 0-299", parts + "/nord_s0", parts + "/nord_w600"),
+        ("Nordland winter 1200-1499 vs summer 600-899", parts + "/nord_s600",
+         parts + "/nord_w1200"),
+        ("Gardens Point day_right vs RTAB-Map lap 1", parts + "/rtab_lap1", gp + "/day_right"),
     ]
     return aligned, unrelated
 

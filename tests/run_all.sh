@@ -28,7 +28,12 @@ export ASAN_OPTIONS="detect_leaks=1:fast_unwind_on_malloc=0:strict_string_checks
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/tests/sanitizers/ubsan.supp"
 export LSAN_OPTIONS="suppressions=$root/tests/sanitizers/lsan.supp:print_suppressions=0"
 echo "== Sanitized suite (ASan + UBSan) in build_asan"
+# -g1 (line tables only): sanitizer reports keep every frame's function, file and line, and the
+# tree builds in 10 instead of 14 minutes on 2 cores (full -g debug information of the
+# OpenCV-heavy sources is most of the difference).
 cmake -S . -B build_asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOPENABLE_SANITIZE=address \
+      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
+      -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
       -DOPENABLE_BUILD_BENCHMARKS=OFF
 cmake --build build_asan -j"$jobs"
 # Two tests are left out of the sanitized suite: the KITTI monocular SNAPS chain (1700 frames of

@@ -171,7 +171,7 @@ TEST(SequenceDistances, SkipLeavesExactlyTheIncompleteCellsEmpty) {
 }
 
 // Naive definition of Sequence_partial ahead, written from the rule and not from AheadShift:
-// list the cells of (i, j)'s diagonal that lie in the traversal of i and in that of j, in order;
+// walk the cells of (i, j)'s diagonal that lie in the traversal of i and in that of j, in order;
 // with fewer than L of them the cell is +inf; at position p >= L - 1 it sums cells p - L + 1 ..
 // p, and before that the first L cells of the diagonal.
 cv::Mat1f NaiveAhead(const cv::Mat1f& d, int L, const std::vector<int>& rs,
@@ -184,16 +184,16 @@ cv::Mat1f NaiveAhead(const cv::Mat1f& d, int L, const std::vector<int>& rs,
       const int dj = reverse ? -1 : 1;  // the column's step as the row goes forward
       int a = i, b = j;                 // walk back to where the diagonal enters
       while (a - 1 >= r0 && b - dj >= c0 && b - dj < c1) --a, b -= dj;
-      std::vector<std::pair<int, int>> cells;
-      for (int x = a, y = b; x < r1 && y >= c0 && y < c1; ++x, y += dj) cells.emplace_back(x, y);
+      int cells = 0;  // the diagonal's cells inside both traversals
+      for (int x = a, y = b; x < r1 && y >= c0 && y < c1; ++x, y += dj) ++cells;
       const int p = i - a;
-      if (static_cast<int>(cells.size()) < L) {
+      if (cells < L) {
         out(i, j) = std::numeric_limits<float>::infinity();
         continue;
       }
       const int first = p >= L - 1 ? p - L + 1 : 0;
       double sum = 0;
-      for (int k = first; k < first + L; ++k) sum += d(cells[k].first, cells[k].second);
+      for (int k = first; k < first + L; ++k) sum += d(a + k, b + k * dj);
       out(i, j) = static_cast<float>(sum);
     }
   return out;
@@ -209,28 +209,31 @@ TEST(SequenceDistances, AheadMatchesTheNaiveRule) {
   for (int L : {1, 2, 3, 10, 25, 60}) {
     const cv::Mat1f fwd = NaiveAhead(d, L, rows, cols);
     const cv::Mat1f rev = NaiveAhead(d, L, rows, cols, true);
-    for (int threads : {1, 2, 3}) {
+    for (int threads : {1, 3}) {
       const auto got = [&](SequenceDirection dir) {
         return SequenceDistances(d, L, rows, cols, dir, threads, SequencePartial::kAhead);
       };
       const cv::Mat1f f = got(SequenceDirection::kForward), r = got(SequenceDirection::kReverse),
                       b = got(SequenceDirection::kBoth);
+      // Cells whose emptiness differs from the naive rule's, and the largest difference of the
+      // others (counted here, one assertion per matrix).
+      int wrong_empty = 0;
+      double largest = 0;
+      const auto compare = [&](float got_value, float want) {
+        if ((got_value == inf) != (want == inf)) {
+          ++wrong_empty;
+        } else if (want != inf) {
+          largest = std::max(largest, static_cast<double>(std::abs(got_value - want)));
+        }
+      };
       for (int i = 0; i < d.rows; ++i)
         for (int j = 0; j < d.cols; ++j) {
-          const float both = std::min(fwd(i, j), rev(i, j));
-          ASSERT_EQ(f(i, j) == inf, fwd(i, j) == inf) << "L=" << L << " at " << i << "," << j;
-          ASSERT_EQ(r(i, j) == inf, rev(i, j) == inf) << "L=" << L << " at " << i << "," << j;
-          ASSERT_EQ(b(i, j) == inf, both == inf) << "L=" << L << " at " << i << "," << j;
-          if (fwd(i, j) != inf) {
-            ASSERT_NEAR(f(i, j), fwd(i, j), 1e-3) << L << " " << i << "," << j;
-          }
-          if (rev(i, j) != inf) {
-            ASSERT_NEAR(r(i, j), rev(i, j), 1e-3) << L << " " << i << "," << j;
-          }
-          if (both != inf) {
-            ASSERT_NEAR(b(i, j), both, 1e-3) << L << " " << i << "," << j;
-          }
+          compare(f(i, j), fwd(i, j));
+          compare(r(i, j), rev(i, j));
+          compare(b(i, j), std::min(fwd(i, j), rev(i, j)));
         }
+      EXPECT_EQ(wrong_empty, 0) << "L=" << L << " threads=" << threads;
+      EXPECT_LE(largest, 1e-3) << "L=" << L << " threads=" << threads;
     }
   }
   // By hand, L = 3 on one 4 x 4 traversal: (0, 1) sums (0,1), (1,2), (2,3) = 2 + 7 + 12;
