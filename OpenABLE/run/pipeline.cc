@@ -864,17 +864,6 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
                                       const RunVerification* verification,
                                       const AutoChoice* automatic) {
   const auto t = Clock::now();
-  // The encodings are independent; the two PNG images dominate (OpenCV's PNG encoder is
-  // single-threaded), so each is encoded on its own thread while the .npy and the text are
-  // written, then staged in order.
-  struct Pending {
-    std::string key, path;
-    std::future<std::string> bytes;
-  };
-  std::vector<Pending> pending;
-  auto encode = [&](const std::string& key, const std::string& path, auto make) {
-    pending.push_back({key, path, std::async(std::launch::async, make)});
-  };
   const OutputOptions& out = config.output;
   const bool dense = !result.bounded;  // bounded runs keep no matrix: only Matches_name
   // Cells without a value (+inf) are shown as the largest finite value in the text and the
@@ -893,6 +882,20 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
       saved.setTo(std::numeric_limits<float>::quiet_NaN(), empty);
     }
   }
+  // The encodings are independent; the two PNG images dominate (OpenCV's PNG encoder is
+  // single-threaded), so each is encoded on its own thread while the .npy and the text are
+  // written, then staged in order.
+  struct Pending {
+    std::string key, path;
+    std::future<std::string> bytes;
+  };
+  // Declared after the matrices the encoders read: when a write fails and the exception
+  // unwinds, the futures (whose destructors wait for their threads) go first, so no encoder
+  // is left reading a freed matrix.
+  std::vector<Pending> pending;
+  auto encode = [&](const std::string& key, const std::string& path, auto make) {
+    pending.push_back({key, path, std::async(std::launch::async, make)});
+  };
   if (dense && !out.png_name.empty())
     encode("Png_name", out.png_name,
            [&] { return EncodePng(ColorizeMatrix(shown, out.matrix_color)); });

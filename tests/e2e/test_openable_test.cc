@@ -574,7 +574,9 @@ TEST(TestOpenABLE, FullDiskFailsWithOneLineAndLeavesNothing) {
   const std::vector<std::string> left = FilesUnder(out);
   ::umount(out.c_str());
   EXPECT_EQ(o.status, 1) << o.err;
-  EXPECT_TRUE(OneLine(o.err.substr(o.err.find("Test_OpenABLE: error"))) ) << o.err;
+  const size_t error = o.err.find("Test_OpenABLE: error");
+  ASSERT_NE(error, std::string::npos) << o.err;
+  EXPECT_TRUE(OneLine(o.err.substr(error))) << o.err;
   EXPECT_NE(o.err.find("No space left on device"), std::string::npos) << o.err;
   EXPECT_NE(o.err.find("_name: cannot write \"out/matrix."), std::string::npos) << o.err;
   EXPECT_TRUE(left.empty()) << left.front();
