@@ -86,7 +86,7 @@ std::vector<cv::Mat1b> ReadGray(const std::vector<fs::path>& files) {
   return frames;
 }
 
-// The pipeline's resize to the patch (OpenABLE/run/describe.cc).
+// The pipeline's resize to the patch (OpenABLE/describe/describe.cc).
 cv::Mat1b ToPatch(const cv::Mat1b& gray) {
   const bool shrink = gray.cols >= kPatch && gray.rows >= kPatch;
   cv::Mat1b patch;

@@ -5,7 +5,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "OpenABLE/run/exports.h"
+#include "OpenABLE/outputs/matrix_files.h"
+#include "OpenABLE/reports/figures.h"
 
 namespace {
 

@@ -34,8 +34,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/progress.h"  // SecondsSince
 #include "OpenABLE/online/online.h"
-#include "OpenABLE/run/progress.h"  // SecondsSince
 
 namespace {
 

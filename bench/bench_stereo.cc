@@ -12,7 +12,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "OpenABLE/run/describe.h"
+#include "OpenABLE/describe/describe.h"
 #include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/stereo/stereo_source.h"
 #include "descriptors/registry.h"

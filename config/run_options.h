@@ -93,7 +93,7 @@ struct ScaleOptions {
 
 // The auto mode (the Auto keys, config/presets/auto.txt): the description and matching
 // settings of a run of two traversals chosen from the data, without ground truth
-// (OpenABLE/run/auto.h; docs/evaluation.md, "Without ground truth").
+// (OpenABLE/tuning/auto.h; docs/evaluation.md, "Without ground truth").
 struct AutoOptions {
   bool enabled = false;  // Auto
   // Auto_candidates: groups separated by '|', each a product of axes "Key=v1,v2" separated by
@@ -110,7 +110,7 @@ struct AutoOptions {
       "Image_descriptor=SAD Contrast_enhancement=1 Image_sequences=10,20,40";
 
   // Throws InputError naming the key of a bad value (the candidates' own checks are the auto
-  // mode's, OpenABLE/run/auto.h).
+  // mode's, OpenABLE/tuning/auto.h).
   void Check() const;
 };
 

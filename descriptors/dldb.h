@@ -18,7 +18,7 @@
 //
 // The patch is 2-channel (Channels() == 2): channel 0 grey, channel 1 disparity, both CV_8U;
 // the disparity is normalised to 8 bits as OpenABLE/stereo/disparity.h describes. Outside the
-// pipeline, OpenABLE/run/describe.h builds such patches from the frames of a stereo source.
+// pipeline, OpenABLE/describe/describe.h builds such patches from the frames of a stereo source.
 #pragma once
 
 #include <string>

@@ -1,10 +1,10 @@
 // Test_OpenABLE: Config.txt in, normalised distance matrix out. A thin layer over
-// openable::Run (OpenABLE/run/run.h).
+// openable::Run (OpenABLE/app/run.h).
 #include <iostream>
 #include <string>
 
 #include "OpenABLE/OpenABLE.h"
-#include "OpenABLE/run/command_line.h"
+#include "OpenABLE/app/command_line.h"
 
 namespace {
 

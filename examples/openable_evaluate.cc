@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "OpenABLE/OpenABLE.h"
-#include "OpenABLE/run/cluster.h"
-#include "OpenABLE/run/html_report.h"
+#include "OpenABLE/cluster/cluster.h"
+#include "OpenABLE/reports/html_report.h"
 #include "OpenABLE/run/pipeline.h"
 
 namespace {

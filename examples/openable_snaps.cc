@@ -1,5 +1,5 @@
 // openable_snaps: the SNAPS add-on from the command line, a thin layer over
-// openable::snaps::RunChain (OpenABLE/snaps/chain.h). A drifting trajectory plus loop matches
+// openable::snaps::RunChain (OpenABLE/app/snaps_chain.h). A drifting trajectory plus loop matches
 // (from SNAPS's own search on the images, a pairs file, or an OpenABLE matrix) give corrected
 // trajectories (the paper's discounted update, a pose graph, or both), their error against a
 // ground truth, a plot and the latencies. Keys: the SNAPS group of Config.txt
@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "OpenABLE/app/command_line.h"
+#include "OpenABLE/app/run.h"
+#include "OpenABLE/app/snaps_chain.h"
 #include "OpenABLE/base/version.h"
-#include "OpenABLE/snaps/chain.h"
-#include "OpenABLE/run/command_line.h"
-#include "OpenABLE/run/run.h"
 
 namespace {
 

@@ -1,11 +1,11 @@
 // openable_sweep: every combination of a few keys' values, each run as Test_OpenABLE runs it,
 // evaluated against the configuration's ground truth and ranked. A thin layer over
-// openable::RunSweep (OpenABLE/run/sweep.h).
+// openable::RunSweep (OpenABLE/tuning/sweep.h).
 #include <iostream>
 #include <string>
 
 #include "OpenABLE/OpenABLE.h"
-#include "OpenABLE/run/command_line.h"
+#include "OpenABLE/app/command_line.h"
 
 namespace {
 

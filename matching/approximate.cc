@@ -14,8 +14,8 @@
 #include <opencv2/flann.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/module_loader.h"
 #include "OpenABLE/base/threading.h"
-#include "OpenABLE/io/module_loader.h"
 #include "matching/distances.h"
 #include "matching/faiss_index.h"
 

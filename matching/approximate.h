@@ -13,7 +13,7 @@
 //    with GPUs", IEEE T-BD 7(3), 2021 (FAISS).
 //
 // FAISS (libfaiss-dev, with OpenMP and BLAS) is compiled into the run-time module
-// libopenable_faiss.so (matching/faiss_module.cc, OpenABLE/io/module_loader.h), loaded when
+// libopenable_faiss.so (matching/faiss_module.cc, OpenABLE/base/module_loader.h), loaded when
 // the first FAISS index is built: a run that uses FLANN or exact search does not load libgomp,
 // BLAS or LAPACK. A build configured without FAISS refuses hnsw and ivf (FaissAvailable()).
 //

@@ -92,7 +92,7 @@ struct BoundedOptions {
   int range_rows = 0;
   // The queries computed: rows [query_begin, query_end) of the block (end -1: to the last),
   // with the sequence history read from the rows before query_begin. A distributed run gives
-  // each process one share (OpenABLE/run/cluster.h); the matches are those the whole block
+  // each process one share (OpenABLE/cluster/cluster.h); the matches are those the whole block
   // gives for these queries.
   int query_begin = 0, query_end = -1;
   // false: distances stay raw (unnormalised, the scores of MatchScore::kDistance too) and

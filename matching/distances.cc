@@ -623,7 +623,7 @@ cv::Mat1f L2Distances(const cv::Mat& a, const cv::Mat& b, int threads,
   // The references padded with zero rows to a multiple of 16: Eigen's product then takes every
   // real column through its full-width kernel, never the narrower one of a last partial panel,
   // so a cell's value does not depend on where its column falls (a run spread over processes
-  // computes rows in other blocks and gets the same floats: OpenABLE/run/distributed.h).
+  // computes rows in other blocks and gets the same floats: OpenABLE/cluster/distributed.h).
   const int padded = (m + 15) / 16 * 16;
   RowMat ea(n, d), eb = RowMat::Zero(padded, d);
   for (int i = 0; i < n; ++i) std::memcpy(ea.row(i).data(), a.ptr<float>(i), d * sizeof(float));

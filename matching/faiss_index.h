@@ -1,7 +1,7 @@
 // The entry points of the run-time module libopenable_faiss.so (matching/faiss_module.cc), the
 // FAISS indexes of ApproximateIndex (matching/approximate.h). The module links FAISS, OpenMP
 // and BLAS and nothing of OpenABLE but this header, so that openable_matching reaches it
-// through ModuleSymbol (OpenABLE/io/module_loader.h) alone. Module and program come from the
+// through ModuleSymbol (OpenABLE/base/module_loader.h) alone. Module and program come from the
 // same build, so C++ types and exceptions cross the boundary.
 #pragma once
 

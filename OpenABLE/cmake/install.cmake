@@ -19,8 +19,9 @@ set(OPENABLE_INSTALL_MODULEDIR "${CMAKE_INSTALL_LIBDIR}/openable")
 # ($<LINK_ONLY:...> in the export), so all of them are in the export set.
 set(OPENABLE_EXPORTED_LIBRARIES
   openable_base openable_io openable_descriptors openable_matching openable_config
-  openable_evaluation openable_stereo openable_image openable_run OpenABLE
-  openable_snaps_core openable_snaps_chain openable_odometry openable_verification)
+  openable_evaluation openable_stereo openable_image openable_describe openable_cluster
+  openable_run openable_reports openable_tuning openable_outputs openable_app OpenABLE
+  openable_snaps_core openable_odometry openable_verification)
 install(TARGETS ${OPENABLE_EXPORTED_LIBRARIES}
   EXPORT OpenABLETargets
   ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}"
@@ -42,7 +43,7 @@ foreach(folder OpenABLE descriptors matching config)
   endforeach()
 endforeach()
 
-# Run-time modules (OpenABLE/io/module_loader.h), where module_loader.cc looks for them.
+# Run-time modules (OpenABLE/base/module_loader.h), where module_loader.cc looks for them.
 install(TARGETS openable_oiio openable_video openable_gui openable_codecs
   LIBRARY DESTINATION "${OPENABLE_INSTALL_MODULEDIR}")
 if(TARGET openable_mpi)  # runs over several processes (docs/distributed.md)

@@ -18,10 +18,10 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/module_loader.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/text_parsing.h"
 #include "OpenABLE/io/module_api.h"
-#include "OpenABLE/io/module_loader.h"
 
 namespace openable {
 namespace {
@@ -390,7 +390,7 @@ cv::Mat1f ReadNpy(const std::string& path, const std::string& where) {
 // Images
 
 cv::Mat1f ReadImage(const std::string& path, const std::string& where) {
-  // OpenCV's imgcodecs, loaded on first use (io/module_loader.h).
+  // OpenCV's imgcodecs, loaded on first use (base/module_loader.h).
   cv::Mat image;
   reinterpret_cast<OpenableCodecsRead>(ModuleSymbol("codecs", "openable_codecs_read"))(
       path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION, image);

@@ -22,10 +22,10 @@
 #include <zlib.h>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/module_loader.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/io/io_common.h"
 #include "OpenABLE/io/module_api.h"
-#include "OpenABLE/io/module_loader.h"
 #include "OpenABLE/io/png_codec.h"
 
 namespace openable {

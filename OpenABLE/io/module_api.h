@@ -51,7 +51,7 @@ extern "C" void openable_gui_show(const cv::Mat& frame);
 using OpenableGuiShow = void (*)(const cv::Mat&);
 
 // libopenable_mpi.so: Open MPI for a run spread over the processes mpirun started
-// (OpenABLE/run/cluster.h). Built only when CMake finds MPI. Every call but init and abort is
+// (OpenABLE/cluster/cluster.h). Built only when CMake finds MPI. Every call but init and abort is
 // collective: each process of the world makes it, in the same order.
 // MPI_Init (with MPI_THREAD_FUNNELED: only the calling thread talks to MPI) and this process's
 // rank and the world's size.

@@ -1,5 +1,5 @@
 // Module libopenable_mpi.so (see module_loader.h and module_api.h): the few MPI calls a run
-// spread over processes needs (OpenABLE/run/cluster.h). A module, so that a single-process run
+// spread over processes needs (OpenABLE/cluster/cluster.h). A module, so that a single-process run
 // does not load Open MPI (and its dozens of libraries) at start-up.
 //
 // MPI counts are ints: buffers of any size go in pieces of at most kPiece bytes, point to point

@@ -9,8 +9,8 @@
 #include <string_view>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/run/descriptor_cache.h"  // Fnv1a64
-#include "OpenABLE/run/exports.h"           // OutputBatch
+#include "OpenABLE/base/hash.h"
+#include "OpenABLE/base/output_batch.h"
 
 namespace openable {
 namespace {

@@ -24,12 +24,12 @@
 
 #include <opencv2/core.hpp>
 
-#include "OpenABLE/run/describe.h"
+#include "OpenABLE/describe/describe.h"
+#include "OpenABLE/verification/verification.h"
 #include "matching/approximate.h"
 #include "matching/distances.h"
 #include "matching/score.h"
 #include "matching/sequence.h"
-#include "OpenABLE/verification/verification.h"
 
 namespace openable {
 

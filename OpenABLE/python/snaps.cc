@@ -9,10 +9,10 @@
 
 #include <pybind11/stl.h>
 
+#include "OpenABLE/app/snaps_chain.h"
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/run/exports.h"
+#include "OpenABLE/base/output_batch.h"
 #include "OpenABLE/python/common.h"
-#include "OpenABLE/snaps/chain.h"
 #include "OpenABLE/snaps/discounted.h"
 #include "OpenABLE/snaps/loops.h"
 #include "OpenABLE/snaps/pose_graph.h"

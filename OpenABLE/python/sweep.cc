@@ -1,4 +1,4 @@
-// openable.sweep: the sweep of openable_sweep (OpenABLE/run/sweep.h) from Python.
+// openable.sweep: the sweep of openable_sweep (OpenABLE/tuning/sweep.h) from Python.
 #include <iostream>
 #include <memory>
 
@@ -7,7 +7,7 @@
 #include <pybind11/stl.h>
 
 #include "OpenABLE/python/common.h"
-#include "OpenABLE/run/sweep.h"
+#include "OpenABLE/tuning/sweep.h"
 
 namespace openable::python {
 namespace {

@@ -88,15 +88,6 @@ bool WriteAll(int fd, const char* data, size_t size) {
 
 }  // namespace
 
-std::uint64_t Fnv1a64(const void* data, size_t size, std::uint64_t h) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (size_t k = 0; k < size; ++k) {
-    h ^= p[k];
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 const std::vector<std::string>& DescriptionKeys() {
   static const std::vector<std::string> keys = {
       "Camera_type",  "Description_type", "Patch_size",  "Grid_x",

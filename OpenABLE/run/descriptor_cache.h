@@ -12,15 +12,11 @@
 
 #include <opencv2/core.hpp>
 
-#include "OpenABLE/run/describe.h"
+#include "OpenABLE/base/hash.h"
+#include "OpenABLE/describe/describe.h"
 #include "config/config.h"
 
 namespace openable {
-
-// FNV-1a, 64 bits (Fowler, Noll, Vo: offset basis 14695981039346656037, prime
-// 1099511628211), continued from `h`. Stable across compilers and machines, unlike std::hash.
-inline constexpr std::uint64_t kFnv1a64Offset = 14695981039346656037ull;
-std::uint64_t Fnv1a64(const void* data, size_t size, std::uint64_t h = kFnv1a64Offset);
 
 // Version of the cache file layout and of the settings text; bumped when either changes.
 inline constexpr int kDescriptorCacheVersion = 1;

@@ -1,5 +1,5 @@
 // Evaluation of a run (Test_OpenABLE with Ground_truth_type set) or of saved matrices
-// (openable_evaluate), and its output files. The protocols themselves are in
+// (openable_evaluate); its files are written by OpenABLE/reports/evaluation_files.h. The protocols themselves are in
 // OpenABLE/evaluation/ (docs/evaluation.md).
 #pragma once
 
@@ -12,7 +12,6 @@
 #include "OpenABLE/evaluation/layout.h"
 #include "OpenABLE/evaluation/metrics.h"
 #include "OpenABLE/evaluation/report.h"
-#include "OpenABLE/run/exports.h"
 #include "config/config.h"
 
 namespace openable {
@@ -52,28 +51,8 @@ void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
                     const EvaluationLayout& layout, const std::string& label,
                     const std::string& source, const VerifiedAnswers* verified = nullptr);
 
-// The suffixes of the evaluation's files: once per evaluation (<prefix>.json, <prefix>_pr.png)
-// and once per run (<prefix>[_<label>]_per_query.csv, ...), in the order StageEvaluation
-// stages them.
-inline constexpr const char* kEvaluationSetSuffixes[] = {".json", "_pr.png"};
-inline constexpr const char* kEvaluationRunSuffixes[] = {"_per_query.csv", "_ablep.csv",
-                                                         "_overlay.png"};
-
-// The figures of the evaluation's files, also shown by the HTML report (html_report.h): the
-// precision-recall figure of every run (<prefix>_pr.png), and run `i`'s ground truth and
-// answers over its matrix (<prefix>_overlay.png), answers marked at the run's operating point
-// (Match_threshold, else the max-F1 threshold).
-cv::Mat3b RenderEvaluationPr(const Evaluation& evaluation);
-cv::Mat3b RenderRunOverlay(const Evaluation& evaluation, std::size_t i, const cv::Mat1f& matrix);
 // The run's operating point: Match_threshold when set, else the max-F1 threshold.
 double OperatingThreshold(const EvaluatedRun& run);
-
-// Stages the evaluation's files under `prefix` into `batch` (key = the config key to name in
-// errors): <prefix>.json, <prefix>_pr.png, and per run <prefix>[_<label>]_per_query.csv,
-// <prefix>[_<label>]_ablep.csv and <prefix>[_<label>]_overlay.png (the label part only when
-// there are several runs). matrices[i] is the normalised matrix of runs[i].
-void StageEvaluation(OutputBatch& batch, const std::string& key, const std::string& prefix,
-                     const Evaluation& evaluation, const std::vector<const cv::Mat1f*>& matrices);
 
 // The checks of a distance matrix before it is evaluated, shared by openable_evaluate
 // (EvaluateMatrixFiles) and Python's evaluate: not empty; every cell >= 0, or a cell without a
@@ -97,11 +76,5 @@ struct MatrixFile {
 std::vector<cv::Mat1f> EvaluateMatrixFiles(Evaluation& evaluation,
                                            const std::vector<MatrixFile>& files,
                                            int reference_frames);
-
-// Writes the files of `evaluation` under `prefix` (StageEvaluation), all or nothing; returns
-// the paths written. `key` names the prefix in errors.
-std::vector<std::string> WriteEvaluation(const std::string& key, const std::string& prefix,
-                                         const Evaluation& evaluation,
-                                         const std::vector<cv::Mat1f>& matrices);
 
 }  // namespace openable

@@ -12,9 +12,10 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/threading.h"
-#include "OpenABLE/io/frame_source.h"
-#include "matching/bounded.h"
 #include "OpenABLE/evaluation/layout.h"
+#include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/run/pipeline.h"
+#include "matching/bounded.h"
 #include "matching/score.h"
 
 namespace openable {
@@ -277,6 +278,22 @@ std::string EncodeLoops(const RunVerification& v) {
                     c.accepted ? 1 : 0);
       out += line;
     }
+  return out;
+}
+
+VerifiedAnswers AnswersOf(const RunVerification& verification, const EvaluationLayout& layout) {
+  VerifiedAnswers out;
+  out.accepted.resize(layout.queries);
+  for (const QueryVerification& q : verification.queries) {
+    if (q.query < 0 || q.query >= layout.queries)
+      throw std::logic_error("AnswersOf: a query outside the layout");
+    for (const VerifiedCandidate& c : q.candidates) {
+      if (c.accepted)
+        out.accepted[q.query].push_back({c.reference, c.distance, c.score});
+      else
+        out.rejected.emplace_back(c.reference, q.query);
+    }
+  }
   return out;
 }
 

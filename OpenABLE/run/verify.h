@@ -9,8 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "OpenABLE/run/pipeline.h"
-#include "OpenABLE/run/progress.h"
+#include "OpenABLE/base/progress.h"
+#include "OpenABLE/run/evaluate.h"
+#include "OpenABLE/run/result.h"
 #include "OpenABLE/verification/verification.h"
 #include "config/config.h"
 
@@ -57,5 +58,9 @@ LatencySummary Summarize(const std::vector<float>& milliseconds);
 // The loops file (Loops_name): CSV "query,reference,rank,distance,score,matches,inliers,model,
 // geometric,streak,verified", one line per candidate checked (docs/output_formats.md).
 std::string EncodeLoops(const RunVerification& verification);
+
+// The answers of a verification for the evaluation of `layout`: each query's accepted
+// candidates, best first, and the cells of the rejected ones.
+VerifiedAnswers AnswersOf(const RunVerification& verification, const EvaluationLayout& layout);
 
 }  // namespace openable

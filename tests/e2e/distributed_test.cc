@@ -1,4 +1,4 @@
-// Runs spread over processes with mpirun (OpenABLE/run/cluster.h, docs/distributed.md): every
+// Runs spread over processes with mpirun (OpenABLE/cluster/cluster.h, docs/distributed.md): every
 // output equals the single-process run's, byte for byte for Hamming distances and within
 // 1e-6 for L2 (whose matrix products sum in another order when the rows are split), in the
 // dense and the bounded mode, for one and two traversals, L = 1 and L = 10, with 1, 2 and 3

@@ -6,9 +6,9 @@
 #include <opencv2/videoio.hpp>
 #include <sstream>
 
-#include "OpenABLE/online/online.h"
+#include "OpenABLE/app/run.h"
 #include "OpenABLE/io/frame_source.h"
-#include "OpenABLE/run/run.h"
+#include "OpenABLE/online/online.h"
 #include "config/config.h"
 #include "tests/e2e/e2e_support.h"
 

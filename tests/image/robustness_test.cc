@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/run/describe.h"
+#include "OpenABLE/describe/describe.h"
 #include "OpenABLE/image/preprocess.h"
 #include "config/config.h"
 #include "tests/test_support.h"

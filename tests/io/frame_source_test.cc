@@ -22,8 +22,8 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/module_loader.h"
 #include "OpenABLE/io/module_api.h"
-#include "OpenABLE/io/module_loader.h"
 #include "tests/test_support.h"
 
 namespace openable {

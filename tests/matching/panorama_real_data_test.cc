@@ -4,9 +4,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
-#include "OpenABLE/run/describe.h"
-#include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/describe/describe.h"
 #include "OpenABLE/image/preprocess.h"
+#include "OpenABLE/io/frame_source.h"
 #include "descriptors/registry.h"
 #include "matching/distances.h"
 #include "matching/panorama.h"

@@ -12,8 +12,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/output_batch.h"
 #include "OpenABLE/online/online.h"
-#include "OpenABLE/run/exports.h"
 #include "tests/test_support.h"
 
 namespace openable {

@@ -13,10 +13,9 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/run/describe.h"
-#include "OpenABLE/run/descriptor_cache.h"
-#include "OpenABLE/run/exports.h"
+#include "OpenABLE/describe/describe.h"
 #include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/run/descriptor_cache.h"
 #include "config/config.h"
 #include "descriptors/registry.h"
 #include "tests/test_support.h"

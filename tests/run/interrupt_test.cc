@@ -1,6 +1,6 @@
-// Interrupted runs (OpenABLE/run/interrupt.h) and write errors leave no output that looks
+// Interrupted runs (OpenABLE/base/interrupt.h) and write errors leave no output that looks
 // complete: temporaries removed on signals, commits deferred until a batch is whole, write
-// errors named, old sets restored, stale temporaries swept (OutputBatch, OpenABLE/run/exports.h).
+// errors named, old sets restored, stale temporaries swept (OutputBatch, OpenABLE/base/output_batch.h).
 #include <sys/mount.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -17,11 +17,11 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/run/describe.h"
-#include "OpenABLE/run/descriptor_cache.h"
-#include "OpenABLE/run/exports.h"
-#include "OpenABLE/run/interrupt.h"
+#include "OpenABLE/base/interrupt.h"
+#include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/describe/describe.h"
 #include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/run/descriptor_cache.h"
 #include "config/config.h"
 #include "descriptors/registry.h"
 #include "tests/test_support.h"

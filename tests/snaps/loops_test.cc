@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "OpenABLE/snaps/chain.h"
+#include "OpenABLE/app/snaps_chain.h"
 #include "config/config.h"
 #include "tests/test_support.h"
 

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "OpenABLE/run/describe.h"
+#include "OpenABLE/describe/describe.h"
 #include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/stereo/rectification.h"
 #include "descriptors/registry.h"

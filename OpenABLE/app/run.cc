@@ -1,0 +1,115 @@
+#include "OpenABLE/app/run.h"
+#include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/outputs/run_outputs.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
+#include "OpenABLE/base/strings.h"
+#include "OpenABLE/base/version.h"
+#include "OpenABLE/cluster/cluster.h"
+#include "OpenABLE/evaluation/report.h"
+
+namespace openable {
+
+RunOutcome Run(const Config& base, ProgressReporter& progress,
+               const std::function<void(const std::string&)>& log) {
+  if (base.output.show_images && std::getenv("DISPLAY") == nullptr &&
+      std::getenv("WAYLAND_DISPLAY") == nullptr)
+    log("warning: Show_images is 1 but there is no display (DISPLAY is not set); frames are "
+        "not shown");
+  RunOutcome out;
+  // Spread over processes (cluster.h): what a single process checks before its first frame,
+  // checked by every process together, so that a check that fails on one of them (a folder
+  // it cannot see) ends the run on all.
+  Cluster& cluster = Cluster::Get();
+  if (cluster.Distributed())
+    cluster.Agree([&] {
+      CheckDistinctOutputs(PlannedOutputs(base));
+      if (EvaluationRequested(base)) {
+        CheckOutputPrefix("Evaluation_name", base.evaluation.name);
+        (void)EvaluationSettingsFrom(base);
+      }
+      CheckRun(base);
+    });
+  // Outputs are checked before the long part of the run: no two at one file, no prefix that
+  // is a folder.
+  CheckDistinctOutputs(PlannedOutputs(base));
+  if (EvaluationRequested(base)) CheckOutputPrefix("Evaluation_name", base.evaluation.name);
+  // Evaluation settings are checked before the long part of the run.
+  if (EvaluationRequested(base)) {
+    out.evaluation = std::make_unique<Evaluation>();
+    out.evaluation->settings = EvaluationSettingsFrom(base);
+  }
+  if (!base.verification.enabled && !base.output.loops_name.empty())
+    log("note: Loops_name: not written: Verification is 0 (no candidate is checked)");
+  // Auto 1: the settings chosen from the data; the run goes on as a run of the chosen
+  // configuration, from the single-frame matrices the choice computed.
+  SingleFrameStore store;
+  const Config* chosen = &base;
+  if (base.automatic.enabled) {
+    out.automatic = std::make_unique<AutoChoice>(ChooseSettings(base, progress, store, log));
+    chosen = &out.automatic->config;
+    if (!out.automatic->reliable)
+      log("warning: Auto: no candidate is consistent enough to be trusted (the best confirms " +
+          FormatFixed(100.0 * out.automatic->candidates[out.automatic->chosen].figures
+                                  .consistency,
+                      1) +
+          " % of its best matches, Auto_min_consistency " +
+          FormatNumber(100.0 * base.automatic.min_consistency) +
+          " %): the outputs are written, but no match is accepted");
+    if (out.evaluation) {
+      out.evaluation->settings = EvaluationSettingsFrom(*chosen);
+      out.evaluation->settings.options.accept_none = !out.automatic->reliable;
+    }
+  }
+  const Config& config = *chosen;
+  out.result = ComputeRun(config, progress, out.automatic ? &store : nullptr);
+  // Process 0 evaluates, verifies and writes; the others have given it their shares.
+  if (cluster.Distributed() && cluster.Rank() != 0) return out;
+  RunResult& result = out.result;
+  if (out.automatic && !out.automatic->reliable && result.accepted_queries > 0)
+    result.accepted_queries = 0;
+  for (const std::string& w : result.warnings) log("warning: " + w);
+  for (const std::string& note : result.notes) log("note: " + note);
+  if (config.verification.enabled) {
+    out.verification =
+        std::make_unique<RunVerification>(VerifyRun(config, result, progress));
+    result.timings.total_seconds += out.verification->seconds;
+  }
+  if (out.evaluation && result.bounded) {
+    log(std::string("note: Ground_truth_type: no evaluation in bounded mode (the protocols "
+                    "need the dense matrix)") +
+        (config.evaluation.report_name.empty() ? "" : ", and so no Report_name") +
+        "; evaluate Matches_name yourself or use Matrix_mode 1");
+    out.evaluation.reset();
+  }
+  if (out.evaluation) {
+    const auto start = std::chrono::steady_clock::now();
+    const EvaluationLayout layout = LayoutOf(result);
+    // Frames that carry times (ROS bags) take their TUM poses by time.
+    GroundTruthOptions& truth = out.evaluation->settings.truth;
+    if (!result.traversals.empty()) truth.frame_times = result.traversals[0].times;
+    if (result.traversals.size() > 1) truth.frame_times_2 = result.traversals[1].times;
+    if (out.verification) {
+      const VerifiedAnswers answers = AnswersOf(*out.verification, layout);
+      EvaluateMatrix(*out.evaluation, result.normalized, layout, RunLabel(config),
+                     "Test_OpenABLE run", &answers);
+    } else {
+      EvaluateMatrix(*out.evaluation, result.normalized, layout, RunLabel(config),
+                     "Test_OpenABLE run");
+    }
+    result.timings.evaluate_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.timings.total_seconds += result.timings.evaluate_seconds;
+  }
+  if (out.automatic) result.timings.total_seconds += out.automatic->seconds;
+  out.written = WriteOutputs(config, result, out.evaluation.get(), out.verification.get(),
+                             out.automatic.get());
+  return out;
+}
+
+}  // namespace openable

@@ -1,0 +1,95 @@
+#include "OpenABLE/base/interrupt.h"
+
+#include <atomic>
+#include <csignal>
+#include <cstring>
+
+#include <unistd.h>
+
+namespace openable {
+namespace {
+
+// Fixed storage: the handler may not allocate. A slot is usable by the handler once its
+// state is kFull (stored after the path, with release order).
+constexpr int kSlots = 64;
+constexpr size_t kPathMax = 4096;
+enum : int { kFree = 0, kClaimed = 1, kFull = 2 };
+char g_paths[kSlots][kPathMax];
+std::atomic<int> g_state[kSlots];
+std::atomic<int> g_deferrals{0};
+std::atomic<int> g_pending{0};
+const char* g_program = "OpenABLE";
+static_assert(std::atomic<int>::is_always_lock_free, "the handler needs lock-free atomics");
+
+void Write(const char* s) {
+  const ssize_t unused = ::write(2, s, std::strlen(s));
+  (void)unused;
+}
+
+const char* SignalName(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    default: return "a signal";
+  }
+}
+
+[[noreturn]] void CleanUpAndExit(int sig) {
+  for (int k = 0; k < kSlots; ++k)
+    if (g_state[k].load(std::memory_order_acquire) == kFull) ::unlink(g_paths[k]);
+  if (::isatty(2)) Write("\n");  // after a progress line redrawn in place
+  Write(g_program);
+  Write(": interrupted by ");
+  Write(SignalName(sig));
+  Write(" (temporary files removed)\n");
+  ::_exit(128 + sig);
+}
+
+void Handler(int sig) {
+  if (g_deferrals.load() > 0) {
+    g_pending.store(sig);
+    return;
+  }
+  CleanUpAndExit(sig);
+}
+
+}  // namespace
+
+void InstallInterruptCleanup(const char* program) {
+  g_program = program;
+  struct sigaction sa;
+  std::memset(&sa, 0, sizeof sa);
+  sa.sa_handler = Handler;
+  sigemptyset(&sa.sa_mask);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&sa.sa_mask, sig);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
+}
+
+int RegisterTemporary(const std::string& path) {
+  if (path.size() >= kPathMax) return -1;
+  for (int k = 0; k < kSlots; ++k) {
+    int expected = kFree;
+    if (g_state[k].compare_exchange_strong(expected, kClaimed)) {
+      std::memcpy(g_paths[k], path.c_str(), path.size() + 1);
+      g_state[k].store(kFull, std::memory_order_release);
+      return k;
+    }
+  }
+  return -1;
+}
+
+void UnregisterTemporary(int slot) {
+  if (slot >= 0 && slot < kSlots) g_state[slot].store(kFree, std::memory_order_release);
+}
+
+InterruptDeferral::InterruptDeferral() { ++g_deferrals; }
+
+InterruptDeferral::~InterruptDeferral() {
+  if (--g_deferrals == 0) {
+    const int sig = g_pending.exchange(0);
+    if (sig != 0) CleanUpAndExit(sig);
+  }
+}
+
+}  // namespace openable

@@ -1,0 +1,44 @@
+// The matrix files of a run: the matrix as text and as float32 .npy, and the matches file.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "matching/bounded.h"
+
+namespace openable {
+
+// Bytes of a NumPy .npy file (format version 1.0, little-endian float32, C order) holding
+// `m` (CV_32FC1).
+std::string EncodeNpy(const cv::Mat1f& m);
+// The header alone (magic, version, dictionary) of a rows x cols float32 .npy; the data
+// follows it in C order.
+std::string NpyHeader(int rows, int cols);
+
+// Text of the matrix: one row per line, values separated by one space. Floats are written
+// with 6 significant digits; CV_8U matrices (thresholded) as integers.
+std::string EncodeText(const cv::Mat& m);
+
+// The same text in pieces of a few hundred rows, each formatted in parallel when asked for,
+// for writing a large matrix without holding its whole text (OutputBatch::Stage with a
+// producer). `m` must outlive the object.
+class TextChunks {
+ public:
+  explicit TextChunks(const cv::Mat& m);
+  // The next piece (valid until the next call); false when the text is done.
+  bool Next(std::string_view& piece);
+
+ private:
+  cv::Mat m_;
+  int next_row_ = 0;
+  std::vector<std::string> parts_;
+  std::string chunk_;
+};
+
+// Bytes of the matches file: .npy (structured array: query, reference int32; distance
+// float32; rank int32; score float32) or .csv (header "query,reference,distance,rank,score").
+std::string EncodeMatches(const std::vector<Match>& matches, bool csv);
+
+}  // namespace openable

@@ -1,0 +1,41 @@
+// The files of a run (docs/output_formats.md): the matrix as text, .npy and images, the
+// matches, the loops, the evaluation and the HTML report, written all or nothing.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "OpenABLE/run/result.h"
+#include "config/config.h"
+
+namespace openable {
+
+struct Evaluation;       // OpenABLE/run/evaluate.h
+struct RunVerification;  // OpenABLE/run/verify.h
+struct AutoChoice;       // OpenABLE/tuning/auto.h
+
+// Writes the outputs the configuration asks for (Txt_name, Npy_name, Png_name,
+// Png_threshold_name, Loops_name when `verification` is given, and the files of
+// Evaluation_name and Report_name when `evaluation` is given; the report lists the auto
+// mode's candidates when `automatic` is given)
+// all-or-nothing. Cells without a value (+inf, Sequence_partial skip) are written as the
+// largest finite value in Txt_name and the PNG images and as NaN in Npy_name. Returns the
+// paths written. Adds the time spent to result.timings.export_seconds. Throws InputError
+// naming the key and path on failure.
+std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
+                                      const Evaluation* evaluation = nullptr,
+                                      const RunVerification* verification = nullptr,
+                                      const AutoChoice* automatic = nullptr);
+
+// Every file a run of `config` may write, as (key, path): the matrix files, the thresholded
+// image, the matches, the loops (Verification) and, when Ground_truth_type and
+// Evaluation_name are set, the evaluation's files (StageEvaluation). Run checks them with
+// CheckDistinctOutputs before any work.
+std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& config);
+
+// The thresholded image's path: Png_threshold_name, or Png_name with "_thresholded" before
+// its extension; empty when no threshold or no PNG is asked for.
+std::string ThresholdPngPath(const Config& config);
+
+}  // namespace openable
