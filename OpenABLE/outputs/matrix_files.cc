@@ -21,35 +21,9 @@
 #include <stdexcept>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/io/npy.h"
 namespace openable {
 
-std::string NpyHeader(int rows, int cols) {
-  // The .npy format: magic, version 1.0, a little-endian uint16 header length, then a Python
-  // dict literal padded with spaces and ended by '\n' so that the data starts at a multiple
-  // of 64 bytes. Written by hand: none of our dependencies writes .npy.
-  std::string dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + std::to_string(rows) +
-                     ", " + std::to_string(cols) + "), }";
-  const size_t preamble = 10;  // magic (6) + version (2) + length (2)
-  size_t total = preamble + dict.size() + 1;
-  const size_t padded = (total + 63) / 64 * 64;
-  dict.append(padded - total, ' ');
-  dict.push_back('\n');
-  std::string out("\x93NUMPY\x01\x00", 8);
-  const auto len = static_cast<std::uint16_t>(dict.size());
-  out.push_back(static_cast<char>(len & 0xFF));
-  out.push_back(static_cast<char>(len >> 8));
-  return out + dict;
-}
-
-std::string EncodeNpy(const cv::Mat1f& m) {
-  std::string out = NpyHeader(m.rows, m.cols);
-  static_assert(sizeof(float) == 4, "float32 expected");
-  const size_t bytes = static_cast<size_t>(m.rows) * m.cols * sizeof(float);
-  out.reserve(out.size() + bytes);
-  for (int i = 0; i < m.rows; ++i)  // x86 and ARM Linux are little-endian, like '<f4'
-    out.append(reinterpret_cast<const char*>(m.ptr<float>(i)), m.cols * sizeof(float));
-  return out;
-}
 
 namespace {
 
@@ -160,18 +134,11 @@ std::string EncodeMatches(const std::vector<Match>& matches, bool csv) {
     }
     return out;
   }
-  // A structured .npy: one record of 20 bytes per match (written by hand, as NpyHeader).
-  std::string dict =
-      "{'descr': [('query', '<i4'), ('reference', '<i4'), ('distance', '<f4'), "
-      "('rank', '<i4'), ('score', '<f4')], 'fortran_order': False, 'shape': (" +
-      std::to_string(matches.size()) + ",), }";
-  const size_t total = 10 + dict.size() + 1;
-  dict.append((total + 63) / 64 * 64 - total, ' ');
-  dict.push_back('\n');
-  std::string out("\x93NUMPY\x01\x00", 8);
-  out.push_back(static_cast<char>(dict.size() & 0xFF));
-  out.push_back(static_cast<char>(dict.size() >> 8));
-  out += dict;
+  // A structured .npy: one record of 20 bytes per match.
+  std::string out = NpyHeaderOf(
+      "[('query', '<i4'), ('reference', '<i4'), ('distance', '<f4'), ('rank', '<i4'), "
+      "('score', '<f4')]",
+      "(" + std::to_string(matches.size()) + ",)");
   out.reserve(out.size() + matches.size() * 20);
   for (const Match& k : matches) {
     char rec[20];

@@ -1,4 +1,5 @@
-// The matrix files of a run: the matrix as text and as float32 .npy, and the matches file.
+// The matrix files of a run: the matrix as text (the .npy encoders are in OpenABLE/io/npy.h),
+// and the matches file.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -6,16 +7,10 @@
 #include <string_view>
 #include <vector>
 
+#include "OpenABLE/io/npy.h"
 #include "matching/bounded.h"
 
 namespace openable {
-
-// Bytes of a NumPy .npy file (format version 1.0, little-endian float32, C order) holding
-// `m` (CV_32FC1).
-std::string EncodeNpy(const cv::Mat1f& m);
-// The header alone (magic, version, dictionary) of a rows x cols float32 .npy; the data
-// follows it in C order.
-std::string NpyHeader(int rows, int cols);
 
 // Text of the matrix: one row per line, values separated by one space. Floats are written
 // with 6 significant digits; CV_8U matrices (thresholded) as integers.
