@@ -1,0 +1,186 @@
+#include "OpenABLE/app/evaluate_files.h"
+
+#include <algorithm>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/evaluation/report.h"
+#include "OpenABLE/reports/evaluation_files.h"
+#include "OpenABLE/reports/html_report.h"
+#include "OpenABLE/run/pipeline.h"
+
+namespace openable {
+namespace {
+
+// Command-line flags that stand for a Config.txt key.
+const std::pair<const char*, const char*> kFlagKeys[] = {
+    {"--gt-type", "Ground_truth_type"},
+    {"--ground-truth", "Ground_truth"},
+    {"--ground-truth-2", "Ground_truth_2"},
+    {"--gt-base", "Ground_truth_base"},
+    {"--radius", "Ground_truth_radius"},
+    {"--heading", "Ground_truth_heading"},
+    {"--min-gap", "Ground_truth_min_gap"},
+    {"--axes", "Ground_truth_axes"},
+    {"--tolerance", "Tolerance"},
+    {"--exclusion", "Exclusion"},
+    {"--vicinity", "Vicinity"},
+    {"--first-frame", "Initial_image"},
+    {"--output", "Evaluation_name"},
+    {"--report", "Report_name"},
+    {"--images", "Images_path"},
+    {"--images-2", "Images_path_2"},
+    {"--video", "Video_path_1"},
+};
+
+// The HTML report of the evaluation (Report_name), with the frames of the worst cases when the
+// command line says where the frames are (Images_path, Images_path_2, Video_path_1).
+std::string EncodeReport(const Config& config, const Evaluation& evaluation,
+                         const std::vector<const cv::Mat1f*>& matrices,
+                         const std::vector<MatrixFile>& files) {
+  ReportInput report;
+  report.program = "openable_evaluate";
+  std::string labels;
+  for (const auto& run : evaluation.runs) labels += (labels.empty() ? "" : " vs ") + run.label;
+  report.title = "OpenABLE report: " + labels;
+  report.settings = ChangedSettings(config);
+  report.evaluation = &evaluation;
+  report.matrices = matrices;
+  report.examples = config.evaluation.report_examples;
+  const InputOptions& input = config.input;
+  const bool video = input.frame_mode != FrameMode::kImageFolders;
+  if (report.examples == 0) {
+    report.frames.missing = "Report_examples is 0";
+  } else if (video ? input.video_path_1.empty() : input.images_path.empty()) {
+    report.frames.missing =
+        "openable_evaluate was not told where the frames are (--images DIR, and --images-2 DIR "
+        "for a second traversal, or --video FILE with --set Frame_mode=1)";
+  } else {
+    std::vector<std::unique_ptr<FrameSource>> sources = OpenFramesToShow(input);
+    const std::string key = video ? "Video_path_1 (--video)" : "Images_path (--images)";
+    int total = 0;
+    for (const auto& s : sources) total += s->Size();
+    // One mapping of rows and columns to frames serves every matrix: they must share a shape.
+    const cv::Mat1f& first = *matrices.front();
+    const bool non_square = first.rows != first.cols;
+    for (std::size_t i = 0; i < matrices.size(); ++i) {
+      const cv::Mat1f& m = *matrices[i];
+      if (m.size() != first.size())
+        throw InputError(key + ": one set of frames for matrices of different sizes (" +
+                         Quoted(files.front().path) + " is " + std::to_string(first.rows) + " x " +
+                         std::to_string(first.cols) + ", " + Quoted(files[i].path) + " is " +
+                         std::to_string(m.rows) + " x " + std::to_string(m.cols) +
+                         "); expected matrices of the same frames, or a report per matrix");
+      const bool fits = non_square ? sources.size() == 2 && m.rows == sources[1]->Size() &&
+                                         m.cols == sources[0]->Size()
+                                   : m.rows == total;
+      if (!fits)
+        throw InputError(
+            key + ": " + std::to_string(total) + " frames" +
+            (sources.size() == 2 ? " (" + std::to_string(sources[0]->Size()) + " + " +
+                                       std::to_string(sources[1]->Size()) + ")"
+                                 : std::string()) +
+            ", but the matrix " + Quoted(files[i].path) + " is " + std::to_string(m.rows) + " x " +
+            std::to_string(m.cols) +
+            "; expected the frames the matrix was computed from (a queries x references "
+            "matrix needs --images for the references and --images-2 for the queries)");
+    }
+    report.frames = FramesFromSources(std::move(sources), non_square);
+  }
+  return EncodeHtmlReport(report);
+}
+
+}  // namespace
+
+std::string ParseEvaluateCommandLine(int argc, const char* const* argv, EvaluateCommandLine& out) {
+  auto value_of = [&](int& i, const std::string& flag) -> std::string {
+    if (i + 1 >= argc) throw std::invalid_argument(flag + " needs a value");
+    return argv[++i];
+  };
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      const auto flag = std::find_if(std::begin(kFlagKeys), std::end(kFlagKeys),
+                                     [&](const auto& f) { return a == f.first; });
+      if (flag != std::end(kFlagKeys)) {
+        out.overrides.push_back(std::string(flag->second) + "=" + value_of(i, a));
+      } else if (a == "--help" || a == "-h" || a == "--version") {
+        // Answered at once, whatever follows.
+        (a == "--version" ? out.version : out.help) = true;
+        return "";
+      } else if (a == "--matrix") {
+        out.matrices.push_back({value_of(i, a), ""});
+      } else if (a == "--label") {
+        if (out.matrices.empty()) throw std::invalid_argument("--label must follow a --matrix");
+        out.matrices.back().label = value_of(i, a);
+      } else if (a == "--reference-frames") {
+        const std::string v = value_of(i, a);
+        std::size_t used = 0;
+        try {
+          out.reference_frames = std::stoi(v, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != v.size() || out.reference_frames < 1)
+          throw std::invalid_argument("--reference-frames: \"" + v +
+                                      "\" is not valid; expected a number of frames >= 1");
+      } else if (a == "--config") {
+        out.config_path = value_of(i, a);
+      } else if (a == "--set") {
+        out.overrides.push_back(value_of(i, a));
+      } else if (a == "--quiet" || a == "-q") {
+        out.quiet = true;
+      } else if (a == "--json") {
+        out.json = true;
+      } else {
+        throw std::invalid_argument("unknown option \"" + a + "\"");
+      }
+    }
+    if (out.matrices.empty()) throw std::invalid_argument("no --matrix given");
+  } catch (const std::invalid_argument& e) {
+    return std::string("openable_evaluate: ") + e.what() + " (see --help)";
+  }
+  return "";
+}
+
+EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line) {
+  Config config =
+      command_line.config_path.empty() ? Config() : LoadConfig(command_line.config_path);
+  for (const auto& o : command_line.overrides) ApplyOverride(config, o);
+  if (!EvaluationRequested(config))
+    throw InputError(
+        "Ground_truth_type: not set; expected --gt-type matrix, pairs, aligned, kitti, tum or "
+        "positions");
+  CheckEvaluationConfig(config);
+  CheckOutputPrefix("Evaluation_name", config.evaluation.name);
+  EvaluatedFiles out;
+  out.config = config;
+  out.evaluation.settings = EvaluationSettingsFrom(config);
+  out.matrices =
+      EvaluateMatrixFiles(out.evaluation, command_line.matrices, command_line.reference_frames);
+  return out;
+}
+
+std::vector<std::string> WriteEvaluatedFiles(const EvaluatedFiles& evaluated,
+                                             const std::vector<MatrixFile>& files) {
+  const Config& config = evaluated.config;
+  OutputBatch batch;
+  std::vector<const cv::Mat1f*> pointers;
+  for (const auto& m : evaluated.matrices) pointers.push_back(&m);
+  if (!config.evaluation.name.empty())
+    StageEvaluation(batch, "Evaluation_name", config.evaluation.name, evaluated.evaluation,
+                    pointers);
+  if (!config.evaluation.report_name.empty())
+    batch.Stage("Report_name", config.evaluation.report_name,
+                EncodeReport(config, evaluated.evaluation, pointers, files));
+  const std::vector<std::string> paths = batch.Paths();
+  batch.Commit();
+  return paths;
+}
+
+}  // namespace openable

@@ -1,0 +1,43 @@
+// openable_evaluate as library calls: its command line (--matrix, --label, the flags that stand
+// for evaluation keys, --config, --set), the evaluation of saved matrices with the keys of
+// Config.txt (docs/evaluation.md), and its files: Evaluation_name's and the HTML report, whose
+// worst cases show the frames when --images (--images-2) or --video says where they are.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "OpenABLE/run/evaluate.h"
+#include "config/config.h"
+
+namespace openable {
+
+struct EvaluateCommandLine {
+  std::vector<MatrixFile> matrices;    // --matrix, each with the --label after it
+  std::vector<std::string> overrides;  // "Key=Value" of the flags and of --set, in order
+  std::string config_path;             // --config
+  int reference_frames = 0;            // --reference-frames
+  bool quiet = false, json = false, help = false, version = false;
+};
+
+// Parses argv. Returns an empty string, or one line ("openable_evaluate: ... (see --help)")
+// naming the bad argument: an unknown option, a missing value, --label before any --matrix, a
+// bad --reference-frames, or no --matrix. --help and --version end the parsing (answered
+// whatever follows, as before any other argument is read).
+std::string ParseEvaluateCommandLine(int argc, const char* const* argv, EvaluateCommandLine& out);
+
+// The configuration of the command line, checked, and each matrix evaluated
+// (EvaluateMatrixFiles). Throws InputError naming the key or file.
+struct EvaluatedFiles {
+  Config config;
+  Evaluation evaluation;
+  std::vector<cv::Mat1f> matrices;  // normalised, in the order of the command line
+};
+EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line);
+
+// Writes Evaluation_name's files and Report_name, all or nothing; returns the paths written.
+std::vector<std::string> WriteEvaluatedFiles(const EvaluatedFiles& evaluated,
+                                             const std::vector<MatrixFile>& files);
+
+}  // namespace openable
