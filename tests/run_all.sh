@@ -75,14 +75,20 @@ echo "== Fuzzers (${fuzz_seconds} s each) in build_fuzz"
 CXX=clang++ cmake -S . -B build_fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOPENABLE_BUILD_FUZZERS=ON \
       -DOPENABLE_BUILD_TESTS=OFF -DOPENABLE_BUILD_BENCHMARKS=OFF
 cmake --build build_fuzz -j"$jobs" --target config_fuzzer image_fuzzer
+# The two fuzzers run side by side (one core each), then each log is read in turn.
 for target in config image; do
   corpus="$probe/$target"
   cp -r "tests/fuzz/corpus/$target" "$corpus"  # new inputs go to the copy, never the committed corpus
+  (status=0
+   "build_fuzz/tests/fuzz/${target}_fuzzer" -max_total_time="$fuzz_seconds" -max_len=65536 \
+     -timeout=30 -rss_limit_mb=3072 -print_final_stats=1 -artifact_prefix="$probe/${target}-" \
+     "$corpus" > "$probe/${target}.log" 2>&1 || status=$?
+   echo "$status" > "$probe/${target}.status") &
+done
+wait
+for target in config image; do
   echo "-- ${target}_fuzzer"
-  status=0
-  "build_fuzz/tests/fuzz/${target}_fuzzer" -max_total_time="$fuzz_seconds" -max_len=65536 \
-    -timeout=30 -rss_limit_mb=3072 -print_final_stats=1 -artifact_prefix="$probe/${target}-" \
-    "$corpus" > "$probe/${target}.log" 2>&1 || status=$?
+  status=$(cat "$probe/${target}.status")
   # The decoders' own complaints (libpng, libjpeg, OpenImageIO) and progress lines are noise.
   grep -v -e '^#[0-9]' -e '^libpng' -e 'JPEG' -e '^INFO: ' -e '^imdecode_' -e '^$' "$probe/${target}.log" | tail -n 40 || true
   if [ "$status" -ne 0 ] || ls "$probe/${target}-"* > /dev/null 2>&1; then
