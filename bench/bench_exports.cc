@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "OpenABLE/io/npy.h"
 #include "OpenABLE/outputs/matrix_files.h"
 #include "OpenABLE/reports/figures.h"
 

@@ -40,8 +40,7 @@ run() {
      --set Txt_name= --set Npy_name=m.npy --set Png_name=m.png --set Evaluation_name=eval \
      "$@" > report.json 2> stderr.log) || echo "exit $?" >> "$out/$name/stderr.log"
 }
-for d in LDB D-LDB BRIEF ORB BRISK FREAK SIFT HOG SAD; do
-  [ "$d" = D-LDB ] && continue  # needs a stereo camera: see the stereo run
+for d in LDB BRIEF ORB BRISK FREAK SIFT HOG SAD; do  # D-LDB needs stereo: see the stereo runs
   run "descriptor_$d" --set Image_descriptor="$d" --set Png_threshold_name=t.png --set Txt_name=m.txt
 done
 run fusion --set Image_descriptor=HOG+LDB --set Fusion_weights=1,1

@@ -9,18 +9,15 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <charconv>
-#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <set>
-#include <stdexcept>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/interrupt.h"
+
 namespace openable {
 
 namespace {

@@ -116,32 +116,28 @@ std::pair<int, int> Cluster::Share(int n, int rank) const {
           static_cast<int>(n * static_cast<std::int64_t>(rank + 1) / k)};
 }
 
-std::vector<char> Cluster::AllGather(const std::vector<char>& mine,
-                                     std::vector<std::int64_t>* sizes) {
+std::vector<char> Cluster::Gather(const std::vector<char>& mine, int root,
+                                  std::vector<std::int64_t>* sizes) {
   std::vector<std::int64_t> counts;
   std::vector<char> all;
   if (!Distributed()) {
     all = mine;
     counts = {static_cast<std::int64_t>(mine.size())};
   } else {
-    Symbol<OpenableMpiGather>("openable_mpi_gather")(mine, -1, all, counts);
+    Symbol<OpenableMpiGather>("openable_mpi_gather")(mine, root, all, counts);
   }
   if (sizes != nullptr) *sizes = counts;
   return all;
 }
 
+std::vector<char> Cluster::AllGather(const std::vector<char>& mine,
+                                     std::vector<std::int64_t>* sizes) {
+  return Gather(mine, -1, sizes);
+}
+
 std::vector<char> Cluster::GatherToFirst(const std::vector<char>& mine,
                                          std::vector<std::int64_t>* sizes) {
-  std::vector<std::int64_t> counts;
-  std::vector<char> all;
-  if (!Distributed()) {
-    all = mine;
-    counts = {static_cast<std::int64_t>(mine.size())};
-  } else {
-    Symbol<OpenableMpiGather>("openable_mpi_gather")(mine, 0, all, counts);
-  }
-  if (sizes != nullptr) *sizes = counts;
-  return all;
+  return Gather(mine, 0, sizes);
 }
 
 void Cluster::GatherInto(const char* mine, std::int64_t bytes, char* into,

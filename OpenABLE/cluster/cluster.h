@@ -94,6 +94,9 @@ class Cluster {
 
  private:
   Cluster();
+  // AllGather (root -1) and GatherToFirst (root 0).
+  std::vector<char> Gather(const std::vector<char>& mine, int root,
+                           std::vector<std::int64_t>* sizes);
   int launch_rank_ = 0, launch_size_ = 1;
   int rank_ = 0, size_ = 1;
   bool connected_ = false, released_ = false;

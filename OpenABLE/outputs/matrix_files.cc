@@ -1,30 +1,17 @@
 #include "OpenABLE/outputs/matrix_files.h"
 
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/file.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
 #include <charconv>
-#include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <opencv2/core/utility.hpp>
-#include <set>
 #include <stdexcept>
+
+#include <opencv2/core/utility.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/io/npy.h"
+
 namespace openable {
-
-
 namespace {
 
 // The text of a float as printf's "%.6g" writes it (std::to_chars with a precision: no locale,

@@ -7,7 +7,6 @@
 #include <string_view>
 #include <vector>
 
-#include "OpenABLE/io/npy.h"
 #include "matching/bounded.h"
 
 namespace openable {

@@ -6,6 +6,7 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/io/npy.h"
 #include "OpenABLE/outputs/matrix_files.h"
 #include "OpenABLE/reports/evaluation_files.h"
 #include "OpenABLE/reports/figures.h"

@@ -1,8 +1,9 @@
 #include "OpenABLE/reports/figures.h"
 
 #include <cmath>
-#include <opencv2/core/utility.hpp>
 #include <stdexcept>
+
+#include <opencv2/core/utility.hpp>
 
 #include "OpenABLE/io/png_codec.h"
 

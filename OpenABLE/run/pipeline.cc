@@ -18,7 +18,6 @@
 #include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/run/descriptor_cache.h"
-#include "OpenABLE/run/evaluate.h"
 #include "OpenABLE/run/verify.h"
 #include "OpenABLE/stereo/calibration.h"
 #include "OpenABLE/stereo/stereo_source.h"

@@ -1,4 +1,5 @@
 #include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/io/npy.h"
 #include "OpenABLE/outputs/matrix_files.h"
 #include "OpenABLE/reports/figures.h"
 
