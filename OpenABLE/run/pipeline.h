@@ -11,7 +11,7 @@
 
 #include "OpenABLE/base/progress.h"
 #include "OpenABLE/evaluation/layout.h"
-#include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/run/plan.h"
 #include "OpenABLE/run/result.h"
 #include "config/config.h"
 
@@ -47,10 +47,15 @@ class SingleFrameStore {
 // The key of descriptor `name`'s single-frame matrix for the run of `config`.
 std::string SingleFrameKey(const Config& config, const std::string& name);
 
-// Computes the matrices of a run. Throws InputError (one line naming the key, file or value)
-// on any problem with the configuration or the input data. Progress goes to `progress`.
-// With `store`, a dense run takes its single-frame matrices from it when they are there, and
-// keeps those it computes.
+// Computes the matrices of a planned run (PlanRun, plan.h): reads the plan's frames and changes
+// nothing in the plan. Throws InputError (one line naming the key, file or value) on a problem
+// with the input data the check phase could not see (an unreadable frame, a changed file).
+// Progress goes to `progress`. With `store`, a dense run takes its single-frame matrices from
+// it when they are there, and keeps those it computes.
+RunResult ComputeRun(const RunPlan& plan, ProgressReporter& progress,
+                     SingleFrameStore* store = nullptr);
+
+// PlanRun then ComputeRun: the run of `config`, checked then computed.
 RunResult ComputeRun(const Config& config, ProgressReporter& progress,
                      SingleFrameStore* store = nullptr);
 
@@ -58,7 +63,7 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress,
 // `config`, kept in `store` (described and compared unless the store holds it already). The
 // result carries the traversals, timings, notes and warnings; no matrix. For runs that build
 // several matrices from the same descriptions (the auto mode). Throws InputError as ComputeRun
-// does; std::logic_error for a bounded configuration.
+// does, and for a run that would be bounded (PlanScope::kSingleFrames).
 RunResult ComputeSingleFrames(const Config& config, ProgressReporter& progress,
                               SingleFrameStore& store);
 
@@ -69,18 +74,11 @@ RunResult ComputeSingleFrames(const Config& config, ProgressReporter& progress,
 cv::Mat1f SingleFrameMatrix(const Config& config, const SingleFrameStore& store,
                             const std::vector<int>& starts);
 
-// The checks of ComputeRun that come before its first frame is described: the
-// configuration, the descriptors and their fusion, the sources (folders, videos, calibration
-// are opened, not read), the ratio window, the mode. Throws InputError as ComputeRun does.
+// The check phase alone: PlanRun, the plan discarded.
 void CheckRun(const Config& config);
 
 // The block a run's matrix is evaluated on: the query-reference block of two traversals, or
 // the whole matrix of one sequence as loop closure.
 EvaluationLayout LayoutOf(const RunResult& result);
-
-// The frames of a run as images to look at (the left image of stereo pairs, as stored), one
-// source per traversal in the order of the matrix: the reference (or only) traversal, then the
-// second. For the HTML report's worst cases. Throws InputError naming the key, as a run does.
-std::vector<std::unique_ptr<FrameSource>> OpenFramesToShow(const InputOptions& input);
 
 }  // namespace openable
