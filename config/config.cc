@@ -24,6 +24,19 @@ constexpr const char* kVerification = "Verification";
 constexpr const char* kSnaps = "SNAPS";
 constexpr const char* kOdometry = "Odometry";
 
+// The help of Ground_truth_type, from the registry of formats.
+const std::string& GroundTruthTypeHelp() {
+  static const std::string help = [] {
+    std::string text = "Empty: no evaluation. ";
+    for (const GroundTruthFormat& f : GroundTruthFormats())
+      text += std::string(&f == &GroundTruthFormats().front() ? "" : "; ") + f.name + ": " +
+              f.summary;
+    return text + ". The run's matrix is evaluated against it with both protocols of "
+                  "docs/evaluation.md.";
+  }();
+  return help;
+}
+
 // Ground_truth_type as Config.txt writes it: empty for no evaluation.
 std::string GroundTruthTypeText(GroundTruthType type) {
   return type == GroundTruthType::kNone ? "" : GroundTruthTypeName(type);
@@ -322,11 +335,7 @@ OptionTable ConfigTable(Config& c) {
   // Evaluation
   t.AddEnumName(
       "Ground_truth_type", kEvaluation, c.evaluation, c.evaluation.truth.type,
-      &ParseGroundTruthType, &GroundTruthTypeText,
-      "Empty: no evaluation. matrix (0/1 text, image, .npy), pairs (CSV or whitespace row,col),"
-      " aligned (two traversals, query i is reference i), kitti (3x4 poses), tum (timestamp tx "
-      "ty tz qx qy qz qw), positions (x,y[,z]): the run's matrix is evaluated against it with "
-      "both protocols of docs/evaluation.md.");
+      &ParseGroundTruthType, &GroundTruthTypeText, GroundTruthTypeHelp().c_str());
   t.Add("Ground_truth", kEvaluation, c.evaluation, c.evaluation.truth.path,
         "Ground-truth file (not needed for aligned). Pairs and poses count frames from the start "
         "of the source, as Initial_image does; for poses of two traversals, the poses of the "

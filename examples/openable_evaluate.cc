@@ -27,11 +27,12 @@ const char* kUsage =
     "(columns). A square matrix is one sequence (loop closure), unless --reference-frames N\n"
     "says it covers two traversals: N reference frames, then the queries (Images_path_2).\n"
     "\n"
-    "Options (each is also --set Key=Value with the Config.txt key in brackets):\n"
+    "Options (each is also --set Key=Value with the Config.txt key in brackets; --name=value\n"
+    "works as --name value):\n"
     "  --matrix FILE           a matrix to evaluate (repeatable)\n"
     "  --label NAME            legend label of the preceding --matrix (default: its file name)\n"
     "  --reference-frames N    square matrix over two traversals, the first N are the reference\n"
-    "  --gt-type TYPE          matrix, pairs, aligned, kitti, tum, positions [Ground_truth_type]\n"
+    "  --gt-type TYPE          @FORMATS@ [Ground_truth_type]\n"
     "  --ground-truth FILE     ground-truth file; for poses of two traversals, the reference's\n"
     "                          [Ground_truth]\n"
     "  --ground-truth-2 FILE   poses of the query traversal [Ground_truth_2]\n"
@@ -55,7 +56,7 @@ const char* kUsage =
     "                          [Images_path]\n"
     "  --images-2 DIR          the frames of the query traversal [Images_path_2]\n"
     "  --video FILE            the frames as one video [Video_path_1; with Frame_mode 1]\n"
-    "  --config FILE           take the keys above from a Config.txt first\n"
+    "  --config FILE           take the keys above from a Config.txt first (or give FILE alone)\n"
     "  --set Key=Value         any evaluation key of Config.txt\n"
     "  --quiet                 print only errors and the list of files written\n"
     "  --json                  print the evaluation as one JSON object on stdout (for scripts)\n"
@@ -68,6 +69,13 @@ const char* kUsage =
     "Exit status: 0 success, 1 bad input (one line on stderr), 2 bad command line, 3 bug.\n";
 
 }  // namespace
+
+// The usage, with the ground-truth formats of the registry.
+std::string Usage() {
+  std::string usage = kUsage;
+  usage.replace(usage.find("@FORMATS@"), 9, openable::GroundTruthFormatList(", "));
+  return usage;
+}
 
 int main(int argc, char** argv) {
   openable::InstallInterruptCleanup("openable_evaluate");  // signals remove the temporaries
@@ -87,7 +95,7 @@ int main(int argc, char** argv) {
     return openable::kExitUsageError;
   }
   if (command_line.help || command_line.version) {
-    std::cout << (command_line.help ? std::string(kUsage)
+    std::cout << (command_line.help ? Usage()
                                     : "OpenABLE " + std::string(openable::kVersion) + "\n");
     return 0;
   }

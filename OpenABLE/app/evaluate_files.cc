@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "OpenABLE/app/command_line.h"
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/output_batch.h"
 #include "OpenABLE/evaluation/report.h"
@@ -98,53 +99,53 @@ std::string EncodeReport(const Config& config, const Evaluation& evaluation,
 }  // namespace
 
 std::string ParseEvaluateCommandLine(int argc, const char* const* argv, EvaluateCommandLine& out) {
-  auto value_of = [&](int& i, const std::string& flag) -> std::string {
-    if (i + 1 >= argc) throw std::invalid_argument(flag + " needs a value");
-    return argv[++i];
+  // The shared command line (command_line.h), with the flags that stand for keys and the
+  // program's own options; a configuration is optional (--config, or a file given alone).
+  ProgramOptions program;
+  program.value_options = {"--matrix", "--label", "--reference-frames", "--config"};
+  for (const auto& [flag, key] : kFlagKeys) program.key_flags.emplace_back(flag, key);
+  program.needs_configuration = false;
+  CommandLine line;
+  const std::string error = ParseCommandLine(argc, argv, "openable_evaluate", line, program);
+  if (!error.empty()) return error;
+  out = EvaluateCommandLine();
+  out.help = line.help || line.help_markdown;
+  out.version = line.version;
+  if (out.help || out.version) return "";
+  if (line.print_config)
+    return "openable_evaluate: --print-config is for the programs that run a configuration; "
+           "expected --config FILE or the flags below (see --help)";
+  out.overrides = line.overrides;
+  out.config_path = line.config_path;
+  out.quiet = line.quiet;
+  out.json = line.json;
+  const auto refuse = [](const std::string& what) {
+    return "openable_evaluate: " + what + " (see --help)";
   };
-  try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string a = argv[i];
-      const auto flag = std::find_if(std::begin(kFlagKeys), std::end(kFlagKeys),
-                                     [&](const auto& f) { return a == f.first; });
-      if (flag != std::end(kFlagKeys)) {
-        out.overrides.push_back(std::string(flag->second) + "=" + value_of(i, a));
-      } else if (a == "--help" || a == "-h" || a == "--version") {
-        // Answered at once, whatever follows.
-        (a == "--version" ? out.version : out.help) = true;
-        return "";
-      } else if (a == "--matrix") {
-        out.matrices.push_back({value_of(i, a), ""});
-      } else if (a == "--label") {
-        if (out.matrices.empty()) throw std::invalid_argument("--label must follow a --matrix");
-        out.matrices.back().label = value_of(i, a);
-      } else if (a == "--reference-frames") {
-        const std::string v = value_of(i, a);
-        std::size_t used = 0;
-        try {
-          out.reference_frames = std::stoi(v, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (used != v.size() || out.reference_frames < 1)
-          throw std::invalid_argument("--reference-frames: \"" + v +
-                                      "\" is not valid; expected a number of frames >= 1");
-      } else if (a == "--config") {
-        out.config_path = value_of(i, a);
-      } else if (a == "--set") {
-        out.overrides.push_back(value_of(i, a));
-      } else if (a == "--quiet" || a == "-q") {
-        out.quiet = true;
-      } else if (a == "--json") {
-        out.json = true;
-      } else {
-        throw std::invalid_argument("unknown option \"" + a + "\"");
+  for (const auto& [option, value] : line.options) {
+    if (option == "--matrix") {
+      out.matrices.push_back({value, ""});
+    } else if (option == "--label") {
+      if (out.matrices.empty()) return refuse("--label must follow a --matrix");
+      out.matrices.back().label = value;
+    } else if (option == "--reference-frames") {
+      std::size_t used = 0;
+      try {
+        out.reference_frames = std::stoi(value, &used);
+      } catch (const std::exception&) {
+        used = 0;
       }
+      if (used != value.size() || out.reference_frames < 1)
+        return refuse("--reference-frames: \"" + value +
+                      "\" is not valid; expected a number of frames >= 1");
+    } else if (!out.config_path.empty()) {  // --config, after a file or another --config
+      return refuse("more than one configuration file (\"" + out.config_path + "\" and \"" +
+                    value + "\"); expected one");
+    } else {
+      out.config_path = value;
     }
-    if (out.matrices.empty()) throw std::invalid_argument("no --matrix given");
-  } catch (const std::invalid_argument& e) {
-    return std::string("openable_evaluate: ") + e.what() + " (see --help)";
   }
+  if (out.matrices.empty()) return refuse("no --matrix given");
   return "";
 }
 
@@ -153,9 +154,8 @@ EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line) {
       command_line.config_path.empty() ? Config() : LoadConfig(command_line.config_path);
   for (const auto& o : command_line.overrides) ApplyOverride(config, o);
   if (!EvaluationRequested(config))
-    throw InputError(
-        "Ground_truth_type: not set; expected --gt-type matrix, pairs, aligned, kitti, tum or "
-        "positions");
+    throw InputError("Ground_truth_type: not set; expected --gt-type " +
+                     GroundTruthFormatList());
   CheckEvaluationConfig(config);
   CheckOutputPrefix("Evaluation_name", config.evaluation.name);
   EvaluatedFiles out;

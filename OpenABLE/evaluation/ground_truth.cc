@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/text_parsing.h"
 #include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/evaluation/pairs_file.h"
@@ -44,11 +45,6 @@ namespace fs = std::filesystem;
 // ---------------------------------------------------------------------------------------------
 // Options
 
-bool IsPoseType(GroundTruthType t) {
-  return t == GroundTruthType::kKitti || t == GroundTruthType::kTum ||
-         t == GroundTruthType::kPositions;
-}
-
 // The options PairsFromPoses uses.
 void CheckPoseOptions(const GroundTruthOptions& o) {
   if (!(std::isfinite(o.radius) && o.radius > 0)) {
@@ -71,17 +67,6 @@ void CheckPoseOptions(const GroundTruthOptions& o) {
 
 // ---------------------------------------------------------------------------------------------
 // Poses
-
-const char* PoseFileLabel(GroundTruthType type) {
-  switch (type) {
-    case GroundTruthType::kKitti:
-      return "KITTI poses";
-    case GroundTruthType::kTum:
-      return "TUM trajectory";
-    default:
-      return "positions";
-  }
-}
 
 // Positions and unit forward vectors over the chosen axes, flat (3 doubles per frame, the
 // unused component 0); has_forward[i] = 0 when frame i has no usable forward vector.
@@ -121,7 +106,7 @@ std::vector<FramePose> PosesOfRun(const std::string& path, GroundTruthType type,
   std::vector<FramePose> poses = ReadPoses(path, type);
   const std::int64_t needed = static_cast<std::int64_t>(first) + count;
   if (static_cast<std::int64_t>(poses.size()) < needed) {
-    throw InputError(std::string(PoseFileLabel(type)) + " " + Quoted(path) + ": file has " +
+    throw InputError(std::string(type.Format().label) + " " + Quoted(path) + ": file has " +
                      std::to_string(poses.size()) + " poses, the run needs " +
                      std::to_string(needed) + " (Initial_image " + std::to_string(first) + " + " +
                      std::to_string(count) + " " + frames_what + ")");
@@ -130,26 +115,23 @@ std::vector<FramePose> PosesOfRun(const std::string& path, GroundTruthType type,
 }
 
 // The poses of frames that carry times (`times`, one per frame of the traversal): each frame
-// takes the TUM pose with the nearest timestamp, which must be within `tolerance` seconds.
-std::vector<FramePose> PosesByTime(const std::string& path, const std::vector<double>& times,
-                                   double tolerance, const std::string& frames_what) {
-  const std::vector<PoseFileLine> lines =
-      ReadPoseFile(path, PoseFileFormat::kTum, PoseFileLabel(GroundTruthType::kTum));
-  if (lines.empty())
-    throw InputError(std::string(PoseFileLabel(GroundTruthType::kTum)) + " " + Quoted(path) +
-                     ": no pose; expected one per line");
+// takes the pose with the nearest timestamp, which must be within `tolerance` seconds.
+std::vector<FramePose> PosesByTime(const std::string& path, GroundTruthType type,
+                                   const std::vector<double>& times, double tolerance,
+                                   const std::string& frames_what) {
+  const std::vector<FramePose> lines = ReadPoses(path, type);
   std::vector<FramePose> poses;
   poses.reserve(times.size());
   for (std::size_t i = 0; i < times.size(); ++i) {
     // Timestamps increase (ReadPoseFile checks it): the nearest is beside the first >= t.
     const auto after = std::lower_bound(
         lines.begin(), lines.end(), times[i],
-        [](const PoseFileLine& line, double t) { return line.timestamp < t; });
+        [](const FramePose& line, double t) { return line.time < t; });
     auto nearest = after == lines.end() ? after - 1 : after;
     if (after != lines.begin() && after != lines.end() &&
-        times[i] - (after - 1)->timestamp < after->timestamp - times[i])
+        times[i] - (after - 1)->time < after->time - times[i])
       nearest = after - 1;
-    const double gap = std::abs(nearest->timestamp - times[i]);
+    const double gap = std::abs(nearest->time - times[i]);
     if (!(gap <= tolerance)) {
       std::string frame = frames_what;  // "frames", "query frames": one of them
       if (!frame.empty() && frame.back() == 's') frame.pop_back();
@@ -159,14 +141,9 @@ std::vector<FramePose> PosesByTime(const std::string& path, const std::vector<do
                     "s away); expected a ground truth that covers the frames, or a larger "
                     "Ground_truth_time_tolerance",
                     tolerance, frame.c_str(), i, times[i], nearest->line, gap);
-      throw InputError(std::string(PoseFileLabel(GroundTruthType::kTum)) + " " + Quoted(path) +
-                       text);
+      throw InputError(std::string(type.Format().label) + " " + Quoted(path) + text);
     }
-    FramePose pose;
-    pose.position = nearest->translation;
-    pose.forward = nearest->rotation.col(2);
-    pose.has_forward = true;
-    poses.push_back(pose);
+    poses.push_back(*nearest);
   }
   return poses;
 }
@@ -176,10 +153,10 @@ std::vector<FramePose> PosesByTime(const std::string& path, const std::vector<do
 std::vector<FramePose> TraversalPoses(const GroundTruthOptions& o, const std::string& path,
                                       const std::vector<double>& times, int count,
                                       const std::string& frames_what) {
-  if (o.type == GroundTruthType::kTum && !times.empty()) {
+  if (o.type.Format().timestamps && !times.empty()) {
     if (static_cast<int>(times.size()) != count)
       throw std::logic_error("TraversalPoses: one time per frame expected");
-    return PosesByTime(path, times, o.time_tolerance, frames_what);
+    return PosesByTime(path, o.type, times, o.time_tolerance, frames_what);
   }
   return PosesOfRun(path, o.type, o.first_frame, count, frames_what);
 }
@@ -234,7 +211,8 @@ void LoadMatrix(const GroundTruthOptions& o, const EvaluationLayout& layout, int
   }
 }
 
-void LoadPairs(const GroundTruthOptions& o, const EvaluationLayout& layout, GroundTruth* gt) {
+void LoadPairs(const GroundTruthOptions& o, const EvaluationLayout& layout, int, int,
+               GroundTruth* gt) {
   const PairsFile file = ReadPairsFile(o.path, o.base, "ground truth pairs");
   const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
   const int base = file.base;
@@ -274,6 +252,7 @@ void LoadPairs(const GroundTruthOptions& o, const EvaluationLayout& layout, Grou
   }
 }
 
+// Pose formats: the pairs from the poses of the run's frames (PairsFromPoses).
 void LoadPoses(const GroundTruthOptions& o, const EvaluationLayout& layout, GroundTruth* gt) {
   if (layout.kind == EvaluationLayout::Kind::kLoopClosure) {
     const std::vector<FramePose> poses =
@@ -301,112 +280,37 @@ void LoadPoses(const GroundTruthOptions& o, const EvaluationLayout& layout, Grou
   gt->matches = PairsFromPoses(queries, reference, o);
 }
 
-}  // namespace
+// The formats' readers and loaders (GroundTruthFormats).
 
-GroundTruthType ParseGroundTruthType(const std::string& name) {
-  if (name.empty()) return GroundTruthType::kNone;
-  return ParseEnum<GroundTruthType>(name, "Ground_truth_type");
-}
-
-std::string GroundTruthTypeName(GroundTruthType type) { return EnumName(type); }
-
-void GroundTruthOptions::Check() const {
-  if (type != GroundTruthType::kNone && type != GroundTruthType::kAligned && path.empty()) {
-    throw InputError(
-        "Ground_truth: empty; expected the path of the ground-truth file "
-        "(Ground_truth_type " +
-        GroundTruthTypeName(type) + ")");
-  }
-  if (base < -1 || base > 1) {
-    throw InputError("Ground_truth_base: " + std::to_string(base) +
-                     " is not valid; expected -1 (from a comment of the file), 0 or 1");
-  }
-  if (first_frame < 0) {
-    throw InputError("Initial_image: " + std::to_string(first_frame) +
-                     " is not valid; expected an integer >= 0");
-  }
-  CheckPoseOptions(*this);
-  if (!(time_tolerance >= 0) || !std::isfinite(time_tolerance)) {
-    throw InputError("Ground_truth_time_tolerance: " + FormatNumber(time_tolerance) +
-                     " is not valid; expected seconds >= 0");
-  }
-  if (type == GroundTruthType::kPositions && heading_limit >= 0) {
-    throw InputError("Ground_truth_heading: " + FormatNumber(heading_limit) +
-                     " needs orientations, but positions have no orientation; expected -1 "
-                     "(no limit), or Ground_truth_type kitti or tum");
-  }
-}
-
-GroundTruth LoadGroundTruth(const GroundTruthOptions& options, const EvaluationLayout& layout,
-                            int full_rows, int full_cols) {
-  options.Check();
-  const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
-  if (layout.queries < 0 || layout.references < 0 || layout.row_offset < 0 ||
-      layout.col_offset < 0 || layout.row_offset + layout.queries > full_rows ||
-      layout.col_offset + layout.references > full_cols ||
-      (loop && layout.queries != layout.references)) {
-    throw std::logic_error("LoadGroundTruth: layout " + std::to_string(layout.queries) + "x" +
-                           std::to_string(layout.references) + " at (" +
-                           std::to_string(layout.row_offset) + ", " +
-                           std::to_string(layout.col_offset) + ") does not fit a " +
-                           std::to_string(full_rows) + "x" + std::to_string(full_cols) + " matrix");
-  }
-  GroundTruth gt;
-  gt.references = layout.references;
-  gt.matches.assign(static_cast<std::size_t>(layout.queries), {});
-  switch (options.type) {
-    case GroundTruthType::kNone:
-      return gt;
-    case GroundTruthType::kMatrix:
-      LoadMatrix(options, layout, full_rows, full_cols, &gt);
-      break;
-    case GroundTruthType::kPairs:
-      LoadPairs(options, layout, &gt);
-      break;
-    case GroundTruthType::kAligned:
-      if (loop) {
-        throw InputError(
-            "Ground_truth_type: aligned needs two traversals (Images_path_2 or Frame_mode 2)");
-      }
-      for (int q = 0; q < std::min(layout.queries, layout.references); ++q) {
-        gt.matches[static_cast<std::size_t>(q)].push_back(q);
-      }
-      break;
-    case GroundTruthType::kKitti:
-    case GroundTruthType::kTum:
-    case GroundTruthType::kPositions:
-      LoadPoses(options, layout, &gt);
-      break;
-  }
-  for (auto& m : gt.matches) {
-    std::sort(m.begin(), m.end());
-    m.erase(std::unique(m.begin(), m.end()), m.end());
-  }
-  return gt;
-}
-
-std::vector<FramePose> ReadPoses(const std::string& path, GroundTruthType type) {
-  if (!IsPoseType(type)) {
-    throw std::logic_error("ReadPoses: type " + GroundTruthTypeName(type) + " is not a pose type");
-  }
+// KITTI and TUM: the pose reader SNAPS uses too (pose_file.h), one format, one set of checks
+// (a rotation that is not one, timestamps out of order, ...).
+std::vector<FramePose> ReadPoseLines(const std::string& path, PoseFileFormat format,
+                                     const char* label) {
   std::vector<FramePose> poses;
-  if (type == GroundTruthType::kKitti || type == GroundTruthType::kTum) {
-    // The pose reader SNAPS uses too (pose_file.h): one format, one set of checks (a rotation
-    // that is not one, timestamps out of order, ...).
-    for (const PoseFileLine& line :
-         ReadPoseFile(path,
-                      type == GroundTruthType::kKitti ? PoseFileFormat::kKitti
-                                                      : PoseFileFormat::kTum,
-                      PoseFileLabel(type))) {
-      FramePose pose;
-      pose.position = line.translation;
-      pose.forward = line.rotation.col(2);  // the optical axis (R is orthonormal)
-      pose.has_forward = true;
-      poses.push_back(pose);
-    }
-    return poses;
+  for (const PoseFileLine& line : ReadPoseFile(path, format, label)) {
+    FramePose pose;
+    pose.position = line.translation;
+    pose.forward = line.rotation.col(2);  // the optical axis (R is orthonormal)
+    pose.has_forward = true;
+    if (format == PoseFileFormat::kTum) pose.time = line.timestamp;
+    pose.line = line.line;
+    poses.push_back(pose);
   }
-  const std::string where = std::string(PoseFileLabel(type)) + " " + Quoted(path);
+  return poses;
+}
+
+std::vector<FramePose> ReadKittiPoses(const std::string& path, const char* label) {
+  return ReadPoseLines(path, PoseFileFormat::kKitti, label);
+}
+
+std::vector<FramePose> ReadTumPoses(const std::string& path, const char* label) {
+  return ReadPoseLines(path, PoseFileFormat::kTum, label);
+}
+
+// Positions: x,y[,z] per line (CSV or whitespace), '#' comments, a header line allowed.
+std::vector<FramePose> ReadPositions(const std::string& path, const char* label) {
+  std::vector<FramePose> poses;
+  const std::string where = std::string(label) + " " + Quoted(path);
   const std::string data = ReadWholeFile(path, where);
   bool first_content = true;
   std::size_t position_count = 0;  // numbers per line of a positions file
@@ -416,7 +320,7 @@ std::vector<FramePose> ReadPoses(const std::string& path, GroundTruthType type) 
     if (line.fields.empty()) return;
     const std::string at = where + ":" + std::to_string(line.number);
     double unused = 0;
-    const bool header = type == GroundTruthType::kPositions && first_content &&
+    const bool header = first_content &&
                         !line.fields[0].empty() && !ParseNumber(line.fields[0], &unused);
     first_content = false;
     if (header) return;  // "x,y,z"
@@ -441,6 +345,7 @@ std::vector<FramePose> ReadPoses(const std::string& path, GroundTruthType type) 
                        std::to_string(position_line) + ")");
     }
     pose.position = Eigen::Vector3d(v[0], v[1], v.size() == 3 ? v[2] : 0.0);
+    pose.line = line.number;
     poses.push_back(pose);
   });
   if (poses.empty()) {
@@ -449,6 +354,142 @@ std::vector<FramePose> ReadPoses(const std::string& path, GroundTruthType type) 
                      "holds only comments)");
   }
   return poses;
+}
+
+void LoadAligned(const GroundTruthOptions&, const EvaluationLayout& layout, int, int,
+                 GroundTruth* gt) {
+  if (layout.kind == EvaluationLayout::Kind::kLoopClosure) {
+    throw InputError(
+        "Ground_truth_type: aligned needs two traversals (Images_path_2 or Frame_mode 2)");
+  }
+  for (int q = 0; q < std::min(layout.queries, layout.references); ++q) {
+    gt->matches[static_cast<std::size_t>(q)].push_back(q);
+  }
+}
+
+}  // namespace
+
+GroundTruthType ParseGroundTruthType(const std::string& name) {
+  if (name.empty()) return GroundTruthType::kNone;
+  const std::string lower = Lower(name);
+  if (lower == "none") return GroundTruthType::kNone;
+  for (const GroundTruthFormat& format : GroundTruthFormats())
+    if (lower == format.name) return GroundTruthType(format.name);
+  throw InputError("Ground_truth_type: " + Quoted(name) + " is not valid; expected " +
+                   GroundTruthFormatList() + " (or empty: no evaluation)");
+}
+
+std::string GroundTruthTypeName(GroundTruthType type) {
+  return type.IsNone() ? "none" : type.Format().name;
+}
+
+const GroundTruthFormat& GroundTruthType::Format() const {
+  for (const GroundTruthFormat& format : GroundTruthFormats())
+    if (name_ == format.name) return format;
+  throw std::logic_error("GroundTruthType: no format named \"" + std::string(name_) + "\"");
+}
+
+const GroundTruthType GroundTruthType::kNone{};
+const GroundTruthType GroundTruthType::kMatrix{"matrix"};
+const GroundTruthType GroundTruthType::kPairs{"pairs"};
+const GroundTruthType GroundTruthType::kAligned{"aligned"};
+const GroundTruthType GroundTruthType::kKitti{"kitti"};
+const GroundTruthType GroundTruthType::kTum{"tum"};
+const GroundTruthType GroundTruthType::kPositions{"positions"};
+
+const std::vector<GroundTruthFormat>& GroundTruthFormats() {
+  static const std::vector<GroundTruthFormat> formats = {
+      {"matrix", "a binary matrix: 0/1 text, an image (non-zero = same place) or .npy",
+       "ground truth matrix file", true, nullptr, false, false, &LoadMatrix},
+      {"pairs", "a list of pairs row,col (CSV or whitespace)", "ground truth pairs", true,
+       nullptr, false, false, &LoadPairs},
+      {"aligned", "two traversals frame by frame: query i is reference i (no file)",
+       "aligned traversals", false, nullptr, false, false, &LoadAligned},
+      {"kitti", "KITTI poses: 12 numbers per line, a 3x4 camera-to-world matrix",
+       "KITTI poses", true, &ReadKittiPoses, true, false, nullptr},
+      {"tum", "a TUM trajectory: timestamp tx ty tz qx qy qz qw per line", "TUM trajectory",
+       true, &ReadTumPoses, true, true, nullptr},
+      {"positions", "positions x,y[,z] per line (no orientation)", "positions", true,
+       &ReadPositions, false, false, nullptr},
+  };
+  return formats;
+}
+
+std::string GroundTruthFormatList(const char* last_separator) {
+  const std::vector<GroundTruthFormat>& formats = GroundTruthFormats();
+  std::string out;
+  for (std::size_t i = 0; i < formats.size(); ++i) {
+    if (i > 0) out += i + 1 == formats.size() ? last_separator : ", ";
+    out += formats[i].name;
+  }
+  return out;
+}
+
+void GroundTruthOptions::Check() const {
+  if (!type.IsNone() && type.Format().needs_file && path.empty()) {
+    throw InputError(
+        "Ground_truth: empty; expected the path of the ground-truth file "
+        "(Ground_truth_type " +
+        GroundTruthTypeName(type) + ")");
+  }
+  if (base < -1 || base > 1) {
+    throw InputError("Ground_truth_base: " + std::to_string(base) +
+                     " is not valid; expected -1 (from a comment of the file), 0 or 1");
+  }
+  if (first_frame < 0) {
+    throw InputError("Initial_image: " + std::to_string(first_frame) +
+                     " is not valid; expected an integer >= 0");
+  }
+  CheckPoseOptions(*this);
+  if (!(time_tolerance >= 0) || !std::isfinite(time_tolerance)) {
+    throw InputError("Ground_truth_time_tolerance: " + FormatNumber(time_tolerance) +
+                     " is not valid; expected seconds >= 0");
+  }
+  if (!type.IsNone() && type.Format().read_poses && !type.Format().orientations &&
+      heading_limit >= 0) {
+    std::string oriented;
+    for (const GroundTruthFormat& f : GroundTruthFormats())
+      if (f.read_poses && f.orientations) oriented += std::string(oriented.empty() ? "" : " or ") + f.name;
+    throw InputError("Ground_truth_heading: " + FormatNumber(heading_limit) + " needs orientations, but " +
+                     type.Format().label + " have no orientation; expected -1 (no limit), or "
+                     "Ground_truth_type " + oriented);
+  }
+}
+
+GroundTruth LoadGroundTruth(const GroundTruthOptions& options, const EvaluationLayout& layout,
+                            int full_rows, int full_cols) {
+  options.Check();
+  const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
+  if (layout.queries < 0 || layout.references < 0 || layout.row_offset < 0 ||
+      layout.col_offset < 0 || layout.row_offset + layout.queries > full_rows ||
+      layout.col_offset + layout.references > full_cols ||
+      (loop && layout.queries != layout.references)) {
+    throw std::logic_error("LoadGroundTruth: layout " + std::to_string(layout.queries) + "x" +
+                           std::to_string(layout.references) + " at (" +
+                           std::to_string(layout.row_offset) + ", " +
+                           std::to_string(layout.col_offset) + ") does not fit a " +
+                           std::to_string(full_rows) + "x" + std::to_string(full_cols) + " matrix");
+  }
+  GroundTruth gt;
+  gt.references = layout.references;
+  gt.matches.assign(static_cast<std::size_t>(layout.queries), {});
+  if (options.type.IsNone()) return gt;
+  const GroundTruthFormat& format = options.type.Format();
+  if (format.read_poses)
+    LoadPoses(options, layout, &gt);
+  else
+    format.load(options, layout, full_rows, full_cols, &gt);
+  for (auto& m : gt.matches) {
+    std::sort(m.begin(), m.end());
+    m.erase(std::unique(m.begin(), m.end()), m.end());
+  }
+  return gt;
+}
+
+std::vector<FramePose> ReadPoses(const std::string& path, GroundTruthType type) {
+  if (type.IsNone() || !type.Format().read_poses)
+    throw std::logic_error("ReadPoses: type " + GroundTruthTypeName(type) + " is not a pose type");
+  return type.Format().read_poses(path, type.Format().label);
 }
 
 std::vector<std::vector<int>> PairsFromPoses(const std::vector<FramePose>& queries,

@@ -4,12 +4,12 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
-
-#include "OpenABLE/base/enum_names.h"
 
 #include "OpenABLE/evaluation/layout.h"
 
@@ -39,21 +39,31 @@ struct GroundTruth {
   }
 };
 
-enum class GroundTruthType {
-  kNone,       // no evaluation
-  kMatrix,     // binary matrix: text 0/1, PNG/BMP/any image OpenCV reads (non-zero = match), .npy
-  kPairs,      // list of pairs "row,col" (or "row col"), '#' comments, extra columns ignored
-  kAligned,    // frame-aligned traversals: query i is reference i
-  kKitti,      // KITTI poses: 12 numbers per line, a 3x4 camera-to-world matrix [R | t]
-  kTum,        // TUM trajectory: "timestamp tx ty tz qx qy qz qw" per line, '#' comments
-  kPositions,  // CSV/whitespace "x,y[,z]" per line (no orientation), '#' comments
-};
-OPENABLE_ENUM_NAMES(GroundTruthType, "none", "matrix", "pairs", "aligned", "kitti", "tum",
-                    "positions")
+struct GroundTruthFormat;
 
-// Parses "matrix", "pairs", "aligned", "kitti", "tum", "positions" (and "" = kNone). Throws
-// InputError naming Ground_truth_type otherwise.
+// A value of Ground_truth_type: a format of the registry (GroundTruthFormats), or none (no
+// evaluation). The built-in formats have names here for the code that sets one.
+class GroundTruthType {
+ public:
+  constexpr GroundTruthType() = default;  // none
+  // The format named `name` (a name of GroundTruthFormats(); Format() checks it).
+  constexpr explicit GroundTruthType(std::string_view name) : name_(name) {}
+  static const GroundTruthType kNone, kMatrix, kPairs, kAligned, kKitti, kTum, kPositions;
+
+  // The format; throws std::logic_error for none or a name outside the registry.
+  const GroundTruthFormat& Format() const;
+  bool IsNone() const { return name_.empty(); }
+  bool operator==(const GroundTruthType& other) const { return name_ == other.name_; }
+  bool operator!=(const GroundTruthType& other) const { return name_ != other.name_; }
+
+ private:
+  std::string_view name_;  // of a format's static name
+};
+
+// Parses a format's name, case-insensitively ("" = none). Throws InputError naming
+// Ground_truth_type and listing the formats otherwise.
 GroundTruthType ParseGroundTruthType(const std::string& name);
+// The format's name ("none" for none).
 std::string GroundTruthTypeName(GroundTruthType type);
 
 struct GroundTruthOptions {
@@ -101,11 +111,42 @@ struct FramePose {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d forward = Eigen::Vector3d::Zero();
   bool has_forward = false;
+  double time = std::numeric_limits<double>::quiet_NaN();  // formats with timestamps
+  int line = 0;  // the line of the file
 };
 
-// Reads a pose or position file of type kKitti, kTum or kPositions. Throws InputError naming
-// the file and line of the first malformed line, or an empty file.
+// Reads a file of a pose format (kitti, tum, positions: Format().read_poses). Throws
+// InputError naming the file and line of the first malformed line, or an empty file;
+// std::logic_error for a format without poses.
 std::vector<FramePose> ReadPoses(const std::string& path, GroundTruthType type);
+
+// A ground-truth format: a value of Ground_truth_type, for Test_OpenABLE, openable_evaluate,
+// openable_sweep and Python's evaluate alike. A format either reads one pose per frame (the
+// pairs then come from the poses: Ground_truth_radius, _axes, _min_gap, _heading) or loads the
+// pairs itself. To add a format: its reader or loader and its entry in GroundTruthFormats()
+// (ground_truth.cc), its section in docs/evaluation.md, and a test; every list users see (the
+// key's help and reference, openable_evaluate's usage, the messages) is made from the registry.
+struct GroundTruthFormat {
+  const char* name;     // the value of Ground_truth_type
+  const char* summary;  // what the file holds, in a few words (help and reference)
+  const char* label;    // the file in messages: "KITTI poses", "ground truth pairs", ...
+  bool needs_file;      // Ground_truth names a file
+  // A pose format: one pose per line, line i the frame i of the source (or, with
+  // `timestamps`, the pose nearest in time to a frame that carries a time).
+  std::vector<FramePose> (*read_poses)(const std::string& path, const char* label);
+  bool orientations;  // the poses carry viewing directions (Ground_truth_heading applies)
+  bool timestamps;    // the poses carry times (FramePose::time, increasing)
+  // Any other format: fills gt->matches over the block of `layout` of a full_rows x full_cols
+  // matrix (unsorted, maybe with duplicates) and counts gt->dropped.
+  void (*load)(const GroundTruthOptions& options, const EvaluationLayout& layout, int full_rows,
+               int full_cols, GroundTruth* gt);
+};
+
+// Every format, in the order users see them.
+const std::vector<GroundTruthFormat>& GroundTruthFormats();
+// The names of the formats, joined as a list for messages: "matrix, pairs, ... or positions"
+// (`last_separator` before the last name).
+std::string GroundTruthFormatList(const char* last_separator = " or ");
 
 // Loop pairs from poses. Loop closure (`reference` empty): pairs (q, j) with
 // q - j >= min_frame_gap. Two traversals: every (query q, reference r). A pair is kept when the

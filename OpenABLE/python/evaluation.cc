@@ -231,6 +231,83 @@ std::string LayoutName(const EvaluationLayout& l) {
   return l.kind == EvaluationLayout::Kind::kLoopClosure ? "loop_closure" : "query_reference";
 }
 
+// The docstring of evaluate, with the ground-truth formats of the registry.
+const std::string& EvaluateDoc() {
+  static const std::string doc = [] {
+    std::string text =
+R"doc(evaluate(matrix, *, truth_matrix=None, pairs=None, poses=None, reference_poses=None,
+    aligned=False, truth_file=None, truth_type=None, truth_file_2="", base=-1, first_frame=0,
+    range_selected=False, layout=None, reference_frames=None, tolerance=2, exclusion=100,
+    vicinity=7, able_thresholds=100, radius=5.0, heading_limit=-1.0, min_frame_gap=None, axes="xyz",
+    normalize=True, label="python", score="distance", score_window=10,
+    accept_threshold=None, accept_consistency=0, sequence_length=1, partial="ahead",
+    direction="forward") -> EvaluationResult
+
+Evaluates a distance matrix against ground truth with both protocols of docs/evaluation.md,
+exactly as Test_OpenABLE (Ground_truth_type) and openable_evaluate do.
+
+Args:
+    matrix (numpy.ndarray): distances (small = similar), shape (N, N) or (Q, R); float32 is
+        read in place.
+    truth_matrix (numpy.ndarray): ground truth as a matrix, non-zero = same place, of the
+        evaluated block's shape or of the whole matrix's (the block is then taken from it).
+        Loop closure: cell (a, b) is the pair (max, min); the diagonal is dropped.
+    pairs (array-like): integer (P, 2) pairs (query, reference) in the block's 0-based
+        indices (loop closure: two frame indices, either order).
+    poses (numpy.ndarray): poses of the frames (loop closure) or of the query frames:
+        (N, 3, 4) / (N, 4, 4) camera-to-world matrices, or (N, 3) / (N, 2) positions. A pair
+        is a loop when the positions over `axes` are closer than `radius` and, with
+        heading_limit >= 0, the viewing directions (third column of R) differ by less than
+        heading_limit degrees; loop closure also needs the frames min_frame_gap apart.
+    reference_poses (numpy.ndarray): poses of the reference frames (query-reference with poses).
+    aligned (bool): two frame-aligned traversals: query i is reference i.
+    truth_file (str): a ground-truth file read as Test_OpenABLE reads Ground_truth, with
+        truth_type one of @FORMATS@;
+        truth_file_2 holds the query poses of two traversals; base (-1, 0, 1) is the index
+        base of a pairs file; first_frame (Initial_image) and range_selected say which part
+        of the source the matrix covers.
+    layout (str | None): "loop_closure" (one sequence, square matrix: the candidates of query
+        q are frames j <= q - exclusion) or "query_reference" (rows are queries, columns
+        references, every reference a candidate). None: query_reference when the matrix is
+        not square or reference_frames is given, else loop_closure.
+    reference_frames (int | None): a square matrix over two concatenated traversals, the
+        reference's frames first: the lower-left block (queries x reference) is evaluated.
+    tolerance (int): frames; an answer within this many frames of a true match is correct.
+    exclusion (int): loop closure: candidates are frames at least this far back (>= 1).
+    vicinity (int): ABLE-P protocol: temporal vicinity in frames.
+    able_thresholds (int): ABLE-P protocol: thresholds evenly spaced in [0, 1].
+    radius, heading_limit, min_frame_gap, axes: the loop rule of poses (metres, degrees or
+        -1 for no limit, frames or None for `exclusion`, "xyz", "xz" or "xy").
+    normalize (bool): divide the matrix by its maximum first (Eq. 5), as openable_evaluate
+        does; Test_OpenABLE's M' is unchanged by it.
+    label (str): the run's label in to_json().
+    score (str): what ranks and accepts each query's best match in the per-query protocol
+        (Match_score): "distance" or "ratio" (its distance over the best candidate more than
+        score_window frames away; docs/evaluation.md). The ABLE-P cell protocol is unchanged.
+    score_window (int): frames on each side of the best match that are not its rivals (>= 0,
+        smaller than the references).
+    accept_threshold (float | None): an operating point (Match_threshold): operating_point
+        gives the precision and recall of the answers whose score is <= it.
+    accept_consistency (int): Match_consistency n: an answer is accepted only when the
+        answers of n independent queries (one sequence apart) agree with it (0: the score
+        alone); sequence_length, partial and direction are those of the matrix (L,
+        Sequence_partial, Sequence_direction), which say which queries are independent.
+
+Returns:
+    EvaluationResult: figures (auc, recall_at_100p, max_f1, recall_at_1/5/10,
+    average_precision, ...) and curves (curve, able_p_curve).
+
+Raises:
+    ValueError (openable.InputError for files and options): one line naming the argument.)doc";
+    std::string formats;
+    for (const GroundTruthFormat& f : GroundTruthFormats())
+      formats += std::string(formats.empty() ? "" : ", ") + "\"" + f.name + "\"";
+    text.replace(text.find("@FORMATS@"), 9, formats);
+    return text;
+  }();
+  return doc;
+}
+
 }  // namespace
 
 void RegisterEvaluation(py::module_& m) {
@@ -474,7 +551,7 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
           t.path_2 = truth_file_2;
           if (truth_type.is_none())
             throw py::value_error(
-                "truth_type: expected with truth_file (matrix, pairs, kitti, tum or positions)");
+                "truth_type: expected with truth_file (" + GroundTruthFormatList() + ")");
           gt = WithArgumentNames([&] {
             t.type = ParseGroundTruthType(truth_type.cast<std::string>());
             return LoadGroundTruth(t, layout, full_rows, full_cols);
@@ -582,70 +659,7 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
       py::arg("accept_threshold") = py::none(), py::arg("accept_consistency") = 0,
       py::arg("sequence_length") = 1, py::arg("partial") = "ahead",
       py::arg("direction") = "forward",
-      R"doc(evaluate(matrix, *, truth_matrix=None, pairs=None, poses=None, reference_poses=None,
-    aligned=False, truth_file=None, truth_type=None, truth_file_2="", base=-1, first_frame=0,
-    range_selected=False, layout=None, reference_frames=None, tolerance=2, exclusion=100,
-    vicinity=7, able_thresholds=100, radius=5.0, heading_limit=-1.0, min_frame_gap=None, axes="xyz",
-    normalize=True, label="python", score="distance", score_window=10,
-    accept_threshold=None, accept_consistency=0, sequence_length=1, partial="ahead",
-    direction="forward") -> EvaluationResult
-
-Evaluates a distance matrix against ground truth with both protocols of docs/evaluation.md,
-exactly as Test_OpenABLE (Ground_truth_type) and openable_evaluate do.
-
-Args:
-    matrix (numpy.ndarray): distances (small = similar), shape (N, N) or (Q, R); float32 is
-        read in place.
-    truth_matrix (numpy.ndarray): ground truth as a matrix, non-zero = same place, of the
-        evaluated block's shape or of the whole matrix's (the block is then taken from it).
-        Loop closure: cell (a, b) is the pair (max, min); the diagonal is dropped.
-    pairs (array-like): integer (P, 2) pairs (query, reference) in the block's 0-based
-        indices (loop closure: two frame indices, either order).
-    poses (numpy.ndarray): poses of the frames (loop closure) or of the query frames:
-        (N, 3, 4) / (N, 4, 4) camera-to-world matrices, or (N, 3) / (N, 2) positions. A pair
-        is a loop when the positions over `axes` are closer than `radius` and, with
-        heading_limit >= 0, the viewing directions (third column of R) differ by less than
-        heading_limit degrees; loop closure also needs the frames min_frame_gap apart.
-    reference_poses (numpy.ndarray): poses of the reference frames (query-reference with poses).
-    aligned (bool): two frame-aligned traversals: query i is reference i.
-    truth_file (str): a ground-truth file read as Test_OpenABLE reads Ground_truth, with
-        truth_type "matrix", "pairs", "aligned", "kitti", "tum" or "positions";
-        truth_file_2 holds the query poses of two traversals; base (-1, 0, 1) is the index
-        base of a pairs file; first_frame (Initial_image) and range_selected say which part
-        of the source the matrix covers.
-    layout (str | None): "loop_closure" (one sequence, square matrix: the candidates of query
-        q are frames j <= q - exclusion) or "query_reference" (rows are queries, columns
-        references, every reference a candidate). None: query_reference when the matrix is
-        not square or reference_frames is given, else loop_closure.
-    reference_frames (int | None): a square matrix over two concatenated traversals, the
-        reference's frames first: the lower-left block (queries x reference) is evaluated.
-    tolerance (int): frames; an answer within this many frames of a true match is correct.
-    exclusion (int): loop closure: candidates are frames at least this far back (>= 1).
-    vicinity (int): ABLE-P protocol: temporal vicinity in frames.
-    able_thresholds (int): ABLE-P protocol: thresholds evenly spaced in [0, 1].
-    radius, heading_limit, min_frame_gap, axes: the loop rule of poses (metres, degrees or
-        -1 for no limit, frames or None for `exclusion`, "xyz", "xz" or "xy").
-    normalize (bool): divide the matrix by its maximum first (Eq. 5), as openable_evaluate
-        does; Test_OpenABLE's M' is unchanged by it.
-    label (str): the run's label in to_json().
-    score (str): what ranks and accepts each query's best match in the per-query protocol
-        (Match_score): "distance" or "ratio" (its distance over the best candidate more than
-        score_window frames away; docs/evaluation.md). The ABLE-P cell protocol is unchanged.
-    score_window (int): frames on each side of the best match that are not its rivals (>= 0,
-        smaller than the references).
-    accept_threshold (float | None): an operating point (Match_threshold): operating_point
-        gives the precision and recall of the answers whose score is <= it.
-    accept_consistency (int): Match_consistency n: an answer is accepted only when the
-        answers of n independent queries (one sequence apart) agree with it (0: the score
-        alone); sequence_length, partial and direction are those of the matrix (L,
-        Sequence_partial, Sequence_direction), which say which queries are independent.
-
-Returns:
-    EvaluationResult: figures (auc, recall_at_100p, max_f1, recall_at_1/5/10,
-    average_precision, ...) and curves (curve, able_p_curve).
-
-Raises:
-    ValueError (openable.InputError for files and options): one line naming the argument.)doc");
+      EvaluateDoc().c_str());
 
   m.def(
       "unsupervised_criteria",

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/evaluation/ground_truth.h"
 #include "config/config.h"
 #include "tests/test_support.h"
 
@@ -87,6 +88,17 @@ TEST(ConfigTable, OdometryKeysShowTheOdometrysLimits) {
   testing::ExpectInputError([&] { c.odometry.Check(); },
                             {"Odometry_num_disparities (StereoOdometryOptions.num_disparities)",
                              "a multiple of 16"});
+}
+
+// Ground_truth_type's help describes every format of the registry (ground_truth.h).
+TEST(ConfigTable, GroundTruthTypeHelpDescribesEveryRegisteredFormat) {
+  Config c;
+  const OptionTable table = ConfigTable(c);
+  const std::string& help = table.Find("Ground_truth_type")->meaning;
+  for (const GroundTruthFormat& f : GroundTruthFormats())
+    EXPECT_NE(help.find(std::string(f.name) + ": " + f.summary), std::string::npos) << f.name;
+  ApplyOverride(c, "Ground_truth_type=positions");
+  EXPECT_EQ(c.evaluation.truth.type, GroundTruthType::kPositions);
 }
 
 // The kinds of binding read and write their fields as Config.txt holds them.
