@@ -15,27 +15,50 @@ namespace openable {
 
 std::string ParseCommandLine(int argc, const char* const* argv, const std::string& program,
                              CommandLine& out, const std::vector<std::string>& value_options) {
+  ProgramOptions options;
+  options.value_options = value_options;
+  return ParseCommandLine(argc, argv, program, out, options);
+}
+
+std::string ParseCommandLine(int argc, const char* const* argv, const std::string& program,
+                             CommandLine& out, const ProgramOptions& options) {
   out = CommandLine();
-  for (int i = 1; i < argc; ++i) {
+  // "--name value" or "--name=value": the value, or false when `a` is not `name`.
+  std::string value;
+  int i = 1;
+  bool missing = false;
+  const auto takes = [&](const std::string& a, const std::string& name) {
+    if (a.rfind(name + "=", 0) == 0) {
+      value = a.substr(name.size() + 1);
+      return true;
+    }
+    if (a != name) return false;
+    missing = i + 1 >= argc;
+    if (!missing) value = argv[++i];
+    return true;
+  };
+  for (; i < argc; ++i) {
     const std::string a = argv[i];
-    const auto own = std::find_if(value_options.begin(), value_options.end(),
-                                  [&a](const std::string& o) {
-                                    return a == o || a.rfind(o + "=", 0) == 0;
-                                  });
-    if (own != value_options.end()) {
-      if (a != *own) {
-        out.options.emplace_back(*own, a.substr(own->size() + 1));
-      } else if (i + 1 >= argc) {
-        return program + ": " + a + " needs a value (see --help)";
-      } else {
-        out.options.emplace_back(*own, argv[++i]);
-      }
+    const auto own = std::find_if(options.value_options.begin(), options.value_options.end(),
+                                  [&](const std::string& o) { return takes(a, o); });
+    const auto flag = own != options.value_options.end()
+                          ? options.key_flags.end()
+                          : std::find_if(options.key_flags.begin(), options.key_flags.end(),
+                                         [&](const auto& f) { return takes(a, f.first); });
+    if (missing) return program + ": " + a + " needs a value (see --help)";
+    if (own != options.value_options.end()) {
+      out.options.emplace_back(*own, value);
+    } else if (flag != options.key_flags.end()) {
+      out.overrides.push_back(flag->second + "=" + value);
     } else if (a == "-h" || a == "--help") {
       out.help = true;
+      return "";
     } else if (a == "--help-markdown") {
       out.help_markdown = true;
+      return "";
     } else if (a == "--version") {
       out.version = true;
+      return "";
     } else if (a == "--set") {
       if (i + 1 >= argc) return program + ": --set needs Key=Value (see --help)";
       out.overrides.push_back(argv[++i]);
@@ -56,8 +79,7 @@ std::string ParseCommandLine(int argc, const char* const* argv, const std::strin
              a + "\"); expected one (see --help)";
     }
   }
-  if (!out.help && !out.help_markdown && !out.version && out.config_path.empty() &&
-      out.overrides.empty())
+  if (options.needs_configuration && out.config_path.empty() && out.overrides.empty())
     return program + ": no configuration given; expected " + program +
            " Config.txt or --set Key=Value (see --help)";
   return "";

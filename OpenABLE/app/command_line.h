@@ -27,11 +27,25 @@ struct CommandLine {
   std::vector<std::pair<std::string, std::string>> options;
 };
 
+// What a program adds to the shared command line.
+struct ProgramOptions {
+  // Its own options that take a value ("--vary" for "--vary X" or "--vary=X"), collected into
+  // CommandLine::options in the order given.
+  std::vector<std::string> value_options;
+  // Flags that stand for a Config.txt key: {"--radius", "Ground_truth_radius"} makes
+  // "--radius 10" the override "Ground_truth_radius=10", in order among the --set.
+  std::vector<std::pair<std::string, std::string>> key_flags;
+  // A configuration (a file or an override) is required.
+  bool needs_configuration = true;
+};
+
 // Parses argv. Returns an empty string on success, or one line (prefixed with `program`)
-// naming the bad argument and pointing at --help: an unknown option, --set without a value,
-// two configuration files, or neither a file nor an override (unless a help or version
-// option was given). `value_options` are the program's own options that take a value
-// ("--vary" for "--vary X" or "--vary=X"), collected into out.options.
+// naming the bad argument and pointing at --help: an unknown option, an option without its
+// value, two configuration files, or (when `options` needs one) neither a file nor an
+// override. --help and --version are answered whatever follows: the parsing stops there.
+std::string ParseCommandLine(int argc, const char* const* argv, const std::string& program,
+                             CommandLine& out, const ProgramOptions& options);
+// The same with the program's own value options alone.
 std::string ParseCommandLine(int argc, const char* const* argv, const std::string& program,
                              CommandLine& out,
                              const std::vector<std::string>& value_options = {});

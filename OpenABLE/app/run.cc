@@ -3,6 +3,7 @@
 #include "OpenABLE/outputs/run_outputs.h"
 
 #include <chrono>
+#include <optional>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -22,24 +23,26 @@ RunOutcome Run(const Config& base, ProgressReporter& progress,
     log("warning: Show_images is 1 but there is no display (DISPLAY is not set); frames are "
         "not shown");
   RunOutcome out;
-  // Spread over processes (cluster.h): what a single process checks before its first frame,
-  // checked by every process together, so that a check that fails on one of them (a folder
-  // it cannot see) ends the run on all.
+  // The check phase, before the long part of the run: no two outputs at one file, no prefix
+  // that is a folder, the evaluation settings, then the run's plan (PlanRun: configuration,
+  // descriptors, sources, mode). With Auto 1 the run's plan is made once the settings are
+  // chosen. Spread over processes (cluster.h), every process checks, together, so that a check
+  // that fails on one of them (a folder it cannot see) ends the run on all.
   Cluster& cluster = Cluster::Get();
+  std::optional<RunPlan> plan;
+  const auto check = [&] {
+    CheckDistinctOutputs(PlannedOutputs(base));
+    if (EvaluationRequested(base)) {
+      CheckOutputPrefix("Evaluation_name", base.evaluation.name);
+      (void)EvaluationSettingsFrom(base);
+    }
+    if (!base.automatic.enabled || cluster.Distributed()) plan.emplace(PlanRun(base));
+  };
   if (cluster.Distributed())
-    cluster.Agree([&] {
-      CheckDistinctOutputs(PlannedOutputs(base));
-      if (EvaluationRequested(base)) {
-        CheckOutputPrefix("Evaluation_name", base.evaluation.name);
-        (void)EvaluationSettingsFrom(base);
-      }
-      CheckRun(base);
-    });
-  // Outputs are checked before the long part of the run: no two at one file, no prefix that
-  // is a folder.
-  CheckDistinctOutputs(PlannedOutputs(base));
-  if (EvaluationRequested(base)) CheckOutputPrefix("Evaluation_name", base.evaluation.name);
-  // Evaluation settings are checked before the long part of the run.
+    cluster.Agree(check);
+  else
+    check();
+  // The evaluation's settings, checked above.
   if (EvaluationRequested(base)) {
     out.evaluation = std::make_unique<Evaluation>();
     out.evaluation->settings = EvaluationSettingsFrom(base);
@@ -67,10 +70,13 @@ RunOutcome Run(const Config& base, ProgressReporter& progress,
     }
   }
   const Config& config = *chosen;
-  out.result = ComputeRun(config, progress, out.automatic ? &store : nullptr);
+  if (out.automatic) plan.emplace(PlanRun(config));
+  out.result = ComputeRun(*plan, progress, out.automatic ? &store : nullptr);
   // Process 0 evaluates, verifies and writes; the others have given it their shares.
   if (cluster.Distributed() && cluster.Rank() != 0) return out;
   RunResult& result = out.result;
+  for (const std::string& note : UnwrittenOutputNotes(config, result))
+    result.notes.push_back(note);
   if (out.automatic && !out.automatic->reliable && result.accepted_queries > 0)
     result.accepted_queries = 0;
   for (const std::string& w : result.warnings) log("warning: " + w);

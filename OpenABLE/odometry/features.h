@@ -10,6 +10,20 @@
 
 namespace openable::odometry {
 
+// The features both odometries match between frames, with the same defaults.
+struct FeatureOptions {
+  // "ORB" or "SIFT" (case-insensitive). SIFT by default: its keypoints are located to a
+  // fraction of a pixel, ORB's to the pixel of their pyramid level; on KITTI 00 frames 0-199
+  // (half size) SIFT gives 0.11 degree of rotation error per step against ORB's 0.24-0.5, and
+  // is faster there (fewer keypoints found on the small frames). See docs/odometry.md.
+  std::string features = "SIFT";
+  // Keypoints kept per frame (strongest), >= 10. 2000 leaves several hundred inliers on KITTI.
+  int max_features = 2000;
+  // Lowe's ratio test, in [0.1, 1]: a match is kept when its distance is below ratio x the
+  // second nearest's. 0.8 is Lowe's value.
+  double ratio_test = 0.8;
+};
+
 // Keypoints of one frame and their descriptors (one row each).
 struct Features {
   std::vector<cv::KeyPoint> keypoints;

@@ -23,17 +23,9 @@
 
 namespace openable::odometry {
 
-struct MonoOdometryOptions {
-  // "ORB" or "SIFT" (case-insensitive). SIFT by default: its keypoints are located to a
-  // fraction of a pixel, ORB's to the pixel of their pyramid level; on KITTI 00 frames 0-199
-  // (half size) SIFT gives 0.11 degree of rotation error per step against ORB's 0.24-0.5, and
-  // is faster there (fewer keypoints found on the small frames). See docs/odometry.md.
-  std::string features = "SIFT";
-  // Keypoints kept per frame (strongest), >= 10. 2000 leaves several hundred inliers on KITTI.
-  int max_features = 2000;
-  // Lowe's ratio test, in [0.1, 1]: a match is kept when its distance is below ratio x the
-  // second nearest's. 0.8 is Lowe's value.
-  double ratio_test = 0.8;
+// The features (FeatureOptions: features, max_features, ratio_test) and the two-view
+// geometry of each step.
+struct MonoOdometryOptions : FeatureOptions {
   // RANSAC inlier threshold of the essential matrix (distance to the epipolar line), pixels,
   // > 0. 0.5 suits SIFT's sub-pixel keypoints: on KITTI 00 frames 0-1699 it gives 0.10 degree
   // of rotation error per step against 0.14 with 1.0, and an unaligned ATE of 9.6 m against

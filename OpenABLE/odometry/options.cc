@@ -9,20 +9,19 @@
 namespace openable::odometry {
 namespace {
 
-void CheckFeatures(const std::string& owner, const std::string& features, int max_features,
-                   double ratio_test) {
-  const std::string f = Upper(features);
+void CheckFeatures(const std::string& owner, const FeatureOptions& o) {
+  const std::string f = Upper(o.features);
   if (f != "ORB" && f != "SIFT")
-    RefuseOption("Odometry_features (" + owner + ".features)", Quoted(features), "ORB or SIFT");
-  CheckIntAtLeast("Odometry_max_features (" + owner + ".max_features)", max_features, 10);
-  CheckNumberRange("Odometry_ratio_test (" + owner + ".ratio_test)", ratio_test, 0.1, 1);
+    RefuseOption("Odometry_features (" + owner + ".features)", Quoted(o.features), "ORB or SIFT");
+  CheckIntAtLeast("Odometry_max_features (" + owner + ".max_features)", o.max_features, 10);
+  CheckNumberRange("Odometry_ratio_test (" + owner + ".ratio_test)", o.ratio_test, 0.1, 1);
 }
 
 }  // namespace
 
 void MonoOdometryOptions::Check() const {
   const std::string o = "MonoOdometryOptions";
-  CheckFeatures(o, features, max_features, ratio_test);
+  CheckFeatures(o, *this);
   CheckNumberAtLeast("Odometry_ransac_threshold (" + o + ".ransac_threshold_px)",
                      ransac_threshold_px, 0, /*lo_excluded=*/true);
   if (!(ransac_confidence > 0 && ransac_confidence < 1))
@@ -43,7 +42,7 @@ void StereoOdometryOptions::Check() const {
                  std::to_string(num_disparities), "a multiple of 16 in [16, 256]");
   if (block_size % 2 != 1 || block_size > 11 || block_size < (m == "BM" ? 5 : 1))
     RefuseOption(o + ".block_size", std::to_string(block_size), "odd, 1-11 (sgbm) or 5-11 (bm)");
-  CheckFeatures(o, features, max_features, ratio_test);
+  CheckFeatures(o, *this);
   CheckNumberAtLeast("Odometry_max_depth (" + o + ".max_depth)", max_depth, 1);
   CheckNumberAtLeast("Odometry_ransac_threshold (" + o + ".pnp_reprojection_px)",
                      pnp_reprojection_px, 0, true);

@@ -25,7 +25,9 @@
 
 namespace openable::odometry {
 
-struct StereoOdometryOptions {
+// The features (FeatureOptions: features, max_features, ratio_test), the disparity and the PnP
+// of each step.
+struct StereoOdometryOptions : FeatureOptions {
   // Disparity: "sgbm" (semi-global, OpenCV's StereoSGBM with the penalties of
   // OpenABLE/stereo/disparity.h) or "bm" (StereoBM, block_size >= 5). Case-insensitive.
   std::string matcher = "sgbm";
@@ -39,12 +41,6 @@ struct StereoOdometryOptions {
   int num_disparities = 64;
   // Matched block side, pixels, odd, 1-11 for sgbm, 5-11 for bm.
   int block_size = 5;
-  // "SIFT" (the paper) or "ORB".
-  std::string features = "SIFT";
-  // Keypoints kept per frame, >= 10.
-  int max_features = 2000;
-  // Lowe's ratio test, in [0.1, 1].
-  double ratio_test = 0.8;
   // Metres, >= 1: points farther than this (in the previous frame) are not used in PnP.
   double max_depth = 80;
   // RANSAC of PnP: inlier reprojection error, pixels (> 0); iterations (>= 1); confidence (0, 1).

@@ -1,6 +1,9 @@
 #include "OpenABLE/outputs/run_outputs.h"
 
 #include <chrono>
+#include <cstdio>
+#include <functional>
+#include <memory>
 #include <future>
 #include <limits>
 
@@ -23,32 +26,213 @@ std::string ThresholdPngPath(const Config& config) {
   return config.output.ThresholdPngPath(config.matching.threshold >= 0.0);
 }
 
+namespace {
+
+using Planned = std::vector<std::pair<std::string, std::string>>;
+
+// What the files of a run are made from.
+struct OutputInput {
+  const Config& config;
+  const RunResult& result;
+  const cv::Mat1f& shown;  // cells without a value as the largest finite value (text, images)
+  const cv::Mat1f& saved;  // cells without a value as NaN (.npy)
+  const Evaluation* evaluation;
+  const RunVerification* verification;
+  const AutoChoice* automatic;
+};
+
+// Stages a file in the batch; empty when the run writes no such file.
+using Stager = std::function<void(OutputBatch&)>;
+
+// One kind of output file of a run. WriteOutputs prepares every kind in the registry's order
+// (an encoder may start on its own thread then), then stages them in the same order, which is
+// the order of the paths it returns; PlannedOutputs lists their paths from the same entries,
+// so that the files checked before a run are the files written after it.
+struct RunOutput {
+  bool dense_only;  // made from the dense matrix: a bounded run writes no such file
+  Planned (*planned)(const Config& config);  // the (key, path) of the files `config` asks for
+  Stager (*prepare)(const OutputInput& in);
+};
+
+// One file of one key when its path is set.
+Planned One(const char* key, const std::string& path) {
+  return path.empty() ? Planned() : Planned{{key, path}};
+}
+
+// A PNG image encoded on its own thread while the other files are written: OpenCV's PNG
+// encoder is single-threaded and the images dominate the time of the outputs.
+Stager EncodedInBackground(const std::string& key, const std::string& path,
+                           std::function<std::string()> encode) {
+  auto bytes = std::make_shared<std::future<std::string>>(
+      std::async(std::launch::async, std::move(encode)));
+  return [key, path, bytes](OutputBatch& batch) { batch.Stage(key, path, bytes->get()); };
+}
+
+const std::vector<RunOutput>& RunOutputs() {
+  static const std::vector<RunOutput> outputs = {
+      // Npy_name: written from the matrix itself while the images are being encoded.
+      {true, [](const Config& c) { return One("Npy_name", c.output.npy_name); },
+       [](const OutputInput& in) -> Stager {
+         const std::string& path = in.config.output.npy_name;
+         if (path.empty()) return {};
+         return [&in, path](OutputBatch& batch) {
+           const cv::Mat1f& saved = in.saved;
+           const std::string header = NpyHeader(saved.rows, saved.cols);
+           std::vector<std::string_view> parts = {header};
+           for (int i = 0; i < saved.rows; ++i)
+             parts.emplace_back(reinterpret_cast<const char*>(saved.ptr<float>(i)),
+                                saved.cols * sizeof(float));
+           batch.Stage("Npy_name", path, parts);
+         };
+       }},
+      // Txt_name: formatted in pieces and written as they come (the images encode meanwhile):
+      // the text of a large matrix is never whole in memory. The thresholded matrix when
+      // Threshold is set.
+      {true, [](const Config& c) { return One("Txt_name", c.output.txt_name); },
+       [](const OutputInput& in) -> Stager {
+         const std::string& path = in.config.output.txt_name;
+         if (path.empty()) return {};
+         return [&in, path](OutputBatch& batch) {
+           TextChunks text(in.result.thresholded.empty() ? cv::Mat(in.shown)
+                                                         : cv::Mat(in.result.thresholded));
+           batch.Stage("Txt_name", path, [&](std::string_view& piece) { return text.Next(piece); });
+         };
+       }},
+      {true, [](const Config& c) { return One("Png_name", c.output.png_name); },
+       [](const OutputInput& in) -> Stager {
+         const OutputOptions& o = in.config.output;
+         if (o.png_name.empty()) return {};
+         return EncodedInBackground("Png_name", o.png_name, [&in] {
+           return EncodePng(ColorizeMatrix(in.shown, in.config.output.matrix_color));
+         });
+       }},
+      // The thresholded image (Eq. 9): Png_threshold_name, or Png_name's path with
+      // "_thresholded".
+      {true,
+       [](const Config& c) {
+         return One(c.output.png_threshold_name.empty() ? "Png_name (thresholded image)"
+                                                        : "Png_threshold_name",
+                    ThresholdPngPath(c));
+       },
+       [](const OutputInput& in) -> Stager {
+         const std::string path = ThresholdPngPath(in.config);
+         if (path.empty()) return {};
+         return EncodedInBackground(
+             in.config.output.png_threshold_name.empty() ? "Png_name" : "Png_threshold_name",
+             path, [&in] {
+               cv::Mat1f binary;
+               in.result.thresholded.convertTo(binary, CV_32F);
+               return EncodePng(ColorizeMatrix(binary, in.config.output.matrix_color));
+             });
+       }},
+      {false, [](const Config& c) { return One("Matches_name", c.scale.matches_name); },
+       [](const OutputInput& in) -> Stager {
+         const std::string& path = in.config.scale.matches_name;
+         if (path.empty()) return {};
+         return [&in, path](OutputBatch& batch) {
+           const bool csv = path.size() >= 4 && path.compare(path.size() - 4, 4, ".csv") == 0;
+           batch.Stage("Matches_name", path, EncodeMatches(in.result.matches, csv));
+         };
+       }},
+      {false,
+       [](const Config& c) {
+         return c.verification.enabled ? One("Loops_name", c.output.loops_name) : Planned();
+       },
+       [](const OutputInput& in) -> Stager {
+         const std::string& path = in.config.output.loops_name;
+         if (in.verification == nullptr || path.empty()) return {};
+         return [&in, path](OutputBatch& batch) {
+           batch.Stage("Loops_name", path, EncodeLoops(*in.verification));
+         };
+       }},
+      // Timestamps_name: "<row> <seconds>" per row, nanosecond resolution (the stamps of ROS
+      // messages).
+      {false, [](const Config& c) { return One("Timestamps_name", c.output.timestamps_name); },
+       [](const OutputInput& in) -> Stager {
+         const std::string& path = in.config.output.timestamps_name;
+         if (path.empty()) return {};
+         return [&in, path](OutputBatch& batch) {
+           std::string text = "# row seconds (frame times of the matrix's rows)\n";
+           for (const Traversal& tr : in.result.traversals) {
+             if (static_cast<int>(tr.times.size()) != tr.frames)
+               throw InputError("Timestamps_name: the frames of " + tr.key +
+                                " carry no times; "
+                                "expected frames of a ROS bag (Frame_mode 3)");
+             char line[64];
+             for (int i = 0; i < tr.frames; ++i) {
+               std::snprintf(line, sizeof line, "%d %.9f\n", tr.first_row + i, tr.times[i]);
+               text += line;
+             }
+           }
+           batch.Stage("Timestamps_name", path, text);
+         };
+       }},
+      // Evaluation_name: the evaluation's files of one run (no label in the names).
+      {false,
+       [](const Config& c) {
+         Planned out;
+         const std::string& prefix = c.evaluation.name;
+         if (!EvaluationRequested(c) || prefix.empty()) return out;
+         for (const char* suffix : kEvaluationSetSuffixes)
+           out.emplace_back("Evaluation_name", prefix + suffix);
+         for (const char* suffix : kEvaluationRunSuffixes)
+           out.emplace_back("Evaluation_name", prefix + suffix);
+         return out;
+       },
+       [](const OutputInput& in) -> Stager {
+         if (in.evaluation == nullptr || in.config.evaluation.name.empty()) return {};
+         return [&in](OutputBatch& batch) {
+           StageEvaluation(batch, "Evaluation_name", in.config.evaluation.name, *in.evaluation,
+                           {&in.result.normalized});
+         };
+       }},
+      {false,
+       [](const Config& c) {
+         return EvaluationRequested(c) ? One("Report_name", c.evaluation.report_name)
+                                       : Planned();
+       },
+       [](const OutputInput& in) -> Stager {
+         if (in.evaluation == nullptr || in.config.evaluation.report_name.empty()) return {};
+         return [&in](OutputBatch& batch) {
+           const Config& config = in.config;
+           ReportInput report;
+           report.program = "Test_OpenABLE";
+           report.title = "OpenABLE report: " + RunLabel(config);
+           report.settings = ChangedSettings(config);
+           report.all_settings = FormatConfig(config);
+           report.evaluation = in.evaluation;
+           report.matrices = {&in.result.normalized};
+           report.examples = config.evaluation.report_examples;
+           if (in.automatic != nullptr) report.tables.push_back(AutoReportTable(*in.automatic));
+           if (report.examples > 0)
+             report.frames = FramesFromSources(OpenFramesToShow(config.input), false);
+           batch.Stage("Report_name", config.evaluation.report_name, EncodeHtmlReport(report));
+         };
+       }},
+  };
+  return outputs;
+}
+
+}  // namespace
+
 std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& config) {
-  std::vector<std::pair<std::string, std::string>> out;
-  const OutputOptions& o = config.output;
-  if (!o.txt_name.empty()) out.emplace_back("Txt_name", o.txt_name);
-  if (!o.npy_name.empty()) out.emplace_back("Npy_name", o.npy_name);
-  if (!o.png_name.empty()) out.emplace_back("Png_name", o.png_name);
-  const std::string threshold_png = ThresholdPngPath(config);
-  if (!threshold_png.empty())
-    out.emplace_back(
-        o.png_threshold_name.empty() ? "Png_name (thresholded image)" : "Png_threshold_name",
-        threshold_png);
-  if (!config.scale.matches_name.empty())
-    out.emplace_back("Matches_name", config.scale.matches_name);
-  if (config.verification.enabled && !o.loops_name.empty())
-    out.emplace_back("Loops_name", o.loops_name);
-  const std::string& prefix = config.evaluation.name;
-  if (EvaluationRequested(config) && !prefix.empty()) {  // one run: no label in the names
-    for (const char* suffix : kEvaluationSetSuffixes)
-      out.emplace_back("Evaluation_name", prefix + suffix);
-    for (const char* suffix : kEvaluationRunSuffixes)
-      out.emplace_back("Evaluation_name", prefix + suffix);
+  Planned out;
+  for (const RunOutput& output : RunOutputs()) {
+    const Planned files = output.planned(config);
+    out.insert(out.end(), files.begin(), files.end());
   }
-  if (EvaluationRequested(config) && !config.evaluation.report_name.empty())
-    out.emplace_back("Report_name", config.evaluation.report_name);
-  if (!o.timestamps_name.empty()) out.emplace_back("Timestamps_name", o.timestamps_name);
   return out;
+}
+
+std::vector<std::string> UnwrittenOutputNotes(const Config& config, const RunResult& result) {
+  std::vector<std::string> notes;
+  if (!result.bounded) return notes;
+  for (const RunOutput& output : RunOutputs())
+    if (output.dense_only)
+      for (const auto& [key, path] : output.planned(config))
+        notes.push_back(key + ": not written: the run is bounded and keeps no dense matrix "
+                        "(see Matches_name)");
+  return notes;
 }
 
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
@@ -74,89 +258,16 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
       saved.setTo(std::numeric_limits<float>::quiet_NaN(), empty);
     }
   }
-  // The encodings are independent; the two PNG images dominate (OpenCV's PNG encoder is
-  // single-threaded), so each is encoded on its own thread while the .npy and the text are
-  // written, then staged in order.
-  struct Pending {
-    std::string key, path;
-    std::future<std::string> bytes;
-  };
+  const OutputInput in{config, result, shown, saved, evaluation, verification, automatic};
   // Declared after the matrices the encoders read: when a write fails and the exception
-  // unwinds, the futures (whose destructors wait for their threads) go first, so no encoder
-  // is left reading a freed matrix.
-  std::vector<Pending> pending;
-  auto encode = [&](const std::string& key, const std::string& path, auto make) {
-    pending.push_back({key, path, std::async(std::launch::async, make)});
-  };
-  if (dense && !out.png_name.empty())
-    encode("Png_name", out.png_name,
-           [&] { return EncodePng(ColorizeMatrix(shown, out.matrix_color)); });
-  const std::string threshold_png = ThresholdPngPath(config);
-  if (dense && !threshold_png.empty()) {
-    encode(out.png_threshold_name.empty() ? "Png_name" : "Png_threshold_name", threshold_png, [&] {
-      cv::Mat1f binary;
-      result.thresholded.convertTo(binary, CV_32F);
-      return EncodePng(ColorizeMatrix(binary, out.matrix_color));
-    });
-  }
+  // unwinds, the stagers (which hold the encoders' futures, whose destructors wait for their
+  // threads) go first, so no encoder is left reading a freed matrix.
+  std::vector<Stager> stagers;
+  for (const RunOutput& output : RunOutputs())
+    if (dense || !output.dense_only) stagers.push_back(output.prepare(in));
   OutputBatch batch;
-  if (dense && !out.npy_name.empty()) {
-    // Written from the matrix itself while the other outputs are being encoded.
-    const std::string header = NpyHeader(saved.rows, saved.cols);
-    std::vector<std::string_view> parts = {header};
-    for (int i = 0; i < saved.rows; ++i)
-      parts.emplace_back(reinterpret_cast<const char*>(saved.ptr<float>(i)),
-                         saved.cols * sizeof(float));
-    batch.Stage("Npy_name", out.npy_name, parts);
-  }
-  if (dense && !out.txt_name.empty()) {
-    // Formatted in pieces and written as they come (the PNGs encode meanwhile): the text of a
-    // large matrix is never whole in memory.
-    TextChunks text(result.thresholded.empty() ? cv::Mat(shown) : cv::Mat(result.thresholded));
-    batch.Stage("Txt_name", out.txt_name,
-                [&](std::string_view& piece) { return text.Next(piece); });
-  }
-  for (Pending& p : pending) batch.Stage(p.key, p.path, p.bytes.get());
-  const std::string& matches = config.scale.matches_name;
-  if (!matches.empty()) {
-    const bool csv = matches.size() >= 4 && matches.compare(matches.size() - 4, 4, ".csv") == 0;
-    batch.Stage("Matches_name", matches, EncodeMatches(result.matches, csv));
-  }
-  if (verification != nullptr && !out.loops_name.empty())
-    batch.Stage("Loops_name", out.loops_name, EncodeLoops(*verification));
-  if (!out.timestamps_name.empty()) {
-    // "<row> <seconds>" per row, nanosecond resolution (the stamps of ROS messages).
-    std::string text = "# row seconds (frame times of the matrix's rows)\n";
-    for (const Traversal& tr : result.traversals) {
-      if (static_cast<int>(tr.times.size()) != tr.frames)
-        throw InputError("Timestamps_name: the frames of " + tr.key +
-                         " carry no times; "
-                         "expected frames of a ROS bag (Frame_mode 3)");
-      char line[64];
-      for (int i = 0; i < tr.frames; ++i) {
-        std::snprintf(line, sizeof line, "%d %.9f\n", tr.first_row + i, tr.times[i]);
-        text += line;
-      }
-    }
-    batch.Stage("Timestamps_name", out.timestamps_name, text);
-  }
-  if (evaluation != nullptr && !config.evaluation.name.empty())
-    StageEvaluation(batch, "Evaluation_name", config.evaluation.name, *evaluation,
-                    {&result.normalized});
-  if (evaluation != nullptr && !config.evaluation.report_name.empty()) {
-    ReportInput report;
-    report.program = "Test_OpenABLE";
-    report.title = "OpenABLE report: " + RunLabel(config);
-    report.settings = ChangedSettings(config);
-    report.all_settings = FormatConfig(config);
-    report.evaluation = evaluation;
-    report.matrices = {&result.normalized};
-    report.examples = config.evaluation.report_examples;
-    if (automatic != nullptr) report.tables.push_back(AutoReportTable(*automatic));
-    if (report.examples > 0)
-      report.frames = FramesFromSources(OpenFramesToShow(config.input), false);
-    batch.Stage("Report_name", config.evaluation.report_name, EncodeHtmlReport(report));
-  }
+  for (const Stager& stage : stagers)
+    if (stage) stage(batch);
   const std::vector<std::string> paths = batch.Paths();
   batch.Commit();
   const double seconds = SecondsSince(t);

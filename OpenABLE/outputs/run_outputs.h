@@ -28,11 +28,20 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
                                       const RunVerification* verification = nullptr,
                                       const AutoChoice* automatic = nullptr);
 
-// Every file a run of `config` may write, as (key, path): the matrix files, the thresholded
-// image, the matches, the loops (Verification) and, when Ground_truth_type and
-// Evaluation_name are set, the evaluation's files (StageEvaluation). Run checks them with
-// CheckDistinctOutputs before any work.
+// Every file a run of `config` may write, as (key, path), in the order WriteOutputs writes
+// them: the matrix files, the images, the matches, the loops (Verification), the frame times
+// and, when Ground_truth_type is set, the evaluation's files (StageEvaluation) and the report.
+// Run checks them with CheckDistinctOutputs before any work.
+//
+// The kinds of output are entries of one registry (run_outputs.cc) that both this list and
+// WriteOutputs read. To add one: its key in OutputOptions (config/run_options.h) and the option
+// table (config/config.cc), its entry in the registry, and its section in
+// docs/output_formats.md.
 std::vector<std::pair<std::string, std::string>> PlannedOutputs(const Config& config);
+
+// The notes of a bounded run for the files it does not write (those made from the dense
+// matrix: Txt_name, Npy_name, the images), one per file asked for: "<key>: not written: ...".
+std::vector<std::string> UnwrittenOutputNotes(const Config& config, const RunResult& result);
 
 // The thresholded image's path: Png_threshold_name, or Png_name with "_thresholded" before
 // its extension; empty when no threshold or no PNG is asked for.
