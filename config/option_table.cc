@@ -122,6 +122,7 @@ void OptionTable::AddNumber(const char* key, const char* group, const char* mean
     const double v = get();
     return integral ? std::to_string(static_cast<long long>(v)) : FormatNumber(v);
   };
+  b.owner = owner_;
   bindings_.push_back(std::move(b));
 }
 
@@ -137,6 +138,7 @@ void OptionTable::AddText(const char* key, const char* group, const char* meanin
   b.assign = [set](const std::string& value, const std::string&) { set(value); };
   b.format = [get] { return "\"" + get() + "\""; };
   b.check = std::move(check);
+  b.owner = owner_;
   bindings_.push_back(std::move(b));
 }
 

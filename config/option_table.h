@@ -38,8 +38,10 @@ struct OptionBinding {
   std::function<std::string()> format;
   // Numeric kinds: sets the field to `value` without any check (tests walk the ranges).
   std::function<void(double value)> set_number;
-  // Check() of the struct that owns the field.
+  // Check() of the struct that owns the field, and that struct (to tell which keys belong to
+  // one module: the settings that change a descriptor row, say).
   std::function<void()> check;
+  const void* owner = nullptr;
 
   // "integer in [0, 2]", "number >= 0", "number >= 0 (0 excluded)", or "text".
   std::string RangeText() const;
@@ -116,8 +118,11 @@ class OptionTable {
   const OptionBinding& Lookup(const std::string& key, const std::string& where) const;
 
  private:
+  // The owner's Check(); notes the owner for the binding being added (every Add passes it as
+  // an argument of the private adder, which stores it).
   template <typename Owner>
-  static std::function<void()> CheckOf(Owner& owner) {
+  std::function<void()> CheckOf(Owner& owner) {
+    owner_ = &owner;
     return [&owner] { owner.Check(); };
   }
   void AddNumber(const char* key, const char* group, const char* meaning, bool is_new,
@@ -132,6 +137,7 @@ class OptionTable {
                std::function<void()> check);
 
   std::vector<OptionBinding> bindings_;
+  const void* owner_ = nullptr;
 };
 
 // Reads the flat "Key: value" subset of YAML that the original's OpenCV FileStorage files use

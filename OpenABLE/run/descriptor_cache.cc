@@ -89,12 +89,18 @@ bool WriteAll(int fd, const char* data, size_t size) {
 }  // namespace
 
 const std::vector<std::string>& DescriptionKeys() {
-  static const std::vector<std::string> keys = {
-      "Camera_type",  "Description_type", "Patch_size",  "Grid_x",
-      "Grid_y",       "Panoramas",        "Illumination_invariance",
-      "Alpha",        "Lambda_red",       "Lambda_green", "Lambda_blue",
-      "Image_descriptor", "Ldb_bits", "Sad_patch", "Side_window", "Side_window_radii",
-      "Noise_gaussian", "Noise_salt_pepper", "Noise_overexposure", "Noise_seed"};
+  // From the option table: the keys of the structs that make a row (the description, the
+  // descriptor, the preprocessing), in the table's order, and the camera type, the one input
+  // key that changes a row (stereo pairs give D-LDB its disparity channel).
+  static const std::vector<std::string> keys = [] {
+    Config c;
+    std::vector<std::string> out;
+    for (const OptionBinding& b : ConfigTable(c).Bindings())
+      if (b.key == "Camera_type" || b.owner == &c.description || b.owner == &c.descriptor ||
+          b.owner == &c.preprocess)
+        out.push_back(b.key);
+    return out;
+  }();
   return keys;
 }
 

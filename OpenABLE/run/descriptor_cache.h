@@ -21,9 +21,10 @@ namespace openable {
 // Version of the cache file layout and of the settings text; bumped when either changes.
 inline constexpr int kDescriptorCacheVersion = 1;
 
-// The Config keys whose values change a frame's descriptor row: the one place to list them.
-// tests/run/descriptor_cache_test.cc fails when a key of the table is neither here nor in
-// its list of keys known not to change rows.
+// The Config keys whose values change a frame's descriptor row, from the option table: every
+// key of the description, descriptor and preprocessing structs, and Camera_type. A key added to
+// those structs enters the cache key by itself; tests/run/descriptor_cache_test.cc fails when a
+// key of the table is neither here nor in its list of keys known not to change rows.
 const std::vector<std::string>& DescriptionKeys();
 
 // The text the settings hash is taken over: the cache version, the library version, the
