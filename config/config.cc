@@ -42,10 +42,8 @@ std::string GroundTruthTypeText(GroundTruthType type) {
   return type == GroundTruthType::kNone ? "" : GroundTruthTypeName(type);
 }
 
-}  // namespace
-
-OptionTable ConfigTable(Config& c) {
-  OptionTable t;
+// The inputs and the matrix outputs (Datasets, Representation).
+void AddInputKeys(OptionTable& t, Config& c) {
   // Datasets
   t.AddEnumNumber("Frame_mode", kDatasets, c.input, c.input.frame_mode,
         "Input: 0 image folder(s) (Images_path, optionally Images_path_2), 1 one video "
@@ -128,6 +126,10 @@ OptionTable ConfigTable(Config& c) {
   t.Add("Show_images", kRepresentation, c.output, c.output.show_images,
         "1 shows each frame in a window while it is described (needs a display; ignored with a "
         "warning when there is none).", false);
+}
+
+// Description and matching.
+void AddDescriptionKeys(OptionTable& t, Config& c) {
   // Description and matching
   t.AddEnumNumber("Camera_type", kDescription, c.input, c.input.camera_type,
         "0 monocular (ABLE-M); 1 stereo (ABLE-S): pairs of Images_path_left and Images_path_right"
@@ -239,6 +241,10 @@ OptionTable ConfigTable(Config& c) {
         "single-frame matrix, first divided by its largest value, comma-separated in the order "
         "of the names (\"1,0.5\"); empty: equal weights, which fusing descriptors of different "
         "distances (Hamming, L2, L1) does not allow. Dense matrices only.");
+}
+
+// Robustness studies and the auto mode.
+void AddRobustnessAndAutoKeys(OptionTable& t, Config& c) {
   // Robustness
   t.Add("Side_window", kRobustness, c.preprocess, c.preprocess.side_window,
         "1 applies side-window multilayer pixel fusion to the grey image before description "
@@ -287,6 +293,10 @@ OptionTable ConfigTable(Config& c) {
         "unreliable and accepts no match. Unrelated traversals reach at most 0.19 in the "
         "measurements, two traversals of a route where the best setting finds the places 0.6 "
         "and more.");
+}
+
+// Scale: dense or bounded matrices, approximate search, the descriptor cache.
+void AddScaleKeys(OptionTable& t, Config& c) {
   // Scale
   t.AddEnumNumber("Matrix_mode", kScale, c.scale, c.scale.matrix_mode,
         "0 auto: dense when the N x N matrix fits in Memory_limit, bounded otherwise (the run "
@@ -332,6 +342,10 @@ OptionTable ConfigTable(Config& c) {
         "(docs/output_formats.md), so a run interrupted or repeated with the same description "
         "settings describes only the frames not cached, and gives the same matrix bit for bit. "
         "Image folders only (not videos or stereo pairs). Created when missing.");
+}
+
+// Evaluation and verification.
+void AddEvaluationKeys(OptionTable& t, Config& c) {
   // Evaluation
   t.AddEnumName(
       "Ground_truth_type", kEvaluation, c.evaluation, c.evaluation.truth.type,
@@ -438,6 +452,10 @@ OptionTable ConfigTable(Config& c) {
         "Verification: CSV of every candidate checked (query, reference, rank, distance, score, "
         "matches, inliers, model, geometric, streak, verified); frame numbers count from the "
         "start of their traversal. Empty: not written.");
+}
+
+// The SNAPS add-on.
+void AddSnapsKeys(OptionTable& t, Config& c) {
   // SNAPS
   t.Add("Snaps_trajectory", kSnaps, c.snaps, c.snaps.trajectory,
         "openable_snaps: the drifting trajectory to correct (visual odometry), in "
@@ -550,6 +568,10 @@ OptionTable ConfigTable(Config& c) {
         "Output prefix: <name>_discounted.txt and/or <name>_pose_graph.txt (the corrected "
         "trajectories), <name>_loops.csv, <name>.json (figures), <name>.png (plot). Empty: "
         "figures printed only.");
+}
+
+// The odometry of the SNAPS chain.
+void AddOdometryKeys(OptionTable& t, Config& c) {
   // Odometry
   t.Add("Odometry_calibration", kOdometry, c.odometry, c.odometry.calibration,
         "KITTI calib.txt (P0, P1 lines) of rectified images: the intrinsics (P0) and, for stereo,"
@@ -585,6 +607,19 @@ OptionTable ConfigTable(Config& c) {
         "odometry's limit).");
   t.Add("Odometry_max_depth", kOdometry, c.odometry, c.odometry.max_depth, 1, kNoLimit,
         "stereo: points farther than this many metres are not used in PnP.");
+}
+
+}  // namespace
+
+OptionTable ConfigTable(Config& c) {
+  OptionTable t;
+  AddInputKeys(t, c);
+  AddDescriptionKeys(t, c);
+  AddRobustnessAndAutoKeys(t, c);
+  AddScaleKeys(t, c);
+  AddEvaluationKeys(t, c);
+  AddSnapsKeys(t, c);
+  AddOdometryKeys(t, c);
   return t;
 }
 
