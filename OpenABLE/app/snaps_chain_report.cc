@@ -6,6 +6,7 @@
 
 #include "OpenABLE/app/snaps_chain.h"
 #include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/reports/figures.h"
 #include "OpenABLE/snaps/plot.h"
@@ -13,11 +14,7 @@
 namespace openable::snaps {
 namespace {
 
-std::string Number(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
+std::string Number(double v) { return FormatNumber(v); }
 
 std::string StatsJson(const LatencyStats& s) {
   std::ostringstream o;

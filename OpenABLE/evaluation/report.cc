@@ -10,10 +10,7 @@ namespace openable {
 namespace {
 
 std::string Number(double v) {
-  if (!std::isfinite(v)) return "null";  // JSON has no NaN or infinity
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.9g", v);
-  return buffer;
+  return std::isfinite(v) ? FormatNumber(v, 9) : "null";  // JSON has no NaN or infinity
 }
 
 // JSON string literal (OpenCV's FileStorage writes JSON too, but not null for non-finite

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/output_batch.h"
 #include "OpenABLE/io/npy.h"
 #include "OpenABLE/outputs/matrix_files.h"
@@ -132,11 +133,8 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
         throw InputError("Timestamps_name: the frames of " + tr.key +
                          " carry no times; "
                          "expected frames of a ROS bag (Frame_mode 3)");
-      char line[64];
-      for (int i = 0; i < tr.frames; ++i) {
-        std::snprintf(line, sizeof line, "%d %.9f\n", tr.first_row + i, tr.times[i]);
-        text += line;
-      }
+      for (int i = 0; i < tr.frames; ++i)
+        text += std::to_string(tr.first_row + i) + " " + FormatFixed(tr.times[i], 9) + "\n";
     }
     batch.Stage("Timestamps_name", out.timestamps_name, text);
   }

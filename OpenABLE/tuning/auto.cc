@@ -153,8 +153,6 @@ int Traversals(const InputOptions& in) {
   return 1;
 }
 
-std::string Fixed(double v, int digits) { return FormatFixed(v, digits); }
-
 // Candidates by agreement, best first (ties: the order of Auto_candidates).
 std::vector<int> Ranking(const AutoChoice& c) {
   std::vector<int> order(c.candidates.size());
@@ -306,8 +304,8 @@ AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress, Sing
     progress.Update(static_cast<std::int64_t>(i + 1));
     log("auto: " + std::to_string(i + 1) + " of " + std::to_string(configs.size()) + ": " +
         AutoSettingsText(choice.candidates[i].settings) + ": consistency " +
-        Fixed(f.consistency, 3) + ", distinctiveness " + Fixed(f.distinctiveness, 3) +
-        ", agreement " + Fixed(f.agreement, 3));
+        FormatFixed(f.consistency, 3) + ", distinctiveness " + FormatFixed(f.distinctiveness, 3) +
+        ", agreement " + FormatFixed(f.agreement, 3));
   }
   progress.End();
 
@@ -360,8 +358,8 @@ ReportTable AutoReportTable(const AutoChoice& c) {
   for (size_t r = 0; r < order.size(); ++r) {
     const AutoCandidate& a = c.candidates[order[r]];
     t.rows.push_back(
-        {std::to_string(r + 1), AutoSettingsText(a.settings), Fixed(a.figures.consistency, 3),
-         Fixed(a.figures.distinctiveness, 3), Fixed(a.figures.agreement, 3),
+        {std::to_string(r + 1), AutoSettingsText(a.settings), FormatFixed(a.figures.consistency, 3),
+         FormatFixed(a.figures.distinctiveness, 3), FormatFixed(a.figures.agreement, 3),
          std::to_string(a.figures.answered) + " of " + std::to_string(a.figures.queries)});
     if (order[r] == c.chosen) t.highlight = static_cast<int>(r);
   }
