@@ -12,6 +12,7 @@
 #include "OpenABLE/base/threading.h"
 #include "OpenABLE/cluster/cluster.h"
 #include "OpenABLE/evaluation/report.h"
+#include "OpenABLE/io/json.h"
 #include "descriptors/registry.h"
 #include "matching/sequence.h"
 
@@ -375,39 +376,35 @@ ReportTable AutoReportTable(const AutoChoice& c) {
   return t;
 }
 
-std::string EncodeAutoJson(const AutoChoice& c, const std::string& indent) {
-  const std::string in = indent + "  ";
+Json AutoJson(const AutoChoice& c) {
   const AutoCandidate& chosen = c.candidates.at(c.chosen);
-  std::ostringstream o;
-  o << "{\n"
-    << in << "\"chosen\": " << JsonText(AutoSettingsText(chosen.settings)) << ",\n"
-    << in << "\"chosen_settings\": {";
-  for (size_t k = 0; k < chosen.settings.size(); ++k)
-    o << (k ? ", " : "") << JsonText(chosen.settings[k].first) << ": "
-      << JsonText(chosen.settings[k].second);
-  o << "},\n"
-    << in << "\"reliable\": " << (c.reliable ? "true" : "false") << ",\n"
-    << in << "\"criterion\": \"agreement\",\n"
-    << in << "\"min_consistency\": " << JsonNumber(c.min_consistency) << ",\n"
-    << in << "\"descriptions\": " << c.descriptions << ",\n"
-    << in << "\"seconds\": " << JsonNumber(c.seconds) << ",\n"
-    << in << "\"candidates\": [";
+  Json o;
+  o["chosen"] = AutoSettingsText(chosen.settings);
+  Json& settings = o["chosen_settings"] = Json::object();
+  for (const auto& [key, value] : chosen.settings) settings[key] = value;
+  o["reliable"] = c.reliable;
+  o["criterion"] = "agreement";
+  o["min_consistency"] = json::Number(c.min_consistency);
+  o["descriptions"] = c.descriptions;
+  o["seconds"] = json::Number(c.seconds);
   const std::vector<int> order = Ranking(c);
   std::vector<int> rank(order.size());
   for (size_t r = 0; r < order.size(); ++r) rank[order[r]] = static_cast<int>(r + 1);
+  Json& candidates = o["candidates"] = Json::array();
   for (size_t i = 0; i < c.candidates.size(); ++i) {
     const UnsupervisedFigures& f = c.candidates[i].figures;
-    o << (i ? ",\n" : "\n") << in
-      << "  {\"settings\": " << JsonText(AutoSettingsText(c.candidates[i].settings))
-      << ", \"rank\": " << rank[i] << ", \"queries\": " << f.queries
-      << ", \"answered\": " << f.answered << ", \"agreeing\": " << f.agreeing
-      << ", \"consistency\": " << JsonNumber(f.consistency)
-      << ", \"distinctiveness\": " << JsonNumber(f.distinctiveness)
-      << ", \"agreement\": " << JsonNumber(f.agreement) << ", \"gap\": " << f.gap
-      << ", \"tolerance\": " << f.tolerance << "}";
+    candidates.push_back({{"settings", AutoSettingsText(c.candidates[i].settings)},
+                          {"rank", rank[i]},
+                          {"queries", f.queries},
+                          {"answered", f.answered},
+                          {"agreeing", f.agreeing},
+                          {"consistency", json::Number(f.consistency)},
+                          {"distinctiveness", json::Number(f.distinctiveness)},
+                          {"agreement", json::Number(f.agreement)},
+                          {"gap", f.gap},
+                          {"tolerance", f.tolerance}});
   }
-  o << "\n" << in << "]\n" << indent << "}";
-  return o.str();
+  return o;
 }
 
 }  // namespace openable
