@@ -8,6 +8,7 @@
 #include "OpenABLE/OpenABLE.h"
 #include "OpenABLE/app/evaluate_files.h"
 #include "OpenABLE/cluster/cluster.h"
+#include "OpenABLE/io/json.h"
 
 namespace {
 
@@ -110,8 +111,8 @@ int main(int argc, char** argv) {
       std::cout << openable::ProgramJson(
           "openable_evaluate",
           {{"evaluation",
-            openable::EncodeEvaluationJson(evaluated.evaluation.settings, evaluated.evaluation.runs,
-                                           openable::kVersion)}},
+            openable::EvaluationJson(evaluated.evaluation.settings, evaluated.evaluation.runs,
+                                     openable::kVersion)}},
           paths);
       return 0;
     }

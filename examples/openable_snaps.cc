@@ -12,6 +12,7 @@
 #include "OpenABLE/app/run.h"
 #include "OpenABLE/app/snaps_chain.h"
 #include "OpenABLE/base/version.h"
+#include "OpenABLE/io/json.h"
 
 namespace {
 

@@ -6,6 +6,7 @@
 
 #include "OpenABLE/OpenABLE.h"
 #include "OpenABLE/app/command_line.h"
+#include "OpenABLE/io/json.h"
 
 namespace {
 
@@ -104,7 +105,7 @@ int main(int argc, char** argv) {
         if (command_line.json) {
           std::cout << openable::ProgramJson(
               "openable_sweep",
-              {{"sweep", openable::EncodeSweepJson(result, openable::kVersion)}}, written);
+              {{"sweep", openable::SweepJson(result, openable::kVersion)}}, written);
           return 0;
         }
         std::cout << openable::FormatSweepTable(result) << "Wrote:\n";

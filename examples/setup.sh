@@ -6,12 +6,13 @@
 # -venv for pip install . (docs/python.md); chromium to open the HTML report in the tests
 # (docs/output_formats.md); librosbag-dev and libsensor-msgs-dev for ROS 1 bags
 # (docs/cameras.md); Open MPI for runs over several processes
-# (docs/distributed.md) and FAISS for approximate search (docs/matching.md).
+# (docs/distributed.md) and FAISS for approximate search (docs/matching.md). nlohmann-json3-dev
+# (header-only) writes every JSON document (OpenABLE/io/json.h).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make pkg-config libopencv-dev libopencv-contrib-dev libeigen3-dev
-          libpng-dev zlib1g-dev libjpeg-dev
+          libpng-dev zlib1g-dev libjpeg-dev nlohmann-json3-dev
           libopenimageio-dev openimageio-tools libgtest-dev libgmock-dev libbenchmark-dev
           python3-numpy python3-dev pybind11-dev python3-pip python3-setuptools python3-wheel
           python3-venv chromium clang libclang-rt-14-dev

@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "OpenABLE/base/progress.h"
 #include "OpenABLE/run/evaluate.h"
 #include "OpenABLE/run/pipeline.h"
@@ -53,16 +55,16 @@ std::string FormatRunReport(const Config& config, const RunOutcome& outcome);
 // (Threshold set, else null), "accepted": {queries, answered, match_threshold} or null,
 // "verification": {queries, candidates_checked, geometric, answered, seconds} or null,
 // "timings": {total, description, matching, sequences, evaluation, export (seconds), frames,
-// pairs}, "evaluation" (EncodeEvaluationJson's object, or null), "auto" (EncodeAutoJson's
-// object with Auto 1, else null), "notes", "written"}. Numbers
-// as in the evaluation JSON (docs/output_formats.md).
+// pairs}, "evaluation" (EvaluationJson's object, or null), "auto" (AutoJson's object with
+// Auto 1, else null), "notes", "written"}. Numbers as in the evaluation JSON (io/json.h,
+// docs/output_formats.md).
 std::string EncodeRunJson(const Config& config, const RunOutcome& outcome);
 
 // The --json report of the other programs: {"program": `program`, "openable_version", then
-// `members` in order (name, JSON value: an object written on several lines is re-indented),
-// then "written": the paths}. One object, ending with a newline.
+// `members` in order (name, value), then "written": the paths}. One object, ending with a
+// newline (json::Dump).
 std::string ProgramJson(const std::string& program,
-                        const std::vector<std::pair<std::string, std::string>>& members,
+                        const std::vector<std::pair<std::string, nlohmann::ordered_json>>& members,
                         const std::vector<std::string>& written);
 
 }  // namespace openable

@@ -6,6 +6,7 @@
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/cluster/cluster.h"
 #include "OpenABLE/evaluation/report.h"
+#include "OpenABLE/io/json.h"
 
 namespace openable {
 
@@ -144,110 +145,83 @@ std::string FormatRunReport(const Config& config, const RunOutcome& outcome) {
   return out.str();
 }
 
-namespace {
-
-// "[a, b]" of JSON strings.
-std::string JsonList(const std::vector<std::string>& items) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + JsonText(items[i]);
-  return out + "]";
-}
-
-// A multi-line JSON object indented by two spaces more, to sit at a member's place.
-std::string Indented(const std::string& object) {
-  std::string out;
-  for (const char ch : object) {
-    out += ch;
-    if (ch == '\n') out += "  ";
-  }
-  while (!out.empty() && (out.back() == ' ' || out.back() == '\n')) out.pop_back();
-  return out;
-}
-
-}  // namespace
-
 std::string EncodeRunJson(const Config& config, const RunOutcome& outcome) {
   const Config& c = outcome.automatic ? outcome.automatic->config : config;
   const RunResult& r = outcome.result;
   const RunTimings& tm = r.timings;
-  std::ostringstream o;
-  o << "{\n  \"program\": \"Test_OpenABLE\",\n  \"openable_version\": " << JsonText(kVersion)
-    << ",\n  \"descriptors\": [";
-  for (std::size_t k = 0; k < r.descriptors.size(); ++k) {
-    const RunDescriptor& e = r.descriptors[k];
-    o << (k ? ", " : "") << "{\"name\": " << JsonText(e.name) << ", \"row_width\": " << e.row_width
-      << ", \"metric\": "
-      << JsonText(e.metric == Metric::kL2   ? "L2"
-                  : e.metric == Metric::kL1 ? "L1"
-                                            : "Hamming")
-      << "}";
-  }
-  o << "],\n  \"camera\": " << JsonText(r.camera) << ",\n  \"traversals\": [";
-  for (std::size_t t = 0; t < r.traversals.size(); ++t) {
-    const Traversal& v = r.traversals[t];
-    o << (t ? "," : "") << "\n    {\"key\": " << JsonText(v.key)
-      << ", \"path\": " << JsonText(v.path) << ", \"frames\": " << v.frames
-      << ", \"first_row\": " << v.first_row << ", \"frame_width\": " << v.frame_size.width
-      << ", \"frame_height\": " << v.frame_size.height << ", \"skipped\": " << JsonList(v.skipped)
-      << "}";
-  }
-  o << "],\n  \"mode\": " << JsonText(r.mode_reason)
-    << ",\n  \"bounded\": " << (r.bounded ? "true" : "false") << ",\n  \"index\": ";
+  Json o;
+  o["program"] = "Test_OpenABLE";
+  o["openable_version"] = kVersion;
+  Json& descriptors = o["descriptors"] = Json::array();
+  for (const RunDescriptor& e : r.descriptors)
+    descriptors.push_back({{"name", e.name},
+                           {"row_width", e.row_width},
+                           {"metric", e.metric == Metric::kL2   ? "L2"
+                                      : e.metric == Metric::kL1 ? "L1"
+                                                                : "Hamming"}});
+  o["camera"] = r.camera;
+  Json& traversals = o["traversals"] = Json::array();
+  for (const Traversal& v : r.traversals)
+    traversals.push_back({{"key", v.key},
+                          {"path", v.path},
+                          {"frames", v.frames},
+                          {"first_row", v.first_row},
+                          {"frame_width", v.frame_size.width},
+                          {"frame_height", v.frame_size.height},
+                          {"skipped", json::Strings(v.skipped)}});
+  o["mode"] = r.mode_reason;
+  o["bounded"] = r.bounded;
   const std::string index = IndexUsed(c, r);
-  o << (index.empty() ? "null" : JsonText(index));
+  o["index"] = index.empty() ? Json() : Json(index);
   if (r.bounded)
-    o << ",\n  \"matches_kept\": " << r.matches.size();
+    o["matches_kept"] = r.matches.size();
   else
-    o << ",\n  \"matrix\": {\"rows\": " << r.normalized.rows << ", \"cols\": " << r.normalized.cols
-      << "}";
-  o << ",\n  \"max_distance\": " << JsonNumber(r.max_distance)
-    << ",\n  \"empty_cells\": " << r.empty_cells << ",\n  \"threshold_cells_below\": ";
-  if (r.thresholded.empty())
-    o << "null";
-  else
-    o << r.thresholded.total() - static_cast<std::size_t>(cv::countNonZero(r.thresholded));
-  o << ",\n  \"accepted\": ";
+    o["matrix"] = {{"rows", r.normalized.rows}, {"cols", r.normalized.cols}};
+  o["max_distance"] = json::Number(r.max_distance);
+  o["empty_cells"] = r.empty_cells;
+  o["threshold_cells_below"] =
+      r.thresholded.empty()
+          ? Json()
+          : Json(r.thresholded.total() -
+                 static_cast<std::size_t>(cv::countNonZero(r.thresholded)));
+  o["accepted"] = Json();
   if (r.accepted_queries >= 0)
-    o << "{\"queries\": " << r.accepted_queries << ", \"answered\": " << r.answered_queries
-      << ", \"match_threshold\": " << JsonNumber(c.matching.match_threshold)
-      << ", \"match_consistency\": " << c.matching.match_consistency << "}";
-  else
-    o << "null";
-  o << ",\n  \"verification\": ";
+    o["accepted"] = {{"queries", r.accepted_queries},
+                     {"answered", r.answered_queries},
+                     {"match_threshold", json::Number(c.matching.match_threshold)},
+                     {"match_consistency", c.matching.match_consistency}};
+  o["verification"] = Json();
   if (const RunVerification* v = outcome.verification.get())
-    o << "{\"queries\": " << v->queries.size() << ", \"candidates_checked\": " << v->pairs
-      << ", \"geometric\": " << v->geometric << ", \"answered\": " << v->answered
-      << ", \"seconds\": " << JsonNumber(v->seconds) << "}";
-  else
-    o << "null";
-  o << ",\n  \"timings\": {\"total\": " << JsonNumber(tm.total_seconds)
-    << ", \"description\": " << JsonNumber(tm.describe_seconds)
-    << ", \"matching\": " << JsonNumber(tm.match_seconds)
-    << ", \"sequences\": " << JsonNumber(tm.sequence_seconds)
-    << ", \"evaluation\": " << JsonNumber(tm.evaluate_seconds)
-    << ", \"export\": " << JsonNumber(tm.export_seconds) << ", \"frames\": " << tm.frames
-    << ", \"pairs\": " << tm.pairs << "},\n  \"evaluation\": ";
-  if (const Evaluation* e = outcome.evaluation.get())
-    o << Indented(EncodeEvaluationJson(e->settings, e->runs, kVersion));
-  else
-    o << "null";
-  o << ",\n  \"auto\": "
-    << (outcome.automatic ? EncodeAutoJson(*outcome.automatic, "  ") : std::string("null"));
-  o << ",\n  \"notes\": " << JsonList(r.notes) << ",\n  \"written\": " << JsonList(outcome.written)
-    << "\n}\n";
-  return o.str();
+    o["verification"] = {{"queries", v->queries.size()},
+                         {"candidates_checked", v->pairs},
+                         {"geometric", v->geometric},
+                         {"answered", v->answered},
+                         {"seconds", json::Number(v->seconds)}};
+  o["timings"] = {{"total", json::Number(tm.total_seconds)},
+                  {"description", json::Number(tm.describe_seconds)},
+                  {"matching", json::Number(tm.match_seconds)},
+                  {"sequences", json::Number(tm.sequence_seconds)},
+                  {"evaluation", json::Number(tm.evaluate_seconds)},
+                  {"export", json::Number(tm.export_seconds)},
+                  {"frames", tm.frames},
+                  {"pairs", tm.pairs}};
+  const Evaluation* e = outcome.evaluation.get();
+  o["evaluation"] = e != nullptr ? EvaluationJson(e->settings, e->runs, kVersion) : Json();
+  o["auto"] = outcome.automatic ? AutoJson(*outcome.automatic) : Json();
+  o["notes"] = json::Strings(r.notes);
+  o["written"] = json::Strings(outcome.written);
+  return json::Dump(o);
 }
 
 std::string ProgramJson(const std::string& program,
-                        const std::vector<std::pair<std::string, std::string>>& members,
+                        const std::vector<std::pair<std::string, Json>>& members,
                         const std::vector<std::string>& written) {
-  std::ostringstream o;
-  o << "{\n  \"program\": " << JsonText(program)
-    << ",\n  \"openable_version\": " << JsonText(kVersion);
-  for (const auto& [name, value] : members)
-    o << ",\n  " << JsonText(name) << ": " << Indented(value);
-  o << ",\n  \"written\": " << JsonList(written) << "\n}\n";
-  return o.str();
+  Json o;
+  o["program"] = program;
+  o["openable_version"] = kVersion;
+  for (const auto& [name, value] : members) o[name] = value;
+  o["written"] = json::Strings(written);
+  return json::Dump(o);
 }
 
 }  // namespace openable

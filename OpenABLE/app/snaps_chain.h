@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "OpenABLE/base/progress.h"
 #include "OpenABLE/snaps/loop_search.h"
 #include "OpenABLE/snaps/loops.h"
@@ -74,8 +76,10 @@ ChainResult RunChain(const Config& config, ProgressReporter& progress,
 // latencies, a few lines.
 std::string FormatChainReport(const Config& config, const ChainResult& result);
 
-// The figures as JSON (<Snaps_output_name>.json).
-std::string ChainJson(const Config& config, const ChainResult& result);
+// The figures as JSON (<Snaps_output_name>.json), 6 significant digits, null when not finite;
+// EncodeChainJson is its text (json::Dump).
+nlohmann::ordered_json ChainJson(const Config& config, const ChainResult& result);
+std::string EncodeChainJson(const Config& config, const ChainResult& result);
 
 // Writes the outputs of Snaps_output_name = P, all or nothing: P_discounted.txt and/or
 // P_pose_graph.txt (the input's format), P_odometry.txt (a computed trajectory), P_loops.csv,

@@ -6,32 +6,34 @@
 
 #include "OpenABLE/app/snaps_chain.h"
 #include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/version.h"
+#include "OpenABLE/io/json.h"
 #include "OpenABLE/reports/figures.h"
 #include "OpenABLE/snaps/plot.h"
 
 namespace openable::snaps {
 namespace {
 
-std::string Number(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
+// The SNAPS figures, in text and JSON alike: 6 significant digits.
+std::string Number(double v) { return FormatNumber(v); }
+Json JsonNumber(double v) { return json::Number(v, 6); }
+
+Json StatsJson(const LatencyStats& s) {
+  return {{"count", s.count},
+          {"mean_s", JsonNumber(s.mean)},
+          {"min_s", JsonNumber(s.min)},
+          {"q1_s", JsonNumber(s.q1)},
+          {"median_s", JsonNumber(s.median)},
+          {"q3_s", JsonNumber(s.q3)},
+          {"max_s", JsonNumber(s.max)}};
 }
 
-std::string StatsJson(const LatencyStats& s) {
-  std::ostringstream o;
-  o << "{\"count\": " << s.count << ", \"mean_s\": " << Number(s.mean) << ", \"min_s\": "
-    << Number(s.min) << ", \"q1_s\": " << Number(s.q1) << ", \"median_s\": " << Number(s.median)
-    << ", \"q3_s\": " << Number(s.q3) << ", \"max_s\": " << Number(s.max) << "}";
-  return o.str();
-}
-
-std::string ErrorJson(const TrajectoryError& e) {
-  std::ostringstream o;
-  o << "{\"rmse_m\": " << Number(e.rmse) << ", \"mean_m\": " << Number(e.mean)
-    << ", \"median_m\": " << Number(e.median) << ", \"max_m\": " << Number(e.max) << "}";
-  return o.str();
+Json ErrorJson(const TrajectoryError& e) {
+  return {{"rmse_m", JsonNumber(e.rmse)},
+          {"mean_m", JsonNumber(e.mean)},
+          {"median_m", JsonNumber(e.median)},
+          {"max_m", JsonNumber(e.max)}};
 }
 
 std::string StatsLine(const LatencyStats& s) {
@@ -104,13 +106,14 @@ std::string PairCountsLine(const Config& c, const ChainResult& r) {
   return o.str();
 }
 
-std::string PairCountsJson(const Config& c, const PairCounts& n) {
-  std::ostringstream o;
-  o << "{\"keyframe_tolerance\": " << c.snaps.keyframe_tolerance << ", \"total\": " << n.Total()
-    << ", \"on_poses\": " << n.on_poses << ", \"associated\": " << n.associated
-    << ", \"dropped\": " << n.dropped << ", \"outside\": " << n.outside
-    << ", \"merged\": " << n.merged << "}";
-  return o.str();
+Json PairCountsJson(const Config& c, const PairCounts& n) {
+  return {{"keyframe_tolerance", c.snaps.keyframe_tolerance},
+          {"total", n.Total()},
+          {"on_poses", n.on_poses},
+          {"associated", n.associated},
+          {"dropped", n.dropped},
+          {"outside", n.outside},
+          {"merged", n.merged}};
 }
 
 }  // namespace
@@ -173,39 +176,42 @@ std::string FormatChainReport(const Config& c, const ChainResult& r) {
   return out.str();
 }
 
-std::string ChainJson(const Config& c, const ChainResult& r) {
+Json ChainJson(const Config& c, const ChainResult& r) {
   const PoseGraphReport& g = r.graph_report;
-  std::ostringstream json;
-  json << "{\n  \"trajectory\": \"" << r.trajectory_name << "\",\n  \"poses\": " << r.input.Size()
-       << ",\n  \"loop_source\": \"" << EnumName(c.snaps.loops) << "\",\n  \"loops\": "
-       << r.loops.size();
-  if (HasPairCounts(c)) json << ",\n  \"pairs\": " << PairCountsJson(c, r.pairs);
-  json << ",\n  \"loops_closed_by_discounted_update\": " << r.closed.size()
-       << ",\n  \"pose_graph\": {\"loop_edges\": " << g.loop_edges << ", \"iterations\": "
-       << g.iterations << ", \"initial_cost\": " << Number(g.initial_cost)
-       << ", \"final_cost\": " << Number(g.final_cost) << ", \"seconds\": " << Number(g.seconds)
-       << "}";
+  Json o;
+  o["trajectory"] = r.trajectory_name;
+  o["poses"] = r.input.Size();
+  o["loop_source"] = EnumName(c.snaps.loops);
+  o["loops"] = r.loops.size();
+  if (HasPairCounts(c)) o["pairs"] = PairCountsJson(c, r.pairs);
+  o["loops_closed_by_discounted_update"] = r.closed.size();
+  o["pose_graph"] = {{"loop_edges", g.loop_edges},
+                     {"iterations", g.iterations},
+                     {"initial_cost", JsonNumber(g.initial_cost)},
+                     {"final_cost", JsonNumber(g.final_cost)},
+                     {"seconds", JsonNumber(g.seconds)}};
   if (r.evaluated) {
-    json << ",\n  \"errors\": {";
-    for (size_t i = 0; i < r.errors.size(); ++i)
-      json << (i ? ", " : "") << "\n    \"" << r.errors[i].name
-           << "\": {\"unaligned\": " << ErrorJson(r.errors[i].raw)
-           << ", \"aligned\": " << ErrorJson(r.errors[i].aligned) << "}";
-    json << "\n  }";
+    Json& errors = o["errors"] = Json::object();
+    for (const ChainErrors& e : r.errors)
+      errors[e.name] = {{"unaligned", ErrorJson(e.raw)}, {"aligned", ErrorJson(e.aligned)}};
   }
   if (c.snaps.loops == LoopSource::kSearch) {
     const SearchLatencies l = LatenciesOf(r.searched);
-    json << ",\n  \"latency\": {\"search_no_loop\": " << StatsJson(l.none)
-         << ", \"search_loop_found\": " << StatsJson(l.found) << ", \"search_all\": "
-         << StatsJson(l.all) << ", \"correction\": " << StatsJson(l.correction)
-         << ", \"thumbnail\": " << StatsJson(l.thumbnail) << "}";
+    o["latency"] = {{"search_no_loop", StatsJson(l.none)},
+                    {"search_loop_found", StatsJson(l.found)},
+                    {"search_all", StatsJson(l.all)},
+                    {"correction", StatsJson(l.correction)},
+                    {"thumbnail", StatsJson(l.thumbnail)}};
   }
   if (r.computed)
-    json << ",\n  \"odometry\": {\"kind\": \"" << r.odometry.kind << "\", \"failed_steps\": "
-         << r.odometry.failed << ", \"per_frame\": " << StatsJson(Summarize(r.odometry.seconds))
-         << "}";
-  json << "\n}\n";
-  return json.str();
+    o["odometry"] = {{"kind", r.odometry.kind},
+                     {"failed_steps", r.odometry.failed},
+                     {"per_frame", StatsJson(Summarize(r.odometry.seconds))}};
+  return o;
+}
+
+std::string EncodeChainJson(const Config& c, const ChainResult& r) {
+  return json::Dump(ChainJson(c, r));
 }
 
 std::vector<std::string> WriteChainOutputs(const Config& c, const ChainResult& r) {
@@ -217,7 +223,7 @@ std::vector<std::string> WriteChainOutputs(const Config& c, const ChainResult& r
   if (r.graph_ran) batch.Stage(key, p + "_pose_graph.txt", EncodeTrajectory(r.graph));
   if (r.computed) batch.Stage(key, p + "_odometry.txt", EncodeTrajectory(r.input));
   batch.Stage(key, p + "_loops.csv", CsvOfLoops(r.input, r.loops));
-  batch.Stage(key, p + ".json", ChainJson(c, r));
+  batch.Stage(key, p + ".json", EncodeChainJson(c, r));
   // The plot: the pose graph's result (or the one corrector's), and the discounted update's
   // in a second figure when both ran.
   auto figure = [&](const Trajectory& corrected, const std::string& label) {

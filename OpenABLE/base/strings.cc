@@ -1,9 +1,7 @@
 #include "OpenABLE/base/strings.h"
 
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <sstream>
 
 #include "OpenABLE/base/error.h"
 
@@ -40,11 +38,10 @@ std::vector<std::string> SplitTrimmed(std::string_view s, char separator) {
   }
 }
 
-std::string FormatNumber(double value) {
-  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  std::ostringstream os;
-  os << value;
-  return os.str();
+std::string FormatNumber(double value, int significant) {
+  char buffer[64];  // %.17g of any double takes at most 24 characters
+  std::snprintf(buffer, sizeof buffer, "%.*g", significant, value);
+  return buffer;
 }
 
 std::string FormatFixed(double value, int decimals) {

@@ -19,11 +19,14 @@ std::string Trim(std::string_view s);
 // "a", "", "b"; "" gives one empty piece).
 std::vector<std::string> SplitTrimmed(std::string_view s, char separator);
 
-// A number as users read it in messages and in Config.txt: the shortest of printf's %g with
-// six significant digits ("0.47", "2500", "1e+06"), "inf" for infinity.
-std::string FormatNumber(double value);
+// The formatter of numbers in the text outputs (messages, reports, CSV and JSON files): printf's
+// %g with `significant` digits. With the default six, a number as users read it in messages and
+// in Config.txt ("0.47", "2500", "1e+06"); nine in the CSV and JSON figures, seventeen where a
+// value must read back exactly. "inf", "-inf" and "nan" as printf writes them.
+std::string FormatNumber(double value, int significant = 6);
 
-// `value` with `decimals` digits after the point ("%.3f"): figures in tables and reports.
+// `value` with `decimals` digits after the point (printf's "%.3f" for 3): figures in tables and
+// reports.
 std::string FormatFixed(double value, int decimals);
 
 // For a message about a path that was not found: " (relative to the working directory

@@ -2,7 +2,6 @@
 #include "OpenABLE/evaluation/drawing.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -47,12 +46,6 @@ std::string Ellipsize(const std::string& text, double scale, int thickness, int 
   std::string t = text;
   while (!t.empty() && TextSize(t + "...", scale, thickness).width > max_width) t.pop_back();
   return t + "...";
-}
-
-std::string Format(const char* format, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, value);
-  return buffer;
 }
 
 // Text rotated by 90 degrees counter-clockwise (reads bottom to top), centred on `centre`.

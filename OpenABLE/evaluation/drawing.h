@@ -45,9 +45,6 @@ void FitBold(const std::string& text, double scale, double min_scale, int max_wi
 // `text` shortened with "..." until it fits in `max_width` at `scale`.
 std::string Ellipsize(const std::string& text, double scale, int thickness, int max_width);
 
-// printf of one double ("%.3f").
-std::string Format(const char* format, double value);
-
 // Black text rotated by 90 degrees counter-clockwise (reads bottom to top), centred on `centre`,
 // drawn over a light background.
 void PutVerticalText(cv::Mat3b& img, const std::string& text, cv::Point centre, double scale,

@@ -19,7 +19,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -28,13 +27,14 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "OpenABLE/base/strings.h"
+
 namespace openable {
 namespace {
 
 using drawing::DrawLegend;
 using drawing::Ellipsize;
 using drawing::FitBold;
-using drawing::Format;
 using drawing::kBlack;
 using drawing::kPalette;
 using drawing::kPaletteSize;
@@ -187,9 +187,9 @@ cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& t
       if (curve.empty())
         suffix = " (no points)";
       else if (panel == 0)
-        suffix = " (AUC " + Format("%.3f", CurveArea(curve)) + ")";
+        suffix = " (AUC " + FormatFixed(CurveArea(curve), 3) + ")";
       else
-        suffix = " (AP " + Format("%.1f", 100.0 * CurveArea(curve)) + "%)";
+        suffix = " (AP " + FormatFixed(100.0 * CurveArea(curve), 1) + "%)";
       legend.push_back({series[i].label, suffix, colour});
     }
     DrawLegend(img, axes.plot, legend);

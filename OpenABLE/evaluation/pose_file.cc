@@ -2,7 +2,6 @@
 
 #include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 
@@ -10,6 +9,7 @@
 #include <Eigen/SVD>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/text_parsing.h"
 
 namespace openable {
@@ -56,12 +56,12 @@ long FrameNumber(const std::string& token, const std::string& where) {
 }  // namespace
 
 std::string ShortestNumber(double v) {
-  char buffer[40];
+  std::string text;
   for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buffer, sizeof(buffer), "%.*g", digits, v);
-    if (std::strtod(buffer, nullptr) == v) break;
+    text = FormatNumber(v, digits);
+    if (std::strtod(text.c_str(), nullptr) == v) break;
   }
-  return buffer;
+  return text;
 }
 
 Eigen::Matrix3d CheckedRotationMatrix(const Eigen::Matrix3d& m, const std::string& where) {

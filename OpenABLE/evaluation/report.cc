@@ -3,151 +3,115 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <utility>
 
 #include "OpenABLE/base/strings.h"
+#include "OpenABLE/io/json.h"
 
 namespace openable {
 namespace {
-
-std::string Number(double v) {
-  if (!std::isfinite(v)) return "null";  // JSON has no NaN or infinity
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.9g", v);
-  return buffer;
-}
-
-// JSON string literal (OpenCV's FileStorage writes JSON too, but not null for non-finite
-// values, so the few objects here are written directly).
-std::string JsonString(const std::string& s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (c < 0x20) {
-      char buffer[8];
-      std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
-      out += buffer;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
 
 const char* KindName(EvaluationLayout::Kind kind) {
   return kind == EvaluationLayout::Kind::kLoopClosure ? "loop_closure" : "query_reference";
 }
 
+// The members of a "per_query" object.
+Json PerQueryJson(const PerQueryResult& q) {
+  Json o;
+  o["auc"] = json::Number(q.auc);
+  o["recall_at_100p"] = json::Number(q.recall_at_100p);
+  o["max_f1"] = json::Number(q.max_f1);
+  o["max_f1_threshold"] = json::Number(q.max_f1_threshold);
+  o["max_f1_precision"] = json::Number(q.max_f1_precision);
+  o["max_f1_recall"] = json::Number(q.max_f1_recall);
+  o["recall_at_1"] = json::Number(q.recall_at_1);
+  o["recall_at_5"] = json::Number(q.recall_at_5);
+  o["recall_at_10"] = json::Number(q.recall_at_10);
+  o["queries"] = q.queries;
+  o["positive_queries"] = q.positive_queries;
+  o["unanswered_queries"] = q.unanswered;
+  if (q.has_operating_point) {
+    const CurvePoint& p = q.operating_point;
+    o["accepted"] = {{"threshold", json::Number(p.threshold)},
+                     {"matches", p.tp + p.fp},
+                     {"precision", json::Number(p.precision)},
+                     {"recall", json::Number(p.recall)}};
+  }
+  o["truth_pairs_outside_candidates"] = q.truth_pairs_outside_candidates;
+  return o;
+}
+
 }  // namespace
+
+std::string CsvNumber(double v) { return std::isfinite(v) ? FormatNumber(v, 9) : "null"; }
 
 std::string EncodeCurveCsv(const std::vector<CurvePoint>& curve) {
   std::string out = "threshold,precision,recall,f1,tp,fp\n";
   for (const CurvePoint& p : curve) {
-    out += Number(p.threshold) + "," + Number(p.precision) + "," + Number(p.recall) + "," +
-           Number(p.f1) + "," + std::to_string(p.tp) + "," + std::to_string(p.fp) + "\n";
+    out += CsvNumber(p.threshold) + "," + CsvNumber(p.precision) + "," + CsvNumber(p.recall) +
+           "," + CsvNumber(p.f1) + "," + std::to_string(p.tp) + "," + std::to_string(p.fp) + "\n";
   }
   return out;
 }
 
-std::string JsonNumber(double v) { return Number(v); }
-
-std::string JsonText(const std::string& s) { return JsonString(s); }
-
-std::string EncodeEvaluationSettingsJson(const EvaluationSettings& s, const std::string& indent) {
-  std::ostringstream o;
+Json EvaluationSettingsJson(const EvaluationSettings& s) {
   const GroundTruthOptions& t = s.truth;
-  const std::string in = indent + "  ";
-  o << "{\n"
-    << in << "\"ground_truth_type\": " << JsonString(GroundTruthTypeName(t.type)) << ",\n"
-    << in << "\"ground_truth\": " << JsonString(t.path) << ",\n"
-    << in << "\"ground_truth_2\": " << JsonString(t.path_2) << ",\n"
-    << in << "\"ground_truth_base\": " << t.base << ",\n"
-    << in << "\"first_frame\": " << t.first_frame << ",\n"
-    << in << "\"radius\": " << Number(t.radius) << ",\n"
-    << in << "\"heading_limit_deg\": " << Number(t.heading_limit) << ",\n"
-    << in << "\"min_frame_gap\": " << t.min_frame_gap << ",\n"
-    << in << "\"axes\": " << JsonString(t.axes) << ",\n"
-    << in << "\"tolerance\": " << s.options.tolerance << ",\n"
-    << in << "\"exclusion\": " << s.options.exclusion << ",\n"
-    << in << "\"vicinity\": " << s.options.vicinity << ",\n"
-    << in << "\"match_score\": " << JsonString(EnumName(s.options.score)) << ",\n"
-    << in << "\"match_score_window\": " << s.options.score_window << ",\n"
-    << in << "\"match_threshold\": " << Number(s.options.accept_threshold) << ",\n"
-    << in << "\"match_consistency\": " << s.options.accept_consistency << ",\n"
-    << in << "\"accept_none\": " << (s.options.accept_none ? "true" : "false") << ",\n"
-    << in << "\"able_thresholds\": " << s.options.able_thresholds << "\n"
-    << indent << "}";
-  return o.str();
+  Json o;
+  o["ground_truth_type"] = GroundTruthTypeName(t.type);
+  o["ground_truth"] = t.path;
+  o["ground_truth_2"] = t.path_2;
+  o["ground_truth_base"] = t.base;
+  o["first_frame"] = t.first_frame;
+  o["radius"] = json::Number(t.radius);
+  o["heading_limit_deg"] = json::Number(t.heading_limit);
+  o["min_frame_gap"] = t.min_frame_gap;
+  o["axes"] = t.axes;
+  o["tolerance"] = s.options.tolerance;
+  o["exclusion"] = s.options.exclusion;
+  o["vicinity"] = s.options.vicinity;
+  o["match_score"] = EnumName(s.options.score);
+  o["match_score_window"] = s.options.score_window;
+  o["match_threshold"] = json::Number(s.options.accept_threshold);
+  o["match_consistency"] = s.options.accept_consistency;
+  o["accept_none"] = s.options.accept_none;
+  o["able_thresholds"] = s.options.able_thresholds;
+  return o;
 }
 
-namespace {
-
-// The members of a "per_query" object, each line indented by `in`.
-std::string PerQueryJson(const PerQueryResult& q, const std::string& in) {
-  std::ostringstream o;
-  o << in << "  \"auc\": " << Number(q.auc) << ",\n"
-    << in << "  \"recall_at_100p\": " << Number(q.recall_at_100p) << ",\n"
-    << in << "  \"max_f1\": " << Number(q.max_f1) << ",\n"
-    << in << "  \"max_f1_threshold\": " << Number(q.max_f1_threshold) << ",\n"
-    << in << "  \"max_f1_precision\": " << Number(q.max_f1_precision) << ",\n"
-    << in << "  \"max_f1_recall\": " << Number(q.max_f1_recall) << ",\n"
-    << in << "  \"recall_at_1\": " << Number(q.recall_at_1) << ",\n"
-    << in << "  \"recall_at_5\": " << Number(q.recall_at_5) << ",\n"
-    << in << "  \"recall_at_10\": " << Number(q.recall_at_10) << ",\n"
-    << in << "  \"queries\": " << q.queries << ",\n"
-    << in << "  \"positive_queries\": " << q.positive_queries << ",\n"
-    << in << "  \"unanswered_queries\": " << q.unanswered << ",\n"
-    << (q.has_operating_point
-            ? in + "  \"accepted\": {\"threshold\": " + Number(q.operating_point.threshold) +
-                  ", \"matches\": " +
-                  std::to_string(q.operating_point.tp + q.operating_point.fp) +
-                  ", \"precision\": " + Number(q.operating_point.precision) +
-                  ", \"recall\": " + Number(q.operating_point.recall) + "},\n"
-            : std::string())
-    << in << "  \"truth_pairs_outside_candidates\": " << q.truth_pairs_outside_candidates
-    << "\n";
-  return o.str();
+void AddEvaluatedRunJson(Json& o, const EvaluatedRun& r) {
+  o["label"] = r.label;
+  o["source"] = r.source;
+  o["layout"] = {{"kind", KindName(r.layout.kind)},
+                 {"queries", r.layout.queries},
+                 {"references", r.layout.references},
+                 {"row_offset", r.layout.row_offset},
+                 {"col_offset", r.layout.col_offset}};
+  o["ground_truth"] = {{"pairs", r.truth_pairs}, {"dropped", r.truth_dropped}};
+  o["verified"] = r.verified;
+  o["per_query"] = PerQueryJson(r.per_query);
+  if (r.verified) o["per_query_unverified"] = PerQueryJson(r.per_query_unverified);
+  o["able_p"] = {{"average_precision_percent", json::Number(r.able_p.average_precision)},
+                 {"candidate_cells", r.able_p.candidate_cells},
+                 {"truth_cells", r.able_p.truth_cells}};
 }
 
-}  // namespace
-
-std::string EncodeEvaluatedRunFieldsJson(const EvaluatedRun& r, const std::string& indent) {
-  const std::string& in = indent;
-  std::ostringstream o;
-  o << in << "\"label\": " << JsonString(r.label) << ",\n"
-    << in << "\"source\": " << JsonString(r.source) << ",\n"
-    << in << "\"layout\": {\"kind\": " << JsonString(KindName(r.layout.kind))
-    << ", \"queries\": " << r.layout.queries << ", \"references\": " << r.layout.references
-    << ", \"row_offset\": " << r.layout.row_offset << ", \"col_offset\": " << r.layout.col_offset
-    << "},\n"
-    << in << "\"ground_truth\": {\"pairs\": " << r.truth_pairs << ", \"dropped\": "
-    << r.truth_dropped << "},\n"
-    << in << "\"verified\": " << (r.verified ? "true" : "false") << ",\n"
-    << in << "\"per_query\": {\n" << PerQueryJson(r.per_query, in) << in << "},\n";
-  if (r.verified)
-    o << in << "\"per_query_unverified\": {\n" << PerQueryJson(r.per_query_unverified, in)
-      << in << "},\n";
-  o << in << "\"able_p\": {\n"
-    << in << "  \"average_precision_percent\": " << Number(r.able_p.average_precision) << ",\n"
-    << in << "  \"candidate_cells\": " << r.able_p.candidate_cells << ",\n"
-    << in << "  \"truth_cells\": " << r.able_p.truth_cells << "\n"
-    << in << "}";
-  return o.str();
+Json EvaluationJson(const EvaluationSettings& s, const std::vector<EvaluatedRun>& runs,
+                    const std::string& version) {
+  Json o;
+  o["openable_version"] = version;
+  o["settings"] = EvaluationSettingsJson(s);
+  Json& list = o["runs"] = Json::array();
+  for (const EvaluatedRun& r : runs) {
+    Json run;
+    AddEvaluatedRunJson(run, r);
+    list.push_back(std::move(run));
+  }
+  return o;
 }
 
 std::string EncodeEvaluationJson(const EvaluationSettings& s, const std::vector<EvaluatedRun>& runs,
                                  const std::string& version) {
-  std::ostringstream o;
-  o << "{\n  \"openable_version\": " << JsonString(version) << ",\n";
-  o << "  \"settings\": " << EncodeEvaluationSettingsJson(s, "  ") << ",\n";
-  o << "  \"runs\": [";
-  for (std::size_t i = 0; i < runs.size(); ++i)
-    o << (i ? ",\n" : "\n") << "    {\n" << EncodeEvaluatedRunFieldsJson(runs[i], "      ")
-      << "\n    }";
-  o << "\n  ]\n}\n";
-  return o.str();
+  return json::Dump(EvaluationJson(s, runs, version));
 }
 
 std::string FormatEvaluationTable(const EvaluationSettings& s,

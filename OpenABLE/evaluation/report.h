@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/layout.h"
 #include "OpenABLE/evaluation/metrics.h"
@@ -37,6 +39,9 @@ struct EvaluationSettings {
 // "threshold,precision,recall,f1,tp,fp" then one line per point, 9 significant digits.
 std::string EncodeCurveCsv(const std::vector<CurvePoint>& curve);
 
+// A number of the CSV files: 9 significant digits (FormatNumber), "null" when it is not finite.
+std::string CsvNumber(double value);
+
 // A JSON object: {"openable_version", "settings": {ground truth, tolerance, exclusion, vicinity,
 // match_score, match_score_window, able_thresholds}, "runs": [{"label", "source",
 // "layout": {...}, "ground_truth": {...}, "verified", "per_query": {auc, recall_at_100p, max_f1,
@@ -44,19 +49,19 @@ std::string EncodeCurveCsv(const std::vector<CurvePoint>& curve);
 // queries, positive_queries, unanswered_queries, accepted (at Match_threshold, when set),
 // truth_pairs_outside_candidates}, "per_query_unverified" (the same, when verified),
 // "able_p": {average_precision_percent, candidate_cells,
-// truth_cells}}]}. Numbers with 9 significant digits (docs/output_formats.md).
+// truth_cells}}]}. Numbers with 9 significant digits, null when not finite
+// (io/json.h, docs/output_formats.md). EncodeEvaluationJson is its text (json::Dump).
+nlohmann::ordered_json EvaluationJson(const EvaluationSettings& settings,
+                                      const std::vector<EvaluatedRun>& runs,
+                                      const std::string& version);
 std::string EncodeEvaluationJson(const EvaluationSettings& settings,
                                  const std::vector<EvaluatedRun>& runs, const std::string& version);
 
 // The pieces of that JSON, for documents that hold evaluated runs among other things
-// (openable_sweep): a number (9 significant digits, null when not finite), a string literal,
-// the "settings" object (its closing brace indented by `indent`), and the members of one run
-// object without its braces, each line indented by `indent`.
-std::string JsonNumber(double value);
-std::string JsonText(const std::string& text);
-std::string EncodeEvaluationSettingsJson(const EvaluationSettings& settings,
-                                         const std::string& indent);
-std::string EncodeEvaluatedRunFieldsJson(const EvaluatedRun& run, const std::string& indent);
+// (openable_sweep): the "settings" object, and the members of one run object, added to `object`
+// after those it holds.
+nlohmann::ordered_json EvaluationSettingsJson(const EvaluationSettings& settings);
+void AddEvaluatedRunJson(nlohmann::ordered_json& object, const EvaluatedRun& run);
 
 // A few lines for a terminal: the protocol settings, then one row per run with AUC, R@100P,
 // max F1 (threshold), R@1/5/10 and ABLE-P AP.

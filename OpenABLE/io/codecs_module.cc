@@ -1,7 +1,7 @@
 // Module libopenable_codecs.so (see module_loader.h): OpenCV's imgcodecs, for the image formats
-// the program does not decode itself (PNG and JPEG are decoded in the program: png_codec.h,
-// frame_source.cc). imgcodecs loads GDAL, GDCM, OpenEXR and about 120 other libraries, which
-// a run on PNG or JPEG frames no longer pays for at start-up.
+// the program does not decode itself (PNG and JPEG are decoded in the program: image_codec.h).
+// imgcodecs loads GDAL, GDCM, OpenEXR and about 120 other libraries, which a run on PNG or JPEG
+// frames no longer pays for at start-up.
 #include <string>
 #include <vector>
 

@@ -1,14 +1,14 @@
 #include "OpenABLE/outputs/run_outputs.h"
 
 #include <chrono>
-#include <cstdio>
 #include <functional>
-#include <memory>
 #include <future>
 #include <limits>
+#include <memory>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/io/npy.h"
 #include "OpenABLE/outputs/matrix_files.h"
 #include "OpenABLE/reports/evaluation_files.h"
@@ -158,11 +158,8 @@ const std::vector<RunOutput>& RunOutputs() {
                throw InputError("Timestamps_name: the frames of " + tr.key +
                                 " carry no times; "
                                 "expected frames of a ROS bag (Frame_mode 3)");
-             char line[64];
-             for (int i = 0; i < tr.frames; ++i) {
-               std::snprintf(line, sizeof line, "%d %.9f\n", tr.first_row + i, tr.times[i]);
-               text += line;
-             }
+             for (int i = 0; i < tr.frames; ++i)
+               text += std::to_string(tr.first_row + i) + " " + FormatFixed(tr.times[i], 9) + "\n";
            }
            batch.Stage("Timestamps_name", path, text);
          };

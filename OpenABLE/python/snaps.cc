@@ -619,7 +619,7 @@ corrections and their errors, as openable_snaps reports them.)doc")
           "report", [](const ChainRun& c) { return snaps::FormatChainReport(c.config, c.result); },
           "report() -> str\n\nThe report openable_snaps prints.")
       .def(
-          "to_json", [](const ChainRun& c) { return snaps::ChainJson(c.config, c.result); },
+          "to_json", [](const ChainRun& c) { return snaps::EncodeChainJson(c.config, c.result); },
           "to_json() -> str\n\nThe figures, as <Snaps_output_name>.json.")
       .def("__repr__", [](const ChainRun& c) {
         return "<openable.snaps.ChainResult " + std::to_string(c.result.input.Size()) +

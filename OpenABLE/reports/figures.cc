@@ -5,7 +5,7 @@
 
 #include <opencv2/core/utility.hpp>
 
-#include "OpenABLE/io/png_codec.h"
+#include "OpenABLE/io/image_codec.h"
 
 namespace openable {
 

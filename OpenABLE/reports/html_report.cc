@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <limits>
 
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/reports/evaluation_files.h"
@@ -65,11 +65,9 @@ std::string Escape(const std::string& text) {
   return out;
 }
 
-std::string Number(const char* format, double value) {
-  if (!std::isfinite(value)) return "&ndash;";
-  char text[64];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
+// `value` with `decimals` digits after the point; a dash when it is not finite.
+std::string Number(double value, int decimals) {
+  return std::isfinite(value) ? FormatFixed(value, decimals) : "&ndash;";
 }
 
 std::string PngImage(const cv::Mat& image, const std::string& css_class, const std::string& alt) {
@@ -298,8 +296,8 @@ std::string EncodeHtmlReport(const ReportInput& input) {
     for (const double v : {p.auc, p.recall_at_100p, p.max_f1, p.max_f1_threshold,
                            p.max_f1_precision, p.max_f1_recall, p.recall_at_1, p.recall_at_5,
                            p.recall_at_10})
-      h += "<td class=\"n\">" + Number("%.4f", v) + "</td>";
-    h += "<td class=\"n\">" + Number("%.2f", run.able_p.average_precision) + "</td></tr>\n";
+      h += "<td class=\"n\">" + Number(v, 4) + "</td>";
+    h += "<td class=\"n\">" + Number(run.able_p.average_precision, 2) + "</td></tr>\n";
   }
   h += "</table>\n<p class=\"note\">Per query, its best match: AUC of the precision-recall "
        "curve, recall at 100 % precision, the best F1 and its threshold; R@N, the share of "
@@ -324,7 +322,7 @@ std::string EncodeHtmlReport(const ReportInput& input) {
          "<figcaption>" + Escape(run.label) + ": " + std::to_string(run.layout.queries) +
          " queries x " + std::to_string(run.layout.references) +
          " references; answers marked at threshold " +
-         Number("%.4f", OperatingThreshold(run)) + "</figcaption></figure>\n";
+         Number(OperatingThreshold(run), 4) + "</figcaption></figure>\n";
   }
   h += "</section>\n";
 
@@ -355,9 +353,9 @@ std::string EncodeHtmlReport(const ReportInput& input) {
     for (std::size_t k = 0; k < cases.size(); ++k) {
       const ReportCase& c = cases[k];
       const auto distance = [&](int column) {
-        return Number("%.4f", matrix(run.layout.row_offset + c.query, run.layout.col_offset + column));
+        return Number(matrix(run.layout.row_offset + c.query, run.layout.col_offset + column), 4);
       };
-      std::string score = c.answer >= 0 ? "score " + Number("%.4f", c.score) + "<br>match: " +
+      std::string score = c.answer >= 0 ? "score " + Number(c.score, 4) + "<br>match: " +
                                               distance(c.answer)
                                         : std::string("no answer");
       if (c.true_place >= 0) score += "<br>true place: " + distance(c.true_place);

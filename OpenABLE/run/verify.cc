@@ -269,15 +269,14 @@ LatencySummary Summarize(const std::vector<float>& milliseconds) {
 std::string EncodeLoops(const RunVerification& v) {
   std::string out =
       "query,reference,rank,distance,score,matches,inliers,model,geometric,streak,verified\n";
-  char line[256];
   for (const QueryVerification& q : v.queries)
-    for (const VerifiedCandidate& c : q.candidates) {
-      std::snprintf(line, sizeof line, "%d,%d,%d,%.9g,%.9g,%d,%d,%s,%d,%d,%d\n", q.query,
-                    c.reference, c.rank, c.distance, c.score, c.check.matches, c.check.inliers,
-                    EnumName(c.check.model).c_str(), c.check.verified ? 1 : 0, c.streak,
-                    c.accepted ? 1 : 0);
-      out += line;
-    }
+    for (const VerifiedCandidate& c : q.candidates)
+      out += std::to_string(q.query) + "," + std::to_string(c.reference) + "," +
+             std::to_string(c.rank) + "," + FormatNumber(c.distance, 9) + "," +
+             FormatNumber(c.score, 9) + "," + std::to_string(c.check.matches) + "," +
+             std::to_string(c.check.inliers) + "," + EnumName(c.check.model) + "," +
+             (c.check.verified ? "1" : "0") + "," + std::to_string(c.streak) + "," +
+             (c.accepted ? "1" : "0") + "\n";
   return out;
 }
 

@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/drawing.h"
 
 namespace openable::snaps {
@@ -49,7 +50,7 @@ double NiceStep(double range, int max_ticks) {
 
 std::string TickLabel(double v, double step) {
   const int decimals = step >= 1 ? 0 : static_cast<int>(std::ceil(-std::log10(step) - 1e-9));
-  std::string s = drawing::Format(("%." + std::to_string(decimals) + "f").c_str(), v);
+  std::string s = FormatFixed(v, decimals);
   if (s == "-0") s = "0";
   return s;
 }

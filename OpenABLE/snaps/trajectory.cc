@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -17,6 +16,7 @@
 #include <Eigen/SVD>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/pose_file.h"
 
 namespace openable::snaps {
@@ -29,11 +29,7 @@ namespace {
 // The shortest text that reads back as `v` (for messages).
 std::string Short(double v) { return ShortestNumber(v); }
 
-std::string G17(double v) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof(buffer), "%.17g", v);
-  return buffer;
-}
+std::string G17(double v) { return FormatNumber(v, 17); }
 
 Eigen::Isometry3d Inverse(const Eigen::Isometry3d& t) {
   Eigen::Isometry3d out = Eigen::Isometry3d::Identity();

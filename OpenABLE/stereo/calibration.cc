@@ -1,20 +1,17 @@
 #include "OpenABLE/stereo/calibration.h"
 
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 
 namespace openable {
 namespace {
 
 std::string Num(double v) {
-  if (std::isnan(v)) return "nan";  // not "-nan": the sign of a NaN means nothing
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
+  return std::isnan(v) ? "nan" : FormatNumber(v);  // not "-nan": the sign of a NaN means nothing
 }
 
 std::string SizeText(int rows, int cols) {

@@ -12,6 +12,7 @@
 #include "OpenABLE/base/threading.h"
 #include "OpenABLE/cluster/cluster.h"
 #include "OpenABLE/evaluation/report.h"
+#include "OpenABLE/io/json.h"
 #include "descriptors/registry.h"
 #include "matching/sequence.h"
 
@@ -152,8 +153,6 @@ int Traversals(const InputOptions& in) {
   }
   return 1;
 }
-
-std::string Fixed(double v, int digits) { return FormatFixed(v, digits); }
 
 // Candidates by agreement, best first (ties: the order of Auto_candidates).
 std::vector<int> Ranking(const AutoChoice& c) {
@@ -306,8 +305,8 @@ AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress, Sing
     progress.Update(static_cast<std::int64_t>(i + 1));
     log("auto: " + std::to_string(i + 1) + " of " + std::to_string(configs.size()) + ": " +
         AutoSettingsText(choice.candidates[i].settings) + ": consistency " +
-        Fixed(f.consistency, 3) + ", distinctiveness " + Fixed(f.distinctiveness, 3) +
-        ", agreement " + Fixed(f.agreement, 3));
+        FormatFixed(f.consistency, 3) + ", distinctiveness " + FormatFixed(f.distinctiveness, 3) +
+        ", agreement " + FormatFixed(f.agreement, 3));
   }
   progress.End();
 
@@ -360,8 +359,8 @@ ReportTable AutoReportTable(const AutoChoice& c) {
   for (size_t r = 0; r < order.size(); ++r) {
     const AutoCandidate& a = c.candidates[order[r]];
     t.rows.push_back(
-        {std::to_string(r + 1), AutoSettingsText(a.settings), Fixed(a.figures.consistency, 3),
-         Fixed(a.figures.distinctiveness, 3), Fixed(a.figures.agreement, 3),
+        {std::to_string(r + 1), AutoSettingsText(a.settings), FormatFixed(a.figures.consistency, 3),
+         FormatFixed(a.figures.distinctiveness, 3), FormatFixed(a.figures.agreement, 3),
          std::to_string(a.figures.answered) + " of " + std::to_string(a.figures.queries)});
     if (order[r] == c.chosen) t.highlight = static_cast<int>(r);
   }
@@ -377,39 +376,35 @@ ReportTable AutoReportTable(const AutoChoice& c) {
   return t;
 }
 
-std::string EncodeAutoJson(const AutoChoice& c, const std::string& indent) {
-  const std::string in = indent + "  ";
+Json AutoJson(const AutoChoice& c) {
   const AutoCandidate& chosen = c.candidates.at(c.chosen);
-  std::ostringstream o;
-  o << "{\n"
-    << in << "\"chosen\": " << JsonText(AutoSettingsText(chosen.settings)) << ",\n"
-    << in << "\"chosen_settings\": {";
-  for (size_t k = 0; k < chosen.settings.size(); ++k)
-    o << (k ? ", " : "") << JsonText(chosen.settings[k].first) << ": "
-      << JsonText(chosen.settings[k].second);
-  o << "},\n"
-    << in << "\"reliable\": " << (c.reliable ? "true" : "false") << ",\n"
-    << in << "\"criterion\": \"agreement\",\n"
-    << in << "\"min_consistency\": " << JsonNumber(c.min_consistency) << ",\n"
-    << in << "\"descriptions\": " << c.descriptions << ",\n"
-    << in << "\"seconds\": " << JsonNumber(c.seconds) << ",\n"
-    << in << "\"candidates\": [";
+  Json o;
+  o["chosen"] = AutoSettingsText(chosen.settings);
+  Json& settings = o["chosen_settings"] = Json::object();
+  for (const auto& [key, value] : chosen.settings) settings[key] = value;
+  o["reliable"] = c.reliable;
+  o["criterion"] = "agreement";
+  o["min_consistency"] = json::Number(c.min_consistency);
+  o["descriptions"] = c.descriptions;
+  o["seconds"] = json::Number(c.seconds);
   const std::vector<int> order = Ranking(c);
   std::vector<int> rank(order.size());
   for (size_t r = 0; r < order.size(); ++r) rank[order[r]] = static_cast<int>(r + 1);
+  Json& candidates = o["candidates"] = Json::array();
   for (size_t i = 0; i < c.candidates.size(); ++i) {
     const UnsupervisedFigures& f = c.candidates[i].figures;
-    o << (i ? ",\n" : "\n") << in
-      << "  {\"settings\": " << JsonText(AutoSettingsText(c.candidates[i].settings))
-      << ", \"rank\": " << rank[i] << ", \"queries\": " << f.queries
-      << ", \"answered\": " << f.answered << ", \"agreeing\": " << f.agreeing
-      << ", \"consistency\": " << JsonNumber(f.consistency)
-      << ", \"distinctiveness\": " << JsonNumber(f.distinctiveness)
-      << ", \"agreement\": " << JsonNumber(f.agreement) << ", \"gap\": " << f.gap
-      << ", \"tolerance\": " << f.tolerance << "}";
+    candidates.push_back({{"settings", AutoSettingsText(c.candidates[i].settings)},
+                          {"rank", rank[i]},
+                          {"queries", f.queries},
+                          {"answered", f.answered},
+                          {"agreeing", f.agreeing},
+                          {"consistency", json::Number(f.consistency)},
+                          {"distinctiveness", json::Number(f.distinctiveness)},
+                          {"agreement", json::Number(f.agreement)},
+                          {"gap", f.gap},
+                          {"tolerance", f.tolerance}});
   }
-  o << "\n" << in << "]\n" << indent << "}";
-  return o.str();
+  return o;
 }
 
 }  // namespace openable

@@ -14,6 +14,8 @@
 #include <utility>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "OpenABLE/base/progress.h"
 #include "OpenABLE/evaluation/unsupervised.h"
 #include "OpenABLE/reports/html_report.h"
@@ -77,8 +79,7 @@ ReportTable AutoReportTable(const AutoChoice& choice);
 // The "auto" object of the --json report and of docs/output_formats.md: {"chosen": "Key=value
 // ...", "chosen_settings": {...}, "reliable", "criterion": "agreement", "min_consistency",
 // "descriptions", "seconds", "candidates": [{"settings", "rank", "queries", "answered",
-// "agreeing", "consistency", "distinctiveness", "agreement", "gap", "tolerance"}]}, indented by
-// `indent` after its first line.
-std::string EncodeAutoJson(const AutoChoice& choice, const std::string& indent);
+// "agreeing", "consistency", "distinctiveness", "agreement", "gap", "tolerance"}]}.
+nlohmann::ordered_json AutoJson(const AutoChoice& choice);
 
 }  // namespace openable

@@ -12,6 +12,7 @@
 #include "OpenABLE/base/threading.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/evaluation/plots.h"
+#include "OpenABLE/io/json.h"
 #include "OpenABLE/reports/figures.h"
 #include "OpenABLE/run/evaluate.h"
 #include "OpenABLE/run/pipeline.h"
@@ -378,65 +379,68 @@ std::string EncodeSweepCsv(const SweepResult& r) {
     for (const std::string& v : run.values) out += "," + CsvField(v);
     out += "," + CsvField(run.label);
     if (r.evaluated) {
-      out += "," + JsonNumber(q.auc) + "," + JsonNumber(q.recall_at_100p) + "," +
-             JsonNumber(q.max_f1) + "," + JsonNumber(q.max_f1_threshold) + "," +
-             JsonNumber(q.recall_at_1) + "," + JsonNumber(q.recall_at_5) + "," +
-             JsonNumber(q.recall_at_10) + "," +
-             JsonNumber(run.evaluation.able_p.average_precision) + "," +
+      out += "," + CsvNumber(q.auc) + "," + CsvNumber(q.recall_at_100p) + "," +
+             CsvNumber(q.max_f1) + "," + CsvNumber(q.max_f1_threshold) + "," +
+             CsvNumber(q.recall_at_1) + "," + CsvNumber(q.recall_at_5) + "," +
+             CsvNumber(q.recall_at_10) + "," +
+             CsvNumber(run.evaluation.able_p.average_precision) + "," +
              std::to_string(q.queries) + "," + std::to_string(q.unanswered);
     } else {  // no ground truth: the figures are empty; queries from the criteria
       out += ",,,,,,,,," + std::to_string(u.queries) + "," +
              std::to_string(u.queries - u.answered);
     }
-    out += "," + JsonNumber(u.consistency) + "," + JsonNumber(u.distinctiveness) + "," +
-           JsonNumber(u.agreement) + "," + JsonNumber(run.seconds) + "," +
+    out += "," + CsvNumber(u.consistency) + "," + CsvNumber(u.distinctiveness) + "," +
+           CsvNumber(u.agreement) + "," + CsvNumber(run.seconds) + "," +
            (run.described ? "1" : "0") + "\n";
   }
   return out;
 }
 
-std::string EncodeSweepJson(const SweepResult& r, const std::string& version) {
-  std::ostringstream o;
-  o << "{\n  \"openable_version\": " << JsonText(version) << ",\n"
-    << "  \"rank_by\": " << JsonText(EnumName(r.rank_by)) << ",\n"
-    << "  \"varied\": [";
-  for (size_t a = 0; a < r.axes.size(); ++a) {
-    o << (a ? ", " : "") << "{\"key\": " << JsonText(r.axes[a].key) << ", \"values\": [";
-    for (size_t v = 0; v < r.axes[a].values.size(); ++v)
-      o << (v ? ", " : "") << JsonText(r.axes[a].values[v]);
-    o << "]}";
-  }
-  o << "],\n  \"descriptions\": " << r.descriptions << ",\n"
-    << "  \"seconds\": " << JsonNumber(r.seconds) << ",\n"
-    << "  \"evaluation\": "
-    << (r.evaluated ? EncodeEvaluationSettingsJson(r.settings, "  ") : std::string("null"))
-    << ",\n  \"runs\": [";
+Json SweepJson(const SweepResult& r, const std::string& version) {
+  Json o;
+  o["openable_version"] = version;
+  o["rank_by"] = EnumName(r.rank_by);
+  Json& varied = o["varied"] = Json::array();
+  for (const SweepAxis& a : r.axes)
+    varied.push_back({{"key", a.key}, {"values", json::Strings(a.values)}});
+  o["descriptions"] = r.descriptions;
+  o["seconds"] = json::Number(r.seconds);
+  o["evaluation"] = r.evaluated ? EvaluationSettingsJson(r.settings) : Json();
   const std::vector<int> by_auc =
       r.evaluated ? RanksBy(r.runs, SweepRank::kAuc) : std::vector<int>();
   const std::vector<int> by_agreement = RanksBy(r.runs, SweepRank::kAgreement);
+  Json& runs = o["runs"] = Json::array();
   for (size_t i = 0; i < r.runs.size(); ++i) {
     const SweepRun& run = r.runs[i];
     const UnsupervisedFigures& u = run.unsupervised;
-    o << (i ? ",\n" : "\n") << "    {\n      \"rank\": " << i + 1 << ",\n      \"settings\": {";
-    for (size_t a = 0; a < r.axes.size(); ++a)
-      o << (a ? ", " : "") << JsonText(r.axes[a].key) << ": " << JsonText(run.values[a]);
-    o << "},\n      \"seconds\": " << JsonNumber(run.seconds) << ",\n"
-      << "      \"described\": " << (run.described ? "true" : "false") << ",\n"
-      << "      \"unsupervised\": {\"consistency\": " << JsonNumber(u.consistency)
-      << ", \"distinctiveness\": " << JsonNumber(u.distinctiveness)
-      << ", \"agreement\": " << JsonNumber(u.agreement) << ", \"queries\": " << u.queries
-      << ", \"answered\": " << u.answered << ", \"agreeing\": " << u.agreeing
-      << ", \"gap\": " << u.gap << ", \"tolerance\": " << u.tolerance
-      << ", \"rank_by_agreement\": " << by_agreement[i] << "}";
-    if (r.evaluated)
-      o << ",\n      \"rank_by_auc\": " << by_auc[i] << ",\n"
-        << EncodeEvaluatedRunFieldsJson(run.evaluation, "      ");
-    else
-      o << ",\n      \"label\": " << JsonText(run.label);
-    o << "\n    }";
+    Json entry;
+    entry["rank"] = i + 1;
+    Json& settings = entry["settings"] = Json::object();
+    for (size_t a = 0; a < r.axes.size(); ++a) settings[r.axes[a].key] = run.values[a];
+    entry["seconds"] = json::Number(run.seconds);
+    entry["described"] = run.described;
+    entry["unsupervised"] = {{"consistency", json::Number(u.consistency)},
+                             {"distinctiveness", json::Number(u.distinctiveness)},
+                             {"agreement", json::Number(u.agreement)},
+                             {"queries", u.queries},
+                             {"answered", u.answered},
+                             {"agreeing", u.agreeing},
+                             {"gap", u.gap},
+                             {"tolerance", u.tolerance},
+                             {"rank_by_agreement", by_agreement[i]}};
+    if (r.evaluated) {
+      entry["rank_by_auc"] = by_auc[i];
+      AddEvaluatedRunJson(entry, run.evaluation);
+    } else {
+      entry["label"] = run.label;
+    }
+    runs.push_back(std::move(entry));
   }
-  o << "\n  ]\n}\n";
-  return o.str();
+  return o;
+}
+
+std::string EncodeSweepJson(const SweepResult& r, const std::string& version) {
+  return json::Dump(SweepJson(r, version));
 }
 
 std::vector<std::string> WriteSweep(const std::string& prefix, const SweepResult& r) {

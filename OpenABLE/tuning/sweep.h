@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "OpenABLE/base/enum_names.h"
 #include "OpenABLE/base/progress.h"
 #include "OpenABLE/evaluation/report.h"
@@ -107,6 +109,8 @@ std::string EncodeSweepCsv(const SweepResult& result);
 
 // The whole sweep as JSON (docs/output_formats.md): varied keys, ranking, evaluation
 // settings, and per run its rank, settings, seconds and the figures of the evaluation JSON.
+// EncodeSweepJson is its text (json::Dump).
+nlohmann::ordered_json SweepJson(const SweepResult& result, const std::string& version);
 std::string EncodeSweepJson(const SweepResult& result, const std::string& version);
 
 // Writes <prefix>.csv, <prefix>.json and, with ground truth, <prefix>_pr.png (the `best` first

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "OpenABLE/io/json.h"
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
 
@@ -33,13 +34,13 @@ std::vector<std::string> With(std::vector<std::string> args,
   return args;
 }
 
-// The JSON object of the sweep run whose settings are `settings` ({"Key": "value", ...} as
-// the sweep writes it), from its opening brace; empty when absent.
-std::string SweepRunJson(const std::string& json, const std::string& settings) {
-  const auto p = json.find("\"settings\": " + settings);
-  if (p == std::string::npos) return "";
-  const auto end = json.find("\"able_p\"", p);
-  return json.substr(p, json.find('}', end) - p);
+// The text of the sweep run whose varied settings are `settings` ({"Key": "value", ...} in the
+// order of the --vary options); empty when absent.
+std::string SweepRunJson(const std::string& json, const Json& settings) {
+  const Json sweep = Json::parse(json);
+  for (const Json& run : sweep.at("runs"))
+    if (run.at("settings") == settings) return json::Dump(run);
+  return "";
 }
 
 // `key`'s figure of each run of the sweep JSON, in the order the runs are listed (best first).
@@ -72,8 +73,7 @@ TEST(Sweep, FiguresEqualTheSingleRunsAndAreRanked) {
     for (const std::string l : {"1", "5"})
       for (const std::string s : {"distance", "ratio"}) {
         const std::string run = SweepRunJson(
-            json, "{\"Image_descriptor\": \"" + d + "\", \"Image_sequences\": \"" + l +
-                      "\", \"Match_score\": \"" + s + "\"}");
+            json, {{"Image_descriptor", d}, {"Image_sequences", l}, {"Match_score", s}});
         ASSERT_FALSE(run.empty()) << d << " " << l << " " << s;
         const Outcome single = RunProgram(
             testing::TestOpenableExe(),

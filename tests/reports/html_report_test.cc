@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "OpenABLE/io/png_codec.h"
+#include "OpenABLE/io/image_codec.h"
 #include "config/config.h"
 
 namespace openable {

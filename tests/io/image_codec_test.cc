@@ -1,5 +1,6 @@
-// PNG decoding (libpng) and writing (zlib) of png_codec.h against OpenCV's own codecs.
-#include "OpenABLE/io/png_codec.h"
+// image_codec.h: the formats recognised from their bytes, and PNG decoding (libpng) and writing
+// (zlib) against OpenCV's own codecs.
+#include "OpenABLE/io/image_codec.h"
 
 #include <png.h>
 
@@ -11,6 +12,8 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "OpenABLE/base/error.h"
 
 namespace openable {
 namespace {
@@ -159,6 +162,41 @@ TEST(EncodePngFile, OpenCvReadsBackTheSamePixels) {
   }
   EXPECT_THROW(EncodePngFile(cv::Mat(3, 3, CV_32F)), std::logic_error);
   EXPECT_THROW(EncodePngFile(cv::Mat()), std::logic_error);
+}
+
+// The first bytes decide the decoder: sound PNG and JPEG in the program (grey + alpha said),
+// damage named before any decoder sees it, and anything unknown left to OpenImageIO (empty).
+TEST(DecodeCommonFormat, RecognisesTheFormatsAndNamesTheDamage) {
+  const cv::Mat grey = Random(9, 13, CV_8UC1, 5);
+  std::vector<unsigned char> png;
+  ASSERT_TRUE(cv::imencode(".png", grey, png));
+  bool grey_alpha = true;
+  ExpectEqualImages(DecodeCommonFormat(png, grey_alpha), grey);
+  EXPECT_FALSE(grey_alpha);
+
+  const std::vector<unsigned char> data(4 * 3 * 2, 200);
+  const std::vector<unsigned char> ga = LibpngFile(4, 3, 8, PNG_COLOR_TYPE_GRAY_ALPHA, false, data);
+  const cv::Mat two = DecodeCommonFormat(ga, grey_alpha);
+  EXPECT_FALSE(two.empty());
+  EXPECT_TRUE(grey_alpha);
+
+  std::vector<unsigned char> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", grey, jpeg));
+  const cv::Mat decoded = DecodeCommonFormat(jpeg, grey_alpha);
+  EXPECT_EQ(decoded.type(), CV_8UC1);
+  EXPECT_EQ(decoded.size(), grey.size());
+
+  const std::vector<unsigned char> cut(png.begin(), png.end() - 20);
+  try {
+    DecodeCommonFormat(cut, grey_alpha);
+    ADD_FAILURE() << "a truncated PNG was decoded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("truncated PNG"), std::string::npos) << e.what();
+  }
+  const std::vector<unsigned char> jpeg_cut(jpeg.begin(), jpeg.begin() + jpeg.size() / 2);
+  EXPECT_TRUE(DecodeCommonFormat(jpeg_cut, grey_alpha).empty());  // no end marker: OpenImageIO
+  const std::string text = "plain text, not an image at all";
+  EXPECT_TRUE(DecodeCommonFormat({text.begin(), text.end()}, grey_alpha).empty());
 }
 
 }  // namespace

@@ -1,9 +1,10 @@
-#include "OpenABLE/io/png_codec.h"
+#include "OpenABLE/io/image_codec.h"
 
 #include <png.h>
 #include <zlib.h>
 
 #include <algorithm>
+#include <cctype>
 #include <csetjmp>
 #include <cstdint>
 #include <cstdio>
@@ -12,7 +13,12 @@
 #include <string>
 #include <vector>
 
+#include <jpeglib.h>  // after <cstdio>: it uses FILE and size_t without including them
+
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/base/module_loader.h"
 #include "OpenABLE/base/threading.h"
+#include "OpenABLE/io/module_api.h"
 
 namespace openable {
 namespace {
@@ -172,6 +178,177 @@ void CompressBand(const cv::Mat& image, int y0, int y1, bool last, Band& band) {
   if (!ok) throw std::runtime_error("PNG encoder: zlib failed on a band of rows");
 }
 
+// ---------------------------------------------------------------------------------------------
+// Recognising the formats, checking PNG chunks and JPEG ends, decoding JPEG (libjpeg).
+
+// CRC-32 of PNG chunks (ISO 3309), zlib's.
+std::uint32_t Crc32(const unsigned char* data, std::size_t size) {
+  return static_cast<std::uint32_t>(crc32(0L, data, static_cast<uInt>(size)));
+}
+
+std::uint32_t BigEndian32(const unsigned char* p) {
+  return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) |
+         std::uint32_t{p[3]};
+}
+
+enum class PngCheck { kNotPng, kSound, kTruncated, kDamaged };
+
+// libpng prints "libpng error: ..." on stderr (through OpenCV, which keeps libpng's default
+// handlers) before any decoder sees the error, and truncated files are the common corruption
+// (an interrupted copy). So a file that starts as a PNG has its chunk layout walked and every
+// chunk's CRC checked before decoding. kTruncated comes with the reason in `why`; kDamaged
+// (a CRC mismatch) also comes with its reason: libpng would print its own complaint first,
+// whichever library calls it. A chunk without a name is left to OpenImageIO to explain.
+PngCheck CheckPng(const std::vector<unsigned char>& bytes, std::string& why) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (bytes.size() < 8 || !std::equal(kSignature, kSignature + 8, bytes.begin())) {
+    return PngCheck::kNotPng;
+  }
+  const std::uint64_t size = bytes.size();
+  std::uint64_t pos = 8;
+  while (true) {
+    if (pos + 8 > size) {
+      why = "truncated PNG: the file ends before its IEND chunk";
+      return PngCheck::kTruncated;
+    }
+    const std::uint64_t length = BigEndian32(&bytes[pos]);
+    const std::string type(reinterpret_cast<const char*>(&bytes[pos + 4]), 4);
+    const bool named = std::all_of(type.begin(), type.end(), [](char c) {
+      return std::isalpha(static_cast<unsigned char>(c)) != 0;
+    });
+    if (!named) return PngCheck::kDamaged;
+    if (pos + 12 + length > size) {
+      why = "truncated PNG: the file ends inside its " + type + " chunk";
+      return PngCheck::kTruncated;
+    }
+    if (Crc32(&bytes[pos + 4], 4 + length) != BigEndian32(&bytes[pos + 8 + length])) {
+      why = "damaged PNG: the checksum (CRC) of its " + type + " chunk does not match its data";
+      return PngCheck::kDamaged;
+    }
+    if (type == "IEND") return PngCheck::kSound;
+    pos += 12 + length;  // length, type, data, CRC
+  }
+}
+
+// True when a JPEG ends with its EOI marker (FF D9), allowing a little padding after it.
+// libjpeg only warns about a missing end (on stderr) and fills the rest with grey.
+bool JpegHasEnd(const std::vector<unsigned char>& bytes) {
+  const std::size_t stop = bytes.size() > 64 ? bytes.size() - 64 : 0;
+  for (std::size_t i = bytes.size(); i >= stop + 2; --i) {
+    if (bytes[i - 2] == 0xFF && bytes[i - 1] == 0xD9) return true;
+  }
+  return false;
+}
+
+// Frames are resized to Patch_size before they are described, so an image of hundreds of
+// megapixels only costs time and memory (4 bytes a pixel once converted to float; a 20000 x
+// 20000 PNG took 10 s and 2 GB per frame): such images are refused before decoding.
+constexpr std::uint64_t kMaxPixels = 100'000'000;
+
+void CheckPixelCount(std::uint64_t width, std::uint64_t height) {
+  if (width * height > kMaxPixels)
+    throw InputError("is " + std::to_string(width) + "x" + std::to_string(height) + " (" +
+                     std::to_string(width * height / 1'000'000) + " megapixels); expected at "
+                     "most " + std::to_string(kMaxPixels / 1'000'000) + " megapixels (frames are "
+                     "resized to Patch_size: scale the images down first)");
+}
+
+// The size in a JPEG's start-of-frame segment; false when the segments before it do not parse.
+bool JpegSize(const std::vector<unsigned char>& bytes, std::uint32_t& width,
+              std::uint32_t& height) {
+  std::size_t pos = 2;
+  while (pos + 9 <= bytes.size() && bytes[pos] == 0xFF) {
+    const unsigned char marker = bytes[pos + 1];
+    const std::size_t length = (std::size_t{bytes[pos + 2]} << 8) | bytes[pos + 3];
+    const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
+                     marker != 0xCC;
+    if (sof) {
+      height = (std::uint32_t{bytes[pos + 5]} << 8) | bytes[pos + 6];
+      width = (std::uint32_t{bytes[pos + 7]} << 8) | bytes[pos + 8];
+      return true;
+    }
+    if (marker == 0xDA || length < 2) return false;  // the scan starts before any frame header
+    pos += 2 + length;
+  }
+  return false;
+}
+
+// libjpeg's error manager for DecodeJpeg: the first warning or error ends the decoding with
+// libjpeg's own text, instead of a line on stderr (warnings) or exit() (errors).
+struct JpegErrors {
+  jpeg_error_mgr manager;
+  std::jmp_buf jump;
+  char message[JMSG_LENGTH_MAX];
+};
+
+[[noreturn]] void JpegStop(j_common_ptr cinfo) {
+  auto* errors = reinterpret_cast<JpegErrors*>(cinfo->err);
+  (*cinfo->err->format_message)(cinfo, errors->message);
+  std::longjmp(errors->jump, 1);
+}
+
+void JpegMessage(j_common_ptr cinfo, int level) {
+  if (level < 0) JpegStop(cinfo);  // a warning: "Corrupt JPEG data: ...", "Premature end ..."
+}
+
+// Decodes a JPEG of 1 or 3 components into CV_8UC1 or CV_8UC3 (BGR) with libjpeg, which
+// OpenCV uses too: OpenCV lets libjpeg print warnings about damaged data on stderr and returns
+// the image with the damage filled in. Returns false with libjpeg's message in `why` at the
+// first warning or error; leaves `image` empty for other colour spaces (CMYK: OpenCV's).
+bool DecodeJpeg(const std::vector<unsigned char>& bytes, cv::Mat& image, std::string& why) {
+  jpeg_decompress_struct cinfo;
+  JpegErrors errors;
+  cinfo.err = jpeg_std_error(&errors.manager);
+  errors.manager.error_exit = JpegStop;
+  errors.manager.emit_message = JpegMessage;
+  if (setjmp(errors.jump) != 0) {
+    jpeg_destroy_decompress(&cinfo);
+    image.release();
+    why = std::string("damaged JPEG: ") + errors.message;
+    return false;
+  }
+  jpeg_create_decompress(&cinfo);
+  jpeg_mem_src(&cinfo, const_cast<unsigned char*>(bytes.data()),
+               static_cast<unsigned long>(bytes.size()));
+  jpeg_read_header(&cinfo, TRUE);
+  if (cinfo.num_components == 1 || cinfo.num_components == 3) {
+    cinfo.out_color_space = cinfo.num_components == 1 ? JCS_GRAYSCALE : JCS_EXT_BGR;
+    jpeg_start_decompress(&cinfo);
+    image.create(static_cast<int>(cinfo.output_height), static_cast<int>(cinfo.output_width),
+                 cinfo.output_components == 1 ? CV_8UC1 : CV_8UC3);
+    while (cinfo.output_scanline < cinfo.output_height) {
+      JSAMPROW row = image.ptr<unsigned char>(static_cast<int>(cinfo.output_scanline));
+      jpeg_read_scanlines(&cinfo, &row, 1);
+    }
+    jpeg_finish_decompress(&cinfo);
+  }
+  jpeg_destroy_decompress(&cinfo);
+  return true;
+}
+
+// The maximum value of a binary or plain PGM/PPM header, or 0 when it cannot be read (or the
+// file is a bitmap, P1/P4, which has none).
+int PnmMaxValue(const std::vector<unsigned char>& bytes) {
+  std::size_t pos = 2;
+  int values[3] = {0, 0, 0};
+  for (int& v : values) {
+    while (pos < bytes.size()) {  // blanks and comments
+      if (bytes[pos] == '#') {
+        while (pos < bytes.size() && bytes[pos] != '\n') ++pos;
+      } else if (std::isspace(bytes[pos]) != 0) {
+        ++pos;
+      } else {
+        break;
+      }
+    }
+    if (pos >= bytes.size() || std::isdigit(bytes[pos]) == 0) return 0;
+    while (pos < bytes.size() && std::isdigit(bytes[pos]) != 0 && v < 1000000) {
+      v = v * 10 + (bytes[pos++] - '0');
+    }
+  }
+  return values[2];
+}
+
 }  // namespace
 
 bool DecodePng(const std::vector<unsigned char>& bytes, cv::Mat& image, std::string& why) {
@@ -251,6 +428,51 @@ std::string EncodePngFile(const cv::Mat& image, int threads) {
   }
   PutChunk(out, "IEND", std::string());
   return out;
+}
+
+cv::Mat DecodeCommonFormat(const std::vector<unsigned char>& bytes, bool& grey_alpha) {
+  grey_alpha = false;
+  std::string why;
+  const PngCheck png = CheckPng(bytes, why);  // before the size check: a cut PNG is short
+  if (!why.empty()) throw InputError(why);
+  if (bytes.size() < 16) return cv::Mat();
+  const bool jpeg = bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
+  const bool pnm = bytes[0] == 'P' && (bytes[1] == '2' || bytes[1] == '3' || bytes[1] == '5' ||
+                                       bytes[1] == '6');
+  const bool bmp = bytes[0] == 'B' && bytes[1] == 'M';
+  if (!why.empty()) throw InputError(why);
+  if (png == PngCheck::kSound) {
+    // IHDR colour type 4: grey + alpha. A sound chunk walk does not mean that IHDR comes first
+    // (or at all: a signature and IEND are 20 bytes), and the decoders refuse such a file.
+    static const unsigned char kIhdr[4] = {'I', 'H', 'D', 'R'};
+    const bool ihdr_first =
+        bytes.size() > 25 && std::equal(kIhdr, kIhdr + 4, bytes.begin() + 12);
+    if (ihdr_first) CheckPixelCount(BigEndian32(&bytes[16]), BigEndian32(&bytes[20]));
+    grey_alpha = ihdr_first && bytes[25] == 4;
+  } else if (png == PngCheck::kDamaged || (jpeg && !JpegHasEnd(bytes))) {
+    return cv::Mat();
+  } else if (pnm) {
+    const int max_value = PnmMaxValue(bytes);
+    if (max_value != 255 && max_value != 65535) return cv::Mat();
+  } else if (!jpeg && !bmp) {
+    return cv::Mat();
+  }
+  if (jpeg) {
+    std::uint32_t width = 0, height = 0;
+    if (JpegSize(bytes, width, height)) CheckPixelCount(width, height);
+    cv::Mat image;
+    if (!DecodeJpeg(bytes, image, why)) throw InputError(why);
+    if (!image.empty()) return image;
+  }
+  if (png == PngCheck::kSound) {
+    cv::Mat image;
+    return DecodePng(bytes, image, why) ? image : cv::Mat();  // libpng's refusal: OpenImageIO
+  }
+  // PGM/PPM and BMP: OpenCV's imgcodecs, loaded on first use.
+  cv::Mat image;
+  reinterpret_cast<OpenableCodecsDecode>(ModuleSymbol("codecs", "openable_codecs_decode"))(
+      bytes, image);
+  return image;
 }
 
 }  // namespace openable

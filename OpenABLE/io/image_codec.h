@@ -1,0 +1,42 @@
+// Image files as bytes, without OpenCV's imgcodecs for the common cases: recognising PNG, JPEG,
+// PGM/PPM and BMP from their first bytes; checking a PNG's chunks and a JPEG's end before
+// decoding; decoding PNG with libpng and JPEG with libjpeg in the program; writing PNG with
+// zlib. imgcodecs brings GDAL, GDCM, OpenEXR and about 120 other shared libraries that every
+// run would load at start-up (about 80 ms on the development machines), while the frames of
+// almost every data set are PNG or JPEG; other formats load imgcodecs on first use
+// (module_loader.h). Frame sources (frame_source.h) read files and hand their bytes here.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace openable {
+
+// Decodes the common formats: PNG whose chunks are sound (DecodePng) and JPEG with its end
+// marker (libjpeg), both in the program, and binary and plain PGM/PPM of 8 or 16 bits and BMP
+// through OpenCV's imgcodecs, a module loaded on first use (module_loader.h). The image comes
+// as the file stores it (8 or 16 bits; 1, 3 or 4 channels, BGR order); `grey_alpha` is set when
+// a PNG is grey + alpha. Returns an empty Mat for anything else, or when the decoder fails, so
+// that OpenImageIO decodes the file or says precisely what is wrong with it. Throws InputError
+// with the damage found when a PNG is truncated or a chunk's CRC does not match, or a JPEG is
+// damaged (libjpeg's first warning), and "is WxH (N megapixels); expected at most 100
+// megapixels ..." for a larger PNG or JPEG, before decoding it (docs/robustness.md).
+cv::Mat DecodeCommonFormat(const std::vector<unsigned char>& bytes, bool& grey_alpha);
+
+// Decodes the bytes of a PNG file whose chunks are sound into 8- or 16-bit pixels, grey
+// (grey, grey + alpha) or BGR (colour, palette, colour + alpha); alpha is dropped, bit depths
+// 1, 2 and 4 are scaled to 8 bits, no gamma is applied: the pixels OpenCV's decoder gives for
+// IMREAD_UNCHANGED once its alpha channel is dropped. Returns false with `why` set when libpng
+// refuses the data.
+bool DecodePng(const std::vector<unsigned char>& bytes, cv::Mat& image, std::string& why);
+
+// The bytes of a PNG file of `image` (CV_8U or CV_16U; 1 channel grey, 3 BGR, 4 BGRA). Rows go
+// through the Sub filter and deflate at level 1 with the run-length strategy (OpenCV's default
+// settings); bands of rows are compressed in parallel as independent deflate blocks, joined
+// into one zlib stream, so the file decodes anywhere as an ordinary PNG. `threads` as in
+// EffectiveThreads (0 = all cores). Throws std::logic_error on another type.
+std::string EncodePngFile(const cv::Mat& image, int threads = 0);
+
+}  // namespace openable

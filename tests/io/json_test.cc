@@ -1,0 +1,103 @@
+// The JSON layer of every document the toolbox writes (io/json.h), against texts written out
+// by hand.
+#include "OpenABLE/io/json.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace openable {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// One number as a document holds it.
+std::string Text(const Json& value) { return value.dump(); }
+
+TEST(Json, NotFiniteNumbersAreNull) {
+  EXPECT_EQ(Text(json::Number(std::nan(""))), "null");
+  EXPECT_EQ(Text(json::Number(-std::nan(""))), "null");
+  EXPECT_EQ(Text(json::Number(kInf)), "null");
+  EXPECT_EQ(Text(json::Number(-kInf)), "null");
+  EXPECT_EQ(Text(json::Number(kInf, 6)), "null");
+}
+
+TEST(Json, NumbersAreRoundedToNineSignificantDigitsAsPrintfDoes) {
+  EXPECT_EQ(Text(json::Number(0.1 + 0.2)), "0.3");
+  EXPECT_EQ(Text(json::Number(1.0 / 3.0)), "0.333333333");
+  EXPECT_EQ(Text(json::Number(2.0 / 3.0)), "0.666666667");
+  EXPECT_EQ(Text(json::Number(-2.0 / 3.0)), "-0.666666667");
+  EXPECT_EQ(Text(json::Number(58.4299130449)), "58.429913");
+  EXPECT_EQ(Text(json::Number(1.05096852349)), "1.05096852");
+  EXPECT_EQ(Text(json::Number(1e-5)), "1e-05");
+  EXPECT_EQ(Text(json::Number(0.000123456789123)), "0.000123456789");
+  // Whole numbers stay whole, as %g writes them.
+  EXPECT_EQ(Text(json::Number(1685.0)), "1685");
+  EXPECT_EQ(Text(json::Number(-1.0)), "-1");
+  EXPECT_EQ(Text(json::Number(0.0)), "0");
+  EXPECT_EQ(Text(json::Number(123456789.4)), "123456789");
+  // Beyond nine digits %g has an exponent: the same value, in nlohmann's spelling.
+  EXPECT_EQ(Text(json::Number(1234567890123.0)), "1234567890000.0");
+  EXPECT_EQ(json::Number(1234567890123.0).get<double>(), 1.23456789e12);
+  // Six digits for the SNAPS figures.
+  EXPECT_EQ(Text(json::Number(24124.1234, 6)), "24124.1");
+  EXPECT_EQ(Text(json::Number(6.24281234e-06, 6)), "6.24281e-06");
+}
+
+TEST(Json, StringsAreEscaped) {
+  EXPECT_EQ(Json("say \"hi\"").dump(), R"("say \"hi\"")");
+  EXPECT_EQ(Json("back\\slash").dump(), R"("back\\slash")");
+  EXPECT_EQ(Json("two\nlines\ttab\r").dump(), R"("two\nlines\ttab\r")");
+  EXPECT_EQ(Json(std::string("nul\x01\x1f", 5)).dump(), R"("nul\u0001\u001f")");
+  EXPECT_EQ(Json("caf\xc3\xa9 /path").dump(), "\"caf\xc3\xa9 /path\"");  // UTF-8 kept as is
+}
+
+TEST(Json, InvalidUtf8IsReplacedNotRefused) {
+  Json doc;
+  doc["path"] = std::string("bad\xff\xfe name\xc3");
+  const std::string replacement = "\xef\xbf\xbd";  // U+FFFD in UTF-8
+  EXPECT_EQ(json::Dump(doc), "{\n  \"path\": \"bad" + replacement + replacement + " name" +
+                                 replacement + "\"\n}\n");
+}
+
+TEST(Json, DumpIndentsByTwoSpacesKeepsOrderAndEndsWithANewline) {
+  Json doc;
+  doc["program"] = "Test_OpenABLE";
+  doc["b"] = 1;
+  doc["a"] = json::Number(0.5);
+  doc["nothing"] = json::Number(std::nan(""));
+  doc["list"] = json::Strings({"x", "y"});
+  doc["empty"] = json::Strings({});
+  doc["object"] = {{"z", true}, {"y", Json()}};
+  EXPECT_EQ(json::Dump(doc),
+            "{\n"
+            "  \"program\": \"Test_OpenABLE\",\n"
+            "  \"b\": 1,\n"
+            "  \"a\": 0.5,\n"
+            "  \"nothing\": null,\n"
+            "  \"list\": [\n"
+            "    \"x\",\n"
+            "    \"y\"\n"
+            "  ],\n"
+            "  \"empty\": [],\n"
+            "  \"object\": {\n"
+            "    \"z\": true,\n"
+            "    \"y\": null\n"
+            "  }\n"
+            "}\n");
+}
+
+TEST(Json, DumpedTextReadsBackToTheSameValues) {
+  Json doc;
+  doc["third"] = json::Number(1.0 / 3.0);
+  doc["count"] = 300;
+  doc["label"] = "LDB L=10";
+  const Json back = Json::parse(json::Dump(doc));
+  EXPECT_EQ(back, doc);
+  EXPECT_DOUBLE_EQ(back["third"].get<double>(), 0.333333333);
+}
+
+}  // namespace
+}  // namespace openable
