@@ -7,13 +7,51 @@
 #include "OpenABLE/base/strings.h"
 
 namespace openable::json {
+namespace {
+
+// A string literal: nlohmann's escaping (quotes, backslashes, control characters as \n, \t or
+// \u0001), with each byte that is not valid UTF-8 replaced by U+FFFD.
+std::string Literal(const std::string& s) {
+  return Json(s).dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+void Write(const Json& v, int depth, std::string& out) {
+  const bool object = v.is_object();
+  if (object || v.is_array()) {
+    if (v.empty()) {
+      out += object ? "{}" : "[]";
+      return;
+    }
+    const std::string inner(2 * (depth + 1), ' ');
+    out += object ? "{\n" : "[\n";
+    bool first = true;
+    for (auto it = v.begin(); it != v.end(); ++it) {
+      out += first ? "" : ",\n";
+      first = false;
+      out += inner;
+      if (object) out += Literal(it.key()) + ": ";
+      Write(it.value(), depth + 1, out);
+    }
+    out += "\n" + std::string(2 * depth, ' ') + (object ? "}" : "]");
+  } else if (v.is_number_float()) {
+    const double x = v.get<double>();
+    out += std::isfinite(x) ? FormatNumber(x, 9) : "null";
+  } else if (v.is_string()) {
+    out += Literal(v.get_ref<const std::string&>());
+  } else {
+    out += v.dump();  // null, true, false, integers
+  }
+}
+
+}  // namespace
 
 Json Number(double value, int significant) {
   if (!std::isfinite(value)) return nullptr;
   const std::string text = FormatNumber(value, significant);
   // Without a point or an exponent the text is an integer of at most `significant` digits
-  // (%g switches to an exponent beyond them), which fits in 64 bits up to 18 digits.
-  if (text.find_first_of(".e") == std::string::npos && significant <= 18)
+  // (%g switches to an exponent beyond them): stored as one, it is written without a point
+  // whatever the writer. "-0" stays a double, to be written as %g writes it.
+  if (text.find_first_of(".e") == std::string::npos && text != "-0" && significant <= 18)
     return static_cast<std::int64_t>(std::strtoll(text.c_str(), nullptr, 10));
   return std::strtod(text.c_str(), nullptr);
 }
@@ -25,7 +63,9 @@ Json Strings(const std::vector<std::string>& items) {
 }
 
 std::string Dump(const Json& document) {
-  return document.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
+  std::string out;
+  Write(document, 0, out);
+  return out + "\n";
 }
 
 }  // namespace openable::json

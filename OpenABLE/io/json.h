@@ -2,7 +2,7 @@
 // SNAPS figures), built on nlohmann-json (Debian's nlohmann-json3-dev). Documents are
 // nlohmann::ordered_json, so members are written in the order they were added; numbers that
 // come from computations go through json::Number, and a document becomes text through
-// json::Dump (docs/output_formats.md, "JSON").
+// json::Dump (docs/output_formats.md, "Reports as JSON").
 #pragma once
 
 #include <string>
@@ -18,21 +18,24 @@ namespace json {
 
 // `value` rounded to `significant` digits exactly as printf's %.<significant>g rounds it, or null
 // when it is NaN or infinite (JSON has neither). The figures of the reports use 9 digits, the
-// SNAPS figures 6. The rounding is done here, on the value, rather than in a serializer of our
-// own: the %g text is read back (as an integer when it has no point and no exponent, so "1685"
-// stays "1685" and not "1685.0"), and nlohmann's shortest round-trip printing of the read-back
-// double gives back the same digits. Only the spelling of large or tiny numbers may differ from
-// %g's ("1e+09" is written 1000000000.0; exponents start at 1e-05 and 1e+15): the same value.
+// SNAPS figures 6. The %g text is read back: as an integer when it has no point and no
+// exponent ("1685", not 1685.0), else as the double nearest to it, which Dump writes with the
+// same digits.
 Json Number(double value, int significant = 9);
 
 // A JSON array of strings.
 Json Strings(const std::vector<std::string>& items);
 
 // The text of `document` as the files hold it: two spaces of indentation per level, one member
-// or element per line, ": " after names, and a final newline. Strings are escaped by nlohmann
-// (quotes, backslashes, control characters); text that is not valid UTF-8 (a path in another
-// encoding) has each invalid byte replaced by U+FFFD (error_handler_t::replace) instead of
-// making the whole document fail.
+// or element per line, ": " after names, "{}" and "[]" when empty, and a final newline.
+// Written here rather than by nlohmann's dump() for one reason, its numbers: nlohmann writes a
+// double with Grisu2, which is not always the shortest text that reads back (0.01530851 can
+// come out as 0.015308510000000001), while every double here is written as printf's %.9g
+// writes it (NaN and infinities as null): the texts the toolbox has always written, and at
+// most 9 significant digits whatever was stored. Strings are escaped by nlohmann (quotes,
+// backslashes, control characters); text that is not valid UTF-8 (a path in another encoding)
+// has each invalid byte replaced by U+FFFD (error_handler_t::replace) instead of making the
+// whole document fail.
 std::string Dump(const Json& document);
 
 }  // namespace json
