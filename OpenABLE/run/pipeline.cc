@@ -622,7 +622,7 @@ RunResult ComputeOrCheckRun(const Config& config, ProgressReporter& progress,
     // as `share` says.
     const auto match_share = [&](const BoundedOptions& share, float& largest) {
       if (scale.approximate_search)
-        return ApproximateMatches(described.rows, block, rules, share, scale.Approximate(),
+        return ApproximateMatches(described.rows, block, rules, share, scale.approximate,
                                   largest);
       return BoundedMatches(described.rows, block, rules, share, largest,
                             [&](int done, int) { progress.Update(done); });
