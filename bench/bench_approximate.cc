@@ -326,7 +326,7 @@ void BM_Exact(benchmark::State& state, int which, bool hog) {
 
 void BM_Approximate(benchmark::State& state, int which, bool hog, ApproximateOptions options,
                     const std::string& setting, const std::string& build_setting) {
-  if (options.engine != openable::ApproximateEngine::kFlann && !openable::FaissAvailable()) {
+  if (!openable::ApproximateEngineAvailable(options.engine)) {
     state.SkipWithError("this build has no FAISS (libfaiss-dev)");
     return;
   }
@@ -391,7 +391,7 @@ std::vector<Setting> LshSettings() {
   for (const auto& [tables, bits, probe] :
        std::vector<std::tuple<int, int, int>>{{12, 20, 2}, {12, 16, 2}}) {
     ApproximateOptions o;
-    o.engine = openable::ApproximateEngine::kFlann;
+    o.engine = "flann";
     o.lsh_tables = tables;
     o.lsh_key_bits = bits;
     o.lsh_probe_level = probe;
@@ -406,7 +406,7 @@ std::vector<Setting> KdSettings() {
   std::vector<Setting> out;
   for (const int checks : {512, 2048}) {
     ApproximateOptions o;
-    o.engine = openable::ApproximateEngine::kFlann;
+    o.engine = "flann";
     o.checks = checks;
     out.push_back({"flann/trees:4/checks:" + std::to_string(checks), "flann/trees:4", o});
   }
@@ -418,13 +418,13 @@ std::vector<Setting> FaissSettings(const std::vector<int>& ef_searches,
   std::vector<Setting> out;
   for (const int ef : ef_searches) {
     ApproximateOptions o;
-    o.engine = openable::ApproximateEngine::kHnsw;
+    o.engine = "hnsw";
     o.ef_search = ef;
     out.push_back({"hnsw/M:32/ef_search:" + std::to_string(ef), "hnsw/M:32", o});
   }
   for (const int nprobe : nprobes) {
     ApproximateOptions o;
-    o.engine = openable::ApproximateEngine::kIvf;
+    o.engine = "ivf";
     o.nprobe = nprobe;
     out.push_back({"ivf/nprobe:" + std::to_string(nprobe), "ivf", o});
   }

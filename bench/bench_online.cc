@@ -9,7 +9,8 @@
 //                     [--block-frames N] [--foreground-merges] [--csv FILE]
 //                     [--verify] [--verify-candidates K] [--verify-consistency N]
 //                     [--verify-features ORB|SIFT] [--verify-max-features N]
-//                     [--engine hnsw|ivf|flann] [--save-map FILE]
+//                     [--engine NAME] [--save-map FILE]
+// --engine NAME: an approximate-search engine of matching/engine_registry.h (default auto).
 // --verify turns geometric verification on (OnlineOptions::verification, tolerance 3 frames):
 // the answer of a frame is then its first verified candidate, and the time of the checks is
 // reported apart ("verify": features of the frame and every candidate's check).
@@ -94,8 +95,7 @@ int main(int argc, char** argv) {
     else if (a == "--foreground-merges") options.background_merges = false;
     else if (a == "--csv") csv = next();
     else if (a == "--engine")
-      options.approximate.engine =
-          openable::ParseEnum<openable::ApproximateEngine>(next(), "--engine");
+      options.approximate.engine = openable::ParseApproximateEngine(next(), "--engine");
     else if (a == "--save-map") save_map = next();
     else if (a == "--verify") options.verification.enabled = true;
     else if (a == "--verify-candidates") options.verification.candidates = std::stoi(next());
@@ -196,7 +196,7 @@ int main(int argc, char** argv) {
                 "%.1f MB\n",
                 options.descriptor.c_str(), options.sequence_length, options.exclusion,
                 openable::EnumName(options.score).c_str(), options.threshold, prefill, detector.Size(), options.exact_limit,
-                approximate_frames, openable::EnumName(options.approximate.engine).c_str(),
+                approximate_frames, options.approximate.engine.c_str(),
                 detector.Blocks(),
                 options.background_merges ? "in the background" : "in AddFrame",
                 detector.MemoryBytes() / 1e6);

@@ -8,6 +8,7 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
 #include "descriptors/registry.h"
+#include "matching/engine_registry.h"
 
 namespace openable {
 namespace {
@@ -321,19 +322,23 @@ void AddScaleKeys(OptionTable& t, Config& c) {
         "1: bounded mode finds the Best_matches candidates of each query with the index of "
         "Approximate_engine instead of comparing every pair, then scores them with the sequence "
         "sum; faster on very large runs, recall below 1 (docs/benchmarks.md). No band.");
-  t.AddEnumName("Approximate_engine", kScale, c.scale, c.scale.approximate_engine,
-        "Index of Approximate_search (docs/matching.md): auto, ivf for binary descriptors (LDB, "
-        "ORB, ...) and hnsw for vector ones (SIFT, HOG), the faster at a given recall for each "
-        "in docs/benchmarks.md; hnsw, FAISS's HNSW graphs; ivf, FAISS's inverted files "
-        "(k-means cells); flann, OpenCV's FLANN (LSH for binary descriptors, k-d trees for "
-        "vector ones). auto, hnsw and ivf need a build with FAISS (libfaiss-dev).");
-  t.Add("Approximate_checks", kScale, c.scale, c.scale.approximate_checks, 1, 100000,
+  // The approximate search's keys: bound onto ApproximateOptions (ScaleOptions::approximate),
+  // the engine names and their meanings from its registry (matching/engine_registry.h), the
+  // ranges from ApproximateOptions.
+  ApproximateOptions& approximate = c.scale.approximate;
+  using A = ApproximateOptions;
+  t.AddName("Approximate_engine", kScale, c.scale, approximate.engine, &ParseApproximateEngine,
+            "Index of Approximate_search (docs/matching.md): " + ApproximateEngineHelp());
+  t.Add("Approximate_checks", kScale, c.scale, approximate.checks, A::kChecksRange.min,
+        A::kChecksRange.max,
         "Approximate_engine flann, k-d trees (vector descriptors): references examined per "
         "query (more: better recall, slower; LSH for binary descriptors ignores it).");
-  t.Add("Approximate_ef_search", kScale, c.scale, c.scale.approximate_ef_search, 1, 100000,
+  t.Add("Approximate_ef_search", kScale, c.scale, approximate.ef_search, A::kEfSearchRange.min,
+        A::kEfSearchRange.max,
         "Approximate_engine hnsw: length of the candidate list while searching the graph "
         "(efSearch; raised to Best_matches when smaller). More: better recall, slower.");
-  t.Add("Approximate_nprobe", kScale, c.scale, c.scale.approximate_nprobe, 1, 65536,
+  t.Add("Approximate_nprobe", kScale, c.scale, approximate.nprobe, A::kNprobeRange.min,
+        A::kNprobeRange.max,
         "Approximate_engine ivf: k-means cells scanned per query (nprobe; the index has about "
         "2 sqrt(N) cells for N references). More: better recall, slower.");
   t.Add("Descriptor_cache", kScale, c.scale, c.scale.descriptor_cache,

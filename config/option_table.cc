@@ -126,7 +126,8 @@ void OptionTable::AddNumber(const char* key, const char* group, const char* mean
   bindings_.push_back(std::move(b));
 }
 
-void OptionTable::AddText(const char* key, const char* group, const char* meaning, bool is_new,
+void OptionTable::AddText(const char* key, const char* group, const std::string& meaning,
+                          bool is_new,
                           std::function<void(const std::string&)> set,
                           std::function<std::string()> get, std::function<void()> check) {
   OptionBinding b;
@@ -142,7 +143,8 @@ void OptionTable::AddText(const char* key, const char* group, const char* meanin
   bindings_.push_back(std::move(b));
 }
 
-void OptionTable::AddEnum(const char* key, const char* group, const char* meaning, bool is_new,
+void OptionTable::AddEnum(const char* key, const char* group, const std::string& meaning,
+                          bool is_new,
                           std::function<void(const std::string&)> set,
                           std::function<std::string()> get, std::function<void()> check) {
   AddText(key, group, meaning, is_new, nullptr, std::move(get), std::move(check));

@@ -11,6 +11,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -108,6 +109,19 @@ class OptionTable {
         [&field, format] { return format(field); }, CheckOf(owner));
   }
 
+  // A name of a registry (an approximate-search engine, say) in a text field: `parse` returns
+  // the value as the field holds it, or throws InputError naming `key` and the valid names;
+  // `meaning` is made at run time from the same registry.
+  template <typename Owner>
+  void AddName(const char* key, const char* group, Owner& owner, std::string& field,
+               std::string (*parse)(std::string_view text, const std::string& key),
+               const std::string& meaning, bool is_new = true) {
+    AddEnum(
+        key, group, meaning, is_new,
+        [&field, parse, k = std::string(key)](const std::string& v) { field = parse(v, k); },
+        [&field] { return field; }, CheckOf(owner));
+  }
+
   const std::vector<OptionBinding>& Bindings() const& { return bindings_; }
   // On a temporary table (`for (auto& b : ConfigTable(c).Bindings())`), a copy that lives as
   // long as the loop; the bindings still refer to the fields of the options given.
@@ -129,10 +143,10 @@ class OptionTable {
                  OptionBinding::Kind kind, double min, double max, bool min_excluded,
                  std::function<void(double)> set, std::function<double()> get,
                  std::function<void()> check);
-  void AddText(const char* key, const char* group, const char* meaning, bool is_new,
+  void AddText(const char* key, const char* group, const std::string& meaning, bool is_new,
                std::function<void(const std::string&)> set, std::function<std::string()> get,
                std::function<void()> check);
-  void AddEnum(const char* key, const char* group, const char* meaning, bool is_new,
+  void AddEnum(const char* key, const char* group, const std::string& meaning, bool is_new,
                std::function<void(const std::string&)> set, std::function<std::string()> get,
                std::function<void()> check);
 

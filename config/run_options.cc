@@ -1,6 +1,8 @@
 #include "config/run_options.h"
 
 #include <filesystem>
+#include <stdexcept>
+#include <string>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/option_checks.h"
@@ -83,22 +85,24 @@ std::string OutputOptions::ThresholdPngPath(bool thresholded) const {
 
 void OutputOptions::Check() const { CheckIntRange("Matrix_color", matrix_color, 0, 11); }
 
-ApproximateOptions ScaleOptions::Approximate() const {
-  ApproximateOptions o;
-  o.engine = approximate_engine;
-  o.checks = approximate_checks;
-  o.ef_search = approximate_ef_search;
-  o.nprobe = approximate_nprobe;
-  return o;
-}
-
 void ScaleOptions::Check() const {
   CheckNumberAtLeast("Memory_limit", memory_limit, 0);
   keep.Check();
-  CheckIntRange("Approximate_checks", approximate_checks, 1, 100000);
-  CheckIntRange("Approximate_ef_search", approximate_ef_search, 1, 100000);
-  CheckIntRange("Approximate_nprobe", approximate_nprobe, 1, 65536);
-  if (approximate_search) CheckEngineAvailable(approximate_engine, "Approximate_engine");
+  // The ranges are ApproximateOptions' (the option table gives the keys the same).
+  const auto check = [](const char* key, int value, ApproximateRange range) {
+    CheckIntRange(key, value, range.min, range.max);
+  };
+  check("Approximate_checks", approximate.checks, ApproximateOptions::kChecksRange);
+  check("Approximate_ef_search", approximate.ef_search, ApproximateOptions::kEfSearchRange);
+  check("Approximate_nprobe", approximate.nprobe, ApproximateOptions::kNprobeRange);
+  ParseApproximateEngine(approximate.engine, "Approximate_engine");
+  // The fields no key sets (a program may): named as the struct's field.
+  try {
+    approximate.Check();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string("ScaleOptions.approximate: ") + e.what());
+  }
+  if (approximate_search) CheckEngineAvailable(approximate.engine, "Approximate_engine");
   if (approximate_search && matrix_mode == MatrixMode::kDense)
     throw InputError("Approximate_search: 1 needs Matrix_mode 2 (bounded) or 0 (auto); "
                      "Matrix_mode is 1 (dense), which compares every pair");

@@ -77,18 +77,15 @@ struct ScaleOptions {
   KeepRules keep;                 // Best_matches and Band_width (its exclusion: Exclusion)
   std::string matches_name;       // kept matches, .npy or .csv
   bool approximate_search = false;  // approximate candidates instead of every pair (bounded)
-  // The engine of the candidates (matching/approximate.h); hnsw and ivf need FAISS in the build.
-  ApproximateEngine approximate_engine = ApproximateEngine::kAuto;
-  int approximate_checks = 512;   // FLANN k-d trees: references examined per query, 1..100000
-  int approximate_ef_search = 128;  // hnsw: candidate list while searching, 1..100000
-  int approximate_nprobe = 64;     // ivf: cells scanned per query, 1..65536
+  // The engine and search budget of those candidates (matching/approximate.h; the keys
+  // Approximate_engine, Approximate_checks, Approximate_ef_search and Approximate_nprobe are
+  // bound onto its fields). The run sets its k (from Best_matches) and threads.
+  ApproximateOptions approximate;
   std::string descriptor_cache;   // folder of the descriptor cache; empty: off
 
   // Throws InputError naming the key: a value out of range, approximate search with the dense
   // mode, the bounded mode without Matches_name, a matches file that is not .npy or .csv.
   void Check() const;
-  // The options of the approximate index these keys give (k and threads left to the caller).
-  ApproximateOptions Approximate() const;
 };
 
 // The auto mode (the Auto keys, config/presets/auto.txt): the description and matching

@@ -1,5 +1,5 @@
 // The bounded mode with approximate candidates (Approximate_search 1): the index of
-// Approximate_engine (matching/approximate.h: FAISS HNSW or IVF, or OpenCV's FLANN) finds the
+// Approximate_engine (matching/approximate.h, an engine of matching/engine_registry.h) finds the
 // candidates of each query; each candidate is then scored by its exact sequence sum
 // (SequenceCellDistance). Declared in matching/bounded.h.
 #include <algorithm>

@@ -1,7 +1,7 @@
 // The entry points of the run-time module libopenable_faiss.so (matching/faiss_module.cc), the
-// FAISS indexes of ApproximateIndex (matching/approximate.h). The module links FAISS, OpenMP
-// and BLAS and nothing of OpenABLE but this header, so that openable_matching reaches it
-// through ModuleSymbol (OpenABLE/base/module_loader.h) alone. Module and program come from the
+// FAISS indexes of the engines hnsw and ivf (matching/faiss_engines.h). The module links FAISS,
+// OpenMP and BLAS and nothing of OpenABLE but this header, so that openable_matching reaches
+// it through ModuleSymbol (OpenABLE/base/module_loader.h) alone. Module and program come from the
 // same build, so C++ types and exceptions cross the boundary.
 #pragma once
 
@@ -11,16 +11,20 @@
 
 namespace openable {
 
-// What the module needs of ApproximateOptions, checked by ApproximateOptions::Check.
+// What the module needs of an index: a plain view of ApproximateOptions and of the rows, made
+// in one place (SettingsOf, matching/faiss_engines.cc) with every field set from them; no
+// defaults of its own, the settings' defaults and ranges are ApproximateOptions'.
 struct FaissSettings {
-  bool hnsw = true;     // HNSW, else IVF
-  bool binary = true;   // Hamming on packed bits (IndexBinary*), else L2 on floats
-  int width = 0;        // bytes of a binary row, floats of a float row
-  int hnsw_m = 32, hnsw_ef_construction = 64, ef_search = 64;
-  int ivf_lists = 0;    // 0: automatic (see ApproximateOptions::ivf_lists)
-  int nprobe = 16;
-  int threads = 0;      // OpenMP threads of training and searches (0: all cores)
-  int seed = 0;         // IVF k-means seed
+  bool hnsw;                 // HNSW, else IVF
+  bool binary;               // Hamming on packed bits (IndexBinary*), else L2 on floats
+  int width;                 // bytes of a binary row, floats of a float row
+  int hnsw_m;                // ApproximateOptions::hnsw_m
+  int hnsw_ef_construction;  // ApproximateOptions::hnsw_ef_construction
+  int ef_search;             // ApproximateOptions::ef_search, raised to k
+  int ivf_lists;             // ApproximateOptions::ivf_lists (0: automatic)
+  int nprobe;                // ApproximateOptions::nprobe
+  int threads;               // OpenMP threads of training and searches (0: all cores)
+  int seed;                  // IVF k-means seed: the low 31 bits of ApproximateOptions::seed
 };
 
 // One built FAISS index.

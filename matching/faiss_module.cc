@@ -55,25 +55,31 @@ void SetClustering(faiss::ClusteringParameters& cp, int seed) {
   cp.max_points_per_centroid = 64;
 }
 
-// The search parameters of `s` on a built or read index; false when the index is not of the
-// kind `s` names (Hnsw or Ivf: the binary or float classes of FAISS).
+// The search parameters (ef_search of HNSW, nprobe of IVF) on a built or read index; false when
+// the index is not of the kind `hnsw` names (Hnsw or Ivf: the binary or float classes of
+// FAISS).
 template <typename Hnsw, typename Ivf, typename Base>
-bool SetSearchAs(Base* index, const FaissSettings& s) {
-  if (auto* h = dynamic_cast<Hnsw*>(index); h && s.hnsw) {
-    h->hnsw.efSearch = s.ef_search;
+bool SetSearchAs(Base* index, bool hnsw, int ef_search, int nprobe) {
+  if (auto* h = dynamic_cast<Hnsw*>(index); h && hnsw) {
+    h->hnsw.efSearch = ef_search;
     return true;
   }
-  if (auto* v = dynamic_cast<Ivf*>(index); v && !s.hnsw) {
-    v->nprobe = std::min<std::size_t>(static_cast<size_t>(s.nprobe), v->nlist);
+  if (auto* v = dynamic_cast<Ivf*>(index); v && !hnsw) {
+    v->nprobe = std::min<std::size_t>(static_cast<size_t>(nprobe), v->nlist);
     return true;
   }
   return false;
 }
-bool SetSearch(faiss::IndexBinary* index, const FaissSettings& s) {
-  return SetSearchAs<faiss::IndexBinaryHNSW, faiss::IndexBinaryIVF>(index, s);
+bool SetSearch(faiss::IndexBinary* index, bool hnsw, int ef_search, int nprobe) {
+  return SetSearchAs<faiss::IndexBinaryHNSW, faiss::IndexBinaryIVF>(index, hnsw, ef_search,
+                                                                    nprobe);
 }
-bool SetSearch(faiss::Index* index, const FaissSettings& s) {
-  return SetSearchAs<faiss::IndexHNSWFlat, faiss::IndexIVFFlat>(index, s);
+bool SetSearch(faiss::Index* index, bool hnsw, int ef_search, int nprobe) {
+  return SetSearchAs<faiss::IndexHNSWFlat, faiss::IndexIVFFlat>(index, hnsw, ef_search, nprobe);
+}
+template <typename Base>
+bool SetSearch(Base* index, const FaissSettings& s) {
+  return SetSearch(index, s.hnsw, s.ef_search, s.nprobe);
 }
 
 bool IsHnsw(const faiss::IndexBinary* index) {
@@ -120,11 +126,7 @@ class Wrapped final : public FaissIndex {
     index_->search(n, static_cast<const Element*>(queries), k, distances.data(), labels);
   }
   void SetSearch(int ef_search, int nprobe) override {
-    FaissSettings s;
-    s.ef_search = ef_search;
-    s.nprobe = nprobe;
-    s.hnsw = IsHnsw(index_.get());
-    openable::SetSearch(index_.get(), s);
+    openable::SetSearch(index_.get(), IsHnsw(index_.get()), ef_search, nprobe);
   }
   std::vector<std::uint8_t> Serialize() const override {
     faiss::VectorIOWriter writer;

@@ -8,6 +8,8 @@
 #include <string>
 #include <utility>
 
+#include "matching/approximate_engine.h"
+
 namespace openable {
 
 struct IncrementalIndex::State {
@@ -190,21 +192,14 @@ int IncrementalIndex::Blocks() const { return static_cast<int>(state_->blocks.si
 std::int64_t IncrementalIndex::MemoryBytes() const {
   const State& s = *state_;
   std::int64_t bytes = static_cast<std::int64_t>(s.buffer.total()) * s.buffer.elemSize();
-  // Each index holds a copy of its rows (for the exact distances) plus its structure. FLANN:
-  // counted as one more copy of the rows (LSH: 12 tables of one 4-byte id per row is less;
-  // k-d trees: 4 trees of nodes per row). FAISS also keeps its own copy of the rows; HNSW adds
-  // its links, 2 M 4-byte ids per row on the bottom layer and about M more above; binary IVF
-  // an 8-byte id per row in FAISS, and the rows again, packed by cell for OpenABLE's scan, with
-  // a 4-byte id each (the centroids are few).
-  const ApproximateOptions& a = s.options.approximate;
+  // Each index holds a copy of its rows (for the exact distances) plus its engine's structure
+  // (ApproximateEngineEntry::bytes_per_row).
   const std::int64_t row_bytes = s.width * static_cast<std::int64_t>(s.buffer.elemSize());
-  auto index_bytes = [&](std::int64_t rows) {
-    std::int64_t extra = 0;
-    const ApproximateEngine engine = ResolvedEngine(a.engine, s.buffer.depth());
-    if (engine == ApproximateEngine::kHnsw) extra = 3 * a.hnsw_m * 4 + 8;
-    if (engine == ApproximateEngine::kIvf) extra = s.type == CV_8U ? 8 + row_bytes + 4 : 8;
-    return rows * (2 * row_bytes + extra);
-  };
+  const ApproximateEngineEntry& engine =
+      FindApproximateEngine(s.options.approximate.engine, s.type);
+  const std::int64_t per_row =
+      row_bytes + engine.bytes_per_row(s.options.approximate, s.type, row_bytes);
+  auto index_bytes = [&](std::int64_t rows) { return rows * per_row; };
   for (const auto& b : s.blocks) bytes += index_bytes(b.count);
   // A merge being built: its index and the copy of its rows handed to the build.
   if (s.merge) bytes += index_bytes(s.merge->count) + s.merge->count * row_bytes;

@@ -3,7 +3,7 @@
 //
 // Rows are appended one by one. While the searchable rows number at most exact_limit, every
 // one is a candidate (an exact scan); beyond, rows are indexed by the engine of
-// options.approximate (matching/approximate.h: FAISS HNSW or IVF, or FLANN) in blocks of
+// options.approximate (matching/approximate.h, matching/engine_registry.h) in blocks of
 // block_frames rows merged as they grow (sizes block_frames x 2^m, at most one of each, like a
 // binary counter), and only the newest unindexed rows (fewer than block_frames) are scanned
 // exactly. Merges of two blocks are built on a background thread while the two old blocks go

@@ -17,7 +17,7 @@ namespace {
 std::string IndexUsed(const Config& c, const RunResult& r) {
   if (!c.scale.approximate_search || r.descriptors.size() != 1) return "";
   const int depth = r.descriptors.front().metric == Metric::kL2 ? CV_32F : CV_8U;
-  return EnumName(ResolvedEngine(c.scale.approximate_engine, depth));
+  return ResolvedEngine(c.scale.approximate.engine, depth);
 }
 
 }  // namespace
@@ -67,8 +67,9 @@ std::string FormatRunReport(const Config& config, const RunOutcome& outcome) {
   out << "  mode: " << r.mode_reason;
   if (const std::string index = IndexUsed(c, r); !index.empty())
     out << ", index " << index
-        << (c.scale.approximate_engine == ApproximateEngine::kAuto ? " (Approximate_engine auto)"
-                                                                   : "");
+        << (Lower(c.scale.approximate.engine) == kAutoApproximateEngine
+                ? " (Approximate_engine auto)"
+                : "");
   out << "\n";
   const Cluster& cluster = Cluster::Get();
   if (cluster.Distributed())

@@ -370,7 +370,7 @@ std::vector<std::pair<std::string, std::string>> IndexSettings(const OnlineOptio
   return {{"exclusion", std::to_string(o.exclusion)},
           {"exact_limit", std::to_string(o.exact_limit)},
           {"block_frames", std::to_string(o.block_frames)},
-          {"engine", EnumName(a.engine)},
+          {"engine", ParseApproximateEngine(a.engine, "OnlineOptions.approximate.engine")},
           {"hnsw_m", std::to_string(a.hnsw_m)},
           {"hnsw_ef_construction", std::to_string(a.hnsw_ef_construction)},
           {"ivf_lists", std::to_string(a.ivf_lists)},

@@ -61,10 +61,10 @@ struct OnlineOptions {
   // docs/library.md). With the ratio score choose it anew (docs/library.md gives figures).
   double threshold = 0.13;
   // Search: exact (every earlier frame) while the searchable map holds at most exact_limit
-  // frames; beyond, frames are indexed by approximate.engine (FAISS HNSW or IVF, or FLANN:
-  // matching/approximate.h) in blocks of block_frames merged as they grow (sizes block_frames x
-  // 2^m, at most one of each), and only the newest unindexed frames (< block_frames) are
-  // scanned exactly.
+  // frames; beyond, frames are indexed by approximate.engine (an engine of
+  // matching/engine_registry.h) in blocks of block_frames merged as they grow (sizes
+  // block_frames x 2^m, at most one of each), and only the newest unindexed frames
+  // (< block_frames) are scanned exactly.
   int exact_limit = 20000;
   int block_frames = 4096;
   // Merges of two blocks into one are built on a background thread while the frames go on

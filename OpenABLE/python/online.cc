@@ -5,6 +5,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <tuple>
 #include <type_traits>
 #include <utility>
@@ -13,6 +14,7 @@
 
 #include "OpenABLE/online/online.h"
 #include "OpenABLE/python/common.h"
+#include "matching/engine_registry.h"
 #include "matching/sequence.h"
 
 namespace openable::python {
@@ -140,26 +142,28 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
         name, [outer, member](const O& o) { return o.*outer.*member; },
         [outer, member](O& o, T v) { o.*outer.*member = v; }, doc);
   };
-  const auto flann = [&nested](const char* name, auto member, const char* doc) {
+  const auto search = [&nested](const char* name, auto member, const char* doc) {
     nested(name, &O::approximate, member, doc);
   };
+  // The engine's names and their meanings come from its registry (matching/engine_registry.h).
+  static const std::string engine_doc =
+      "Index of the blocks beyond exact_limit: " + ApproximateEngineHelp();
   c.def_property(
-      "engine", [](const O& o) { return EnumName(o.approximate.engine); },
+      "engine", [](const O& o) { return o.approximate.engine; },
       [](O& o, const std::string& v) {
-        o.approximate.engine = ParseEnum<ApproximateEngine>(v, "engine");
+        o.approximate.engine = ParseApproximateEngine(v, "engine");
       },
-      "Index of the blocks beyond exact_limit: \"auto\" (default: \"ivf\" for binary "
-      "descriptors, \"hnsw\" for vector ones), \"hnsw\" or \"ivf\" (FAISS), \"flann\".");
-  flann("approximate_k", &ApproximateOptions::k, "Candidates per block (>= candidates).");
-  flann("ef_search", &ApproximateOptions::ef_search, "HNSW: candidate list while searching.");
-  flann("nprobe", &ApproximateOptions::nprobe, "IVF: cells scanned per query.");
-  flann("checks", &ApproximateOptions::checks, "k-d trees: references examined per query.");
-  flann("lsh_tables", &ApproximateOptions::lsh_tables, "LSH hash tables.");
-  flann("lsh_key_bits", &ApproximateOptions::lsh_key_bits, "Bits of an LSH key.");
-  flann("lsh_probe_level", &ApproximateOptions::lsh_probe_level, "LSH multi-probe level.");
-  flann("kd_trees", &ApproximateOptions::kd_trees, "Randomised k-d trees.");
-  flann("threads", &ApproximateOptions::threads, "Threads of a search; 0 = all cores.");
-  flann("seed", &ApproximateOptions::seed, "Seed of the index build.");
+      engine_doc.c_str());
+  search("approximate_k", &ApproximateOptions::k, "Candidates per block (>= candidates).");
+  search("ef_search", &ApproximateOptions::ef_search, "HNSW: candidate list while searching.");
+  search("nprobe", &ApproximateOptions::nprobe, "IVF: cells scanned per query.");
+  search("checks", &ApproximateOptions::checks, "k-d trees: references examined per query.");
+  search("lsh_tables", &ApproximateOptions::lsh_tables, "LSH hash tables.");
+  search("lsh_key_bits", &ApproximateOptions::lsh_key_bits, "Bits of an LSH key.");
+  search("lsh_probe_level", &ApproximateOptions::lsh_probe_level, "LSH multi-probe level.");
+  search("kd_trees", &ApproximateOptions::kd_trees, "Randomised k-d trees.");
+  search("threads", &ApproximateOptions::threads, "Threads of a search; 0 = all cores.");
+  search("seed", &ApproximateOptions::seed, "Seed of the index build.");
   // Geometric verification (OpenABLE/verification/verification.h, the Verification_* keys).
   const auto verify = [&nested](const char* name, auto member, const char* doc) {
     nested(name, &O::verification, member, doc);
@@ -246,6 +250,14 @@ const char* const kDescriptionArgs =
 }  // namespace
 
 void RegisterOnline(py::module_& m) {
+  m.def("approximate_engines", &ApproximateEngineNames,
+        (std::string(R"doc(approximate_engines() -> list[str]
+
+Names of the approximate-search engines, the values of OnlineOptions.engine (any case), in
+the order shown to users: )doc") +
+         ApproximateEngineHelp())
+            .c_str());
+
   m.def(
       "describe",
       [](const py::object& image, const std::string& descriptor, const std::string& description,

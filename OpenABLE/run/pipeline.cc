@@ -245,7 +245,7 @@ void ComputeBounded(const RunPlan& plan, ProgressReporter& progress, RunResult& 
   // as `share` says.
   const auto match_share = [&](const BoundedOptions& share, float& largest) {
     if (scale.approximate_search)
-      return ApproximateMatches(described.rows, block, rules, share, scale.Approximate(),
+      return ApproximateMatches(described.rows, block, rules, share, scale.approximate,
                                 largest);
     return BoundedMatches(described.rows, block, rules, share, largest,
                           [&](int done, int) { progress.Update(done); });

@@ -189,27 +189,27 @@ TEST(Config, ApproximateEngineValues) {
   Config c;
   c.input.images_path = "x";
   c.scale.matches_name = "m.csv";
-  EXPECT_EQ(c.scale.approximate_engine, ApproximateEngine::kAuto);  // the default
+  EXPECT_EQ(c.scale.approximate.engine, "auto");  // the default
   ApplyOverride(c, "Approximate_engine=flann");
-  EXPECT_EQ(c.scale.approximate_engine, ApproximateEngine::kFlann);
+  EXPECT_EQ(c.scale.approximate.engine, "flann");
   ApplyOverride(c, "Approximate_engine=IVF");
-  EXPECT_EQ(c.scale.approximate_engine, ApproximateEngine::kIvf);
+  EXPECT_EQ(c.scale.approximate.engine, "ivf");
   ApplyOverride(c, "Approximate_engine=hnsw");
-  EXPECT_EQ(c.scale.approximate_engine, ApproximateEngine::kHnsw);
+  EXPECT_EQ(c.scale.approximate.engine, "hnsw");
   EXPECT_EQ(ConfigValueText(c, "Approximate_engine"), "\"hnsw\"");
   const std::string bad = ErrorOf([&] { ApplyOverride(c, "Approximate_engine=annoy"); });
   EXPECT_NE(bad.find("Approximate_engine"), std::string::npos) << bad;
   EXPECT_NE(bad.find("annoy"), std::string::npos) << bad;
   EXPECT_NE(bad.find("flann, hnsw, ivf or auto"), std::string::npos) << bad;
   EXPECT_EQ(bad.find('\n'), std::string::npos) << bad;
-  EXPECT_EQ(c.scale.approximate_engine, ApproximateEngine::kHnsw);  // unchanged
+  EXPECT_EQ(c.scale.approximate.engine, "hnsw");  // unchanged
   // Read from a file as well.
   const Config f = LoadConfig(WriteFile("%YAML:1.0\nApproximate_engine: ivf\n"
                                         "Approximate_nprobe: 32\nApproximate_ef_search: 128\n"));
-  EXPECT_EQ(f.scale.approximate_engine, ApproximateEngine::kIvf);
-  EXPECT_EQ(f.scale.Approximate().nprobe, 32);
-  EXPECT_EQ(f.scale.Approximate().ef_search, 128);
-  EXPECT_EQ(f.scale.Approximate().engine, ApproximateEngine::kIvf);
+  EXPECT_EQ(f.scale.approximate.engine, "ivf");
+  EXPECT_EQ(f.scale.approximate.nprobe, 32);
+  EXPECT_EQ(f.scale.approximate.ef_search, 128);
+  EXPECT_EQ(f.scale.approximate.engine, "ivf");
 
   c.scale.approximate_search = true;
   for (const char* engine : {"flann", "hnsw", "ivf", "auto"}) {

@@ -198,7 +198,7 @@ TEST(ExactNearest, ViewsAndEmptyQueries) {
 // FLANN's options (the default engine is auto: IVF or HNSW).
 ApproximateOptions FlannOptions() {
   ApproximateOptions o;
-  o.engine = ApproximateEngine::kFlann;
+  o.engine = "flann";
   return o;
 }
 
@@ -455,7 +455,7 @@ TEST(MeasureRecall, TiesCountAndAtKCounts) {
 #define SKIP_WITHOUT_FAISS() \
   if (!FaissAvailable()) GTEST_SKIP() << "this build has no FAISS (libfaiss-dev)"
 
-ApproximateOptions EngineOptions(ApproximateEngine engine) {
+ApproximateOptions EngineOptions(const std::string& engine) {
   ApproximateOptions o;
   o.engine = engine;
   return o;
@@ -478,8 +478,8 @@ TEST(ApproximateIndex, FaissBinaryIndexesFindPlantedNearDuplicates) {
   const std::vector<int> source = EveryNth(4000, 4);
   const cv::Mat queries = FlipBits(refs, source, 8, 102);
   const CandidateLists exact = ExactNearest(refs, queries, 10);
-  for (const ApproximateEngine engine : {ApproximateEngine::kHnsw, ApproximateEngine::kIvf}) {
-    SCOPED_TRACE(EnumName(engine));
+  for (const std::string engine : {"hnsw", "ivf"}) {
+    SCOPED_TRACE(engine);
     const ApproximateIndex index(refs, EngineOptions(engine));
     EXPECT_EQ(index.Type(), CV_8U);
     const CandidateLists approximate = index.Search(queries);
@@ -500,8 +500,8 @@ TEST(ApproximateIndex, FaissFloatIndexesFindPlantedNearDuplicates) {
   const std::vector<int> source = EveryNth(4000, 4);
   const cv::Mat queries = AddNoise(refs, source, 0.1f, 112);
   const CandidateLists exact = ExactNearest(refs, queries, 10);
-  for (const ApproximateEngine engine : {ApproximateEngine::kHnsw, ApproximateEngine::kIvf}) {
-    SCOPED_TRACE(EnumName(engine));
+  for (const std::string engine : {"hnsw", "ivf"}) {
+    SCOPED_TRACE(engine);
     const ApproximateIndex index(refs, EngineOptions(engine));
     EXPECT_EQ(index.Type(), CV_32F);
     const CandidateLists approximate = index.Search(queries);
@@ -517,12 +517,12 @@ TEST(ApproximateIndex, FaissSearchBudgetChangesRecall) {
   SKIP_WITHOUT_FAISS();
   const cv::Mat refs = RandomFloats(4000, 32, 121), queries = RandomFloats(200, 32, 122);
   const CandidateLists exact = ExactNearest(refs, queries, 10);
-  ApproximateOptions small = EngineOptions(ApproximateEngine::kIvf), large = small;
+  ApproximateOptions small = EngineOptions("ivf"), large = small;
   small.nprobe = 1;
   large.nprobe = 1000;  // every cell: exact
   EXPECT_LT(MeasureRecall(exact, ApproximateIndex(refs, small).Search(queries)).at_k, 0.8);
   EXPECT_DOUBLE_EQ(MeasureRecall(exact, ApproximateIndex(refs, large).Search(queries)).at_k, 1.0);
-  small = large = EngineOptions(ApproximateEngine::kHnsw);
+  small = large = EngineOptions("hnsw");
   small.ef_search = 1;  // raised to k = 10
   large.ef_search = 2000;
   EXPECT_LT(MeasureRecall(exact, ApproximateIndex(refs, small).Search(queries)).at_k,
@@ -539,7 +539,7 @@ TEST(ApproximateIndex, BinaryIvfScansItsCellsWithExactDistances) {
     SCOPED_TRACE(width);
     const cv::Mat refs = RandomBytes(3000, width, 150 + width);
     const cv::Mat queries = FlipBits(refs, EveryNth(3000, 25), 4 * width / 8 + 1, 160 + width);
-    ApproximateOptions all = EngineOptions(ApproximateEngine::kIvf), one = all;
+    ApproximateOptions all = EngineOptions("ivf"), one = all;
     all.nprobe = 65536;
     one.nprobe = 1;
     ExpectSameLists(NaiveNearest(refs, queries, all.k), ApproximateIndex(refs, all).Search(queries));
@@ -561,10 +561,10 @@ TEST(ApproximateIndex, BinaryIvfScansItsCellsWithExactDistances) {
 }
 
 TEST(ApproximateIndex, AutoEngineIsIvfForBinaryRowsAndHnswForFloatRows) {
-  EXPECT_EQ(ResolvedEngine(ApproximateEngine::kAuto, CV_8U), ApproximateEngine::kIvf);
-  EXPECT_EQ(ResolvedEngine(ApproximateEngine::kAuto, CV_32F), ApproximateEngine::kHnsw);
-  EXPECT_EQ(ResolvedEngine(ApproximateEngine::kFlann, CV_8U), ApproximateEngine::kFlann);
-  EXPECT_EQ(ResolvedEngine(ApproximateEngine::kHnsw, CV_8U), ApproximateEngine::kHnsw);
+  EXPECT_EQ(ResolvedEngine("auto", CV_8U), "ivf");
+  EXPECT_EQ(ResolvedEngine("auto", CV_32F), "hnsw");
+  EXPECT_EQ(ResolvedEngine("flann", CV_8U), "flann");
+  EXPECT_EQ(ResolvedEngine("hnsw", CV_8U), "hnsw");
   SKIP_WITHOUT_FAISS();
   // The index built with auto is the one built with the resolved engine: same candidates.
   const cv::Mat bytes = RandomBytes(2000, 32, 171), floats = RandomFloats(2000, 16, 172);
@@ -572,7 +572,7 @@ TEST(ApproximateIndex, AutoEngineIsIvfForBinaryRowsAndHnswForFloatRows) {
     const cv::Mat queries = refs.rowRange(0, 100);
     ApproximateOptions automatic;
     ApproximateOptions resolved = automatic;
-    resolved.engine = refs.depth() == CV_8U ? ApproximateEngine::kIvf : ApproximateEngine::kHnsw;
+    resolved.engine = refs.depth() == CV_8U ? "ivf" : "hnsw";
     const ApproximateIndex index(refs, automatic);
     EXPECT_EQ(index.Options().engine, resolved.engine);
     EXPECT_TRUE(SameLists(index.Search(queries), ApproximateIndex(refs, resolved).Search(queries)));
@@ -587,8 +587,8 @@ TEST(ApproximateIndex, FaissDeterministicAcrossBuildsAndThreads) {
   const cv::Mat float_queries = AddNoise(floats, EveryNth(3000, 3), 0.5f, 134);
   for (const auto& [refs, queries] :
        {std::pair{bytes, byte_queries}, std::pair{floats, float_queries}}) {
-    for (const ApproximateEngine engine : {ApproximateEngine::kHnsw, ApproximateEngine::kIvf}) {
-      SCOPED_TRACE(EnumName(engine) + (refs.depth() == CV_8U ? " binary" : " float"));
+    for (const std::string engine : {"hnsw", "ivf"}) {
+      SCOPED_TRACE(engine + (refs.depth() == CV_8U ? " binary" : " float"));
       ApproximateOptions one = EngineOptions(engine), two = one;
       one.threads = 1;
       two.threads = 2;
@@ -599,7 +599,7 @@ TEST(ApproximateIndex, FaissDeterministicAcrossBuildsAndThreads) {
       const CandidateLists c = ApproximateIndex(refs, two).Search(queries);
       EXPECT_TRUE(SameLists(a, b));
       EXPECT_TRUE(SameLists(b, c));
-      if (engine == ApproximateEngine::kIvf) {  // the k-means seed is used
+      if (engine == "ivf") {  // the k-means seed is used
         ApproximateOptions other = one;
         other.seed = 12345;
         EXPECT_FALSE(SameLists(a, ApproximateIndex(refs, other).Search(queries)));
@@ -610,8 +610,8 @@ TEST(ApproximateIndex, FaissDeterministicAcrossBuildsAndThreads) {
 
 TEST(ApproximateIndex, FaissSmallSetsAndConcurrentSearches) {
   SKIP_WITHOUT_FAISS();
-  for (const ApproximateEngine engine : {ApproximateEngine::kHnsw, ApproximateEngine::kIvf}) {
-    SCOPED_TRACE(EnumName(engine));
+  for (const std::string engine : {"hnsw", "ivf"}) {
+    SCOPED_TRACE(engine);
     // Fewer references than k (IVF: one cell): every one, in order.
     const cv::Mat refs = RandomFloats(5, 8, 141), queries = RandomFloats(3, 8, 142);
     ExpectSameLists(NaiveNearest(refs, queries, 10),
@@ -635,13 +635,13 @@ TEST(ApproximateIndex, FaissSmallSetsAndConcurrentSearches) {
 TEST(ApproximateIndex, RejectsBadFaissOptions) {
   const cv::Mat bytes = RandomBytes(10, 32, 151);
   auto with = [](auto change) {
-    ApproximateOptions o = EngineOptions(ApproximateEngine::kHnsw);
+    ApproximateOptions o = EngineOptions("hnsw");
     change(o);
     return o;
   };
   const std::pair<ApproximateOptions, const char*> bad[] = {
-      {with([](ApproximateOptions& o) { o.engine = static_cast<ApproximateEngine>(7); }),
-       "engine = 7, expected one of flann, hnsw, ivf or auto"},
+      {with([](ApproximateOptions& o) { o.engine = "annoy"; }),
+       "engine = \"annoy\", expected one of flann, hnsw, ivf or auto"},
       {with([](ApproximateOptions& o) { o.hnsw_m = 2; }), "hnsw_m = 2, expected 4..128"},
       {with([](ApproximateOptions& o) { o.hnsw_ef_construction = 0; }),
        "hnsw_ef_construction = 0"},
@@ -664,8 +664,8 @@ TEST(ApproximateIndex, RejectsBadFaissOptions) {
 // A build without FAISS refuses its engines with one line naming the key; with FAISS they are
 // accepted. FLANN is always available.
 TEST(ApproximateIndex, FaissEnginesNeedFaissInTheBuild) {
-  EXPECT_NO_THROW(CheckEngineAvailable(ApproximateEngine::kFlann, "Approximate_engine"));
-  for (const ApproximateEngine engine : {ApproximateEngine::kHnsw, ApproximateEngine::kIvf}) {
+  EXPECT_NO_THROW(CheckEngineAvailable("flann", "Approximate_engine"));
+  for (const std::string engine : {"hnsw", "ivf"}) {
     if (FaissAvailable()) {
       EXPECT_NO_THROW(CheckEngineAvailable(engine, "Approximate_engine"));
       continue;
@@ -674,7 +674,7 @@ TEST(ApproximateIndex, FaissEnginesNeedFaissInTheBuild) {
       CheckEngineAvailable(engine, "Approximate_engine");
       ADD_FAILURE() << "accepted without FAISS";
     } catch (const InputError& e) {
-      EXPECT_EQ(std::string(e.what()).rfind("Approximate_engine: " + EnumName(engine), 0), 0u)
+      EXPECT_EQ(std::string(e.what()).rfind("Approximate_engine: " + engine, 0), 0u)
           << e.what();
     }
     EXPECT_THROW(ApproximateIndex(RandomBytes(10, 32, 161), EngineOptions(engine)), InputError);

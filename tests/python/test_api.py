@@ -102,6 +102,25 @@ class SameMessageAsTheProgramsTest(TempDirTestCase):
                                   self.tmp)
         self.assertEqual(done.stderr, "Test_OpenABLE: error: %s\n" % caught.exception)
 
+    def test_approximate_engines_are_the_programs(self):
+        # The names come from the engine registry: the Python property accepts each (any case),
+        # its docstring names each, and a bad name lists them as Test_OpenABLE's key does.
+        names = openable.approximate_engines()
+        self.assertEqual(names[-1], "auto")
+        self.assertEqual(openable.OnlineOptions().engine, "auto")
+        doc = openable.OnlineOptions.engine.__doc__
+        for name in names:
+            self.assertEqual(openable.OnlineOptions(engine=name.upper()).engine, name)
+            self.assertRegex(doc, r"\b%s[ ,]" % re.escape(name))
+        with self.assertRaises(openable.InputError) as caught:
+            openable.OnlineOptions(engine="annoy")
+        listed = ", ".join(names[:-1]) + " or " + names[-1]
+        self.assertEqual(str(caught.exception),
+                         'engine: "annoy" is not valid; expected %s' % listed)
+        done = run_expect_failure("Test_OpenABLE", ["--set", "Approximate_engine=annoy"], self.tmp)
+        self.assertIn('Approximate_engine: "annoy" is not valid; expected %s\n' % listed,
+                      done.stderr)
+
 
 def run_expect_failure(name, args, cwd):
     import subprocess
