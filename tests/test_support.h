@@ -19,6 +19,10 @@ std::string ReadBytes(const std::string& path);
 // one of `parts`.
 void ExpectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts);
 
+// The message of the InputError that `f` throws; fails the test (and returns "") when `f` throws
+// nothing or another exception.
+std::string InputErrorMessage(const std::function<void()>& f);
+
 // `path` between double quotes, as error messages quote file names.
 inline std::string Q(const std::string& path) { return "\"" + path + "\""; }
 
