@@ -23,6 +23,17 @@ void ExpectInputError(const std::function<void()>& f, std::initializer_list<std:
 // nothing or another exception.
 std::string InputErrorMessage(const std::function<void()>& f);
 
+// The message of the InputError that Check() throws on `Options` at their defaults but for what
+// `change` sets; fails the test (and returns "") when it throws nothing or another exception.
+template <typename Options>
+std::string CheckError(const std::function<void(Options&)>& change) {
+  return InputErrorMessage([&] {
+    Options o;
+    change(o);
+    o.Check();
+  });
+}
+
 // `path` between double quotes, as error messages quote file names.
 inline std::string Q(const std::string& path) { return "\"" + path + "\""; }
 
