@@ -3,13 +3,11 @@
 # against summer references, 1788 each): share of queries whose exact best match (dense run,
 # same settings) is the approximate best (top-1) or among the approximate Best_matches (in-k),
 # and the wall times. Usage: bench/approximate_recall.sh [descriptor] [L] [checks ...]
-set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
-data="$root/../shared/datasets/nordland_trimmed"
-exe="$root/build/examples/Test_OpenABLE"
+source "$(dirname "$0")/common.sh"
+data="$datasets/nordland_trimmed"
 desc="${1:-LDB}"; L="${2:-1}"; shift $(( $# > 2 ? 2 : $# )) || true
 checks=("$@"); [ ${#checks[@]} -gt 0 ] || checks=(32 128 512)
-out="$(mktemp -d)"; trap 'rm -rf "$out"' EXIT
+prepare "$data" "$exe"
 run() {  # name, extra settings...
   local name="$1"; shift
   /usr/bin/time -f "%e" -o "$out/$name.time" "$exe" --quiet --set Images_path="$data/summer" \

@@ -302,12 +302,16 @@ struct Summary {
 };
 std::map<std::string, Summary> g_summary;  // by set/descriptor/setting
 
+// Marks the benchmark skipped with the data set's error when it could not be read.
+bool SkippedForError(benchmark::State& state, const DataSet& d) {
+  if (d.error.empty()) return false;
+  state.SkipWithError(d.error.c_str());
+  return true;
+}
+
 void BM_Exact(benchmark::State& state, int which, bool hog) {
   const DataSet& d = Data(which);
-  if (!d.error.empty()) {
-    state.SkipWithError(d.error.c_str());
-    return;
-  }
+  if (SkippedForError(state, d)) return;
   const cv::Mat& refs = References(d, hog);
   const cv::Mat& queries = Queries(d, hog);
   CandidateLists lists;
@@ -331,10 +335,7 @@ void BM_Approximate(benchmark::State& state, int which, bool hog, ApproximateOpt
     return;
   }
   const DataSet& d = Data(which);
-  if (!d.error.empty()) {
-    state.SkipWithError(d.error.c_str());
-    return;
-  }
+  if (SkippedForError(state, d)) return;
   const cv::Mat& refs = References(d, hog);
   const cv::Mat& queries = Queries(d, hog);
   const Exact& exact = ExactOf(which, hog);

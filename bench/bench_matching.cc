@@ -27,15 +27,23 @@ cv::Mat RandomRows(int n, int width, int type) {
 
 std::int64_t TrianglePairs(std::int64_t n) { return n * (n - 1) / 2; }
 
-// Args: frames N, bytes per descriptor, threads.
-void BM_Hamming(benchmark::State& state) {
+// The distance matrix of N random rows of `type` against themselves, by `distances` (Args:
+// frames N, values per descriptor, threads). Items: pairs of the triangle.
+using DistancesFunction = cv::Mat1f (*)(const cv::Mat&, const cv::Mat&, int,
+                                        const openable::PairProgress&);
+void TimeDistances(benchmark::State& state, int type, DistancesFunction distances) {
   const int n = static_cast<int>(state.range(0));
-  const cv::Mat rows = RandomRows(n, static_cast<int>(state.range(1)), CV_8U);
+  const cv::Mat rows = RandomRows(n, static_cast<int>(state.range(1)), type);
   for (auto _ : state) {
-    cv::Mat1f d = openable::HammingDistances(rows, cv::Mat(), static_cast<int>(state.range(2)));
+    cv::Mat1f d = distances(rows, cv::Mat(), static_cast<int>(state.range(2)), {});
     benchmark::DoNotOptimize(d.data);
   }
   state.SetItemsProcessed(state.iterations() * TrianglePairs(n));
+}
+
+// Args: frames N, bytes per descriptor, threads.
+void BM_Hamming(benchmark::State& state) {
+  TimeDistances(state, CV_8U, openable::HammingDistances);
 }
 BENCHMARK(BM_Hamming)
     ->Args({3576, 32, 1})->Args({3576, 32, 2})->Args({3576, 174, 2})->Args({10000, 32, 2})
@@ -154,15 +162,7 @@ BENCHMARK(BM_HammingKernel)
     ->Args({2048, 174, 1})->Args({2048, 174, 2})->Args({2048, 174, 3})->Args({2048, 174, 4});
 
 // Args: frames N, floats per descriptor, threads.
-void BM_L2(benchmark::State& state) {
-  const int n = static_cast<int>(state.range(0));
-  const cv::Mat rows = RandomRows(n, static_cast<int>(state.range(1)), CV_32F);
-  for (auto _ : state) {
-    cv::Mat1f d = openable::L2Distances(rows, cv::Mat(), static_cast<int>(state.range(2)));
-    benchmark::DoNotOptimize(d.data);
-  }
-  state.SetItemsProcessed(state.iterations() * TrianglePairs(n));
-}
+void BM_L2(benchmark::State& state) { TimeDistances(state, CV_32F, openable::L2Distances); }
 BENCHMARK(BM_L2)
     ->Args({3576, 128, 2})->Args({3576, 1764, 2})
     ->Unit(benchmark::kMillisecond)->UseRealTime();

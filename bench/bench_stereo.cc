@@ -58,6 +58,11 @@ const Data* Load() {
   return data.get();
 }
 
+// The four pairs as the pipeline reads them: each frame rectified, with its SGBM disparity.
+std::unique_ptr<FrameSource> OpenPairs(const Data& d) {
+  return OpenStereoFolders(d.folders + "/left", d.folders + "/right", "png", 0, -1, d.calibration);
+}
+
 int Hamming(const cv::Mat& a, const cv::Mat& b) {
   return static_cast<int>(cv::norm(a, b, cv::NORM_HAMMING));
 }
@@ -65,8 +70,7 @@ int Hamming(const cv::Mat& a, const cv::Mat& b) {
 void PrintDistances() {
   const Data* d = Load();
   if (d == nullptr) return;
-  const auto source = OpenStereoFolders(d->folders + "/left", d->folders + "/right", "png", 0, -1,
-                                        d->calibration);
+  const auto source = OpenPairs(*d);
   std::printf("Hamming distances on the EuRoC pairs (0-1 revisit; 2-3 0.5 s apart):\n");
   std::printf("%-28s %5s %5s %5s %5s %5s %5s %6s\n", "setting", "0-1", "0-2", "0-3", "1-2",
               "1-3", "2-3", "bits");
@@ -116,8 +120,7 @@ BENCHMARK(BM_Sgbm)->Unit(benchmark::kMillisecond);
 void BM_DldbDescribe(benchmark::State& state) {
   const Data* d = Load();
   if (d == nullptr) return state.SkipWithError("dataset absent: ../shared/datasets");
-  const auto source = OpenStereoFolders(d->folders + "/left", d->folders + "/right", "png", 0, -1,
-                                        d->calibration);
+  const auto source = OpenPairs(*d);
   const cv::Mat input = ToGrayDisparity8(source->Read(0));
   const auto dldb = CreateDescriptor("D-LDB", DescriptorOptions{});
   const FrameDescriber describer(*dldb, DescriptionType::kGlobal);
@@ -130,8 +133,7 @@ BENCHMARK(BM_DldbDescribe)->Unit(benchmark::kMillisecond);
 void BM_StereoFrame(benchmark::State& state) {
   const Data* d = Load();
   if (d == nullptr) return state.SkipWithError("dataset absent: ../shared/datasets");
-  const auto source = OpenStereoFolders(d->folders + "/left", d->folders + "/right", "png", 0, -1,
-                                        d->calibration);
+  const auto source = OpenPairs(*d);
   int i = 0;
   for (auto _ : state) benchmark::DoNotOptimize(source->Read(i++ % 4));
 }

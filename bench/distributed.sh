@@ -6,19 +6,11 @@
 # parallel efficiency against one process with the same threads per process:
 # efficiency = time(1 process) / (K x time(K processes)) with K x T cores in use.
 # Usage: bench/distributed.sh [N] [K] [T]   (defaults 100000 2 1)
-set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
-data="$root/../shared/datasets/nordland_trimmed"
-exe="$root/build/examples/Test_OpenABLE"
-make="$root/build/bench/make_scale_data"
-cache="${OPENABLE_SCALE_DATA:-$root/build/scale_data}"
+source "$(dirname "$0")/common.sh"
 n="${1:-100000}"; k="${2:-2}"; t="${3:-1}"
-[ -d "$data" ] || { echo "distributed.sh: $data not found (see ../shared/datasets/README.md)" >&2; exit 1; }
-[ -x "$exe" ] && [ -x "$make" ] || { echo "distributed.sh: build first (cmake --build build)" >&2; exit 1; }
-command -v mpirun > /dev/null || { echo "distributed.sh: mpirun not found (Debian: openmpi-bin)" >&2; exit 1; }
-dir="$cache/$n"
-if [ ! -f "$dir/.done" ]; then "$make" "$data" "$dir" "$n" && touch "$dir/.done"; fi
-out="$(mktemp -d)"; trap 'rm -rf "$out"' EXIT
+command -v mpirun > /dev/null || fail "mpirun not found (Debian: openmpi-bin)"
+prepare "$datasets/nordland_trimmed" "$exe" "$root/build/bench/make_scale_data"
+scale_data "$n"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 args=(--set Images_path="$dir/summer" --set Images_path_2="$dir/winter"
       --set Image_descriptor=LDB --set Patch_size=64 --set Image_sequences=10

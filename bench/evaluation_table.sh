@@ -3,20 +3,11 @@
 # (winter vs summer) and Gardens Point (day_right vs day_left), with the protocols of
 # docs/benchmarks.md ("Accuracy"), evaluated by Test_OpenABLE itself. Prints one Markdown row per run.
 # Usage: bench/evaluation_table.sh [descriptor ...]   (default: LDB ORB BRISK SIFT HOG BRIEF FREAK)
-set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
-data="$root/../shared/datasets"
-exe="$root/build/examples/Test_OpenABLE"
-[ -d "$data" ] || { echo "evaluation_table.sh: $data not found" >&2; exit 1; }
-[ -x "$exe" ] || { echo "evaluation_table.sh: $exe not built (run examples/setup.sh)" >&2; exit 1; }
-out="$(mktemp -d)"
-trap 'rm -rf "$out"' EXIT
+source "$(dirname "$0")/common.sh"
+data="$datasets"
+prepare "$data" "$exe"
 descriptors=("$@")
 [ ${#descriptors[@]} -gt 0 ] || descriptors=(LDB ORB BRISK SIFT HOG BRIEF FREAK)
-
-figure() {  # figure KEY FILE: the first number after "KEY": in a JSON file
-  grep -o "\"$1\": [-0-9.e]*" "$2" | head -1 | awk '{print $2}'
-}
 
 run() {  # run NAME SETTING... : one row
   local name=$1; shift

@@ -4,12 +4,9 @@
 # to a 4000 K light at 60 % intensity (build/bench/relight: a global change along the black-body
 # locus, the change Eq. 6 cancels), and the Sussex panoramas (re-run vs training, 30 cm).
 # Prints one Markdown row per setting. Usage: bench/illumination.sh [descriptor ...]
-set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
-data="$root/../shared/datasets"
-exe="$root/build/examples/Test_OpenABLE"
-[ -d "$data" ] || { echo "illumination.sh: $data not found" >&2; exit 1; }
-out="$(mktemp -d)"; trap 'rm -rf "$out"' EXIT
+source "$(dirname "$0")/common.sh"
+data="$datasets"
+prepare "$data" "$exe" "$root/build/bench/relight" "$root/build/bench/shift_panoramas"
 descriptors=("$@"); [ ${#descriptors[@]} -gt 0 ] || descriptors=(LDB HOG)
 "$root/build/bench/relight" "$data/gardens_point/day_right" "$out/dusk" 6500 4000 0.6 > /dev/null
 sx="$data/sussex_panoramas"
@@ -19,10 +16,7 @@ awk 'NR > 1 && $5 == 0 {print $3 "," $4}' "$sx/gt_positions_test_infomax_binary.
 
 figures() {  # figures SETTING...: "R@1 / AUC" of one run
   "$exe" --quiet --set Evaluation_name="$out/e" "$@" > /dev/null
-  local r1 auc
-  r1=$(grep -o '"recall_at_1": [-0-9.e]*' "$out/e.json" | head -1 | awk '{print $2}')
-  auc=$(grep -o '"auc": [-0-9.e]*' "$out/e.json" | head -1 | awk '{print $2}')
-  printf '%.3f / %.3f' "$r1" "$auc"
+  printf '%.3f / %.3f' "$(figure recall_at_1 "$out/e.json")" "$(figure auc "$out/e.json")"
 }
 echo "| data | descriptor | grey R@1 / AUC | Eq. 6 (alpha 0.47) R@1 / AUC |"
 echo "|---|---|---|---|"

@@ -3,14 +3,9 @@
 # 64x64, L = 10 by default. Prints R@1 (share of winter frames whose best summer match lies within
 # +-2 frames), wall time and peak memory of Test_OpenABLE (GNU time), for docs/benchmarks.md.
 # Usage: bench/nordland_bar.sh [--set Key=Value ...]   (from anywhere; needs ../shared/datasets)
-set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
-data="$root/../shared/datasets/nordland_trimmed"
-exe="$root/build/examples/Test_OpenABLE"
-[ -d "$data" ] || { echo "nordland_bar.sh: $data not found (see ../shared/datasets/README.md)" >&2; exit 1; }
-[ -x "$exe" ] || { echo "nordland_bar.sh: $exe not built (run examples/setup.sh)" >&2; exit 1; }
-out="$(mktemp -d)"
-trap 'rm -rf "$out"' EXIT
+source "$(dirname "$0")/common.sh"
+data="$datasets/nordland_trimmed"
+prepare "$data" "$exe"
 /usr/bin/time -f "wall %e s, peak RSS %M KiB" -o "$out/time" \
   "$exe" --quiet --set Images_path="$data/summer" --set Images_path_2="$data/winter" \
   --set Image_descriptor=LDB --set Description_type=0 --set Patch_size=64 \

@@ -13,21 +13,16 @@
 #      same 32 runs of Test_OpenABLE.
 # Usage: bench/presets.sh [sweeps|table|timing ...]   (default: all three; about 4 minutes on
 # 2 cores). Files go to a temporary folder, or to $OPENABLE_BENCH_OUT when set.
-set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
-data="$root/../shared/datasets"
-exe="$root/build/examples/Test_OpenABLE"
+source "$(dirname "$0")/common.sh"
+data="$datasets"
 sweep="$root/build/examples/openable_sweep"
-[ -d "$data" ] || { echo "presets.sh: $data not found (see ../shared/datasets/README.md)" >&2; exit 1; }
-for p in "$exe" "$sweep"; do
-  [ -x "$p" ] || { echo "presets.sh: $p not built (run examples/setup.sh)" >&2; exit 1; }
-done
+need_data "$data"
+need_built "$exe" "$sweep"
 if [ -n "${OPENABLE_BENCH_OUT:-}" ]; then
   out="$OPENABLE_BENCH_OUT"
   mkdir -p "$out"
 else
-  out="$(mktemp -d)"
-  trap 'rm -rf "$out"' EXIT
+  temp_out
 fi
 parts=("$@")
 [ ${#parts[@]} -gt 0 ] || parts=(sweeps table timing)
@@ -46,10 +41,6 @@ rtabmap=(--set Images_path="$data/rtabmap_samples/images" --set Ground_truth_typ
          --set Ground_truth="$data/rtabmap_samples/ground_truth_pairs.txt"
          --set Ground_truth_base=1 --set Exclusion=10 --set Tolerance=1)
 no_files=(--set Txt_name= --set Npy_name= --set Png_name= --set Evaluation_name=)
-
-figure() {  # figure KEY FILE: the first number after "KEY": in a JSON file
-  grep -o "\"$1\": [-0-9.e]*" "$2" | head -1 | awk '{print $2}'
-}
 
 for part in "${parts[@]}"; do
   case "$part" in

@@ -13,14 +13,9 @@
 #   SUPPLEMENT=1         also: KITTI with the Gaussian noise of seeds 2 and 3 (run-to-run spread
 #                        of the noise alone), and KITTI at Patch_size 256 (less averaging of the
 #                        noise by the resize to the patch), clean / noisy / fused
-set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
-data="$root/../shared/datasets"
-exe="$root/build/examples/Test_OpenABLE"
-[ -d "$data" ] || { echo "robustness.sh: $data not found" >&2; exit 1; }
-[ -x "$exe" ] || { echo "robustness.sh: $exe not built" >&2; exit 1; }
-out="$(mktemp -d)"
-trap 'rm -rf "$out"' EXIT
+source "$(dirname "$0")/common.sh"
+data="$datasets"
+prepare "$data" "$exe"
 descriptors=("$@")
 [ ${#descriptors[@]} -gt 0 ] || descriptors=(LDB)
 radii="${RADII:-1,2,3}"
@@ -28,10 +23,6 @@ alt_radii="${ALT_RADII-1 1,1 2,2 1,2,3,4}"
 nordland="${NORDLAND:-1}"
 main="${MAIN:-1}"
 supplement="${SUPPLEMENT:-0}"
-
-figure() {  # figure KEY FILE: the first number after "KEY": in a JSON file
-  grep -o "\"$1\": [-0-9.e]*" "$2" | head -1 | awk '{print $2}'
-}
 
 declare -A auc
 run() {  # run DATA TAG DISTURBANCE FUSION SETTING... : one row; AUC kept as auc[TAG]
@@ -49,6 +40,25 @@ run() {  # run DATA TAG DISTURBANCE FUSION SETTING... : one row; AUC kept as auc
 noises=("none|" "Gaussian 0.003|--set Noise_gaussian=0.003"
         "salt-and-pepper 10 %|--set Noise_salt_pepper=0.1"
         "overexposure x2|--set Noise_overexposure=1")
+
+# noise_rows DATA PREFIX ALTERNATIVES SETTING...: for each disturbance k, the row without fusion
+# (AUC kept as auc[PREFIXk]); for the noisy ones also the row fused with $radii (auc[PREFIXkf])
+# and one fused with each radii of ALTERNATIVES (space-separated).
+noise_rows() {
+  local data_name=$1 prefix=$2 alternatives=$3; shift 3
+  local k name set a
+  for k in "${!noises[@]}"; do
+    name="${noises[$k]%%|*}"; read -r -a set <<< "${noises[$k]#*|}"
+    run "$data_name" "$prefix$k" "$name" "off" "$@" "${set[@]}"
+    [ "$k" -eq 0 ] && continue
+    run "$data_name" "$prefix${k}f" "$name" "$radii" "$@" "${set[@]}" \
+      --set Side_window=1 --set Side_window_radii="$radii"
+    for a in $alternatives; do
+      run "$data_name" "$prefix${k}a$a" "$name" "$a (alternative)" "$@" "${set[@]}" \
+        --set Side_window=1 --set Side_window_radii="$a"
+    done
+  done
+}
 
 echo "| data | descriptor | disturbance | side-window radii | R@1 | AUC | wall time |"
 echo "|---|---|---|---|---|---|---|"
@@ -76,25 +86,9 @@ for d in "${descriptors[@]}"; do
     done
   fi
   [ "$main" = 1 ] || continue
-  for k in "${!noises[@]}"; do
-    name="${noises[$k]%%|*}"; read -r -a set <<< "${noises[$k]#*|}"
-    run "KITTI 00 0-1699" "k$k" "$name" "off" "${kitti[@]}" "${set[@]}"
-    [ "$k" -eq 0 ] && continue
-    run "KITTI 00 0-1699" "k${k}f" "$name" "$radii" "${kitti[@]}" "${set[@]}" \
-      --set Side_window=1 --set Side_window_radii="$radii"
-    for a in $alt_radii; do
-      run "KITTI 00 0-1699" "k${k}a$a" "$name" "$a (alternative)" "${kitti[@]}" "${set[@]}" \
-        --set Side_window=1 --set Side_window_radii="$a"
-    done
-  done
+  noise_rows "KITTI 00 0-1699" k "$alt_radii" "${kitti[@]}"
   if [ "$nordland" = 1 ]; then
-    for k in "${!noises[@]}"; do
-      name="${noises[$k]%%|*}"; read -r -a set <<< "${noises[$k]#*|}"
-      run "Nordland winter vs summer, L=10" "n$k" "$name" "off" "${nord[@]}" "${set[@]}"
-      [ "$k" -eq 0 ] && continue
-      run "Nordland winter vs summer, L=10" "n${k}f" "$name" "$radii" "${nord[@]}" "${set[@]}" \
-        --set Side_window=1 --set Side_window_radii="$radii"
-    done
+    noise_rows "Nordland winter vs summer, L=10" n "" "${nord[@]}"
   fi
   # The bar: on KITTI, fusion recovers at least half of the AUC the noise removed.
   echo

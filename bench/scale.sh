@@ -6,20 +6,12 @@
 # peak memory (GNU time) per run. Frames are cached in $OPENABLE_SCALE_DATA (default
 # build/scale_data; about 3 KB per frame).
 # Usage: bench/scale.sh [N ...]
-set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
-data="$root/../shared/datasets/nordland_trimmed"
-exe="$root/build/examples/Test_OpenABLE"
-make="$root/build/bench/make_scale_data"
-cache="${OPENABLE_SCALE_DATA:-$root/build/scale_data}"
-[ -d "$data" ] || { echo "scale.sh: $data not found (see ../shared/datasets/README.md)" >&2; exit 1; }
-[ -x "$exe" ] && [ -x "$make" ] || { echo "scale.sh: build first (cmake --build build)" >&2; exit 1; }
+source "$(dirname "$0")/common.sh"
 sizes=("$@"); [ ${#sizes[@]} -gt 0 ] || sizes=(1000 10000 50000 100000)
-out="$(mktemp -d)"; trap 'rm -rf "$out"' EXIT
+prepare "$datasets/nordland_trimmed" "$exe" "$root/build/bench/make_scale_data"
 printf "%-8s %-8s %10s %14s %12s\n" N mode "wall (s)" "pairs/s" "peak (MiB)"
 for n in "${sizes[@]}"; do
-  dir="$cache/$n"
-  if [ ! -f "$dir/.done" ]; then "$make" "$data" "$dir" "$n" && touch "$dir/.done"; fi
+  scale_data "$n"
   for mode in 1 2; do
     total=$((2 * n))
     if [ "$mode" = 1 ] && [ $((total * total * 4 / 1024 / 1024 / 1024)) -ge 16 ]; then continue; fi

@@ -6,13 +6,12 @@
 # the same images; the SO-DSO runs again with the pairs' frames that are not keyframes moved to
 # the nearest keyframe within 1, 2 and 5 frames (Snaps_keyframe_tolerance). Prints
 # openable_snaps' reports. Usage: bench/snaps_kitti.sh
-set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
-data="$root/../shared/datasets"
+source "$(dirname "$0")/common.sh"
+data="$datasets"
 kt="$data/kitti_trajectories"
 snaps="$root/build/examples/openable_snaps"
-able="$root/build/examples/Test_OpenABLE"
-[ -d "$kt" ] || { echo "snaps_kitti.sh: $kt not found" >&2; exit 1; }
+able="$exe"
+need_data "$kt"
 out="${SNAPS_OUT:-$(mktemp -d)}"
 mkdir -p "$out"
 

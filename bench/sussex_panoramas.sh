@@ -6,13 +6,10 @@
 # queries whose best match is a true place. Each setting is run on the unshifted re-run and on
 # the re-run with every panorama circularly shifted by half its width (the robot facing the
 # other way). Usage: bench/sussex_panoramas.sh [descriptor ...] (default LDB HOG)
-set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
-data="$root/../shared/datasets/sussex_panoramas"
-exe="$root/build/examples/Test_OpenABLE"
+source "$(dirname "$0")/common.sh"
+data="$datasets/sussex_panoramas"
 shift_tool="$root/build/bench/shift_panoramas"
-[ -d "$data" ] || { echo "sussex_panoramas.sh: $data not found" >&2; exit 1; }
-out="$(mktemp -d)"; trap 'rm -rf "$out"' EXIT
+prepare "$data" "$exe" "$shift_tool"
 descriptors=("$@"); [ ${#descriptors[@]} -gt 0 ] || descriptors=(LDB HOG)
 
 "$shift_tool" "$data/test_infomax_binary" "$out/rerun" 0 96
@@ -27,7 +24,7 @@ r1() {  # r1 QUERIES SETTING...: R@1 of one run
     --set Ground_truth_type=positions --set Ground_truth="$out/train.csv" \
     --set Ground_truth_2="$out/rerun.csv" --set Ground_truth_radius=30 --set Tolerance=0 \
     --set Evaluation_name="$out/e" "$@" > /dev/null
-  grep -o '"recall_at_1": [-0-9.e]*' "$out/e.json" | head -1 | awk '{printf "%.3f", $2}'
+  printf '%.3f' "$(figure recall_at_1 "$out/e.json")"
 }
 
 echo "| descriptor | Panoramas | aligned, unshifted | aligned, half-turn | cross-correlation, half-turn | circular, half-turn | cross-correlation, unshifted | circular, unshifted |"

@@ -43,6 +43,19 @@ void ExpectInputError(const std::function<void()>& f, std::initializer_list<std:
     ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
   }
 }
+std::string InputErrorMessage(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "expected InputError, nothing was thrown";
+  return "";
+}
+
 namespace {
 
 struct TempRoot {

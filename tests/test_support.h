@@ -19,6 +19,21 @@ std::string ReadBytes(const std::string& path);
 // one of `parts`.
 void ExpectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts);
 
+// The message of the InputError that `f` throws; fails the test (and returns "") when `f` throws
+// nothing or another exception.
+std::string InputErrorMessage(const std::function<void()>& f);
+
+// The message of the InputError that Check() throws on `Options` at their defaults but for what
+// `change` sets; fails the test (and returns "") when it throws nothing or another exception.
+template <typename Options>
+std::string CheckError(const std::function<void(Options&)>& change) {
+  return InputErrorMessage([&] {
+    Options o;
+    change(o);
+    o.Check();
+  });
+}
+
 // `path` between double quotes, as error messages quote file names.
 inline std::string Q(const std::string& path) { return "\"" + path + "\""; }
 

@@ -1,6 +1,8 @@
 #include "config/config.h"
 
 #include <fstream>
+#include <functional>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -16,17 +18,8 @@ std::string WriteFile(const std::string& text) {
   return path;
 }
 
-// Runs `f`, expects an InputError, and returns its message.
-template <typename F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InputError thrown";
-  return "";
-}
+// The message of the InputError that `f` throws (testing::InputErrorMessage).
+std::string ErrorOf(const std::function<void()>& f) { return testing::InputErrorMessage(f); }
 
 // '#' starts a comment only at the start of a line or after a space or tab (YAML, and OpenCV's
 // FileStorage, which read the original's files): inside an unquoted value it is a character.
@@ -47,21 +40,21 @@ TEST(Config, HashInsideAnUnquotedValueIsKept) {
 }
 
 TEST(Config, ReadsTheOriginalFormat) {
-  const std::string path = WriteFile(
-      "%YAML:1.0\n"
-      "# a comment\n"
-      "Frame_mode: 0\n"
-      "Images_path: \"/data/seq # not a comment\"\n"
-      "Images_format: png   # trailing comment\n"
-      "Initial_image: 10\n"
-      "Final_image: 200\n"
-      "Txt_name: 'out.txt'\n"
-      "Camera_type: 0\n"
-      "Image_descriptor: ORB\n"
-      "Patch_size: 48\n"
-      "Image_sequences: 7\n"
-      "Threshold: 0.25\n"
-      "Show_images: 0\n");
+  const std::string path = WriteFile(R"(%YAML:1.0
+# a comment
+Frame_mode: 0
+Images_path: "/data/seq # not a comment"
+Images_format: png   # trailing comment
+Initial_image: 10
+Final_image: 200
+Txt_name: 'out.txt'
+Camera_type: 0
+Image_descriptor: ORB
+Patch_size: 48
+Image_sequences: 7
+Threshold: 0.25
+Show_images: 0
+)");
   const Config c = LoadConfig(path);
   EXPECT_EQ(c.input.images_path, "/data/seq # not a comment");
   EXPECT_EQ(c.input.images_format, "png");

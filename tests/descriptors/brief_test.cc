@@ -8,17 +8,13 @@
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace openable {
 namespace {
 
-using testing_util::Describe;
-using testing_util::Hamming;
-using testing_util::Options;
-using testing_util::TexturedPatch;
-
-int Bit(const cv::Mat& row, int k) { return (row.at<std::uint8_t>(0, k / 8) >> (k % 8)) & 1; }
+using namespace testing_util;  // NOLINT: the descriptor test helpers are this file's vocabulary
 
 // The pattern's pixel position of a unit offset, from the header's formula.
 int Pixel(double z, int s) {
@@ -140,13 +136,8 @@ TEST(BriefTest, BitsMatchABruteForceReference) {
     const BriefDescriptor d(Options(size));
     for (int seed = 0; seed < 4; ++seed) {
       const cv::Mat patch = TexturedPatch(size, 700 + seed);
-      const cv::Mat row = Describe(d, patch);
-      const std::vector<int> expected = ReferenceBits(patch);
-      int ones = 0;
-      for (int k = 0; k < 256; ++k) {
-        EXPECT_EQ(Bit(row, k), expected[k]) << "size " << size << " seed " << seed << " bit " << k;
-        ones += expected[k];
-      }
+      SCOPED_TRACE("size " + std::to_string(size) + " seed " + std::to_string(seed));
+      const int ones = ExpectBitsAre(Describe(d, patch), ReferenceBits(patch));
       EXPECT_GT(ones, 60);
       EXPECT_LT(ones, 196);
     }
@@ -154,28 +145,21 @@ TEST(BriefTest, BitsMatchABruteForceReference) {
 }
 
 TEST(BriefTest, BrightLeftDarkRightGivesTheBitsTheGeometryPredicts) {
-  // Columns 0-31 at 200, 32-63 at 50. A box wholly on the left has mean 200, wholly on the
-  // right 50: bit = 1 when x is right and y left, 0 when x is left and y right or both boxes
-  // are on the same side (equal means).
-  cv::Mat patch(64, 64, CV_8UC1, cv::Scalar(50));
-  patch(cv::Rect(0, 0, 32, 64)).setTo(200);
+  // A box wholly on the left has mean 200, wholly on the right 50: bit = 1 when x is right and
+  // y left, 0 when x is left and y right or both boxes are on the same side (equal means).
   const BriefDescriptor d(Options(64));
   const int h = d.BoxHalfSide();
-  const cv::Mat row = Describe(d, patch);
-  int decided = 0, ones = 0;
-  for (int k = 0; k < 256; ++k) {
+  const auto half = [h](int col) {
+    return col + h < 32 ? Half::kLeft : col - h >= 32 ? Half::kRight : Half::kStraddles;
+  };
+  const auto halves = [&](int k) {
     const BriefPixelTest& t = d.PixelTests()[k];
-    const bool x_left = t.x_col + h < 32, x_right = t.x_col - h >= 32;
-    const bool y_left = t.y_col + h < 32, y_right = t.y_col - h >= 32;
-    if ((x_left || x_right) && (y_left || y_right)) {
-      ++decided;
-      const int expected = x_right && y_left ? 1 : 0;
-      EXPECT_EQ(Bit(row, k), expected) << "bit " << k;
-      ones += expected;
-    }
-  }
-  EXPECT_GT(decided, 60);
-  EXPECT_GT(ones, 10);
+    return std::make_pair(half(t.x_col), half(t.y_col));
+  };
+  const DecidedBits count = ExpectBitsDecidedByHalves(Describe(d, BrightLeftDarkRightPatch()), 256,
+                                                      halves, {Half::kRight, Half::kLeft});
+  EXPECT_GT(count.decided, 60);
+  EXPECT_GT(count.ones, 10);
 }
 
 TEST(BriefTest, UniformPatchGivesZeros) {
@@ -184,11 +168,8 @@ TEST(BriefTest, UniformPatchGivesZeros) {
 }
 
 TEST(BriefTest, SmallNoiseChangesFewBitsAndOtherImagesAboutHalf) {
-  const BriefDescriptor d(Options(64));
-  const auto mean = testing_util::MeanDistancesToNoisyAndOther(d, 99, 800, 900);
-  EXPECT_LT(mean.noise, 26);  // < 10% of 256 bits
-  EXPECT_GT(mean.other, 90);  // about half of 256
-  EXPECT_LT(mean.other, 166);
+  // Noise changes fewer than 10% of the 256 bits, an unrelated patch about half of them.
+  ExpectNoisyCloseAndOtherFar(BriefDescriptor(Options(64)), 99, 800, 900, {26, 90, 166});
 }
 
 }  // namespace

@@ -8,20 +8,16 @@
 #include <map>
 #include <opencv2/core.hpp>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
 namespace openable {
 namespace {
 
-using testing_util::Describe;
-using testing_util::Hamming;
-using testing_util::Options;
-using testing_util::TexturedPatch;
+using namespace testing_util;  // NOLINT: the descriptor test helpers are this file's vocabulary
 
 constexpr double kPi = 3.14159265358979323846;
-
-int Bit(const cv::Mat& row, int k) { return (row.at<std::uint8_t>(0, k / 8) >> (k % 8)) & 1; }
 
 // Mean of a field by brute force: every pixel whose centre lies in the disc, or the pixel under
 // the field centre when none does.
@@ -131,13 +127,8 @@ TEST(FreakTest, BitsMatchABruteForceReference) {
     const FreakDescriptor d(Options(size));
     for (int seed = 0; seed < 3; ++seed) {
       const cv::Mat patch = TexturedPatch(size, 600 + seed);
-      const cv::Mat row = Describe(d, patch);
-      const std::vector<int> expected = ReferenceBits(patch);
-      int ones = 0;
-      for (int k = 0; k < 512; ++k) {
-        EXPECT_EQ(Bit(row, k), expected[k]) << "size " << size << " seed " << seed << " bit " << k;
-        ones += expected[k];
-      }
+      SCOPED_TRACE("size " + std::to_string(size) + " seed " + std::to_string(seed));
+      const int ones = ExpectBitsAre(Describe(d, patch), ReferenceBits(patch));
       EXPECT_GT(ones, 50);  // neither all 0 nor all 1: the comparison is not vacuous
       EXPECT_LT(ones, 462);
     }
@@ -160,29 +151,24 @@ TEST(FreakTest, AllPairBitsHoldsTheSelectedBits) {
 }
 
 TEST(FreakTest, BrightLeftDarkRightGivesTheBitsTheGeometryPredicts) {
-  // Columns 0-31 at 200, 32-63 at 50. A field wholly left of x = 32 has mean 200, wholly right
-  // 50: bit (a, b) = 1 when a is left and b right, 0 when a is right and b left or both are on
-  // the same side.
-  cv::Mat patch(64, 64, CV_8UC1, cv::Scalar(50));
-  patch(cv::Rect(0, 0, 32, 64)).setTo(200);
+  // A field wholly left of x = 32 has mean 200, wholly right 50: bit (a, b) = 1 when a is left
+  // and b right, 0 when a is right and b left or both are on the same side.
+  const cv::Mat patch = BrightLeftDarkRightPatch();
   const FreakDescriptor d(Options(64));
   const std::vector<FreakField> fields = FreakFields(64);
-  const cv::Mat row = Describe(d, patch);
-  int decided = 0, ones = 0;
-  for (int k = 0; k < 512; ++k) {
-    const FreakField& a = fields[FreakPairs()[k][0]];
-    const FreakField& b = fields[FreakPairs()[k][1]];
-    const bool a_left = a.x + a.radius < 32, a_right = a.x - a.radius > 32;
-    const bool b_left = b.x + b.radius < 32, b_right = b.x - b.radius > 32;
-    if ((a_left || a_right) && (b_left || b_right)) {
-      ++decided;
-      const int expected = a_left && b_right ? 1 : 0;
-      EXPECT_EQ(Bit(row, k), expected) << "bit " << k;
-      ones += expected;
-    }
-  }
-  EXPECT_GT(decided, 100);
-  EXPECT_GT(ones, 10);
+  const auto half = [](const FreakField& f) {
+    return f.x + f.radius < 32   ? Half::kLeft
+           : f.x - f.radius > 32 ? Half::kRight
+                                 : Half::kStraddles;
+  };
+  const DecidedBits count = ExpectBitsDecidedByHalves(
+      Describe(d, patch), 512,
+      [&](int k) {
+        return std::make_pair(half(fields[FreakPairs()[k][0]]), half(fields[FreakPairs()[k][1]]));
+      },
+      {Half::kLeft, Half::kRight});
+  EXPECT_GT(count.decided, 100);
+  EXPECT_GT(count.ones, 10);
   // Field 3 (left, 180 degrees) against field 0 (right) on the outer ring, by hand.
   const std::vector<std::uint8_t> all = d.AllPairBits(patch);
   EXPECT_EQ(all[0 * 42 + (3 - 1)], 0);  // pair (0, 3): mean(right) > mean(left) is false
@@ -195,11 +181,8 @@ TEST(FreakTest, UniformPatchGivesZeros) {
 }
 
 TEST(FreakTest, SmallNoiseChangesFewBitsAndOtherImagesAboutHalf) {
-  const FreakDescriptor d(Options(64));
-  const auto mean = testing_util::MeanDistancesToNoisyAndOther(d, 77, 810, 910);
-  EXPECT_LT(mean.noise, 51);   // < 10% of 512 bits
-  EXPECT_GT(mean.other, 180);  // about half of 512
-  EXPECT_LT(mean.other, 332);
+  // Noise changes fewer than 10% of the 512 bits, an unrelated patch about half of them.
+  ExpectNoisyCloseAndOtherFar(FreakDescriptor(Options(64)), 77, 810, 910, {51, 180, 332});
 }
 
 }  // namespace

@@ -21,15 +21,10 @@
 namespace openable {
 namespace {
 
-using testing_util::Describe;
-using testing_util::Hamming;
-using testing_util::Options;
-using testing_util::TexturedPatch;
+using namespace testing_util;  // NOLINT: the descriptor test helpers are this file's vocabulary
 
 constexpr int kLevels[] = {2, 3, 4, 5};
 enum Feature { kI = 0, kGx = 1, kGy = 2 };
-
-int Bit(const cv::Mat& row, int k) { return (row.at<std::uint8_t>(0, k / 8) >> (k % 8)) & 1; }
 
 // Index of test (level n, cells i < j, feature) in the canonical order, counted independently.
 int CanonicalIndex(int n, int i, int j, int feature) {
@@ -203,6 +198,31 @@ TEST(LdbTest, SelectedBitsAreTheFullDescriptorBitsAtTheSelectedTests) {
   }
 }
 
+// Expects the 18 bits of level 2: the I bits of the cell pairs (0,1) (0,2) (0,3) (1,2) (1,3)
+// (2,3) as given, every G_x and G_y bit 0.
+void ExpectLevel2(const std::vector<int>& bits, const std::array<int, 6>& intensity) {
+  std::vector<int> expected;
+  for (const int i : intensity) expected.insert(expected.end(), {i, 0, 0});
+  EXPECT_EQ(std::vector<int>(bits.begin(), bits.begin() + 18), expected);
+}
+
+// Whether the level-3 bit of one feature is 1 for the cells i < j.
+using PairRule = bool (*)(int i, int j);
+bool Never(int /*i*/, int /*j*/) { return false; }
+
+// Expects every bit of level 3 to follow the rules of I, G_x and G_y.
+void ExpectLevel3(const std::vector<int>& bits, PairRule intensity, PairRule gx, PairRule gy) {
+  const PairRule rules[] = {intensity, gx, gy};
+  for (int i = 0; i < 9; ++i) {
+    for (int j = i + 1; j < 9; ++j) {
+      for (const Feature f : {kI, kGx, kGy}) {
+        EXPECT_EQ(bits[CanonicalIndex(3, i, j, f)], rules[f](i, j) ? 1 : 0)
+            << i << "," << j << " feature " << f;
+      }
+    }
+  }
+}
+
 // Left half (columns 0..31) dark, right half bright.
 int LeftDarkRightBright(int /*y*/, int x) { return x < 32 ? 0 : 200; }
 
@@ -210,15 +230,7 @@ TEST(LdbTest, HandComputedBitsOfAVerticalEdge) {
   const std::vector<int> bits = FullBits(FromFunction(64, LeftDarkRightBright));
   // Level 2: cells 0, 2 dark, 1, 3 bright; every cell uniform, so G_x = G_y = 0 everywhere.
   // I bit of (i, j) = 1 iff I(i) < I(j): (0,1) 0 < 200, (0,3), (2,3).
-  const std::vector<int> level2 = {
-      1, 0, 0,  // (0,1)
-      0, 0, 0,  // (0,2)
-      1, 0, 0,  // (0,3)
-      0, 0, 0,  // (1,2)
-      0, 0, 0,  // (1,3)
-      1, 0, 0,  // (2,3)
-  };
-  EXPECT_EQ(std::vector<int>(bits.begin(), bits.begin() + 18), level2);
+  ExpectLevel2(bits, {1, 0, 1, 0, 0, 1});
 
   // Level 3: columns [0,21) all dark; [21,42) has 11 dark and 10 bright columns:
   // I = 200 * 10 / 21 = 95.2, halves [21,31) dark and [31,42) 1 dark + 10 bright, so
@@ -236,14 +248,9 @@ TEST(LdbTest, HandComputedBitsOfAVerticalEdge) {
   EXPECT_EQ(bits[CanonicalIndex(3, 6, 8, kI)], 1);   // 0 < 200
   // The whole of level 3 follows from the column means: I bit iff col(i) < col(j);
   // G_x bit iff col(j) is the middle column and col(i) is not.
-  for (int i = 0; i < 9; ++i) {
-    for (int j = i + 1; j < 9; ++j) {
-      EXPECT_EQ(bits[CanonicalIndex(3, i, j, kI)], i % 3 < j % 3 ? 1 : 0) << i << "," << j;
-      EXPECT_EQ(bits[CanonicalIndex(3, i, j, kGx)], (j % 3 == 1 && i % 3 != 1) ? 1 : 0)
-          << i << "," << j;
-      EXPECT_EQ(bits[CanonicalIndex(3, i, j, kGy)], 0) << i << "," << j;
-    }
-  }
+  ExpectLevel3(
+      bits, [](int i, int j) { return i % 3 < j % 3; },
+      [](int i, int j) { return j % 3 == 1 && i % 3 != 1; }, Never);
 }
 
 int VerticalRamp(int y, int /*x*/) { return 4 * y; }
@@ -253,51 +260,25 @@ TEST(LdbTest, HandComputedBitsOfAVerticalRamp) {
   const std::vector<int> bits = FullBits(FromFunction(64, VerticalRamp));
   // Level 2: top cells 0, 1 have I = 4 * 15.5 = 62, bottom cells 2, 3 have 190; every cell is
   // 32 rows high so G_y = 4 * 16 = 64 everywhere (ties give 0); G_x = 0.
-  const std::vector<int> level2 = {
-      0, 0, 0,  // (0,1)
-      1, 0, 0,  // (0,2)
-      1, 0, 0,  // (0,3)
-      1, 0, 0,  // (1,2)
-      1, 0, 0,  // (1,3)
-      0, 0, 0,  // (2,3)
-  };
-  EXPECT_EQ(std::vector<int>(bits.begin(), bits.begin() + 18), level2);
+  ExpectLevel2(bits, {0, 1, 1, 1, 1, 0});
   // Level 3: rows [0,21) and [21,42) split 10 + 11 rows, G_y = 4 * 10.5 = 42; rows [42,64)
   // split 11 + 11, G_y = 4 * 11 = 44. So the G_y bit is 1 iff j is in the last row and i is not.
   EXPECT_EQ(bits[CanonicalIndex(3, 0, 6, kGy)], 1);  // 42 < 44
   EXPECT_EQ(bits[CanonicalIndex(3, 4, 8, kGy)], 1);  // 42 < 44
   EXPECT_EQ(bits[CanonicalIndex(3, 0, 3, kGy)], 0);  // 42 = 42
   EXPECT_EQ(bits[CanonicalIndex(3, 6, 7, kGy)], 0);  // 44 = 44
-  for (int i = 0; i < 9; ++i) {
-    for (int j = i + 1; j < 9; ++j) {
-      EXPECT_EQ(bits[CanonicalIndex(3, i, j, kI)], i / 3 < j / 3 ? 1 : 0) << i << "," << j;
-      EXPECT_EQ(bits[CanonicalIndex(3, i, j, kGx)], 0) << i << "," << j;
-      EXPECT_EQ(bits[CanonicalIndex(3, i, j, kGy)], (j / 3 == 2 && i / 3 != 2) ? 1 : 0)
-          << i << "," << j;
-    }
-  }
+  ExpectLevel3(
+      bits, [](int i, int j) { return i / 3 < j / 3; }, Never,
+      [](int i, int j) { return j / 3 == 2 && i / 3 != 2; });
 }
 
 TEST(LdbTest, HandComputedBitsOfAHorizontalRamp) {
   // The transpose of the vertical ramp: the roles of G_x and G_y swap.
   const std::vector<int> bits = FullBits(FromFunction(64, HorizontalRamp));
-  const std::vector<int> level2 = {
-      1, 0, 0,  // (0,1): 62 < 190
-      0, 0, 0,  // (0,2)
-      1, 0, 0,  // (0,3)
-      0, 0, 0,  // (1,2)
-      0, 0, 0,  // (1,3)
-      1, 0, 0,  // (2,3)
-  };
-  EXPECT_EQ(std::vector<int>(bits.begin(), bits.begin() + 18), level2);
-  for (int i = 0; i < 9; ++i) {
-    for (int j = i + 1; j < 9; ++j) {
-      EXPECT_EQ(bits[CanonicalIndex(3, i, j, kI)], i % 3 < j % 3 ? 1 : 0) << i << "," << j;
-      EXPECT_EQ(bits[CanonicalIndex(3, i, j, kGx)], (j % 3 == 2 && i % 3 != 2) ? 1 : 0)
-          << i << "," << j;
-      EXPECT_EQ(bits[CanonicalIndex(3, i, j, kGy)], 0) << i << "," << j;
-    }
-  }
+  ExpectLevel2(bits, {1, 0, 1, 0, 0, 1});  // (0,1): 62 < 190
+  ExpectLevel3(
+      bits, [](int i, int j) { return i % 3 < j % 3; },
+      [](int i, int j) { return j % 3 == 2 && i % 3 != 2; }, Never);
 }
 
 TEST(LdbTest, UniformPatchHasNoBitsSet) {

@@ -16,10 +16,7 @@
 namespace openable {
 namespace {
 
-using testing_util::Describe;
-using testing_util::Hamming;
-using testing_util::Options;
-using testing_util::TexturedPatch;
+using namespace testing_util;  // NOLINT: the descriptor test helpers are this file's vocabulary
 
 double L2(const cv::Mat& a, const cv::Mat& b) {
   double sum = 0.0;

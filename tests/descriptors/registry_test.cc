@@ -12,24 +12,12 @@
 #include "descriptors/hog.h"
 #include "descriptors/ldb.h"
 #include "descriptors/opencv_descriptors.h"
+#include "tests/test_support.h"
 
 namespace openable {
 namespace {
 
-// The message of the InputError thrown by `f`; fails the test when none is thrown.
-template <typename F>
-std::string InputErrorMessage(F f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "expected InputError, nothing was thrown";
-  return "";
-}
+using testing::InputErrorMessage;
 
 bool Contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;

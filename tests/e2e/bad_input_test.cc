@@ -506,8 +506,7 @@ TEST(BadInputCorpus, VideoWithoutFrames) {
   const std::string dir = testing::TempDir();
   const std::string video = dir + "/none.avi";
   {
-    cv::VideoWriter writer(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10,
-                           cv::Size(64, 32));
+    cv::VideoWriter writer = MjpgWriter(video);
     if (!writer.isOpened()) GTEST_SKIP() << "this OpenCV cannot write MJPG video";
   }
   ASSERT_TRUE(fs::exists(video));

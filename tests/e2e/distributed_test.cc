@@ -120,6 +120,21 @@ void ExpectSameMatches(const std::string& a, const std::string& b, bool exact) {
   }
 }
 
+// Copies the sample's summer frames to <dir>/frames; returns the copies in order.
+std::vector<std::string> CopySummerFrames(const std::string& dir) {
+  fs::create_directories(dir + "/frames");
+  std::vector<fs::path> images;
+  for (const auto& e : fs::directory_iterator(testing::SampleDir() + "/summer"))
+    images.push_back(e.path());
+  std::sort(images.begin(), images.end());
+  std::vector<std::string> copies;
+  for (const fs::path& p : images) {
+    copies.push_back(dir + "/frames/" + p.filename().string());
+    fs::copy_file(p, copies.back());
+  }
+  return copies;
+}
+
 class Spread : public ::testing::TestWithParam<Case> {};
 
 TEST_P(Spread, OneTwoAndThreeProcessesWriteTheSingleProcessOutputs) {
@@ -190,13 +205,7 @@ TEST(SpreadFailure, AFrameOfOneShareEndsTheRunInOneLineWithNoOutput) {
   const std::string missing = MissingMpi();
   if (!missing.empty()) GTEST_SKIP() << missing;
   const std::string dir = testing::TempDir();
-  fs::create_directories(dir + "/frames");
-  std::vector<fs::path> images;
-  for (const auto& e : fs::directory_iterator(testing::SampleDir() + "/summer"))
-    images.push_back(e.path());
-  std::sort(images.begin(), images.end());
-  for (const fs::path& p : images) fs::copy_file(p, dir + "/frames/" + p.filename().string());
-  const std::string damaged = dir + "/frames/" + images.back().filename().string();
+  const std::string damaged = CopySummerFrames(dir).back();
   std::ofstream(damaged, std::ios::trunc) << "not an image";
   const Case c{"", "LDB", false, false, 5};
   const std::string config = ConfigOf(dir, c, dir + "/frames");
@@ -216,13 +225,8 @@ TEST(SpreadFailure, SkippedFramesOfAShareAreSkippedAsInOneProcess) {
   const std::string missing = MissingMpi();
   if (!missing.empty()) GTEST_SKIP() << missing;
   const std::string dir = testing::TempDir();
-  fs::create_directories(dir + "/frames");
-  std::vector<fs::path> images;
-  for (const auto& e : fs::directory_iterator(testing::SampleDir() + "/summer"))
-    images.push_back(e.path());
-  std::sort(images.begin(), images.end());
-  for (const fs::path& p : images) fs::copy_file(p, dir + "/frames/" + p.filename().string());
-  std::ofstream(dir + "/frames/" + images.back().filename().string(), std::ios::trunc) << "x";
+  const std::vector<std::string> frames = CopySummerFrames(dir);
+  std::ofstream(frames.back(), std::ios::trunc) << "x";
   const Case c{"", "LDB", false, false, 5};
   const std::string config = ConfigOf(dir, c, dir + "/frames");
   std::ofstream(config, std::ios::app) << "Skip_unreadable: 1\n";
@@ -233,10 +237,8 @@ TEST(SpreadFailure, SkippedFramesOfAShareAreSkippedAsInOneProcess) {
   const Outcome o = RunSpread(3, testing::TestOpenableExe(), {config, "--quiet"}, dir);
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_EQ(ReadAll(dir + "/out/matrix.npy"), single);
-  EXPECT_NE(o.out.find("skipped: image \"" + dir + "/frames/" + images.back().filename().string()),
-            std::string::npos)
-      << o.out;
-  EXPECT_NE(o.out.find(std::to_string(images.size() - 1) + " frames of"), std::string::npos)
+  EXPECT_NE(o.out.find("skipped: image \"" + frames.back()), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find(std::to_string(frames.size() - 1) + " frames of"), std::string::npos)
       << o.out;
 }
 

@@ -1,6 +1,7 @@
 // Helpers of the end-to-end tests: running a program, reading what it wrote.
 #pragma once
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -12,11 +13,10 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/core.hpp>
 
 #include "tests/test_support.h"
 
@@ -38,6 +38,13 @@ inline std::string ShellQuote(const std::string& s) {
   return q + "'";
 }
 
+// A bad command line: the arguments it adds to a good one, and the parts that the one line of
+// its error must hold.
+struct BadArgs {
+  std::vector<std::string> args;
+  std::vector<std::string> parts;
+};
+
 // Runs `exe` with `args` in `dir`; captures its exit status, stdout and stderr.
 inline Outcome RunProgram(const std::string& exe, const std::vector<std::string>& args,
                    const std::string& dir) {
@@ -52,6 +59,43 @@ inline Outcome RunProgram(const std::string& exe, const std::vector<std::string>
   fs::remove(dir + "/stdout.log");
   fs::remove(dir + "/stderr.log");
   return o;
+}
+
+// `first` (a Config.txt or a preset, when there is one), "--quiet", then each of `settings`
+// ("Key=value") after --set: the arguments of a quiet run of Test_OpenABLE or openable_snaps.
+inline std::vector<std::string> QuietArgs(const std::vector<std::string>& settings,
+                                          const std::vector<std::string>& first = {}) {
+  std::vector<std::string> args = first;
+  args.push_back("--quiet");
+  for (const std::string& setting : settings) args.insert(args.end(), {"--set", setting});
+  return args;
+}
+
+// Runs Test_OpenABLE quietly in `dir` with each of `settings` ("Key=value") set.
+inline Outcome RunTestOpenable(const std::string& dir, const std::vector<std::string>& settings) {
+  return RunProgram(testing::TestOpenableExe(), QuietArgs(settings), dir);
+}
+
+// The settings of a loop-closure evaluation of KITTI 00 frames 0-1699 (the folder `kitti`) with
+// sequences of `length` frames: loops from the poses (5 m in the ground plane, headings within
+// 45 degrees, 100 frames apart), tolerance 3, the matrix m.npy and the evaluation "eval".
+inline std::vector<std::string> Kitti00LoopSettings(const std::string& kitti, int length) {
+  return {"Images_path=" + kitti + "/image_0",
+          "Image_sequences=" + std::to_string(length),
+          "Npy_name=m.npy",
+          "Ground_truth_type=kitti",
+          "Ground_truth=" + kitti + "/poses/00_first1700.txt",
+          "Ground_truth_axes=xz",
+          "Ground_truth_heading=45",
+          "Exclusion=100",
+          "Tolerance=3",
+          "Evaluation_name=eval"};
+}
+
+// A writer of 64 x 32 colour MJPG frames at 10 frames a second to `path`; not opened when this
+// OpenCV cannot write MJPG video.
+inline cv::VideoWriter MjpgWriter(const std::string& path) {
+  return cv::VideoWriter(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10, cv::Size(64, 32));
 }
 
 // Independent .npy reader: float32, C order, 2-D.
@@ -157,21 +201,33 @@ inline double JsonNumber(const std::string& json, const std::string& key, std::s
   return std::strtod(json.c_str() + p + k.size(), nullptr);
 }
 
-// Runs the reference on `json`'s matrix; returns its output, and fails the test when a figure
-// differs by more than 5e-4.
+// Runs the reference on the matrix m.npy of a run in `dir` with `args` (the ground truth and
+// the evaluation's settings; vicinity 7), prints the last line of its output, and fails the test
+// when a figure of the run's eval.json differs by more than 5e-4.
 inline void CheckAgainstReference(const std::string& dir, const std::vector<std::string>& args) {
   if (std::system("/usr/bin/python3 -c 'import numpy' 2>/dev/null") != 0)
     GTEST_SKIP() << "/usr/bin/python3 with numpy is absent (examples/setup.sh installs it)";
-  const Outcome o = RunProgram(
-      "/usr/bin/python3",
-      [&] {
-        std::vector<std::string> a = {testing::SourceDir() + "/tests/tools/evaluate_reference.py"};
-        a.insert(a.end(), args.begin(), args.end());
-        return a;
-      }(),
-      dir);
+  std::vector<std::string> all = {testing::SourceDir() + "/tests/tools/evaluate_reference.py",
+                                  "--matrix", "m.npy"};
+  all.insert(all.end(), args.begin(), args.end());
+  all.insert(all.end(), {"--vicinity", "7", "--compare", "eval.json"});
+  const Outcome o = RunProgram("/usr/bin/python3", all, dir);
   EXPECT_EQ(o.status, 0) << o.out << o.err;
   std::cout << o.out.substr(o.out.rfind('\n', o.out.size() - 2) + 1);
+}
+
+// Runs Test_OpenABLE in a fresh temporary folder with `settings` (which name the matrix m.npy and
+// the evaluation "eval"), prints its evaluation, and checks the figures against the reference
+// run with `reference` (CheckAgainstReference). Returns the folder.
+inline std::string EvaluateAgainstTheReference(const std::vector<std::string>& settings,
+                                               const std::vector<std::string>& reference) {
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunTestOpenable(dir, settings);
+  EXPECT_EQ(o.status, 0) << o.err;
+  if (o.status != 0) return dir;
+  std::cout << o.out.substr(o.out.find("Evaluation"));
+  CheckAgainstReference(dir, reference);
+  return dir;
 }
 
 }  // namespace e2e

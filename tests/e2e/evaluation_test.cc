@@ -156,56 +156,29 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(EvaluationOnDatasets, NordlandWinterAgainstSummer) {
   const std::string data = testing::DatasetsDir() + "/nordland_trimmed";
   OPENABLE_REQUIRE_PATH(data);
-  const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram(
-      testing::TestOpenableExe(),
-      {"--quiet", "--set", "Images_path=" + data + "/summer", "--set",
-       "Images_path_2=" + data + "/winter", "--set", "Image_sequences=10", "--set",
-       "Npy_name=m.npy", "--set", "Ground_truth_type=aligned", "--set", "Tolerance=2", "--set",
-       "Evaluation_name=eval"},
-      dir);
-  ASSERT_EQ(o.status, 0) << o.err;
-  std::cout << o.out.substr(o.out.find("Evaluation"));
+  const std::string dir = EvaluateAgainstTheReference(
+      {"Images_path=" + data + "/summer", "Images_path_2=" + data + "/winter", "Image_sequences=10",
+       "Npy_name=m.npy", "Ground_truth_type=aligned", "Tolerance=2", "Evaluation_name=eval"},
+      {"--reference-frames", "1788", "--aligned", "--tolerance", "2"});
   EXPECT_GE(JsonNumber(ReadAll(dir + "/eval.json"), "recall_at_1"), 0.355);
-  CheckAgainstReference(dir, {"--matrix", "m.npy", "--reference-frames", "1788", "--aligned",
-                              "--tolerance", "2", "--vicinity", "7", "--compare", "eval.json"});
 }
 
 TEST(EvaluationOnDatasets, GardensPointDayRightAgainstDayLeft) {
   const std::string data = testing::DatasetsDir() + "/gardens_point";
   OPENABLE_REQUIRE_PATH(data);
-  const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram(
-      testing::TestOpenableExe(),
-      {"--quiet", "--set", "Images_path=" + data + "/day_left", "--set",
-       "Images_path_2=" + data + "/day_right", "--set", "Image_sequences=5", "--set",
-       "Npy_name=m.npy", "--set", "Ground_truth_type=aligned", "--set", "Evaluation_name=eval"},
-      dir);
-  ASSERT_EQ(o.status, 0) << o.err;
-  std::cout << o.out.substr(o.out.find("Evaluation"));
-  CheckAgainstReference(dir, {"--matrix", "m.npy", "--reference-frames", "200", "--aligned",
-                              "--tolerance", "2", "--vicinity", "7", "--compare", "eval.json"});
+  EvaluateAgainstTheReference(
+      {"Images_path=" + data + "/day_left", "Images_path_2=" + data + "/day_right",
+       "Image_sequences=5", "Npy_name=m.npy", "Ground_truth_type=aligned", "Evaluation_name=eval"},
+      {"--reference-frames", "200", "--aligned", "--tolerance", "2"});
 }
 
 TEST(EvaluationOnDatasets, Kitti00LoopsFromPosesAgainstTheLoopList) {
   const std::string data = testing::DatasetsDir() + "/kitti00_first1700";
   OPENABLE_REQUIRE_PATH(data);
-  const std::string dir = testing::TempDir();
-  // Loops derived here from the poses (5 m in the ground plane, headings within 45 degrees,
-  // 100 frames apart); the reference reads them from loop_gt_5m.txt instead.
-  const Outcome o = RunProgram(
-      testing::TestOpenableExe(),
-      {"--quiet", "--set", "Images_path=" + data + "/image_0", "--set", "Image_sequences=1",
-       "--set", "Npy_name=m.npy", "--set", "Ground_truth_type=kitti", "--set",
-       "Ground_truth=" + data + "/poses/00_first1700.txt", "--set", "Ground_truth_axes=xz",
-       "--set", "Ground_truth_heading=45", "--set", "Exclusion=100", "--set", "Tolerance=3",
-       "--set", "Evaluation_name=eval"},
-      dir);
-  ASSERT_EQ(o.status, 0) << o.err;
-  std::cout << o.out.substr(o.out.find("Evaluation"));
-  CheckAgainstReference(dir, {"--matrix", "m.npy", "--pairs", data + "/loop_gt_5m.txt",
-                              "--max-col4", "45", "--exclusion", "100", "--tolerance", "3",
-                              "--vicinity", "7", "--compare", "eval.json"});
+  // Loops derived here from the poses; the reference reads them from loop_gt_5m.txt instead.
+  EvaluateAgainstTheReference(Kitti00LoopSettings(data, 1),
+                              {"--pairs", data + "/loop_gt_5m.txt", "--max-col4", "45",
+                               "--exclusion", "100", "--tolerance", "3"});
 }
 
 }  // namespace

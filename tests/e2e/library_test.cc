@@ -17,29 +17,15 @@
 namespace openable {
 namespace {
 
+using e2e::JsonNumber;
 using e2e::Outcome;
 using e2e::ReadNpy;
-using e2e::RunProgram;
-
-// The number after "key": in a JSON text (first occurrence); NaN when absent.
-double JsonNumber(const std::string& json, const std::string& key) {
-  const size_t at = json.find("\"" + key + "\": ");
-  if (at == std::string::npos) return std::nan("");
-  return std::strtod(json.c_str() + at + key.size() + 4, nullptr);
-}
 
 TEST(Library, BatchPathGivesTestOpenablesMatrixAndFigures) {
   const std::string data = testing::DatasetsDir() + "/kitti00_first1700";
   OPENABLE_REQUIRE_PATH(data);
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram(
-      testing::TestOpenableExe(),
-      {"--quiet", "--set", "Images_path=" + data + "/image_0", "--set", "Image_sequences=5",
-       "--set", "Npy_name=m.npy", "--set", "Ground_truth_type=kitti", "--set",
-       "Ground_truth=" + data + "/poses/00_first1700.txt", "--set", "Ground_truth_axes=xz",
-       "--set", "Ground_truth_heading=45", "--set", "Exclusion=100", "--set", "Tolerance=3",
-       "--set", "Evaluation_name=eval"},
-      dir);
+  const Outcome o = e2e::RunTestOpenable(dir, e2e::Kitti00LoopSettings(data, 5));
   ASSERT_EQ(o.status, 0) << o.err;
   const cv::Mat1f cli = ReadNpy(dir + "/m.npy");
   ASSERT_EQ(cli.rows, 1700);

@@ -137,9 +137,8 @@ TEST(MatchScore, RatioEvaluationOfTheSampleAgreesWithTheReference) {
   const std::string json = ReadAll(dir + "/eval.json");
   EXPECT_NE(json.find("\"match_score\": \"ratio\""), std::string::npos);
   EXPECT_EQ(JsonNumber(json, "match_score_window"), 7);
-  CheckAgainstReference(dir, {"--matrix", "m.npy", "--reference-frames", "300", "--aligned",
-                              "--tolerance", "2", "--vicinity", "7", "--score", "ratio",
-                              "--score-window", "7", "--compare", "eval.json"});
+  CheckAgainstReference(dir, {"--reference-frames", "300", "--aligned", "--tolerance", "2",
+                              "--score", "ratio", "--score-window", "7"});
 }
 
 // Loop closure on a real indoor sequence that goes round twice (84 frames, 1-based pairs):
@@ -147,20 +146,13 @@ TEST(MatchScore, RatioEvaluationOfTheSampleAgreesWithTheReference) {
 TEST(MatchScore, RatioLoopClosureOnRtabmapAgreesWithTheReference) {
   const std::string data = testing::DatasetsDir() + "/rtabmap_samples";
   OPENABLE_REQUIRE_PATH(data);
-  const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram(
-      testing::TestOpenableExe(),
-      {"--quiet", "--set", "Images_path=" + data + "/images", "--set", "Image_sequences=3",
-       "--set", "Npy_name=m.npy", "--set", "Ground_truth_type=pairs", "--set",
-       "Ground_truth=" + data + "/ground_truth_pairs.txt", "--set", "Ground_truth_base=1",
-       "--set", "Exclusion=10", "--set", "Tolerance=1", "--set", "Match_score=ratio", "--set",
-       "Match_score_window=3", "--set", "Evaluation_name=eval"},
-      dir);
-  ASSERT_EQ(o.status, 0) << o.err;
-  CheckAgainstReference(dir, {"--matrix", "m.npy", "--pairs", data + "/ground_truth_pairs.txt",
-                              "--base", "1", "--exclusion", "10", "--tolerance", "1",
-                              "--vicinity", "7", "--score", "ratio", "--score-window", "3",
-                              "--compare", "eval.json"});
+  EvaluateAgainstTheReference(
+      {"Images_path=" + data + "/images", "Image_sequences=3", "Npy_name=m.npy",
+       "Ground_truth_type=pairs", "Ground_truth=" + data + "/ground_truth_pairs.txt",
+       "Ground_truth_base=1", "Exclusion=10", "Tolerance=1", "Match_score=ratio",
+       "Match_score_window=3", "Evaluation_name=eval"},
+      {"--pairs", data + "/ground_truth_pairs.txt", "--base", "1", "--exclusion", "10",
+       "--tolerance", "1", "--score", "ratio", "--score-window", "3"});
 }
 
 // The report counts the best matches that Match_threshold accepts, by the chosen score.

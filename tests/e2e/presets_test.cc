@@ -19,19 +19,23 @@ std::string Preset(const std::string& name) {
   return testing::SourceDir() + "/config/presets/" + name + ".txt";
 }
 
+// Test_OpenABLE run quietly in `dir` as a user runs a preset: Test_OpenABLE <preset> --set ...
+Outcome RunPreset(const std::string& name, const std::string& dir,
+                  const std::vector<std::string>& settings) {
+  return RunProgram(testing::TestOpenableExe(), QuietArgs(settings, {Preset(name)}), dir);
+}
+
 // Two traversals of 300 frames (summer reference, winter queries) with the frame alignment as
 // ground truth: the settings the preset's comment announces are in effect, R@1 of the report is
 // that of the written matrix, and the accepted best matches are those whose ratio to the best
 // match outside +-10 frames is at most 0.9 and that an independent query confirms.
 TEST(Presets, AcrossConditionsRunsOnTheSample) {
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram(
-      testing::TestOpenableExe(),
-      {Preset("across_conditions"), "--quiet", "--set",
-       "Images_path=" + testing::SampleDir() + "/summer", "--set",
-       "Images_path_2=" + testing::SampleDir() + "/winter", "--set", "Ground_truth_type=aligned",
-       "--set", "Npy_name=m.npy", "--set", "Png_name=m.png", "--set", "Evaluation_name=eval"},
-      dir);
+  const Outcome o =
+      RunPreset("across_conditions", dir,
+                {"Images_path=" + testing::SampleDir() + "/summer",
+                 "Images_path_2=" + testing::SampleDir() + "/winter", "Ground_truth_type=aligned",
+                 "Npy_name=m.npy", "Png_name=m.png", "Evaluation_name=eval"});
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_NE(o.out.find("HOG ("), std::string::npos) << o.out;
   EXPECT_NE(o.out.find(" + LDB ("), std::string::npos) << o.out;
@@ -61,12 +65,9 @@ TEST(Presets, AcrossConditionsRunsOnTheSample) {
 // the matrix of SIFT with sequences of 5 frames, verifies its candidates and says so.
 TEST(Presets, LoopClosureRunsOnTheSample) {
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram(
-      testing::TestOpenableExe(),
-      {Preset("loop_closure"), "--quiet", "--set",
-       "Images_path=" + testing::SampleDir() + "/summer", "--set", "Npy_name=m.npy", "--set",
-       "Png_name=m.png"},
-      dir);
+  const Outcome o = RunPreset(
+      "loop_closure", dir,
+      {"Images_path=" + testing::SampleDir() + "/summer", "Npy_name=m.npy", "Png_name=m.png"});
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_NE(o.out.find("SIFT ("), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("sequence length 5"), std::string::npos) << o.out;

@@ -1,15 +1,16 @@
 // End-to-end runs of openable_snaps on the real KITTI trajectories
 // (../shared/datasets/kitti_trajectories): the files it writes, the figures in them recomputed
 // here from those files, and its input errors (one line, exit 1, nothing written).
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
@@ -51,14 +52,30 @@ std::map<long, Position> ReadPositions(const std::string& path, bool with_id,
   return out;
 }
 
+double Distance(const Position& a, const Position& b) {
+  return std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) +
+                   (a.z - b.z) * (a.z - b.z));
+}
+
 double MeanDeviation(const std::map<long, Position>& a, const std::map<long, Position>& truth) {
   double sum = 0;
-  for (const auto& [id, p] : a) {
-    const Position& g = truth.at(id);
-    sum += std::sqrt((p.x - g.x) * (p.x - g.x) + (p.y - g.y) * (p.y - g.y) +
-                     (p.z - g.z) * (p.z - g.z));
-  }
+  for (const auto& [id, p] : a) sum += Distance(p, truth.at(id));
   return sum / static_cast<double>(a.size());
+}
+
+// The loop pairs "query,reference" of a loops file that openable_snaps wrote ('#' comments).
+std::vector<std::pair<long, long>> ReadLoops(const std::string& path) {
+  std::vector<std::pair<long, long>> loops;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    long q = 0, r = 0;
+    char comma = 0;
+    std::istringstream(line) >> q >> comma >> r;
+    loops.emplace_back(q, r);
+  }
+  return loops;
 }
 
 // The first number after "key": in `json` from position `from`.
@@ -71,23 +88,12 @@ double JsonNumber(const std::string& json, const std::string& key, size_t from =
 std::vector<std::string> SoDsoArgs(const std::string& seq, const std::string& out) {
   const std::string pairs =
       seq == "00" ? "groundTruth_KITTI00.pairs.csv" : "kitti06GroundTruth.pairs.csv";
-  return {"--quiet",
-          "--set",
-          "Snaps_trajectory=" + Kitti() + "/vo_so_dso/seq" + seq + "/poses_history_file.txt",
-          "--set",
-          "Snaps_trajectory_format=kitti-id",
-          "--set",
-          "Snaps_world_to_camera=1",
-          "--set",
-          "Snaps_ground_truth=" + Kitti() + "/poses/" + seq + ".txt",
-          "--set",
-          "Snaps_loops=pairs",
-          "--set",
-          "Snaps_loops_file=" + Kitti() + "/loop_pairs/" + pairs,
-          "--set",
-          "Snaps_drop_outside=1",
-          "--set",
-          "Snaps_output_name=" + out};
+  return QuietArgs(
+      {"Snaps_trajectory=" + Kitti() + "/vo_so_dso/seq" + seq + "/poses_history_file.txt",
+       "Snaps_trajectory_format=kitti-id", "Snaps_world_to_camera=1",
+       "Snaps_ground_truth=" + Kitti() + "/poses/" + seq + ".txt", "Snaps_loops=pairs",
+       "Snaps_loops_file=" + Kitti() + "/loop_pairs/" + pairs, "Snaps_drop_outside=1",
+       "Snaps_output_name=" + out});
 }
 
 // A bad input for openable_snaps: the overrides added to a good command line, and the text its
@@ -153,24 +159,13 @@ TEST_P(SoDso, CorrectsWithGroundTruthPairsAndWritesWhatItReports) {
   EXPECT_NEAR(in_mean, seq == "00" ? 9.59 : 4.83, 0.01);
   // The loops the graph was given are closed: the mean gap between the two positions of the
   // written loop pairs shrinks at least by half.
-  std::ifstream loops(dir + "/out/run_loops.csv");
-  std::string line;
+  const std::vector<std::pair<long, long>> loops = ReadLoops(dir + "/out/run_loops.csv");
   double gap_in = 0, gap_out = 0;
-  int n = 0;
-  while (std::getline(loops, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    long q = 0, r = 0;
-    char comma = 0;
-    std::istringstream(line) >> q >> comma >> r;
-    auto gap = [&](const std::map<long, Position>& t) {
-      const Position a = t.at(q), b = t.at(r);
-      return std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) +
-                       (a.z - b.z) * (a.z - b.z));
-    };
-    gap_in += gap(input);
-    gap_out += gap(graph);
-    ++n;
+  for (const auto& [q, r] : loops) {
+    gap_in += Distance(input.at(q), input.at(r));
+    gap_out += Distance(graph.at(q), graph.at(r));
   }
+  const int n = static_cast<int>(loops.size());
   ASSERT_GT(n, 100);
   EXPECT_LT(gap_out, 0.5 * gap_in) << "mean loop gap " << gap_in / n << " -> " << gap_out / n;
 }
@@ -205,12 +200,6 @@ TEST(SnapsErrors, OneLineNonZeroExitNothingWritten) {
   ExpectEveryCaseRefused(SoDsoArgs("06", dir + "/out/run"), cases, dir);
 }
 
-}  // namespace
-}  // namespace openable
-
-namespace openable {
-namespace {
-
 // The whole chain from images: KITTI 00 frames 0-1699 -> monocular odometry (scale
 // from the ground truth's step lengths) -> loops found by OpenABLE on the same frames -> pose
 // graph and discounted update -> error against the ground truth, recomputed here from the
@@ -221,11 +210,10 @@ TEST(SnapsChain, KittiMonocularOdometryLoopsFromOpenableAndCorrection) {
   const std::string dir = testing::TempDir();
   const Outcome o = RunProgram(
       testing::OpenableSnapsExe(),
-      {"--quiet", "--set", "Snaps_odometry=mono", "--set", "Images_path=" + kitti + "/image_0",
-       "--set", "Odometry_calibration=" + kitti + "/calib.txt", "--set",
-       "Odometry_calibration_scale=0.5", "--set",
-       "Snaps_ground_truth=" + kitti + "/poses/00_first1700.txt", "--set", "Snaps_loops=openable",
-       "--set", "Snaps_output_name=" + dir + "/out/chain"},
+      QuietArgs({"Snaps_odometry=mono", "Images_path=" + kitti + "/image_0",
+                 "Odometry_calibration=" + kitti + "/calib.txt", "Odometry_calibration_scale=0.5",
+                 "Snaps_ground_truth=" + kitti + "/poses/00_first1700.txt", "Snaps_loops=openable",
+                 "Snaps_output_name=" + dir + "/out/chain"}),
       dir);
   ASSERT_EQ(o.status, 0) << o.err << o.out;
   std::cout << o.out;
@@ -238,20 +226,12 @@ TEST(SnapsChain, KittiMonocularOdometryLoopsFromOpenableAndCorrection) {
   std::cout << "[ chain ] mean deviation " << before << " m -> " << after << " m\n";
   // Every loop OpenABLE gave is a real revisit (within 5 m in the ground truth) of the one
   // revisit of this stretch (frames 1559-1641 over 108-180, the ends of the runs reaching 191).
-  std::ifstream loops(dir + "/out/chain_loops.csv");
-  std::string line;
-  int n = 0;
-  while (std::getline(loops, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    long q = 0, r = 0;
-    char comma = 0;
-    std::istringstream(line) >> q >> comma >> r;
-    const Position a = truth.at(q), b = truth.at(r);
-    EXPECT_LT(std::hypot(a.x - b.x, a.y - b.y, a.z - b.z), 5.0) << line;
-    EXPECT_TRUE(q >= 1559 && q <= 1641 && r >= 100 && r <= 200) << line;
-    ++n;
+  const std::vector<std::pair<long, long>> loops = ReadLoops(dir + "/out/chain_loops.csv");
+  for (const auto& [q, r] : loops) {
+    EXPECT_LT(Distance(truth.at(q), truth.at(r)), 5.0) << q << "," << r;
+    EXPECT_TRUE(q >= 1559 && q <= 1641 && r >= 100 && r <= 200) << q << "," << r;
   }
-  EXPECT_GE(n, 10);
+  EXPECT_GE(loops.size(), 10u);
   // The correction lowers the mean deviation (measured: 9.58 -> 6.72 m unaligned; aligned
   // 6.15 -> 2.08 m, the figure the report prints and the JSON holds).
   EXPECT_LT(after, 0.8 * before);
@@ -266,12 +246,6 @@ TEST(SnapsChain, KittiMonocularOdometryLoopsFromOpenableAndCorrection) {
   EXPECT_NEAR(JsonNumber(json, "mean_m", json.find("\"pose_graph\"", errors)), after, 1e-3);
 }
 
-}  // namespace
-}  // namespace openable
-
-namespace openable {
-namespace {
-
 // Odometry inputs that cannot work: one line naming the key, exit 1, nothing written.
 TEST(SnapsChainErrors, OneLineNonZeroExitNothingWritten) {
   const std::string kitti = testing::DatasetsDir() + "/kitti00_first1700";
@@ -285,10 +259,10 @@ TEST(SnapsChainErrors, OneLineNonZeroExitNothingWritten) {
     if (i < 2) std::filesystem::copy_file(kitti + "/image_0" + name, dir + "/right" + name);
   }
   std::ofstream(dir + "/calib.txt") << "P0: 1 0 0 0 0 1 0 0 0 0 1\n";  // 11 numbers
-  const std::vector<std::string> base = {
-      "--quiet", "--set", "Images_path=" + kitti + "/image_0", "--set", "Snaps_loops=openable",
-      "--set", "Snaps_ground_truth=" + kitti + "/poses/00_first1700.txt", "--set",
-      "Snaps_output_name=" + dir + "/out/run"};
+  const std::vector<std::string> base =
+      QuietArgs({"Images_path=" + kitti + "/image_0", "Snaps_loops=openable",
+                 "Snaps_ground_truth=" + kitti + "/poses/00_first1700.txt",
+                 "Snaps_output_name=" + dir + "/out/run"});
   const std::vector<RefusedCase> cases = {
       {{"Snaps_odometry=mono"}, "Odometry_calibration: empty"},
       {{"Snaps_odometry=mono", "Odometry_calibration=" + kitti + "/calib.txt",

@@ -34,6 +34,11 @@ std::vector<std::string> With(std::vector<std::string> args,
   return args;
 }
 
+// openable_sweep run in `dir` on the sample (SampleArgs) with the arguments `more`.
+Outcome RunSweep(const std::string& dir, const std::vector<std::string>& more) {
+  return RunProgram(testing::OpenableSweepExe(), With(SampleArgs(), more), dir);
+}
+
 // The text of the sweep run whose varied settings are `settings` ({"Key": "value", ...} in the
 // order of the --vary options); empty when absent.
 std::string SweepRunJson(const std::string& json, const Json& settings) {
@@ -54,11 +59,9 @@ std::vector<double> RankedFigures(const std::string& json, const std::string& ke
 
 TEST(Sweep, FiguresEqualTheSingleRunsAndAreRanked) {
   const std::string dir = testing::TempDir();
-  const Outcome sweep = RunProgram(
-      testing::OpenableSweepExe(),
-      With(SampleArgs(), {"--vary", "Image_descriptor=LDB,HOG", "--vary", "Image_sequences=1,5",
-                          "--vary", "Match_score=distance,ratio", "--output", "out/sweep"}),
-      dir);
+  const Outcome sweep =
+      RunSweep(dir, {"--vary", "Image_descriptor=LDB,HOG", "--vary", "Image_sequences=1,5",
+                     "--vary", "Match_score=distance,ratio", "--output", "out/sweep"});
   ASSERT_EQ(sweep.status, 0) << sweep.err;
   const std::string json = ReadAll(dir + "/out/sweep.json");
   ASSERT_FALSE(json.empty());
@@ -111,11 +114,8 @@ TEST(Sweep, FiguresEqualTheSingleRunsAndAreRanked) {
 
 TEST(Sweep, RanksByTheChosenFigure) {
   const std::string dir = testing::TempDir();
-  const Outcome sweep = RunProgram(
-      testing::OpenableSweepExe(),
-      With(SampleArgs(), {"--vary", "Image_sequences=1,3,5", "--rank-by", "recall_at_1",
-                          "--best", "2", "--output", "r"}),
-      dir);
+  const Outcome sweep = RunSweep(dir, {"--vary", "Image_sequences=1,3,5", "--rank-by",
+                                       "recall_at_1", "--best", "2", "--output", "r"});
   ASSERT_EQ(sweep.status, 0) << sweep.err;
   const std::string json = ReadAll(dir + "/r.json");
   const std::vector<double> r1 = RankedFigures(json, "recall_at_1");
@@ -128,10 +128,7 @@ TEST(Sweep, RanksByTheChosenFigure) {
 // started (the checks come before the first frame is read).
 TEST(Sweep, BadValuesStopBeforeAnyWork) {
   const std::string dir = testing::TempDir();
-  struct Case {
-    std::vector<std::string> args;
-    std::vector<std::string> parts;
-  } cases[] = {
+  const BadArgs cases[] = {
       {{"--vary", "Imge_sequences=1,5"}, {"--vary", "Imge_sequences", "Image_sequences"}},
       {{"--vary", "Image_sequences=1,0"}, {"--vary", "Image_sequences", "\"0\""}},
       {{"--vary", "Image_sequences=1,,5"}, {"--vary", "Image_sequences", "empty value"}},
@@ -154,11 +151,9 @@ TEST(Sweep, BadValuesStopBeforeAnyWork) {
       {{"--vary", "Image_descriptor=LDB,HOG+LDB", "--set", "Image_sequences=2"},
        {"Image_descriptor=HOG+LDB", "Fusion_weights"}},
   };
-  for (const Case& c : cases) {
+  for (const BadArgs& c : cases) {
     fs::remove_all(dir + "/bad");
-    const Outcome o = RunProgram(
-        testing::OpenableSweepExe(),
-        With(With(SampleArgs(), {"--output", "bad/sweep"}), c.args), dir);
+    const Outcome o = RunSweep(dir, With({"--output", "bad/sweep"}, c.args));
     std::string what;
     for (const auto& a : c.args) what += a + " ";
     EXPECT_EQ(o.status, 1) << what << o.err;

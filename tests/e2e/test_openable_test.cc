@@ -230,8 +230,7 @@ TEST(TestOpenABLE, VideoModeReadsFrames) {
   const std::string dir = testing::TempDir();
   const std::string video = dir + "/clip.avi";
   {
-    cv::VideoWriter writer(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10,
-                           cv::Size(64, 32));
+    cv::VideoWriter writer = MjpgWriter(video);
     if (!writer.isOpened()) GTEST_SKIP() << "this OpenCV cannot write MJPG video";
     std::vector<std::string> names;
     for (const auto& e : fs::directory_iterator(testing::SampleDir() + "/summer"))
@@ -616,18 +615,15 @@ TEST(TestOpenABLE, OutputsAtTheSameFileAreRefusedBeforeWork) {
 // relative path was taken from, a descriptor row too large to hold (refused before any work).
 TEST(TestOpenABLE, MessagesNameTheRealLimitAndTheWorkingDirectory) {
   const std::string dir = testing::TempDir();
-  struct Case {
-    std::vector<std::string> args;
-    std::vector<std::string> parts;
-  } cases[] = {
+  const BadArgs cases[] = {
       {{"--set", "Initial_image=4294967296"}, {"Initial_image", "2147483647"}},
       {{"--set", "Images_path=no/such/folder"},
        {"no/such/folder", "relative to the working directory", dir}},
-      {{"--set", "Image_descriptor=HOG", "--set", "Patch_size=1024", "--set",
-        "Description_type=1", "--set", "Grid_x=64", "--set", "Grid_y=32"},
+      {{"--set", "Image_descriptor=HOG", "--set", "Patch_size=1024", "--set", "Description_type=1",
+        "--set", "Grid_x=64", "--set", "Grid_y=32"},
        {"Patch_size", "1024", "Grid_x 64 x Grid_y 32", "GiB per frame"}},
   };
-  for (const Case& c : cases) {
+  for (const BadArgs& c : cases) {
     std::vector<std::string> args = {"--set", "Images_path=" + testing::SampleDir() + "/summer",
                                      "--set", "Npy_name=m.npy"};
     args.insert(args.end(), c.args.begin(), c.args.end());

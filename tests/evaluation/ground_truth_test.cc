@@ -181,12 +181,12 @@ TEST(GroundTruthMatrix, ImageNpyAndBadCells) {
 
 TEST(GroundTruthPairs, OneBasedHeaderCommentAndDuplicates) {
   const std::string path = TempDir() + "/pairs.txt";
-  WriteBytes(path,
-            "# query match (1-based)\n"
-            "3,1\n"
-            "4 2\n"
-            "4,2\n"
-            "2,4   # the same as 4,2\n");
+  WriteBytes(path, R"(# query match (1-based)
+3,1
+4 2
+4,2
+2,4   # the same as 4,2
+)");
   const GroundTruth gt = LoadLoop(Options(GroundTruthType::kPairs, path), 4);
   EXPECT_EQ(gt.matches, M(4, {{2, {0}}, {3, {1}}}));
   EXPECT_EQ(gt.dropped, 0);
@@ -194,14 +194,14 @@ TEST(GroundTruthPairs, OneBasedHeaderCommentAndDuplicates) {
 
 TEST(GroundTruthPairs, ZeroBasedCommentHeaderLineAndExtraColumns) {
   const std::string path = TempDir() + "/pairs.csv";
-  WriteBytes(path,
-            "# 0-based\n"
-            "row,col,distance\n"
-            "2,0,0.5\n"
-            "0,3,1.5\n"
-            "\n"
-            "3,1,x\n"
-            "2,2\n");
+  WriteBytes(path, R"(# 0-based
+row,col,distance
+2,0,0.5
+0,3,1.5
+
+3,1,x
+2,2
+)");
   const GroundTruth gt = LoadLoop(Options(GroundTruthType::kPairs, path), 4);
   EXPECT_EQ(gt.matches, M(4, {{2, {0}}, {3, {0, 1}}}));
   EXPECT_EQ(gt.dropped, 1);  // the diagonal pair 2,2
@@ -348,13 +348,19 @@ TEST(PosesKitti, ReadsPositionsAndForwardVectors) {
   EXPECT_TRUE(poses[0].has_forward);
 }
 
-TEST(PosesKitti, SquareLoopWithRadiusHeadingGapAndAxes) {
+// The square loop's 8 poses in a fresh file, compared within 2 m over x and z, 3 frames apart.
+GroundTruthOptions SquareLoop() {
   const std::string path = TempDir() + "/poses.txt";
   WriteBytes(path, KittiLines(0, 8));
   GroundTruthOptions o = Options(GroundTruthType::kKitti, path);
   o.radius = 2;
   o.axes = "xz";
   o.min_frame_gap = 3;
+  return o;
+}
+
+TEST(PosesKitti, SquareLoopWithRadiusHeadingGapAndAxes) {
+  GroundTruthOptions o = SquareLoop();
   // 4-0 and 5-0 are 1 m apart, 6-1 and 7-2 at the same place.
   GroundTruth gt = LoadLoop(o, 8);
   EXPECT_EQ(gt.matches, M(8, {{4, {0}}, {5, {0}}, {6, {1}}, {7, {2}}}));
@@ -391,17 +397,12 @@ TEST(PosesKitti, SquareLoopWithRadiusHeadingGapAndAxes) {
 }
 
 TEST(PosesKitti, FirstFrameSelectsPoseLines) {
-  const std::string path = TempDir() + "/poses.txt";
-  WriteBytes(path, KittiLines(0, 8));
-  GroundTruthOptions o = Options(GroundTruthType::kKitti, path);
-  o.radius = 2;
-  o.axes = "xz";
-  o.min_frame_gap = 3;
+  GroundTruthOptions o = SquareLoop();
   o.first_frame = 2;
   // Rows 0..5 are frames 2..7: only 7-2 remains.
   EXPECT_EQ(LoadLoop(o, 6).matches, M(6, {{5, {0}}}));
   ExpectInputError([&] { LoadLoop(o, 7); },
-                   {"KITTI poses " + Q(path), "file has 8 poses", "needs 9", "Initial_image 2"});
+                   {"KITTI poses " + Q(o.path), "file has 8 poses", "needs 9", "Initial_image 2"});
 }
 
 TEST(PosesKitti, TwoTraversals) {

@@ -17,10 +17,7 @@
 namespace openable {
 namespace {
 
-using openable::testing::TempDir;
-using openable::testing::ExpectInputError;
-using openable::testing::Q;
-using openable::testing::WriteBytes;
+using namespace openable::testing;  // NOLINT: TempDir, WriteBytes, Q, ExpectInputError
 
 // A .npy file from its parts: magic, version, little-endian header length (2 bytes for 1.0,
 // 4 for 2.0 and 3.0), the dict padded to a multiple of 64 bytes with '\n' last, then `data`

@@ -6,9 +6,12 @@
 
 #include <limits>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "tests/test_support.h"
 #include "tests/tools/brute_per_query.h"
 
 namespace openable {
@@ -206,13 +209,17 @@ TEST(PerQuery, AnswersChosenElsewhere) {
 }
 
 // ABLE-P protocol with 3 thresholds (0, 0.5, 1) on the query-reference block above; truth
-// cells (0,1), (1,4), (3,3).
-TEST(AbleP, HandWorkedVicinityZero) {
+// cells (0,1), (1,4), (3,3); a detection counts within `vicinity` rows and columns of one.
+AblePResult AblePOfTheBlock(int vicinity) {
   EvaluationOptions o;
   o.able_thresholds = 3;
-  o.vicinity = 0;
-  const AblePResult r = EvaluateAbleP(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
-                                      Truth({{1}, {4}, {}, {3}}, 5), o);
+  o.vicinity = vicinity;
+  return EvaluateAbleP(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
+                       Truth({{1}, {4}, {}, {3}}, 5), o);
+}
+
+TEST(AbleP, HandWorkedVicinityZero) {
+  const AblePResult r = AblePOfTheBlock(0);
   EXPECT_EQ(r.candidate_cells, 20);
   EXPECT_EQ(r.truth_cells, 3);
   ASSERT_EQ(r.curve.size(), 3u);
@@ -234,11 +241,7 @@ TEST(AbleP, HandWorkedVicinityZero) {
 }
 
 TEST(AbleP, HandWorkedVicinityOne) {
-  EvaluationOptions o;
-  o.able_thresholds = 3;
-  o.vicinity = 1;
-  const AblePResult r = EvaluateAbleP(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
-                                      Truth({{1}, {4}, {}, {3}}, 5), o);
+  const AblePResult r = AblePOfTheBlock(1);
   // theta 0.5: each of the 6 detections is within one row and column of a truth cell; (3,3)
   // is found through its neighbour (2,3) = 0.35.
   EXPECT_EQ(r.curve[1].tp, 6);
@@ -270,20 +273,13 @@ TEST(AbleP, LoopClosureCountsOnlyCandidateCells) {
 }
 
 TEST(EvaluationOptions, CheckNamesTheKey) {
-  EvaluationOptions o;
-  o.tolerance = -1;
-  try {
-    o.Check();
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("Tolerance: -1"), std::string::npos);
-  }
-  o = EvaluationOptions();
-  o.exclusion = 0;
-  EXPECT_THROW(o.Check(), InputError);
-  o = EvaluationOptions();
-  o.vicinity = -3;
-  EXPECT_THROW(o.Check(), InputError);
+  const std::pair<void (*)(EvaluationOptions&), const char*> cases[] = {
+      {[](EvaluationOptions& o) { o.tolerance = -1; }, "Tolerance: -1"},
+      {[](EvaluationOptions& o) { o.exclusion = 0; }, "Exclusion: 0"},
+      {[](EvaluationOptions& o) { o.vicinity = -3; }, "Vicinity: -3"},
+  };
+  for (const auto& [change, key] : cases)
+    EXPECT_NE(testing::CheckError<EvaluationOptions>(change).find(key), std::string::npos) << key;
 }
 
 

@@ -6,29 +6,17 @@
 #include <cstdint>
 #include <string>
 
-#include "OpenABLE/base/error.h"
 #include "config/config.h"
+#include "tests/fuzz/fuzz_support.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const std::string text(reinterpret_cast<const char*>(data), size);
+  using openable::fuzz::Refuses;
+  const std::string text = openable::fuzz::Bytes(data, size);
   openable::Config config;
-  try {
-    config = openable::ParseConfigText(text, "fuzz.txt");
-  } catch (const openable::InputError&) {
-    return 0;
-  }
-  try {
-    openable::CheckConfig(config);
-  } catch (const openable::InputError&) {
-  }
-  try {
-    openable::CheckSnapsConfig(config);
-  } catch (const openable::InputError&) {
-  }
+  if (Refuses([&] { config = openable::ParseConfigText(text, "fuzz.txt"); })) return 0;
+  Refuses([&] { openable::CheckConfig(config); });
+  Refuses([&] { openable::CheckSnapsConfig(config); });
   // The same bytes as one --set override (first line only, as a shell argument would be).
-  try {
-    openable::ApplyOverride(config, text.substr(0, text.find('\n')));
-  } catch (const openable::InputError&) {
-  }
+  Refuses([&] { openable::ApplyOverride(config, text.substr(0, text.find('\n'))); });
   return 0;
 }

@@ -12,8 +12,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "OpenABLE/base/error.h"
 #include "OpenABLE/io/frame_source.h"
+#include "tests/fuzz/fuzz_support.h"
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   // A header may announce a huge image; OpenCV's decoders refuse more pixels than this
@@ -23,13 +23,10 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const std::string bytes(reinterpret_cast<const char*>(data), size);
+  const std::string bytes = openable::fuzz::Bytes(data, size);
   cv::Mat frame;
-  try {
-    frame = openable::DecodeImageBytes(bytes, "fuzz");
-  } catch (const openable::InputError&) {
+  if (openable::fuzz::Refuses([&] { frame = openable::DecodeImageBytes(bytes, "fuzz"); }))
     return 0;
-  }
   const bool format_ok = !frame.empty() && (frame.type() == CV_32FC1 || frame.type() == CV_32FC3);
   double lo = 0.0;
   double hi = 0.0;

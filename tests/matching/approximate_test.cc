@@ -9,29 +9,17 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "tests/matching/random_rows.h"
 
 namespace openable {
 namespace {
 
-cv::Mat RandomBytes(int rows, int cols, unsigned seed) {
-  std::mt19937 rng(seed);
-  cv::Mat m(rows, cols, CV_8U);
-  for (int i = 0; i < rows; ++i)
-    for (int j = 0; j < cols; ++j) m.at<std::uint8_t>(i, j) = static_cast<std::uint8_t>(rng());
-  return m;
-}
-
-cv::Mat RandomFloats(int rows, int cols, unsigned seed, float offset = 0, float sigma = 1) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<float> normal(0.0f, sigma);
-  cv::Mat m(rows, cols, CV_32F);
-  for (int i = 0; i < rows; ++i)
-    for (int j = 0; j < cols; ++j) m.at<float>(i, j) = offset + normal(rng);
-  return m;
-}
+using matching_test::RandomBytes;
+using matching_test::RandomFloats;
 
 // Row i of the result: row source[i] of `refs` with `bits` distinct bits flipped.
 cv::Mat FlipBits(const cv::Mat& refs, const std::vector<int>& source, int bits, unsigned seed) {
@@ -270,13 +258,19 @@ TEST(ApproximateIndex, KdTreesFindPlantedNearDuplicates) {
   EXPECT_GE(full.at_k, 0.99);
 }
 
+// Two sets of `rows` references of 32 columns and their queries (every 3rd reference, altered):
+// random bytes with `flipped_bits` bits flipped (seeds `seed`, `seed` + 1), and unit Gaussians
+// plus noise of deviation 0.5 (seeds `seed` + 2, `seed` + 3).
+std::vector<std::pair<cv::Mat, cv::Mat>> BinaryAndFloatRows(int rows, int flipped_bits,
+                                                            unsigned seed) {
+  const cv::Mat bytes = RandomBytes(rows, 32, seed);
+  const cv::Mat floats = RandomFloats(rows, 32, seed + 2);
+  return {{bytes, FlipBits(bytes, EveryNth(rows, 3), flipped_bits, seed + 1)},
+          {floats, AddNoise(floats, EveryNth(rows, 3), 0.5f, seed + 3)}};
+}
+
 TEST(ApproximateIndex, DeterministicAcrossBuildsAndThreads) {
-  const cv::Mat bytes = RandomBytes(1000, 32, 31);
-  const cv::Mat byte_queries = FlipBits(bytes, EveryNth(1000, 3), 30, 32);
-  const cv::Mat floats = RandomFloats(1000, 32, 33);
-  const cv::Mat float_queries = AddNoise(floats, EveryNth(1000, 3), 0.5f, 34);
-  for (const auto& [refs, queries] :
-       {std::pair{bytes, byte_queries}, std::pair{floats, float_queries}}) {
+  for (const auto& [refs, queries] : BinaryAndFloatRows(1000, 30, 31)) {
     ApproximateOptions one = FlannOptions(), two = one;
     one.threads = 1;
     two.threads = 2;
@@ -470,27 +464,35 @@ double PlantedFound(const CandidateLists& lists, const std::vector<int>& source)
   return static_cast<double>(found) / static_cast<double>(lists.size());
 }
 
+// Each Faiss engine on `refs` and `queries` (query q near reference source[q]): the index holds
+// rows of `type`, its candidates carry exact distances, and for at least 98% of the queries its
+// first candidate is the planted row and the exact nearest.
+void ExpectFaissEnginesFindThePlantedRows(const cv::Mat& refs, const cv::Mat& queries,
+                                          const std::vector<int>& source, int type) {
+  const CandidateLists exact = ExactNearest(refs, queries, 10);
+  for (const std::string engine : {"hnsw", "ivf"}) {
+    SCOPED_TRACE(engine);
+    const ApproximateIndex index(refs, EngineOptions(engine));
+    EXPECT_EQ(index.Type(), type);
+    const CandidateLists approximate = index.Search(queries);
+    ExpectExactDistances(refs, queries, approximate, 10);
+    EXPECT_GE(PlantedFound(approximate, source), 0.98);
+    EXPECT_GE(MeasureRecall(exact, approximate).top1, 0.98);
+  }
+}
+
 // 4000 random 256-bit references; queries every 4th with 8 bits flipped (the planted row at 8
 // bits, every other ~128 away). Each engine must find the planted row, with exact distances.
+// HNSW: the planted row is far nearer than any other, the graph search reaches it. IVF: cells
+// are k-means of random bits; 8 flipped bits rarely move a query out of its source's nearest 16
+// cells (of 102).
 TEST(ApproximateIndex, FaissBinaryIndexesFindPlantedNearDuplicates) {
   SKIP_WITHOUT_FAISS();
   const cv::Mat refs = RandomBytes(4000, 32, 101);
   const std::vector<int> source = EveryNth(4000, 4);
   const cv::Mat queries = FlipBits(refs, source, 8, 102);
-  const CandidateLists exact = ExactNearest(refs, queries, 10);
-  for (const std::string engine : {"hnsw", "ivf"}) {
-    SCOPED_TRACE(engine);
-    const ApproximateIndex index(refs, EngineOptions(engine));
-    EXPECT_EQ(index.Type(), CV_8U);
-    const CandidateLists approximate = index.Search(queries);
-    ExpectExactDistances(refs, queries, approximate, 10);
-    EXPECT_DOUBLE_EQ(PlantedFound(exact, source), 1.0);
-    // HNSW: the planted row is far nearer than any other, the graph search reaches it. IVF:
-    // cells are k-means of random bits; 8 flipped bits rarely move a query out of its
-    // source's nearest 16 cells (of 102).
-    EXPECT_GE(PlantedFound(approximate, source), 0.98);
-    EXPECT_GE(MeasureRecall(exact, approximate).top1, 0.98);
-  }
+  EXPECT_DOUBLE_EQ(PlantedFound(ExactNearest(refs, queries, 10), source), 1.0);
+  ExpectFaissEnginesFindThePlantedRows(refs, queries, source, CV_8U);
 }
 
 // 4000 float references of 64 unit Gaussians; queries every 4th plus noise of deviation 0.1.
@@ -498,17 +500,7 @@ TEST(ApproximateIndex, FaissFloatIndexesFindPlantedNearDuplicates) {
   SKIP_WITHOUT_FAISS();
   const cv::Mat refs = RandomFloats(4000, 64, 111);
   const std::vector<int> source = EveryNth(4000, 4);
-  const cv::Mat queries = AddNoise(refs, source, 0.1f, 112);
-  const CandidateLists exact = ExactNearest(refs, queries, 10);
-  for (const std::string engine : {"hnsw", "ivf"}) {
-    SCOPED_TRACE(engine);
-    const ApproximateIndex index(refs, EngineOptions(engine));
-    EXPECT_EQ(index.Type(), CV_32F);
-    const CandidateLists approximate = index.Search(queries);
-    ExpectExactDistances(refs, queries, approximate, 10);
-    EXPECT_GE(PlantedFound(approximate, source), 0.98);
-    EXPECT_GE(MeasureRecall(exact, approximate).top1, 0.98);
-  }
+  ExpectFaissEnginesFindThePlantedRows(refs, AddNoise(refs, source, 0.1f, 112), source, CV_32F);
 }
 
 // The search budget is used: a tiny IVF probe or HNSW list finds fewer of the exact 10 nearest
@@ -581,12 +573,7 @@ TEST(ApproximateIndex, AutoEngineIsIvfForBinaryRowsAndHnswForFloatRows) {
 
 TEST(ApproximateIndex, FaissDeterministicAcrossBuildsAndThreads) {
   SKIP_WITHOUT_FAISS();
-  const cv::Mat bytes = RandomBytes(3000, 32, 131);
-  const cv::Mat byte_queries = FlipBits(bytes, EveryNth(3000, 3), 40, 132);
-  const cv::Mat floats = RandomFloats(3000, 32, 133);
-  const cv::Mat float_queries = AddNoise(floats, EveryNth(3000, 3), 0.5f, 134);
-  for (const auto& [refs, queries] :
-       {std::pair{bytes, byte_queries}, std::pair{floats, float_queries}}) {
+  for (const auto& [refs, queries] : BinaryAndFloatRows(3000, 40, 131)) {
     for (const std::string engine : {"hnsw", "ivf"}) {
       SCOPED_TRACE(engine + (refs.depth() == CV_8U ? " binary" : " float"));
       ApproximateOptions one = EngineOptions(engine), two = one;

@@ -9,16 +9,12 @@
 
 #include <cstdio>
 
+#include "tests/matching/random_rows.h"
+
 namespace openable {
 namespace {
 
-cv::Mat RandomBytes(int rows, int cols, unsigned seed) {
-  std::mt19937 rng(seed);
-  cv::Mat m(rows, cols, CV_8U);
-  for (int i = 0; i < rows; ++i)
-    for (int j = 0; j < cols; ++j) m.at<std::uint8_t>(i, j) = static_cast<std::uint8_t>(rng());
-  return m;
-}
+using matching_test::RandomBytes;
 
 // Brute force: count the differing bits one bit at a time.
 int BitCount(const cv::Mat& a, int i, const cv::Mat& b, int j) {

@@ -15,12 +15,7 @@
 namespace openable::odometry {
 namespace {
 
-using odometry_test::Degrees;
-using odometry_test::Pose;
-using odometry_test::SyntheticRoom;
-
-const cv::Size kSize(640, 480);
-Intrinsics SyntheticIntrinsics() { return Intrinsics{400, 400, 319.5, 239.5}; }
+using namespace odometry_test;  // NOLINT: the synthetic room is this file's vocabulary
 
 // Relative pose error of `estimate` against `truth`: rotation angle (degrees) of
 // R_truth^T R_estimate and angle (degrees) between the translations.
@@ -47,13 +42,13 @@ void CheckTwoViews(const std::string& features, double ransac_px, double max_dir
   MonoOdometryOptions options;
   options.features = features;
   options.ransac_threshold_px = ransac_px;
-  MonoOdometry mono(SyntheticIntrinsics(), options);
-  const Eigen::Isometry3d p0 = mono.Step(room.Render(SyntheticIntrinsics(), kSize, first), 0.0);
+  MonoOdometry mono(kIntrinsics, options);
+  const Eigen::Isometry3d p0 = mono.Step(room.Render(kIntrinsics, kSize, first), 0.0);
   EXPECT_TRUE(p0.isApprox(Eigen::Isometry3d::Identity()));
   EXPECT_EQ(mono.last().note, "first frame");
   const double length = second.translation().norm();
   const Eigen::Isometry3d p1 =
-      mono.Step(room.Render(SyntheticIntrinsics(), kSize, second), length);
+      mono.Step(room.Render(kIntrinsics, kSize, second), length);
   EXPECT_TRUE(mono.last().ok) << mono.last().note;
   EXPECT_GT(mono.last().inliers, 100);
   EXPECT_NEAR(p1.translation().norm(), length, 1e-9);
@@ -67,10 +62,10 @@ TEST(MonoOdometry, RecoversAKnownMotionInASyntheticRoomWithOrb) { CheckTwoViews(
 
 TEST(MonoOdometry, UnknownStepLengthGivesUnitSteps) {
   const SyntheticRoom room(7);
-  MonoOdometry mono(SyntheticIntrinsics(), MonoOdometryOptions());
-  mono.Step(room.Render(SyntheticIntrinsics(), kSize, Eigen::Isometry3d::Identity()), -1);
+  MonoOdometry mono(kIntrinsics, MonoOdometryOptions());
+  mono.Step(room.Render(kIntrinsics, kSize, Eigen::Isometry3d::Identity()), -1);
   const Eigen::Isometry3d p = mono.Step(
-      room.Render(SyntheticIntrinsics(), kSize,
+      room.Render(kIntrinsics, kSize,
                   Pose(1.0, Eigen::Vector3d::UnitY(), Eigen::Vector3d(0.0, 0.0, 0.5))),
       -1);
   EXPECT_NEAR(p.translation().norm(), 1.0, 1e-9);
@@ -79,10 +74,10 @@ TEST(MonoOdometry, UnknownStepLengthGivesUnitSteps) {
 
 TEST(MonoOdometry, FallsBackToConstantVelocityOnAFeaturelessFrame) {
   const SyntheticRoom room(7);
-  MonoOdometry mono(SyntheticIntrinsics(), MonoOdometryOptions());
+  MonoOdometry mono(kIntrinsics, MonoOdometryOptions());
   const Eigen::Isometry3d step = Pose(0.0, Eigen::Vector3d::UnitY(), Eigen::Vector3d(0, 0, 0.5));
-  mono.Step(room.Render(SyntheticIntrinsics(), kSize, Eigen::Isometry3d::Identity()), 0);
-  const Eigen::Isometry3d p1 = mono.Step(room.Render(SyntheticIntrinsics(), kSize, step), 0.5);
+  mono.Step(room.Render(kIntrinsics, kSize, Eigen::Isometry3d::Identity()), 0);
+  const Eigen::Isometry3d p1 = mono.Step(room.Render(kIntrinsics, kSize, step), 0.5);
   ASSERT_TRUE(mono.last().ok);
   // A uniform frame: no features, so the step repeats the previous motion with the new length.
   const Eigen::Isometry3d p2 = mono.Step(cv::Mat(kSize, CV_8UC1, cv::Scalar(128)), 1.0);
@@ -96,12 +91,12 @@ TEST(MonoOdometry, FallsBackToConstantVelocityOnAFeaturelessFrame) {
 
 TEST(MonoOdometry, IsDeterministic) {
   const SyntheticRoom room(3);
-  const cv::Mat a = room.Render(SyntheticIntrinsics(), kSize, Eigen::Isometry3d::Identity());
-  const cv::Mat b = room.Render(SyntheticIntrinsics(), kSize,
+  const cv::Mat a = room.Render(kIntrinsics, kSize, Eigen::Isometry3d::Identity());
+  const cv::Mat b = room.Render(kIntrinsics, kSize,
                                 Pose(2.0, Eigen::Vector3d::UnitY(), Eigen::Vector3d(0.2, 0, 0.6)));
   Eigen::Isometry3d results[2];
   for (auto& r : results) {
-    MonoOdometry mono(SyntheticIntrinsics(), MonoOdometryOptions());
+    MonoOdometry mono(kIntrinsics, MonoOdometryOptions());
     mono.Step(a, 0);
     r = mono.Step(b, 0.63);
   }
@@ -113,7 +108,7 @@ TEST(MonoOdometryOptions, CheckNamesTheField) {
     MonoOdometryOptions o;
     change(o);
     testing::ExpectInputError([&] { o.Check(); }, {"MonoOdometryOptions." + field});
-    testing::ExpectInputError([&] { MonoOdometry(SyntheticIntrinsics(), o); },
+    testing::ExpectInputError([&] { MonoOdometry(kIntrinsics, o); },
                               {"MonoOdometryOptions." + field});
   };
   expect([](MonoOdometryOptions& o) { o.features = "SURF"; }, "features");

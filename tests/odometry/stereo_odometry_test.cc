@@ -22,12 +22,8 @@
 namespace openable::odometry {
 namespace {
 
-using odometry_test::Degrees;
-using odometry_test::Pose;
-using odometry_test::SyntheticRoom;
+using namespace odometry_test;  // NOLINT: the synthetic room is this file's vocabulary
 
-const cv::Size kSize(640, 480);
-const Intrinsics kIntrinsics{400, 400, 319.5, 239.5};
 constexpr double kBaseline = 0.2;  // metres
 
 // The left and right images of a rectified rig whose left camera is at `pose`.

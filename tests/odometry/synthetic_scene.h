@@ -106,4 +106,9 @@ inline Eigen::Isometry3d Pose(double degrees, const Eigen::Vector3d& axis,
 
 inline double Degrees(double radians) { return radians * 180.0 / M_PI; }
 
+// The camera that renders the room in the tests: 640 x 480 pixels, focal length 400 pixels, the
+// principal point at the image centre.
+inline const cv::Size kSize(640, 480);
+inline const odometry::Intrinsics kIntrinsics{400, 400, 319.5, 239.5};
+
 }  // namespace openable::odometry_test

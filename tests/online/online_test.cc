@@ -17,6 +17,8 @@
 
 #include "OpenABLE/base/error.h"
 #include "matching/bounded.h"
+#include "tests/online/index_engines.h"
+#include "tests/test_frames.h"
 #include "tests/test_support.h"
 
 namespace openable {
@@ -24,19 +26,8 @@ namespace {
 
 using testing::ExpectInputError;
 
-std::string KittiDir() { return testing::DatasetsDir() + "/kitti00_first1700/image_0"; }
-
-// Every `step`-th KITTI 00 frame from 0 to `last`, as 8-bit grey images.
-std::vector<cv::Mat> KittiFrames(int step, int last) {
-  std::vector<cv::Mat> frames;
-  for (int i = 0; i <= last; i += step) {
-    char name[32];
-    std::snprintf(name, sizeof name, "/%06d.png", i);
-    frames.push_back(cv::imread(KittiDir() + name, cv::IMREAD_GRAYSCALE));
-    EXPECT_FALSE(frames.back().empty()) << name;
-  }
-  return frames;
-}
+using testing::Kitti00LeftDir;
+using testing::ReadKitti00Frames;
 
 // Brute force: D(a, b) bit by bit (CV_8U rows) or Euclidean in double (CV_32F rows).
 double Single(const cv::Mat& rows, int a, int b) {
@@ -77,9 +68,9 @@ std::vector<Expected> BruteForce(const cv::Mat& rows, int q, int L, int exclusio
 }
 
 TEST(OnlineDetector, GivesTheBruteForceCandidatesOnRealKittiFrames) {
-  OPENABLE_REQUIRE_PATH(KittiDir());
+  OPENABLE_REQUIRE_PATH(Kitti00LeftDir());
   // Every 4th frame of 0-1699: the loop of frames 1559-1641 revisits the start of the route.
-  const std::vector<cv::Mat> frames = KittiFrames(4, 1699);
+  const std::vector<cv::Mat> frames = ReadKitti00Frames(4, 1699);
   OnlineOptions options;
   options.sequence_length = 5;
   options.exclusion = 25;
@@ -136,8 +127,8 @@ TEST(OnlineDetector, GivesTheBruteForceCandidatesOnRealKittiFrames) {
 }
 
 TEST(OnlineDetector, FloatDescriptorsMatchTheBruteForceToo) {
-  OPENABLE_REQUIRE_PATH(KittiDir());
-  const std::vector<cv::Mat> frames = KittiFrames(20, 1699);
+  OPENABLE_REQUIRE_PATH(Kitti00LeftDir());
+  const std::vector<cv::Mat> frames = ReadKitti00Frames(20, 1699);
   OnlineOptions options;
   options.descriptor = "HOG";
   options.sequence_length = 3;
@@ -163,12 +154,12 @@ TEST(OnlineDetector, FloatDescriptorsMatchTheBruteForceToo) {
   }
 }
 
-// The index blocks of `engine` beyond the exact limit, against the exact detector.
-void SearchesBlocksBeyondTheExactLimit(const std::string& engine) {
-  OPENABLE_REQUIRE_PATH(KittiDir());
-  if (!ApproximateEngineAvailable(engine))
-    GTEST_SKIP() << "this build has no FAISS (libfaiss-dev)";
-  const std::vector<cv::Mat> frames = KittiFrames(2, 1699);  // 850 frames
+// The index blocks of each engine beyond the exact limit, against the exact detector.
+class OnlineDetectorEngine : public online_test::KittiEngineTest {};
+
+TEST_P(OnlineDetectorEngine, SearchesBlocksBeyondTheExactLimit) {
+  const std::string engine = GetParam();
+  const std::vector<cv::Mat> frames = ReadKitti00Frames(2, 1699);  // 850 frames
   OnlineOptions exact_options;
   exact_options.exclusion = 50;
   exact_options.candidates = 1;
@@ -227,19 +218,12 @@ void SearchesBlocksBeyondTheExactLimit(const std::string& engine) {
   EXPECT_EQ(background.Blocks(), approximate.Blocks());
 }
 
-TEST(OnlineDetector, SearchesFlannBlocksBeyondTheExactLimit) {
-  SearchesBlocksBeyondTheExactLimit("flann");
-}
-TEST(OnlineDetector, SearchesHnswBlocksBeyondTheExactLimit) {
-  SearchesBlocksBeyondTheExactLimit("hnsw");
-}
-TEST(OnlineDetector, SearchesIvfBlocksBeyondTheExactLimit) {
-  SearchesBlocksBeyondTheExactLimit("ivf");
-}
+INSTANTIATE_TEST_SUITE_P(Index, OnlineDetectorEngine, online_test::IndexEngines(),
+                         online_test::EngineName);
 
 TEST(OnlineDetector, DistanceMatrixIsTheNormalisedBruteForce) {
-  OPENABLE_REQUIRE_PATH(KittiDir());
-  const std::vector<cv::Mat> frames = KittiFrames(50, 1699);
+  OPENABLE_REQUIRE_PATH(Kitti00LeftDir());
+  const std::vector<cv::Mat> frames = ReadKitti00Frames(50, 1699);
   OnlineOptions options;
   const cv::Mat rows = DescribeImages(frames, options);
   float max_distance = 0;

@@ -14,6 +14,8 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/output_batch.h"
 #include "OpenABLE/online/online.h"
+#include "tests/online/index_engines.h"
+#include "tests/test_frames.h"
 #include "tests/test_support.h"
 
 namespace openable {
@@ -21,18 +23,8 @@ namespace {
 
 using testing::ExpectInputError;
 
-std::string KittiDir() { return testing::DatasetsDir() + "/kitti00_first1700/image_0"; }
-
-std::vector<cv::Mat> KittiFrames(int step, int last) {
-  std::vector<cv::Mat> frames;
-  for (int i = 0; i <= last; i += step) {
-    char name[32];
-    std::snprintf(name, sizeof name, "/%06d.png", i);
-    frames.push_back(cv::imread(KittiDir() + name, cv::IMREAD_GRAYSCALE));
-    EXPECT_FALSE(frames.back().empty()) << name;
-  }
-  return frames;
-}
+using testing::Kitti00LeftDir;
+using testing::ReadKitti00Frames;
 
 // Options whose index blocks start early: 850 frames give blocks of 64 x 2^m rows.
 OnlineOptions BlockOptions(const std::string& engine) {
@@ -64,13 +56,13 @@ bool SameBytes(const cv::Mat& a, const cv::Mat& b) {
 }
 
 // The detector that saved its map after `saved` frames and the one that loaded it are fed the
-// remaining frames: every candidate is the same.
-void SavedMapGivesTheSameCandidates(const std::string& engine) {
-  OPENABLE_REQUIRE_PATH(KittiDir());
-  if (!ApproximateEngineAvailable(engine))
-    GTEST_SKIP() << "this build has no FAISS (libfaiss-dev)";
+// remaining frames: every candidate is the same, with each index engine.
+class SavedMapEngine : public online_test::KittiEngineTest {};
+
+TEST_P(SavedMapEngine, GivesTheSameCandidatesAfterLoading) {
+  const std::string engine = GetParam();
   const OnlineOptions options = BlockOptions(engine);
-  const cv::Mat rows = DescribeImages(KittiFrames(2, 1699), options);  // 850 frames
+  const cv::Mat rows = DescribeImages(ReadKitti00Frames(2, 1699), options);  // 850 frames
   const int saved = 600;
   OnlineDetector yesterday(options);
   for (int q = 0; q < saved; ++q) yesterday.AddDescriptor(rows.row(q));
@@ -99,22 +91,15 @@ void SavedMapGivesTheSameCandidates(const std::string& engine) {
   EXPECT_EQ(today.Blocks(), yesterday.Blocks());
 }
 
-TEST(SavedMap, FlannMapGivesTheSameCandidatesAfterLoading) {
-  SavedMapGivesTheSameCandidates("flann");
-}
-TEST(SavedMap, HnswMapGivesTheSameCandidatesAfterLoading) {
-  SavedMapGivesTheSameCandidates("hnsw");
-}
-TEST(SavedMap, IvfMapGivesTheSameCandidatesAfterLoading) {
-  SavedMapGivesTheSameCandidates("ivf");
-}
+INSTANTIATE_TEST_SUITE_P(Index, SavedMapEngine, online_test::IndexEngines(),
+                         online_test::EngineName);
 
 // Another block size: the saved blocks are set aside and the index built from the rows, as a
 // detector with that block size given the same rows by AddToMap builds it.
 TEST(SavedMap, OtherIndexSettingsRebuildTheBlocks) {
-  OPENABLE_REQUIRE_PATH(KittiDir());
+  OPENABLE_REQUIRE_PATH(Kitti00LeftDir());
   const OnlineOptions options = BlockOptions("flann");
-  const cv::Mat rows = DescribeImages(KittiFrames(2, 1699), options);
+  const cv::Mat rows = DescribeImages(ReadKitti00Frames(2, 1699), options);
   const int saved = 600;
   OnlineDetector yesterday(options);
   for (int q = 0; q < saved; ++q) yesterday.AddDescriptor(rows.row(q));
@@ -138,12 +123,12 @@ TEST(SavedMap, OtherIndexSettingsRebuildTheBlocks) {
 // Float rows (HOG, exact search): the rows and the normalising unit (the largest single-frame
 // distance so far) come back exactly, so the normalised distances are equal too.
 TEST(SavedMap, FloatMapKeepsItsNormalisation) {
-  OPENABLE_REQUIRE_PATH(KittiDir());
+  OPENABLE_REQUIRE_PATH(Kitti00LeftDir());
   OnlineOptions options;
   options.descriptor = "HOG";
   options.sequence_length = 3;
   options.exclusion = 5;
-  const cv::Mat rows = DescribeImages(KittiFrames(20, 1699), options);  // 85 frames
+  const cv::Mat rows = DescribeImages(ReadKitti00Frames(20, 1699), options);  // 85 frames
   OnlineDetector yesterday(options);
   for (int q = 0; q < 60; ++q) yesterday.AddDescriptor(rows.row(q));
   const std::string path = testing::TempDir() + "/hog.map";
@@ -158,8 +143,8 @@ TEST(SavedMap, FloatMapKeepsItsNormalisation) {
 // With verification, every frame's local features are saved: the loaded frames are verified
 // against later frames with the same features (the matches and inliers are equal).
 TEST(SavedMap, VerificationFeaturesAreSavedWithTheMap) {
-  OPENABLE_REQUIRE_PATH(KittiDir());
-  const std::vector<cv::Mat> frames = KittiFrames(10, 1699);  // 170 frames
+  OPENABLE_REQUIRE_PATH(Kitti00LeftDir());
+  const std::vector<cv::Mat> frames = ReadKitti00Frames(10, 1699);  // 170 frames
   OnlineOptions options;
   options.exclusion = 50;
   options.verification.enabled = true;

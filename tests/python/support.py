@@ -46,6 +46,20 @@ def run(name, args, cwd):
     return done
 
 
+def settings(*pairs):
+    """The arguments that set each of `pairs` ("Key=value"): --set before each."""
+    return [arg for pair in pairs for arg in ("--set", pair)]
+
+
+def run_sample(cwd, *pairs, first=()):
+    """Runs Test_OpenABLE quietly in `cwd` on the bundled sample (summer references, winter
+    queries) with each of `pairs` ("Key=value") set, after the arguments `first` (a preset)."""
+    return run("Test_OpenABLE",
+               list(first) + ["--quiet"] + settings("Images_path=%s" % (SAMPLE / "summer"),
+                                                    "Images_path_2=%s" % (SAMPLE / "winter"),
+                                                    *pairs), cwd)
+
+
 class TempDirTestCase(unittest.TestCase):
     """A test case with a fresh temporary folder per class (self.tmp), removed afterwards
     unless OPENABLE_KEEP_TEST_FILES is set."""

@@ -87,16 +87,12 @@ class DemoReport(support.TempDirTestCase):
     @classmethod
     def setUpClass(cls):
         super().setUpClass()
-        sample = support.SAMPLE
         cls.report = cls.tmp / "report.html"
-        support.run("Test_OpenABLE", [
-            support.SOURCE_DIR / "config" / "presets" / "across_conditions.txt",
-            "--set", "Images_path=%s" % (sample / "summer"),
-            "--set", "Images_path_2=%s" % (sample / "winter"),
-            "--set", "Ground_truth_type=aligned",
-            "--set", "Npy_name=%s" % (cls.tmp / "m.npy"), "--set", "Png_name=",
-            "--set", "Evaluation_name=%s" % (cls.tmp / "eval"),
-            "--set", "Report_name=%s" % cls.report, "--quiet"], cls.tmp)
+        preset = support.SOURCE_DIR / "config" / "presets" / "across_conditions.txt"
+        support.run_sample(cls.tmp, "Ground_truth_type=aligned",
+                           "Npy_name=%s" % (cls.tmp / "m.npy"), "Png_name=",
+                           "Evaluation_name=%s" % (cls.tmp / "eval"), "Report_name=%s" % cls.report,
+                           first=[preset])
         cls.text = cls.report.read_text()
         cls.page = Page(cls.text)
         cls.figures = support.read_json(cls.tmp / "eval.json")["runs"][0]["per_query"]
@@ -189,13 +185,8 @@ class EvaluateReport(support.TempDirTestCase):
     @classmethod
     def setUpClass(cls):
         super().setUpClass()
-        sample = support.SAMPLE
         cls.matrix = cls.tmp / "m.npy"
-        support.run("Test_OpenABLE", [
-            "--set", "Images_path=%s" % (sample / "summer"),
-            "--set", "Images_path_2=%s" % (sample / "winter"),
-            "--set", "Image_sequences=10", "--set", "Npy_name=%s" % cls.matrix,
-            "--set", "Png_name=", "--quiet"], cls.tmp)
+        support.run_sample(cls.tmp, "Image_sequences=10", "Npy_name=%s" % cls.matrix, "Png_name=")
 
     def evaluate(self, *extra):
         return subprocess.run(

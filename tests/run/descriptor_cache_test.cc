@@ -200,6 +200,21 @@ TEST(DescriptorCache, MissThenHitGivesTheSameRows) {
   EXPECT_TRUE(SameBytes(after.rows, Describe(f, nullptr).rows));
 }
 
+// Opens the cache of `f` again, describes its frames with it and closes it: expects one warning
+// on the way, holding `warning`, `hits` rows read from the cache, `stored` rows stored in it, and
+// the rows of `clean`.
+void ExpectOneWarningAndTheCleanRows(const Fixture& f, const DescribedSequence& clean,
+                                     const std::string& warning, int hits, int stored) {
+  std::vector<std::string> w;
+  auto c = OpenCache(f, w);
+  const DescribedSequence r = Describe(f, c.get());
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find(warning), std::string::npos) << w[0];
+  EXPECT_EQ(c->Hits(), hits);
+  EXPECT_EQ(c->Stored(), stored);
+  EXPECT_TRUE(SameBytes(r.rows, clean.rows));
+}
+
 TEST(DescriptorCache, TruncatedOrDamagedFileIsRepairedWithAWarningNeverAWrongRow) {
   const Fixture f = MakeFixture(10);
   const DescribedSequence clean = Describe(f, nullptr);
@@ -214,41 +229,16 @@ TEST(DescriptorCache, TruncatedOrDamagedFileIsRepairedWithAWarningNeverAWrongRow
   // A run killed while writing: half a record at the end.
   const size_t record = 24 + static_cast<size_t>(f.describer->RowWidth()) + 8;
   fs::resize_file(path, full.size() - 3 * record - record / 2);
-  {
-    w.clear();
-    auto c = OpenCache(f, w);
-    const DescribedSequence r = Describe(f, c.get());
-    ASSERT_EQ(w.size(), 1u);
-    EXPECT_NE(w[0].find("Descriptor_cache"), std::string::npos) << w[0];
-    EXPECT_EQ(c->Hits(), 6);
-    EXPECT_EQ(c->Stored(), 4);
-    EXPECT_TRUE(SameBytes(r.rows, clean.rows));
-  }
+  ExpectOneWarningAndTheCleanRows(f, clean, "Descriptor_cache", 6, 4);
   EXPECT_EQ(ReadAll(path).size(), full.size());  // repaired: whole records only
   // A flipped bit inside a row: that record and the ones after it are dropped, not used.
   std::string bytes = ReadAll(path);
   bytes[bytes.size() - 5 * record + 30] ^= 0x10;
   testing::WriteBytes(path, bytes);
-  {
-    w.clear();
-    auto c = OpenCache(f, w);
-    const DescribedSequence r = Describe(f, c.get());
-    EXPECT_EQ(w.size(), 1u);
-    EXPECT_EQ(c->Hits(), 5);
-    EXPECT_TRUE(SameBytes(r.rows, clean.rows));
-  }
+  ExpectOneWarningAndTheCleanRows(f, clean, "", 5, 5);
   // Garbage instead of a header: started afresh.
   testing::WriteBytes(path, "not a cache file at all");
-  {
-    w.clear();
-    auto c = OpenCache(f, w);
-    const DescribedSequence r = Describe(f, c.get());
-    ASSERT_EQ(w.size(), 1u);
-    EXPECT_NE(w[0].find("bad header"), std::string::npos) << w[0];
-    EXPECT_EQ(c->Hits(), 0);
-    EXPECT_EQ(c->Stored(), 10);
-    EXPECT_TRUE(SameBytes(r.rows, clean.rows));
-  }
+  ExpectOneWarningAndTheCleanRows(f, clean, "bad header", 0, 10);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "OpenABLE/snaps/loop_search.h"
 
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -40,9 +41,17 @@ void Drive(LoopSearch& search, int first) {
   for (int i = 40; i < first; ++i) ASSERT_FALSE(search.Step(i, Pose(500, i), Noise(i)));
 }
 
-TEST(LoopSearch, FindsTheRevisitedFrame) {
-  LoopSearch search(Options());
+// A search with Options() but for what `change` sets, driven through frames 0..59 (Drive).
+LoopSearch Driven(const std::function<void(SearchOptions&)>& change = [](SearchOptions&) {}) {
+  SearchOptions o = Options();
+  change(o);
+  LoopSearch search(o);
   Drive(search, 60);
+  return search;
+}
+
+TEST(LoopSearch, FindsTheRevisitedFrame) {
+  LoopSearch search = Driven();
   const auto loop = search.Step(60, Pose(0, 10), Noise(10));
   ASSERT_TRUE(loop);
   EXPECT_EQ(loop->query, 60);
@@ -67,16 +76,14 @@ TEST(LoopSearch, NotWithinFrameDistance) {
 
 TEST(LoopSearch, YawLimit) {
   for (const double yaw : {15.0, -12.0, 8.0, -9.5}) {
-    LoopSearch search(Options());
-    Drive(search, 60);
+    LoopSearch search = Driven();
     EXPECT_EQ(search.Step(60, Pose(0, 10, yaw), Noise(10)).has_value(), std::abs(yaw) <= 10)
         << yaw;
   }
 }
 
 TEST(LoopSearch, InterFramePause) {
-  LoopSearch search(Options());
-  Drive(search, 60);
+  LoopSearch search = Driven();
   ASSERT_TRUE(search.Step(60, Pose(0, 10), Noise(10)));
   for (int i = 61; i <= 65; ++i) {  // i - 60 <= pause = 5
     EXPECT_FALSE(search.Step(i, Pose(0, i - 50), Noise(i - 50))) << i;
@@ -90,10 +97,7 @@ TEST(LoopSearch, InterFramePause) {
 
 TEST(LoopSearch, Radius) {
   for (const double radius : {3.0, 5.0}) {
-    SearchOptions o = Options();
-    o.radius = radius;
-    LoopSearch search(o);
-    Drive(search, 60);
+    LoopSearch search = Driven([&](SearchOptions& o) { o.radius = radius; });
     // 4 m beside frame 10.
     EXPECT_EQ(search.Step(60, Pose(4, 10), Noise(10)).has_value(), radius >= 4) << radius;
   }
@@ -102,10 +106,7 @@ TEST(LoopSearch, Radius) {
 TEST(LoopSearch, AttemptsNearestFirst) {
   // At z = 12 the candidates by distance are 12, 11, 13, 10, ...: frame 10 is the 4th.
   for (const int attempts : {3, 4}) {
-    SearchOptions o = Options();
-    o.attempts = attempts;
-    LoopSearch search(o);
-    Drive(search, 60);
+    LoopSearch search = Driven([&](SearchOptions& o) { o.attempts = attempts; });
     const auto loop = search.Step(60, Pose(0, 12), Noise(10));
     EXPECT_EQ(loop.has_value(), attempts >= 4) << attempts;
     EXPECT_EQ(search.records().back().candidates, attempts);
@@ -133,10 +134,7 @@ TEST(LoopSearch, BestOrFirst) {
 
 TEST(LoopSearch, MinimumSimilarity) {
   for (const double min : {0.75, 0.99}) {
-    SearchOptions o = Options();
-    o.min_similarity = min;
-    LoopSearch search(o);
-    Drive(search, 60);
+    LoopSearch search = Driven([&](SearchOptions& o) { o.min_similarity = min; });
     cv::Mat1b t = Noise(10).clone();
     cv::Mat1b noise(t.size());
     cv::RNG(3).fill(noise, cv::RNG::UNIFORM, 0, 30);

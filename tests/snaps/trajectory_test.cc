@@ -15,10 +15,7 @@
 namespace openable::snaps {
 namespace {
 
-using openable::testing::ExpectInputError;
-using openable::testing::Q;
-using openable::testing::TempDir;
-using openable::testing::WriteBytes;
+using namespace openable::testing;  // NOLINT: TempDir, WriteBytes, Q, ExpectInputError
 
 std::string Write(const std::string& name, const std::string& text) {
   const std::string path = TempDir() + "/" + name;
