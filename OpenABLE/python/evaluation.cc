@@ -310,7 +310,9 @@ Raises:
 
 }  // namespace
 
-void RegisterEvaluation(py::module_& m) {
+namespace {
+
+void RegisterCurve(py::module_& m) {
   py::class_<Curve>(m, "Curve", R"doc(A precision-recall curve: one point per threshold, in
 increasing order of threshold. Each property is a float64 NumPy array with one value per
 point.)doc")
@@ -349,6 +351,9 @@ point.)doc")
       .def("__repr__", [](const Curve& c) {
         return "<openable.Curve of " + std::to_string(c.points.size()) + " points>";
       });
+}
+
+void RegisterEvaluationResult(py::module_& m) {
 
   py::class_<Result>(m, "EvaluationResult", R"doc(The figures and curves of evaluate(): the
 per-query best-match protocol (auc, recall_at_100p, max_f1, recall_at_1/5/10, curve) and the
@@ -488,6 +493,9 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
                       r.run.able_p.average_precision);
         return std::string(b);
       });
+}
+
+void RegisterEvaluate(py::module_& m) {
 
   m.def(
       "evaluate",
@@ -660,6 +668,9 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
       py::arg("sequence_length") = 1, py::arg("partial") = "ahead",
       py::arg("direction") = "forward",
       EvaluateDoc().c_str());
+}
+
+void RegisterUnsupervised(py::module_& m) {
 
   m.def(
       "unsupervised_criteria",
@@ -728,6 +739,15 @@ Returns:
     ratio, 0 for a query without answer), agreement ((10 consistency + distinctiveness) / 11),
     queries, answered, agreeing, gap and tolerance (frames), and per query row of the block
     best (column, -1 none), ratio and agrees (bool).)doc");
+}
+
+}  // namespace
+
+void RegisterEvaluation(py::module_& m) {
+  RegisterCurve(m);
+  RegisterEvaluationResult(m);
+  RegisterEvaluate(m);
+  RegisterUnsupervised(m);
 }
 
 }  // namespace openable::python

@@ -64,7 +64,9 @@ py::array PairDistances(const py::object& a, const py::object& b, int threads, E
 
 }  // namespace
 
-void RegisterMatching(py::module_& m) {
+namespace {
+
+void RegisterDistances(py::module_& m) {
   m.def(
       "hamming_distances",
       [](const py::object& a, const py::object& b, int threads) {
@@ -195,6 +197,9 @@ Returns:
 
 Raises:
     ValueError: L < 1, starts not increasing from 0, a bad direction or partial.)doc");
+}
+
+void RegisterSequencesAndScores(py::module_& m) {
 
   m.def(
       "contrast_enhancement",
@@ -293,6 +298,9 @@ Args:
 
 Returns:
     numpy.ndarray: uint8 0/1, shape (N, M).)doc");
+}
+
+void RegisterMatrices(py::module_& m) {
 
   m.def(
       "best_matches",
@@ -367,6 +375,14 @@ Returns:
 
 Raises:
     openable.InputError: one line naming the file (and line) on any problem.)doc");
+}
+
+}  // namespace
+
+void RegisterMatching(py::module_& m) {
+  RegisterDistances(m);
+  RegisterSequencesAndScores(m);
+  RegisterMatrices(m);
 }
 
 }  // namespace openable::python

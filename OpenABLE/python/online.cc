@@ -249,7 +249,9 @@ const char* const kDescriptionArgs =
 
 }  // namespace
 
-void RegisterOnline(py::module_& m) {
+namespace {
+
+void RegisterOnlineHelpers(py::module_& m) {
   m.def("approximate_engines", &ApproximateEngineNames,
         (std::string(R"doc(approximate_engines() -> list[str]
 
@@ -377,6 +379,9 @@ Returns:
     numpy.ndarray: float32 (N, N) in [0, 1] (+inf for cells without a value), owning the C++ result
     (no copy); or (matrix, max) with return_max=True.)doc");
 
+}
+
+void RegisterDetector(py::module_& m) {
   BindOnlineOptions(m);
   // The signature of the constructor, from the defaults of the options' properties.
   const py::object defaults = py::cast(OnlineOptions());
@@ -591,6 +596,13 @@ installs its index.)doc")
                ", L=" + std::to_string(o.sequence_length) + ", " +
                std::to_string(d.detector->Size()) + " frames>";
       });
+}
+
+}  // namespace
+
+void RegisterOnline(py::module_& m) {
+  RegisterOnlineHelpers(m);
+  RegisterDetector(m);
 }
 
 }  // namespace openable::python

@@ -139,13 +139,9 @@ struct ChainRun {
 
 }  // namespace
 
-void RegisterSnaps(py::module_& parent) {
-  py::module_ m = parent.def_submodule("snaps", R"doc(The SNAPS add-on (docs/snaps.md).
+namespace {
 
-Trajectories (camera-to-world poses per frame), their files (KITTI, KITTI with frame ids,
-TUM), loop pairs (from a pairs file or an OpenABLE matrix), the paper's discounted update
-(Eq. 6), a least-squares pose graph, and the absolute trajectory error against a ground truth.
-Loops are lists of (query, reference, similarity) tuples of pose indices (query > reference).)doc");
+void RegisterTrajectory(py::module_& m) {
 
   py::class_<Trajectory>(
       m, "Trajectory",
@@ -269,6 +265,9 @@ Returns:
 
 Raises:
     openable.InputError: a pose without counterpart (naming the first such frame).)doc");
+}
+
+void RegisterTrajectoryErrors(py::module_& m) {
 
   py::class_<snaps::TrajectoryError>(m, "TrajectoryError",
                                      "Absolute trajectory error of the positions (metres).")
@@ -389,6 +388,9 @@ Returns:
 The references of each query split into runs (frame ids less than run_gap apart); only the
 middle reference of each run is kept (the earlier of two middles). Sorted by query, then
 reference.)doc");
+}
+
+void RegisterLoopsAndCorrections(py::module_& m) {
 
   m.def(
       "loops_from_matrix",
@@ -517,6 +519,9 @@ Returns:
             r.converged ? "" : " (not converged)");
         return std::string(b);
       });
+}
+
+void RegisterPoseGraph(py::module_& m) {
 
   m.def(
       "correct_pose_graph",
@@ -625,6 +630,9 @@ corrections and their errors, as openable_snaps reports them.)doc")
         return "<openable.snaps.ChainResult " + std::to_string(c.result.input.Size()) +
                " poses, " + std::to_string(c.result.loops.size()) + " loops>";
       });
+}
+
+void RegisterChain(py::module_& m) {
 
   m.def(
       "run",
@@ -667,6 +675,22 @@ Returns:
 
 Raises:
     openable.InputError: one line naming the key, file or value (as openable_snaps).)doc");
+}
+
+}  // namespace
+
+void RegisterSnaps(py::module_& parent) {
+  py::module_ m = parent.def_submodule("snaps", R"doc(The SNAPS add-on (docs/snaps.md).
+
+Trajectories (camera-to-world poses per frame), their files (KITTI, KITTI with frame ids,
+TUM), loop pairs (from a pairs file or an OpenABLE matrix), the paper's discounted update
+(Eq. 6), a least-squares pose graph, and the absolute trajectory error against a ground truth.
+Loops are lists of (query, reference, similarity) tuples of pose indices (query > reference).)doc");
+  RegisterTrajectory(m);
+  RegisterTrajectoryErrors(m);
+  RegisterLoopsAndCorrections(m);
+  RegisterPoseGraph(m);
+  RegisterChain(m);
 }
 
 }  // namespace openable::python

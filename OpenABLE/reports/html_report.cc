@@ -199,6 +199,91 @@ std::vector<std::pair<std::string, std::string>> ChangedSettings(const Config& c
   return out;
 }
 
+namespace {
+
+// The two sections of worst cases (most confident wrong matches, misses), one table per run,
+// with the frames when the report can read them.
+std::string WorstCaseSections(const ReportInput& input) {
+  const Evaluation& evaluation = *input.evaluation;
+  const int exclusion = evaluation.settings.options.exclusion;
+  std::string h;
+  const ReportFrames& frames = input.frames;
+  const auto frame_name = [&](Frame f) {
+    if (frames.name) return frames.name(f.row, f.index);
+    return std::string(f.row ? "row " : "column ") + std::to_string(f.index);
+  };
+  const auto cell = [&](const EvaluatedRun& run, bool query, int block_index,
+                        const std::string& what, const std::string& css) {
+    if (block_index < 0) return "<td class=\"note\">" + what + "</td>";
+    const Frame f = query ? Frame{true, run.layout.row_offset + block_index}
+                          : Frame{false, run.layout.col_offset + block_index};
+    std::string c = "<td class=\"" + css + "\">";
+    if (frames.read)
+      c += PngImage(Thumbnail(frames.read(f.row, f.index)), "frame", frame_name(f));
+    c += Escape(frame_name(f)) + "<br>" + (query ? "query " : "reference ") +
+         std::to_string(block_index) + "</td>";
+    return c;
+  };
+  const auto cases_table = [&](const EvaluatedRun& run, const cv::Mat1f& matrix,
+                               const std::vector<ReportCase>& cases, const std::string& kind) {
+    std::string t = "<h3>" + Escape(run.label) + "</h3>\n";
+    if (cases.empty()) return t + "<p class=\"note\">None.</p>\n";
+    t += "<table class=\"cases\" data-kind=\"" + kind + "\">\n<tr><th>#</th><th>query</th><th>" +
+         (kind == "wrong" ? "wrong match" : "best match") + "</th><th>true place</th></tr>\n";
+    for (std::size_t k = 0; k < cases.size(); ++k) {
+      const ReportCase& c = cases[k];
+      const auto distance = [&](int column) {
+        return Number(matrix(run.layout.row_offset + c.query, run.layout.col_offset + column), 4);
+      };
+      std::string score = c.answer >= 0 ? "score " + Number(c.score, 4) + "<br>match: " +
+                                              distance(c.answer)
+                                        : std::string("no answer");
+      if (c.true_place >= 0) score += "<br>true place: " + distance(c.true_place);
+      t += "<tr data-query=\"" + std::to_string(c.query) + "\"><td>" + std::to_string(k + 1) +
+           "<br>" + score + "</td>" + cell(run, true, c.query, "", "") +
+           cell(run, false, c.answer, "no answer", c.correct ? "right" : "wrong") +
+           cell(run, false, c.true_place, "no true place among the candidates", "right") +
+           "</tr>\n";
+    }
+    return t + "</table>\n";
+  };
+  const std::string no_images =
+      frames.read ? ""
+                  : "<p class=\"note\">Frames are named, not shown: " + Escape(frames.missing) +
+                        "</p>\n";
+  // One section per kind of worst case, one table per run.
+  const auto cases_section = [&](const std::string& id, const std::string& title,
+                                 const std::string& note, const std::string& kind,
+                                 const auto& select) {
+    std::string section = "<section id=\"" + id + "\">\n<h2>" + title +
+                          "</h2>\n<p class=\"note\">" + note + "</p>\n" + no_images;
+    for (std::size_t i = 0; i < evaluation.runs.size(); ++i)
+      section += cases_table(evaluation.runs[i], *input.matrices[i],
+                             select(evaluation.runs[i], evaluation.truths[i], *input.matrices[i]),
+                             kind);
+    return section + "</section>\n";
+  };
+  h += cases_section(
+      "wrong-matches", "Most confident wrong matches",
+      "Queries whose best match is not a true place (outside the tolerance), lowest score "
+      "first: the wrong loops a threshold would accept first. Beside each, the true place: the "
+      "query's ground-truth candidate with the smallest distance.",
+      "wrong", [&](const EvaluatedRun& run, const GroundTruth& truth, const cv::Mat1f& m) {
+        return ConfidentWrongMatches(run, truth, m, exclusion, input.examples);
+      });
+  h += cases_section(
+      "misses", "Misses",
+      "Queries with a true place that the run does not find at its operating point "
+      "(Match_threshold, else the max-F1 threshold): no answer, a wrong answer, or a right one "
+      "with a score above the threshold; least confident first.",
+      "miss", [&](const EvaluatedRun& run, const GroundTruth& truth, const cv::Mat1f& m) {
+        return Misses(run, truth, m, exclusion, OperatingThreshold(run), input.examples);
+      });
+  return h;
+}
+
+}  // namespace
+
 std::string EncodeHtmlReport(const ReportInput& input) {
   const Evaluation& evaluation = *input.evaluation;
   if (input.matrices.size() != evaluation.runs.size())
@@ -326,79 +411,7 @@ std::string EncodeHtmlReport(const ReportInput& input) {
   }
   h += "</section>\n";
 
-  // Worst cases.
-  const ReportFrames& frames = input.frames;
-  const auto frame_name = [&](Frame f) {
-    if (frames.name) return frames.name(f.row, f.index);
-    return std::string(f.row ? "row " : "column ") + std::to_string(f.index);
-  };
-  const auto cell = [&](const EvaluatedRun& run, bool query, int block_index,
-                        const std::string& what, const std::string& css) {
-    if (block_index < 0) return "<td class=\"note\">" + what + "</td>";
-    const Frame f = query ? Frame{true, run.layout.row_offset + block_index}
-                          : Frame{false, run.layout.col_offset + block_index};
-    std::string c = "<td class=\"" + css + "\">";
-    if (frames.read)
-      c += PngImage(Thumbnail(frames.read(f.row, f.index)), "frame", frame_name(f));
-    c += Escape(frame_name(f)) + "<br>" + (query ? "query " : "reference ") +
-         std::to_string(block_index) + "</td>";
-    return c;
-  };
-  const auto cases_table = [&](const EvaluatedRun& run, const cv::Mat1f& matrix,
-                               const std::vector<ReportCase>& cases, const std::string& kind) {
-    std::string t = "<h3>" + Escape(run.label) + "</h3>\n";
-    if (cases.empty()) return t + "<p class=\"note\">None.</p>\n";
-    t += "<table class=\"cases\" data-kind=\"" + kind + "\">\n<tr><th>#</th><th>query</th><th>" +
-         (kind == "wrong" ? "wrong match" : "best match") + "</th><th>true place</th></tr>\n";
-    for (std::size_t k = 0; k < cases.size(); ++k) {
-      const ReportCase& c = cases[k];
-      const auto distance = [&](int column) {
-        return Number(matrix(run.layout.row_offset + c.query, run.layout.col_offset + column), 4);
-      };
-      std::string score = c.answer >= 0 ? "score " + Number(c.score, 4) + "<br>match: " +
-                                              distance(c.answer)
-                                        : std::string("no answer");
-      if (c.true_place >= 0) score += "<br>true place: " + distance(c.true_place);
-      t += "<tr data-query=\"" + std::to_string(c.query) + "\"><td>" + std::to_string(k + 1) +
-           "<br>" + score + "</td>" + cell(run, true, c.query, "", "") +
-           cell(run, false, c.answer, "no answer", c.correct ? "right" : "wrong") +
-           cell(run, false, c.true_place, "no true place among the candidates", "right") +
-           "</tr>\n";
-    }
-    return t + "</table>\n";
-  };
-  const std::string no_images =
-      frames.read ? ""
-                  : "<p class=\"note\">Frames are named, not shown: " + Escape(frames.missing) +
-                        "</p>\n";
-  // One section per kind of worst case, one table per run.
-  const auto cases_section = [&](const std::string& id, const std::string& title,
-                                 const std::string& note, const std::string& kind,
-                                 const auto& select) {
-    std::string section = "<section id=\"" + id + "\">\n<h2>" + title +
-                          "</h2>\n<p class=\"note\">" + note + "</p>\n" + no_images;
-    for (std::size_t i = 0; i < evaluation.runs.size(); ++i)
-      section += cases_table(evaluation.runs[i], *input.matrices[i],
-                             select(evaluation.runs[i], evaluation.truths[i], *input.matrices[i]),
-                             kind);
-    return section + "</section>\n";
-  };
-  h += cases_section(
-      "wrong-matches", "Most confident wrong matches",
-      "Queries whose best match is not a true place (outside the tolerance), lowest score "
-      "first: the wrong loops a threshold would accept first. Beside each, the true place: the "
-      "query's ground-truth candidate with the smallest distance.",
-      "wrong", [&](const EvaluatedRun& run, const GroundTruth& truth, const cv::Mat1f& m) {
-        return ConfidentWrongMatches(run, truth, m, exclusion, input.examples);
-      });
-  h += cases_section(
-      "misses", "Misses",
-      "Queries with a true place that the run does not find at its operating point "
-      "(Match_threshold, else the max-F1 threshold): no answer, a wrong answer, or a right one "
-      "with a score above the threshold; least confident first.",
-      "miss", [&](const EvaluatedRun& run, const GroundTruth& truth, const cv::Mat1f& m) {
-        return Misses(run, truth, m, exclusion, OperatingThreshold(run), input.examples);
-      });
+  h += WorstCaseSections(input);
 
   // Every embedded image must decode: the console names any that did not (a damaged or
   // truncated page), and the page records the count (data-images-loaded) for tests.
