@@ -1,5 +1,5 @@
 // Exact against approximate k-nearest search on real data: queries per second, speed-up and
-// recall of each approximate engine (matching/approximate.h: FLANN, FAISS HNSW, FAISS IVF),
+// recall of each approximate engine (matching/search/approximate.h: FLANN, FAISS HNSW, FAISS IVF),
 // k = 10, all cores for every search.
 //
 // Data (../shared/datasets, skipped with a message when absent):
@@ -46,7 +46,7 @@
 #include <vector>
 
 #include "descriptors/registry.h"
-#include "matching/approximate.h"
+#include "matching/search/approximate.h"
 
 namespace {
 

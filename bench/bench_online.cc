@@ -10,7 +10,7 @@
 //                     [--verify] [--verify-candidates K] [--verify-consistency N]
 //                     [--verify-features ORB|SIFT] [--verify-max-features N]
 //                     [--engine NAME] [--save-map FILE]
-// --engine NAME: an approximate-search engine of matching/engine_registry.h (default auto).
+// --engine NAME: an approximate-search engine of matching/search/engine_registry.h (default auto).
 // --verify turns geometric verification on (OnlineOptions::verification, tolerance 3 frames):
 // the answer of a frame is then its first verified candidate, and the time of the checks is
 // reported apart ("verify": features of the frame and every candidate's check).

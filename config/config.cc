@@ -8,7 +8,7 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
 #include "descriptors/registry.h"
-#include "matching/engine_registry.h"
+#include "matching/search/engine_registry.h"
 
 namespace openable {
 namespace {
@@ -323,7 +323,7 @@ void AddScaleKeys(OptionTable& t, Config& c) {
         "Approximate_engine instead of comparing every pair, then scores them with the sequence "
         "sum; faster on very large runs, recall below 1 (docs/benchmarks.md). No band.");
   // The approximate search's keys: bound onto ApproximateOptions (ScaleOptions::approximate),
-  // the engine names and their meanings from its registry (matching/engine_registry.h), the
+  // the engine names and their meanings from its registry (matching/search/engine_registry.h), the
   // ranges from ApproximateOptions.
   ApproximateOptions& approximate = c.scale.approximate;
   using A = ApproximateOptions;

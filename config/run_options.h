@@ -9,7 +9,7 @@
 #include "OpenABLE/base/enum_names.h"
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/metrics.h"
-#include "matching/approximate.h"
+#include "matching/search/approximate.h"
 #include "matching/bounded.h"
 
 namespace openable {
@@ -77,7 +77,7 @@ struct ScaleOptions {
   KeepRules keep;                 // Best_matches and Band_width (its exclusion: Exclusion)
   std::string matches_name;       // kept matches, .npy or .csv
   bool approximate_search = false;  // approximate candidates instead of every pair (bounded)
-  // The engine and search budget of those candidates (matching/approximate.h; the keys
+  // The engine and search budget of those candidates (matching/search/approximate.h; the keys
   // Approximate_engine, Approximate_checks, Approximate_ef_search and Approximate_nprobe are
   // bound onto its fields). The run sets its k (from Best_matches) and threads.
   ApproximateOptions approximate;

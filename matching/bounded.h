@@ -24,7 +24,7 @@
 #include <opencv2/core.hpp>
 
 #include "matching/agreement.h"
-#include "matching/approximate.h"
+#include "matching/search/approximate.h"
 #include "matching/distances.h"
 #include "matching/score.h"
 #include "matching/sequence.h"
@@ -114,7 +114,7 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
                                   const std::function<void(int, int)>& progress = {});
 
 // Approximate_search: the index of `approximate` (its engine and search budget; its k and
-// threads are set here: matching/approximate.h) gives Best_matches candidates per query (with
+// threads are set here: matching/search/approximate.h) gives Best_matches candidates per query (with
 // one traversal, Best_matches + 2 x Exclusion, of which those Exclusion frames back are kept),
 // each scored by its exact sequence sum; the k best by that score are kept. Normalised by the
 // largest score computed.

@@ -22,7 +22,7 @@
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/verification/verification.h"
-#include "matching/incremental_index.h"
+#include "matching/search/incremental_index.h"
 
 namespace openable {
 

@@ -16,7 +16,7 @@
 #include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/online/map_file.h"
 #include "descriptors/registry.h"
-#include "matching/incremental_index.h"
+#include "matching/search/incremental_index.h"
 #include "matching/matrix.h"
 
 namespace openable {

@@ -26,7 +26,7 @@
 
 #include "OpenABLE/describe/describe.h"
 #include "OpenABLE/verification/verification.h"
-#include "matching/approximate.h"
+#include "matching/search/approximate.h"
 #include "matching/distances.h"
 #include "matching/score.h"
 #include "matching/sequence.h"
@@ -62,7 +62,7 @@ struct OnlineOptions {
   double threshold = 0.13;
   // Search: exact (every earlier frame) while the searchable map holds at most exact_limit
   // frames; beyond, frames are indexed by approximate.engine (an engine of
-  // matching/engine_registry.h) in blocks of block_frames merged as they grow (sizes
+  // matching/search/engine_registry.h) in blocks of block_frames merged as they grow (sizes
   // block_frames x 2^m, at most one of each), and only the newest unindexed frames
   // (< block_frames) are scanned exactly.
   int exact_limit = 20000;

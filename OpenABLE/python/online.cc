@@ -14,7 +14,7 @@
 
 #include "OpenABLE/online/online.h"
 #include "OpenABLE/python/common.h"
-#include "matching/engine_registry.h"
+#include "matching/search/engine_registry.h"
 #include "matching/sequence.h"
 
 namespace openable::python {
@@ -135,7 +135,7 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
                      "large index build; candidates then depend on when a merge finishes); "
                      "False builds them inside add_frame, for repeatable results.");
   // Members of the nested option structs as top-level properties: the approximate search
-  // (matching/approximate.h) and the verification (prefix verification_).
+  // (matching/search/approximate.h) and the verification (prefix verification_).
   const auto nested = [&c](const char* name, auto outer, auto member, const char* doc) {
     using T = std::remove_reference_t<decltype(std::declval<O&>().*outer.*member)>;
     c.def_property(
@@ -145,7 +145,7 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
   const auto search = [&nested](const char* name, auto member, const char* doc) {
     nested(name, &O::approximate, member, doc);
   };
-  // The engine's names and their meanings come from its registry (matching/engine_registry.h).
+  // The engine's names and their meanings come from its registry (matching/search/engine_registry.h).
   static const std::string engine_doc =
       "Index of the blocks beyond exact_limit: " + ApproximateEngineHelp();
   c.def_property(

@@ -1,6 +1,6 @@
 // The keys of approximate search agree with the library they are bound onto: the defaults,
 // ranges and engine names that Test_OpenABLE --help, docs/configuration.md and Config.txt show
-// are those of ApproximateOptions and of the engine registry (matching/engine_registry.h), and
+// are those of ApproximateOptions and of the engine registry (matching/search/engine_registry.h), and
 // every engine of the registry reads back through the key.
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
 #include "config/config.h"
-#include "matching/engine_registry.h"
-#include "matching/incremental_index.h"
+#include "matching/search/engine_registry.h"
+#include "matching/search/incremental_index.h"
 
 namespace openable {
 namespace {

@@ -19,7 +19,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "config/config.h"
-#include "matching/approximate.h"
+#include "matching/search/approximate.h"
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
 

@@ -1,4 +1,4 @@
-#include "matching/approximate.h"
+#include "matching/search/approximate.h"
 
 #include <gtest/gtest.h>
 
@@ -522,7 +522,7 @@ TEST(ApproximateIndex, FaissSearchBudgetChangesRecall) {
 }
 
 TEST(ApproximateIndex, BinaryIvfScansItsCellsWithExactDistances) {
-  // The binary IVF index scans FAISS's cells itself (matching/approximate.cc, IvfCells):
+  // The binary IVF index scans FAISS's cells itself (matching/search/approximate.cc, IvfCells):
   // probing every cell must give the brute-force lists, ties included (2-byte rows: many equal
   // distances; 13 bytes: a width that is not a multiple of the kernels' words), and probing one
   // cell only true distances, each reference once, in order.

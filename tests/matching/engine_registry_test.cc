@@ -1,8 +1,8 @@
-// Every engine of the registry (matching/engine_registry.cc) keeps the contract of
+// Every engine of the registry (matching/search/engine_registry.cc) keeps the contract of
 // ApproximateIndex on both kinds of rows, whatever engines the table lists: exact distances in
 // order, the same candidates from an index read back from its Serialize(), a memory estimate,
 // and a refusal naming the key when the build lacks what it needs.
-#include "matching/engine_registry.h"
+#include "matching/search/engine_registry.h"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
-#include "matching/approximate.h"
-#include "matching/approximate_engine.h"
+#include "matching/search/approximate.h"
+#include "matching/search/approximate_engine.h"
 #include "matching/distances.h"
 
 namespace openable {

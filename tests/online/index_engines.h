@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "matching/approximate.h"
-#include "matching/engine_registry.h"
+#include "matching/search/approximate.h"
+#include "matching/search/engine_registry.h"
 #include "tests/test_frames.h"
 
 namespace openable {

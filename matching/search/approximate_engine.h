@@ -1,5 +1,5 @@
-// What an approximate-search engine provides to ApproximateIndex (matching/approximate.h): an
-// entry of the table of matching/engine_registry.cc (name, help, whether it needs FAISS, its
+// What an approximate-search engine provides to ApproximateIndex (matching/search/approximate.h): an
+// entry of the table of matching/search/engine_registry.cc (name, help, whether it needs FAISS, its
 // build and its memory per row) and the index it builds (EngineIndex). The helpers below are
 // shared by the engines and by the exact search of approximate.cc.
 #pragma once
@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "OpenABLE/base/threading.h"
-#include "matching/approximate.h"
+#include "matching/search/approximate.h"
 
 namespace openable {
 
@@ -35,7 +35,7 @@ class EngineIndex {
   virtual std::vector<std::uint8_t> Serialize() const { return {}; }
 };
 
-// An engine of the table (matching/engine_registry.cc).
+// An engine of the table (matching/search/engine_registry.cc).
 struct ApproximateEngineEntry {
   // Its name: a value of ApproximateOptions::engine and of the key Approximate_engine (lower
   // case, no spaces).

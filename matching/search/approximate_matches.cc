@@ -1,12 +1,12 @@
 // The bounded mode with approximate candidates (Approximate_search 1): the index of
-// Approximate_engine (matching/approximate.h, an engine of matching/engine_registry.h) finds the
+// Approximate_engine (matching/search/approximate.h, an engine of matching/search/engine_registry.h) finds the
 // candidates of each query; each candidate is then scored by its exact sequence sum
 // (SequenceCellDistance). Declared in matching/bounded.h.
 #include <algorithm>
 #include <cmath>
 
 #include "OpenABLE/base/threading.h"
-#include "matching/approximate.h"
+#include "matching/search/approximate.h"
 #include "matching/bounded.h"
 #include "matching/sequence.h"
 

@@ -1,5 +1,5 @@
-// The entry points of the run-time module libopenable_faiss.so (matching/faiss_module.cc), the
-// FAISS indexes of the engines hnsw and ivf (matching/faiss_engines.h). The module links FAISS,
+// The entry points of the run-time module libopenable_faiss.so (matching/search/faiss_module.cc), the
+// FAISS indexes of the engines hnsw and ivf (matching/search/faiss_engines.h). The module links FAISS,
 // OpenMP and BLAS and nothing of OpenABLE but this header, so that openable_matching reaches
 // it through ModuleSymbol (OpenABLE/base/module_loader.h) alone. Module and program come from the
 // same build, so C++ types and exceptions cross the boundary.
@@ -12,7 +12,7 @@
 namespace openable {
 
 // What the module needs of an index: a plain view of ApproximateOptions and of the rows, made
-// in one place (SettingsOf, matching/faiss_engines.cc) with every field set from them; no
+// in one place (SettingsOf, matching/search/faiss_engines.cc) with every field set from them; no
 // defaults of its own, the settings' defaults and ranges are ApproximateOptions'.
 struct FaissSettings {
   bool hnsw;                 // HNSW, else IVF

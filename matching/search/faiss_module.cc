@@ -1,4 +1,4 @@
-// Module libopenable_faiss.so (matching/faiss_index.h): the HNSW and IVF indexes of FAISS for
+// Module libopenable_faiss.so (matching/search/faiss_index.h): the HNSW and IVF indexes of FAISS for
 // ApproximateIndex. FAISS brings libgomp, BLAS and LAPACK, which a run that does not use it no
 // longer loads at start-up.
 #include <omp.h>
@@ -19,7 +19,7 @@
 #include <faiss/impl/io.h>
 #include <faiss/index_io.h>
 
-#include "matching/faiss_index.h"
+#include "matching/search/faiss_index.h"
 
 namespace openable {
 namespace {

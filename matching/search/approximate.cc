@@ -1,4 +1,4 @@
-#include "matching/approximate.h"
+#include "matching/search/approximate.h"
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -8,7 +8,7 @@
 #include <string>
 
 #include "OpenABLE/base/error.h"
-#include "matching/approximate_engine.h"
+#include "matching/search/approximate_engine.h"
 #include "matching/distances.h"
 
 namespace openable {

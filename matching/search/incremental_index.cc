@@ -1,4 +1,4 @@
-#include "matching/incremental_index.h"
+#include "matching/search/incremental_index.h"
 
 #include <algorithm>
 #include <chrono>
@@ -8,7 +8,7 @@
 #include <string>
 #include <utility>
 
-#include "matching/approximate_engine.h"
+#include "matching/search/approximate_engine.h"
 
 namespace openable {
 

@@ -1,10 +1,10 @@
 // Approximate candidate search for very large reference sets: the k nearest references of each
-// query found by one of the engines of matching/engine_registry.h (FAISS's HNSW graphs and
+// query found by one of the engines of matching/search/engine_registry.h (FAISS's HNSW graphs and
 // inverted files, faiss_engines.h; OpenCV's FLANN, flann_engine.h), and the exact search they
 // are measured against.
 //
 // FAISS (libfaiss-dev, with OpenMP and BLAS) is compiled into the run-time module
-// libopenable_faiss.so (matching/faiss_module.cc, OpenABLE/base/module_loader.h), loaded when
+// libopenable_faiss.so (matching/search/faiss_module.cc, OpenABLE/base/module_loader.h), loaded when
 // the first FAISS index is built: a run that uses FLANN or exact search does not load libgomp,
 // BLAS or LAPACK. A build configured without FAISS refuses the engines that need it
 // (CheckEngineAvailable).
@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "matching/engine_registry.h"
+#include "matching/search/engine_registry.h"
 
 namespace openable {
 

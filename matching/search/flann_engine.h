@@ -1,4 +1,4 @@
-// The engine flann (matching/engine_registry.h): OpenCV's FLANN, LSH for binary rows (Hamming)
+// The engine flann (matching/search/engine_registry.h): OpenCV's FLANN, LSH for binary rows (Hamming)
 // and randomised k-d trees for float rows (L2).
 //
 // Papers: M. Muja and D. G. Lowe, "Scalable Nearest Neighbor Algorithms for High Dimensional
@@ -14,7 +14,7 @@
 // serialised: it is built again from the rows (milliseconds to seconds).
 #pragma once
 
-#include "matching/approximate_engine.h"
+#include "matching/search/approximate_engine.h"
 
 namespace openable {
 

@@ -1,4 +1,4 @@
-// The engines of approximate search (ApproximateIndex, matching/approximate.h) by name: the
+// The engines of approximate search (ApproximateIndex, matching/search/approximate.h) by name: the
 // values of ApproximateOptions::engine, of the key Approximate_engine, of the online detector's
 // engine and of bench_online's --engine. Every list of them that users see (the key's help and
 // its Markdown reference, error messages, the Python docstrings) is made here from the one
@@ -9,7 +9,7 @@
 // rows' kind (ResolvedEngine).
 //
 // Adding an engine: its own files (an ApproximateEngineEntry and an EngineIndex, see
-// matching/approximate_engine.h and flann_engine.cc), one line in the table of
+// matching/search/approximate_engine.h and flann_engine.cc), one line in the table of
 // engine_registry.cc, its source in matching/CMakeLists.txt, its row in docs/matching.md.
 #pragma once
 
@@ -19,7 +19,7 @@
 
 namespace openable {
 
-struct ApproximateEngineEntry;  // matching/approximate_engine.h
+struct ApproximateEngineEntry;  // matching/search/approximate_engine.h
 
 // The name that stands for the engine chosen by the rows' kind; the default engine.
 inline constexpr char kAutoApproximateEngine[] = "auto";

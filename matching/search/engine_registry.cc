@@ -1,4 +1,4 @@
-#include "matching/engine_registry.h"
+#include "matching/search/engine_registry.h"
 
 #include <opencv2/core.hpp>
 #include <string>
@@ -7,18 +7,18 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
-#include "matching/approximate_engine.h"
-#include "matching/faiss_engines.h"
-#include "matching/flann_engine.h"
+#include "matching/search/approximate_engine.h"
+#include "matching/search/faiss_engines.h"
+#include "matching/search/flann_engine.h"
 
 namespace openable {
 namespace {
 
 // The one table of engines, in the order shown to users (auto comes after them).
 const ApproximateEngineEntry* const kEngines[] = {
-    &kFlannEngine,  // matching/flann_engine.h
-    &kHnswEngine,   // matching/faiss_engines.h
-    &kIvfEngine,    // matching/faiss_engines.h
+    &kFlannEngine,  // matching/search/flann_engine.h
+    &kHnswEngine,   // matching/search/faiss_engines.h
+    &kIvfEngine,    // matching/search/faiss_engines.h
 };
 
 // What auto stands for, measured by bench/bench_approximate (docs/matching.md, "Choosing an

@@ -1,4 +1,4 @@
-#include "matching/faiss_engines.h"
+#include "matching/search/faiss_engines.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -10,7 +10,7 @@
 
 #include "OpenABLE/base/module_loader.h"
 #include "matching/distances.h"
-#include "matching/faiss_index.h"
+#include "matching/search/faiss_index.h"
 
 namespace openable {
 namespace {

@@ -3,7 +3,7 @@
 //
 // Rows are appended one by one. While the searchable rows number at most exact_limit, every
 // one is a candidate (an exact scan); beyond, rows are indexed by the engine of
-// options.approximate (matching/approximate.h, matching/engine_registry.h) in blocks of
+// options.approximate (matching/search/approximate.h, matching/search/engine_registry.h) in blocks of
 // block_frames rows merged as they grow (sizes block_frames x 2^m, at most one of each, like a
 // binary counter), and only the newest unindexed rows (fewer than block_frames) are scanned
 // exactly. Merges of two blocks are built on a background thread while the two old blocks go
@@ -16,7 +16,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "matching/approximate.h"
+#include "matching/search/approximate.h"
 
 namespace openable {
 

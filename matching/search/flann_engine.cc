@@ -1,4 +1,4 @@
-#include "matching/flann_engine.h"
+#include "matching/search/flann_engine.h"
 
 #include <algorithm>
 #include <cstdint>
