@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
       return argv[++i];
     };
     if (a == "--datasets") datasets = next();
-    else if (a == "--descriptor") options.descriptor = next();
+    else if (a == "--descriptor") options.descriptor.name = next();
     else if (a == "--sequence") options.sequence_length = std::stoi(next());
     else if (a == "--exclusion") options.exclusion = std::stoi(next());
     else if (a == "--threshold") options.threshold = std::stod(next());
@@ -194,7 +194,7 @@ int main(int argc, char** argv) {
                 "threshold %.3f, %d random rows before (map %d frames at the end), exact limit %d, %d "
                 "frames searched with %s index blocks (%d blocks at the end, merges %s), memory "
                 "%.1f MB\n",
-                options.descriptor.c_str(), options.sequence_length, options.exclusion,
+                options.descriptor.name.c_str(), options.sequence_length, options.exclusion,
                 openable::EnumName(options.score).c_str(), options.threshold, prefill, detector.Size(), options.exact_limit,
                 approximate_frames, options.approximate.engine.c_str(),
                 detector.Blocks(),

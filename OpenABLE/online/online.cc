@@ -81,15 +81,11 @@ void OnlineOptions::Check() const {
 
 Describer MakeDescriber(const OnlineOptions& options) {
   options.Check();
-  DescriptorOptions d;
-  d.patch_size = options.patch_size;
-  d.ldb_bits = options.ldb_bits;
-  d.sad_patch = options.sad_patch;
   Describer out;
-  out.descriptor = CreateDescriptor(options.descriptor, d);
+  out.descriptor = CreateDescriptor(options.descriptor);
   // A grey image per frame: descriptors of several channels (D-LDB: grey + disparity) need
   // stereo pairs.
-  Require(out.descriptor->Channels() == 1, "descriptor", options.descriptor,
+  Require(out.descriptor->Channels() == 1, "descriptor", options.descriptor.name,
           "a single-camera descriptor (" + out.descriptor->Name() +
               " needs stereo pairs: use Test_OpenABLE with Camera_type 1)");
   out.frame = std::make_unique<FrameDescriber>(*out.descriptor, options.description,
@@ -173,7 +169,7 @@ OnlineDetector::OnlineDetector(const OnlineOptions& options) : state_(std::make_
   s.options = options;
   s.describer = MakeDescriber(options);  // checks the options
   Require(s.describer.descriptor->Distance() != DistanceKind::kL1, "descriptor",
-          options.descriptor,
+          options.descriptor.name,
           "a Hamming or L2 descriptor (" + s.describer.descriptor->Name() +
               "'s L1 distance has no index for the search beyond exact_limit: use "
               "DescribeImages and DistanceMatrix, or Test_OpenABLE)");
@@ -356,10 +352,10 @@ std::string Exact(double v) {
 // The settings that make the rows: a map made with others cannot be searched with this
 // detector's rows.
 std::vector<std::pair<std::string, std::string>> DescriptionSettings(const OnlineOptions& o) {
-  return {{"descriptor", o.descriptor},
+  return {{"descriptor", o.descriptor.name},
           {"description", EnumName(o.description)},
-          {"patch_size", std::to_string(o.patch_size)},
-          {"ldb_bits", std::to_string(o.ldb_bits)},
+          {"patch_size", std::to_string(o.descriptor.patch_size)},
+          {"ldb_bits", std::to_string(o.descriptor.ldb_bits)},
           {"grid_x", std::to_string(o.grid_x)},
           {"grid_y", std::to_string(o.grid_y)}};
 }

@@ -25,6 +25,7 @@
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/describe/describe.h"
+#include "descriptors/descriptor.h"
 #include "OpenABLE/verification/verification.h"
 #include "matching/search/approximate.h"
 #include "matching/distances.h"
@@ -34,13 +35,12 @@
 namespace openable {
 
 struct OnlineOptions {
-  // Description (as the keys Description_type, Patch_size, Ldb_bits, Sad_patch, Grid_x,
-  // Grid_y).
-  std::string descriptor = "LDB";
+  // Description: the descriptor and its settings, the struct of a run's keys Image_descriptor,
+  // Patch_size, Ldb_bits and Sad_patch (descriptors/descriptor.h: name "LDB", patch 64, 256
+  // bits; sad_patch for SAD, DescribeImages only), and how a frame is cut (Description_type,
+  // Grid_x, Grid_y).
+  DescriptorOptions descriptor;
   DescriptionType description = DescriptionType::kGlobal;
-  int patch_size = 64;
-  int ldb_bits = 256;
-  int sad_patch = 8;  // SAD (DescribeImages only): side of the normalised squares (Sad_patch)
   int grid_x = 1, grid_y = 1;
   // Matching.
   // L (the key Image_sequences): frames summed along the diagonal. A candidate among the first

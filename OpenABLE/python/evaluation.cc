@@ -16,6 +16,7 @@
 #include "OpenABLE/evaluation/unsupervised.h"
 #include "OpenABLE/python/common.h"
 #include "OpenABLE/run/evaluate.h"
+#include "matching/matrix.h"
 #include "matching/normalize.h"
 
 namespace openable::python {
@@ -496,6 +497,10 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
 }
 
 void RegisterEvaluate(py::module_& m) {
+  // The keywords' defaults are those of the structs they fill, so that they cannot drift.
+  const EvaluationOptions kOptions;
+  const GroundTruthOptions kTruth;
+  const MatchingOptions kMatching;
 
   m.def(
       "evaluate",
@@ -657,20 +662,26 @@ void RegisterEvaluate(py::module_& m) {
       py::arg("pairs") = py::none(), py::arg("poses") = py::none(),
       py::arg("reference_poses") = py::none(), py::arg("aligned") = false,
       py::arg("truth_file") = py::none(), py::arg("truth_type") = py::none(),
-      py::arg("truth_file_2") = "", py::arg("base") = -1, py::arg("first_frame") = 0,
-      py::arg("range_selected") = false, py::arg("layout") = py::none(),
-      py::arg("reference_frames") = py::none(), py::arg("tolerance") = 2,
-      py::arg("exclusion") = 100, py::arg("vicinity") = 7, py::arg("able_thresholds") = 100,
-      py::arg("radius") = 5.0, py::arg("heading_limit") = -1.0,
-      py::arg("min_frame_gap") = py::none(), py::arg("axes") = "xyz", py::arg("normalize") = true,
-      py::arg("label") = "python", py::arg("score") = "distance", py::arg("score_window") = 10,
-      py::arg("accept_threshold") = py::none(), py::arg("accept_consistency") = 0,
-      py::arg("sequence_length") = 1, py::arg("partial") = "ahead",
-      py::arg("direction") = "forward",
+      py::arg("truth_file_2") = "", py::arg("base") = kTruth.base,
+      py::arg("first_frame") = kTruth.first_frame, py::arg("range_selected") = false,
+      py::arg("layout") = py::none(), py::arg("reference_frames") = py::none(),
+      py::arg("tolerance") = kOptions.tolerance, py::arg("exclusion") = kOptions.exclusion,
+      py::arg("vicinity") = kOptions.vicinity, py::arg("able_thresholds") = kOptions.able_thresholds,
+      py::arg("radius") = kTruth.radius, py::arg("heading_limit") = kTruth.heading_limit,
+      py::arg("min_frame_gap") = py::none(), py::arg("axes") = kTruth.axes,
+      py::arg("normalize") = true, py::arg("label") = "python",
+      py::arg("score") = EnumName(kOptions.score), py::arg("score_window") = kOptions.score_window,
+      py::arg("accept_threshold") = py::none(),
+      py::arg("accept_consistency") = kOptions.accept_consistency,
+      py::arg("sequence_length") = kMatching.sequence_length,
+      py::arg("partial") = EnumName(kMatching.partial),
+      py::arg("direction") = EnumName(kMatching.direction),
       EvaluateDoc().c_str());
 }
 
 void RegisterUnsupervised(py::module_& m) {
+  const EvaluationOptions kOptions;
+  const MatchingOptions kMatching;
 
   m.def(
       "unsupervised_criteria",
@@ -712,9 +723,11 @@ void RegisterUnsupervised(py::module_& m) {
         return d;
       },
       py::arg("matrix"), py::kw_only(), py::arg("layout") = py::none(),
-      py::arg("reference_frames") = py::none(), py::arg("sequence_length") = 1,
-      py::arg("partial") = "ahead", py::arg("direction") = "forward", py::arg("exclusion") = 100,
-      py::arg("score_window") = 10,
+      py::arg("reference_frames") = py::none(),
+      py::arg("sequence_length") = kMatching.sequence_length,
+      py::arg("partial") = EnumName(kMatching.partial),
+      py::arg("direction") = EnumName(kMatching.direction),
+      py::arg("exclusion") = kOptions.exclusion, py::arg("score_window") = kOptions.score_window,
       R"doc(unsupervised_criteria(matrix, *, layout=None, reference_frames=None,
     sequence_length=1, partial="ahead", direction="forward", exclusion=100,
     score_window=10) -> dict

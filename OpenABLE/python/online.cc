@@ -25,11 +25,11 @@ OnlineOptions DescriptionOptions(const std::string& descriptor, const std::strin
                                  int patch_size, int ldb_bits, std::pair<int, int> grid,
                                  int sad_patch) {
   OnlineOptions o;
-  o.descriptor = descriptor;
+  o.descriptor.name = descriptor;
   o.description = ParseEnum<DescriptionType>(description, "description");
-  o.patch_size = patch_size;
-  o.ldb_bits = ldb_bits;
-  o.sad_patch = sad_patch;
+  o.descriptor.patch_size = patch_size;
+  o.descriptor.ldb_bits = ldb_bits;
+  o.descriptor.sad_patch = sad_patch;
   o.grid_x = grid.first;
   o.grid_y = grid.second;
   return o;
@@ -89,19 +89,27 @@ The options of OnlineDetector (OpenABLE/online/online.h), with their defaults. R
 dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
   c.def(py::init([](const py::kwargs& kwargs) { return OnlineOptionsOf(kwargs); }),
         "__init__(**options)\n\nThe defaults, with the options given by keyword.")
-      .def_readwrite("descriptor", &O::descriptor,
-                     "A name of descriptor_names() but D-LDB (case-insensitive).")
+      .def_property(
+          "descriptor", [](const O& o) { return o.descriptor.name; },
+          [](O& o, const std::string& name) { o.descriptor.name = name; },
+          "A name of descriptor_names() but D-LDB (case-insensitive).")
       .def_property(
           "description", [](const O& o) { return EnumName(o.description); },
           [](O& o, const std::string& n) {
             o.description = ParseEnum<DescriptionType>(n, "description");
           },
           "\"global\" (the frame resized to the patch) or \"grid\" (grid cells).")
-      .def_readwrite("patch_size", &O::patch_size, "Side of the square patch, pixels.")
-      .def_readwrite("ldb_bits", &O::ldb_bits, "Bits of LDB rows (1..1386).")
-      .def_readwrite("sad_patch", &O::sad_patch,
-                     "SAD: side of the normalised squares, pixels (2..64; describe_images only: "
-                     "the detector needs a Hamming or L2 descriptor).")
+      .def_property(
+          "patch_size", [](const O& o) { return o.descriptor.patch_size; },
+          [](O& o, int v) { o.descriptor.patch_size = v; }, "Side of the square patch, pixels.")
+      .def_property(
+          "ldb_bits", [](const O& o) { return o.descriptor.ldb_bits; },
+          [](O& o, int v) { o.descriptor.ldb_bits = v; }, "Bits of LDB rows (1..1386).")
+      .def_property(
+          "sad_patch", [](const O& o) { return o.descriptor.sad_patch; },
+          [](O& o, int v) { o.descriptor.sad_patch = v; },
+          "SAD: side of the normalised squares, pixels (2..64; describe_images only: "
+          "the detector needs a Hamming or L2 descriptor).")
       .def_property(
           "grid", [](const O& o) { return std::make_pair(o.grid_x, o.grid_y); },
           [](O& o, std::pair<int, int> g) { std::tie(o.grid_x, o.grid_y) = g; },
@@ -381,6 +389,8 @@ Returns:
 
 }
 
+void BindDetectorMapAndState(py::class_<Detector>& c);
+
 void RegisterDetector(py::module_& m) {
   BindOnlineOptions(m);
   // The signature of the constructor, from the defaults of the options' properties.
@@ -404,8 +414,8 @@ Raises:
     unknown option.
 
 Calls from several threads are serialised by a lock.)doc";
-  py::class_<Detector>(m, "OnlineDetector", class_doc.c_str())
-      .def(py::init([](const py::kwargs& kwargs) {
+  py::class_<Detector> c(m, "OnlineDetector", class_doc.c_str());
+  c.def(py::init([](const py::kwargs& kwargs) {
              auto d = std::make_unique<Detector>();
              d->detector = std::make_unique<OnlineDetector>(OnlineOptionsOf(kwargs));
              return d;
@@ -488,8 +498,13 @@ Saves the map (the settings it was made with, every frame's descriptor row, the 
 and with verification every frame's local features) to `path`, so that a later session starts
 from it with load_map(). Versioned and checksummed; written through a temporary file renamed
 into place when complete. Raises openable.InputError naming the path when it cannot be
-written.)doc")
-      .def(
+written.)doc");
+  BindDetectorMapAndState(c);
+}
+
+// The detector's loading of a saved map, finish_merges, and its state (the properties).
+void BindDetectorMapAndState(py::class_<Detector>& c) {
+  c.def(
           "load_map",
           [](Detector& det, const py::object& path_object) {
             const std::string path = FileSystemPath(path_object, "load_map: path");
@@ -592,7 +607,7 @@ installs its index.)doc")
       .def("__repr__", [](Detector& d) {
         std::lock_guard<std::mutex> lock(d.mutex);
         const OnlineOptions& o = d.detector->Options();
-        return "<openable.OnlineDetector " + o.descriptor + " " + EnumName(o.description) +
+        return "<openable.OnlineDetector " + o.descriptor.name + " " + EnumName(o.description) +
                ", L=" + std::to_string(o.sequence_length) + ", " +
                std::to_string(d.detector->Size()) + " frames>";
       });

@@ -183,7 +183,7 @@ TEST(Verification, OnlineDetectorGivesTheBatchRunsLoops) {
   ASSERT_TRUE(batch.verification);
 
   OnlineOptions options;
-  options.descriptor = "LDB";
+  options.descriptor.name = "LDB";
   options.exclusion = kExclusion;
   options.score_window = config.matching.score_window;
   options.verification = config.verification;

@@ -130,7 +130,7 @@ TEST(OnlineDetector, FloatDescriptorsMatchTheBruteForceToo) {
   OPENABLE_REQUIRE_PATH(Kitti00LeftDir());
   const std::vector<cv::Mat> frames = ReadKitti00Frames(20, 1699);
   OnlineOptions options;
-  options.descriptor = "HOG";
+  options.descriptor.name = "HOG";
   options.sequence_length = 3;
   options.exclusion = 5;
   options.candidates = 3;
@@ -255,9 +255,9 @@ TEST(OnlineDetector, BadOptionsAndFramesAreOneLineErrors) {
     return o;
   };
   ExpectInputError(
-      [&] { OnlineDetector d(with([](OnlineOptions& o) { o.descriptor = "D-LDB"; })); },
+      [&] { OnlineDetector d(with([](OnlineOptions& o) { o.descriptor.name = "D-LDB"; })); },
       {"OnlineOptions.descriptor", "D-LDB", "stereo"});
-  ExpectInputError([&] { OnlineDetector d(with([](OnlineOptions& o) { o.descriptor = "SURF"; })); },
+  ExpectInputError([&] { OnlineDetector d(with([](OnlineOptions& o) { o.descriptor.name = "SURF"; })); },
                    {"SURF"});
   ExpectInputError([&] { OnlineDetector d(with([](OnlineOptions& o) { o.sequence_length = 0; })); },
                    {"OnlineOptions.sequence_length", "0", "1..1000"});

@@ -125,7 +125,7 @@ TEST(SavedMap, OtherIndexSettingsRebuildTheBlocks) {
 TEST(SavedMap, FloatMapKeepsItsNormalisation) {
   OPENABLE_REQUIRE_PATH(Kitti00LeftDir());
   OnlineOptions options;
-  options.descriptor = "HOG";
+  options.descriptor.name = "HOG";
   options.sequence_length = 3;
   options.exclusion = 5;
   const cv::Mat rows = DescribeImages(ReadKitti00Frames(20, 1699), options);  // 85 frames
@@ -229,7 +229,7 @@ TEST(SavedMap, DefectsAreOneLineErrors) {
   ExpectInputError([&] { load(dir + "/tiny.map"); }, {"tiny.map", "truncated"});
 
   OnlineOptions wider = options;
-  wider.ldb_bits = 512;
+  wider.descriptor.ldb_bits = 512;
   OnlineDetector other(wider);
   ExpectInputError([&] { other.LoadMap(path); },
                    {path, "ldb_bits = 256", "this detector has ldb_bits = 512"});
