@@ -207,32 +207,28 @@ void OpenSources(RunPlan& plan) {
   const bool disparity = plan.describers.front()->Channels() == 2;
   plan.specs = SourcesOf(input);
   for (const auto& spec : plan.specs) {
-    if (spec.kind == SourceKind::kStereoBag) {
-      StereoSourceOptions stereo_options;
-      stereo_options.compute_disparity = disparity;
-      const StereoCalibration calibration = WithKey(
-          "Calibration_path", [&] { return LoadStereoCalibration(input.calibration_path); });
-      SourceSpec right = spec;
-      right.topic_key = "Bag_topic_right";
-      right.topic = input.bag_topic_right;
-      plan.sources.push_back(OpenStereoSources(OpenStoredFrames(spec, input),
-                                               OpenStoredFrames(right, input), calibration,
-                                               stereo_options, "Bag_topic", "Bag_topic_right"));
+    if (spec.kind != SourceKind::kStereo && spec.kind != SourceKind::kStereoBag) {
+      plan.sources.push_back(OpenStoredFrames(spec, input));  // folders, videos, bags
       continue;
     }
+    // Stereo pairs, rectified with the calibration; the stereo source's messages name their
+    // keys (Images_path_left, Images_path_right, Bag_topic_right, Calibration_path) themselves.
+    StereoSourceOptions stereo_options;
+    stereo_options.compute_disparity = disparity;  // only D-LDB reads it
+    const StereoCalibration calibration = WithKey(
+        "Calibration_path", [&] { return LoadStereoCalibration(input.calibration_path); });
     if (spec.kind == SourceKind::kStereo) {
-      // The stereo source's messages name their keys (Images_path_left, Images_path_right,
-      // Calibration_path) themselves.
-      StereoSourceOptions stereo_options;
-      stereo_options.compute_disparity = disparity;  // only D-LDB reads it
-      const StereoCalibration calibration = WithKey(
-          "Calibration_path", [&] { return LoadStereoCalibration(input.calibration_path); });
       plan.sources.push_back(OpenStereoFolders(input.images_path_left, input.images_path_right,
                                                input.images_format, input.initial_image,
                                                input.final_image, calibration, stereo_options));
       continue;
     }
-    plan.sources.push_back(OpenStoredFrames(spec, input));  // folders, videos, bags
+    SourceSpec right = spec;
+    right.topic_key = "Bag_topic_right";
+    right.topic = input.bag_topic_right;
+    plan.sources.push_back(OpenStereoSources(OpenStoredFrames(spec, input),
+                                             OpenStoredFrames(right, input), calibration,
+                                             stereo_options, "Bag_topic", "Bag_topic_right"));
   }
 }
 
