@@ -126,6 +126,7 @@ int RunConfigProgram(
   if (cluster.LaunchRank() > 0) {
     std::cout.setstate(std::ios::badbit);
     std::cerr.setstate(std::ios::badbit);
+    SilenceInterruptMessage();
   }
   CommandLine cl;
   const std::string usage_error = ParseCommandLine(argc, argv, program, cl, value_options);

@@ -19,6 +19,7 @@ std::atomic<int> g_state[kSlots];
 std::atomic<int> g_deferrals{0};
 std::atomic<int> g_pending{0};
 const char* g_program = "OpenABLE";
+std::atomic<bool> g_silent{false};
 static_assert(std::atomic<int>::is_always_lock_free, "the handler needs lock-free atomics");
 
 void Write(const char* s) {
@@ -38,6 +39,7 @@ const char* SignalName(int sig) {
 [[noreturn]] void CleanUpAndExit(int sig) {
   for (int k = 0; k < kSlots; ++k)
     if (g_state[k].load(std::memory_order_acquire) == kFull) ::unlink(g_paths[k]);
+  if (g_silent.load()) ::_exit(128 + sig);
   if (::isatty(2)) Write("\n");  // after a progress line redrawn in place
   Write(g_program);
   Write(": interrupted by ");
@@ -65,6 +67,8 @@ void InstallInterruptCleanup(const char* program) {
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&sa.sa_mask, sig);
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
 }
+
+void SilenceInterruptMessage() { g_silent.store(true); }
 
 int RegisterTemporary(const std::string& path) {
   if (path.size() >= kPathMax) return -1;

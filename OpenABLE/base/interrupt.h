@@ -16,6 +16,13 @@ namespace openable {
 // the message.
 void InstallInterruptCleanup(const char* program);
 
+// From now on an interruption still removes the temporary files and ends the process with
+// 128 + signal, but prints nothing: for the processes other than the first under mpirun, which
+// speak through process 0 (cluster.h). mpirun ends them with SIGTERM when the run stops on
+// Ctrl-C or when process 0 has already reported a failure and exited; one line from process 0
+// (or none) is what the user should see, not one per process.
+void SilenceInterruptMessage();
+
 // Registers a file to remove if the process is interrupted. Returns a slot for
 // UnregisterTemporary, or -1 when every slot is taken (the file is then only removed by the
 // owner or by a later run's stale-file sweep).

@@ -15,6 +15,10 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
@@ -217,6 +221,58 @@ TEST(SpreadFailure, AFrameOfOneShareEndsTheRunInOneLineWithNoOutput) {
       << o.err;
   EXPECT_NE(o.err.find("(process 1 of 2)"), std::string::npos) << o.err;
   EXPECT_FALSE(fs::exists(dir + "/out")) << "an output of the failed run was left";
+}
+
+// Ctrl-C on mpirun while KITTI 00's frames are described (twice, as two traversals): mpirun ends every process with
+// SIGTERM; the user reads one line (process 0's), not one per process, and no output is left.
+// The other processes, silent by design, are also what mpirun ends when process 0 has already
+// reported a failure (the case above), so this guards that one line too.
+TEST(SpreadFailure, CtrlCOnMpirunPrintsOneLineAndLeavesNoOutput) {
+  const std::string missing = MissingMpi();
+  if (!missing.empty()) GTEST_SKIP() << missing;
+  const std::string data = testing::DatasetsDir() + "/kitti00_first1700/image_0";
+  OPENABLE_REQUIRE_PATH(data);
+  const std::string dir = testing::TempDir();
+  // The same frames as a second traversal: the progress line of the first traversal (written
+  // when it is described, stderr not being a terminal) says the second is being described.
+  const std::string config = dir + "/Config.txt";
+  std::ofstream(config) << "%YAML:1.0\nImages_path: \"" << data << "\"\nImages_path_2: \""
+                        << data << "\"\nImage_descriptor: LDB\nThreads: 1\n"
+                        << "Npy_name: \"out/matrix.npy\"\n";
+  const std::string err = dir + "/stderr.log";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    if (::chdir(dir.c_str()) != 0) ::_exit(99);
+    const int fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 2);
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, 1);
+    ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+    ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+    ::setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 1);
+    const std::string exe = testing::TestOpenableExe();
+    ::execlp("mpirun", "mpirun", "--quiet", "-np", "2", exe.c_str(), config.c_str(),
+             static_cast<char*>(nullptr));
+    ::_exit(98);
+  }
+  // Wait until process 0 is describing, then a little more.
+  for (int k = 0; k < 1000 && ReadAll(err).find("describing") == std::string::npos; ++k)
+    ::usleep(10000);
+  ::usleep(300000);
+  int status = 0;
+  if (::waitpid(child, &status, WNOHANG) == child)
+    GTEST_SKIP() << "the run finished before it could be interrupted";
+  ASSERT_EQ(::kill(child, SIGINT), 0);
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  EXPECT_FALSE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  const std::string e = ReadAll(err);
+  const std::string line = "Test_OpenABLE: interrupted by SIGTERM (temporary files removed)\n";
+  size_t count = 0;
+  for (size_t at = e.find(line); at != std::string::npos; at = e.find(line, at + 1)) ++count;
+  EXPECT_EQ(count, 1u) << e;
+  EXPECT_EQ(e.find("(process 1 of 2)"), std::string::npos) << e;
+  EXPECT_FALSE(fs::exists(dir + "/out")) << "an output of the interrupted run was left";
 }
 
 // With Skip_unreadable, the damaged frame of the last share is skipped as in a single
