@@ -736,9 +736,27 @@ std::string FormatConfig(const Config& config) {
   return FormatOptionText(ConfigTable(copy));
 }
 
-std::string ConfigHelpText() {
+std::string ConfigHelpText(const std::string& group) {
   Config defaults;
-  return OptionHelpText(ConfigTable(defaults));
+  const OptionTable table = ConfigTable(defaults);
+  if (group.empty()) return OptionHelpText(table);
+  // A group by its name or its first word, in any case ("description" for "Description and
+  // matching").
+  const std::vector<std::string> groups = OptionGroups(table);
+  std::string names;
+  for (const std::string& g : groups) {
+    const std::string name = Lower(g);
+    if (name == Lower(group) || name.substr(0, name.find(' ')) == Lower(group))
+      return OptionHelpText(table, g);
+    names += (names.empty() ? "" : ", ") + g;
+  }
+  throw InputError("--help-keys: no group " + Quoted(group) + "; expected one of " + names +
+                   " (or none: every key)");
+}
+
+std::vector<std::string> ConfigGroupNames() {
+  Config defaults;
+  return OptionGroups(ConfigTable(defaults));
 }
 
 std::string ConfigMarkdownReference() {

@@ -79,8 +79,13 @@ void CheckEvaluationConfig(const Config& config);
 // Writes `config` in the same format LoadConfig reads (every key, with a comment each).
 std::string FormatConfig(const Config& config);
 
-// The keys for --help: grouped, one entry per key with its meaning, default and range.
-std::string ConfigHelpText();
+// The keys for --help-keys: grouped, one entry per key with its meaning, default and range;
+// only those of `group` when it is not empty (a group's name or its first word, any case).
+// Throws InputError naming the groups for a group that is none of them.
+std::string ConfigHelpText(const std::string& group = "");
+
+// The groups of the keys, in the order of --help-keys ("Datasets", "Representation", ...).
+std::vector<std::string> ConfigGroupNames();
 
 // The same information as a Markdown table, for docs/configuration.md.
 std::string ConfigMarkdownReference();

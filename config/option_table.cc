@@ -171,7 +171,7 @@ const OptionBinding& OptionTable::Lookup(const std::string& key, const std::stri
   const std::string near = Nearest(*this, key);
   throw InputError(where + ": unknown key " + Quoted(key) +
                    (near.empty() ? "" : "; did you mean " + Quoted(near) + "?") +
-                   " (Test_OpenABLE --help lists every key)");
+                   " (Test_OpenABLE --help-keys lists every key)");
 }
 
 void ParseOptionText(const OptionTable& table, const std::string& contents,
@@ -253,11 +253,24 @@ std::string FormatOptionText(const OptionTable& table) {
   return os.str();
 }
 
-std::string OptionHelpText(const OptionTable& table) {
-  std::ostringstream os;
+std::vector<std::string> OptionGroups(const OptionTable& table) {
+  std::vector<std::string> groups;
   ForEachByGroup(
-      table, [&](const std::string& g) { os << "\n" << g << ":\n"; },
+      table, [&](const std::string& g) { groups.push_back(g); }, [](const OptionBinding&) {});
+  return groups;
+}
+
+std::string OptionHelpText(const OptionTable& table, const std::string& group) {
+  std::ostringstream os;
+  bool shown = group.empty();
+  ForEachByGroup(
+      table,
+      [&](const std::string& g) {
+        shown = group.empty() || g == group;
+        if (shown) os << "\n" << g << ":\n";
+      },
       [&](const OptionBinding& b) {
+        if (!shown) return;
         os << "  " << b.key << (b.is_new ? " (new)" : "") << "  [" << b.RangeText()
            << ", default " << b.format() << "]\n";
         // Wrap the meaning at about 90 columns, indented.

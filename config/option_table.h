@@ -170,9 +170,13 @@ void ApplyOptionOverride(const OptionTable& table, const std::string& assignment
 // The whole table in the format ParseOptionText reads, a comment with each key's meaning.
 std::string FormatOptionText(const OptionTable& table);
 
-// Every key for --help: grouped, each with its range, its value in `table` (the defaults when
-// the table is over default options) and its meaning wrapped at about 90 columns.
-std::string OptionHelpText(const OptionTable& table);
+// Every key for --help-keys: grouped, each with its range, its value in `table` (the defaults
+// when the table is over default options) and its meaning wrapped at about 90 columns. Only the
+// keys of `group` (one of OptionGroups, exactly) when it is not empty.
+std::string OptionHelpText(const OptionTable& table, const std::string& group = "");
+
+// The groups of the table's keys, in their order.
+std::vector<std::string> OptionGroups(const OptionTable& table);
 
 // The same as Markdown tables, one per group (docs/configuration.md).
 std::string OptionMarkdown(const OptionTable& table);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "OpenABLE/OpenABLE.h"
+#include "OpenABLE/app/command_line.h"
 #include "OpenABLE/app/evaluate_files.h"
 #include "OpenABLE/cluster/cluster.h"
 #include "OpenABLE/io/json.h"
@@ -39,7 +40,7 @@ const char* kUsage =
     "  --ground-truth-2 FILE   poses of the query traversal [Ground_truth_2]\n"
     "  --gt-base 0|1|-1        pairs are 0- or 1-based; -1 reads the header [Ground_truth_base]\n"
     "  --radius R              poses: same place when closer than R (5) [Ground_truth_radius]\n"
-    "  --heading DEG           poses: and headings closer than DEG (-1 off) "
+    "  --heading DEG           poses: and headings within DEG (-1 off) "
     "[Ground_truth_heading]\n"
     "  --min-gap N             poses, one sequence: frames apart (-1 = Exclusion)\n"
     "                          [Ground_truth_min_gap]\n"
@@ -58,10 +59,10 @@ const char* kUsage =
     "  --images-2 DIR          the frames of the query traversal [Images_path_2]\n"
     "  --video FILE            the frames as one video [Video_path_1; with Frame_mode 1]\n"
     "  --config FILE           take the keys above from a Config.txt first (or give FILE alone)\n"
-    "  --set Key=Value         any evaluation key of Config.txt\n"
+    "  --set Key=Value         any evaluation key of Config.txt (--help-keys Evaluation)\n"
     "  --quiet                 print only errors and the list of files written\n"
     "  --json                  print the evaluation as one JSON object on stdout (for scripts)\n"
-    "  --help, --version\n"
+    "  --help, --help-keys [GROUP], --version\n"
     "\n"
     "Example (KITTI 00, loops within 5 m seen in the same direction):\n"
     "  openable_evaluate --matrix kitti.npy --gt-type kitti --ground-truth poses/00.txt \\\n"
@@ -95,6 +96,8 @@ int main(int argc, char** argv) {
     std::cerr << error << "\n";
     return openable::kExitUsageError;
   }
+  if (command_line.help_keys)
+    return openable::AnswerHelpKeys("openable_evaluate", command_line.help_group);
   if (command_line.help || command_line.version) {
     std::cout << (command_line.help ? Usage()
                                     : "OpenABLE " + std::string(openable::kVersion) + "\n");

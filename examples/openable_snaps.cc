@@ -16,7 +16,7 @@
 
 namespace {
 
-const char* const kUsage =
+const openable::ProgramHelp kHelp = {
     "Usage: openable_snaps [Config.txt] [--set Key=Value ...] [options]\n"
     "\n"
     "The SNAPS add-on: corrects a drifting visual-odometry trajectory (Snaps_trajectory) with\n"
@@ -29,28 +29,35 @@ const char* const kUsage =
     "\n"
     "Options:\n"
     "  --set Key=Value   override one key (repeatable; also without a file)\n"
-    "  --quiet           no progress lines\n"
-    "  --json            print the report as one JSON object on stdout (for scripts)\n"
+    "  --quiet           no progress lines      --json   the report as JSON on stdout\n"
     "  --print-config    print the configuration in effect and exit\n"
-    "  -h, --help        this help (the SNAPS keys are in the group SNAPS below)\n"
-    "\n"
+    "  --help-keys [GROUP] (SNAPS, Odometry: every key of SNAPS), --version, -h/--help\n"
     "Exit status: 0 success, 1 bad configuration or input data, 2 bad command line,\n"
     "3 internal error, 128 + signal when interrupted (temporaries removed).\n"
-    "\n"
+    "\n",
+    {{"Snaps_trajectory", "the drifting trajectory (or Snaps_odometry computes one)"},
+     {"Snaps_trajectory_format", "its format: kitti, kitti-id (keyframes) or tum"},
+     {"Snaps_world_to_camera", "1 when its poses map the world to the camera (SO-DSO)"},
+     {"Snaps_ground_truth", "poses to measure the error against (optional)"},
+     {"Snaps_loops", "loops from: search, openable, pairs or matrix"},
+     {"Snaps_loops_file", "the pairs file or the OpenABLE matrix of the loops"},
+     {"Snaps_corrector", "discounted (Eq. 6), pose-graph or both"},
+     {"Snaps_images", "the frames, for SNAPS's own loop search (search, openable)"},
+     {"Snaps_axes", "ground plane of the plot and the yaw: xz (KITTI) or xy"},
+     {"Snaps_output_name", "prefix P of the outputs"}},
     "Example (KITTI 00, SO-DSO keyframes, ground-truth loop pairs, pose graph):\n"
     "  openable_snaps --set Snaps_trajectory=seq00/poses_history_file.txt \\\n"
     "    --set Snaps_trajectory_format=kitti-id --set Snaps_world_to_camera=1 \\\n"
     "    --set Snaps_ground_truth=poses/00.txt --set Snaps_loops=pairs \\\n"
     "    --set Snaps_loops_file=loop_pairs/groundTruth_KITTI00.pairs.csv \\\n"
-    "    --set Snaps_drop_outside=1 \\\n"
-    "    --set Snaps_output_name=out/kitti00\n"
-    "\n";
+    "    --set Snaps_drop_outside=1 --set Snaps_output_name=out/kitti00\n"
+    "\n"};
 
 }  // namespace
 
 int main(int argc, char** argv) {
   return openable::RunConfigProgram(
-      argc, argv, "openable_snaps", kUsage, "openable_snaps " + std::string(openable::kVersion),
+      argc, argv, "openable_snaps", kHelp, "openable_snaps " + std::string(openable::kVersion),
       [](const openable::Config& config, const openable::CommandLine& cl,
          openable::ProgressReporter& progress) {
         const auto say = [&](const std::string& line) {

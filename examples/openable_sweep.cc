@@ -6,56 +6,52 @@
 
 #include "OpenABLE/OpenABLE.h"
 #include "OpenABLE/app/command_line.h"
+#include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/io/json.h"
 
 namespace {
 
-const char* kUsage =
-    "Usage: openable_sweep Config.txt --vary Key=v1,v2,... [--vary ...] [--set Key=Value ...]\n"
-    "                      [--output PREFIX] [--rank-by FIGURE] [--best N] [options]\n"
-    "\n"
-    "Runs every combination of the values given with --vary, each as Test_OpenABLE would run\n"
-    "the configuration with those values set, evaluates each against the configuration's\n"
-    "ground truth (Ground_truth_type and its keys, docs/evaluation.md), and ranks the runs.\n"
-    "Without ground truth, --rank-by agreement ranks them by criteria of their matrices alone\n"
-    "(how consistent and how distinct the best matches are; with ground truth both are shown,\n"
-    "so you can see whether the criterion agrees with the figures).\n"
-    "Frames are described once per description setting: runs that differ only in sequence\n"
-    "length, score, contrast enhancement, fusion weights or threshold reuse the single-frame\n"
-    "matrices. Writes the ranked table on stdout and PREFIX.csv, PREFIX.json and, with ground\n"
-    "truth, PREFIX_pr.png (the precision-recall curves of the best runs), all or nothing.\n"
-    "\n"
-    "Options:\n"
-    "  --vary Key=v1,v2  a key and its values (repeatable, one per key); values are separated\n"
-    "                    by commas, or by semicolons when a value holds commas\n"
-    "                    (--vary Fusion_weights=1,1;2,1). Image_descriptor values may fuse\n"
-    "                    descriptors with '+' (HOG+LDB). Output, Scale, SNAPS and odometry\n"
-    "                    keys cannot be varied.\n"
-    "  --output PREFIX   where the files go (default: Evaluation_name of the configuration,\n"
-    "                    else \"sweep\" in the current folder)\n"
-    "  --rank-by FIGURE  auc (default), recall_at_100p, recall_at_1, max_f1 or\n"
-    "                    average_precision (ABLE-P), which need ground truth; or agreement,\n"
-    "                    consistency or distinctiveness, which do not (docs/evaluation.md)\n"
-    "  --best N          runs drawn in the precision-recall figure (default 5)\n"
-    "  --set Key=Value   override one key of Config.txt for every run (repeatable)\n"
-    "  --quiet           no progress lines (errors and the table are still printed)\n"
-    "  --json            print the table as one JSON object on stdout (PREFIX.json's content)\n"
-    "  --print-config    print the base configuration in effect and exit\n"
-    "  --help-markdown   print the key reference as Markdown\n"
-    "  --version         print the version\n"
-    "  -h, --help        this help\n"
-    "\n"
-    "Every combination is checked before the first frame is read. Exit status: 0 success,\n"
-    "1 bad configuration, value or input data (nothing written), 2 bad command line,\n"
-    "3 internal error, 128 + signal when interrupted.\n"
-    "\n"
-    "Example (the presets were chosen this way):\n"
-    "  openable_sweep config/presets/across_conditions.txt --set Images_path=A \\\n"
-    "      --set Images_path_2=B --set Ground_truth_type=aligned \\\n"
-    "      --vary Image_descriptor=LDB,HOG,SIFT --vary Image_sequences=1,5,10,30 \\\n"
-    "      --vary Match_score=distance,ratio --output results/sweep\n"
-    "\n"
-    "Configuration keys (Config.txt: one 'Key: value' per line, '#' comments):\n";
+// A function, not a constant: the ground-truth formats come from their registry.
+openable::ProgramHelp Help() {
+  return {
+      "Usage: openable_sweep Config.txt --vary Key=v1,v2,... [--vary ...] [--set Key=Value ...]\n"
+      "                      [--output PREFIX] [--rank-by FIGURE] [--best N] [options]\n"
+      "\n"
+      "Runs every combination of the --vary values as Test_OpenABLE would, evaluates each\n"
+      "against the configuration's ground truth (docs/evaluation.md) and ranks them; without\n"
+      "ground truth, --rank-by agreement ranks them by their matrices alone. Frames are described\n"
+      "once per description setting. Writes the table on stdout and PREFIX.csv, PREFIX.json and,\n"
+      "with ground truth, PREFIX_pr.png (the best runs' curves), all or nothing.\n"
+      "\n"
+      "Options:\n"
+      "  --vary Key=v1,v2  a key and its values (repeatable); ';' separates values holding commas\n"
+      "                    (Fusion_weights=1,1;2,1); '+' fuses descriptors (HOG+LDB). Output,\n"
+      "                    Scale, SNAPS and odometry keys cannot be varied.\n"
+      "  --output PREFIX   where the files go (default: Evaluation_name, else \"sweep\")\n"
+      "  --rank-by FIGURE  auc (default), recall_at_100p, recall_at_1, max_f1, average_precision\n"
+      "                    (need ground truth); agreement, consistency, distinctiveness (do not)\n"
+      "  --best N          runs drawn in the precision-recall figure (default 5)\n"
+      "  --set Key=Value   one key for every run    --quiet, --json, --print-config, --version\n"
+      "  --help-keys [GROUP], --help-markdown, -h/--help\n"
+      "Every combination is checked before the first frame is read. Exit status: 0 success,\n"
+      "1 bad configuration, value or input (nothing written), 2 bad command line, 3 internal\n"
+      "error, 128 + signal when interrupted.\n"
+      "\n",
+      {{"Images_path", "folder of the frames (the reference traversal)"},
+       {"Images_path_2", "folder of a second traversal, matched against the first"},
+       {"Ground_truth_type", "none (empty), " + openable::GroundTruthFormatList(", ")},
+       {"Ground_truth", "the ground-truth file"},
+       {"Tolerance", "frames of tolerance of a correct match"},
+       {"Exclusion", "one sequence: loops are at least this many frames back"},
+       {"Evaluation_name", "the files' prefix when --output is not given"},
+       {"Threads", "worker threads; 0: every core"}},
+      "Example (the presets were chosen this way):\n"
+      "  openable_sweep config/presets/across_conditions.txt --set Images_path=A \\\n"
+      "      --set Images_path_2=B --set Ground_truth_type=aligned \\\n"
+      "      --vary Image_descriptor=LDB,HOG,SIFT --vary Image_sequences=1,5,10,30 \\\n"
+      "      --vary Match_score=distance,ratio --output results/sweep\n"
+      "\n"};
+}
 
 int ParseCount(const std::string& option, const std::string& text) {
   std::size_t used = 0;
@@ -76,7 +72,7 @@ int ParseCount(const std::string& option, const std::string& text) {
 int main(int argc, char** argv) {
   openable::KeepFrameBuffersOnTheHeap();
   return openable::RunConfigProgram(
-      argc, argv, "openable_sweep", kUsage, "OpenABLE " + std::string(openable::kVersion),
+      argc, argv, "openable_sweep", Help(), "OpenABLE " + std::string(openable::kVersion),
       [](const openable::Config& config, const openable::CommandLine& command_line,
          openable::ProgressReporter& progress) {
         openable::SweepOptions options;

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
-
 #include <opencv2/core/utils/logger.hpp>
+#include <sstream>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/interrupt.h"
@@ -53,6 +53,13 @@ std::string ParseCommandLine(int argc, const char* const* argv, const std::strin
     } else if (a == "-h" || a == "--help") {
       out.help = true;
       return "";
+    } else if (a == "--help-keys" || a.rfind("--help-keys=", 0) == 0) {
+      out.help_keys = true;
+      if (a.size() > 11)
+        out.help_group = a.substr(12);
+      else if (i + 1 < argc && argv[i + 1][0] != '-')
+        out.help_group = argv[i + 1];
+      return "";
     } else if (a == "--help-markdown") {
       out.help_markdown = true;
       return "";
@@ -85,12 +92,66 @@ std::string ParseCommandLine(int argc, const char* const* argv, const std::strin
   return "";
 }
 
+std::string FormatProgramHelp(const std::string& program, const ProgramHelp& help) {
+  std::string text = help.usage;
+  if (!help.keys.empty()) {
+    text +=
+        "Keys people change most (in Config.txt as 'Key: value', or --set Key=Value;\n"
+        "default in brackets):\n";
+    size_t width = 0;
+    for (const auto& k : help.keys) width = std::max(width, k.first.size());
+    Config defaults;
+    for (const auto& [key, meaning] : help.keys) {
+      const std::string value = ConfigValueText(defaults, key);
+      text +=
+          "  " + key + std::string(width + 2 - key.size(), ' ') + meaning + " [" + value + "]\n";
+    }
+    text += "\n";
+  }
+  text += help.example;
+  // The groups by their first words, which --help-keys takes ("Description").
+  std::string groups;
+  for (const std::string& g : ConfigGroupNames())
+    groups += (groups.empty() ? "" : ", ") + g.substr(0, g.find(' '));
+  text += "Every key, with its meaning and range: " + program + " --help-keys [GROUP], GROUP" +
+          " one of " + groups + " (docs/configuration.md: the same reference).\n";
+  // Lines wrapped at 92 columns (the list of groups is longer than one).
+  std::string wrapped, line;
+  std::istringstream lines(text);
+  while (std::getline(lines, line)) {
+    while (line.size() > 92) {
+      const size_t cut = line.rfind(' ', 92);
+      if (cut == std::string::npos || cut == 0) break;
+      wrapped += line.substr(0, cut) + "\n";
+      line = "  " + line.substr(cut + 1);
+    }
+    wrapped += line + "\n";
+  }
+  return wrapped;
+}
+
+int AnswerHelpKeys(const std::string& program, const std::string& group) {
+  std::string keys;
+  try {
+    keys = ConfigHelpText(group);
+  } catch (const InputError& e) {
+    std::cerr << program << ": " << e.what() << "\n";
+    return 2;
+  }
+  std::cout << "Configuration keys (Config.txt: one 'Key: value' per line, '#' comments;\n"
+               "or --set Key=Value):\n"
+            << keys;
+  return 0;
+}
+
 int AnswerWithoutRunning(const CommandLine& command_line, const std::string& usage_error,
-                         const std::string& usage, const std::string& version_line) {
+                         const std::string& program, const ProgramHelp& help,
+                         const std::string& version_line) {
   if (command_line.help) {
-    std::cout << usage << ConfigHelpText();
+    std::cout << FormatProgramHelp(program, help);
     return 0;
   }
+  if (command_line.help_keys) return AnswerHelpKeys(program, command_line.help_group);
   if (command_line.help_markdown) {
     std::cout << ConfigMarkdownReference();
     return 0;
@@ -114,7 +175,7 @@ Config ConfigOf(const CommandLine& command_line) {
 }
 
 int RunConfigProgram(
-    int argc, const char* const* argv, const char* program, const std::string& usage,
+    int argc, const char* const* argv, const char* program, const ProgramHelp& help,
     const std::string& version_line,
     const std::function<int(const Config&, const CommandLine&, ProgressReporter&)>& body,
     const std::vector<std::string>& value_options, bool spreads_over_processes) {
@@ -130,7 +191,7 @@ int RunConfigProgram(
   }
   CommandLine cl;
   const std::string usage_error = ParseCommandLine(argc, argv, program, cl, value_options);
-  const int answered = AnswerWithoutRunning(cl, usage_error, usage, version_line);
+  const int answered = AnswerWithoutRunning(cl, usage_error, program, help, version_line);
   if (answered >= 0) return answered;
   const int status = RunProgram(program, [&]() -> int {
     const Config config = ConfigOf(cl);

@@ -110,8 +110,10 @@ std::string ParseEvaluateCommandLine(int argc, const char* const* argv, Evaluate
   if (!error.empty()) return error;
   out = EvaluateCommandLine();
   out.help = line.help || line.help_markdown;
+  out.help_keys = line.help_keys;
+  out.help_group = line.help_group;
   out.version = line.version;
-  if (out.help || out.version) return "";
+  if (out.help || out.help_keys || out.version) return "";
   if (line.print_config)
     return "openable_evaluate: --print-config is for the programs that run a configuration; "
            "expected --config FILE or the flags below (see --help)";

@@ -6,7 +6,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
+#include <string>
 
 #include <fcntl.h>
 #include <signal.h>
@@ -218,12 +221,74 @@ TEST(TestOpenABLE, BoundedModeNeedsAMatchesFile) {
       << o.err;
 }
 
-TEST(TestOpenABLE, HelpListsEveryKey) {
+// --help fits a screen for every program: at most 55 lines of at most 92 columns, with the
+// usage, an example and where the rest is; Test_OpenABLE's names keys people change most,
+// each a real key (so its default is shown).
+TEST(TestOpenABLE, EveryProgramsHelpFitsAScreen) {
   const std::string dir = testing::TempDir();
+  for (const std::string& exe :
+       {testing::TestOpenableExe(), testing::OpenableSweepExe(), testing::OpenableSnapsExe(),
+        testing::OpenableEvaluateExe()}) {
+    const Outcome o = RunProgram(exe, {"--help"}, dir);
+    ASSERT_EQ(o.status, 0) << exe << "\n" << o.err;
+    EXPECT_EQ(o.err, "") << exe;
+    std::istringstream lines(o.out);
+    std::string line;
+    int count = 0;
+    while (std::getline(lines, line)) {
+      ++count;
+      EXPECT_LE(line.size(), 92u) << exe << ": " << line;
+    }
+    EXPECT_LE(count, 55) << exe << "\n" << o.out;
+    EXPECT_EQ(o.out.rfind("Usage: ", 0), 0u) << exe;
+    EXPECT_NE(o.out.find("Example"), std::string::npos) << exe;
+    EXPECT_NE(o.out.find("--help-keys"), std::string::npos) << exe;
+  }
   const Outcome o = RunProgram(testing::TestOpenableExe(), {"--help"}, dir);
-  ASSERT_EQ(o.status, 0);
-  for (const auto& key : ConfigKeyNames()) EXPECT_NE(o.out.find(key), std::string::npos) << key;
-  EXPECT_NE(o.out.find("--set Key=Value"), std::string::npos);
+  for (const char* key : {"Images_path_2", "Image_descriptor", "Image_sequences", "Npy_name",
+                          "Ground_truth_type", "Report_name"})
+    EXPECT_NE(o.out.find(std::string("\n  ") + key + " "), std::string::npos) << key;
+  EXPECT_NE(o.out.find("Image_sequences    "), std::string::npos);
+}
+
+// --help-keys lists every key; --help-keys GROUP the keys of that group exactly, as the
+// Markdown reference (docs/configuration.md) groups them; an unknown group is a usage error.
+TEST(TestOpenABLE, HelpKeysListsEveryKeyOrOneGroup) {
+  const std::string dir = testing::TempDir();
+  const Outcome all = RunProgram(testing::TestOpenableExe(), {"--help-keys"}, dir);
+  ASSERT_EQ(all.status, 0) << all.err;
+  for (const auto& key : ConfigKeyNames())
+    EXPECT_NE(all.out.find("\n  " + key + " "), std::string::npos) << key;
+  // The keys of each group of the Markdown reference: "### Group" then "| `Key` ...".
+  const Outcome md = RunProgram(testing::TestOpenableExe(), {"--help-markdown"}, dir);
+  std::map<std::string, std::set<std::string>> groups;
+  std::string group, line;
+  std::istringstream lines(md.out);
+  while (std::getline(lines, line)) {
+    if (line.rfind("### ", 0) == 0) group = line.substr(4);
+    if (line.rfind("| `", 0) == 0) groups[group].insert(line.substr(3, line.find('`', 3) - 3));
+  }
+  ASSERT_GE(groups.size(), 8u);
+  for (const auto& [name, keys] : groups) {
+    const std::string first_word = name.substr(0, name.find(' '));
+    const Outcome o = RunProgram(testing::TestOpenableExe(), {"--help-keys", first_word}, dir);
+    ASSERT_EQ(o.status, 0) << name << ": " << o.err;
+    std::set<std::string> listed;
+    std::istringstream out(o.out);
+    while (std::getline(out, line))
+      if (line.size() > 2 && line[0] == ' ' && line[1] == ' ' && line[2] != ' ')
+        listed.insert(line.substr(2, line.find(' ', 2) - 2));
+    EXPECT_EQ(listed, keys) << name;
+  }
+  const Outcome bad = RunProgram(testing::OpenableSweepExe(), {"--help-keys=Colours"}, dir);
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_EQ(bad.out, "");
+  EXPECT_TRUE(OneLine(bad.err)) << bad.err;
+  EXPECT_EQ(bad.err.rfind("openable_sweep: --help-keys: no group \"Colours\"; expected one of "
+                          "Datasets, ",
+                          0),
+            0u)
+      << bad.err;
 }
 
 TEST(TestOpenABLE, VideoModeReadsFrames) {
