@@ -642,7 +642,9 @@ Config ParseConfigText(const std::string& text, const std::string& name) {
   return config;
 }
 
-Config LoadConfig(const std::string& path) {
+Config LoadConfig(const std::string& path) { return LoadConfig(path, Config()); }
+
+Config LoadConfig(const std::string& path, Config base) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     std::error_code ec;
@@ -654,7 +656,8 @@ Config LoadConfig(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw InputError("configuration file " + Quoted(path) + " could not be read");
-  return ParseConfigText(text.str(), path);
+  ParseOptionText(ConfigTable(base), text.str(), path);
+  return base;
 }
 
 void ApplyOverride(Config& config, const std::string& assignment, const std::string& where) {

@@ -52,6 +52,8 @@ OptionTable ConfigTable(Config& config);
 // "Key: value", an unknown key (naming the nearest valid one), a duplicated key, or a value
 // of the wrong type or out of range.
 Config LoadConfig(const std::string& path);
+// The same over `base`: the keys the file gives replace those of `base`, the others are kept.
+Config LoadConfig(const std::string& path, Config base);
 
 // The parser of LoadConfig on the text of a configuration already in memory; `name` stands
 // for the file in messages ("<name>:<line>: ..."). Same checks, same InputError messages.

@@ -1,7 +1,11 @@
 #include "OpenABLE/app/evaluate_files.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <iterator>
+#include <map>
+#include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -10,7 +14,9 @@
 #include "OpenABLE/app/command_line.h"
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/report.h"
+#include "OpenABLE/outputs/matrix_settings.h"
 #include "OpenABLE/reports/evaluation_files.h"
 #include "OpenABLE/reports/html_report.h"
 #include "OpenABLE/run/pipeline.h"
@@ -151,9 +157,63 @@ std::string ParseEvaluateCommandLine(int argc, const char* const* argv, Evaluate
   return "";
 }
 
+namespace {
+
+using Remembered = std::map<std::string, std::pair<std::string, std::string>>;
+
+// The settings file a remembered key came from.
+const std::string& SettingsFileOf(const Remembered& remembered, const std::string& key) {
+  return remembered.at(key).second;
+}
+
+// Two paths of the same existing file.
+bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  return std::filesystem::equivalent(a, b, ec) && !ec;
+}
+
+}  // namespace
+
 EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line) {
-  Config config =
-      command_line.config_path.empty() ? Config() : LoadConfig(command_line.config_path);
+  // The settings the matrices remember (matrix_settings.h) come first, then the configuration
+  // file's keys and the command line's, which override them (and are said to).
+  Remembered remembered;  // key: its value, the settings file it came from
+  std::set<std::string> given;  // keys the command line sets
+  for (const auto& o : command_line.overrides) given.insert(Trim(o.substr(0, o.find('='))));
+  int reference_frames = command_line.reference_frames;
+  std::string reference_file;
+  for (const MatrixFile& m : command_line.matrices) {
+    const std::optional<SavedMatrixSettings> saved = ReadMatrixSettings(m.path);
+    if (!saved) continue;
+    if (saved->thresholded)
+      throw InputError("--matrix " + Quoted(m.path) +
+                       ": holds the thresholded matrix M'' of Eq. 9, not distances (" +
+                       saved->path + "); expected a distance matrix (Npy_name, or Txt_name "
+                       "without Threshold)");
+    for (const auto& [key, value] : saved->keys) {
+      const auto known = remembered.find(key);
+      if (known != remembered.end() && known->second.first != value && !given.count(key))
+        throw InputError("--matrix " + Quoted(m.path) + ": its run had " + key + " " +
+                         Quoted(value) + " (" + saved->path + "), the run of " +
+                         known->second.second + " had " + Quoted(known->second.first) +
+                         "; expected one value: give --set " + key + "=VALUE for all");
+      remembered.emplace(key, std::make_pair(value, saved->path));
+    }
+    if (command_line.reference_frames == 0 && saved->reference_frames > 0) {
+      if (reference_frames > 0 && reference_frames != saved->reference_frames)
+        throw InputError("--matrix " + Quoted(m.path) + ": its run had " +
+                         std::to_string(saved->reference_frames) + " reference frames (" +
+                         saved->path + "), the run of " + reference_file + " had " +
+                         std::to_string(reference_frames) +
+                         "; expected one value: give --reference-frames N");
+      reference_frames = saved->reference_frames;
+      reference_file = saved->path;
+    }
+  }
+  Config config;
+  for (const auto& [key, value_file] : remembered)
+    ApplyOverride(config, key + "=" + value_file.first, value_file.second);
+  if (!command_line.config_path.empty()) config = LoadConfig(command_line.config_path, config);
   for (const auto& o : command_line.overrides) ApplyOverride(config, o);
   if (!EvaluationRequested(config))
     throw InputError("Ground_truth_type: not set; expected --gt-type " +
@@ -163,8 +223,29 @@ EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line) {
   EvaluatedFiles out;
   out.config = config;
   out.evaluation.settings = EvaluationSettingsFrom(config);
-  out.matrices =
-      EvaluateMatrixFiles(out.evaluation, command_line.matrices, command_line.reference_frames);
+  // Say where the settings came from, and which of them this evaluation changed.
+  std::string applied;
+  const Config defaults;
+  for (const auto& [key, value_file] : remembered) {
+    const std::string& value = value_file.first;
+    const std::string now = ConfigValueText(config, key);
+    const std::string plain =
+        now.size() >= 2 && now.front() == '"' ? now.substr(1, now.size() - 2) : now;
+    const bool same = plain == value || (key.rfind("Ground_truth", 0) == 0 && !plain.empty() &&
+                                         SameFile(plain, value));
+    if (!same && !(value.empty() && key.rfind("Ground_truth", 0) == 0))
+      out.notes.push_back(key + " " + Quoted(plain) + " as given here, not " + Quoted(value) +
+                          " as the matrix's run had it (" + SettingsFileOf(remembered, key) +
+                          "): the figures may differ from the run's");
+    else if (ConfigValueText(defaults, key) != now)
+      applied += (applied.empty() ? "" : ", ") + key + " " + plain;
+  }
+  if (!remembered.empty())
+    out.notes.insert(out.notes.begin(),
+                     "evaluated with the settings the matrix's run had (" +
+                         remembered.begin()->second.second + ")" +
+                         (applied.empty() ? "" : ": " + applied));
+  out.matrices = EvaluateMatrixFiles(out.evaluation, command_line.matrices, reference_frames);
   return out;
 }
 

@@ -30,11 +30,17 @@ struct EvaluateCommandLine {
 std::string ParseEvaluateCommandLine(int argc, const char* const* argv, EvaluateCommandLine& out);
 
 // The configuration of the command line, checked, and each matrix evaluated
-// (EvaluateMatrixFiles). Throws InputError naming the key or file.
+// (EvaluateMatrixFiles). A matrix with a settings file (m.npy.json, matrix_settings.h) is
+// evaluated with its run's evaluation settings and reference frames, under those of
+// --config and the command line; matrices whose files disagree on a setting the command line
+// does not give are refused. Throws InputError naming the key or file.
 struct EvaluatedFiles {
   Config config;
   Evaluation evaluation;
   std::vector<cv::Mat1f> matrices;  // normalised, in the order of the command line
+  // Where the settings came from when a matrix has a settings file (matrix_settings.h), and
+  // each of its settings this evaluation changed: one line each, for stderr.
+  std::vector<std::string> notes;
 };
 EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line);
 

@@ -11,6 +11,7 @@
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/io/npy.h"
 #include "OpenABLE/outputs/matrix_files.h"
+#include "OpenABLE/outputs/matrix_settings.h"
 #include "OpenABLE/reports/evaluation_files.h"
 #include "OpenABLE/reports/figures.h"
 #include "OpenABLE/reports/html_report.h"
@@ -96,6 +97,33 @@ const std::vector<RunOutput>& RunOutputs() {
            TextChunks text(in.result.thresholded.empty() ? cv::Mat(in.shown)
                                                          : cv::Mat(in.result.thresholded));
            batch.Stage("Txt_name", path, [&](std::string_view& piece) { return text.Next(piece); });
+         };
+       }},
+      // Beside each matrix file, the settings that shaped it and those of its evaluation
+      // (matrix_settings.h), so that openable_evaluate and Python evaluate it as the run did.
+      {true,
+       [](const Config& c) {
+         Planned p = One("Npy_name (settings)", c.output.npy_name.empty()
+                                                    ? ""
+                                                    : MatrixSettingsPath(c.output.npy_name));
+         const Planned t = One("Txt_name (settings)", c.output.txt_name.empty()
+                                                          ? ""
+                                                          : MatrixSettingsPath(c.output.txt_name));
+         p.insert(p.end(), t.begin(), t.end());
+         return p;
+       },
+       [](const OutputInput& in) -> Stager {
+         const OutputOptions& o = in.config.output;
+         if (o.npy_name.empty() && o.txt_name.empty()) return {};
+         return [&in](OutputBatch& batch) {
+           const OutputOptions& o = in.config.output;
+           if (!o.npy_name.empty())
+             batch.Stage("Npy_name", MatrixSettingsPath(o.npy_name),
+                         EncodeMatrixSettings(in.config, in.result, o.npy_name, false));
+           if (!o.txt_name.empty())
+             batch.Stage("Txt_name", MatrixSettingsPath(o.txt_name),
+                         EncodeMatrixSettings(in.config, in.result, o.txt_name,
+                                              !in.result.thresholded.empty()));
          };
        }},
       {true, [](const Config& c) { return One("Png_name", c.output.png_name); },

@@ -97,6 +97,96 @@ TEST(Evaluation, OpenableEvaluateComparesRunsInOneFigureAndAgreesWithTheRun) {
   EXPECT_NE(cmp.find("\"label\": \"HOG\""), std::string::npos);
 }
 
+// A saved matrix remembers its run's settings (out/matrix.npy.json): openable_evaluate given
+// the matrix alone (no ground-truth type, no reference frames, no score) gives the run's own
+// figures; a setting given on the command line overrides the remembered one, a note says so,
+// and the figures are then those of a run made with that setting.
+TEST(Evaluation, SavedMatrixIsEvaluatedWithItsRunsSettingsUnlessOverridden) {
+  const std::string dir = testing::TempDir();
+  const std::string config = SampleConfig(
+      dir, "Ground_truth_type: aligned\nEvaluation_name: out/run\nMatch_score: ratio\n"
+           "Match_threshold: 0.9\nMatch_consistency: 1\nTolerance: 3\n");
+  ASSERT_EQ(RunProgram(testing::TestOpenableExe(), {config, "--quiet"}, dir).status, 0);
+  ASSERT_TRUE(fs::exists(dir + "/out/matrix.npy.json"));
+  const Outcome o = RunProgram(testing::OpenableEvaluateExe(),
+                               {"--matrix", "out/matrix.npy", "--output", "out/later"}, dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_NE(o.err.find("openable_evaluate: note: evaluated with the settings the matrix's run "
+                       "had (out/matrix.npy.json): "),
+            std::string::npos)
+      << o.err;
+  const std::string run = ReadAll(dir + "/out/run.json"), later = ReadAll(dir + "/out/later.json");
+  for (const char* key : {"auc", "recall_at_100p", "max_f1", "recall_at_1", "recall_at_10",
+                          "accepted", "tolerance", "average_precision_percent"})
+    EXPECT_EQ(JsonNumber(run, key), JsonNumber(later, key)) << key;
+  EXPECT_NE(later.find("\"match_score\": \"ratio\""), std::string::npos) << later;
+
+  // Overridden: the figures of a run made with the distance score, and a note.
+  ASSERT_EQ(RunProgram(testing::TestOpenableExe(),
+                       {config, "--quiet", "--set", "Match_score=distance", "--set",
+                        "Match_threshold=-1", "--set", "Match_consistency=0", "--set",
+                        "Npy_name=out/distance.npy", "--set", "Evaluation_name=out/distance"},
+                       dir)
+                .status,
+            0);
+  const Outcome d = RunProgram(
+      testing::OpenableEvaluateExe(),
+      {"--matrix", "out/matrix.npy", "--set", "Match_score=distance", "--set",
+       "Match_threshold=-1", "--set", "Match_consistency=0", "--output", "out/overridden"},
+      dir);
+  ASSERT_EQ(d.status, 0) << d.err;
+  EXPECT_NE(d.err.find("openable_evaluate: note: Match_score \"distance\" as given here, not "
+                       "\"ratio\" as the matrix's run had it (out/matrix.npy.json)"),
+            std::string::npos)
+      << d.err;
+  const std::string distance = ReadAll(dir + "/out/distance.json");
+  const std::string overridden = ReadAll(dir + "/out/overridden.json");
+  for (const char* key : {"auc", "recall_at_100p", "max_f1", "recall_at_1"})
+    EXPECT_EQ(JsonNumber(distance, key), JsonNumber(overridden, key)) << key;
+  EXPECT_NE(JsonNumber(distance, "auc"), JsonNumber(run, "auc"));
+}
+
+// Settings files that cannot be used: matrices whose runs disagree on a setting the command
+// line does not give, the thresholded matrix M'', a file that is not such a file. One line,
+// status 1, nothing written.
+TEST(Evaluation, SavedMatrixSettingsThatCannotBeUsedAreRefused) {
+  const std::string dir = testing::TempDir();
+  const std::string config = SampleConfig(
+      dir, "Ground_truth_type: aligned\nTxt_name: \"out/thresholded.txt\"\nThreshold: 0.2\n");
+  ASSERT_EQ(RunProgram(testing::TestOpenableExe(), {config, "--quiet"}, dir).status, 0);
+  ASSERT_EQ(RunProgram(testing::TestOpenableExe(),
+                       {config, "--quiet", "--set", "Tolerance=5", "--set",
+                        "Npy_name=out/other.npy", "--set", "Txt_name="},
+                       dir)
+                .status,
+            0);
+  const auto refused = [&](const std::vector<std::string>& args, const std::string& expect) {
+    std::vector<std::string> all = args;
+    all.insert(all.end(), {"--output", "out/none"});
+    const Outcome o = RunProgram(testing::OpenableEvaluateExe(), all, dir);
+    EXPECT_EQ(o.status, 1) << o.err;
+    EXPECT_TRUE(OneLine(o.err)) << o.err;
+    EXPECT_NE(o.err.find(expect), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(dir + "/out/none.json"));
+  };
+  refused({"--matrix", "out/matrix.npy", "--matrix", "out/other.npy"},
+          "openable_evaluate: error: --matrix \"out/other.npy\": its run had Tolerance \"5\" "
+          "(out/other.npy.json), the run of out/matrix.npy.json had \"2\"; expected one value: "
+          "give --set Tolerance=VALUE for all");
+  refused({"--matrix", "out/thresholded.txt"},
+          "--matrix \"out/thresholded.txt\": holds the thresholded matrix M'' of Eq. 9");
+  std::ofstream(dir + "/out/matrix.npy.json") << "[1, 2]";
+  refused({"--matrix", "out/matrix.npy"},
+          "settings of the matrix \"out/matrix.npy.json\": no \"evaluation_keys\" object");
+  // Given on the command line, the disagreeing setting is one value for both: evaluated.
+  fs::remove(dir + "/out/matrix.npy.json");
+  const Outcome o = RunProgram(testing::OpenableEvaluateExe(),
+                               {"--matrix", "out/matrix.npy", "--matrix", "out/other.npy",
+                                "--tolerance", "4", "--reference-frames", "300"},
+                               dir);
+  EXPECT_EQ(o.status, 0) << o.err;
+}
+
 // Bad evaluation inputs: status 1, one line naming the file or key, nothing written.
 struct BadTruth {
   const char* name;

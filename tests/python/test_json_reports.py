@@ -87,6 +87,38 @@ class RunJsonTest(TempDirTestCase):
         self.assertEqual(swept["sweep"], read_json(self.tmp / "out" / "sweep.json"))
 
 
+class SavedMatrixSettingsTest(TempDirTestCase):
+    """A matrix's settings file (m.npy.json) gives Python's openable.evaluate the keywords that
+    reproduce the run's figures: here the across-conditions preset, which scores by ratio and
+    accepts with a consistency partner, against the bundled sample's alignment."""
+
+    def test_python_evaluates_a_saved_matrix_as_the_run_did(self):
+        import openable
+
+        preset = SOURCE_DIR / "config" / "presets" / "across_conditions.txt"
+        done = run("Test_OpenABLE",
+                   [preset, "--quiet", "--json", "--set", "Images_path=%s" % (SAMPLE / "summer"),
+                    "--set", "Images_path_2=%s" % (SAMPLE / "winter"),
+                    "--set", "Ground_truth_type=aligned", "--set", "Png_name=",
+                    "--set", "Npy_name=out/m.npy"], self.tmp)
+        report = json.loads(done.stdout)["evaluation"]["runs"][0]["per_query"]
+        m = self.tmp / "out" / "m.npy"
+        settings = openable.read_matrix_settings(m)
+        self.assertEqual(settings["match_score"], "ratio")
+        self.assertEqual(settings["reference_frames"], 300)
+        result = openable.evaluate(openable.read_matrix(str(m)), **settings["python_evaluate"])
+        self.assertAlmostEqual(result.auc, report["auc"], places=8)
+        self.assertAlmostEqual(result.recall_at_1, report["recall_at_1"], places=8)
+        self.assertAlmostEqual(result.max_f1, report["max_f1"], places=8)
+        # Without the settings (the distance score, one sequence): other figures.
+        plain = openable.evaluate(openable.read_matrix(str(m)), aligned=True, reference_frames=300)
+        self.assertNotAlmostEqual(plain.auc, report["auc"], places=3)
+        self.assertIsNone(openable.read_matrix_settings(self.tmp / "out" / "absent.npy"))
+        (self.tmp / "out" / "bad.npy.json").write_text("[1]")
+        with self.assertRaises(openable.InputError):
+            openable.read_matrix_settings(self.tmp / "out" / "bad.npy")
+
+
 class SnapsJsonTest(TempDirTestCase):
     def test_snaps(self):
         require(KITTI_TRAJECTORIES)
