@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/option_checks.h"
@@ -83,7 +84,22 @@ std::string OutputOptions::ThresholdPngPath(bool thresholded) const {
       .string();
 }
 
-void OutputOptions::Check() const { CheckIntRange("Matrix_color", matrix_color, 0, 11); }
+void OutputOptions::Check() const {
+  CheckIntRange("Matrix_color", matrix_color, 0, 11);
+  // The matrix images are written as PNG (lossless: a JPEG would blur the distances), so a
+  // path that names another format would hold PNG bytes under the wrong name.
+  for (const auto& [key, path] : {std::pair<const char*, const std::string&>{"Png_name", png_name},
+                                  {"Png_threshold_name", png_threshold_name}}) {
+    if (path.empty()) continue;
+    const auto dot = path.find_last_of("./");
+    const std::string ext =
+        dot == std::string::npos || path[dot] != '.' ? "" : Lower(path.substr(dot));
+    if (ext != ".png")
+      throw InputError(std::string(key) + ": " + Quoted(path) +
+                       " does not end in .png; expected a .png path (the matrix image is "
+                       "written as PNG, lossless)");
+  }
+}
 
 void ScaleOptions::Check() const {
   CheckNumberAtLeast("Memory_limit", memory_limit, 0);

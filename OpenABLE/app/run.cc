@@ -37,6 +37,11 @@ RunOutcome Run(const Config& base, ProgressReporter& progress,
       (void)EvaluationSettingsFrom(base);
     }
     if (!base.automatic.enabled || cluster.Distributed()) plan.emplace(PlanRun(base));
+    // An aligned ground truth of traversals of unequal length is refused before any frame
+    // is read (the sources know their lengths).
+    if (plan && plan->sources.size() == 2 &&
+        base.evaluation.truth.type == GroundTruthType::kAligned)
+      CheckAlignedLengths(plan->sources[1]->Size(), plan->sources[0]->Size());
   };
   if (cluster.Distributed())
     cluster.Agree(check);

@@ -118,6 +118,60 @@ Json PairCountsJson(const Config& c, const PairCounts& n) {
 
 }  // namespace
 
+namespace {
+
+// The change from `before` to `after` in percent, signed and rounded to 0.1: "+8.1 %".
+std::string SignedPercent(double after, double before) {
+  const double change = 100.0 * (after - before) / before;
+  return (change >= 0 ? "+" : "") + FormatFixed(change, 1) + " %";
+}
+
+// What the error table means, in words, when it can mislead: a correction that raises the
+// unaligned error while lowering the aligned one, and an input that cannot be the ground
+// truth's route (its aligned error a large part of the route's extent): wrong conventions
+// rather than drift.
+std::vector<std::string> ErrorReading(const ChainResult& r) {
+  std::vector<std::string> lines;
+  const ChainErrors& input = r.errors.front();
+  for (size_t i = 1; i < r.errors.size(); ++i) {
+    const ChainErrors& e = r.errors[i];
+    if (e.raw.mean > input.raw.mean && e.aligned.mean < input.aligned.mean) {
+      lines.push_back("Read: " + e.name +
+                      " makes the route's shape closer to the ground truth (aligned "
+                      "error " +
+                      FormatFixed(input.aligned.mean, 2) + " -> " + FormatFixed(e.aligned.mean, 2) +
+                      " m) but moves it as a whole (unaligned " + FormatFixed(input.raw.mean, 2) +
+                      " -> " + FormatFixed(e.raw.mean, 2) +
+                      " m): loops fix the shape, not where the start and its "
+                      "heading sit; the aligned columns measure the shape.");
+      break;
+    }
+  }
+  // The route's extent: the diagonal of the ground truth's bounding box. An input this far
+  // from it is not a drifting estimate of it, and the reading above would mislead: only the
+  // hint is given.
+  if (!r.truth.poses.empty()) {
+    Eigen::Vector3d lo = r.truth.poses.front().translation(), hi = lo;
+    for (const Eigen::Isometry3d& p : r.truth.poses) {
+      lo = lo.cwiseMin(p.translation());
+      hi = hi.cwiseMax(p.translation());
+    }
+    const double extent = (hi - lo).norm();
+    if (extent > 0 && input.aligned.mean > 0.25 * extent)
+      lines = {
+          "Hint: the input is " + FormatFixed(input.aligned.mean, 1) +
+          " m from the ground truth on average even after alignment, on a route " +
+          FormatFixed(extent, 1) +
+          " m across: more than drift. Check Snaps_world_to_camera (1 "
+          "when the file holds world-to-camera matrices, as SO-DSO's poses_history_file.txt), "
+          "Snaps_trajectory_format and Snaps_ground_truth_format, and that both cover the same "
+          "frames."};
+  }
+  return lines;
+}
+
+}  // namespace
+
 std::string FormatChainReport(const Config& c, const ChainResult& r) {
   const SnapsOptions& s = c.snaps;
   const std::string source = EnumName(s.loops);
@@ -156,10 +210,26 @@ std::string FormatChainReport(const Config& c, const ChainResult& r) {
                     e.name.c_str(), e.raw.mean, e.raw.rmse, e.raw.max, e.aligned.mean,
                     e.aligned.rmse);
       out << line;
-      if (i > 0 && input_mean > 0)
-        out << "   (mean deviation " << std::showpos
-            << Number(100.0 * (e.raw.mean - input_mean) / input_mean) << std::noshowpos << " %)";
+      if (i > 0 && input_mean > 0) {
+        const double aligned_input = r.errors.front().aligned.mean;
+        out << "   (mean dev. " << SignedPercent(e.raw.mean, input_mean);
+        if (aligned_input > 0) out << ", aligned " << SignedPercent(e.aligned.mean, aligned_input);
+        out << ")";
+      }
       out << "\n";
+    }
+    // Each reading wrapped at 92 columns.
+    for (const std::string& reading : ErrorReading(r)) {
+      std::istringstream words(reading);
+      std::string word, line = " ";
+      while (words >> word) {
+        if (line.size() + word.size() + 1 > 92) {
+          out << line << "\n";
+          line = "   ";
+        }
+        line += " " + word;
+      }
+      out << line << "\n";
     }
   }
   if (s.loops == LoopSource::kSearch) {
@@ -170,8 +240,8 @@ std::string FormatChainReport(const Config& c, const ChainResult& r) {
         << "  correction (Eq. 6) " << StatsLine(l.correction) << "\n"
         << "  thumbnail (read)   " << StatsLine(l.thumbnail) << "\n";
   } else if (r.discounted_ran && !r.closed.empty()) {
-    out << "  discounted update: " << Number(r.discounted_seconds) << " s for " << r.closed.size()
-        << " loops\n";
+    out << "  discounted update: " << FormatFixed(1e3 * r.discounted_seconds, 2) << " ms for "
+        << r.closed.size() << " loops\n";
   }
   return out.str();
 }

@@ -356,13 +356,32 @@ std::vector<FramePose> ReadPositions(const std::string& path, const char* label)
   return poses;
 }
 
+}  // namespace
+
+void CheckAlignedLengths(int queries, int references) {
+  // Frame i of one traversal is frame i of the other only when both have as many frames:
+  // with one longer, its frames past the other's end would have no place, and the places of
+  // the others would drift (evaluated, a run that finds every place scores near 0).
+  if (queries != references)
+    throw InputError(
+        "Ground_truth_type: aligned pairs query frame i with reference frame i, "
+        "but the query traversal has " +
+        std::to_string(queries) + " frames and the reference traversal " +
+        std::to_string(references) +
+        "; expected traversals of equal length (else a pairs or poses ground "
+        "truth)");
+}
+
+namespace {
+
 void LoadAligned(const GroundTruthOptions&, const EvaluationLayout& layout, int, int,
                  GroundTruth* gt) {
   if (layout.kind == EvaluationLayout::Kind::kLoopClosure) {
     throw InputError(
         "Ground_truth_type: aligned needs two traversals (Images_path_2 or Frame_mode 2)");
   }
-  for (int q = 0; q < std::min(layout.queries, layout.references); ++q) {
+  CheckAlignedLengths(layout.queries, layout.references);
+  for (int q = 0; q < layout.queries; ++q) {
     gt->matches[static_cast<std::size_t>(q)].push_back(q);
   }
 }

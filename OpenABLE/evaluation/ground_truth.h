@@ -142,6 +142,10 @@ struct GroundTruthFormat {
                int full_cols, GroundTruth* gt);
 };
 
+// The aligned ground truth pairs query frame i with reference frame i: throws InputError
+// (Ground_truth_type, both lengths) unless the traversals have as many frames.
+void CheckAlignedLengths(int queries, int references);
+
 // Every format, in the order users see them.
 const std::vector<GroundTruthFormat>& GroundTruthFormats();
 // The names of the formats, joined as a list for messages: "matrix, pairs, ... or positions"

@@ -300,6 +300,15 @@ std::string FormatSweepTable(const SweepResult& r) {
       << (s.truth.path.empty() ? "" : " \"" + s.truth.path + "\"") << ": tolerance +-"
       << s.options.tolerance << " frames";
     if (loop) o << ", candidates at least " << s.options.exclusion << " frames back";
+    // The per-query figures rank each query's best match by its score: say which.
+    const bool score_varied = std::any_of(
+        r.axes.begin(), r.axes.end(), [](const SweepAxis& a) { return a.key == "Match_score"; });
+    if (score_varied)
+      o << "; score: each run's Match_score";
+    else if (s.options.score == MatchScore::kRatio)
+      o << "; score: ratio to the best rival beyond +-" << s.options.score_window << " frames";
+    else
+      o << "; score: distance";
     o << "; ABLE-P vicinity " << s.options.vicinity << "\n";
   } else {
     o << "No ground truth (Ground_truth_type empty): the criteria of the matrices alone "

@@ -338,6 +338,14 @@ TEST_P(BadInputs, OneLineNonZeroExitNoOutput) {
   cv::imwrite(dir + "/sizes/f2.png", cv::Mat(40, 64, CV_8UC1, cv::Scalar(9)));
   std::ofstream(dir + "/fake.avi") << "text";
   std::ofstream(dir + "/fake.txt") << "text that FFmpeg would render as frames\n";
+  // Two traversals of 20 and 30 frames, which an aligned ground truth cannot pair frame by frame.
+  fs::create_directories(dir + "/twenty");
+  fs::create_directories(dir + "/thirty");
+  for (int i = 0; i < 30; ++i) {
+    const cv::Mat frame(32, 64, CV_8UC1, cv::Scalar(4 * i));
+    cv::imwrite(dir + "/thirty/f" + std::to_string(i) + ".png", frame);
+    if (i < 20) cv::imwrite(dir + "/twenty/f" + std::to_string(i) + ".png", frame);
+  }
 
   std::vector<std::string> args = {SampleConfig(dir)};
   for (auto s : c.sets) {
@@ -362,18 +370,28 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"EmptyFolder", {"Images_path=$DIR/empty"}, "Images_path: "},
         BadInput{"CorruptImage", {"Images_path=$DIR/corrupt"}, "a2.png"},
         BadInput{"DifferentSizes", {"Images_path=$DIR/sizes", "Images_path_2="}, "f2.png"},
+        BadInput{"MatrixImageNotPng",
+                 {"Png_name=out/m.jpg"},
+                 "Png_name: \"out/m.jpg\" does not end in .png; expected a .png path"},
+        BadInput{
+            "AlignedTruthOfUnequalTraversals",
+            {"Images_path=$DIR/twenty", "Images_path_2=$DIR/thirty", "Ground_truth_type=aligned"},
+            "Ground_truth_type: aligned pairs query frame i with reference frame i, but "
+            "the query traversal has 30 frames and the reference traversal 20"},
         BadInput{"UnopenableVideo", {"Frame_mode=1", "Video_path_1=$DIR/fake.avi"}, "fake.avi"},
         BadInput{"TextAsVideo", {"Frame_mode=1", "Video_path_1=$DIR/fake.txt"}, "fake.txt"},
         BadInput{"Surf", {"Image_descriptor=SURF"}, "SURF"},
         BadInput{"UnknownDescriptor", {"Image_descriptor=XYZ"}, "Image_descriptor"},
         BadInput{"StereoWithSecondTraversal", {"Camera_type=1"}, "Images_path_2: "},
-        BadInput{"StereoVideo", {"Camera_type=1", "Frame_mode=1", "Video_path_1=$DIR/a.avi"},
+        BadInput{"StereoVideo",
+                 {"Camera_type=1", "Frame_mode=1", "Video_path_1=$DIR/a.avi"},
                  "Frame_mode: 1 with Camera_type 1"},
         BadInput{"StereoWithoutCalibration",
                  {"Camera_type=1", "Images_path_2=", "Images_path_left=$DIR/l",
                   "Images_path_right=$DIR/r"},
                  "Calibration_path: empty"},
-        BadInput{"DldbWithoutStereo", {"Image_descriptor=D-LDB"},
+        BadInput{"DldbWithoutStereo",
+                 {"Image_descriptor=D-LDB"},
                  "Image_descriptor: D-LDB needs Camera_type 1 (stereo)"},
         BadInput{"OutOfRange", {"Matrix_color=12"}, "Matrix_color"},
         BadInput{"UnknownKey", {"Patch_sise=3"}, "did you mean \"Patch_size\""},
@@ -382,7 +400,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"IlluminationOnGreyFrames", {"Illumination_invariance=1"}, "is grey"},
         BadInput{"OneLambdaOnly", {"Lambda_red=610"}, "Lambda_red"},
         BadInput{"LambdasOutOfOrder",
-                 {"Lambda_red=470", "Lambda_green=535", "Lambda_blue=610"}, "Lambda_blue"},
+                 {"Lambda_red=470", "Lambda_green=535", "Lambda_blue=610"},
+                 "Lambda_blue"},
         BadInput{"PanoramasWiderThanTheFrame",
                  {"Camera_type=2", "Panoramas=40", "Description_type=1", "Grid_x=2"},
                  "Grid_x x Panoramas"},
@@ -390,19 +409,25 @@ INSTANTIATE_TEST_SUITE_P(
                  {"Camera_type=2", "Matrix_mode=2", "Matches_name=out/m.csv"},
                  "Panorama_matching: 1"},
         BadInput{"UnknownScore", {"Match_score=confidence"}, "Match_score"},
-        BadInput{"UnknownNameInAFusion", {"Image_descriptor=HOG+XYZ"},
+        BadInput{"UnknownNameInAFusion",
+                 {"Image_descriptor=HOG+XYZ"},
                  "Image_descriptor: unknown descriptor \"XYZ\""},
-        BadInput{"EmptyNameInAFusion", {"Image_descriptor=HOG++LDB"},
+        BadInput{"EmptyNameInAFusion",
+                 {"Image_descriptor=HOG++LDB"},
                  "Image_descriptor: \"HOG++LDB\" has an empty name"},
         BadInput{"DescriptorTwiceInAFusion", {"Image_descriptor=HOG,hog"}, "names HOG twice"},
         BadInput{"RatioWindowAsLargeAsTheReferences",
-                 {"Match_score=ratio", "Match_score_window=300"}, "Match_score_window: 300"},
-        BadInput{"FusionOfDistancesWithoutWeights", {"Image_descriptor=HOG+LDB"},
+                 {"Match_score=ratio", "Match_score_window=300"},
+                 "Match_score_window: 300"},
+        BadInput{"FusionOfDistancesWithoutWeights",
+                 {"Image_descriptor=HOG+LDB"},
                  "Fusion_weights: empty, but Image_descriptor \"HOG+LDB\" fuses distances of "
                  "different kinds (HOG: L2, LDB: Hamming)"},
         BadInput{"WeightsForAnotherNumberOfDescriptors",
-                 {"Image_descriptor=HOG+LDB", "Fusion_weights=1,1,1"}, "Fusion_weights: \"1,1,1\""},
-        BadInput{"NegativeWeight", {"Image_descriptor=HOG+LDB", "Fusion_weights=1,-1"},
+                 {"Image_descriptor=HOG+LDB", "Fusion_weights=1,1,1"},
+                 "Fusion_weights: \"1,1,1\""},
+        BadInput{"NegativeWeight",
+                 {"Image_descriptor=HOG+LDB", "Fusion_weights=1,-1"},
                  "Fusion_weights"},
         BadInput{"FusionNeedsTheDenseMatrix",
                  {"Image_descriptor=HOG+LDB", "Fusion_weights=1,1", "Matrix_mode=2",
@@ -414,7 +439,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"SadHasNoApproximateSearch",
                  {"Image_descriptor=SAD", "Approximate_search=1", "Matches_name=out/m.csv"},
                  "Approximate_search: 1 with Image_descriptor SAD"},
-        BadInput{"SadPatchTooLarge", {"Image_descriptor=SAD", "Patch_size=32", "Sad_patch=20"},
+        BadInput{"SadPatchTooLarge",
+                 {"Image_descriptor=SAD", "Patch_size=32", "Sad_patch=20"},
                  "Sad_patch: 20"},
         BadInput{"UnknownPartial", {"Sequence_partial=drop"}, "Sequence_partial"}),
     [](const ::testing::TestParamInfo<BadInput>& info) { return std::string(info.param.name); });
