@@ -270,7 +270,7 @@ window.addEventListener('load', function () {
 
     function update() {
       var t = threshold(), s = stats(t);
-      root.querySelector('.ex-threshold-value').textContent = num(t, 6);
+      root.querySelector('.ex-threshold-value').textContent = String(+t.toPrecision(6));
       root.querySelector('.ex-accepted').textContent = s.accepted;
       root.querySelector('.ex-correct').textContent = s.tp;
       root.querySelector('.ex-precision').textContent = fixed(s.precision, 4);
@@ -434,8 +434,11 @@ window.addEventListener('load', function () {
 
     root.hidden = false;
     update();
-    var first = answered.length ? answered[0] : 0;
-    pin(first, answered.length ? run.best[first] : 0);
+    // At first, the most confident answer.
+    var first = -1;
+    for (var a = 0; a < answered.length; ++a)
+      if (first < 0 || run.score[answered[a]] < run.score[first]) first = answered[a];
+    pin(Math.max(first, 0), first >= 0 ? run.best[first] : 0);
   }
 
   var roots = document.querySelectorAll('.explorer');
@@ -552,7 +555,10 @@ std::string ExplorerSection(const ReportInput& input) {
   h += "<script type=\"application/json\" id=\"explore-frames\">" + ScriptSafe(set_json.dump()) +
        "</script>\n";
   if (!frames.read)
-    h += "<p class=\"note\">Frames are named, not shown: " + HtmlEscape(frames.missing) + "</p>\n";
+    h += frames.missing.empty()
+             ? std::string("<p class=\"note\">Frames are named, not shown.</p>\n")
+             : "<p class=\"note\">Frames are named, not shown: " + HtmlEscape(frames.missing) +
+                   "</p>\n";
 
   const std::string score_kind = options.score == MatchScore::kRatio ? "ratio" : "distance";
   for (std::size_t i = 0; i < evaluation.runs.size(); ++i) {
