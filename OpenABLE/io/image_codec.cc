@@ -8,6 +8,7 @@
 #include <csetjmp>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -473,6 +474,43 @@ cv::Mat DecodeCommonFormat(const std::vector<unsigned char>& bytes, bool& grey_a
   reinterpret_cast<OpenableCodecsDecode>(ModuleSymbol("codecs", "openable_codecs_decode"))(
       bytes, image);
   return image;
+}
+
+std::string EncodeJpegFile(const cv::Mat& image, int quality) {
+  if (image.type() != CV_8UC1 && image.type() != CV_8UC3)
+    throw std::logic_error("EncodeJpegFile: expected an 8-bit grey or BGR image");
+  if (image.empty()) throw std::logic_error("EncodeJpegFile: empty image");
+  jpeg_compress_struct cinfo;
+  JpegErrors errors;
+  cinfo.err = jpeg_std_error(&errors.manager);
+  errors.manager.error_exit = JpegStop;
+  unsigned char* buffer = nullptr;
+  unsigned long size = 0;
+  if (setjmp(errors.jump) != 0) {
+    jpeg_destroy_compress(&cinfo);
+    std::free(buffer);
+    throw InputError(std::string("JPEG encoding failed: ") + errors.message);
+  }
+  jpeg_create_compress(&cinfo);
+  jpeg_mem_dest(&cinfo, &buffer, &size);
+  cinfo.image_width = static_cast<JDIMENSION>(image.cols);
+  cinfo.image_height = static_cast<JDIMENSION>(image.rows);
+  cinfo.input_components = image.channels();
+  cinfo.in_color_space = image.channels() == 1 ? JCS_GRAYSCALE : JCS_EXT_BGR;
+  jpeg_set_defaults(&cinfo);
+  jpeg_set_quality(&cinfo, std::clamp(quality, 1, 100), TRUE);
+  cinfo.optimize_coding = TRUE;  // Huffman tables of the image itself: smaller files
+  jpeg_start_compress(&cinfo, TRUE);
+  while (cinfo.next_scanline < cinfo.image_height) {
+    JSAMPROW row = const_cast<unsigned char*>(image.ptr<unsigned char>(
+        static_cast<int>(cinfo.next_scanline)));
+    jpeg_write_scanlines(&cinfo, &row, 1);
+  }
+  jpeg_finish_compress(&cinfo);
+  jpeg_destroy_compress(&cinfo);
+  std::string bytes(reinterpret_cast<const char*>(buffer), size);
+  std::free(buffer);
+  return bytes;
 }
 
 }  // namespace openable

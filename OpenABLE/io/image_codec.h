@@ -39,4 +39,9 @@ bool DecodePng(const std::vector<unsigned char>& bytes, cv::Mat& image, std::str
 // EffectiveThreads (0 = all cores). Throws std::logic_error on another type.
 std::string EncodePngFile(const cv::Mat& image, int threads = 0);
 
+// The bytes of a baseline JPEG file of an 8-bit grey (CV_8UC1) or BGR (CV_8UC3) image at
+// `quality` (1-100, libjpeg's scale), with libjpeg: the thumbnails of the HTML report. Throws
+// std::logic_error on another type, InputError with libjpeg's message should it fail.
+std::string EncodeJpegFile(const cv::Mat& image, int quality = 85);
+
 }  // namespace openable

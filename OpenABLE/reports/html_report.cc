@@ -13,6 +13,8 @@
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/reports/evaluation_files.h"
 #include "OpenABLE/reports/figures.h"
+#include "OpenABLE/reports/html_explorer.h"
+#include "OpenABLE/reports/html_text.h"
 #include "config/config.h"
 
 namespace openable {
@@ -20,50 +22,7 @@ namespace {
 
 constexpr int kThumbnailWidth = 320;  // frames of the worst cases, pixels across at most
 
-// Base64 (RFC 4648) for the data URIs. Written here: none of the project's libraries offers a
-// public encoder (OpenCV's is internal to its persistence code).
-std::string Base64(const std::string& bytes) {
-  static const char kDigits[] =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((bytes.size() + 2) / 3 * 4);
-  std::size_t i = 0;
-  for (; i + 2 < bytes.size(); i += 3) {
-    const unsigned v = (static_cast<unsigned char>(bytes[i]) << 16) |
-                       (static_cast<unsigned char>(bytes[i + 1]) << 8) |
-                       static_cast<unsigned char>(bytes[i + 2]);
-    out += kDigits[(v >> 18) & 63];
-    out += kDigits[(v >> 12) & 63];
-    out += kDigits[(v >> 6) & 63];
-    out += kDigits[v & 63];
-  }
-  if (i < bytes.size()) {
-    unsigned v = static_cast<unsigned char>(bytes[i]) << 16;
-    const bool two = i + 1 < bytes.size();
-    if (two) v |= static_cast<unsigned char>(bytes[i + 1]) << 8;
-    out += kDigits[(v >> 18) & 63];
-    out += kDigits[(v >> 12) & 63];
-    out += two ? kDigits[(v >> 6) & 63] : '=';
-    out += '=';
-  }
-  return out;
-}
-
-std::string Escape(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
+std::string Escape(const std::string& text) { return HtmlEscape(text); }
 
 // `value` with `decimals` digits after the point; a dash when it is not finite.
 std::string Number(double value, int decimals) {
@@ -178,6 +137,7 @@ ReportFrames FramesFromSources(std::vector<std::unique_ptr<FrameSource>> sources
     throw std::out_of_range("FramesFromSources: frame beyond the sources");
   };
   ReportFrames frames;
+  frames.same_rows_and_columns = !rows_are_second || shared->size() != 2;
   frames.read = [locate](bool row, int index) {
     const auto [source, i] = locate(row, index);
     return source->Read(i);
@@ -308,6 +268,18 @@ std::string EncodeHtmlReport(const ReportInput& input) {
        "image-rendering:pixelated}\n"
        ".wrong{color:#b00000}.right{color:#006400}.note{color:#555}\n"
        "pre{background:#f7f7f7;padding:.5em;overflow:auto;font-size:.85em}\n"
+       // The explorer (html_explorer.h).
+       ".ex-controls{margin:.5em 0;line-height:1.8}.ex-threshold{width:360px;vertical-align:middle}\n"
+       ".ex-row{display:flex;flex-wrap:wrap;gap:1.2em;align-items:flex-start}\n"
+       ".ex-matrix{position:relative;flex:none;cursor:crosshair;outline:1px solid #ccc}\n"
+       ".ex-matrix:focus{outline:2px solid #ffb000}\n"
+       ".ex-image{display:block;width:100%;height:100%;image-rendering:pixelated}\n"
+       ".ex-overlay{position:absolute;left:0;top:0;width:100%;height:100%;pointer-events:none}\n"
+       ".ex-side{max-width:420px}.ex-cell{margin-top:.5em;line-height:1.5}\n"
+       ".ex-cell-frames canvas{height:96px;margin:0 6px 4px 0;border:1px solid #ccc;"
+       "image-rendering:pixelated}\n"
+       "table.ex-queries td{vertical-align:middle}table.ex-queries tbody tr{cursor:pointer}\n"
+       "table.ex-queries canvas{height:48px;display:block;image-rendering:pixelated}\n"
        "</style>\n</head>\n<body>\n";
   h += "<h1>" + Escape(input.title) + "</h1>\n";
   h += "<p class=\"note\">Written by " + Escape(input.program) + " (OpenABLE " + kVersion +
@@ -318,7 +290,7 @@ std::string EncodeHtmlReport(const ReportInput& input) {
   h += "<nav><a href=\"#settings\">Settings</a> &middot; " + extra_links +
        "<a href=\"#figures\">Figures</a> "
        "&middot; <a href=\"#pr\">Precision-recall</a> &middot; <a href=\"#matrix\">Matrix</a> "
-       "&middot; <a href=\"#wrong-matches\">Wrong matches</a> &middot; "
+       "&middot; <a href=\"#explore\">Explore</a> &middot; <a href=\"#wrong-matches\">Wrong matches</a> &middot; "
        "<a href=\"#misses\">Misses</a></nav>\n";
 
   // Settings.
@@ -411,6 +383,7 @@ std::string EncodeHtmlReport(const ReportInput& input) {
   }
   h += "</section>\n";
 
+  h += ExplorerSection(input);
   h += WorstCaseSections(input);
 
   // Every embedded image must decode: the console names any that did not (a damaged or

@@ -2,7 +2,8 @@
 // self-contained page a person opens in a browser, offline: every image is embedded as a data
 // URI, no script or style sheet is fetched. It shows the settings, the figures of each run,
 // the precision-recall figure, the matrix with the ground truth drawn over it, and for each
-// run the frames of its worst cases side by side, as VPR_Tutorial shows them:
+// run the frames of its worst cases side by side, as VPR_Tutorial shows them, and an
+// interactive explorer of each run (html_explorer.h):
 //
 //   most confident wrong matches  answered queries whose best match is wrong, most confident
 //                                 (lowest score) first: query, wrong match, true place
@@ -58,6 +59,9 @@ struct ReportFrames {
   // A short name of the frame (its file name); unset: "row 12" / "column 40".
   std::function<std::string(bool row, int index)> name;
   std::string missing;  // why no images are shown (when `read` is unset)
+  // Row i and column i of the matrix are the same frame (one sequence): the explorer embeds
+  // the thumbnails once.
+  bool same_rows_and_columns = false;
 };
 
 // ReportFrames over the frame sources of a run (OpenFramesToShow, pipeline.h): row and column

@@ -20,7 +20,7 @@ import openable
 import support
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-SECTIONS = ["settings", "figures", "pr", "matrix", "wrong-matches", "misses"]
+SECTIONS = ["settings", "figures", "pr", "matrix", "explore", "wrong-matches", "misses"]
 
 
 def browse(page, out_dir, screenshot=None):
@@ -123,9 +123,12 @@ class DemoReport(support.TempDirTestCase):
         self.assertEqual(int(values[header.index("queries")]), self.figures["queries"])
         settings = dict((r[0], r[1]) for r in self.page.tables["settings-table"][1:])
         self.assertEqual(settings["Image_descriptor"], '"HOG+LDB"')
-        # Every image is embedded and decodes; the frames are the sample's PNGs themselves.
+        # Every image is embedded and decodes; the frames are the sample's PNGs themselves, the
+        # explorer's thumbnail sheets JPEG.
         for image in self.page.images:
-            self.assertTrue(image["src"].startswith("data:image/png;base64,"))
+            kind = "jpeg" if image.get("class") == "sheet" else "png"
+            self.assertTrue(image["src"].startswith("data:image/%s;base64," % kind), image["alt"])
+        self.assertEqual(len([i for i in self.page.images if i.get("class") == "sheet"]), 2)
         self.assertNotIn("http", self.text)
 
     def test_worst_cases_are_the_runs_own(self):
@@ -168,7 +171,8 @@ class DamagedReport(support.TempDirTestCase):
         self.assertIn('data-images-loaded="0/1"', dom)
 
     def _script(self):
-        # The checking script of a real report, taken from a report openable_evaluate writes.
+        # The checking script of a real report (the last script of the page), taken from a
+        # report openable_evaluate writes.
         m = self.tmp / "m.npy"
         np.save(m, np.random.default_rng(1).random((20, 20)).astype(np.float32))
         out = self.tmp / "r.html"
@@ -176,7 +180,7 @@ class DamagedReport(support.TempDirTestCase):
                                           "--reference-frames", "10", "--report", out,
                                           "--quiet"], self.tmp)
         text = out.read_text()
-        return text[text.index("<script>"):]
+        return text[text.rindex("<script>"):]
 
 
 class EvaluateReport(support.TempDirTestCase):

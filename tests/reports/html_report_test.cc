@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <string>
@@ -10,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include "OpenABLE/io/image_codec.h"
+#include "OpenABLE/io/json.h"
+#include "OpenABLE/reports/html_explorer.h"
 #include "config/config.h"
 
 namespace openable {
@@ -144,7 +147,8 @@ TEST(HtmlReport, PageIsSelfContainedWithEveryImageDecodable) {
   };
   const std::string page = EncodeHtmlReport(input);
 
-  for (const char* id : {"settings", "figures", "pr", "matrix", "wrong-matches", "misses"})
+  for (const char* id :
+       {"settings", "figures", "pr", "matrix", "explore", "wrong-matches", "misses"})
     EXPECT_NE(page.find("<section id=\"" + std::string(id) + "\">"), std::string::npos) << id;
   EXPECT_NE(page.find("Report &lt;of&gt; test"), std::string::npos);
   EXPECT_NE(page.find("LDB &lt;b&gt;&amp;"), std::string::npos);
@@ -153,25 +157,38 @@ TEST(HtmlReport, PageIsSelfContainedWithEveryImageDecodable) {
   EXPECT_EQ(page.find("<link"), std::string::npos);
   EXPECT_EQ(page.find("http"), std::string::npos);
   // (std::regex recurses per character: a data URI of 100 kB would overflow the stack.)
-  int images = 0;
+  int images = 0, sheets = 0;
   for (std::size_t at = page.find("src=\""); at != std::string::npos;
        at = page.find("src=\"", at + 1)) {
     const std::size_t begin = at + 5;
     const std::string value = page.substr(begin, page.find('"', begin) - begin);
-    const std::string prefix = "data:image/png;base64,";
-    ASSERT_EQ(value.compare(0, prefix.size(), prefix), 0) << value.substr(0, 40);
-    const std::string bytes = Base64Decode(value.substr(prefix.size()));
-    cv::Mat decoded;
-    std::string why;
-    EXPECT_TRUE(DecodePng(std::vector<unsigned char>(bytes.begin(), bytes.end()), decoded, why))
-        << why;
+    const std::string png = "data:image/png;base64,", jpeg = "data:image/jpeg;base64,";
+    const bool is_jpeg = value.compare(0, jpeg.size(), jpeg) == 0;
+    ASSERT_TRUE(is_jpeg || value.compare(0, png.size(), png) == 0) << value.substr(0, 40);
+    const std::string bytes = Base64Decode(value.substr((is_jpeg ? jpeg : png).size()));
+    bool grey_alpha = false;
+    const cv::Mat decoded =
+        DecodeCommonFormat(std::vector<unsigned char>(bytes.begin(), bytes.end()), grey_alpha);
     EXPECT_FALSE(decoded.empty());
+    if (is_jpeg) {
+      // A thumbnail sheet of the explorer: 40 frames of 50 x 30 (at most 96 high) on one row
+      // of 32 and one of 8.
+      ++sheets;
+      EXPECT_EQ(decoded.cols, 32 * 50);
+      EXPECT_EQ(decoded.rows, 2 * 30);
+    }
     ++images;
   }
-  // The PR figure, one overlay, then three frames (query, answer, true place) per worst case:
-  // four wrong matches and four misses, each with an answer and a true place.
-  EXPECT_EQ(images, 2 + 3 * (4 + 4));
-  EXPECT_EQ(reads, 3 * (4 + 4));
+  // The PR figure, one overlay, the explorer's matrix and its two thumbnail sheets (queries,
+  // references), then three frames (query, answer, true place) per worst case: four wrong
+  // matches and four misses, each with an answer and a true place.
+  EXPECT_EQ(sheets, 2);
+  EXPECT_EQ(images, 2 + 3 + 3 * (4 + 4));
+  // The worst cases' frames, and each frame of the block once for the explorer.
+  EXPECT_EQ(reads, 3 * (4 + 4) + 2 * kFrames);
+  // The explorer's data: names of the frames, the run's best matches.
+  EXPECT_NE(page.find("\"q79.png\""), std::string::npos);
+  EXPECT_NE(page.find("\"r0.png\""), std::string::npos);
   // The figures table holds the run's AUC as computed.
   char auc[32];
   std::snprintf(auc, sizeof auc, "%.4f", f.evaluation.runs[0].per_query.auc);
@@ -193,7 +210,78 @@ TEST(HtmlReport, WithoutFramesTheCasesAreNamedAndTheReasonGiven) {
   int images = 0;
   for (std::size_t at = page.find("<img "); at != std::string::npos; at = page.find("<img ", at + 1))
     ++images;
-  EXPECT_EQ(images, 2);
+  EXPECT_EQ(images, 3);  // the PR figure, the overlay, the explorer's matrix
+}
+
+// The text of the element `<script ... id="ID">TEXT</script>` of `page`.
+std::string ScriptText(const std::string& page, const std::string& id) {
+  const std::size_t at = page.find("id=\"" + id + "\">");
+  if (at == std::string::npos) return "";
+  const std::size_t begin = page.find('>', at) + 1;
+  return page.substr(begin, page.find("</script>", begin) - begin);
+}
+
+TEST(HtmlReport, ExplorerEmbedsEachQuerysBestMatchAndThe8BitBlock) {
+  const Fixture f;
+  ReportInput input;
+  input.evaluation = &f.evaluation;
+  input.matrices = {&f.matrix};
+  input.frames.missing = "no frames given";
+  const std::string page = EncodeHtmlReport(input);
+  const Json run = Json::parse(ScriptText(page, "explore-run-0"));
+  const std::vector<Expected> expected = BruteForce(f.matrix);
+  ASSERT_EQ(run["queries"], kFrames);
+  ASSERT_EQ(run["references"], kFrames);
+  EXPECT_EQ(run["row_offset"], kFrames);
+  EXPECT_EQ(run["score_kind"], "distance");
+  for (int q = 0; q < kFrames; ++q) {
+    EXPECT_EQ(run["best"][q], expected[q].answer) << q;
+    EXPECT_FLOAT_EQ(run["distance"][q].get<float>(), expected[q].distance) << q;
+    EXPECT_FLOAT_EQ(run["score"][q].get<float>(), expected[q].distance) << q;
+    EXPECT_EQ(run["correct"].get<std::string>()[q], expected[q].correct ? '1' : '0') << q;
+  }
+  // The curve: one point per distinct score, (threshold, tp, fp).
+  EXPECT_EQ(run["curve"].size(), f.evaluation.runs[0].per_query.curve.size());
+  // The block, one byte per cell, row by row.
+  EXPECT_EQ(run["values"]["cell_rows"], 1);
+  const std::string codes = Base64Decode(ScriptText(page, "explore-values-0"));
+  ASSERT_EQ(codes.size(), static_cast<std::size_t>(kFrames * kFrames));
+  for (int q = 0; q < kFrames; ++q)
+    for (int c = 0; c < kFrames; ++c) {
+      const int code = static_cast<unsigned char>(codes[q * kFrames + c]);
+      EXPECT_NEAR(code / 254.0, f.matrix(kFrames + q, c), 0.5 / 254 + 1e-6) << q << " " << c;
+    }
+  // Names without frames to read: rows and columns of the matrix.
+  EXPECT_NE(ScriptText(page, "explore-frames").find("\"row 79\""), std::string::npos);
+  EXPECT_NE(ScriptText(page, "explore-frames").find("\"column 0\""), std::string::npos);
+}
+
+TEST(HtmlReport, ExplorerCodesAndGroupsOfCells) {
+  EXPECT_EQ(ExploreCode(0.0f), 0);
+  EXPECT_EQ(ExploreCode(1.0f), 254);
+  EXPECT_EQ(ExploreCode(0.5f), 127);
+  EXPECT_EQ(ExploreCode(2.0f), 254);
+  EXPECT_EQ(ExploreCode(-1.0f), 0);
+  EXPECT_EQ(ExploreCode(std::numeric_limits<float>::quiet_NaN()), 255);
+  EXPECT_EQ(ExploreCode(std::numeric_limits<float>::infinity()), 255);
+  // A block taller than kExploreValuesSide: rows go by groups, each the mean of its finite
+  // cells; a group without one has no value.
+  const int rows = kExploreValuesSide * 2 + 7, cols = 3;
+  cv::Mat1f m(rows + 1, cols + 2, 0.9f);  // one row and two columns outside the block
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) m(1 + r, 2 + c) = static_cast<float>((r % 3) * 0.25 + c * 0.1);
+  for (int r = 0; r < 3; ++r) m(1 + r, 2) = std::numeric_limits<float>::infinity();
+  const EvaluationLayout layout{EvaluationLayout::Kind::kQueryReference, rows, cols, 1, 2};
+  int cell_rows = 0, cell_cols = 0;
+  const cv::Mat1b values = ExploreValues(m, layout, cell_rows, cell_cols);
+  EXPECT_EQ(cell_rows, 3);
+  EXPECT_EQ(cell_cols, 1);
+  ASSERT_EQ(values.rows, (rows + 2) / 3);
+  ASSERT_EQ(values.cols, cols);
+  EXPECT_EQ(values(0, 0), 255);                     // rows 0-2 of column 0 have no value
+  EXPECT_EQ(values(1, 0), ExploreCode(0.25f));      // rows 3-5: 0, 0.25, 0.5
+  EXPECT_EQ(values(1, 2), ExploreCode(0.45f));      // plus 0.2
+  EXPECT_EQ(values(values.rows - 1, 1), ExploreCode(0.225f));  // the last group: 2 rows (0.1, 0.35)
 }
 
 TEST(HtmlReport, ChangedSettingsAreTheKeysDifferentFromTheDefaults) {
