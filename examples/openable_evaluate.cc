@@ -28,9 +28,8 @@ const char* kUsage =
     "no change for Test_OpenABLE's M'). A non-square matrix is queries (rows) x references\n"
     "(columns). A square matrix is one sequence (loop closure), unless --reference-frames N\n"
     "says it covers two traversals: N reference frames, then the queries (Images_path_2).\n"
-    "A matrix Test_OpenABLE wrote has its run's settings beside it (M.npy.json): they are\n"
-    "used (score, tolerance, ground truth, reference frames), so the figures are the run's;\n"
-    "a flag or --set overrides one, and a note says so.\n"
+    "A matrix with its run's settings beside it (M.npy.json) is evaluated with them (score,\n"
+    "ground truth, reference frames...): the run's figures, unless a flag overrides one.\n"
     "\n"
     "Options (each is also --set Key=Value with the Config.txt key in brackets; --name=value\n"
     "works as --name value):\n"
@@ -108,13 +107,14 @@ int main(int argc, char** argv) {
   }
   return openable::RunProgram("openable_evaluate", [&] {
     const openable::EvaluatedFiles evaluated = openable::EvaluateFiles(command_line);
-    for (const std::string& note : evaluated.notes)
-      std::cerr << "openable_evaluate: note: " << note << "\n";
     if (!command_line.quiet && !command_line.json)
       std::cout << openable::FormatEvaluationTable(evaluated.evaluation.settings,
                                                    evaluated.evaluation.runs);
     const std::vector<std::string> paths =
         openable::WriteEvaluatedFiles(evaluated, command_line.matrices);
+    // After the files are written: a run that fails says so in its one line alone.
+    for (const std::string& note : evaluated.notes)
+      std::cerr << "openable_evaluate: note: " << note << "\n";
     if (command_line.json) {
       std::cout << openable::ProgramJson(
           "openable_evaluate",

@@ -51,6 +51,9 @@ using Stager = std::function<void(OutputBatch&)>;
 // so that the files checked before a run are the files written after it.
 struct RunOutput {
   bool dense_only;  // made from the dense matrix: a bounded run writes no such file
+  // Written beside another output (the settings beside a matrix): not noted on its own when
+  // a bounded run leaves it out.
+  bool companion;
   Planned (*planned)(const Config& config);  // the (key, path) of the files `config` asks for
   Stager (*prepare)(const OutputInput& in);
 };
@@ -72,7 +75,7 @@ Stager EncodedInBackground(const std::string& key, const std::string& path,
 const std::vector<RunOutput>& RunOutputs() {
   static const std::vector<RunOutput> outputs = {
       // Npy_name: written from the matrix itself while the images are being encoded.
-      {true, [](const Config& c) { return One("Npy_name", c.output.npy_name); },
+      {true, false, [](const Config& c) { return One("Npy_name", c.output.npy_name); },
        [](const OutputInput& in) -> Stager {
          const std::string& path = in.config.output.npy_name;
          if (path.empty()) return {};
@@ -89,7 +92,7 @@ const std::vector<RunOutput>& RunOutputs() {
       // Txt_name: formatted in pieces and written as they come (the images encode meanwhile):
       // the text of a large matrix is never whole in memory. The thresholded matrix when
       // Threshold is set.
-      {true, [](const Config& c) { return One("Txt_name", c.output.txt_name); },
+      {true, false, [](const Config& c) { return One("Txt_name", c.output.txt_name); },
        [](const OutputInput& in) -> Stager {
          const std::string& path = in.config.output.txt_name;
          if (path.empty()) return {};
@@ -101,7 +104,7 @@ const std::vector<RunOutput>& RunOutputs() {
        }},
       // Beside each matrix file, the settings that shaped it and those of its evaluation
       // (matrix_settings.h), so that openable_evaluate and Python evaluate it as the run did.
-      {true,
+      {true, true,
        [](const Config& c) {
          Planned p = One("Npy_name (settings)", c.output.npy_name.empty()
                                                     ? ""
@@ -126,7 +129,7 @@ const std::vector<RunOutput>& RunOutputs() {
                                               !in.result.thresholded.empty()));
          };
        }},
-      {true, [](const Config& c) { return One("Png_name", c.output.png_name); },
+      {true, false, [](const Config& c) { return One("Png_name", c.output.png_name); },
        [](const OutputInput& in) -> Stager {
          const OutputOptions& o = in.config.output;
          if (o.png_name.empty()) return {};
@@ -136,7 +139,7 @@ const std::vector<RunOutput>& RunOutputs() {
        }},
       // The thresholded image (Eq. 9): Png_threshold_name, or Png_name's path with
       // "_thresholded".
-      {true,
+      {true, false,
        [](const Config& c) {
          return One(c.output.png_threshold_name.empty() ? "Png_name (thresholded image)"
                                                         : "Png_threshold_name",
@@ -153,7 +156,7 @@ const std::vector<RunOutput>& RunOutputs() {
                return EncodePng(ColorizeMatrix(binary, in.config.output.matrix_color));
              });
        }},
-      {false, [](const Config& c) { return One("Matches_name", c.scale.matches_name); },
+      {false, false, [](const Config& c) { return One("Matches_name", c.scale.matches_name); },
        [](const OutputInput& in) -> Stager {
          const std::string& path = in.config.scale.matches_name;
          if (path.empty()) return {};
@@ -162,7 +165,7 @@ const std::vector<RunOutput>& RunOutputs() {
            batch.Stage("Matches_name", path, EncodeMatches(in.result.matches, csv));
          };
        }},
-      {false,
+      {false, false,
        [](const Config& c) {
          return c.verification.enabled ? One("Loops_name", c.output.loops_name) : Planned();
        },
@@ -175,7 +178,8 @@ const std::vector<RunOutput>& RunOutputs() {
        }},
       // Timestamps_name: "<row> <seconds>" per row, nanosecond resolution (the stamps of ROS
       // messages).
-      {false, [](const Config& c) { return One("Timestamps_name", c.output.timestamps_name); },
+      {false, false,
+       [](const Config& c) { return One("Timestamps_name", c.output.timestamps_name); },
        [](const OutputInput& in) -> Stager {
          const std::string& path = in.config.output.timestamps_name;
          if (path.empty()) return {};
@@ -193,7 +197,7 @@ const std::vector<RunOutput>& RunOutputs() {
          };
        }},
       // Evaluation_name: the evaluation's files of one run (no label in the names).
-      {false,
+      {false, false,
        [](const Config& c) {
          Planned out;
          const std::string& prefix = c.evaluation.name;
@@ -211,7 +215,7 @@ const std::vector<RunOutput>& RunOutputs() {
                            {&in.result.normalized});
          };
        }},
-      {false,
+      {false, false,
        [](const Config& c) {
          return EvaluationRequested(c) ? One("Report_name", c.evaluation.report_name)
                                        : Planned();
@@ -253,7 +257,7 @@ std::vector<std::string> UnwrittenOutputNotes(const Config& config, const RunRes
   std::vector<std::string> notes;
   if (!result.bounded) return notes;
   for (const RunOutput& output : RunOutputs())
-    if (output.dense_only)
+    if (output.dense_only && !output.companion)
       for (const auto& [key, path] : output.planned(config))
         notes.push_back(key + ": not written: the run is bounded and keeps no dense matrix "
                         "(see Matches_name)");

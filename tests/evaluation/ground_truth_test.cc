@@ -296,9 +296,19 @@ TEST(GroundTruthPairs, FirstFrameShiftsAndDropsPairsOutsideTheRange) {
 
 TEST(GroundTruthAligned, QueryIIsReferenceI) {
   GroundTruthOptions o = Options(GroundTruthType::kAligned, "");
-  const GroundTruth gt = LoadGroundTruth(o, EvaluationLayout::TwoTraversals(2, 3), 5, 5);
-  EXPECT_EQ(gt.matches, M(3, {{0, {0}}, {1, {1}}}));
-  EXPECT_EQ(gt.references, 2);
+  const GroundTruth gt = LoadGroundTruth(o, EvaluationLayout::TwoTraversals(3, 3), 6, 6);
+  EXPECT_EQ(gt.matches, M(3, {{0, {0}}, {1, {1}}, {2, {2}}}));
+  EXPECT_EQ(gt.references, 3);
+  // Traversals of unequal length: frame i has no counterpart to be paired with.
+  try {
+    LoadGroundTruth(o, EvaluationLayout::TwoTraversals(2, 3), 5, 5);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "Ground_truth_type: aligned pairs query frame i with reference frame i, but the "
+                 "query traversal has 3 frames and the reference traversal 2; expected "
+                 "traversals of equal length (else a pairs or poses ground truth)");
+  }
   try {
     LoadLoop(o, 4);
     ADD_FAILURE() << "no InputError";

@@ -57,11 +57,14 @@ TEST(RunOutputs, ThePlannedFilesAreTheFilesWrittenInTheirOrder) {
   fs::create_directories(dir);
   const Config c = EveryOutput(dir);
   const auto planned = PlannedOutputs(c);
-  // Written by hand from docs/output_formats.md: the matrix files, the images, the matches.
+  // Written by hand from docs/output_formats.md: the matrix files, the settings beside them,
+  // the images, the matches.
   EXPECT_EQ(PathsOf(planned),
-            (std::vector<std::string>{dir + "/m.npy", dir + "/m.txt", dir + "/m.png",
+            (std::vector<std::string>{dir + "/m.npy", dir + "/m.txt", dir + "/m.npy.json",
+                                      dir + "/m.txt.json", dir + "/m.png",
                                       dir + "/m_thresholded.png", dir + "/matches.csv"}));
-  EXPECT_EQ(planned[3].first, "Png_name (thresholded image)");
+  EXPECT_EQ(planned[2].first, "Npy_name (settings)");
+  EXPECT_EQ(planned[5].first, "Png_name (thresholded image)");
   RunResult r = SmallRun();
   const std::vector<std::string> written = WriteOutputs(c, r);
   EXPECT_EQ(written, PathsOf(planned));

@@ -231,9 +231,13 @@ class EvaluateReport(support.TempDirTestCase):
     def test_matrices_of_different_sizes_cannot_share_the_frames(self):
         other = self.tmp / "other.npy"
         np.save(other, np.random.default_rng(2).random((40, 20)).astype(np.float32))
+        # A pairs ground truth both fit (an aligned one needs as many queries as references).
+        pairs = self.tmp / "pairs.csv"
+        pairs.write_text("0,0\n5,5\n")
         out = self.tmp / "two.html"
-        done = self.evaluate("--matrix", other, "--report", out, "--images",
-                             support.SAMPLE / "summer", "--images-2", support.SAMPLE / "winter")
+        done = self.evaluate("--matrix", other, "--gt-type", "pairs", "--ground-truth", pairs,
+                             "--report", out, "--images", support.SAMPLE / "summer",
+                             "--images-2", support.SAMPLE / "winter")
         self.assertEqual(done.returncode, 1)
         self.assertEqual(len(done.stderr.strip().splitlines()), 1, done.stderr)
         self.assertIn("matrices of different sizes", done.stderr)
