@@ -263,6 +263,41 @@ cv::Mat3b OverlayLegend(int width, bool verification) {
   return strip;
 }
 
+// A step between labelled frames: 1, 2 or 5 times a power of ten, the smallest that puts at
+// most 8 labels along `frames`.
+int TickStep(int frames) {
+  for (int power = 1;; power *= 10)
+    for (int m : {1, 2, 5})
+      if (frames <= 8 * m * power) return m * power;
+}
+
+// The frame numbers of the block's rows (queries, left) and columns (references, top), every
+// TickStep frames, each at the middle of its enlarged cell, with the axes' titles.
+void DrawOverlayAxes(cv::Mat3b& img, int rows, int cols, int k) {
+  const double scale = 0.4;
+  const int left = kOverlayAxisLeft, top = kOverlayAxisTop;
+  const cv::Scalar tick(90, 90, 90);
+  const int text_h = TextSize("0", scale, 1).height;
+  for (int c = 0, step = TickStep(cols); c < cols; c += step) {
+    const int x = left + c * k + k / 2;
+    cv::line(img, {x, top - 5}, {x, top - 1}, tick, 1);
+    const std::string label = std::to_string(c);
+    const int w = TextSize(label, scale, 1).width;
+    PutText(img, label, {std::max(0, x - w / 2), top - 8}, scale, 1, kBlack);
+  }
+  for (int q = 0, step = TickStep(rows); q < rows; q += step) {
+    const int y = top + q * k + k / 2;
+    cv::line(img, {left - 5, y}, {left - 1, y}, tick, 1);
+    const std::string label = std::to_string(q);
+    const int w = TextSize(label, scale, 1).width;
+    PutText(img, label, {left - 8 - w, y + text_h / 2}, scale, 1, kBlack);
+  }
+  const int title_w = TextSize("reference frame", scale, 1).width;
+  PutText(img, "reference frame", {left + (std::min(cols * k, 600) - title_w) / 2, 13}, scale,
+          1, kBlack);
+  PutVerticalText(img, "query frame", {9, top + std::min(rows * k, 600) / 2}, scale, 1);
+}
+
 }  // namespace
 
 cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
@@ -304,10 +339,15 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
   // Nearest-neighbour enlargement by an integer factor.
   const int k = std::max(1, (kOverlayTarget + std::max(rows, cols) - 1) / std::max(rows, cols));
   const int image_w = cols * k, image_h = rows * k;
-  const cv::Mat3b legend = OverlayLegend(std::max(image_w, kOverlayTarget), rejected != nullptr);
-  cv::Mat3b img(image_h + legend.rows, legend.cols, cv::Vec3b(255, 255, 255));
+  const int left = kOverlayAxisLeft, top = kOverlayAxisTop;
+  const cv::Mat3b legend =
+      OverlayLegend(left + std::max(image_w, kOverlayTarget), rejected != nullptr);
+  cv::Mat3b whole(top + image_h + legend.rows, legend.cols, cv::Vec3b(255, 255, 255));
+  DrawOverlayAxes(whole, rows, cols, k);
+  // The block's pixels: `img` is a view of them, so that marks are placed in cell units.
+  cv::Mat3b img = whole(cv::Rect(left, top, image_w, image_h));
   if (k == 1) {
-    cells.copyTo(img(cv::Rect(0, 0, cols, rows)));
+    cells.copyTo(img);
   } else {
     for (int q = 0; q < rows; ++q) {
       const cv::Vec3b* in = cells.ptr<cv::Vec3b>(q);
@@ -350,8 +390,8 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
     }
   }
 
-  legend.copyTo(img(cv::Rect(0, image_h, legend.cols, legend.rows)));
-  return img;
+  legend.copyTo(whole(cv::Rect(0, top + image_h, legend.cols, legend.rows)));
+  return whole;
 }
 
 }  // namespace openable

@@ -39,6 +39,12 @@ cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& t
 // verification: cells (x = reference column, y = query row) of candidates that verification
 // rejected), those are marked in magenta under the answers, and the answers are labelled
 // "verified".
+//
+// Frame numbers (indices within the block: a traversal's frames from 0) are written along
+// the top (references) and the left (queries) every 1, 2 or 5 x 10^n frames: the block
+// starts kOverlayAxisLeft pixels from the left and kOverlayAxisTop from the top.
+inline constexpr int kOverlayAxisLeft = 48;
+inline constexpr int kOverlayAxisTop = 40;
 cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                         const GroundTruth& truth, const PerQueryResult& result,
                         double accept_threshold,

@@ -164,8 +164,14 @@ GroundTruth Truth(std::vector<std::vector<int>> matches, int references) {
 }
 
 // Centre pixel of block cell (q, r) with enlargement k.
+// The pixel at the middle of the enlarged cell (q, r): the block starts after the axes.
 cv::Vec3b Cell(const cv::Mat3b& img, int k, int q, int r) {
-  return img(q * k + k / 2, r * k + k / 2);
+  return img(kOverlayAxisTop + q * k + k / 2, kOverlayAxisLeft + r * k + k / 2);
+}
+
+// The pixel (y, x) of the block.
+cv::Vec3b At(const cv::Mat3b& img, int y, int x) {
+  return img(kOverlayAxisTop + y, kOverlayAxisLeft + x);
 }
 
 const cv::Vec3b kGreen(0, 200, 0);
@@ -192,11 +198,12 @@ PerQueryResult SmallResult() {
 TEST(Overlay, SizeIsTheEnlargedBlockAndALegendStrip) {
   const cv::Mat3b img = RenderOverlay(SmallBlock(), EvaluationLayout::QueryReference(4, 5),
                                       Truth({{1}, {4}, {}, {3}}, 5), SmallResult(), 0.3);
-  EXPECT_EQ(img.cols, 600);
-  EXPECT_GE(img.rows, 480 + 25);
-  EXPECT_LE(img.rows, 480 + 90);
+  EXPECT_EQ(img.cols, kOverlayAxisLeft + 600);
+  EXPECT_GE(img.rows, kOverlayAxisTop + 480 + 25);
+  EXPECT_LE(img.rows, kOverlayAxisTop + 480 + 90);
   // The strip below the block is white with some dark text.
-  const cv::Mat3b strip = img(cv::Rect(0, 480, img.cols, img.rows - 480));
+  const int below = kOverlayAxisTop + 480;
+  const cv::Mat3b strip = img(cv::Rect(0, below, img.cols, img.rows - below));
   EXPECT_EQ(strip(0, 0), cv::Vec3b(255, 255, 255));
   EXPECT_GT(CountColour(strip, {0, 0, strip.cols, strip.rows}, cv::Vec3b(0, 0, 0)), 50);
   EXPECT_GT(CountColour(strip, {0, 0, strip.cols, strip.rows}, kGreen), 50);
@@ -210,10 +217,28 @@ TEST(Overlay, AcceptedMatchesAreGreenWhenCorrectAndRedWhenWrong) {
   EXPECT_EQ(Cell(img, k, 0, 1), kGreen);  // q0 best c1 at 0.1, correct
   EXPECT_EQ(Cell(img, k, 1, 2), kRed);    // q1 best c2 at 0.2, wrong
   // The whole enlarged cell is marked.
-  EXPECT_EQ(img(0, k), kGreen);
-  EXPECT_EQ(img(k - 1, 2 * k - 1), kGreen);
+  EXPECT_EQ(At(img, 0, k), kGreen);
+  EXPECT_EQ(At(img, k - 1, 2 * k - 1), kGreen);
   // Above the threshold: not marked (q2 at 0.35, q3 at 0.45): plain grey.
   EXPECT_EQ(Cell(img, k, 2, 3), cv::Vec3b(89, 89, 89));  // round(255 * 0.35) = 89
+}
+
+// The block's frame numbers: a tick at the middle of every column and row of a 4 x 5 block
+// (fewer than 8 frames: every frame), with dark label text above and to the left.
+TEST(Overlay, FrameNumbersAlongTheTopAndTheLeft) {
+  const cv::Mat3b img = RenderOverlay(SmallBlock(), EvaluationLayout::QueryReference(4, 5),
+                                      Truth({{1}, {4}, {}, {3}}, 5), SmallResult(), 0.3);
+  const int k = 120;
+  const cv::Vec3b tick(90, 90, 90);
+  for (int c = 0; c < 5; ++c)
+    EXPECT_EQ(img(kOverlayAxisTop - 3, kOverlayAxisLeft + c * k + k / 2), tick) << c;
+  for (int q = 0; q < 4; ++q)
+    EXPECT_EQ(img(kOverlayAxisTop + q * k + k / 2, kOverlayAxisLeft - 3), tick) << q;
+  EXPECT_EQ(img(kOverlayAxisTop - 3, kOverlayAxisLeft + k / 4), cv::Vec3b(255, 255, 255));
+  EXPECT_GT(CountColour(img, {kOverlayAxisLeft, 0, 5 * k, kOverlayAxisTop}, cv::Vec3b(0, 0, 0)),
+            20);
+  EXPECT_GT(CountColour(img, {0, kOverlayAxisTop, kOverlayAxisLeft, 4 * k}, cv::Vec3b(0, 0, 0)),
+            20);
 }
 
 TEST(Overlay, GreyLevelIsTheRoundedValue) {
@@ -223,7 +248,7 @@ TEST(Overlay, GreyLevelIsTheRoundedValue) {
   EXPECT_EQ(Cell(img, k, 0, 0), cv::Vec3b(230, 230, 230));  // 255 * 0.9 = 229.5 -> 230
   EXPECT_EQ(Cell(img, k, 2, 0), cv::Vec3b(128, 128, 128));  // 127.5 -> 128
   EXPECT_EQ(Cell(img, k, 1, 0), cv::Vec3b(77, 77, 77));     // 76.5 -> 77
-  EXPECT_EQ(img(k - 1, 0), cv::Vec3b(230, 230, 230));       // last pixel row of cell (0, 0)
+  EXPECT_EQ(At(img, k - 1, 0), cv::Vec3b(230, 230, 230));   // last pixel row of cell (0, 0)
   // Values are clamped to [0, 1]: the -0.2 of cell (3, 4) is black (it is not marked: 0.45).
   EXPECT_EQ(Cell(img, k, 3, 4), cv::Vec3b(0, 0, 0));
 }
@@ -253,7 +278,7 @@ TEST(Overlay, UsesTheBlockOfTheLayout) {
   const cv::Mat3b img =
       RenderOverlay(m, EvaluationLayout::TwoTraversals(3, 3), Truth({{}, {}, {}}, 3), r, 0.5);
   const int k = 200;
-  EXPECT_EQ(img.cols, 600);
+  EXPECT_EQ(img.cols, kOverlayAxisLeft + 600);
   EXPECT_EQ(Cell(img, k, 0, 0), cv::Vec3b(51, 51, 51));
   EXPECT_EQ(Cell(img, k, 2, 2), cv::Vec3b(153, 153, 153));
   EXPECT_EQ(Cell(img, k, 1, 1), cv::Vec3b(255, 255, 255));
@@ -271,11 +296,11 @@ TEST(Overlay, OneByOneBlock) {
   const cv::Mat3b img =
       RenderOverlay(cv::Mat1f(1, 1, 0.25f), EvaluationLayout::QueryReference(1, 1),
                     Truth({{0}}, 1), r, 0.5);
-  EXPECT_EQ(img.cols, 600);
-  EXPECT_GT(img.rows, 600);
-  EXPECT_EQ(img(0, 0), kGreen);
-  EXPECT_EQ(img(599, 599), kGreen);
-  EXPECT_EQ(img(600, 599), cv::Vec3b(255, 255, 255));  // legend strip
+  EXPECT_EQ(img.cols, kOverlayAxisLeft + 600);
+  EXPECT_GT(img.rows, kOverlayAxisTop + 600);
+  EXPECT_EQ(At(img, 0, 0), kGreen);
+  EXPECT_EQ(At(img, 599, 599), kGreen);
+  EXPECT_EQ(At(img, 600, 599), cv::Vec3b(255, 255, 255));  // legend strip
 }
 
 TEST(Overlay, LargeBlockMarksAreAtLeast3x3) {
@@ -297,16 +322,23 @@ TEST(Overlay, LargeBlockMarksAreAtLeast3x3) {
   GroundTruth t = Truth(std::vector<std::vector<int>>(rows), cols);
   for (int q = 0; q < rows; ++q) t.matches[q] = {q / 2};
   const cv::Mat3b img = RenderOverlay(m, EvaluationLayout::QueryReference(rows, cols), t, r, 0.5);
-  EXPECT_EQ(img.cols, cols);
-  EXPECT_GT(img.rows, rows);
+  EXPECT_EQ(img.cols, kOverlayAxisLeft + cols);
+  EXPECT_GT(img.rows, kOverlayAxisTop + rows);
   for (int dy = -1; dy <= 1; ++dy)
     for (int dx = -1; dx <= 1; ++dx) {
-      EXPECT_EQ(img(1000 + dy, 500 + dx), kGreen);
-      EXPECT_EQ(img(2000 + dy, 1200 + dx), kRed);
+      EXPECT_EQ(At(img, 1000 + dy, 500 + dx), kGreen);
+      EXPECT_EQ(At(img, 2000 + dy, 1200 + dx), kRed);
     }
   // Untouched: a random cell away from the marks and the truth diagonal.
-  EXPECT_EQ(img(10, 1000)[0], static_cast<int>(std::lround(255 * m(10, 1000))));
-  EXPECT_EQ(img(10, 1000)[0], img(10, 1000)[2]);
+  EXPECT_EQ(At(img, 10, 1000)[0], static_cast<int>(std::lround(255 * m(10, 1000))));
+  EXPECT_EQ(At(img, 10, 1000)[0], At(img, 10, 1000)[2]);
+  // Frame numbers every 500 rows (3576 / 8 rounded up to 1, 2 or 5 x 10^n) and every 500
+  // columns (1788 / 8 -> 500): a tick beside row 500 and above column 1500, none between.
+  const cv::Vec3b tick(90, 90, 90), white(255, 255, 255);
+  EXPECT_EQ(img(kOverlayAxisTop + 500, kOverlayAxisLeft - 3), tick);
+  EXPECT_EQ(img(kOverlayAxisTop + 250, kOverlayAxisLeft - 3), white);
+  EXPECT_EQ(img(kOverlayAxisTop - 3, kOverlayAxisLeft + 1500), tick);
+  EXPECT_EQ(img(kOverlayAxisTop - 3, kOverlayAxisLeft + 1250), white);
 }
 
 }  // namespace
