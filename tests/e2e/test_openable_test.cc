@@ -251,6 +251,28 @@ TEST(TestOpenABLE, EveryProgramsHelpFitsAScreen) {
   EXPECT_NE(o.out.find("Image_sequences    "), std::string::npos);
 }
 
+// The timings block keeps every stage's line when geometric verification runs too (the
+// loop-closure preset verifies): description, matching, sequences, verification, export.
+TEST(TestOpenABLE, TimingsListEveryStageWithVerification) {
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunProgram(
+      testing::TestOpenableExe(),
+      {testing::SourceDir() + "/config/presets/loop_closure.txt", "--quiet", "--set",
+       "Images_path=" + testing::SampleDir() + "/summer", "--set", "Npy_name=", "--set",
+       "Png_name="},
+      dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const size_t timings = o.out.find("Timings (wall clock):\n");
+  ASSERT_NE(timings, std::string::npos) << o.out;
+  size_t at = timings;
+  for (const char* line : {"\n  total ", "\n  description ", "\n  matching ",
+                           "\n  sequences+norm. ", "\n  verification ", "\n  export "}) {
+    const size_t next = o.out.find(line, at);
+    EXPECT_NE(next, std::string::npos) << line << "\n" << o.out;
+    if (next != std::string::npos) at = next;
+  }
+}
+
 // --help-keys lists every key; --help-keys GROUP the keys of that group exactly, as the
 // Markdown reference (docs/configuration.md) groups them; an unknown group is a usage error.
 TEST(TestOpenABLE, HelpKeysListsEveryKeyOrOneGroup) {
