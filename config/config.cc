@@ -104,21 +104,22 @@ void AddInputKeys(OptionTable& t, Config& c) {
   // Representation
   t.Add("Txt_name", kRepresentation, c.output, c.output.txt_name,
         "Output: the normalised matrix M' (or M'' when Threshold is set, as the original) as "
-        "space-separated text, one row per line. Empty: not written (text is slow and large for "
-        "long runs).", false);
+        "space-separated text, one row per line, with <name>.json beside it (the settings that "
+        "shaped it). Empty: not written (text is slow and large for long runs).", false);
   t.Add("Npy_name", kRepresentation, c.output, c.output.npy_name,
         "Output: the normalised matrix M' (before any threshold) as a float32 NumPy .npy file "
-        "(numpy.load reads it). Empty: not written.");
+        "(numpy.load reads it), and beside it <name>.json, the settings that shaped it "
+        "(docs/output_formats.md). Empty: not written.");
   t.Add("Timestamps_name", kRepresentation, c.output, c.output.timestamps_name,
         "Output: the time of every frame of the matrix (ROS bags, Frame_mode 3: message header "
         "stamps), one line \"<row> <seconds>\" per row, for tools that associate frames by time "
         "(Snaps_frame_times, TUM trajectories). Empty: not written; refused for frames without "
         "times.");
   t.Add("Png_name", kRepresentation, c.output, c.output.png_name,
-        "Output: the normalised matrix M' as a colour image, one pixel per pair of frames, "
-        "coloured with Matrix_color. Empty: not written.", false);
+        "Output: the normalised matrix M' as a colour PNG image (a .png path), one pixel per "
+        "pair of frames, coloured with Matrix_color. Empty: not written.", false);
   t.Add("Png_threshold_name", kRepresentation, c.output, c.output.png_threshold_name,
-        "Output when Threshold is set: the thresholded matrix M'' as an image, coloured with "
+        "Output when Threshold is set: the thresholded matrix M'' as a PNG image, coloured with "
         "Matrix_color at 0 (loop candidate, M' < Threshold) and 1 (not): black and white with map"
         " 0. Empty: Png_name with _thresholded before the extension.");
   t.Add("Matrix_color", kRepresentation, c.output, c.output.matrix_color, 0, 11,
