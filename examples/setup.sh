@@ -11,7 +11,7 @@
 # without the packages Debian only recommends) and builds the programs Test_OpenABLE and
 # openable_evaluate (`cmake --build build` adds openable_sweep and openable_snaps), not the
 # tests, benchmarks or the Python module. The optional parts, each its packages and what they build:
-#   tests     GoogleTest, Google Benchmark and oiiotool: the test suite and benchmarks
+#   tests     GoogleTest and Google Benchmark: the test suite and benchmarks
 #   python    pybind11, NumPy, the Python headers, pip/setuptools/wheel/venv: the module
 #             openable and `pip install .` (docs/python.md)
 #   mpi       Open MPI: runs over several processes (docs/distributed.md)
@@ -29,12 +29,14 @@ usage() { sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; }
 # What the configuration requires (CMakeLists.txt's find_package ... REQUIRED): OpenCV (its
 # libopencv-dev depends on libopencv-contrib-dev, which holds ximgproc), Eigen, OpenImageIO,
 # libpng, zlib, libjpeg, nlohmann-json (header-only; every JSON document, OpenABLE/io/json.h).
-core=(cmake g++ make libopencv-dev libeigen3-dev libopenimageio-dev libpng-dev zlib1g-dev
-      libjpeg-dev nlohmann-json3-dev)
+# openimageio-tools too: Debian's OpenImageIO CMake package names its programs (iconvert, ...)
+# as targets and stops the configuration when they are absent.
+core=(cmake g++ make libopencv-dev libeigen3-dev libopenimageio-dev openimageio-tools
+      libpng-dev zlib1g-dev libjpeg-dev nlohmann-json3-dev)
 all_parts=(tests python mpi faiss rosbag chromium fuzz)
 part_packages() {
   case "$1" in
-    tests) echo libgtest-dev libgmock-dev libbenchmark-dev openimageio-tools ;;
+    tests) echo libgtest-dev libgmock-dev libbenchmark-dev ;;
     python) echo python3-numpy python3-dev pybind11-dev python3-pip python3-setuptools \
                  python3-wheel python3-venv ;;
     mpi) echo libopenmpi-dev openmpi-bin ;;
