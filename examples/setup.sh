@@ -6,6 +6,7 @@
 #   bash examples/setup.sh --with mpi,python  the programs plus the parts named
 #   bash examples/setup.sh --all              every part: the whole build, tests included
 #   bash examples/setup.sh --help
+#   bash examples/setup.sh [--all | --with ...] --print-packages   the Debian packages, no more
 #
 # Without options it installs the packages the build cannot do without (the first list below,
 # without the packages Debian only recommends) and builds the programs Test_OpenABLE and
@@ -24,7 +25,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-usage() { sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { awk 'NR == 1 { next } /^#/ { sub(/^# ?/, ""); print; next } { exit }' "$0"; }
 
 # What the configuration requires (CMakeLists.txt's find_package ... REQUIRED): OpenCV (its
 # libopencv-dev depends on libopencv-contrib-dev, which holds ximgproc), Eigen, OpenImageIO,
@@ -49,14 +50,17 @@ part_packages() {
 }
 
 parts=()
+print_packages=0
 while (($#)); do
   case "$1" in
     --all) parts=("${all_parts[@]}") ;;
     --with) [ $# -ge 2 ] || { echo "setup.sh: --with needs a list, e.g. --with mpi,python" >&2; exit 2; }
             IFS=, read -r -a more <<< "$2"; parts+=("${more[@]}"); shift ;;
     --with=*) IFS=, read -r -a more <<< "${1#--with=}"; parts+=("${more[@]}") ;;
+    --print-packages) print_packages=1 ;;
     -h|--help) usage; exit 0 ;;
-    *) echo "setup.sh: unknown argument '$1' (--all, --with PART[,PART...], --help)" >&2; exit 2 ;;
+    *) echo "setup.sh: unknown argument '$1' (--all, --with PART[,PART...], --print-packages, --help)" >&2
+       exit 2 ;;
   esac
   shift
 done
@@ -69,6 +73,10 @@ for p in "${parts[@]}"; do
   read -r -a more <<< "$list"
   packages+=("${more[@]}")
 done
+if ((print_packages)); then
+  echo "${core[@]}" "${packages[@]}"
+  exit 0
+fi
 
 missing() {
   local p
