@@ -19,12 +19,51 @@ import re
 import shutil
 import subprocess
 import sys
+import sysconfig
 
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 ROOT = os.path.dirname(os.path.abspath(__file__))
 PROGRAMS = ["Test_OpenABLE", "openable_evaluate", "openable_snaps", "openable_sweep"]
+
+
+BUILD_COMMANDS = {"build", "build_ext", "bdist_wheel", "install", "develop", "egg_info",
+                  "dist_info", "editable_wheel"}
+VENV_HINT = ("/usr/bin/python3 -m venv --system-site-packages ~/venvs/openable, then "
+             "~/venvs/openable/bin/pip install --no-build-isolation . (docs/python.md)")
+
+
+def importable(name):
+    try:
+        __import__(name)
+    except ImportError:
+        return False
+    return True
+
+
+def check_interpreter():
+    """One line and exit 1, before anything is built, when this Python cannot build the package.
+
+    pip install --no-build-isolation . runs setup.py with the interpreter of the pip it was
+    given: a Python of pyenv or conda, or a venv made from one, often lacks NumPy (which the
+    module imports) and wheel (setuptools before 70.1 makes wheels with it), whereas Debian's
+    python3-numpy and python3-wheel belong to /usr/bin/python3.
+    """
+    lacks = []
+    if not importable("numpy"):
+        lacks.append("NumPy")
+    if not (importable("setuptools.command.bdist_wheel") or importable("wheel.bdist_wheel")):
+        lacks.append("wheel (bdist_wheel)")
+    if lacks:
+        which = sys.executable
+        if sys.prefix != sys.base_prefix:
+            which += ", a venv of " + sys.base_prefix
+        sys.stderr.write("setup.py: this Python (%s; %d.%d) has no %s: make the environment with "
+                         "Debian's Python: %s\n"
+                         % (which, sys.version_info[0], sys.version_info[1],
+                            " and no ".join(lacks), VENV_HINT))
+        sys.exit(1)
 
 
 def project_version():
@@ -71,6 +110,12 @@ class CMakeBuild(build_ext):
                 if line.strip():
                     folder, path = line.rstrip("\n").split(" ", 1)
                     entries.append((folder, path))
+        suffix = sysconfig.get_config_var("EXT_SUFFIX")
+        for folder, path in entries:
+            if folder == "." and not path.endswith(suffix):
+                sys.exit("setup.py: the build tree %s made %s, for another Python than this one "
+                         "(%s, whose extensions end in %s): %s"
+                         % (build_dir, os.path.basename(path), sys.executable, suffix, VENV_HINT))
         target = self.get_ext_fullpath(ext.name)
         package_out = os.path.dirname(target)
         for folder in ("bin", "modules"):
@@ -84,6 +129,8 @@ class CMakeBuild(build_ext):
             shutil.copy2(path, destination)
 
 
+if BUILD_COMMANDS & set(sys.argv[1:]):
+    check_interpreter()
 # setuptools' own folders inside build/ (not build/lib.*, next to CMake's build tree) and no
 # openable.egg-info/ at the root of the clone.
 os.makedirs(os.path.join(ROOT, "build", "pip"), exist_ok=True)

@@ -14,7 +14,7 @@
 namespace openable {
 namespace {
 
-std::string Shape(const cv::Mat& m) {
+std::string MatShape(const cv::Mat& m) {
   return std::to_string(m.rows) + " x " + std::to_string(m.cols) + " " + cv::typeToString(m.type());
 }
 
@@ -46,7 +46,7 @@ void ComputeOne(const std::string& name, cv::Feature2D& feature, const cv::Mat& 
   if (keypoints.size() != 1 || descriptors.rows != 1 || descriptors.cols != row.cols ||
       descriptors.type() != row.type()) {
     throw std::logic_error(name + ": OpenCV returned " + std::to_string(keypoints.size()) +
-                           " keypoint(s) and a " + Shape(descriptors) +
+                           " keypoint(s) and a " + MatShape(descriptors) +
                            " descriptor block for the central keypoint; expected 1 and 1 x " +
                            std::to_string(row.cols) + " " + cv::typeToString(row.type()));
   }
@@ -151,7 +151,7 @@ void BriskDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
     throw std::logic_error(
         "BRISK: OpenCV returned " + std::to_string(keypoints.size()) + " keypoint(s)" +
         (keypoints.empty() ? std::string() : " at angle " + std::to_string(keypoints[0].angle)) +
-        " and a " + Shape(descriptors) +
+        " and a " + MatShape(descriptors) +
         " descriptor block; expected 1 keypoint at angle 0 and 1 x 64 CV_8UC1");
   }
   descriptors.copyTo(row);

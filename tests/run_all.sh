@@ -13,8 +13,8 @@ root=$(pwd)
 jobs=${OPENABLE_JOBS:-$(nproc)}
 step_start=$SECONDS
 done_step() { echo "== $1 done in $((SECONDS - step_start)) s"; step_start=$SECONDS; }
-bash examples/setup.sh
-done_step "Set-up, build and demo (examples/setup.sh)"
+bash examples/setup.sh --all
+done_step "Set-up and build (examples/setup.sh --all)"
 (cd build && ctest --output-on-failure -j"$jobs" --timeout 1200)
 done_step "Test suite"
 
@@ -70,7 +70,7 @@ echo 'extern "C" int LLVMFuzzerTestOneInput(const char*, unsigned long) { return
   > "$probe/probe.cc"
 if ! command -v clang++ > /dev/null ||
    ! clang++ -fsanitize=fuzzer "$probe/probe.cc" -o "$probe/probe" 2> /dev/null; then
-  echo "== Fuzzers skipped: clang++ with libFuzzer is not available (examples/setup.sh installs it)"
+  echo "== Fuzzers skipped: clang++ with libFuzzer is not available (examples/setup.sh --all installs it)"
   exit 0
 fi
 echo "== Fuzzers (${fuzz_seconds} s each) in build_fuzz"

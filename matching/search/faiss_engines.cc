@@ -15,7 +15,7 @@
 namespace openable {
 namespace {
 
-[[noreturn]] void Fail(const std::string& message) { throw std::invalid_argument(message); }
+[[noreturn]] void FailFaiss(const std::string& message) { throw std::invalid_argument(message); }
 
 // Binary IVF: the cells FAISS trained and filled, scanned here with OpenABLE's Hamming
 // kernels rather than by FAISS's search. Debian's libfaiss is built for baseline x86-64: its
@@ -70,10 +70,10 @@ std::unique_ptr<FaissIndex> ReadFaiss(const ApproximateOptions& o, const cv::Mat
   try {
     index.reset(read(SettingsOf(o, refs, hnsw), saved.data(), saved.size()));
   } catch (const std::runtime_error& e) {
-    Fail(std::string("ApproximateIndex: the saved index cannot be read: ") + e.what());
+    FailFaiss(std::string("ApproximateIndex: the saved index cannot be read: ") + e.what());
   }
   if (index->Size() != refs.rows)
-    Fail("ApproximateIndex: the saved index holds " + std::to_string(index->Size()) +
+    FailFaiss("ApproximateIndex: the saved index holds " + std::to_string(index->Size()) +
          " rows, expected " + std::to_string(refs.rows) + " (its references)");
   return index;
 }
@@ -86,7 +86,7 @@ std::unique_ptr<IvfCells> CellsOf(const FaissIndex& index, const cv::Mat& refs) 
   if (refs.depth() != CV_8U || !index.BinaryCells(&centres, &cells) || cells.empty()) return {};
   const std::size_t width = static_cast<std::size_t>(refs.cols);
   if (centres.size() != cells.size() * width)
-    Fail("ApproximateIndex: the IVF index has " + std::to_string(centres.size()) +
+    FailFaiss("ApproximateIndex: the IVF index has " + std::to_string(centres.size()) +
          " bytes of cell centres, expected " + std::to_string(cells.size() * width));
   auto out = std::make_unique<IvfCells>();
   const cv::Mat centre_rows(static_cast<int>(cells.size()), refs.cols, CV_8U, centres.data());
@@ -101,7 +101,7 @@ std::unique_ptr<IvfCells> CellsOf(const FaissIndex& index, const cv::Mat& refs) 
     cv::Mat rows(static_cast<int>(ids.size()), refs.cols, CV_8U);
     for (std::size_t i = 0; i < ids.size(); ++i) {
       if (ids[i] < 0 || ids[i] >= refs.rows)
-        Fail("ApproximateIndex: the IVF index names row " + std::to_string(ids[i]) +
+        FailFaiss("ApproximateIndex: the IVF index names row " + std::to_string(ids[i]) +
              ", expected 0 to " + std::to_string(refs.rows - 1));
       refs.row(static_cast<int>(ids[i])).copyTo(rows.row(static_cast<int>(i)));
       out->ids[l].push_back(static_cast<int>(ids[i]));
@@ -109,7 +109,7 @@ std::unique_ptr<IvfCells> CellsOf(const FaissIndex& index, const cv::Mat& refs) 
     out->rows[l] = std::make_unique<HammingReferences>(rows);
   }
   if (total != refs.rows)
-    Fail("ApproximateIndex: the IVF index's cells hold " + std::to_string(total) +
+    FailFaiss("ApproximateIndex: the IVF index's cells hold " + std::to_string(total) +
          " rows, expected " + std::to_string(refs.rows));
   return out;
 }

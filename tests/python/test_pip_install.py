@@ -8,6 +8,7 @@ build; its time is in docs/benchmarks.md ("pip install").
 """
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -181,6 +182,123 @@ class UserSite(support.TempDirTestCase):
             where = check([sys.executable, "-c", "import openable; print(openable.__file__)"],
                           self.tmp, env, "import").stdout
             self.assertNotIn(str(base), where)
+
+
+DEBIAN_PYTHON = "/usr/bin/python3"
+ONE_LINE_HINT = "/usr/bin/python3 -m venv --system-site-packages"
+
+
+def foreign_python(env):
+    """The first python3 on PATH that is not Debian's (pyenv, conda, a build of one's own), as
+    (interpreter, base prefix), or None."""
+    for folder in env.get("PATH", "").split(os.pathsep):
+        candidate = os.path.join(folder, "python3")
+        if not folder or not os.access(candidate, os.X_OK):
+            continue
+        done = subprocess.run([candidate, "-c", "import sys; print(sys.executable); "
+                               "print(sys.base_prefix)"], env=env, text=True,
+                              stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+        if done.returncode != 0:
+            continue
+        executable, base = done.stdout.split("\n")[:2]
+        if base != "/usr":
+            return executable, base
+        return None  # the first python3 on PATH is Debian's
+    return None
+
+
+class NotDebiansPython(support.TempDirTestCase):
+    """docs/python.md's install run by a python3 that is not Debian's (pyenv, conda): it must
+    work, or stop before building with one line naming Debian's Python; the build tree's module
+    imported by it must work, or fail with a one-line hint.
+
+    When PATH has no such Python (a CI machine), a venv of Debian's Python made without its
+    site packages stands in: it has pip and setuptools but neither NumPy nor wheel, as a fresh
+    pyenv Python.
+    """
+
+    @classmethod
+    def setUpClass(cls):
+        super().setUpClass()
+        if not (Path(BUILD_TREE) / "python" / "package_files.txt").exists():
+            raise unittest.SkipTest("no Python package in the build tree %s" % BUILD_TREE)
+        cls.env = clean_env(OPENABLE_CMAKE_BUILD_DIR=BUILD_TREE)
+        found = foreign_python(cls.env)
+        if found:
+            cls.python, base = found
+            cls.what = "%s (base %s)" % (cls.python, base)
+            # What a user of that Python does with the documented commands: a venv of it.
+            cls.venv = cls.tmp / "venv"
+            check([cls.python, "-m", "venv", "--system-site-packages", cls.venv], cls.tmp,
+                  cls.env, "venv of " + cls.python)
+        else:
+            cls.venv = cls.tmp / "stand_in"
+            cls.what = "stand-in venv of %s without its site packages" % DEBIAN_PYTHON
+            check([DEBIAN_PYTHON, "-m", "venv", cls.venv], cls.tmp, cls.env, "stand-in venv")
+        print("\nNot Debian's Python: %s" % cls.what, file=sys.stderr)
+        cls.venv_python = cls.venv / "bin" / "python"
+
+    def test_pip_install_works_or_says_in_one_line_what_to_use(self):
+        done = subprocess.run([str(self.venv_python), "-m", "pip", "install",
+                               "--no-build-isolation", str(support.SOURCE_DIR)],
+                              cwd=str(self.tmp), env=self.env, text=True,
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+        output = done.stdout
+        if done.returncode == 0:
+            # This Python had NumPy and wheel: the installed package must import and work.
+            image = np.full((3, 4), 102, np.uint8)
+            pgm(self.tmp / "probe.pgm", image)
+            report = probe(self.venv_python, self.env, self.tmp, self.tmp / "probe.pgm")
+            np.testing.assert_allclose(np.array(report["image"]), image / 255.0, atol=1e-7)
+            return
+        lines = [line.strip() for line in output.splitlines() if "setup.py: " in line]
+        self.assertEqual(len(lines), 1, output[-3000:])
+        self.assertIn(ONE_LINE_HINT, lines[0])
+        self.assertIn(str(self.venv_python.parent), lines[0])  # names the Python it ran with
+        self.assertNotIn("invalid command", output)
+        self.assertNotIn("Traceback", output)
+        # Nothing was installed.
+        done = subprocess.run([str(self.venv_python), "-c", "import openable"], cwd=str(self.tmp),
+                              env=self.env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.assertNotEqual(done.returncode, 0)
+
+    def test_build_tree_module_imports_or_gives_a_one_line_hint(self):
+        env = dict(self.env, PYTHONPATH=str(Path(BUILD_TREE) / "python"))
+        pgm(self.tmp / "tree.pgm", np.full((2, 5), 153, np.uint8))
+        # Importing is not enough: reading an image returns a NumPy array.
+        done = subprocess.run([str(self.venv_python), "-c",
+                               "import sys, openable; print(openable.read_image(sys.argv[1])"
+                               ".shape)", str(self.tmp / "tree.pgm")],
+                              cwd=str(self.tmp), env=env, text=True, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE)
+        if done.returncode == 0:
+            self.assertEqual(done.stdout.strip(), "(2, 5)")
+            return
+        last = done.stderr.strip().splitlines()[-1]
+        self.assertTrue(last.startswith("ImportError: openable"), done.stderr)
+        self.assertIn(ONE_LINE_HINT, last)
+        built_for = (Path(BUILD_TREE) / "python" / "openable" / "_build_tree.py").read_text()
+        named = re.search(r"built for (\S+?)[;,]", last)
+        self.assertTrue(named, last)
+        self.assertIn('PYTHON_EXECUTABLE = "%s"' % named.group(1), built_for)
+        # The hint replaces the error: no chained traceback of the failed import.
+        self.assertNotIn("During handling", done.stderr)
+
+    def test_debians_python_installs_it(self):
+        """The documented command with Debian's Python works (the other classes check the
+        installed package in detail)."""
+        if not os.access(DEBIAN_PYTHON, os.X_OK):
+            self.skipTest("no %s" % DEBIAN_PYTHON)
+        venv = self.tmp / "debian_venv"
+        check([DEBIAN_PYTHON, "-m", "venv", "--system-site-packages", venv], self.tmp, self.env,
+              "python3 -m venv")
+        check([venv / "bin" / "pip", "install", "--no-build-isolation", support.SOURCE_DIR],
+              self.tmp, self.env, "pip install --no-build-isolation .")
+        image = np.full((2, 3), 204, np.uint8)
+        pgm(self.tmp / "debian.pgm", image)
+        report = probe(venv / "bin" / "python", self.env, self.tmp, self.tmp / "debian.pgm")
+        self.assertTrue(Path(report["file"]).resolve().is_relative_to(venv.resolve()), report)
+        np.testing.assert_allclose(np.array(report["image"]), image / 255.0, atol=1e-7)
 
 
 if __name__ == "__main__":
