@@ -161,11 +161,6 @@ namespace {
 
 using Remembered = std::map<std::string, std::pair<std::string, std::string>>;
 
-// The settings file a remembered key came from.
-const std::string& SettingsFileOf(const Remembered& remembered, const std::string& key) {
-  return remembered.at(key).second;
-}
-
 // Two paths of the same existing file.
 bool SameFile(const std::string& a, const std::string& b) {
   std::error_code ec;
@@ -227,17 +222,15 @@ EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line) {
   std::string applied;
   const Config defaults;
   for (const auto& [key, value_file] : remembered) {
-    const std::string& value = value_file.first;
-    const std::string now = ConfigValueText(config, key);
-    const std::string plain =
-        now.size() >= 2 && now.front() == '"' ? now.substr(1, now.size() - 2) : now;
+    const auto& [value, file] = value_file;
+    const std::string plain = MatrixSettingValue(config, key);
     const bool same = plain == value || (key.rfind("Ground_truth", 0) == 0 && !plain.empty() &&
                                          SameFile(plain, value));
     if (!same && !(value.empty() && key.rfind("Ground_truth", 0) == 0))
       out.notes.push_back(key + " " + Quoted(plain) + " as given here, not " + Quoted(value) +
-                          " as the matrix's run had it (" + SettingsFileOf(remembered, key) +
+                          " as the matrix's run had it (" + file +
                           "): the figures may differ from the run's");
-    else if (ConfigValueText(defaults, key) != now)
+    else if (MatrixSettingValue(defaults, key) != plain)
       applied += (applied.empty() ? "" : ", ") + key + " " + plain;
   }
   if (!remembered.empty())

@@ -26,14 +26,13 @@ const std::vector<std::string>& MatrixEvaluationKeys() {
 
 std::string MatrixSettingsPath(const std::string& matrix_path) { return matrix_path + ".json"; }
 
-namespace {
-
-// A key's value as --set takes it: Config.txt's text without the quotes of a text value.
-std::string PlainValue(const Config& config, const std::string& key) {
+std::string MatrixSettingValue(const Config& config, const std::string& key) {
   std::string v = ConfigValueText(config, key);
   if (v.size() >= 2 && v.front() == '"' && v.back() == '"') v = v.substr(1, v.size() - 2);
   return v;
 }
+
+namespace {
 
 std::string Absolute(const std::string& path) {
   if (path.empty()) return path;
@@ -59,9 +58,9 @@ std::string EncodeMatrixSettings(const Config& config, const RunResult& result,
   for (const Traversal& t : result.traversals)
     traversals.push_back({{"key", t.key}, {"path", t.path}, {"frames", t.frames}});
   o["reference_frames"] = result.traversals.size() == 2 ? result.traversals[0].frames : 0;
-  o["match_score"] = PlainValue(c, "Match_score");
+  o["match_score"] = MatrixSettingValue(c, "Match_score");
   Json& keys = o["evaluation_keys"] = Json::object();
-  for (const std::string& key : MatrixEvaluationKeys()) keys[key] = PlainValue(c, key);
+  for (const std::string& key : MatrixEvaluationKeys()) keys[key] = MatrixSettingValue(c, key);
   // The same settings as the keywords of Python's openable.evaluate (docs/python.md).
   const EvaluationSettings s = EvaluationSettingsFrom(c);
   Json& py = o["python_evaluate"] = Json::object();
@@ -92,7 +91,7 @@ std::string EncodeMatrixSettings(const Config& config, const RunResult& result,
   // Every key of the run, for the record: what else shaped the matrix (descriptor, sequences,
   // preprocessing...). Readers apply only evaluation_keys.
   Json& all = o["settings"] = Json::object();
-  for (const std::string& key : ConfigKeyNames()) all[key] = PlainValue(c, key);
+  for (const std::string& key : ConfigKeyNames()) all[key] = MatrixSettingValue(c, key);
   return json::Dump(o);
 }
 

@@ -21,6 +21,10 @@ namespace openable {
 // sequence settings the consistency acceptance follows. A reader applies these.
 const std::vector<std::string>& MatrixEvaluationKeys();
 
+// The value of `key` in `config` as a settings file holds it and --set takes it: Config.txt's
+// text without the quotes of a text value.
+std::string MatrixSettingValue(const Config& config, const std::string& key);
+
 // The path of the settings file of `matrix_path`: matrix_path + ".json".
 std::string MatrixSettingsPath(const std::string& matrix_path);
 

@@ -4,6 +4,10 @@
 // dense and the bounded mode, for one and two traversals, L = 1 and L = 10, with 1, 2 and 3
 // processes; a process that fails ends the run with one line naming it and leaves no output.
 // Skipped, saying why, when mpirun or the MPI module is absent.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,12 +17,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
@@ -240,26 +238,12 @@ TEST(SpreadFailure, CtrlCOnMpirunPrintsOneLineAndLeavesNoOutput) {
                         << data << "\"\nImage_descriptor: LDB\nThreads: 1\n"
                         << "Npy_name: \"out/matrix.npy\"\n";
   const std::string err = dir + "/stderr.log";
-  const pid_t child = ::fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    if (::chdir(dir.c_str()) != 0) ::_exit(99);
-    const int fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, 2);
-    const int null = ::open("/dev/null", O_WRONLY);
-    ::dup2(null, 1);
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-    ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-    ::setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 1);
-    const std::string exe = testing::TestOpenableExe();
-    ::execlp("mpirun", "mpirun", "--quiet", "-np", "2", exe.c_str(), config.c_str(),
-             static_cast<char*>(nullptr));
-    ::_exit(98);
-  }
-  // Wait until process 0 is describing, then a little more.
-  for (int k = 0; k < 1000 && ReadAll(err).find("describing") == std::string::npos; ++k)
-    ::usleep(10000);
-  ::usleep(300000);
+  const pid_t child = StartRunToInterrupt(
+      dir, {"mpirun", "--quiet", "-np", "2", testing::TestOpenableExe(), config}, err,
+      {"OMPI_ALLOW_RUN_AS_ROOT=1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1",
+       "OMPI_MCA_rmaps_base_oversubscribe=1"},
+      10000);
+  ASSERT_GT(child, 0);
   int status = 0;
   if (::waitpid(child, &status, WNOHANG) == child)
     GTEST_SKIP() << "the run finished before it could be interrupted";

@@ -1,8 +1,10 @@
 // Helpers of the end-to-end tests: running a program, reading what it wrote.
 #pragma once
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -59,6 +61,33 @@ inline Outcome RunProgram(const std::string& exe, const std::vector<std::string>
   fs::remove(dir + "/stdout.log");
   fs::remove(dir + "/stderr.log");
   return o;
+}
+
+// A run started in the background to be interrupted: `argv` (argv[0] looked up in PATH) runs
+// in `dir` with `env` ("NAME=value") added, stdout discarded and stderr in `err`. Returns once
+// stderr says "describing" (its first progress line, written when a traversal is described, as
+// stderr is not a terminal) and 300 ms more, or after `wait_ms` without it; the test then
+// checks the child is still running, signals it and reaps it. -1 when fork failed.
+inline pid_t StartRunToInterrupt(const std::string& dir, const std::vector<std::string>& argv,
+                                 const std::string& err, const std::vector<std::string>& env = {},
+                                 int wait_ms = 4000) {
+  const pid_t child = ::fork();
+  if (child == 0) {
+    if (::chdir(dir.c_str()) != 0) ::_exit(99);
+    ::dup2(::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644), 2);
+    ::dup2(::open("/dev/null", O_WRONLY), 1);
+    for (const std::string& e : env) ::putenv(const_cast<char*>(e.c_str()));
+    std::vector<char*> args;
+    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    ::execvp(args[0], args.data());
+    ::_exit(98);
+  }
+  for (int k = 0;
+       child > 0 && k < wait_ms / 10 && ReadAll(err).find("describing") == std::string::npos; ++k)
+    ::usleep(10000);
+  ::usleep(300000);
+  return child;
 }
 
 // `first` (a Config.txt or a preset, when there is one), "--quiet", then each of `settings`

@@ -642,25 +642,12 @@ TEST(TestOpenABLE, SigtermDuringARunLeavesNoOutput) {
   const std::string dir = testing::TempDir();
   const std::string config = SampleConfig(dir);
   const std::string err = dir + "/stderr.log";
-  const pid_t child = ::fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    if (::chdir(dir.c_str()) != 0) ::_exit(99);
-    const int fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, 2);
-    const int null = ::open("/dev/null", O_WRONLY);
-    ::dup2(null, 1);
-    const std::string exe = testing::TestOpenableExe();
-    const std::string a = "Images_path=" + data + "/summer",
-                      b = "Images_path_2=" + data + "/winter";
-    ::execl(exe.c_str(), exe.c_str(), config.c_str(), "--set", a.c_str(), "--set", b.c_str(),
-            "--set", "Threads=1", static_cast<char*>(nullptr));
-    ::_exit(98);
-  }
-  // Wait until the run is describing, then a little more.
-  for (int k = 0; k < 400 && ReadAll(err).find("describing") == std::string::npos; ++k)
-    ::usleep(10000);
-  ::usleep(300000);
+  const pid_t child = StartRunToInterrupt(
+      dir,
+      {testing::TestOpenableExe(), config, "--set", "Images_path=" + data + "/summer", "--set",
+       "Images_path_2=" + data + "/winter", "--set", "Threads=1"},
+      err);
+  ASSERT_GT(child, 0);
   int status = 0;
   if (::waitpid(child, &status, WNOHANG) == child)
     GTEST_SKIP() << "the run finished before it could be interrupted";
