@@ -9,9 +9,9 @@
 #   bash examples/setup.sh [--all | --with ...] --print-packages   the Debian packages, no more
 #
 # Without options it installs the packages the build cannot do without (the first list below,
-# without the packages Debian only recommends) and builds the programs Test_OpenABLE and
-# openable_evaluate (`cmake --build build` adds openable_sweep and openable_snaps), not the
-# tests, benchmarks or the Python module. The optional parts, each its packages and what they build:
+# without the packages Debian only recommends) and builds the program the demo runs,
+# Test_OpenABLE (`cmake --build build` adds openable_evaluate, openable_sweep and
+# openable_snaps), not the tests, benchmarks or the Python module. The optional parts, each its packages and what they build:
 #   tests     GoogleTest and Google Benchmark: the test suite and benchmarks
 #   python    pybind11, NumPy, the Python headers, pip/setuptools/wheel/venv: the module
 #             openable and `pip install .` (docs/python.md)
@@ -119,8 +119,9 @@ cmake -S . -B build "${settings[@]}"
 if has_part tests; then
   cmake --build build -j"$jobs"  # everything
 else
-  # openable_sweep and openable_snaps too with `cmake --build build` (or any --with python).
-  targets=(Test_OpenABLE openable_evaluate)
+  # openable_evaluate, openable_sweep and openable_snaps too with `cmake --build build` (or
+  # any --with python).
+  targets=(Test_OpenABLE)
   has_part python && targets+=(openable_python_package)
   # The run-time modules (those of mpi, faiss and rosbag when their packages are there) come
   # with the programs.
