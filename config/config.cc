@@ -1,11 +1,9 @@
 #include "config/config.h"
 
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/input_file.h"
 #include "OpenABLE/base/strings.h"
 #include "descriptors/registry.h"
 #include "matching/search/engine_registry.h"
@@ -198,16 +196,17 @@ void AddDescriptionKeys(OptionTable& t, Config& c) {
         "0 sums along diagonals (both routes driven the same way, the original); 1 along anti-"
         "diagonals (the reference route driven the opposite way); 2 the smaller of the two for "
         "every cell (needs a second matrix in dense mode).");
-  t.AddEnumName("Sequence_partial", kDescription, c.matching, c.matching.partial,
-        "What a sequence cell holds when fewer than L frames precede it in its traversal (the "
-        "first L - 1 frames; along anti-diagonals also the last L - 1 references): ahead, the "
-        "sum of the L frames that start where its diagonal enters both traversals (the window "
-        "looks ahead where it cannot look back, so every cell sums L frames and the first "
-        "frames can be matched; a diagonal of fewer than L frames in all has no value); scale, "
-        "the terms it has scaled up to L (fewer terms: noisier cells, some become attractors); "
-        "skip, no value, the rule of OpenSeqSLAM. A cell without a value is never a candidate "
-        "nor a best match, and is written as the largest value of the matrix in Txt_name and "
-        "the PNGs and as NaN in Npy_name (docs/matching.md compares the three).");
+  t.AddEnumName(
+      "Sequence_partial", kDescription, c.matching, c.matching.partial,
+      "What a sequence cell holds when fewer than L frames precede it in its traversal (the "
+      "first L - 1 frames; along anti-diagonals also the last L - 1 references): ahead, the "
+      "sum of the L frames that start where its diagonal enters both traversals (the window "
+      "looks ahead where it cannot look back, so every cell sums L frames and the first "
+      "frames can be matched; a diagonal of fewer than L frames in all has no value); scale, "
+      "the terms it has scaled up to L (fewer terms: noisier cells, some become attractors); "
+      "skip, no value, the rule of OpenSeqSLAM. A cell without a value is never a candidate "
+      "nor a best match, and is written as the largest value of the matrix in Txt_name and "
+      "the PNGs and as +inf in Npy_name (docs/matching.md compares the three).");
   t.AddEnumName("Match_score", kDescription, c.matching, c.matching.score,
         "How confident a query's best match is, for Match_threshold, the per-query evaluation "
         "(PR curve, AUC, R@100P, F1), the score column of Matches_name: distance (its "
@@ -646,18 +645,10 @@ Config ParseConfigText(const std::string& text, const std::string& name) {
 Config LoadConfig(const std::string& path) { return LoadConfig(path, Config()); }
 
 Config LoadConfig(const std::string& path, Config base) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    std::error_code ec;
-    const bool exists = std::filesystem::exists(path, ec);
-    throw InputError("configuration file " + Quoted(path) +
-                     (exists ? " cannot be opened" : " does not exist" + WorkingDirectoryNote(path)) +
-                     " (expected a readable Config.txt; see Test_OpenABLE --help)");
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError("configuration file " + Quoted(path) + " could not be read");
-  ParseOptionText(ConfigTable(base), text.str(), path);
+  const std::string text =
+      ReadInputFile(path, "configuration file " + Quoted(path),
+                    "expected a readable Config.txt; see Test_OpenABLE --help");
+  ParseOptionText(ConfigTable(base), text, path);
   return base;
 }
 

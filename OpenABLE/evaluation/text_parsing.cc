@@ -3,32 +3,17 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <system_error>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/input_file.h"
 #include "OpenABLE/base/strings.h"
 
 namespace openable::evaluation_internal {
 
-namespace fs = std::filesystem;
-
-void RequireFile(const std::string& path, const std::string& where) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (!fs::exists(st)) throw InputError(where + ": file not found" + WorkingDirectoryNote(path));
-  if (fs::is_directory(st)) throw InputError(where + ": is a folder; expected a file");
-}
+void RequireFile(const std::string& path, const std::string& where) { CheckInputFile(path, where); }
 
 std::string ReadWholeFile(const std::string& path, const std::string& where) {
-  RequireFile(path, where);
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(where + ": cannot be opened for reading");
-  std::string data((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  if (f.bad()) throw InputError(where + ": read error");
-  return data;
+  return ReadInputFile(path, where);
 }
 
 bool ParseNumber(std::string_view token, double* value) {
@@ -52,6 +37,19 @@ bool ParseIndex(std::string_view field, std::int64_t* value) {
   }
   *value = static_cast<std::int64_t>(d);
   return true;
+}
+
+bool IsHeaderLine(const Line& line) {
+  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  for (const std::string_view f : line.fields) {
+    std::size_t i = 0;
+    if (i < f.size() && (f[i] == '+' || f[i] == '-')) ++i;
+    if (i < f.size() && f[i] == '.') ++i;
+    if (i < f.size() && digit(f[i])) return false;
+    double value = 0;  // "nan", "inf": numbers too
+    if (ParseNumber(f, &value)) return false;
+  }
+  return !line.fields.empty();
 }
 
 void SplitFields(std::string_view s, std::vector<std::string_view>* out) {

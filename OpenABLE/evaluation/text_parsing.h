@@ -10,11 +10,11 @@
 
 namespace openable::evaluation_internal {
 
-// Throws InputError "<where>: file not found" / "is a folder; expected a file" unless `path`
-// is an existing file that is not a folder.
+// Throws InputError "<where> does not exist ..." / "<where> is a folder, not a regular file" /
+// ... unless `path` is a regular file that can be read (base/input_file.h).
 void RequireFile(const std::string& path, const std::string& where);
 
-// The whole content of `path` (after RequireFile); throws InputError starting with `where`.
+// The whole content of `path` (base/input_file.h); throws InputError starting with `where`.
 std::string ReadWholeFile(const std::string& path, const std::string& where);
 
 // Blank characters that separate fields (not '\n').
@@ -36,6 +36,12 @@ struct Line {
   std::vector<std::string_view> fields;
   std::string_view comment;
 };
+
+// The header rule of the text readers (pairs, positions): the first line with fields is a
+// header when none of its fields begins like a number (a digit, or a sign or point and a
+// digit): "a,b" and "x y z" are headers, "12;34" is data (and refused as such, naming the
+// value), so that a line of numbers in an unexpected separator is never dropped in silence.
+bool IsHeaderLine(const Line& line);
 
 // The fields of `s` as Line::fields describes them.
 void SplitFields(std::string_view s, std::vector<std::string_view>* out);

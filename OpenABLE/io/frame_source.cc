@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cstddef>
 #include <filesystem>
-#include <fstream>
 #include <opencv2/imgproc.hpp>
 #include <set>
 #include <string>
@@ -12,6 +11,7 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/input_file.h"
 #include "OpenABLE/base/module_loader.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/io/image_codec.h"
@@ -216,48 +216,12 @@ std::vector<std::string> ListImages(const std::string& folder, const std::string
 }
 
 cv::Mat ReadImageFile(const std::string& path) {
-  auto fail = [&](const std::string& what) -> InputError {
-    return InputError("image " + Quoted(path) + " " + what + " (" + kExpectedImage + ")");
-  };
-
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (!fs::exists(status)) {
-    std::error_code link_ec;
-    if (fs::is_symlink(fs::symlink_status(path, link_ec))) {
-      const std::string target = fs::read_symlink(path, link_ec).string();
-      throw fail("is a symbolic link to " + Quoted(target) + " that leads nowhere (" +
-                 (ec ? FirstLine(ec.message()) : std::string("dangling: no such file")) + ")");
-    }
-    throw fail("does not exist" + WorkingDirectoryNote(path));
+  const std::string data = ReadInputFile(path, "image " + Quoted(path), kExpectedImage);
+  if (data.empty()) {
+    throw InputError("image " + Quoted(path) + " is an empty file (0 bytes) (" + kExpectedImage +
+                     ")");
   }
-  if (!fs::is_regular_file(status)) {
-    const fs::file_type type = status.type();
-    throw fail(std::string("is ") +
-               (type == fs::file_type::fifo        ? "a FIFO (named pipe)"
-                : type == fs::file_type::socket    ? "a socket"
-                : type == fs::file_type::character ? "a character device"
-                : type == fs::file_type::block     ? "a block device"
-                : type == fs::file_type::directory ? "a folder"
-                                                   : "a special file") +
-               ", not a regular file");
-  }
-  if (fs::file_size(path, ec) == 0 && !ec) throw fail("is an empty file (0 bytes)");
-
-  std::vector<unsigned char> bytes;
-  {
-    std::ifstream f(path, std::ios::binary);
-    if (f) {
-      f.seekg(0, std::ios::end);
-      const std::streamoff size = f.tellg();
-      if (size > 0) {
-        bytes.resize(static_cast<std::size_t>(size));
-        f.seekg(0);
-        f.read(reinterpret_cast<char*>(bytes.data()), size);
-      }
-    }
-    if (!f) throw fail("cannot be read (permission denied or I/O error)");
-  }
+  const std::vector<unsigned char> bytes(data.begin(), data.end());
   return DecodeBytes(bytes, path, [&] {
     cv::Mat frame;
     reinterpret_cast<OpenableOiioRead>(ModuleSymbol("oiio", "openable_oiio_read"))(path, frame);
@@ -290,11 +254,10 @@ std::unique_ptr<FrameSource> OpenImageFolder(const std::string& folder,
 }
 
 std::unique_ptr<FrameSource> OpenVideo(const std::string& path, int first, int last) {
-  std::error_code ec;
-  if (!fs::exists(path, ec) && path.find("://") == std::string::npos) {
-    throw InputError("video " + Quoted(path) + " does not exist" + WorkingDirectoryNote(path) +
-                     " (" + kExpectedVideo + ")");
-  }
+  // A URL ("rtsp://...") goes to OpenCV as it is; a path must be a regular file (a FIFO would
+  // block FFmpeg's probe for ever).
+  if (path.find("://") == std::string::npos)
+    CheckInputFile(path, "video " + Quoted(path), kExpectedVideo);
   // FFmpeg's "tty" demuxer renders any text file as ANSI-art frames, so a configuration or
   // ground-truth file given as a video by mistake would "work". Refuse the usual text types.
   static const std::set<std::string> kTextExtensions = {"txt", "csv", "yaml", "yml", "json",
@@ -317,10 +280,7 @@ std::unique_ptr<FrameSource> OpenBag(const std::string& path, const std::string&
   if (topic.empty())
     throw InputError(topic_key + ": empty; expected the image topic of bag " + Quoted(path) +
                      " to read (e.g. /cam0/image_raw)");
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    throw InputError(key + ": bag " + Quoted(path) + " does not exist" +
-                     WorkingDirectoryNote(path) + " (expected a ROS 1 bag)");
+  CheckInputFile(path, key + ": bag " + Quoted(path), "expected a ROS 1 bag");
   std::unique_ptr<FrameSource> source;
   reinterpret_cast<OpenableRosbagOpen>(ModuleSymbol("rosbag", "openable_rosbag_open"))(
       path, topic, first, last, key, topic_key, source);

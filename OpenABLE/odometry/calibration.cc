@@ -1,12 +1,12 @@
 #include "OpenABLE/odometry/calibration.h"
 
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <sstream>
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/input_file.h"
 
 namespace openable::odometry {
 
@@ -25,8 +25,8 @@ void Intrinsics::Check(const std::string& what) const {
 KittiCalibration ReadKittiCalibration(const std::string& path, double scale) {
   if (!(scale > 0) || !std::isfinite(scale))
     throw InputError(Quoted(path) + ": scale " + std::to_string(scale) + ", expected > 0");
-  std::ifstream in(path);
-  if (!in) throw InputError(Quoted(path) + ": cannot read the KITTI calibration file");
+  std::istringstream in(ReadInputFile(path, "KITTI calibration " + Quoted(path),
+                                      "expected a KITTI calib.txt: \"P0: 12 numbers\" per line"));
   std::map<std::string, std::pair<int, cv::Matx34d>> projections;  // name -> (line, P)
   std::string line;
   int number = 0;

@@ -1,15 +1,13 @@
 #include "OpenABLE/online/map_file.h"
 
-#include <cerrno>
 #include <cstring>
 #include <deque>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <string_view>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/hash.h"
+#include "OpenABLE/base/input_file.h"
 #include "OpenABLE/base/output_batch.h"
 
 namespace openable {
@@ -144,15 +142,8 @@ void WriteMapFile(const std::string& path, const MapFile& map) {
 }
 
 MapFile ReadMapFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int error = errno;
-    throw InputError(path + ": cannot read the map: " +
-                     (error != 0 ? std::strerror(error) : "cannot open the file"));
-  }
-  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw InputError(path + ": cannot read the map: a read error");
   const std::string expected_what = "expected a file written by OnlineDetector::SaveMap";
+  const std::string data = ReadInputFile(path, "map " + Quoted(path), expected_what);
   if (data.size() < kSignatureBytes || data.compare(0, kSignatureBytes, kSignature) != 0)
     throw InputError(path + ": not an OpenABLE map (" + expected_what +
                      ", which begins with \"OpenABLE-map\")");

@@ -1,10 +1,9 @@
 #include "OpenABLE/outputs/matrix_settings.h"
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/input_file.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/io/json.h"
@@ -99,11 +98,8 @@ std::optional<SavedMatrixSettings> ReadMatrixSettings(const std::string& matrix_
   const std::string path = MatrixSettingsPath(matrix_path);
   std::error_code ec;
   if (!fs::exists(path, ec)) return std::nullopt;
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in && !in.eof())
-    throw InputError("settings of the matrix " + Quoted(path) + " cannot be read");
+  const std::string text = ReadInputFile(path, "settings of the matrix " + Quoted(path),
+                                         "expected the JSON file OpenABLE writes beside a matrix");
   const auto refuse = [&](const std::string& why) {
     return InputError("settings of the matrix " + Quoted(path) + ": " + why +
                       "; expected the JSON file OpenABLE writes beside a matrix (delete or "
@@ -111,7 +107,7 @@ std::optional<SavedMatrixSettings> ReadMatrixSettings(const std::string& matrix_
   };
   Json o;
   try {
-    o = Json::parse(text.str());
+    o = Json::parse(text);
   } catch (const std::exception&) {
     throw refuse("not valid JSON");
   }

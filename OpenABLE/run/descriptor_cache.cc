@@ -56,9 +56,16 @@ std::string Hex(std::uint64_t v) {
   return buf;
 }
 
+// False for anything but a regular file: O_NONBLOCK so that a FIFO put in the cache folder
+// neither blocks the open nor, refused by fstat, the read.
 bool ReadFile(const std::string& path, std::string* out) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) return false;
+  struct stat st;
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return false;
+  }
   out->clear();
   char buf[1 << 16];
   for (;;) {
@@ -136,12 +143,24 @@ std::unique_ptr<DescriptorCache> DescriptorCache::Open(const std::string& folder
   const std::string where = "Descriptor_cache: \"" + c->path_ + "\": ";
   const std::string header = Header(settings_text, c->row_bytes_, row_width, row_type);
 
-  c->fd_ = ::open(c->path_.c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC, 0666);
+  c->fd_ = ::open(c->path_.c_str(), O_RDWR | O_CREAT | O_APPEND | O_NONBLOCK | O_CLOEXEC, 0666);
   if (c->fd_ < 0) {
     warnings.push_back(where + "cannot be opened (" + std::strerror(errno) +
                        "); every frame is described, nothing is cached");
     return c;
   }
+  struct stat st;
+  if (::fstat(c->fd_, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(c->fd_);
+    c->fd_ = -1;
+    warnings.push_back(where +
+                       "is not a regular file (a folder, FIFO or device); every frame "
+                       "is described, nothing is cached");
+    return c;
+  }
+  // Back to blocking reads and writes on the regular file (O_NONBLOCK only kept the open from
+  // waiting).
+  ::fcntl(c->fd_, F_SETFL, ::fcntl(c->fd_, F_GETFL) & ~O_NONBLOCK);
   // One run at a time writes a cache file; another run reads what is there.
   const bool locked = ::flock(c->fd_, LOCK_EX | LOCK_NB) == 0;
   if (!locked)

@@ -3,17 +3,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <map>
-#include <stdexcept>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/input_file.h"
 #include "OpenABLE/evaluation/matrix_file.h"
-#include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/evaluation/pairs_file.h"
 #include "OpenABLE/image/preprocess.h"
+#include "OpenABLE/io/frame_source.h"
 
 namespace openable::snaps {
 
@@ -140,10 +140,8 @@ std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
 }
 
 std::vector<double> ReadFrameTimes(const std::string& path, const std::string& key) {
-  std::ifstream in(path);
-  if (!in)
-    throw InputError(key + ": frame times " + Quoted(path) +
-                     " cannot be opened (expected the file Timestamps_name wrote)");
+  std::istringstream in(ReadInputFile(path, key + ": frame times " + Quoted(path),
+                                      "expected the file Timestamps_name wrote"));
   std::vector<double> times;
   std::string line;
   int number = 0;

@@ -1,10 +1,9 @@
 #include "OpenABLE/stereo/calibration.h"
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/input_file.h"
 #include "OpenABLE/base/strings.h"
 
 namespace openable {
@@ -97,23 +96,22 @@ std::string OneLine(std::string s) {
 StereoCalibration LoadStereoCalibration(const std::string& path) {
   const std::string where = "calibration \"" + path + "\": ";
   if (path.empty()) throw InputError("calibration: empty path; expected a calibration file");
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec))
-    throw InputError(where + "no such file; expected an OpenCV YAML stereo calibration");
-  if (std::filesystem::is_directory(path, ec))
-    throw InputError(where + "is a folder; expected an OpenCV YAML stereo calibration file");
-  std::ifstream in(path, std::ios::binary);
-  std::string first;
-  if (!in || !std::getline(in, first))
-    throw InputError(where + "cannot be read or is empty; expected an OpenCV YAML stereo "
-                             "calibration (first line %YAML:1.0)");
+  const std::string text = ReadInputFile(path, "calibration " + Quoted(path),
+                                         "expected an OpenCV YAML stereo calibration");
+  if (text.empty())
+    throw InputError(where +
+                     "is empty (0 bytes); expected an OpenCV YAML stereo calibration "
+                     "(first line %YAML:1.0)");
+  std::string first = text.substr(0, text.find('\n'));
+  if (!first.empty() && first.back() == '\r') first.pop_back();
   if (first.rfind("%YAML", 0) != 0)
     throw InputError(where + "first line \"" + OneLine(first.substr(0, 40)) +
                      "\" is not a YAML header; expected OpenCV FileStorage YAML starting with "
                      "%YAML:1.0");
   cv::FileStorage fs;
   try {
-    fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
+    // From the bytes already read and checked: OpenCV would open the path again.
+    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   } catch (const cv::Exception& e) {
     throw InputError(where + "not valid OpenCV YAML (" + OneLine(e.err) +
                      "); expected keys ML, MR, DL, DR, R, T as opencv-matrix nodes");

@@ -2,13 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/input_file.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/odometry/calibration.h"
@@ -51,12 +50,10 @@ void VerificationOptions::Check() const {
 CameraIntrinsics ReadVerificationCalibration(const std::string& path, double scale,
                                              const std::string& key) {
   return WithKey(key, [&] {
-    std::ifstream in(path);
-    if (!in)
-      throw InputError(Quoted(path) + " cannot be read" + WorkingDirectoryNote(path) +
-                       "; expected a KITTI calib.txt or an OpenCV YAML stereo calibration");
-    std::string first;
-    std::getline(in, first);
+    const std::string text =
+        ReadInputFile(path, "calibration " + Quoted(path),
+                      "expected a KITTI calib.txt or an OpenCV YAML stereo calibration");
+    const std::string first = text.substr(0, text.find('\n'));
     CameraIntrinsics c;
     if (first.rfind("%YAML", 0) == 0) {
       // OpenABLE's stereo calibration: the left camera matrix.

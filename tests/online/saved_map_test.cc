@@ -1,15 +1,16 @@
 // Saved maps of the online detector (OnlineDetector::SaveMap / LoadMap): a detector that
 // loads yesterday's map gives every later frame the candidates the detector that saved it
 // gives, on real KITTI 00 frames, with each index engine; the file is checked on loading.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/output_batch.h"
@@ -22,6 +23,7 @@ namespace openable {
 namespace {
 
 using testing::ExpectInputError;
+using testing::Q;
 
 using testing::Kitti00LeftDir;
 using testing::ReadKitti00Frames;
@@ -211,7 +213,16 @@ TEST(SavedMap, DefectsAreOneLineErrors) {
     }
   };
   ExpectInputError([&] { load(dir + "/absent.map"); },
-                   {dir + "/absent.map", "cannot read the map", "No such file"});
+                   {"map " + Q(dir + "/absent.map") + " does not exist",
+                    "expected a file written by OnlineDetector::SaveMap"});
+  // A folder and a FIFO are named before a byte is read (a FIFO with no writer would block).
+  std::filesystem::create_directories(dir + "/folder.map");
+  ExpectInputError([&] { load(dir + "/folder.map"); },
+                   {"map " + Q(dir + "/folder.map") + " is a folder, not a regular file"});
+  std::filesystem::remove(dir + "/fifo.map");
+  ASSERT_EQ(::mkfifo((dir + "/fifo.map").c_str(), 0600), 0);
+  ExpectInputError([&] { load(dir + "/fifo.map"); },
+                   {"map " + Q(dir + "/fifo.map") + " is a FIFO (named pipe), not a regular file"});
   testing::WriteBytes(dir + "/text.map", "frames 40\n");
   ExpectInputError([&] { load(dir + "/text.map"); }, {"text.map", "not an OpenABLE map"});
   std::string newer = good;
@@ -250,6 +261,27 @@ TEST(SavedMap, DefectsAreOneLineErrors) {
   for (const auto& entry : std::filesystem::directory_iterator(dir))
     files += entry.path().filename().string().find(".tmp-") != std::string::npos;
   EXPECT_EQ(files, 0);
+}
+
+// A detector that holds no frame saves a map of no frame, which loads back into an empty
+// detector that then grows as usual; its rows keep the descriptor's width.
+TEST(SavedMap, AnEmptyMapSavesAndLoads) {
+  OnlineOptions options;
+  options.exclusion = 5;
+  OnlineDetector empty(options);
+  const std::string path = testing::TempDir() + "/empty.map";
+  empty.SaveMap(path);
+  OnlineDetector loaded(options);
+  const OnlineDetector::LoadedMap info = loaded.LoadMap(path);
+  EXPECT_EQ(info.frames, 0);
+  EXPECT_EQ(loaded.Size(), 0);
+  EXPECT_EQ(loaded.Descriptors().rows, 0);
+  EXPECT_EQ(loaded.Descriptors().cols, 32);  // LDB's 256 bits
+  cv::Mat rows(8, 32, CV_8U);
+  cv::randu(rows, 0, 256);
+  for (int q = 0; q < rows.rows; ++q) loaded.AddDescriptor(rows.row(q));
+  EXPECT_EQ(loaded.Size(), 8);
+  EXPECT_TRUE(SameBytes(loaded.Descriptors(), rows));
 }
 
 }  // namespace
