@@ -51,13 +51,27 @@ cv::Mat DecodeImage(const sensor_msgs::Image& m, const std::string& what) {
   }
   const Layout layout = found->second;
   const std::size_t pixel = CV_ELEM_SIZE(layout.type);
-  if (m.width == 0 || m.height == 0 || m.width > 100000 || m.height > 100000 ||
-      m.step < m.width * pixel ||
-      static_cast<std::uint64_t>(m.step) * m.height > m.data.size())
-    throw InputError(what + ": " + std::to_string(m.width) + "x" + std::to_string(m.height) +
-                     " " + m.encoding + " with step " + std::to_string(m.step) + " and " +
-                     std::to_string(m.data.size()) + " bytes of data; expected height x step <= " +
-                     "the data and step >= width x " + std::to_string(pixel) + " bytes");
+  // Each condition on its own, so that the message states the one that failed.
+  const std::string size = std::to_string(m.width) + " x " + std::to_string(m.height);
+  if (m.width == 0 || m.height == 0)
+    throw InputError(what + ": the image is " + size +
+                     " pixels (width x height); expected at "
+                     "least 1 x 1");
+  if (m.width > 100000 || m.height > 100000)
+    throw InputError(what + ": the image is " + size +
+                     " pixels (width x height); expected at "
+                     "most 100000 on each side");
+  const std::uint64_t row_bytes = static_cast<std::uint64_t>(m.width) * pixel;
+  if (m.step < row_bytes)
+    throw InputError(what + ": step " + std::to_string(m.step) +
+                     " bytes is shorter than a row of " + size + " " + m.encoding + " (" +
+                     std::to_string(row_bytes) + " bytes); expected step >= width x " +
+                     std::to_string(pixel) + " bytes");
+  const std::uint64_t needed = static_cast<std::uint64_t>(m.step) * m.height;
+  if (needed > m.data.size())
+    throw InputError(what + ": " + std::to_string(m.data.size()) + " bytes of data for " + size +
+                     " " + m.encoding + " rows of step " + std::to_string(m.step) +
+                     "; expected height x step = " + std::to_string(needed) + " bytes");
   cv::Mat pixels(static_cast<int>(m.height), static_cast<int>(m.width), layout.type,
                  const_cast<unsigned char*>(m.data.data()), m.step);
   pixels = pixels.clone();
@@ -91,10 +105,13 @@ class BagSource final : public FrameSource {
     }
     // Every topic of the bag, with its type: to name them when the topic asked for is not there.
     std::map<std::string, std::string> topics;
+    std::map<std::string, std::set<std::string>> types_of_topic;  // a topic may mix types
     {
       rosbag::View all(bag_);
-      for (const rosbag::ConnectionInfo* c : all.getConnections())
+      for (const rosbag::ConnectionInfo* c : all.getConnections()) {
         topics[c->topic] = c->datatype;
+        types_of_topic[c->topic].insert(c->datatype);
+      }
     }
     const auto type = topics.find(topic);
     if (type == topics.end()) {
@@ -108,6 +125,13 @@ class BagSource final : public FrameSource {
                        (images.empty() ? "it has none" : images) +
                        (others.empty() ? "" : "; other topics: " + others));
     }
+    if (const std::set<std::string>& types = types_of_topic[topic]; types.size() > 1) {
+      std::string list;
+      for (const std::string& t : types) list += (list.empty() ? "" : ", ") + t;
+      throw InputError(topic_key + ": topic " + Quoted(topic) + " of " + bag_text + " carries " +
+                       std::to_string(types.size()) + " message types (" + list +
+                       "); expected one: " + kImage + " or " + kCompressed);
+    }
     if (type->second != kImage && type->second != kCompressed)
       throw InputError(topic_key + ": topic " + Quoted(topic) + " of " + bag_text + " holds " +
                        type->second + "; expected " + kImage + " or " + kCompressed);
@@ -120,6 +144,9 @@ class BagSource final : public FrameSource {
                        "); expected a complete ROS 1 bag");
     }
     const int count = static_cast<int>(messages_.size());
+    if (count == 0)
+      throw InputError(topic_key + ": topic " + Quoted(topic) + " of " + bag_text +
+                       " holds no message; expected at least one " + type->second + " message");
     const int end = last < 0 ? count : std::min(last, count);
     if (count == 0 || first >= end)
       throw InputError(topic_key + ": topic " + Quoted(topic) + " of " + bag_text + " holds " +
@@ -194,8 +221,14 @@ class BagSource final : public FrameSource {
       throw InputError(what + " cannot be read (" + e.what() +
                        "); expected a complete message (a damaged or truncated bag?)");
     } catch (const ros::Exception& e) {
-      throw InputError(what + " cannot be decoded (" + e.what() +
-                       "); expected a complete message (a damaged or truncated bag?)");
+      // The bytes do not fit the type the topic's connection declares. A bag cannot tell which
+      // of two causes it is: a message of another type written under that connection (rosbag's
+      // writer files a topic's messages under its first connection unless each comes with its
+      // own connection header), or damage.
+      const std::string type = compressed_ ? kCompressed : kImage;
+      throw InputError(what + " does not decode as " + type + ", the type its connection " +
+                       "declares (" + e.what() + "); expected " + type + " messages only: a " +
+                       "message of another type written on the topic, or a damaged bag");
     }
     if (stamp.isZero()) stamp = m.getTime();  // no header stamp: the record time
     stamps_[i] = stamp.toSec();

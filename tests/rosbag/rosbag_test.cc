@@ -1,22 +1,23 @@
 // ROS 1 bags as input (Frame_mode 3, OpenBag): bags written here with Debian's rosbag_storage
 // from real frames of ../shared/datasets, read back by Test_OpenABLE and compared with the same
 // frames read from their folders.
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <string>
-#include <vector>
-
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <rosbag/bag.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <std_msgs/String.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <boost/make_shared.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 #include "OpenABLE/io/frame_source.h"
 #include "tests/e2e/e2e_support.h"
@@ -436,6 +437,86 @@ TEST(RosBag, BadBagsAreOneLineNamingBagAndTopic) {
   EXPECT_EQ(t.status, 1);
   EXPECT_NE(t.err.find("Timestamps_name: \"t.txt\" with Frame_mode 0"), std::string::npos)
       << t.err;
+}
+
+// Messages that state the condition that failed: a topic that mixes two message types (each
+// message on its own is fine), an image message of 0 x 0 pixels (not "step >= width x ..."
+// conditions that both hold), an image whose step is shorter than a row, and data shorter than
+// height x step.
+TEST(RosBag, MessagesStateTheConditionThatFailed) {
+  const std::string dir = testing::TempDir();
+  const std::vector<std::string> frames = Frames(Sample() + "/summer", 3);
+  const cv::Mat grey = cv::imread(frames[0], cv::IMREAD_GRAYSCALE);
+  std_msgs::String text;
+  text.data = "not an image";
+  {
+    // As rosbag record files two publishers of the topic: a connection each, with its type.
+    rosbag::Bag bag(dir + "/mixed.bag", rosbag::bagmode::Write);
+    auto header = [](const std::string& caller, const std::string& type) {
+      auto h = boost::make_shared<ros::M_string>();
+      (*h)["callerid"] = caller;
+      (*h)["type"] = type;
+      return h;
+    };
+    bag.write("/cam0/image_raw", ros::Time(1), ImageMessage(grey, "mono8", 1),
+              header("/camera", "sensor_msgs/Image"));
+    bag.write("/cam0/image_raw", ros::Time(2), text, header("/chatter", "std_msgs/String"));
+  }
+  {
+    // rosbag's writer without connection headers files the text under the topic's first
+    // connection, a sensor_msgs/Image one: only decoding can tell.
+    rosbag::Bag bag(dir + "/misfiled.bag", rosbag::bagmode::Write);
+    bag.write("/cam0/image_raw", ros::Time(1), ImageMessage(grey, "mono8", 1));
+    bag.write("/cam0/image_raw", ros::Time(2), text);
+  }
+  sensor_msgs::Image empty = ImageMessage(grey, "mono8", 1);
+  empty.width = 0;
+  empty.height = 0;
+  empty.step = 0;
+  empty.data.clear();
+  sensor_msgs::Image short_step = ImageMessage(grey, "mono8", 1);
+  short_step.step = short_step.width - 1;
+  sensor_msgs::Image short_data = ImageMessage(grey, "mono8", 1);
+  short_data.data.resize(short_data.data.size() - 1);
+  const std::vector<std::pair<std::string, sensor_msgs::Image>> images = {
+      {"empty", empty}, {"short_step", short_step}, {"short_data", short_data}};
+  for (const auto& [name, message] : images) {
+    rosbag::Bag bag(dir + "/" + name + ".bag", rosbag::bagmode::Write);
+    bag.write("/cam0/image_raw", ros::Time(1), message);
+  }
+  const std::string w = std::to_string(grey.cols), h = std::to_string(grey.rows);
+  struct Case {
+    std::string bag, expected;
+  };
+  const std::vector<Case> cases = {
+      {"mixed.bag",
+       "Bag_topic: topic \"/cam0/image_raw\" of bag \"mixed.bag\" carries 2 message types "
+       "(sensor_msgs/Image, std_msgs/String); expected one: sensor_msgs/Image or "
+       "sensor_msgs/CompressedImage"},
+      {"misfiled.bag",
+       "message 1 does not decode as sensor_msgs/Image, the type its connection declares ("},
+      {"empty.bag",
+       "message 0: the image is 0 x 0 pixels (width x height); expected at least "
+       "1 x 1"},
+      {"short_step.bag", "message 0: step " + std::to_string(grey.cols - 1) +
+                             " bytes is shorter than a row of " + w + " x " + h + " mono8 (" + w +
+                             " bytes); expected step >= width x 1 bytes"},
+      {"short_data.bag", "message 0: " + std::to_string(grey.total() - 1) + " bytes of data for " +
+                             w + " x " + h + " mono8 rows of step " + w +
+                             "; expected height x step = " + std::to_string(grey.total()) +
+                             " bytes"},
+  };
+  for (const Case& c : cases) {
+    const Outcome o = RunProgram(
+        testing::TestOpenableExe(),
+        {"--set", "Frame_mode=3", "--set", "Bag_path=" + c.bag, "--set",
+         "Bag_topic=/cam0/image_raw", "--set", "Npy_name=out/m.npy", "--set", "Ground_truth_type="},
+        dir);
+    EXPECT_EQ(o.status, 1) << c.bag << " " << o.err;
+    EXPECT_TRUE(OneLine(o.err)) << o.err;
+    EXPECT_NE(o.err.find(c.expected), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(dir + "/out")) << c.bag;
+  }
 }
 
 }  // namespace
