@@ -214,6 +214,9 @@ void LoadMatrix(const GroundTruthOptions& o, const EvaluationLayout& layout, int
 void LoadPairs(const GroundTruthOptions& o, const EvaluationLayout& layout, int, int,
                GroundTruth* gt) {
   const PairsFile file = ReadPairsFile(o.path, o.base, "ground truth pairs");
+  if (file.header_line > 0)
+    gt->skipped_header = "line " + std::to_string(file.header_line) + " of " + Quoted(o.path) +
+                         ": " + Quoted(file.header);
   const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
   const int base = file.base;
   const std::int64_t rows = layout.queries, cols = layout.references;
@@ -319,9 +322,7 @@ std::vector<FramePose> ReadPositions(const std::string& path, const char* label)
   ForEachLine(data, [&](const Line& line) {
     if (line.fields.empty()) return;
     const std::string at = where + ":" + std::to_string(line.number);
-    double unused = 0;
-    const bool header = first_content &&
-                        !line.fields[0].empty() && !ParseNumber(line.fields[0], &unused);
+    const bool header = first_content && evaluation_internal::IsHeaderLine(line);
     first_content = false;
     if (header) return;  // "x,y,z"
     v.resize(line.fields.size());

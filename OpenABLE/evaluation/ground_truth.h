@@ -26,6 +26,9 @@ struct GroundTruth {
   // (without a range, a pair past the last frame is an error: a wrong file). (Pairs
   // inside the exclusion window are kept here; the evaluation leaves them out and says so.)
   std::int64_t dropped = 0;
+  // A first line of a pairs file read as a header and skipped, for the report: `line 1 of
+  // "gt.txt": "a,b"`; "" when none.
+  std::string skipped_header;
 
   std::int64_t PairCount() const {
     std::int64_t n = 0;

@@ -9,7 +9,6 @@ namespace openable {
 using evaluation_internal::ForEachLine;
 using evaluation_internal::Line;
 using evaluation_internal::ParseIndex;
-using evaluation_internal::ParseNumber;
 using evaluation_internal::ReadWholeFile;
 
 PairsFile ReadPairsFile(const std::string& path, int base, const std::string& what) {
@@ -41,13 +40,17 @@ PairsFile ReadPairsFile(const std::string& path, int base, const std::string& wh
   ForEachLine(data, [&](const Line& line) {
     if (line.fields.empty()) return;
     const std::string at = out.where + ":" + std::to_string(line.number);
-    double unused = 0;
-    const bool header =
-        first_content && !line.fields[0].empty() && !ParseNumber(line.fields[0], &unused);
+    const bool header = first_content && evaluation_internal::IsHeaderLine(line);
     first_content = false;
-    if (header) return;
+    if (header) {
+      out.header_line = line.number;
+      for (const std::string_view f : line.fields)
+        out.header += (out.header.empty() ? "" : ",") + std::string(f);
+      return;
+    }
     if (line.fields.size() < 2)
-      throw InputError(at + ": line has 1 value; expected two frame indices \"a,b\"");
+      throw InputError(at + ": line has 1 value, " + Quoted(line.fields[0]) +
+                       "; expected two frame indices \"a,b\" separated by a comma or blanks");
     std::int64_t raw[2];
     for (int k = 0; k < 2; ++k) {
       if (!ParseIndex(line.fields[static_cast<std::size_t>(k)], &raw[k]))

@@ -27,6 +27,10 @@ struct PairsFile {
   // Ground_truth_base)", " (0-based; set Ground_truth_base to 1 if the file counts from 1)".
   std::string base_note;
   std::string where;        // `what` and the path, as messages name the file
+  // The first line, when it was read as a header and skipped (text_parsing.h's rule), and its
+  // number; 0 and "" when the file has none. Reports say so: no line is dropped unsaid.
+  int header_line = 0;
+  std::string header;
 };
 
 // Reads `path`. `base`: 0 or 1, or -1 to read it from a comment ("0-based" or "1-based"; both

@@ -87,6 +87,7 @@ void AddEvaluatedRunJson(Json& o, const EvaluatedRun& r) {
                  {"row_offset", r.layout.row_offset},
                  {"col_offset", r.layout.col_offset}};
   o["ground_truth"] = {{"pairs", r.truth_pairs}, {"dropped", r.truth_dropped}};
+  if (!r.truth_skipped_header.empty()) o["ground_truth"]["skipped_header"] = r.truth_skipped_header;
   o["verified"] = r.verified;
   o["per_query"] = PerQueryJson(r.per_query);
   if (r.verified) o["per_query_unverified"] = PerQueryJson(r.per_query_unverified);
@@ -152,6 +153,8 @@ std::string FormatEvaluationTable(const EvaluationSettings& s,
           o << "    (" << r.truth_dropped
             << " ground-truth pairs dropped: on the diagonal or outside the processed "
                "frames)\n";
+        if (!r.truth_skipped_header.empty())
+          o << "    (ground truth " << r.truth_skipped_header << " read as a header and skipped)\n";
       }
       if (q.unanswered > 0)
         o << "    (" << q.unanswered

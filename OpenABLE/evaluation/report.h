@@ -21,6 +21,7 @@ struct EvaluatedRun {
   EvaluationLayout layout;
   std::int64_t truth_pairs = 0;    // ground-truth pairs loaded over the block
   std::int64_t truth_dropped = 0;  // GroundTruth::dropped
+  std::string truth_skipped_header;  // GroundTruth::skipped_header
   // The run's final answers: with verification (`verified`), each query's best-ranked verified
   // candidate (a query without one has no answer), and per_query_unverified the matrix's best
   // matches; without verification, per_query holds the matrix's best matches.

@@ -236,7 +236,7 @@ std::string LayoutName(const EvaluationLayout& l) {
 const std::string& EvaluateDoc() {
   static const std::string doc = [] {
     std::string text =
-R"doc(evaluate(matrix, *, truth_matrix=None, pairs=None, poses=None, reference_poses=None,
+        R"doc(evaluate(matrix, *, truth_matrix=None, pairs=None, poses=None, reference_poses=None,
     aligned=False, truth_file=None, truth_type=None, truth_file_2="", base=-1, first_frame=0,
     range_selected=False, layout=None, reference_frames=None, tolerance=2, exclusion=100,
     vicinity=7, able_thresholds=100, radius=5.0, heading_limit=-1.0, min_frame_gap=None, axes="xyz",
@@ -249,7 +249,8 @@ exactly as Test_OpenABLE (Ground_truth_type) and openable_evaluate do.
 
 Args:
     matrix (numpy.ndarray): distances (small = similar), shape (N, N) or (Q, R); float32 is
-        read in place.
+        read in place. +inf is a cell without a value (never an answer); NaN is refused as
+        damage.
     truth_matrix (numpy.ndarray): ground truth as a matrix, non-zero = same place, of the
         evaluated block's shape or of the whole matrix's (the block is then taken from it).
         Loop closure: cell (a, b) is the pair (max, min); the diagonal is dropped.
@@ -639,9 +640,10 @@ void RegisterEvaluate(py::module_& m) {
         run.layout = layout;
         run.truth_pairs = gt.PairCount();
         run.truth_dropped = gt.dropped;
+        run.truth_skipped_header = gt.skipped_header;
         {
           py::gil_scoped_release release;
-          // The checks of openable_evaluate: distances >= 0, NaN or inf for no value.
+          // The checks of openable_evaluate: distances >= 0, +inf for no value, NaN refused.
           cv::Mat1f m = DistancesForEvaluation(cv::Mat1f(view.mat), "matrix");
           if (normalize) {
             double lo = 0, hi = 0;
@@ -700,10 +702,12 @@ void RegisterUnsupervised(py::module_& m) {
         o.agreement.direction = ParseEnum<SequenceDirection>(direction, "direction");
         o.exclusion = exclusion;
         o.score_window = score_window;
+        // evaluate's checks: +inf is a cell without a value, NaN is refused as damage.
+        const cv::Mat1f checked = DistancesForEvaluation(cv::Mat1f(view.mat), "matrix");
         UnsupervisedFigures f;
         {
           py::gil_scoped_release release;
-          f = UnsupervisedCriteria(cv::Mat1f(view.mat), layout, o);
+          f = UnsupervisedCriteria(checked, layout, o);
         }
         py::dict d;
         d["consistency"] = f.consistency;
@@ -739,8 +743,8 @@ of the nearest query whose sequence shares no frame with it (at least max(L, 10)
 back or else forward) lies where the route says, within max(3, gap / 10) frames.
 
 Args:
-    matrix (numpy.ndarray): distances (small = similar), as for evaluate; +inf and NaN cells
-        are never answers.
+    matrix (numpy.ndarray): distances (small = similar), as for evaluate: +inf cells are never
+        answers, NaN is refused.
     layout, reference_frames, exclusion: the evaluated block and its candidates, as for
         evaluate.
     sequence_length (int), partial (str), direction (str): the matrix's L, Sequence_partial

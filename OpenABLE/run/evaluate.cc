@@ -57,6 +57,7 @@ void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
   run.layout = layout;
   run.truth_pairs = truth.PairCount();
   run.truth_dropped = truth.dropped;
+  run.truth_skipped_header = truth.skipped_header;
   run.per_query = EvaluatePerQuery(normalized, layout, truth, evaluation.settings.options);
   if (verified != nullptr) {
     run.verified = true;
@@ -84,29 +85,27 @@ cv::Mat1f DistancesForEvaluation(const cv::Mat1f& matrix, const std::string& wha
     throw InputError(what + " is empty (" + std::to_string(matrix.rows) + " x " +
                      std::to_string(matrix.cols) + "); expected a distance matrix with at least "
                      "one query and one reference");
-  // A plain loop: OpenCV's vectorised comparisons do not single out NaN.
-  bool has_nan = false;
+  // A plain loop: OpenCV's vectorised comparisons do not single out NaN. +inf is a cell without
+  // a value (Sequence_partial: skip, or a diagonal too short for a sequence); NaN is damage,
+  // never a value OpenABLE writes, so it is refused rather than read as a skipped cell.
   for (int i = 0; i < matrix.rows; ++i) {
     const float* row = matrix.ptr<float>(i);
     for (int j = 0; j < matrix.cols; ++j) {
       const float v = row[j];
-      if (std::isnan(v)) {
-        has_nan = true;
-      } else if (!(v >= 0.0f)) {
+      if (std::isnan(v))
+        throw InputError(what + " holds NaN at row " + std::to_string(i) + ", column " +
+                         std::to_string(j) +
+                         ": a damaged matrix; expected distances >= 0, and "
+                         "+inf for a cell without a value (matrices written by earlier OpenABLE "
+                         "builds held NaN there: numpy.nan_to_num(m, nan=numpy.inf) converts "
+                         "one)");
+      if (!(v >= 0.0f))
         throw InputError(what + " holds " + FormatNumber(v) + " at row " + std::to_string(i) +
                          ", column " + std::to_string(j) +
-                         "; expected distances >= 0 (NaN or inf for a cell without a value)");
-      }
+                         "; expected distances >= 0 (+inf for a cell without a value)");
     }
   }
-  if (!has_nan) return matrix;
-  cv::Mat1f out = matrix.clone();
-  for (int i = 0; i < out.rows; ++i) {
-    float* row = out.ptr<float>(i);
-    for (int j = 0; j < out.cols; ++j)
-      if (std::isnan(row[j])) row[j] = std::numeric_limits<float>::infinity();
-  }
-  return out;
+  return matrix;
 }
 
 std::vector<cv::Mat1f> EvaluateMatrixFiles(Evaluation& evaluation,

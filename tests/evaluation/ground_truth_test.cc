@@ -25,9 +25,10 @@ namespace openable {
 namespace {
 
 using openable::testing::DatasetsDir;
-using openable::testing::TempDir;
 using openable::testing::ExpectInputError;
+using openable::testing::InputErrorMessage;
 using openable::testing::Q;
+using openable::testing::TempDir;
 using openable::testing::WriteBytes;
 using Matches = std::vector<std::vector<int>>;
 
@@ -205,6 +206,34 @@ row,col,distance
   const GroundTruth gt = LoadLoop(Options(GroundTruthType::kPairs, path), 4);
   EXPECT_EQ(gt.matches, M(4, {{2, {0}}, {3, {0, 1}}}));
   EXPECT_EQ(gt.dropped, 1);  // the diagonal pair 2,2
+}
+
+// A first line is a header only when none of its fields begins like a number: one header is
+// skipped and said (the report prints GroundTruth::skipped_header); a first line of numbers in
+// another separator is data, refused with its value, never dropped in silence.
+TEST(GroundTruthPairs, AFirstLineOfNumbersIsNeverTakenAsAHeader) {
+  const std::string path = TempDir() + "/pairs_header.csv";
+  WriteBytes(path, "query,match\n2,0\n3,1\n");
+  GroundTruth gt = LoadLoop(Options(GroundTruthType::kPairs, path), 4);
+  EXPECT_EQ(gt.matches, M(4, {{2, {0}}, {3, {1}}}));
+  EXPECT_EQ(gt.skipped_header, "line 1 of " + Q(path) + ": \"query,match\"");
+
+  WriteBytes(path, "2,0\n3,1\n");
+  EXPECT_EQ(LoadLoop(Options(GroundTruthType::kPairs, path), 4).skipped_header, "");
+
+  for (const std::string first : {"2;0", "2|0", "-1;0", ".5;1", "nan,1"}) {
+    WriteBytes(path, first + "\n3,1\n");
+    EXPECT_EQ(InputErrorMessage([&] {
+                LoadLoop(Options(GroundTruthType::kPairs, path), 4);
+              }).find("ground truth pairs " + Q(path) + ":1: "),
+              0u)
+        << first;
+  }
+  WriteBytes(path, "2;0\n3,1\n");
+  EXPECT_EQ(InputErrorMessage([&] { LoadLoop(Options(GroundTruthType::kPairs, path), 4); }),
+            "ground truth pairs " + Q(path) +
+                ":1: line has 1 value, \"2;0\"; expected two "
+                "frame indices \"a,b\" separated by a comma or blanks");
 }
 
 TEST(GroundTruthPairs, BaseOptionAndDefault) {
