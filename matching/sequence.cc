@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <exception>
 #include <limits>
 #include <stdexcept>
 #include <thread>
@@ -81,6 +83,14 @@ void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, 
   std::vector<double> prev(static_cast<size_t>(m)), cur(static_cast<size_t>(m));
   threads = std::max(1, std::min(threads, m / 256 + 1));
   SpinBarrier barrier(threads);
+  // A stop asked by the host's interrupt check (Ctrl-C in Python, threading.h), run by the
+  // thread of the first columns between rows at most every 50 ms: a sweep over a large matrix
+  // takes seconds, and every thread must leave at the same row, or the others would wait at
+  // the barrier for ever. The flag is set before the first barrier of a row and read between
+  // the two, so all threads see it at the same row.
+  std::atomic<bool> stop{false};
+  std::exception_ptr stopped;
+  auto last_check = std::chrono::steady_clock::now();
   // Columns are split evenly between the threads, which meet at the barrier once per row.
   auto work = [&](int c0, int c1) {
     for (int i = 0; i < n; ++i) {
@@ -103,15 +113,31 @@ void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, 
         cur[static_cast<size_t>(j)] = w;
         row[j] = ScaleSequenceSum(w, SequenceTerms(L, t), L, partial);
       }
+      if (c0 == 0) {
+        const auto now = std::chrono::steady_clock::now();
+        if (now - last_check >= std::chrono::milliseconds(50)) {
+          last_check = now;
+          try {
+            CheckForInterrupt();
+          } catch (...) {
+            stopped = std::current_exception();
+            stop.store(true, std::memory_order_relaxed);
+          }
+        }
+      }
       barrier.Wait();  // every column of row i done before anyone reads it as row i - 1
+      // Read between the two barriers: the flag can only change before the first one.
+      const bool leave = stop.load(std::memory_order_relaxed);
       if (c0 == 0) std::swap(prev, cur);
       barrier.Wait();
+      if (leave) return;
     }
   };
   RunOnThreads(threads, [&](int t) {
     work(static_cast<int>(static_cast<long>(m) * t / threads),
          static_cast<int>(static_cast<long>(m) * (t + 1) / threads));
   });
+  if (stopped) std::rethrow_exception(stopped);
 }
 
 // FillAheadCells on known traversals.

@@ -36,7 +36,7 @@ struct OutputInput {
   const Config& config;
   const RunResult& result;
   const cv::Mat1f& shown;  // cells without a value as the largest finite value (text, images)
-  const cv::Mat1f& saved;  // cells without a value as NaN (.npy)
+  const cv::Mat1f& saved;  // cells without a value as +inf (.npy)
   const Evaluation* evaluation;
   const RunVerification* verification;
   const AutoChoice* automatic;
@@ -272,7 +272,8 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
   const OutputOptions& out = config.output;
   const bool dense = !result.bounded;  // bounded runs keep no matrix: only Matches_name
   // Cells without a value (+inf) are shown as the largest finite value in the text and the
-  // image, and are NaN in the .npy file: readable exports, and NumPy code that skips NaN.
+  // image (readable exports), and stay +inf in the .npy file, where NaN would be
+  // indistinguishable from damage (readers refuse NaN: DistancesForEvaluation).
   cv::Mat1f shown = result.normalized, saved = result.normalized;
   if (dense && result.empty_cells > 0) {
     const cv::Mat1b empty = result.normalized == std::numeric_limits<float>::infinity();
@@ -281,10 +282,6 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
     if (!out.txt_name.empty() || !out.png_name.empty()) {
       shown = result.normalized.clone();
       shown.setTo(largest, empty);
-    }
-    if (!out.npy_name.empty()) {
-      saved = result.normalized.clone();
-      saved.setTo(std::numeric_limits<float>::quiet_NaN(), empty);
     }
   }
   const OutputInput in{config, result, shown, saved, evaluation, verification, automatic};

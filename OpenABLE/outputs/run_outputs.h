@@ -20,7 +20,7 @@ struct AutoChoice;       // OpenABLE/tuning/auto.h
 // Evaluation_name and Report_name when `evaluation` is given; the report lists the auto
 // mode's candidates when `automatic` is given)
 // all-or-nothing. Cells without a value (+inf, Sequence_partial skip) are written as the
-// largest finite value in Txt_name and the PNG images and as NaN in Npy_name. Returns the
+// largest finite value in Txt_name and the PNG images and as +inf in Npy_name. Returns the
 // paths written. Adds the time spent to result.timings.export_seconds. Throws InputError
 // naming the key and path on failure.
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,

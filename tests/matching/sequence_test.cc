@@ -1,10 +1,15 @@
 #include "matching/sequence.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <limits>
 #include <random>
+#include <stdexcept>
 
-#include <gtest/gtest.h>
+#include "OpenABLE/base/threading.h"
 
 namespace openable {
 namespace {
@@ -308,6 +313,46 @@ TEST(SequenceDistances, RejectsBadArguments) {
   EXPECT_THROW(SequenceDistances(d, 0), std::logic_error);
   EXPECT_THROW(SequenceDistances(d, 2, {1}, {0}), std::logic_error);
   EXPECT_THROW(SequenceDistances(d, 2, {0, 3, 2}, {0}), std::logic_error);
+}
+
+}  // namespace
+}  // namespace openable
+
+namespace openable {
+namespace {
+
+std::atomic<int> g_sequence_checks{0};
+void StopOnFirstCheck() {
+  ++g_sequence_checks;
+  throw std::runtime_error("stopped");
+}
+
+// The sums of a large matrix take seconds: the host's interrupt check (Ctrl-C in Python) runs
+// between rows, and its exception ends the sweep on every thread at the same row, well before
+// the end, and reaches the caller.
+TEST(SequenceDistances, AnInterruptCheckStopsTheSumsWithinTheirRows) {
+  cv::Mat1f d(8000, 8000);  // about 0.2 s of sums on 2 cores, against 50 ms between checks
+  cv::randu(d, 0.0f, 1.0f);
+  const cv::Mat1f before = d.clone();
+  for (const SequenceDirection direction :
+       {SequenceDirection::kForward, SequenceDirection::kBoth}) {
+    cv::Mat1f work = before.clone();
+    SetInterruptCheck(&StopOnFirstCheck);
+    g_sequence_checks = 0;
+    const auto start = std::chrono::steady_clock::now();
+    EXPECT_THROW(SequenceDistancesInPlace(work, 10, {0}, {0}, direction, 2), std::runtime_error);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    SetInterruptCheck(nullptr);
+    EXPECT_EQ(g_sequence_checks.load(), 1);
+    EXPECT_LT(seconds, 1.0);
+    // Stopped part-way: the last rows still hold the single-frame distances.
+    EXPECT_EQ(cv::norm(work.rowRange(7990, 8000), before.rowRange(7990, 8000), cv::NORM_INF), 0.0);
+  }
+  // With no check installed the sums run to the end.
+  cv::Mat1f whole = before.clone();
+  SequenceDistancesInPlace(whole, 10, {0}, {0}, SequenceDirection::kForward, 2);
+  EXPECT_GT(cv::norm(whole.rowRange(7990, 8000), before.rowRange(7990, 8000), cv::NORM_INF), 0.0);
 }
 
 }  // namespace

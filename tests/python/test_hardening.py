@@ -2,9 +2,12 @@
 wrong result or a crash: float images outside [0, 1], a conversion that cannot be allocated,
 negative or NaN distances, thresholds outside [0, 1], traversal starts beyond the rows,
 trajectories whose timestamps do not increase."""
+import _thread
 import os
 import shutil
 import tempfile
+import threading
+import time
 import unittest
 
 import numpy as np
@@ -45,14 +48,46 @@ class HardeningTest(unittest.TestCase):
         with self.assertRaises(openable.InputError) as caught:
             openable.evaluate(bad, aligned=True, reference_frames=10)
         self.assertIn("row 3, column 7", str(caught.exception))
-        # NaN is a cell without a value, as in a saved .npy: a query with only NaN candidates
+        # +inf is a cell without a value, as in a saved .npy: a query with only +inf candidates
         # has no answer.
-        nan = m.copy()
-        nan[15, :10] = np.nan
-        result = openable.evaluate(nan, aligned=True, reference_frames=10)
+        skipped = m.copy()
+        skipped[15, :10] = np.inf
+        result = openable.evaluate(skipped, aligned=True, reference_frames=10)
         self.assertEqual(result.unanswered_queries, 1)
+        # NaN is damage, refused with the cell, whatever band it lies in: never read as skipped.
+        for row, col in ((15, 3), (0, 0), (19, 19)):
+            nan = m.copy()
+            nan[row, col] = np.nan
+            with self.assertRaises(openable.InputError) as caught:
+                openable.evaluate(nan, aligned=True, reference_frames=10)
+            self.assertIn(f"NaN at row {row}, column {col}: a damaged matrix", str(caught.exception))
+            with self.assertRaises(openable.InputError):
+                openable.unsupervised_criteria(nan, reference_frames=10)
         with self.assertRaises(ValueError):
             openable.evaluate(np.zeros((0, 0), np.float32), aligned=True)
+
+    def test_ctrl_c_stops_the_sequence_sums(self):
+        # The sums of a 10000 x 10000 matrix take a while; Ctrl-C (interrupt_main, 0.05 s into
+        # the call) must end them long before their end, not when the call returns.
+        single = np.random.default_rng(3).random((10000, 10000), dtype=np.float32)
+        start = time.monotonic()
+        openable.sequence_distances(single, 10, direction="both")
+        whole = time.monotonic() - start
+        pressed = []
+
+        def press():
+            time.sleep(0.05)
+            pressed.append(time.monotonic())
+            _thread.interrupt_main()
+
+        thread = threading.Thread(target=press)
+        thread.start()
+        with self.assertRaises(KeyboardInterrupt):
+            openable.sequence_distances(single, 10, direction="both")
+        stopped = time.monotonic()
+        thread.join()
+        self.assertLess(stopped - pressed[0], max(0.5 * whole, 0.2),
+                        f"the whole call takes {whole:.2f} s")
 
     def test_threshold_matrix_domain(self):
         m = np.array([[0.1, 0.5], [0.9, 0.2]], np.float32)
