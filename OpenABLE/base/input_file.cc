@@ -85,7 +85,14 @@ int OpenRegular(const std::string& path, std::string* problem, off_t* size) {
   }
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) {
-    *problem = SystemProblem(path, errno);
+    const int error = errno;
+    // A socket cannot be opened at all (ENXIO): name what it is rather than the system's words.
+    struct stat st;
+    if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+      *problem = TypeProblem(st.st_mode);
+      return -1;
+    }
+    *problem = SystemProblem(path, error);
     return -1;
   }
   struct stat st;

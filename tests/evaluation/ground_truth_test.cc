@@ -273,7 +273,7 @@ TEST(GroundTruthPairs, OutOfRangeMessagesNameTheLinePairAndRange) {
   ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/word.txt"), 4); },
                    {Q(dir + "/word.txt") + ":2:", "\"b\"", "not an integer"});
   ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/absent.txt"), 4); },
-                   {Q(dir + "/absent.txt"), "not found"});
+                   {Q(dir + "/absent.txt"), "does not exist"});
   // An empty ground truth would give figures of 0 for any matrix: refused.
   WriteBytes(dir + "/empty.txt", "query,reference\n# nothing\n");
   ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/empty.txt"), 4); },
@@ -560,7 +560,7 @@ TEST(PosesErrors, MalformedFilesNameFileAndLine) {
   ExpectInputError([&] { ReadPoses(dir + "/empty.txt", GroundTruthType::kKitti); },
                    {Q(dir + "/empty.txt"), "no pose"});
   ExpectInputError([&] { ReadPoses(dir + "/absent.txt", GroundTruthType::kTum); },
-                   {Q(dir + "/absent.txt"), "not found"});
+                   {Q(dir + "/absent.txt"), "does not exist"});
   EXPECT_THROW(ReadPoses(dir + "/k.txt", GroundTruthType::kMatrix), std::logic_error);
   // The checks SNAPS applies to the same files (one reader, pose_file.h): a matrix that is not
   // a rotation, timestamps out of order.

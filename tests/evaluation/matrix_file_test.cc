@@ -229,7 +229,7 @@ TEST(MatrixFileImage, GreyColourAndSixteenBit) {
 TEST(MatrixFileErrors, MissingFileExtensionAndUndecodableImage) {
   const std::string dir = TempDir();
   ExpectInputError([&] { ReadMatrixFile(dir + "/absent.npy"); },
-                   {Q(dir + "/absent.npy"), "not found"});
+                   {Q(dir + "/absent.npy"), "does not exist"});
   ExpectInputError([&] { ReadMatrixFile(dir); }, {Q(dir), "folder"});
 
   WriteBytes(dir + "/m.json", "[[1]]");

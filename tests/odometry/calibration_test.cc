@@ -74,7 +74,7 @@ TEST(ReadKittiCalibration, RejectsMalformedFilesWithFileAndLine) {
 
   const std::string absent = dir + "/absent.txt";
   testing::ExpectInputError([&] { ReadKittiCalibration(absent, 0.5); },
-                            {testing::Q(absent), "cannot read"});
+                            {testing::Q(absent), "does not exist"});
   testing::ExpectInputError([&] { ReadKittiCalibration(missing_p1, 0.0); }, {"scale"});
 }
 

@@ -190,7 +190,7 @@ TEST(ReadTrajectory, ErrorsNameFileLineValueAndExpectation) {
   p = Write("empty.txt", "\n  \n");
   ExpectInputError(read(p, TrajectoryFormat::kKitti), {Q(p), "no pose", "12 numbers"});
   p = TempDir() + "/missing.txt";
-  ExpectInputError(read(p, TrajectoryFormat::kKitti), {Q(p), "not found"});
+  ExpectInputError(read(p, TrajectoryFormat::kKitti), {Q(p), "does not exist"});
   p = Write("quat.txt", "0 1 2 3 0 0 0 1\n1 1 2 3 0 0 0.5 0.5\n");
   ExpectInputError(read(p, TrajectoryFormat::kTum),
                    {Q(p) + ":2", "norm 0.70710678118654", "unit quaternion"});

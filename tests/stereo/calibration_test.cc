@@ -78,7 +78,7 @@ TEST(StereoCalibration, AcceptsRowVectorsAndDefaultsTheRenderingKeys) {
 
 TEST(StereoCalibration, MissingFile) {
   const std::string path = testing::TempDir() + "/none.yaml";
-  ExpectInputError([&] { LoadStereoCalibration(path); }, {testing::Q(path), "no such file"});
+  ExpectInputError([&] { LoadStereoCalibration(path); }, {testing::Q(path), "does not exist"});
 }
 
 TEST(StereoCalibration, NotYaml) {
