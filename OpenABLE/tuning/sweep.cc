@@ -374,7 +374,7 @@ std::string FormatSweepTable(const SweepResult& r) {
       << " of " << r.runs.size() << " by AUC (the best AUC is " << FormatFixed(best_auc, 3)
       << ")\n";
   }
-  return o.str();
+  return ToValidUtf8(o.str());
 }
 
 std::string EncodeSweepCsv(const SweepResult& r) {
