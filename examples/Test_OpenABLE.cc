@@ -5,6 +5,7 @@
 
 #include "OpenABLE/OpenABLE.h"
 #include "OpenABLE/app/command_line.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/ground_truth.h"
 
 namespace {
@@ -63,7 +64,7 @@ int main(int argc, char** argv) {
         const bool quiet = command_line.quiet;
         const auto log = [quiet](const std::string& line) {
           if (!quiet || line.rfind("auto: ", 0) != 0)
-            std::cerr << "Test_OpenABLE: " << line << "\n";
+            std::cerr << "Test_OpenABLE: " << openable::ToValidUtf8(line) << "\n";
         };
         const openable::RunOutcome outcome = openable::Run(config, progress, log);
         std::cout << (command_line.json ? openable::EncodeRunJson(config, outcome)

@@ -8,6 +8,7 @@
 #include "OpenABLE/OpenABLE.h"
 #include "OpenABLE/app/command_line.h"
 #include "OpenABLE/app/evaluate_files.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/cluster/cluster.h"
 #include "OpenABLE/io/json.h"
 
@@ -94,7 +95,7 @@ int main(int argc, char** argv) {
   openable::EvaluateCommandLine command_line;
   const std::string error = openable::ParseEvaluateCommandLine(argc, argv, command_line);
   if (!error.empty()) {
-    std::cerr << error << "\n";
+    std::cerr << openable::ToValidUtf8(error) << "\n";
     return openable::kExitUsageError;
   }
   if (command_line.help_keys)
@@ -113,7 +114,7 @@ int main(int argc, char** argv) {
         openable::WriteEvaluatedFiles(evaluated, command_line.matrices);
     // After the files are written: a run that fails says so in its one line alone.
     for (const std::string& note : evaluated.notes)
-      std::cerr << "openable_evaluate: note: " << note << "\n";
+      std::cerr << "openable_evaluate: note: " << openable::ToValidUtf8(note) << "\n";
     if (command_line.json) {
       std::cout << openable::ProgramJson(
           "openable_evaluate",
@@ -125,7 +126,7 @@ int main(int argc, char** argv) {
     }
     if (paths.empty()) return 0;
     std::cout << "Wrote:\n";
-    for (const auto& p : paths) std::cout << "  " << p << "\n";
+    for (const auto& p : paths) std::cout << "  " << openable::ToValidUtf8(p) << "\n";
     return 0;
   });
 }

@@ -11,6 +11,7 @@
 #include "OpenABLE/app/command_line.h"
 #include "OpenABLE/app/run.h"
 #include "OpenABLE/app/snaps_chain.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/io/json.h"
 
@@ -61,7 +62,7 @@ int main(int argc, char** argv) {
       [](const openable::Config& config, const openable::CommandLine& cl,
          openable::ProgressReporter& progress) {
         const auto say = [&](const std::string& line) {
-          if (!cl.quiet) std::cerr << "  " << line << "\n";
+          if (!cl.quiet) std::cerr << "  " << openable::ToValidUtf8(line) << "\n";
         };
         const openable::snaps::ChainResult result = openable::snaps::RunChain(config, progress, say);
         if (cl.json) {
@@ -74,7 +75,7 @@ int main(int argc, char** argv) {
         const std::vector<std::string> paths = openable::snaps::WriteChainOutputs(config, result);
         if (!paths.empty()) {
           std::cout << "Wrote:\n";
-          for (const auto& path : paths) std::cout << "  " << path << "\n";
+          for (const auto& path : paths) std::cout << "  " << openable::ToValidUtf8(path) << "\n";
         }
         return 0;
       });

@@ -6,6 +6,7 @@
 
 #include "OpenABLE/OpenABLE.h"
 #include "OpenABLE/app/command_line.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/io/json.h"
 
@@ -94,7 +95,7 @@ int main(int argc, char** argv) {
         const bool quiet = command_line.quiet;
         const auto log = [quiet](const std::string& line) {
           if (!quiet || line.rfind("run ", 0) != 0)
-            std::cerr << "openable_sweep: " << line << "\n";
+            std::cerr << "openable_sweep: " << openable::ToValidUtf8(line) << "\n";
         };
         const openable::SweepResult result = openable::RunSweep(config, options, progress, log);
         const std::vector<std::string> written = openable::WriteSweep(prefix, result);
@@ -105,7 +106,8 @@ int main(int argc, char** argv) {
           return 0;
         }
         std::cout << openable::FormatSweepTable(result) << "Wrote:\n";
-        for (const std::string& path : written) std::cout << "  " << path << "\n";
+        for (const std::string& path : written)
+          std::cout << "  " << openable::ToValidUtf8(path) << "\n";
         return 0;
       },
       {"--vary", "--output", "--rank-by", "--best"});

@@ -5,6 +5,7 @@
 #include "OpenABLE/base/error.h"
 
 #include <atomic>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <mutex>
@@ -25,6 +26,36 @@ void WriteBytes(const std::string& path, const std::string& bytes) {
   std::ofstream f(path, std::ios::binary);
   f << bytes;
   ASSERT_TRUE(f.good()) << path;
+}
+
+std::size_t FirstInvalidUtf8Byte(const std::string& text) {
+  const std::uint32_t kSmallest[] = {0, 0, 0x80, 0x800, 0x10000};  // by length
+  for (std::size_t i = 0; i < text.size();) {
+    const auto lead = static_cast<unsigned char>(text[i]);
+    std::size_t length = 0;
+    std::uint32_t code = 0;
+    if (lead < 0x80) {
+      ++i;
+      continue;
+    } else if ((lead & 0xe0) == 0xc0) {
+      length = 2, code = lead & 0x1fu;
+    } else if ((lead & 0xf0) == 0xe0) {
+      length = 3, code = lead & 0x0fu;
+    } else if ((lead & 0xf8) == 0xf0) {
+      length = 4, code = lead & 0x07u;
+    } else {
+      return i;  // a continuation byte, or a lead of 5 or more bytes
+    }
+    if (i + length > text.size()) return i;
+    for (std::size_t k = 1; k < length; ++k) {
+      const auto next = static_cast<unsigned char>(text[i + k]);
+      if ((next & 0xc0) != 0x80) return i;
+      code = (code << 6) | (next & 0x3fu);
+    }
+    if (code < kSmallest[length] || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff)) return i;
+    i += length;
+  }
+  return std::string::npos;
 }
 
 void ExpectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts) {

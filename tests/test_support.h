@@ -15,6 +15,13 @@ void WriteBytes(const std::string& path, const std::string& bytes);
 // The bytes of `path` (empty when it cannot be read).
 std::string ReadBytes(const std::string& path);
 
+// The offset of the first byte of `text` that is not part of valid UTF-8, or std::string::npos
+// when all of it is valid. Written from the definition of UTF-8 (RFC 3629, section 3), not
+// from the project's converter (ToValidUtf8): the lead byte's high bits give the length, the
+// others are 10xxxxxx, and the code point they hold must be a Unicode scalar value (at most
+// U+10FFFF, not a surrogate D800-DFFF) that needs exactly that many bytes.
+std::size_t FirstInvalidUtf8Byte(const std::string& text);
+
 // Runs `f` and expects an InputError whose message is one line (no '\n' or '\r') holding every
 // one of `parts`.
 void ExpectInputError(const std::function<void()>& f, std::initializer_list<std::string> parts);

@@ -9,6 +9,7 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/interrupt.h"
 #include "OpenABLE/base/program.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/cluster/cluster.h"
 
 namespace openable {
@@ -135,7 +136,7 @@ int AnswerHelpKeys(const std::string& program, const std::string& group) {
   try {
     keys = ConfigHelpText(group);
   } catch (const InputError& e) {
-    std::cerr << program << ": " << e.what() << "\n";
+    std::cerr << program << ": " << ToValidUtf8(e.what()) << "\n";
     return 2;
   }
   std::cout << "Configuration keys (Config.txt: one 'Key: value' per line, '#' comments;\n"
@@ -161,7 +162,7 @@ int AnswerWithoutRunning(const CommandLine& command_line, const std::string& usa
     return 0;
   }
   if (!usage_error.empty()) {
-    std::cerr << usage_error << "\n";
+    std::cerr << ToValidUtf8(usage_error) << "\n";
     return 2;
   }
   return -1;
@@ -219,8 +220,8 @@ int RunConfigProgram(
       // when not process 0) and ends the run.
       const bool input = dynamic_cast<const InputError*>(&e) != nullptr;
       std::fprintf(stderr, "%s: %s%s (%s)\n", program,
-                   input ? "error: " : "internal error (please report): ", e.what(),
-                   cluster.Name(cluster.Rank()).c_str());
+                   input ? "error: " : "internal error (please report): ",
+                   ToValidUtf8(e.what()).c_str(), cluster.Name(cluster.Rank()).c_str());
       std::fflush(stderr);
       cluster.Abort(input ? kExitInputError : kExitInternalError);
     }

@@ -44,7 +44,9 @@ RunOutcome Run(const Config& config, ProgressReporter& progress,
 
 // The report Test_OpenABLE prints at the end: descriptor and camera, traversals, mode and
 // matrix, the auto mode's candidates and choice, timings, the evaluation table, the files
-// written. With Auto 1 the run is described by the chosen configuration, not `config`.
+// written. With Auto 1 the run is described by the chosen configuration, not `config`. Paths
+// and names that are not valid UTF-8 are shown by ToValidUtf8 (base/strings.h), as in every
+// text output.
 std::string FormatRunReport(const Config& config, const RunOutcome& outcome);
 
 // The same report as one JSON object (Test_OpenABLE --json), for scripts: {"program",

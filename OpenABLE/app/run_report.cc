@@ -143,7 +143,7 @@ std::string FormatRunReport(const Config& config, const RunOutcome& outcome) {
     out << "Wrote:\n";
     for (const auto& p : outcome.written) out << "  " << p << "\n";
   }
-  return out.str();
+  return ToValidUtf8(out.str());
 }
 
 std::string EncodeRunJson(const Config& config, const RunOutcome& outcome) {

@@ -73,7 +73,7 @@ ChainResult RunChain(const Config& config, ProgressReporter& progress,
                      const std::function<void(const std::string&)>& say = {});
 
 // The report openable_snaps prints: trajectory, odometry, loops, corrections, errors and
-// latencies, a few lines.
+// latencies, a few lines; text that is not valid UTF-8 shown by ToValidUtf8.
 std::string FormatChainReport(const Config& config, const ChainResult& result);
 
 // The figures as JSON (<Snaps_output_name>.json), 6 significant digits, null when not finite;

@@ -243,7 +243,7 @@ std::string FormatChainReport(const Config& c, const ChainResult& r) {
     out << "  discounted update: " << FormatFixed(1e3 * r.discounted_seconds, 2) << " ms for "
         << r.closed.size() << " loops\n";
   }
-  return out.str();
+  return ToValidUtf8(out.str());
 }
 
 Json ChainJson(const Config& c, const ChainResult& r) {

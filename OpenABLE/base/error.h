@@ -11,6 +11,8 @@
 #include <string>
 #include <string_view>
 
+#include "OpenABLE/base/strings.h"
+
 namespace openable {
 
 class InputError : public std::runtime_error {
@@ -19,11 +21,12 @@ class InputError : public std::runtime_error {
 };
 
 // `s` between double quotes, with quotes and control characters escaped so that a message
-// stays on one line whatever the file name holds.
+// stays on one line whatever the file name holds, and bytes that are not valid UTF-8 written
+// as \xNN (ToValidUtf8, strings.h), as every text output shows them.
 inline std::string Quoted(std::string_view s) {
   static const char* const kHex = "0123456789abcdef";
   std::string out = "\"";
-  for (const char c : s) {
+  for (const char c : ToValidUtf8(s)) {
     const auto u = static_cast<unsigned char>(c);
     if (c == '"') {
       out += "\\\"";

@@ -6,6 +6,7 @@
 #include <malloc.h>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 
 namespace openable {
 
@@ -18,10 +19,10 @@ int RunProgram(const std::string& program, const std::function<int()>& body) {
   try {
     return body();
   } catch (const InputError& e) {
-    std::cerr << program << ": error: " << e.what() << "\n";
+    std::cerr << program << ": error: " << ToValidUtf8(e.what()) << "\n";
     return kExitInputError;
   } catch (const std::exception& e) {
-    std::cerr << program << ": internal error (please report): " << e.what() << "\n";
+    std::cerr << program << ": internal error (please report): " << ToValidUtf8(e.what()) << "\n";
     return kExitInternalError;
   }
 }

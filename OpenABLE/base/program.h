@@ -14,7 +14,9 @@ inline constexpr int kExitInternalError = 3;  // a bug: a broken internal precon
 
 // Runs `body` and returns its status; an InputError becomes one line
 // "<program>: error: <message>" on stderr and status 1, any other exception
-// "<program>: internal error (please report): <message>" and status 3.
+// "<program>: internal error (please report): <message>" and status 3. The message is shown
+// by ToValidUtf8 (strings.h), as every line the programs print: a path in another encoding
+// quoted raw by a message has its invalid bytes written \xNN.
 int RunProgram(const std::string& program, const std::function<int()>& body);
 
 // For programs that describe frames one after the other (Test_OpenABLE, openable_sweep): every

@@ -50,6 +50,67 @@ std::string FormatFixed(double value, int decimals) {
   return buffer;
 }
 
+namespace {
+
+// The length of the well-formed UTF-8 sequence that starts `s` (The Unicode Standard, Table
+// 3-7), 0 when none does. The second byte's range depends on the first (E0: A0-BF, no overlong
+// 3-byte form; ED: 80-9F, no surrogate; F0: 90-BF, no overlong 4-byte form; F4: 80-8F, nothing
+// above U+10FFFF); every other following byte is 80-BF. C0, C1 and F5-FF start nothing.
+// Written here: none of the libraries the project links checks UTF-8 and tells where it fails
+// (nlohmann-json's decoder is private to its serializer and only refuses, drops or replaces;
+// OpenCV has none; OpenImageIO's utf8_to_unicode lets invalid sequences through), and ICU would
+// be a new dependency of every program for these few lines.
+std::size_t WellFormedLength(std::string_view s) {
+  const auto byte = [s](std::size_t i) { return static_cast<unsigned char>(s[i]); };
+  const unsigned char first = byte(0);
+  if (first < 0x80) return 1;
+  std::size_t length = 0;
+  unsigned char low = 0x80, high = 0xbf;  // the second byte's range
+  if (first >= 0xc2 && first <= 0xdf) {
+    length = 2;
+  } else if (first == 0xe0) {
+    length = 3, low = 0xa0;
+  } else if ((first >= 0xe1 && first <= 0xec) || first == 0xee || first == 0xef) {
+    length = 3;
+  } else if (first == 0xed) {
+    length = 3, high = 0x9f;
+  } else if (first == 0xf0) {
+    length = 4, low = 0x90;
+  } else if (first >= 0xf1 && first <= 0xf3) {
+    length = 4;
+  } else if (first == 0xf4) {
+    length = 4, high = 0x8f;
+  } else {
+    return 0;
+  }
+  if (s.size() < length || byte(1) < low || byte(1) > high) return 0;
+  for (std::size_t i = 2; i < length; ++i)
+    if (byte(i) < 0x80 || byte(i) > 0xbf) return 0;
+  return length;
+}
+
+}  // namespace
+
+std::string ToValidUtf8(std::string_view s) {
+  static const char* const kHex = "0123456789abcdef";
+  std::string out;
+  out.reserve(s.size());
+  for (std::size_t i = 0; i < s.size();) {
+    const std::size_t length = WellFormedLength(s.substr(i));
+    if (length > 0) {
+      out.append(s.substr(i, length));
+      i += length;
+      continue;
+    }
+    // Only this byte: the next one may start a well-formed sequence of its own.
+    const auto u = static_cast<unsigned char>(s[i++]);
+    out += "\\x";
+    out += kHex[u >> 4];
+    out += kHex[u & 0xf];
+  }
+  return out;
+}
+
 std::string WorkingDirectoryNote(std::string_view path) {
   const std::filesystem::path p(path);
   if (path.empty() || p.is_absolute()) return "";

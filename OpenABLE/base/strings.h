@@ -1,4 +1,5 @@
-// Small text helpers shared by every module: case folding, trimming, number formatting.
+// Small text helpers shared by every module: case folding, trimming, number formatting, text
+// made valid UTF-8 for the outputs.
 #pragma once
 
 #include <string>
@@ -28,6 +29,27 @@ std::string FormatNumber(double value, int significant = 6);
 // `value` with `decimals` digits after the point (printf's "%.3f" for 3): figures in tables and
 // reports.
 std::string FormatFixed(double value, int decimals);
+
+// `s` as text that every output can show: `s` itself, byte for byte, when it is valid UTF-8;
+// otherwise each byte that is not part of a well-formed UTF-8 sequence (The Unicode Standard,
+// section 3.9, Table 3-7: no overlong forms, no surrogates D800-DFFF, nothing above U+10FFFF, no
+// truncated sequence, no lone continuation byte) written as the four characters \xNN (two
+// lower-case hex digits), the well-formed sequences around it kept. File names on Linux are
+// bytes, so a name in another encoding ("caf\xe9.png", Latin-1) would otherwise reach files that
+// declare UTF-8. The one rule of every text output: the HTML report, the JSON documents, the
+// CSV files and the terminal (Quoted() and the programs' report, note and error lines); files
+// are still opened by their real names.
+//
+// Escapes rather than U+FFFD: the replacement character makes names that differ only in their
+// invalid bytes look the same ("caf\xe9.png" and "caf\xe8.png" would both read "caf<U+FFFD>.png",
+// "\xe2\x82" and "\xe2" both one U+FFFD), while escapes keep every name distinct and tell the
+// user the real bytes to type (printf 'caf\xe9.png'). They are the escapes Quoted() already
+// writes for control bytes, and what Python's bytes.decode("utf-8", "backslashreplace") gives.
+// nlohmann-json's error_handler_t cannot write them (it refuses, drops, or writes U+FFFD per
+// ill-formed subsequence), so the JSON writer applies this function before nlohmann escapes
+// the string. A backslash in a valid name is kept as it is (valid names come out unchanged), so
+// a valid name holding the text "\xe9" reads like one holding the byte E9: such names are rare.
+std::string ToValidUtf8(std::string_view s);
 
 // For a message about a path that was not found: " (relative to the working directory
 // "/home/user/run")" when `path` is relative, else "". A relative path in a Config.txt is

@@ -184,7 +184,7 @@ std::string FormatEvaluationTable(const EvaluationSettings& s,
       }
     }
   }
-  return o.str();
+  return ToValidUtf8(o.str());
 }
 
 }  // namespace openable

@@ -65,7 +65,8 @@ nlohmann::ordered_json EvaluationSettingsJson(const EvaluationSettings& settings
 void AddEvaluatedRunJson(nlohmann::ordered_json& object, const EvaluatedRun& run);
 
 // A few lines for a terminal: the protocol settings, then one row per run with AUC, R@100P,
-// max F1 (threshold), R@1/5/10 and ABLE-P AP.
+// max F1 (threshold), R@1/5/10 and ABLE-P AP. Text that is not valid UTF-8 (the ground truth's
+// path, a label) is shown by ToValidUtf8.
 std::string FormatEvaluationTable(const EvaluationSettings& settings,
                                   const std::vector<EvaluatedRun>& runs);
 

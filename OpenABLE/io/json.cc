@@ -9,10 +9,28 @@
 namespace openable::json {
 namespace {
 
-// A string literal: nlohmann's escaping (quotes, backslashes, control characters as \n, \t or
-// \u0001), with each byte that is not valid UTF-8 replaced by U+FFFD.
+// A string literal: the text shown by ToValidUtf8, then nlohmann's escaping (quotes, backslashes,
+// control characters as \n, \t or \u0001). The text is valid UTF-8 by then; `replace` only
+// keeps a document from ever failing on a string.
 std::string Literal(const std::string& s) {
-  return Json(s).dump(-1, ' ', false, Json::error_handler_t::replace);
+  return Json(ToValidUtf8(s)).dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+// `v` with every string and name shown by ToValidUtf8 (DumpLine).
+Json ShownStrings(const Json& v) {
+  if (v.is_string()) return ToValidUtf8(v.get_ref<const std::string&>());
+  if (v.is_array()) {
+    Json out = Json::array();
+    for (const Json& e : v) out.push_back(ShownStrings(e));
+    return out;
+  }
+  if (v.is_object()) {
+    Json out = Json::object();
+    for (auto it = v.begin(); it != v.end(); ++it)
+      out[ToValidUtf8(it.key())] = ShownStrings(it.value());
+    return out;
+  }
+  return v;
 }
 
 void Write(const Json& v, int depth, std::string& out) {
@@ -66,6 +84,10 @@ std::string Dump(const Json& document) {
   std::string out;
   Write(document, 0, out);
   return out + "\n";
+}
+
+std::string DumpLine(const Json& document) {
+  return ShownStrings(document).dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
 }  // namespace openable::json

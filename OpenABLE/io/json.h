@@ -32,11 +32,18 @@ Json Strings(const std::vector<std::string>& items);
 // double with Grisu2, which is not always the shortest text that reads back (0.01530851 can
 // come out as 0.015308510000000001), while every double here is written as printf's %.9g
 // writes it (NaN and infinities as null): the texts the toolbox has always written, and at
-// most 9 significant digits whatever was stored. Strings are escaped by nlohmann (quotes,
-// backslashes, control characters); text that is not valid UTF-8 (a path in another encoding)
-// has each invalid byte replaced by U+FFFD (error_handler_t::replace) instead of making the
-// whole document fail.
+// most 9 significant digits whatever was stored. Strings (and names) are shown by the rule of
+// every text output first (ToValidUtf8, base/strings.h: a path in another encoding has each
+// byte outside a well-formed UTF-8 sequence written \xNN, so the JSON string holds \\xNN),
+// then escaped by nlohmann (quotes, backslashes, control characters). nlohmann's own
+// error_handler_t could only refuse the document, drop such bytes or write U+FFFD for them,
+// which would make names that differ in those bytes read the same.
 std::string Dump(const Json& document);
+
+// `document` on one line exactly as nlohmann's dump() writes it (the data embedded in the HTML
+// report), its strings and names shown by the same rule as Dump's. For a document whose text
+// is all valid UTF-8 the same bytes as dump().
+std::string DumpLine(const Json& document);
 
 }  // namespace json
 }  // namespace openable

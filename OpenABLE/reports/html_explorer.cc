@@ -552,8 +552,8 @@ std::string ExplorerSection(const ReportInput& input) {
     set_json.push_back(j);
   }
   h += "<div hidden>\n" + sheets_html + "</div>\n";
-  h += "<script type=\"application/json\" id=\"explore-frames\">" + ScriptSafe(set_json.dump()) +
-       "</script>\n";
+  h += "<script type=\"application/json\" id=\"explore-frames\">" +
+       ScriptSafe(json::DumpLine(set_json)) + "</script>\n";
   if (!frames.read)
     h += frames.missing.empty()
              ? std::string("<p class=\"note\">Frames are named, not shown.</p>\n")
@@ -626,7 +626,8 @@ std::string ExplorerSection(const ReportInput& input) {
               std::to_string(image.rows) + " pixels; clicks and arrow keys still select single cells.";
 
     h += "<h3>" + HtmlEscape(run.label) + "</h3>\n";
-    h += "<script type=\"application/json\" id=\"explore-run-" + n + "\">" + ScriptSafe(j.dump()) +
+    h += "<script type=\"application/json\" id=\"explore-run-" + n + "\">" +
+         ScriptSafe(json::DumpLine(j)) +
          "</script>\n<script type=\"text/plain\" id=\"explore-values-" + n + "\">" +
          Base64(std::string(reinterpret_cast<const char*>(values.data), values.total())) +
          "</script>\n";

@@ -1,5 +1,7 @@
 #include "OpenABLE/reports/html_text.h"
 
+#include "OpenABLE/base/strings.h"
+
 namespace openable {
 
 // Written here: none of the project's libraries offers a public encoder (OpenCV's is internal
@@ -34,7 +36,7 @@ std::string Base64(const std::string& bytes) {
 std::string HtmlEscape(const std::string& text) {
   std::string out;
   out.reserve(text.size());
-  for (const char c : text) {
+  for (const char c : ToValidUtf8(text)) {
     switch (c) {
       case '&': out += "&amp;"; break;
       case '<': out += "&lt;"; break;

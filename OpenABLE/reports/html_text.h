@@ -9,7 +9,10 @@ namespace openable {
 // Base64 (RFC 4648), with padding.
 std::string Base64(const std::string& bytes);
 
-// `text` with & < > " ' escaped, for HTML text and attribute values.
+// `text` with & < > " ' escaped, for HTML text and attribute values. The page declares UTF-8:
+// text that is not valid UTF-8 (a file name in another encoding) is first shown by the rule of
+// every text output (ToValidUtf8, base/strings.h: each byte outside a well-formed sequence as
+// \xNN); valid text is escaped as it is.
 std::string HtmlEscape(const std::string& text);
 
 // JSON text made safe inside a <script> element: < > & (which JSON has only inside strings)

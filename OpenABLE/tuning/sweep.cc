@@ -116,10 +116,13 @@ std::vector<std::vector<std::string>> Combinations(const std::vector<SweepAxis>&
   return all;
 }
 
+// A CSV field: the text shown by ToValidUtf8 (a value naming a folder in another encoding),
+// quoted when it holds a comma, a quote or a line break.
 std::string CsvField(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  const std::string text = ToValidUtf8(s);
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
   std::string out = "\"";
-  for (const char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  for (const char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
   return out + "\"";
 }
 
@@ -371,7 +374,7 @@ std::string FormatSweepTable(const SweepResult& r) {
       << " of " << r.runs.size() << " by AUC (the best AUC is " << FormatFixed(best_auc, 3)
       << ")\n";
   }
-  return o.str();
+  return ToValidUtf8(o.str());
 }
 
 std::string EncodeSweepCsv(const SweepResult& r) {

@@ -100,7 +100,7 @@ SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressRe
 // ground truth (consistency, distinctiveness, agreement) and, with ground truth, AUC, R@100P,
 // max F1, R@1, R@5 and ABLE-P AP, and its rank by the other kind (by AUC when ranked by a
 // criterion, by agreement when ranked by a figure), so the two can be compared; a line on how
-// often frames were described.
+// often frames were described. Text that is not valid UTF-8 is shown by ToValidUtf8.
 std::string FormatSweepTable(const SweepResult& result);
 
 // The same rows as CSV: rank, one column per varied key, label, the figures of the evaluation

@@ -62,12 +62,29 @@ TEST(Json, StringsAreEscaped) {
   EXPECT_EQ(json::Dump(keyed), "{\n  \"a\\\"b\": 1\n}\n");  // names too
 }
 
-TEST(Json, InvalidUtf8IsReplacedNotRefused) {
+// Text that is not valid UTF-8 (a path in another encoding) is neither refused nor replaced by
+// U+FFFD: each byte outside a well-formed sequence is written \xNN (ToValidUtf8), as in every
+// other output, so the JSON text holds \\xNN. Names too, and DumpLine writes the same strings.
+TEST(Json, InvalidUtf8IsShownAsEscapesNotRefused) {
   Json doc;
   doc["path"] = std::string("bad\xff\xfe name\xc3");
-  const std::string replacement = "\xef\xbf\xbd";  // U+FFFD in UTF-8
-  EXPECT_EQ(json::Dump(doc), "{\n  \"path\": \"bad" + replacement + replacement + " name" +
-                                 replacement + "\"\n}\n");
+  doc["caf\xe9"] = Json::array({"\xed\xa0\x80", "ok \xc3\xa9"});
+  EXPECT_EQ(json::Dump(doc),
+            "{\n  \"path\": \"bad\\\\xff\\\\xfe name\\\\xc3\",\n  \"caf\\\\xe9\": [\n"
+            "    \"\\\\xed\\\\xa0\\\\x80\",\n    \"ok \xc3\xa9\"\n  ]\n}\n");
+  EXPECT_EQ(json::DumpLine(doc),
+            "{\"path\":\"bad\\\\xff\\\\xfe name\\\\xc3\",\"caf\\\\xe9\":"
+            "[\"\\\\xed\\\\xa0\\\\x80\",\"ok \xc3\xa9\"]}");
+  // Read back, the strings are the escapes.
+  EXPECT_EQ(Json::parse(json::Dump(doc))["path"], "bad\\xff\\xfe name\\xc3");
+}
+
+// DumpLine is nlohmann's one-line dump() for text that is valid UTF-8.
+TEST(Json, DumpLineIsNlohmannsDumpForValidText) {
+  Json doc;
+  doc["a"] = {1, 2.5, "caf\xc3\xa9 \"q\"\n", nullptr, true};
+  doc["b"] = Json::object();
+  EXPECT_EQ(json::DumpLine(doc), doc.dump());
 }
 
 TEST(Json, DumpIndentsByTwoSpacesKeepsOrderAndEndsWithANewline) {

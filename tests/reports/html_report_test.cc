@@ -14,6 +14,7 @@
 #include "OpenABLE/io/json.h"
 #include "OpenABLE/reports/html_explorer.h"
 #include "config/config.h"
+#include "tests/test_support.h"
 
 namespace openable {
 namespace {
@@ -219,6 +220,40 @@ std::string ScriptText(const std::string& page, const std::string& id) {
   if (at == std::string::npos) return "";
   const std::size_t begin = page.find('>', at) + 1;
   return page.substr(begin, page.find("</script>", begin) - begin);
+}
+
+// Frame names, a label, a title and settings that are not valid UTF-8: the page (which declares
+// UTF-8) is valid UTF-8 and shows each byte outside a well-formed sequence as \xNN, then escaped
+// for HTML as any text; in the explorer's data, the same text as a JSON string.
+TEST(HtmlReport, TextThatIsNotUtf8IsShownAsEscapes) {
+  Fixture f;
+  f.evaluation.runs[0].label = "LDB \xe9<";
+  ReportInput input;
+  input.title = "run of caf\xe9";
+  input.settings = {{"Images_path", "frames/\xed\xa0\x80"}};
+  input.all_settings = "Images_path: frames/\xed\xa0\x80\n";
+  input.evaluation = &f.evaluation;
+  input.matrices = {&f.matrix};
+  input.examples = 3;
+  input.frames.name = [](bool row, int index) {
+    return std::string(row ? "q\xe9" : "r\xc0\xaf") + std::to_string(index) + ".png";
+  };
+  input.frames.missing = "names only";
+  const std::string page = EncodeHtmlReport(input);
+  EXPECT_EQ(testing::FirstInvalidUtf8Byte(page), std::string::npos);
+  EXPECT_NE(page.find("<title>run of caf\\xe9</title>"), std::string::npos);
+  EXPECT_NE(page.find("<code>frames/\\xed\\xa0\\x80</code>"), std::string::npos);
+  EXPECT_NE(page.find("<pre>Images_path: frames/\\xed\\xa0\\x80\n</pre>"), std::string::npos);
+  EXPECT_NE(page.find("<h3>LDB \\xe9&lt;</h3>"), std::string::npos);
+  const std::size_t query = page.find(".png<br>query ");
+  ASSERT_NE(query, std::string::npos);
+  EXPECT_EQ(page.compare(page.rfind('>', query) + 1, 5, "q\\xe9"), 0)
+      << page.substr(page.rfind('>', query), 30);
+  const std::string frames = ScriptText(page, "explore-frames");
+  EXPECT_NE(frames.find("\"q\\\\xe9" + std::to_string(kFrames) + ".png\""), std::string::npos);
+  EXPECT_NE(frames.find("\"r\\\\xc0\\\\xaf0.png\""), std::string::npos);
+  const Json run = Json::parse(ScriptText(page, "explore-run-0"));
+  EXPECT_EQ(run["label"], "LDB \\xe9<");
 }
 
 TEST(HtmlReport, ExplorerEmbedsEachQuerysBestMatchAndThe8BitBlock) {
