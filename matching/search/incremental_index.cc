@@ -185,7 +185,12 @@ void IncrementalIndex::Restore(const cv::Mat& rows, const std::vector<SavedBlock
   s.indexed = next;
 }
 
-cv::Mat IncrementalIndex::Rows() const { return state_->buffer.rowRange(0, state_->size); }
+cv::Mat IncrementalIndex::Rows() const {
+  const State& s = *state_;
+  // Before the first row there is no buffer to take a range of.
+  if (s.size == 0) return cv::Mat(0, s.width, s.type);
+  return s.buffer.rowRange(0, s.size);
+}
 int IncrementalIndex::Size() const { return state_->size; }
 int IncrementalIndex::Blocks() const { return static_cast<int>(state_->blocks.size()); }
 

@@ -62,6 +62,10 @@ void WriteMaps(const std::string& dir) {
     for (int i = 0; i < 3; ++i) d.AddFrame(MapFrame(i));
     d.SaveMap(dir + "/verifying.map");
   }
+  {  // An empty map.
+    OnlineDetector d(MapDetectorOptions(MapKind::kRows));
+    d.SaveMap(dir + "/empty.map");
+  }
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/output_batch.h"
 #include "OpenABLE/online/online.h"
+#include "tests/fuzz/map_detectors.h"
 #include "tests/online/index_engines.h"
 #include "tests/test_frames.h"
 #include "tests/test_support.h"
@@ -250,6 +251,21 @@ TEST(SavedMap, DefectsAreOneLineErrors) {
   for (const auto& entry : std::filesystem::directory_iterator(dir))
     files += entry.path().filename().string().find(".tmp-") != std::string::npos;
   EXPECT_EQ(files, 0);
+}
+
+// A detector that has no frame yet saves an empty map, which loads into an empty detector
+// (saving it threw a cv::Exception: the rows of an empty index were a range of no buffer).
+TEST(SavedMap, EmptyDetectorSavesAndLoads) {
+  const OnlineOptions options = fuzz::MapDetectorOptions(fuzz::MapKind::kRows);
+  OnlineDetector empty(options);
+  EXPECT_EQ(empty.Descriptors().rows, 0);
+  EXPECT_EQ(empty.Descriptors().cols, empty.RowWidth());
+  const std::string path = testing::TempDir() + "/empty.map";
+  empty.SaveMap(path);
+  OnlineDetector today(options);
+  EXPECT_EQ(today.LoadMap(path).frames, 0);
+  EXPECT_EQ(today.Size(), 0);
+  EXPECT_EQ(today.AddDescriptor(cv::Mat::zeros(1, today.RowWidth(), CV_8U)).frame, 0);
 }
 
 }  // namespace
