@@ -268,5 +268,27 @@ TEST(SavedMap, EmptyDetectorSavesAndLoads) {
   EXPECT_EQ(today.AddDescriptor(cv::Mat::zeros(1, today.RowWidth(), CV_8U)).frame, 0);
 }
 
+// The maps of the map fuzzer's corpus (tests/fuzz/corpus/map/, written by
+// tests/fuzz/write_seeds.cc and tests/fuzz/map_fuzzer.cc's findings).
+std::string MapSeed(const std::string& name) {
+  return testing::SourceDir() + "/tests/fuzz/corpus/map/" + name;
+}
+
+// Found by tests/fuzz/map_fuzzer.cc on its seed verifying.map: with 5 inliers required, a
+// candidate with 6 matches threw a cv::Exception from the fundamental matrix's estimator
+// (tests/verification has the unit test). The frame is now verified.
+TEST(SavedMap, FuzzerSeedWithVerificationSearchesAndVerifies) {
+  OnlineDetector detector(fuzz::MapDetectorOptions(fuzz::MapKind::kVerifying));
+  EXPECT_EQ(detector.LoadMap(MapSeed("verifying.map")).frames, 3);
+  const OnlineResult r = detector.AddFrame(fuzz::MapFrame(0));
+  ASSERT_EQ(r.candidates.size(), 1u);  // the three frames are one place (score_window 10)
+  EXPECT_EQ(r.candidates[0].frame, 0);  // the same image
+  // 6 of its 10 features pass the ratio test: too few for the fundamental matrix, the
+  // homography fits them.
+  EXPECT_EQ(r.candidates[0].matches, 6);
+  EXPECT_EQ(r.candidates[0].model, GeometricModel::kHomography);
+  EXPECT_TRUE(r.candidates[0].geometric);
+}
+
 }  // namespace
 }  // namespace openable
