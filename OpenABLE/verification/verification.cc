@@ -89,7 +89,11 @@ PairVerifier::PairVerifier(const VerificationOptions& options,
                            std::optional<CameraIntrinsics> camera)
     : options_(options), camera_(camera) {
   options_.Check();
-  norm_ = options_.features == LocalFeatures::kOrb ? cv::NORM_HAMMING : cv::NORM_L2;
+  const odometry::FeatureExtractor extractor(EnumName(options_.features), options_.max_features,
+                                             "Verification_features");
+  norm_ = extractor.Norm();
+  descriptor_width_ = extractor.DescriptorWidth();
+  descriptor_type_ = extractor.DescriptorType();
 }
 
 FrameFeatures PairVerifier::Extract(const cv::Mat& image) const {

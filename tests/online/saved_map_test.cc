@@ -2,9 +2,13 @@
 // loads yesterday's map gives every later frame the candidates the detector that saved it
 // gives, on real KITTI 00 frames, with each index engine; the file is checked on loading.
 #include <cerrno>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -12,7 +16,9 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/hash.h"
 #include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/online/map_file.h"
 #include "OpenABLE/online/online.h"
 #include "tests/fuzz/map_detectors.h"
 #include "tests/online/index_engines.h"
@@ -274,6 +280,41 @@ std::string MapSeed(const std::string& name) {
   return testing::SourceDir() + "/tests/fuzz/corpus/map/" + name;
 }
 
+// `bytes` with the checksum of a map file (the FNV-1a 64 of all but its last 8 bytes) in its
+// last 8 bytes, written to `path`: a file that passes the checksum and is checked further.
+void WriteWithChecksum(const std::string& path, std::string bytes) {
+  std::uint64_t sum = Fnv1a64(bytes.data(), bytes.size() - 8);
+  for (size_t i = 0; i < 8; ++i, sum >>= 8)
+    bytes[bytes.size() - 8 + i] = static_cast<char>(sum & 0xFF);
+  testing::WriteBytes(path, bytes);
+}
+
+// Found by tests/fuzz/map_fuzzer.cc: a frame's feature count of 0xffffff.. was allocated (as
+// points, 34 GB) before the bytes behind it were counted: an abort under AddressSanitizer,
+// std::bad_alloc or a machine out of memory otherwise. Every size read from a map is now
+// checked against the bytes that follow before anything of that size is allocated: the rows
+// that frames x row_width announce too.
+TEST(SavedMap, SizesAreCheckedBeforeAllocating) {
+  const std::string path = MapSeed("huge_point_count.map");
+  ExpectInputError([&] { ReadMapFile(path); },
+                   {path, "the map is truncated", "for a frame's feature points"});
+
+  // Signature, version 1, the settings, the rows' length, (no rows), the checksum.
+  auto put64 = [](std::string& out, std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
+  };
+  std::string huge("OpenABLE-map\r\n\x1a\n\x01\0\0\0", 20);
+  const std::string settings = "frames 100000\nrow_width 100000\nrow_type CV_32F\n";
+  put64(huge, settings.size());
+  huge += settings;
+  put64(huge, 40000000000);  // 100000 x 100000 floats
+  huge += std::string(8, '\0');
+  const std::string rows_path = testing::TempDir() + "/huge_rows.map";
+  WriteWithChecksum(rows_path, huge);
+  ExpectInputError([&] { ReadMapFile(rows_path); },
+                   {rows_path, "the map is truncated", "for the rows, expected 40000000000"});
+}
+
 // Found by tests/fuzz/map_fuzzer.cc on its seed verifying.map: with 5 inliers required, a
 // candidate with 6 matches threw a cv::Exception from the fundamental matrix's estimator
 // (tests/verification has the unit test). The frame is now verified.
@@ -288,6 +329,40 @@ TEST(SavedMap, FuzzerSeedWithVerificationSearchesAndVerifies) {
   EXPECT_EQ(r.candidates[0].matches, 6);
   EXPECT_EQ(r.candidates[0].model, GeometricModel::kHomography);
   EXPECT_TRUE(r.candidates[0].geometric);
+}
+
+// Local features that verification could not use are refused on loading: a descriptor row
+// count other than the points', a point that is not finite, descriptors of another width or
+// type than the detector's features.
+TEST(SavedMap, InconsistentFeaturesAreRefused) {
+  const OnlineOptions options = fuzz::MapDetectorOptions(fuzz::MapKind::kVerifying);
+  const std::string good = MapSeed("verifying.map");
+  const MapFile map = ReadMapFile(good);
+  ASSERT_EQ(map.features.size(), 3u);
+  ASSERT_GT(map.features[1].points.size(), 1u);
+  const std::string dir = testing::TempDir();
+  auto written = [&](const std::string& name, const std::function<void(MapFile&)>& change) {
+    MapFile m = map;
+    for (FrameFeatures& f : m.features) f.descriptors = f.descriptors.clone();
+    change(m);
+    WriteMapFile(dir + "/" + name, m);
+    return dir + "/" + name;
+  };
+  const std::string fewer =
+      written("fewer.map", [](MapFile& m) { m.features[1].points.pop_back(); });
+  ExpectInputError([&] { ReadMapFile(fewer); }, {fewer, "feature descriptors", "row per point"});
+  const std::string nan = written("nan.map", [](MapFile& m) {
+    m.features[2].points[0].x = std::numeric_limits<float>::quiet_NaN();
+  });
+  ExpectInputError([&] { ReadMapFile(nan); }, {nan, "feature point is (nan", "pixel coordinates"});
+  const std::string narrow = written("narrow.map", [](MapFile& m) {
+    m.features[1].descriptors = m.features[1].descriptors.colRange(0, 16).clone();
+  });
+  EXPECT_NO_THROW(ReadMapFile(narrow));
+  OnlineDetector detector(options);
+  ExpectInputError([&] { detector.LoadMap(narrow); },
+                   {narrow, "frame 1", "descriptors of 16 CV_8UC1", "expected 32 CV_8UC1 (ORB)"});
+  EXPECT_EQ(detector.Size(), 0);
 }
 
 }  // namespace
