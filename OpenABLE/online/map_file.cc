@@ -183,6 +183,12 @@ MapFile ReadMapFile(const std::string& path) {
     size_t stop = text.find('\n', start);
     if (stop == std::string::npos) stop = text.size();
     const std::string line = text.substr(start, stop - start);
+    // Settings are printable text (SaveMap writes names and numbers): a control character
+    // would also break the one-line messages that quote them.
+    for (const char c : line)
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+        throw InputError(path + ": the map's setting line " + Quoted(line) +
+                         " holds a control character; expected lines \"key value\" of text");
     const size_t space = line.find(' ');
     map.settings.emplace_back(line.substr(0, space),
                               space == std::string::npos ? "" : line.substr(space + 1));

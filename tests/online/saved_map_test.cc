@@ -315,6 +315,16 @@ TEST(SavedMap, SizesAreCheckedBeforeAllocating) {
                    {rows_path, "the map is truncated", "for the rows, expected 40000000000"});
 }
 
+// Found by tests/fuzz/map_fuzzer.cc: a setting whose value held a carriage return (the fuzzer
+// had pasted the map's signature into row_type) gave a message of two lines. Settings are text:
+// a line with a control character is refused, and named escaped (the first such line of the
+// committed input holds bytes 0x17).
+TEST(SavedMap, SettingsWithControlCharactersAreRefused) {
+  const std::string path = MapSeed("setting_control_character.map");
+  ExpectInputError([&] { ReadMapFile(path); },
+                   {path, "setting line \"openable\\x17", "control character"});
+}
+
 // Found by tests/fuzz/map_fuzzer.cc on its seed verifying.map: with 5 inliers required, a
 // candidate with 6 matches threw a cv::Exception from the fundamental matrix's estimator
 // (tests/verification has the unit test). The frame is now verified.
