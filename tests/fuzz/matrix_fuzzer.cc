@@ -25,6 +25,7 @@ namespace {
 
 bool SameBits(const cv::Mat1f& a, const cv::Mat1f& b) {
   if (a.size() != b.size()) return false;
+  if (a.empty()) return true;  // an empty matrix has no rows to compare (and no data pointer)
   for (int r = 0; r < a.rows; ++r)
     if (std::memcmp(a[r], b[r], a.cols * sizeof(float)) != 0) return false;
   return true;
