@@ -102,10 +102,10 @@ wait
 for name in "${fuzzers[@]}"; do
   echo "-- ${name}_fuzzer"
   status=$(cat "$probe/${name}.status")
-  # The decoders' own complaints (libpng, libjpeg, OpenImageIO, OpenCV's imdecode and imread)
-  # and progress lines are noise.
-  grep -v -e '^#[0-9]' -e '^libpng' -e 'JPEG' -e '^INFO: ' -e '^imdecode_' -e '^imread_' -e '^$' \
-    "$probe/${name}.log" | tail -n 40 || true
+  # The decoders' own complaints (libpng, libjpeg, OpenImageIO, GDAL's two-line NITF error,
+  # OpenCV's imdecode and imread) and progress lines are noise.
+  grep -v -e '^#[0-9]' -e '^libpng' -e 'JPEG' -e '^INFO: ' -e '^imdecode_' -e '^imread_' \
+    -e '^ERROR [0-9]*: ' -e '^or empty\.$' -e '^$' "$probe/${name}.log" | tail -n 40 || true
   if [ "$status" -ne 0 ] || ls "$probe/${name}-"* > /dev/null 2>&1; then
     mkdir -p build_fuzz/artifacts
     cp "$probe/${name}.log" "$probe/${name}-"* build_fuzz/artifacts/ 2> /dev/null || true
