@@ -5,7 +5,7 @@
 # (build_asan), and each libFuzzer target of tests/fuzz/ for a bounded time on a copy of its
 # committed corpus when clang's libFuzzer is available (docs/robustness.md).
 # OPENABLE_SANITIZE_STEP=0 skips the sanitizer step, OPENABLE_FUZZ_SECONDS sets the time of
-# each fuzzer (45 s; 0 skips them). Each step ends with its wall time ("== ... done in N s"),
+# each fuzzer (60 s; 0 skips them). Each step ends with its wall time ("== ... done in N s"),
 # so that a slow CI run shows where its time went.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -70,7 +70,7 @@ done_step "Sanitized build"
          -E '^(install\..*|SnapsChain\.KittiMonocularOdometryLoopsFromOpenableAndCorrection|Auto\.NightLikeGardensPointIsWithinTheBestOfTheSweep|MonoOdometry\.KittiFrames0To199StayCloseToTheGroundTruth|Verification\.OnlineDetectorGivesTheBatchRunsLoops|Library\.BatchPathGivesTestOpenablesMatrixAndFigures|Kitti/SoDso\.CorrectsWithGroundTruthPairsAndWritesWhatItReports/seq00)( |$)')
 done_step "Sanitized suite"
 
-fuzz_seconds=${OPENABLE_FUZZ_SECONDS:-45}
+fuzz_seconds=${OPENABLE_FUZZ_SECONDS:-60}
 [ "$fuzz_seconds" = 0 ] && exit 0
 probe=$(mktemp -d)
 trap 'rm -rf "$probe"' EXIT
@@ -81,31 +81,44 @@ if ! command -v clang++ > /dev/null ||
   echo "== Fuzzers skipped: clang++ with libFuzzer is not available (examples/setup.sh --all installs it)"
   exit 0
 fi
-echo "== Fuzzers (${fuzz_seconds} s each) in build_fuzz"
 CXX=clang++ cmake -S . -B build_fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOPENABLE_BUILD_FUZZERS=ON \
       -DOPENABLE_BUILD_TESTS=OFF -DOPENABLE_BUILD_BENCHMARKS=OFF
-cmake --build build_fuzz -j"$jobs" --target config_fuzzer image_fuzzer
-# The two fuzzers run side by side (one core each), then each log is read in turn.
-for target in config image; do
-  corpus="$probe/$target"
-  cp -r "tests/fuzz/corpus/$target" "$corpus"  # new inputs go to the copy, never the committed corpus
-  (status=0
-   "build_fuzz/tests/fuzz/${target}_fuzzer" -max_total_time="$fuzz_seconds" -max_len=65536 \
-     -timeout=30 -rss_limit_mb=3072 -print_final_stats=1 -artifact_prefix="$probe/${target}-" \
-     "$corpus" > "$probe/${target}.log" 2>&1 || status=$?
-   echo "$status" > "$probe/${target}.status") &
+cmake --build build_fuzz -j"$jobs" --target fuzzers
+# The fuzzers the build made (the bag fuzzer only with the rosbag module), each <name>_fuzzer
+# with its corpus tests/fuzz/corpus/<name>/.
+mapfile -t fuzzers < build_fuzz/tests/fuzz/fuzzers.txt
+echo "== Fuzzers (${fuzz_seconds} s each, two at a time) in build_fuzz: ${fuzzers[*]}"
+run_fuzzer() {
+  local name=$1 status=0
+  cp -r "tests/fuzz/corpus/$name" "$probe/$name"  # new inputs go to the copy, never the committed corpus
+  "build_fuzz/tests/fuzz/${name}_fuzzer" -max_total_time="$fuzz_seconds" -max_len=65536 \
+    -timeout=30 -rss_limit_mb=3072 -print_final_stats=1 -artifact_prefix="$probe/${name}-" \
+    "$probe/$name" > "$probe/${name}.log" 2>&1 || status=$?
+  echo "$status" > "$probe/${name}.status"
+}
+# Two side by side (one core each): a new one starts when one ends. Then each log is read in turn.
+running=0
+for name in "${fuzzers[@]}"; do
+  if [ "$running" -ge 2 ]; then
+    wait -n
+    running=$((running - 1))
+  fi
+  run_fuzzer "$name" &
+  running=$((running + 1))
 done
 wait
-for target in config image; do
-  echo "-- ${target}_fuzzer"
-  status=$(cat "$probe/${target}.status")
-  # The decoders' own complaints (libpng, libjpeg, OpenImageIO) and progress lines are noise.
-  grep -v -e '^#[0-9]' -e '^libpng' -e 'JPEG' -e '^INFO: ' -e '^imdecode_' -e '^$' "$probe/${target}.log" | tail -n 40 || true
-  if [ "$status" -ne 0 ] || ls "$probe/${target}-"* > /dev/null 2>&1; then
+for name in "${fuzzers[@]}"; do
+  echo "-- ${name}_fuzzer"
+  status=$(cat "$probe/${name}.status")
+  # The decoders' own complaints (libpng, libjpeg, OpenImageIO, GDAL's two-line NITF error,
+  # OpenCV's imdecode and imread) and progress lines are noise.
+  grep -v -e '^#[0-9]' -e '^libpng' -e 'JPEG' -e '^INFO: ' -e '^imdecode_' -e '^imread_' \
+    -e '^ERROR [0-9]*: ' -e '^or empty\.$' -e '^$' "$probe/${name}.log" | tail -n 40 || true
+  if [ "$status" -ne 0 ] || ls "$probe/${name}-"* > /dev/null 2>&1; then
     mkdir -p build_fuzz/artifacts
-    cp "$probe/${target}.log" "$probe/${target}-"* build_fuzz/artifacts/ 2> /dev/null || true
-    echo "${target}_fuzzer failed (exit $status); log and failing input in build_fuzz/artifacts" \
-         "(reproduce: build_fuzz/tests/fuzz/${target}_fuzzer FILE)"
+    cp "$probe/${name}.log" "$probe/${name}-"* build_fuzz/artifacts/ 2> /dev/null || true
+    echo "${name}_fuzzer failed (exit $status); log and failing input in build_fuzz/artifacts" \
+         "(reproduce: build_fuzz/tests/fuzz/${name}_fuzzer FILE)"
     exit 1
   fi
 done

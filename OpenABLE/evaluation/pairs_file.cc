@@ -56,7 +56,8 @@ PairsFile ReadPairsFile(const std::string& path, int base, const std::string& wh
       if (!ParseIndex(line.fields[static_cast<std::size_t>(k)], &raw[k]))
         throw InputError(at + ": value " + Quoted(line.fields[static_cast<std::size_t>(k)]) +
                          " in column " + std::to_string(k + 1) +
-                         " is not an integer; expected two frame indices \"a,b\"");
+                         " is not an integer of at most 10^15 in size; expected two frame "
+                         "indices \"a,b\"");
     }
     out.pairs.push_back({raw[0] - base, raw[1] - base, line.number});
   });

@@ -36,7 +36,8 @@ struct PairsFile {
 // Reads `path`. `base`: 0 or 1, or -1 to read it from a comment ("0-based" or "1-based"; both
 // is an error), else 0. `what` names the file in messages ("ground truth pairs", "loop pairs
 // file"). Throws InputError "<what> "<path>":<line>: ..." on a missing or unreadable file, a
-// line with one value, a value that is not an integer, and a file that holds no pair.
+// line with one value, a value that is not an integer (or larger than 10^15 in size), and a
+// file that holds no pair.
 PairsFile ReadPairsFile(const std::string& path, int base, const std::string& what);
 
 }  // namespace openable

@@ -30,9 +30,12 @@ bool ParseIndex(std::string_view field, std::int64_t* value) {
   if (!f.empty() && f.front() == '+') f.remove_prefix(1);
   const char* end = f.data() + f.size();
   const auto r = std::from_chars(f.data(), end, *value);
-  if (!f.empty() && r.ec == std::errc() && r.ptr == end) return true;
+  if (!f.empty() && r.ec == std::errc() && r.ptr == end) {
+    return *value >= -kMaxIndex && *value <= kMaxIndex;
+  }
   double d = 0.0;
-  if (!ParseNumber(field, &d) || !std::isfinite(d) || d != std::floor(d) || std::abs(d) > 1e15) {
+  if (!ParseNumber(field, &d) || !std::isfinite(d) || d != std::floor(d) ||
+      std::abs(d) > static_cast<double>(kMaxIndex)) {
     return false;
   }
   *value = static_cast<std::int64_t>(d);

@@ -25,7 +25,9 @@ inline bool IsBlank(char c) {
 // A whole token as a number ("1", "-2.5e3", "+4", "nan", "inf"); false on anything else.
 bool ParseNumber(std::string_view token, double* value);
 
-// A whole field as an integer; "12.0" is accepted as 12.
+// A whole field as an integer of at most kMaxIndex in size; "12.0" is accepted as 12. (The
+// bound leaves room for the arithmetic of frame numbers: a base or a first frame subtracted.)
+inline constexpr std::int64_t kMaxIndex = 1000000000000000;  // 10^15
 bool ParseIndex(std::string_view field, std::int64_t* value);
 
 // One line of a text file: its number (from 1), its fields (split at blanks and commas, the

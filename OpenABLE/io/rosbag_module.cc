@@ -21,6 +21,7 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/io/module_api.h"
+#include "OpenABLE/io/rosbag_check.h"
 
 namespace openable {
 namespace {
@@ -88,6 +89,15 @@ cv::Mat DecodeImage(const sensor_msgs::Image& m, const std::string& what) {
   cv::Mat frame;
   pixels.convertTo(frame, CV_32F, pixels.depth() == CV_16U ? 1.0 / 65535.0 : 1.0 / 255.0);
   return frame;
+}
+
+// rosbag_storage reads a damaged bag unsafely: its structure is checked first (before a
+// rosbag::Bag is made, whose encryptor plug-in is looked up through ROS's package index).
+void CheckBag(const std::string& path, const std::string& key) {
+  const std::string defect = BagDefect(path);
+  if (!defect.empty())
+    throw InputError(key + ": bag " + Quoted(path) + " cannot be read (" + defect +
+                     "); expected a complete ROS 1 bag of format 2.0 (rosbag record)");
 }
 
 class BagSource final : public FrameSource {
@@ -251,5 +261,6 @@ extern "C" void openable_rosbag_open(const std::string& path, const std::string&
                                      int first, int last, const std::string& key,
                                      const std::string& topic_key,
                                      std::unique_ptr<openable::FrameSource>& source) {
+  openable::CheckBag(path, key);
   source = std::make_unique<openable::BagSource>(path, topic, first, last, key, topic_key);
 }

@@ -41,6 +41,10 @@ class FeatureExtractor {
   Features Extract(const cv::Mat& gray) const;
   // The descriptor distance: cv::NORM_HAMMING (ORB) or cv::NORM_L2 (SIFT).
   int Norm() const { return norm_; }
+  // The descriptor rows Extract gives: elements per row and OpenCV type (ORB: 32 CV_8U, SIFT:
+  // 128 CV_32F).
+  int DescriptorWidth() const { return detector_->descriptorSize(); }
+  int DescriptorType() const { return detector_->descriptorType(); }
 
  private:
   cv::Ptr<cv::Feature2D> detector_;

@@ -1,5 +1,6 @@
 #include "OpenABLE/online/map_file.h"
 
+#include <cmath>
 #include <cstring>
 #include <deque>
 #include <limits>
@@ -173,6 +174,12 @@ MapFile ReadMapFile(const std::string& path) {
     size_t stop = text.find('\n', start);
     if (stop == std::string::npos) stop = text.size();
     const std::string line = text.substr(start, stop - start);
+    // Settings are printable text (SaveMap writes names and numbers): a control character
+    // would also break the one-line messages that quote them.
+    for (const char c : line)
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+        throw InputError(path + ": the map's setting line " + Quoted(line) +
+                         " holds a control character; expected lines \"key value\" of text");
     const size_t space = line.find(' ');
     map.settings.emplace_back(line.substr(0, space),
                               space == std::string::npos ? "" : line.substr(space + 1));
@@ -193,8 +200,11 @@ MapFile ReadMapFile(const std::string& path) {
                      " bytes; expected " + std::to_string(expected) + " (" +
                      std::to_string(frames) + " frames of " + std::to_string(width) + " " +
                      type_name + ")");
+  // Every size read from the file is checked against the bytes that follow before anything of
+  // that size is allocated: a damaged or made-up size gives one line, not an allocation.
+  const char* row_data = r.Take(row_bytes, "the rows");
   map.rows = cv::Mat(frames, width, type);
-  if (row_bytes > 0) std::memcpy(map.rows.data, r.Take(row_bytes, "the rows"), row_bytes);
+  if (row_bytes > 0) std::memcpy(map.rows.data, row_data, row_bytes);
 
   const auto blocks = r.Get<std::uint32_t>("the block count");
   for (std::uint32_t i = 0; i < blocks; ++i) {
@@ -212,22 +222,31 @@ MapFile ReadMapFile(const std::string& path) {
     map.features.resize(static_cast<size_t>(frames));
     for (FrameFeatures& f : map.features) {
       const auto points = r.Get<std::uint32_t>("a frame's feature count");
+      const size_t point_bytes = static_cast<size_t>(points) * sizeof(cv::Point2f);
+      const char* point_data = r.Take(point_bytes, "a frame's feature points");
       f.points.resize(points);
-      const size_t point_bytes = points * sizeof(cv::Point2f);
-      if (point_bytes > 0)
-        std::memcpy(f.points.data(), r.Take(point_bytes, "a frame's feature points"),
-                    point_bytes);
+      if (point_bytes > 0) std::memcpy(f.points.data(), point_data, point_bytes);
+      for (const cv::Point2f& p : f.points)
+        if (!std::isfinite(p.x) || !std::isfinite(p.y))
+          throw InputError(path + ": a frame's feature point is (" + std::to_string(p.x) + ", " +
+                           std::to_string(p.y) + "): expected pixel coordinates");
       const int drows = r.Get<std::int32_t>("a frame's descriptor rows");
       const int dcols = r.Get<std::int32_t>("a frame's descriptor columns");
       const int dtype = r.Get<std::int32_t>("a frame's descriptor type");
-      if (drows < 0 || dcols < 0 || (dtype != CV_8UC1 && dtype != CV_32FC1))
+      // One descriptor row per feature point (none without points), as the verification
+      // extracted them.
+      if (drows < 0 || dcols < 0 || (dtype != CV_8UC1 && dtype != CV_32FC1) ||
+          static_cast<std::uint32_t>(drows) != points || (drows > 0 && dcols == 0))
         throw InputError(path + ": a frame's feature descriptors are " + std::to_string(drows) +
                          "x" + std::to_string(dcols) + " of type " + std::to_string(dtype) +
-                         ": expected CV_8UC1 (ORB) or CV_32FC1 (SIFT) rows");
-      if (drows > 0 && dcols > 0) {
+                         " for " + std::to_string(points) + " feature points: expected one " +
+                         "CV_8UC1 (ORB) or CV_32FC1 (SIFT) row per point");
+      if (drows > 0) {
+        const size_t bytes =
+            static_cast<size_t>(drows) * static_cast<size_t>(dcols) * CV_ELEM_SIZE(dtype);
+        const char* data = r.Take(bytes, "a frame's feature descriptors");
         f.descriptors = cv::Mat(drows, dcols, dtype);
-        const size_t bytes = f.descriptors.total() * f.descriptors.elemSize();
-        std::memcpy(f.descriptors.data, r.Take(bytes, "a frame's feature descriptors"), bytes);
+        std::memcpy(f.descriptors.data, data, bytes);
       }
     }
   }

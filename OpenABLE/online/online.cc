@@ -435,6 +435,16 @@ OnlineDetector::LoadedMap OnlineDetector::LoadMap(const std::string& path) {
     if (!map.has_features || map.features.size() != static_cast<size_t>(map.rows.rows))
       throw InputError(path + ": the map holds no local features; expected a map saved by a "
                        "detector with verification enabled");
+    // The matcher compares them with the descriptors of later frames.
+    const int width = s.verifier->DescriptorWidth(), type = s.verifier->DescriptorType();
+    for (size_t i = 0; i < map.features.size(); ++i) {
+      const cv::Mat& d = map.features[i].descriptors;
+      if (!d.empty() && (d.cols != width || d.type() != type))
+        throw InputError(path + ": the local features of frame " + std::to_string(i) +
+                         " have descriptors of " + std::to_string(d.cols) + " " +
+                         cv::typeToString(d.type()) + "; expected " + std::to_string(width) +
+                         " " + cv::typeToString(type) + " (" + map.Setting("features") + ")");
+    }
   }
   double unit = s.unit;
   if (s.type == CV_32F) {

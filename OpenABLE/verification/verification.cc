@@ -86,7 +86,11 @@ PairVerifier::PairVerifier(const VerificationOptions& options,
                            std::optional<CameraIntrinsics> camera)
     : options_(options), camera_(camera) {
   options_.Check();
-  norm_ = options_.features == LocalFeatures::kOrb ? cv::NORM_HAMMING : cv::NORM_L2;
+  const odometry::FeatureExtractor extractor(EnumName(options_.features), options_.max_features,
+                                             "Verification_features");
+  norm_ = extractor.Norm();
+  descriptor_width_ = extractor.DescriptorWidth();
+  descriptor_type_ = extractor.DescriptorType();
 }
 
 FrameFeatures PairVerifier::Extract(const cv::Mat& image) const {
@@ -125,6 +129,11 @@ PairCheck PairVerifier::Verify(const FrameFeatures& query, const FrameFeatures& 
   // true epipolar lines); plain RANSAC for the essential matrix, where USAC's mask
   // under-counted instead (88 of 125). tests/verification checks the counts.
   cv::Mat mask;
+  // OpenCV's estimators need their minimal samples: 5 point pairs for the essential matrix
+  // (min_inliers >= 5 leaves at least that many), 7 for USAC's fundamental matrix, which asserts
+  // otherwise; 8 are asked for it, so that its fit is not exact. With fewer matches only the
+  // homography (4 points) is fitted.
+  constexpr std::size_t kFundamentalMatches = 8;
   if (camera_) {
     const cv::Matx33d k(camera_->fx, 0, camera_->cx, 0, camera_->fy, camera_->cy, 0, 0, 1);
     const cv::Mat e = cv::findEssentialMat(p, q, k, cv::RANSAC, 0.999, threshold, mask);
@@ -132,7 +141,7 @@ PairCheck PairVerifier::Verify(const FrameFeatures& query, const FrameFeatures& 
       check.model = GeometricModel::kEssential;
       check.inliers = CountMask(mask);
     }
-  } else {
+  } else if (matches.size() >= kFundamentalMatches) {
     const cv::Mat f = cv::findFundamentalMat(p, q, cv::USAC_ACCURATE, threshold, 0.999, mask);
     if (!f.empty()) {
       check.model = GeometricModel::kFundamental;

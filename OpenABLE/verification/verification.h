@@ -108,11 +108,16 @@ class PairVerifier {
   PairCheck Verify(const FrameFeatures& query, const FrameFeatures& reference) const;
   const VerificationOptions& Options() const { return options_; }
   bool Calibrated() const { return camera_.has_value(); }
+  // The descriptor rows Extract gives: elements per row and OpenCV type (ORB: 32 CV_8U, SIFT:
+  // 128 CV_32F). Features kept elsewhere (a saved map) must have them to be verified.
+  int DescriptorWidth() const { return descriptor_width_; }
+  int DescriptorType() const { return descriptor_type_; }
 
  private:
   VerificationOptions options_;
   std::optional<CameraIntrinsics> camera_;
   int norm_;
+  int descriptor_width_ = 0, descriptor_type_ = 0;
 };
 
 // One candidate of a query and what verification found.

@@ -1,12 +1,5 @@
 // End-to-end runs of the Test_OpenABLE program: the files it writes, the figures in them, and
 // every input error of the issue (one line, non-zero exit, no output left behind).
-#include <fcntl.h>
-#include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/mount.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -15,11 +8,19 @@
 #include <fstream>
 #include <limits>
 #include <map>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/videoio.hpp>
 #include <set>
 #include <sstream>
 #include <string>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/mount.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "config/config.h"
 #include "matching/search/approximate.h"

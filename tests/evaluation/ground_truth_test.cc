@@ -28,6 +28,8 @@ using openable::testing::DatasetsDir;
 using openable::testing::ExpectInputError;
 using openable::testing::InputErrorMessage;
 using openable::testing::Q;
+using openable::testing::ReadBytes;
+using openable::testing::SourceDir;
 using openable::testing::TempDir;
 using openable::testing::WriteBytes;
 using Matches = std::vector<std::vector<int>>;
@@ -278,6 +280,35 @@ TEST(GroundTruthPairs, OutOfRangeMessagesNameTheLinePairAndRange) {
   WriteBytes(dir + "/empty.txt", "query,reference\n# nothing\n");
   ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, dir + "/empty.txt"), 4); },
                    {Q(dir + "/empty.txt"), "holds no pair"});
+}
+
+// Found with tests/fuzz/ground_truth_fuzzer.cc (reading the code; the fuzzer's binary
+// confirmed it under UBSan): an index of -2^63 in a 1-based file, or of -2^63 + 1 read from
+// frame 3, overflowed when the base or the first frame was subtracted (undefined behaviour).
+// Indices are now integers of at most 10^15 in size. The inputs are the fuzzer's, whose first
+// byte chooses the reader and its options (pairs 1-based; pairs 0-based from frame 3).
+TEST(GroundTruthPairs, IndicesBeyondTenToTheFifteenAreRefused) {
+  struct Case {
+    const char* name;
+    int base, first_frame;
+  };
+  for (const Case& c : {Case{"pairs_int64_min_1based.txt", 1, 0},
+                        Case{"pairs_int64_from_frame_3.txt", 0, 3}}) {
+    const std::string path = TempDir() + "/" + c.name;
+    const std::string input =
+        ReadBytes(SourceDir() + "/tests/fuzz/corpus/ground_truth/" + c.name);
+    WriteBytes(path, input.substr(1));
+    GroundTruthOptions o = Options(GroundTruthType::kPairs, path);
+    o.base = c.base;
+    o.first_frame = c.first_frame;
+    ExpectInputError([&] { LoadLoop(o, 40); },
+                     {Q(path) + ":1:", "column 1", "not an integer of at most 10^15 in size"});
+  }
+  // 10^15 itself is an index: here out of the range of the run.
+  const std::string path = TempDir() + "/bound.txt";
+  WriteBytes(path, "-1000000000000000,1\n");
+  ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kPairs, path), 40); },
+                   {Q(path) + ":1:", "pair -1000000000000000,1", "out of range"});
 }
 
 TEST(GroundTruthPairs, QueryReferenceKeepsTheOrder) {

@@ -1,13 +1,13 @@
 #include "matching/sequence.h"
 
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <limits>
 #include <random>
 #include <stdexcept>
+
+#include <gtest/gtest.h>
 
 #include "OpenABLE/base/threading.h"
 

@@ -1,20 +1,28 @@
 // Saved maps of the online detector (OnlineDetector::SaveMap / LoadMap): a detector that
 // loads yesterday's map gives every later frame the candidates the detector that saved it
 // gives, on real KITTI 00 frames, with each index engine; the file is checked on loading.
-#include <gtest/gtest.h>
 #include <sys/stat.h>
 
 #include <cerrno>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/hash.h"
 #include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/online/map_file.h"
 #include "OpenABLE/online/online.h"
+#include "tests/fuzz/map_detectors.h"
 #include "tests/online/index_engines.h"
 #include "tests/test_frames.h"
 #include "tests/test_support.h"
@@ -263,25 +271,120 @@ TEST(SavedMap, DefectsAreOneLineErrors) {
   EXPECT_EQ(files, 0);
 }
 
-// A detector that holds no frame saves a map of no frame, which loads back into an empty
-// detector that then grows as usual; its rows keep the descriptor's width.
-TEST(SavedMap, AnEmptyMapSavesAndLoads) {
-  OnlineOptions options;
-  options.exclusion = 5;
+// A detector that has no frame yet saves an empty map, which loads into an empty detector
+// (saving it threw a cv::Exception: the rows of an empty index were a range of no buffer).
+TEST(SavedMap, EmptyDetectorSavesAndLoads) {
+  const OnlineOptions options = fuzz::MapDetectorOptions(fuzz::MapKind::kRows);
   OnlineDetector empty(options);
+  EXPECT_EQ(empty.Descriptors().rows, 0);
+  EXPECT_EQ(empty.Descriptors().cols, empty.RowWidth());
   const std::string path = testing::TempDir() + "/empty.map";
   empty.SaveMap(path);
-  OnlineDetector loaded(options);
-  const OnlineDetector::LoadedMap info = loaded.LoadMap(path);
-  EXPECT_EQ(info.frames, 0);
-  EXPECT_EQ(loaded.Size(), 0);
-  EXPECT_EQ(loaded.Descriptors().rows, 0);
-  EXPECT_EQ(loaded.Descriptors().cols, 32);  // LDB's 256 bits
-  cv::Mat rows(8, 32, CV_8U);
-  cv::randu(rows, 0, 256);
-  for (int q = 0; q < rows.rows; ++q) loaded.AddDescriptor(rows.row(q));
-  EXPECT_EQ(loaded.Size(), 8);
-  EXPECT_TRUE(SameBytes(loaded.Descriptors(), rows));
+  OnlineDetector today(options);
+  EXPECT_EQ(today.LoadMap(path).frames, 0);
+  EXPECT_EQ(today.Size(), 0);
+  EXPECT_EQ(today.AddDescriptor(cv::Mat::zeros(1, today.RowWidth(), CV_8U)).frame, 0);
+}
+
+// The maps of the map fuzzer's corpus (tests/fuzz/corpus/map/, written by
+// tests/fuzz/write_seeds.cc and tests/fuzz/map_fuzzer.cc's findings).
+std::string MapSeed(const std::string& name) {
+  return testing::SourceDir() + "/tests/fuzz/corpus/map/" + name;
+}
+
+// `bytes` with the checksum of a map file (the FNV-1a 64 of all but its last 8 bytes) in its
+// last 8 bytes, written to `path`: a file that passes the checksum and is checked further.
+void WriteWithChecksum(const std::string& path, std::string bytes) {
+  std::uint64_t sum = Fnv1a64(bytes.data(), bytes.size() - 8);
+  for (size_t i = 0; i < 8; ++i, sum >>= 8)
+    bytes[bytes.size() - 8 + i] = static_cast<char>(sum & 0xFF);
+  testing::WriteBytes(path, bytes);
+}
+
+// Found by tests/fuzz/map_fuzzer.cc: a frame's feature count of 0xffffff.. was allocated (as
+// points, 34 GB) before the bytes behind it were counted: an abort under AddressSanitizer,
+// std::bad_alloc or a machine out of memory otherwise. Every size read from a map is now
+// checked against the bytes that follow before anything of that size is allocated: the rows
+// that frames x row_width announce too.
+TEST(SavedMap, SizesAreCheckedBeforeAllocating) {
+  const std::string path = MapSeed("huge_point_count.map");
+  ExpectInputError([&] { ReadMapFile(path); },
+                   {path, "the map is truncated", "for a frame's feature points"});
+
+  // Signature, version 1, the settings, the rows' length, (no rows), the checksum.
+  auto put64 = [](std::string& out, std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
+  };
+  std::string huge("OpenABLE-map\r\n\x1a\n\x01\0\0\0", 20);
+  const std::string settings = "frames 100000\nrow_width 100000\nrow_type CV_32F\n";
+  put64(huge, settings.size());
+  huge += settings;
+  put64(huge, 40000000000);  // 100000 x 100000 floats
+  huge += std::string(8, '\0');
+  const std::string rows_path = testing::TempDir() + "/huge_rows.map";
+  WriteWithChecksum(rows_path, huge);
+  ExpectInputError([&] { ReadMapFile(rows_path); },
+                   {rows_path, "the map is truncated", "for the rows, expected 40000000000"});
+}
+
+// Found by tests/fuzz/map_fuzzer.cc: a setting whose value held a carriage return (the fuzzer
+// had pasted the map's signature into row_type) gave a message of two lines. Settings are text:
+// a line with a control character is refused, and named escaped (the first such line of the
+// committed input holds bytes 0x17).
+TEST(SavedMap, SettingsWithControlCharactersAreRefused) {
+  const std::string path = MapSeed("setting_control_character.map");
+  ExpectInputError([&] { ReadMapFile(path); },
+                   {path, "setting line \"openable\\x17", "control character"});
+}
+
+// Found by tests/fuzz/map_fuzzer.cc on its seed verifying.map: with 5 inliers required, a
+// candidate with 6 matches threw a cv::Exception from the fundamental matrix's estimator
+// (tests/verification has the unit test). The frame is now verified.
+TEST(SavedMap, FuzzerSeedWithVerificationSearchesAndVerifies) {
+  OnlineDetector detector(fuzz::MapDetectorOptions(fuzz::MapKind::kVerifying));
+  EXPECT_EQ(detector.LoadMap(MapSeed("verifying.map")).frames, 3);
+  const OnlineResult r = detector.AddFrame(fuzz::MapFrame(0));
+  ASSERT_EQ(r.candidates.size(), 1u);  // the three frames are one place (score_window 10)
+  EXPECT_EQ(r.candidates[0].frame, 0);  // the same image
+  // 6 of its 10 features pass the ratio test: too few for the fundamental matrix, the
+  // homography fits them.
+  EXPECT_EQ(r.candidates[0].matches, 6);
+  EXPECT_EQ(r.candidates[0].model, GeometricModel::kHomography);
+  EXPECT_TRUE(r.candidates[0].geometric);
+}
+
+// Local features that verification could not use are refused on loading: a descriptor row
+// count other than the points', a point that is not finite, descriptors of another width or
+// type than the detector's features.
+TEST(SavedMap, InconsistentFeaturesAreRefused) {
+  const OnlineOptions options = fuzz::MapDetectorOptions(fuzz::MapKind::kVerifying);
+  const std::string good = MapSeed("verifying.map");
+  const MapFile map = ReadMapFile(good);
+  ASSERT_EQ(map.features.size(), 3u);
+  ASSERT_GT(map.features[1].points.size(), 1u);
+  const std::string dir = testing::TempDir();
+  auto written = [&](const std::string& name, const std::function<void(MapFile&)>& change) {
+    MapFile m = map;
+    for (FrameFeatures& f : m.features) f.descriptors = f.descriptors.clone();
+    change(m);
+    WriteMapFile(dir + "/" + name, m);
+    return dir + "/" + name;
+  };
+  const std::string fewer =
+      written("fewer.map", [](MapFile& m) { m.features[1].points.pop_back(); });
+  ExpectInputError([&] { ReadMapFile(fewer); }, {fewer, "feature descriptors", "row per point"});
+  const std::string nan = written("nan.map", [](MapFile& m) {
+    m.features[2].points[0].x = std::numeric_limits<float>::quiet_NaN();
+  });
+  ExpectInputError([&] { ReadMapFile(nan); }, {nan, "feature point is (nan", "pixel coordinates"});
+  const std::string narrow = written("narrow.map", [](MapFile& m) {
+    m.features[1].descriptors = m.features[1].descriptors.colRange(0, 16).clone();
+  });
+  EXPECT_NO_THROW(ReadMapFile(narrow));
+  OnlineDetector detector(options);
+  ExpectInputError([&] { detector.LoadMap(narrow); },
+                   {narrow, "frame 1", "descriptors of 16 CV_8UC1", "expected 32 CV_8UC1 (ORB)"});
+  EXPECT_EQ(detector.Size(), 0);
 }
 
 }  // namespace

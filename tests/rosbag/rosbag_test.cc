@@ -1,23 +1,24 @@
 // ROS 1 bags as input (Frame_mode 3, OpenBag): bags written here with Debian's rosbag_storage
 // from real frames of ../shared/datasets, read back by Test_OpenABLE and compared with the same
 // frames read from their folders.
-#include <gtest/gtest.h>
-#include <rosbag/bag.h>
-#include <sensor_msgs/CompressedImage.h>
-#include <sensor_msgs/Image.h>
-#include <std_msgs/String.h>
-
-#include <Eigen/Geometry>
 #include <algorithm>
-#include <boost/make_shared.hpp>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <boost/make_shared.hpp>
+#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <string>
-#include <vector>
+#include <rosbag/bag.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <sensor_msgs/Image.h>
+#include <std_msgs/String.h>
 
 #include "OpenABLE/io/frame_source.h"
 #include "tests/e2e/e2e_support.h"
@@ -516,6 +517,73 @@ TEST(RosBag, MessagesStateTheConditionThatFailed) {
     EXPECT_TRUE(OneLine(o.err)) << o.err;
     EXPECT_NE(o.err.find(c.expected), std::string::npos) << o.err;
     EXPECT_FALSE(fs::exists(dir + "/out")) << c.bag;
+
+// The bags of the bag fuzzer's corpus (tests/fuzz/corpus/bag/: written by rosbag_storage
+// through tests/fuzz/write_seeds.cc, and damaged ones).
+std::string FuzzBag(const std::string& name) {
+  return testing::SourceDir() + "/tests/fuzz/corpus/bag/" + name;
+}
+
+// Found by tests/fuzz/bag_fuzzer.cc on its seed mono8_flipped_index.bag (mono8.bag with one byte
+// of its index changed): Debian's rosbag_storage read 65 KB past a buffer of 138 bytes, since
+// ros::Header::parse takes a field's length as the file gives it (AddressSanitizer:
+// heap-buffer-overflow). Its reader trusts the other lengths and positions of a bag as well;
+// the bags beside it, made from mono8.bag, show three: a pixel array announcing 4 GB (allocated
+// and zeroed before the data is found missing), an index entry naming a byte inside a record
+// (read as a record header), a time whose nanoseconds overflow its seconds (std::runtime_error
+// from ros::Time). OpenBag now walks a bag before rosbag_storage reads it
+// (OpenABLE/io/rosbag_check.h): each is one line naming the bag and the defect.
+TEST(RosBag, DamagedBagsAreRefusedBeforeRosbagStorageReadsThem) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"mono8_flipped_index.bag",
+       "its chunk info record at byte 5314's header has a field of 65544 bytes where 8 are left"},
+      {"image_data_length.bag",
+       "the message of topic \"/image\" at byte 389 of its chunk at byte 4117 is cut short"},
+      {"index_offset_inside_record.bag",
+       "an index entry of its chunk at byte 4117 names byte 393 of its content, where no "
+       "message record begins"},
+      {"index_time_overflow.bag",
+       "its index record at byte 4900 has a time of 4294967295 s and 4294967295 ns"},
+      {"mono8_truncated.bag", "its connection record at byte 5145 is cut short"},
+  };
+  for (const auto& [name, defect] : cases) {
+    const std::string path = FuzzBag(name);
+    testing::ExpectInputError(
+        [&] { OpenBag(path, "/image", 0, -1, "Bag_path", "Bag_topic"); },
+        {"Bag_path: bag " + testing::Q(path) + " cannot be read (" + defect,
+         "expected a complete ROS 1 bag of format 2.0"});
+  }
+  // Not bags of format 2.0, and a bag without index.
+  const std::string dir = testing::TempDir();
+  std::ofstream(dir + "/old.bag") << "#ROSBAG V1.2\nrecords\n";
+  std::ofstream(dir + "/text.bag") << "a text\n";
+  std::string unindexed = ReadAll(FuzzBag("mono8.bag"));
+  unindexed.replace(unindexed.find("index_pos=") + 10, 8, std::string(8, '\0'));
+  std::ofstream(dir + "/unindexed.bag", std::ios::binary) << unindexed;
+  for (const auto& [name, defect] :
+       std::vector<std::pair<std::string, std::string>>{
+           {"old.bag", "it is a bag of format \"1.2\"; OpenABLE reads format 2.0"},
+           {"text.bag", "it is not a ROS 1 bag"},
+           {"unindexed.bag", "it has no index: a recording cut short (rosbag reindex"}})
+    testing::ExpectInputError(
+        [&] { OpenBag(dir + "/" + name, "/image", 0, -1, "Bag_path", "Bag_topic"); },
+        {testing::Q(dir + "/" + name) + " cannot be read (" + defect});
+}
+
+// The bags rosbag_storage writes pass the walk, whatever their chunks' compression and the
+// messages' encodings: every frame of the fuzzer's seeds is read, with its time.
+TEST(RosBag, FuzzerSeedsWrittenByRosbagAreRead) {
+  for (const std::string name : {"mono8.bag", "mono8_bz2.bag", "mono8_lz4.bag",
+                                 "mono8_full_definitions.bag", "rgb8.bag", "bgra8.bag",
+                                 "mono16_big_endian.bag", "rgb16.bag", "png.bag"}) {
+    const auto source = OpenBag(FuzzBag(name), "/image", 0, -1, "Bag_path", "Bag_topic");
+    ASSERT_GE(source->Size(), 1) << name;
+    for (int i = 0; i < source->Size(); ++i) {
+      const cv::Mat frame = source->Read(i);
+      EXPECT_EQ(frame.size(), cv::Size(8, 6)) << name << " " << i;
+      EXPECT_EQ(frame.depth(), CV_32F) << name << " " << i;
+      EXPECT_NEAR(source->Timestamp(i), 10.0 + 0.5 * i, 0.011) << name << " " << i;
+    }
   }
 }
 

@@ -189,6 +189,31 @@ TEST(PairVerifier, TooFewMatchesSkipRansac) {
   EXPECT_EQ(check.inliers, 0);
 }
 
+// Found by tests/fuzz/map_fuzzer.cc: with Verification_min_inliers below 7, a candidate with
+// that many to 6 matches reached cv::findFundamentalMat, whose USAC sampler throws a
+// cv::Exception for fewer points than its 7-point sample. Every count from the smallest
+// min_inliers up is checked here, uncalibrated and calibrated; below 8 matches only the
+// homography is fitted without a calibration.
+TEST(PairVerifier, FewMatchesAboveTheSmallestMinInliersAreChecked) {
+  VerificationOptions o = Options();
+  o.min_inliers = 5;
+  const PairVerifier plain(o, std::nullopt);
+  const PairVerifier calibrated(o, CameraIntrinsics{kFocal, kFocal, kCx, kCy});
+  cv::RNG rng(11);
+  for (int n = 5; n <= 9; ++n) {
+    FrameFeatures f;
+    f.descriptors.create(n, 32, CV_8U);
+    rng.fill(f.descriptors, cv::RNG::UNIFORM, 0, 256);  // distinct rows: each matches itself
+    for (int i = 0; i < n; ++i)
+      f.points.emplace_back(rng.uniform(0.f, 640.f), rng.uniform(0.f, 480.f));
+    PairCheck check;
+    ASSERT_NO_THROW(check = plain.Verify(f, f)) << n << " matches";
+    EXPECT_EQ(check.matches, n);
+    if (n < 8) EXPECT_NE(check.model, GeometricModel::kFundamental) << n;
+    ASSERT_NO_THROW(calibrated.Verify(f, f)) << n << " matches, calibrated";
+  }
+}
+
 TEST(VerificationOptions, RefusesValuesOutOfRangeNamingTheKey) {
   VerificationOptions o;
   o.max_features = 0;
