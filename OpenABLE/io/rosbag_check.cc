@@ -301,9 +301,14 @@ void CheckChunk(std::string_view content, const std::vector<Entry>& entries,
     const bool image = c.md5sum == image_md5, compressed = c.md5sum == compressed_md5;
     if ((image && !ImageFits(message->second)) ||
         (compressed && !CompressedImageFits(message->second)))
+      // The bytes do not fit the type the connection declares: a message of another type
+      // filed under it (rosbag's writer files a topic's messages under its first connection
+      // unless each comes with its own connection header) or damage; a bag cannot tell which.
       Fail("the message of topic " + Quoted(c.topic) + At(e.offset) + " of " + what +
-           " is cut short: a field's length runs past its " +
-           std::to_string(message->second.size()) + " bytes");
+           " does not decode as " + (image ? "sensor_msgs/Image" : "sensor_msgs/CompressedImage") +
+           ", the type its connection declares (a field's length runs past its " +
+           std::to_string(message->second.size()) +
+           " bytes): a message of another type written on the topic, or damage");
   }
 }
 

@@ -495,7 +495,9 @@ TEST(RosBag, MessagesStateTheConditionThatFailed) {
        "(sensor_msgs/Image, std_msgs/String); expected one: sensor_msgs/Image or "
        "sensor_msgs/CompressedImage"},
       {"misfiled.bag",
-       "message 1 does not decode as sensor_msgs/Image, the type its connection declares ("},
+       "does not decode as sensor_msgs/Image, the type its connection declares (a field's "
+       "length runs past its 16 bytes): a message of another type written on the topic, or "
+       "damage"},
       {"empty.bag",
        "message 0: the image is 0 x 0 pixels (width x height); expected at least "
        "1 x 1"},
@@ -517,6 +519,8 @@ TEST(RosBag, MessagesStateTheConditionThatFailed) {
     EXPECT_TRUE(OneLine(o.err)) << o.err;
     EXPECT_NE(o.err.find(c.expected), std::string::npos) << o.err;
     EXPECT_FALSE(fs::exists(dir + "/out")) << c.bag;
+  }
+}
 
 // The bags of the bag fuzzer's corpus (tests/fuzz/corpus/bag/: written by rosbag_storage
 // through tests/fuzz/write_seeds.cc, and damaged ones).
@@ -538,7 +542,9 @@ TEST(RosBag, DamagedBagsAreRefusedBeforeRosbagStorageReadsThem) {
       {"mono8_flipped_index.bag",
        "its chunk info record at byte 5314's header has a field of 65544 bytes where 8 are left"},
       {"image_data_length.bag",
-       "the message of topic \"/image\" at byte 389 of its chunk at byte 4117 is cut short"},
+       "the message of topic \"/image\" at byte 389 of its chunk at byte 4117 does not decode "
+       "as sensor_msgs/Image, the type its connection declares (a field's length runs past its "
+       "93 bytes)"},
       {"index_offset_inside_record.bag",
        "an index entry of its chunk at byte 4117 names byte 393 of its content, where no "
        "message record begins"},

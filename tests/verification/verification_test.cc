@@ -209,7 +209,9 @@ TEST(PairVerifier, FewMatchesAboveTheSmallestMinInliersAreChecked) {
     PairCheck check;
     ASSERT_NO_THROW(check = plain.Verify(f, f)) << n << " matches";
     EXPECT_EQ(check.matches, n);
-    if (n < 8) EXPECT_NE(check.model, GeometricModel::kFundamental) << n;
+    if (n < 8) {
+      EXPECT_NE(check.model, GeometricModel::kFundamental) << n;
+    }
     ASSERT_NO_THROW(calibrated.Verify(f, f)) << n << " matches, calibrated";
   }
 }
