@@ -41,7 +41,8 @@ bool Refuses(F f, const std::string& named = "") {
 }
 
 // A file of /tmp holding `bytes`, named openable_fuzz_XXXXXX<suffix> (mkstemps), removed when
-// the object goes: the readers that take a path read the fuzzer's input through it.
+// the object goes: the readers that take a path read the fuzzer's input through it. (An input
+// that crashes the fuzzer leaves its file behind, a copy of the crash artifact.)
 class TempFile {
  public:
   explicit TempFile(const std::string& bytes, const std::string& suffix = "") {
