@@ -233,8 +233,17 @@ const std::vector<RunOutput>& RunOutputs() {
            report.matrices = {&in.result.normalized};
            report.examples = config.evaluation.report_examples;
            if (in.automatic != nullptr) report.tables.push_back(AutoReportTable(*in.automatic));
-           if (report.examples > 0)
-             report.frames = FramesFromSources(OpenFramesToShow(config.input), false);
+           if (report.examples > 0) {
+             // Row i of a traversal is its i-th kept frame: frames skipped as unreadable
+             // would otherwise shift every later frame's name and thumbnail.
+             try {
+               report.frames = FramesFromSources(
+                   FramesOfRows(OpenFramesToShow(config.input), in.result.traversals), false);
+             } catch (const std::logic_error& e) {
+               report.frames.missing =
+                   std::string("the frames of the rows could not be found (") + e.what() + ")";
+             }
+           }
            batch.Stage("Report_name", config.evaluation.report_name, EncodeHtmlReport(report));
          };
        }},

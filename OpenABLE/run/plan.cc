@@ -103,6 +103,50 @@ std::vector<std::unique_ptr<FrameSource>> OpenFramesToShow(const InputOptions& i
 
 namespace {
 
+// The frames of a source at `indices`, renumbered from 0: the rows a run kept.
+class SelectedFrames final : public FrameSource {
+ public:
+  SelectedFrames(std::unique_ptr<FrameSource> source, std::vector<int> indices)
+      : source_(std::move(source)), indices_(std::move(indices)) {}
+  int Size() const override { return static_cast<int>(indices_.size()); }
+  std::string FrameName(int i) const override { return source_->FrameName(indices_.at(i)); }
+  cv::Mat Read(int i) const override { return source_->Read(indices_.at(i)); }
+  bool ParallelReads() const override { return source_->ParallelReads(); }
+  double Timestamp(int i) const override { return source_->Timestamp(indices_.at(i)); }
+
+ private:
+  std::unique_ptr<FrameSource> source_;
+  std::vector<int> indices_;
+};
+
+}  // namespace
+
+std::vector<std::unique_ptr<FrameSource>> FramesOfRows(
+    std::vector<std::unique_ptr<FrameSource>> sources, const std::vector<Traversal>& traversals) {
+  if (sources.size() != traversals.size())
+    throw std::logic_error("FramesOfRows: " + std::to_string(sources.size()) + " sources for " +
+                           std::to_string(traversals.size()) + " traversals");
+  for (std::size_t t = 0; t < sources.size(); ++t) {
+    const Traversal& tr = traversals[t];
+    if (tr.skipped.empty() && sources[t]->Size() == tr.frames) continue;
+    // The kept frames are in the source's order: one pass matches them by name.
+    std::vector<int> indices;
+    indices.reserve(tr.names.size());
+    int next = 0;
+    for (const std::string& name : tr.names) {
+      while (next < sources[t]->Size() && sources[t]->FrameName(next) != name) ++next;
+      if (next == sources[t]->Size())
+        throw std::logic_error("FramesOfRows: frame " + Quoted(name) + " of " + tr.key +
+                               " is not among its source's frames");
+      indices.push_back(next++);
+    }
+    sources[t] = std::make_unique<SelectedFrames>(std::move(sources[t]), std::move(indices));
+  }
+  return sources;
+}
+
+namespace {
+
 // The descriptors of Image_descriptor, each created (and so checked), their fusion checked,
 // the row of a frame refused when it cannot be held, and the camera described.
 void PlanDescriptors(RunPlan& plan) {

@@ -64,4 +64,11 @@ std::vector<SourceSpec> SourcesOf(const InputOptions& input);
 // second. For the HTML report's worst cases. Throws InputError naming the key, as a run does.
 std::vector<std::unique_ptr<FrameSource>> OpenFramesToShow(const InputOptions& input);
 
+// OpenFramesToShow's sources cut to the rows of the run's matrix: frame i of source t is row i
+// of traversals[t], so that frames the run skipped as unreadable (Skip_unreadable) do not shift
+// the later ones. The rows are found by their names (Traversal::names). Throws std::logic_error
+// when a traversal's names are not frames of its source, in its order.
+std::vector<std::unique_ptr<FrameSource>> FramesOfRows(
+    std::vector<std::unique_ptr<FrameSource>> sources, const std::vector<Traversal>& traversals);
+
 }  // namespace openable

@@ -3,27 +3,27 @@
 // write exactly one line on stderr naming the file or key, leave no output behind, not crash
 // (a signal) and not hang (every run goes through `timeout`). docs/robustness.md lists the
 // cases and the decided behaviours (1x1 and huge images, odd names, symbolic links).
-#include <atomic>
-#include <thread>
-#include <filesystem>
-#include <functional>
-#include <fstream>
-#include <iomanip>
-#include <random>
-#include <sstream>
-#include <string>
-#include <vector>
-
+#include <gtest/gtest.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
-#include <gtest/gtest.h>
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iomanip>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
 
+#include "OpenABLE/io/frame_source.h"
 #include "config/config.h"
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
@@ -178,6 +178,41 @@ TEST(BadInputCorpus, SkipUnreadableRunsOnTheSoundImages) {
   EXPECT_NE(o.out.find("b1.png"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("b2.jpg"), std::string::npos) << o.out;
   EXPECT_EQ(ReadNpy(dir + "/out/matrix.npy").rows, 2);
+}
+
+// The report of a run that skipped unreadable frames shows each row's own frame: a skipped
+// file that sorts first used to make the report read it again (the run failed), and one in the
+// middle would have shifted every later frame's name and thumbnail by one.
+TEST(BadInputCorpus, ReportOfASkippingRunShowsEachRowsFrame) {
+  const std::string dir = testing::TempDir();
+  const std::string summer = dir + "/summer", winter = dir + "/winter";
+  fs::create_directories(summer);
+  fs::create_directories(winter);
+  const std::vector<std::string> names = ListImages(testing::SampleDir() + "/summer", "");
+  for (int i = 0; i < 30; ++i) {
+    const std::string name = fs::path(names[i]).filename().string();
+    fs::copy_file(names[i], summer + "/" + name);
+    fs::copy_file(testing::SampleDir() + "/winter/" + name, winter + "/" + name);
+  }
+  testing::WriteBytes(summer + "/images-00000.png", Png().substr(0, 40));  // sorts first
+  std::string pairs;
+  for (int i = 0; i < 30; ++i) pairs += std::to_string(i) + "," + std::to_string(i) + "\n";
+  testing::WriteBytes(dir + "/pairs.txt", pairs);
+  const Outcome o = RunBounded(
+      dir, {WriteConfig(dir, summer,
+                        "Skip_unreadable: 1\nImages_path_2: \"" + winter +
+                            "\"\nImage_sequences: 3\nGround_truth_type: pairs\n"
+                            "Ground_truth: \"pairs.txt\"\nReport_name: \"out/report.html\"\n"
+                            "Report_examples: 30\n")});
+  ASSERT_EQ(o.status, 0) << o.err;
+  const std::string report = ReadAll(dir + "/out/report.html");
+  EXPECT_EQ(report.find("could not be found"), std::string::npos);
+  // Every query's true place is the reference of the same name: with rows shifted by the
+  // skipped file, the names shown beside each other would differ by 10 (images-000k0.png).
+  for (int i = 0; i < 30; ++i) {
+    const std::string name = fs::path(names[i]).filename().string();
+    EXPECT_NE(report.find(name), std::string::npos) << name;
+  }
 }
 
 // A folder named like an image is not a frame: it is passed over like any subfolder; alone,
