@@ -3,25 +3,26 @@
 // write exactly one line on stderr naming the file or key, leave no output behind, not crash
 // (a signal) and not hang (every run goes through `timeout`). docs/robustness.md lists the
 // cases and the decided behaviours (1x1 and huge images, odd names, symbolic links).
-#include <gtest/gtest.h>
+#include <atomic>
+#include <thread>
+#include <filesystem>
+#include <functional>
+#include <fstream>
+#include <iomanip>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
-#include <atomic>
-#include <filesystem>
-#include <fstream>
-#include <functional>
-#include <iomanip>
+#include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
-#include <random>
-#include <sstream>
-#include <string>
-#include <thread>
-#include <vector>
 
 #include "OpenABLE/io/frame_source.h"
 #include "config/config.h"
