@@ -36,7 +36,6 @@ struct OutputInput {
   const Config& config;
   const RunResult& result;
   const cv::Mat1f& shown;  // cells without a value as the largest finite value (text, images)
-  const cv::Mat1f& saved;  // cells without a value as +inf (.npy)
   const Evaluation* evaluation;
   const RunVerification* verification;
   const AutoChoice* automatic;
@@ -80,7 +79,7 @@ const std::vector<RunOutput>& RunOutputs() {
          const std::string& path = in.config.output.npy_name;
          if (path.empty()) return {};
          return [&in, path](OutputBatch& batch) {
-           const cv::Mat1f& saved = in.saved;
+           const cv::Mat1f& saved = in.result.normalized;  // +inf kept (no value)
            const std::string header = NpyHeader(saved.rows, saved.cols);
            std::vector<std::string_view> parts = {header};
            for (int i = 0; i < saved.rows; ++i)
@@ -283,7 +282,7 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
   // Cells without a value (+inf) are shown as the largest finite value in the text and the
   // image (readable exports), and stay +inf in the .npy file, where NaN would be
   // indistinguishable from damage (readers refuse NaN: DistancesForEvaluation).
-  cv::Mat1f shown = result.normalized, saved = result.normalized;
+  cv::Mat1f shown = result.normalized;
   if (dense && result.empty_cells > 0) {
     const cv::Mat1b empty = result.normalized == std::numeric_limits<float>::infinity();
     double largest = 0;
@@ -293,7 +292,7 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
       shown.setTo(largest, empty);
     }
   }
-  const OutputInput in{config, result, shown, saved, evaluation, verification, automatic};
+  const OutputInput in{config, result, shown, evaluation, verification, automatic};
   // Declared after the matrices the encoders read: when a write fails and the exception
   // unwinds, the stagers (which hold the encoders' futures, whose destructors wait for their
   // threads) go first, so no encoder is left reading a freed matrix.

