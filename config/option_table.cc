@@ -40,7 +40,8 @@ std::string Nearest(const OptionTable& table, const std::string& key) {
 std::string Unquote(const std::string& v, const std::string& where, const std::string& key) {
   if (!v.empty() && (v.front() == '"' || v.front() == '\'')) {
     if (v.size() < 2 || v.back() != v.front())
-      throw InputError(where + ": " + key + ": unterminated quoted value " + v);
+      throw InputError(where + ": " + key + ": unterminated quoted value " + Quoted(v) +
+                       " (expected the closing " + std::string(1, v.front()) + ")");
     return v.substr(1, v.size() - 2);
   }
   return v;
@@ -193,7 +194,7 @@ void ParseOptionText(const OptionTable& table, const std::string& contents,
   bool any_key = false;
   while (std::getline(in, line)) {
     ++number;
-    const std::string where = name + ":" + std::to_string(number);
+    const std::string where = Escaped(name) + ":" + std::to_string(number);
     std::string text = Trim(StripComment(line));
     if (number == 1 && text.rfind("\xEF\xBB\xBF", 0) == 0) text = Trim(text.substr(3));  // BOM
     if (text.empty() || text.rfind("%YAML", 0) == 0 || text == "---" || text == "...") continue;

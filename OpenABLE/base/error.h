@@ -20,12 +20,12 @@ class InputError : public std::runtime_error {
   explicit InputError(const std::string& message) : std::runtime_error(message) {}
 };
 
-// `s` between double quotes, with quotes and control characters escaped so that a message
-// stays on one line whatever the file name holds, and bytes that are not valid UTF-8 written
+// `s` with double quotes and control characters escaped so that a message stays on one line
+// whatever a file name or a value holds, and bytes that are not valid UTF-8 written
 // as \xNN (ToValidUtf8, strings.h), as every text output shows them.
-inline std::string Quoted(std::string_view s) {
+inline std::string Escaped(std::string_view s) {
   static const char* const kHex = "0123456789abcdef";
-  std::string out = "\"";
+  std::string out;
   for (const char c : ToValidUtf8(s)) {
     const auto u = static_cast<unsigned char>(c);
     if (c == '"') {
@@ -44,8 +44,11 @@ inline std::string Quoted(std::string_view s) {
       out += c;
     }
   }
-  return out + "\"";
+  return out;
 }
+
+// `s` between double quotes, escaped as by Escaped.
+inline std::string Quoted(std::string_view s) { return "\"" + Escaped(s) + "\""; }
 
 // Runs `f` and prefixes `key` (a config key naming the source) to any InputError it throws.
 template <typename F>

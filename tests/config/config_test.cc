@@ -137,6 +137,13 @@ TEST(Config, MalformedLinesDuplicatesAndEmptyFiles) {
             std::string::npos);
   EXPECT_NE(ErrorOf([&] { LoadConfig(WriteFile("Images_path: \"abc\n")); }).find("unterminated"),
             std::string::npos);
+  // A carriage return inside the value (not at the line's end) is shown escaped: the message
+  // stays on one line. So does a configuration whose name holds a newline.
+  const std::string cr = ErrorOf([&] { ParseConfigText("Images_path: \"a=\r4\n", "m"); });
+  EXPECT_NE(cr.find("unterminated quoted value \"\\\"a=\\r4\""), std::string::npos) << cr;
+  EXPECT_EQ(cr.find_first_of("\r\n"), std::string::npos) << cr;
+  const std::string named = ErrorOf([&] { ParseConfigText("Nope: 1\n", "two\nlines"); });
+  EXPECT_EQ(named.rfind("two\\nlines:1: unknown key", 0), 0u) << named;
 }
 
 TEST(Config, ParsesTextInMemoryLikeAFile) {
