@@ -1,5 +1,6 @@
 #include "matching/distances.h"
 
+#include "matching/blas.h"
 #include "matching/large_matrix.h"
 
 #include "OpenABLE/base/threading.h"
@@ -12,7 +13,6 @@
 #include <stdexcept>
 #include <vector>
 
-#include <Eigen/Core>
 #include <immintrin.h>
 
 namespace openable {
@@ -610,54 +610,171 @@ bool ForceHammingKernel(HammingKernel kernel) {
   return true;
 }
 
+namespace {
+
+// L2 matrices are computed in tiles of kL2Tile x kL2Tile cells (512: on the Intel Xeon of
+// docs/benchmarks.md the HOG matrix took 150 ms against 190 ms with tiles of 256, the packing
+// of operands by OpenBLAS being shared by more cells), each by one product on one thread
+// (MultiplyTransposed) and turned into distances while it is in cache. A cell's float depends
+// only on the product it comes from, and every path computes a cell in the same product: the
+// tile of its row blocks (I, J) counted from the first row of each operand, and for a
+// symmetric matrix the tile (max(I, J), min(I, J)), lower triangle, read mirrored. So a
+// symmetric matrix costs half the arithmetic, and its rows computed apart (a run spread over
+// processes, L2DistanceRows) are the same floats whatever OpenBLAS's kernels do with the
+// shapes and the order of operands.
+constexpr int kTile = kL2Tile;
+
+// Relative size below which |a|^2 + |b|^2 - 2ab has lost most of its digits: such cells
+// (near-duplicate rows) are summed directly.
+constexpr float kCancellation = 1e-3f;
+
+struct L2Operands {
+  cv::Mat a, b;  // continuous rows
+  std::vector<float> na, nb;  // squared norms
+  int Tiles(const cv::Mat& m) const { return (m.rows + kTile - 1) / kTile; }
+};
+
+// Squared norms summed in double and rounded once.
+std::vector<float> SquaredNorms(const cv::Mat& rows) {
+  std::vector<float> out(static_cast<size_t>(rows.rows));
+  for (int i = 0; i < rows.rows; ++i) {
+    const float* r = rows.ptr<float>(i);
+    double sum = 0.0;
+    for (int k = 0; k < rows.cols; ++k) sum += static_cast<double>(r[k]) * r[k];
+    out[static_cast<size_t>(i)] = static_cast<float>(sum);
+  }
+  return out;
+}
+
+L2Operands MakeOperands(const cv::Mat& a, const cv::Mat& b) {
+  L2Operands o;
+  // Descriptor rows may be a view with gaps: the product wants rows at a fixed stride.
+  o.a = a.isContinuous() ? a : a.clone();
+  o.na = SquaredNorms(o.a);
+  if (b.empty()) {
+    o.b = o.a;
+    o.nb = o.na;
+  } else {
+    o.b = b.isContinuous() ? b : b.clone();
+    o.nb = SquaredNorms(o.b);
+  }
+  return o;
+}
+
+// Tile (I, J): distances of the rows of block I of a to those of block J of b, into c (rows
+// ldc floats apart).
+void L2Tile(const L2Operands& o, int I, int J, float* c, size_t ldc) {
+  const int r0 = I * kTile, rows = std::min(kTile, o.a.rows - r0);
+  const int c0 = J * kTile, cols = std::min(kTile, o.b.rows - c0);
+  const int d = o.a.cols;
+  MultiplyTransposed(o.a.ptr<float>(r0), rows, static_cast<int>(o.a.step1()), o.b.ptr<float>(c0),
+                     cols, static_cast<int>(o.b.step1()), d, c, static_cast<int>(ldc));
+  const float* nb = o.nb.data() + c0;
+  for (int r = 0; r < rows; ++r) {
+    float* row = c + static_cast<size_t>(r) * ldc;
+    const float ni = o.na[static_cast<size_t>(r0 + r)];
+    bool cancelled = false;
+    for (int j = 0; j < cols; ++j) {
+      const float scale = ni + nb[j];
+      const float sq = scale - 2.0f * row[j];
+      cancelled |= sq < kCancellation * scale;
+      row[j] = std::sqrt(std::max(sq, 0.0f));
+    }
+    if (!cancelled) continue;
+    for (int j = 0; j < cols; ++j)
+      if (row[j] * row[j] < kCancellation * (ni + nb[j]))
+        row[j] = L2Distance(o.a.ptr<float>(r0 + r), o.b.ptr<float>(c0 + j), d);
+  }
+}
+
+}  // namespace
+
 cv::Mat1f L2Distances(const cv::Mat& a, const cv::Mat& b, int threads,
                       const PairProgress& progress) {
   CheckInputs(a, b, CV_32F, "L2Distances");
   const bool same = b.empty();
-  const cv::Mat& bb = same ? a : b;
-  const int n = a.rows, m = bb.rows, d = a.cols;
-  cv::Mat1f out(n, m, 0.0f);
+  const int n = a.rows, m = same ? n : b.rows;
+  cv::Mat1f out = LargeMatrix(n, m);
   if (n == 0 || m == 0) return out;
-  using RowMat = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  // Descriptor rows may not be continuous (a view); copy once into Eigen's layout.
-  // The references padded with zero rows to a multiple of 16: Eigen's product then takes every
-  // real column through its full-width kernel, never the narrower one of a last partial panel,
-  // so a cell's value does not depend on where its column falls (a run spread over processes
-  // computes rows in other blocks and gets the same floats: OpenABLE/cluster/distributed.h).
-  const int padded = (m + 15) / 16 * 16;
-  RowMat ea(n, d), eb = RowMat::Zero(padded, d);
-  for (int i = 0; i < n; ++i) std::memcpy(ea.row(i).data(), a.ptr<float>(i), d * sizeof(float));
-  for (int j = 0; j < m; ++j) std::memcpy(eb.row(j).data(), bb.ptr<float>(j), d * sizeof(float));
-  const Eigen::VectorXf na = ea.rowwise().squaredNorm();
-  const Eigen::VectorXf nb = eb.rowwise().squaredNorm();
-  // One block of rows at a time keeps the product's memory bounded and lets rows run in
-  // parallel and report progress.
-  constexpr int kBlock = 256;
-  const int blocks = (n + kBlock - 1) / kBlock;
-  auto pairs_of_block = [&](int blk) -> std::int64_t {
-    return static_cast<std::int64_t>(std::min(kBlock, n - blk * kBlock)) * m;
+  const L2Operands o = MakeOperands(a, b);
+  const int ti = o.Tiles(o.a), tj = o.Tiles(o.b);
+  // The tiles in order of rows; a symmetric matrix takes those of the lower triangle.
+  std::vector<std::pair<int, int>> tiles;
+  for (int I = 0; I < ti; ++I)
+    for (int J = 0; J < (same ? I + 1 : tj); ++J) tiles.emplace_back(I, J);
+  const auto cells = [&](int t) -> std::int64_t {
+    const auto [I, J] = tiles[static_cast<size_t>(t)];
+    return static_cast<std::int64_t>(std::min(kTile, n - I * kTile)) *
+           std::min(kTile, m - J * kTile);
   };
-  // Relative size below which |a|^2 + |b|^2 - 2ab has lost most of its digits.
-  constexpr float kCancellation = 1e-3f;
-  ParallelRows(blocks, threads, progress, pairs_of_block, static_cast<std::int64_t>(n) * m,
-               [&](int blk) {
-                 const int r0 = blk * kBlock, rows = std::min(kBlock, n - r0);
-                 const RowMat g = ea.middleRows(r0, rows) * eb.transpose();
-                 for (int r = 0; r < rows; ++r) {
-                   const int i = r0 + r;
-                   float* o = out.ptr<float>(i);
-                   for (int j = 0; j < m; ++j) {
-                     const float scale = na[i] + nb[j];
-                     float sq = scale - 2.0f * g(r, j);
-                     if (sq < kCancellation * scale) sq = (ea.row(i) - eb.row(j)).squaredNorm();
-                     o[j] = std::sqrt(std::max(sq, 0.0f));
-                   }
-                 }
-               });
-  if (same) {
-    for (int i = 0; i < n; ++i) out(i, i) = 0.0f;
-    cv::completeSymm(out, /*lowerToUpper=*/false);  // exact symmetry despite rounding order
-  }
+  std::int64_t total = 0;
+  for (int t = 0; t < static_cast<int>(tiles.size()); ++t) total += cells(t);
+  // Progress in cells of the whole matrix, of which a symmetric one computes about half.
+  const std::int64_t whole = static_cast<std::int64_t>(n) * m;
+  const PairProgress in_cells =
+      progress ? PairProgress([&](std::int64_t done, std::int64_t) {
+        progress(static_cast<std::int64_t>(static_cast<double>(done) / total * whole), whole);
+      })
+               : PairProgress();
+  ParallelRows(static_cast<int>(tiles.size()), threads, in_cells, cells, total, [&](int t) {
+    const auto [I, J] = tiles[static_cast<size_t>(t)];
+    L2Tile(o, I, J, out.ptr<float>(I * kTile) + J * kTile, out.step1());
+    if (!same) return;
+    // The upper triangle from the lower, while the tile is in cache: tile (J, I) is tile (I, J)
+    // transposed; a diagonal tile's upper half is its lower half mirrored, its diagonal zero.
+    const int r0 = I * kTile, c0 = J * kTile;
+    const int rows = std::min(kTile, n - r0), cols = std::min(kTile, m - c0);
+    if (I != J) {
+      cv::Mat1f upper = out(cv::Rect(r0, c0, rows, cols));
+      cv::transpose(out(cv::Rect(c0, r0, cols, rows)), upper);
+      return;
+    }
+    for (int r = 0; r < rows; ++r) {
+      float* row = out.ptr<float>(r0 + r) + c0;
+      row[r] = 0.0f;
+      for (int j = r + 1; j < cols; ++j) row[j] = out(r0 + j, c0 + r);
+    }
+  });
+  return out;
+}
+
+cv::Mat1f L2DistanceRows(const cv::Mat& a, int first, int last, int threads,
+                         const PairProgress& progress) {
+  CheckInputs(a, cv::Mat(), CV_32F, "L2DistanceRows");
+  if (first < 0 || last > a.rows || first > last)
+    throw std::logic_error("L2DistanceRows: rows out of range");
+  const int n = a.rows, rows = last - first;
+  cv::Mat1f out = LargeMatrix(rows, n);
+  if (rows == 0 || n == 0) return out;
+  const L2Operands o = MakeOperands(a, cv::Mat());
+  const int blocks = o.Tiles(o.a);
+  const int i0 = first / kTile, i1 = (last - 1) / kTile + 1;
+  const int tiles = (i1 - i0) * blocks;
+  const auto cells = [&](int t) -> std::int64_t {
+    const int I = i0 + t / blocks, J = t % blocks;
+    const int r0 = std::max(first, I * kTile), r1 = std::min(last, I * kTile + kTile);
+    return static_cast<std::int64_t>(r1 - r0) * std::min(kTile, n - J * kTile);
+  };
+  const std::int64_t total = static_cast<std::int64_t>(rows) * n;
+  ParallelRows(tiles, threads, progress, cells, total, [&](int t) {
+    const int I = i0 + t / blocks, J = t % blocks;
+    // The tile that holds these cells in the symmetric matrix: (I, J) below the diagonal,
+    // (J, I) read transposed above it; the diagonal tile's upper half mirrored from its lower.
+    const int hi = std::max(I, J), lo = std::min(I, J);
+    std::vector<float> tile(static_cast<size_t>(kTile) * kTile);
+    L2Tile(o, hi, lo, tile.data(), kTile);
+    const auto at = [&](int i, int j) {  // cell (i, j) of the symmetric matrix, i, j in the tile
+      const int gi = std::max(i, j), gj = std::min(i, j);
+      const int ri = gi - hi * kTile, rj = gj - lo * kTile;
+      return gi == gj ? 0.0f : tile[static_cast<size_t>(ri) * kTile + rj];
+    };
+    const int r0 = std::max(first, I * kTile), r1 = std::min(last, I * kTile + kTile);
+    const int c0 = J * kTile, c1 = std::min(n, c0 + kTile);
+    for (int i = r0; i < r1; ++i) {
+      float* o_row = out.ptr<float>(i - first);
+      for (int j = c0; j < c1; ++j) o_row[j] = at(i, j);
+    }
+  });
   return out;
 }
 

@@ -91,11 +91,19 @@ class HammingReferences {
 };
 
 // Euclidean distances between the rows of `a` (N x W, CV_32F) and `b` (M x W, CV_32F); b
-// empty means b = a (symmetric, zero diagonal). Computed through one matrix product,
-// |a|^2 + |b|^2 - 2 a.b (Eigen); cells where that form loses precision to cancellation
-// (distance small against the norms) are recomputed directly, so every cell is within
-// float rounding of the direct sum.
+// empty means b = a (symmetric, zero diagonal, half the arithmetic). Computed through one
+// matrix product, |a|^2 + |b|^2 - 2 a.b (OpenBLAS: matching/blas.h); cells where that form
+// loses precision to cancellation (distance small against the norms) are recomputed directly,
+// so every cell is within float rounding of the direct sum.
 cv::Mat1f L2Distances(const cv::Mat& a, const cv::Mat& b = cv::Mat(), int threads = 0,
                       const PairProgress& progress = {});
+
+// Rows [first, last) of L2Distances(a) (the symmetric matrix), the same floats: for a run
+// spread over processes, each computing its own rows (best on multiples of kL2Tile, the rows
+// and columns of the tiles L2 matrices are computed in: a tile split between two processes is
+// computed by both).
+inline constexpr int kL2Tile = 512;
+cv::Mat1f L2DistanceRows(const cv::Mat& a, int first, int last, int threads = 0,
+                         const PairProgress& progress = {});
 
 }  // namespace openable

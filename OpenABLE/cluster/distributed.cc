@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "OpenABLE/base/error.h"
+#include "matching/distances.h"
 #include "matching/large_matrix.h"
 #include "matching/matrix.h"
 
@@ -141,15 +142,20 @@ cv::Mat1f DistanceRows(const cv::Mat& rows, int row_first, int row_last, Metric 
   if (row_first == 0 && row_last == rows.rows)
     return PairwiseDistances(rows, metric, strips, mode, threads, progress);
   if (row_last <= row_first) return cv::Mat1f(0, rows.rows);  // a process with no rows
+  // L2 cells of a symmetric matrix come from its lower triangle's products (L2Distances): the
+  // rows of a share are computed from the same products, never as rows against references.
+  if (metric == Metric::kL2 && (strips == 1 || mode == PanoramaMatching::kAligned))
+    return L2DistanceRows(rows, row_first, row_last, threads, progress);
   return PanoramaDistances(rows.rowRange(row_first, row_last), rows, strips, mode, threads,
                            progress, metric);
 }
 
 DenseShare DenseShareOf(const Cluster& cluster, int n, int sequence_length) {
-  // Shares and their first computed row on multiples of the row blocks of the matrix products
-  // (L2Distances computes 256 rows at a time): every row is then computed in a block of the
-  // same rows as in a single process, and its L2 cells are the same floats.
-  constexpr int kRowBlock = 256;
+  // Shares and their first computed row on multiples of the tiles of the L2 matrices
+  // (kL2Tile): every row is then computed in a tile of the same rows as in a single process
+  // (the sub-panoramas' matrices are computed as rows against references), and its L2 cells
+  // are the same floats; no tile is computed by two processes.
+  constexpr int kRowBlock = kL2Tile;
   const auto aligned = [&](int row) {
     return row >= n ? n : std::min(n, (row + kRowBlock / 2) / kRowBlock * kRowBlock);
   };

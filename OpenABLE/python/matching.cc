@@ -8,6 +8,7 @@
 
 #include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/python/common.h"
+#include "matching/blas.h"
 #include "matching/contrast.h"
 #include "matching/distances.h"
 #include "matching/normalize.h"
@@ -91,6 +92,13 @@ Returns:
 Raises:
     ValueError: not uint8, or rows of different widths.)doc");
 
+  m.def("blas_description", &BlasDescription,
+        R"doc(blas_description() -> str
+
+The OpenBLAS the float matrices run on: its build, the kernels it runs (and whether OpenABLE
+chose them, on a CPU the library does not know) and its threading. For bug reports and
+benchmarks.)doc");
+
   m.def(
       "l2_distances",
       [](const py::object& a, const py::object& b, int threads) {
@@ -99,9 +107,10 @@ Raises:
       py::arg("a"), py::arg("b") = py::none(), py::arg("threads") = 0,
       R"doc(l2_distances(a, b=None, threads=0) -> numpy.ndarray
 
-Euclidean distances (Eq. 8) between every row of `a` and every row of `b`: one matrix
-product (Eigen), with the cells that lose precision to cancellation recomputed directly, so
-every cell is within float rounding of the direct sum.
+Euclidean distances (Eq. 8) between every row of `a` and every row of `b`: matrix products
+on OpenBLAS (the one numpy uses), with the cells that lose precision to cancellation
+recomputed directly, so every cell is within float rounding of the direct sum. A symmetric
+matrix (b=None) costs half the arithmetic.
 
 Args:
     a (numpy.ndarray): shape (N, W) vector descriptor rows; float32 is read in place, other

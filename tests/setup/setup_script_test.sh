@@ -10,7 +10,8 @@ fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 has() { [[ " $1 " == *" $2 "* ]]; }
 
 demo=$(bash "$setup" --print-packages) || fail "--print-packages exited with $?"
-for p in cmake g++ make ninja-build libopencv-dev libeigen3-dev libopenimageio-dev openimageio-tools \
+for p in cmake g++ make ninja-build libopencv-dev libeigen3-dev libopenblas-dev libopenimageio-dev \
+         openimageio-tools \
          libpng-dev zlib1g-dev libjpeg-dev nlohmann-json3-dev; do
   has "$demo" "$p" || fail "the demo's packages lack $p: $demo"
 done
