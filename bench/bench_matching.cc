@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "matching/distances.h"
+#include "matching/matrix.h"
 #include "matching/normalize.h"
 #include "matching/sequence.h"
 
@@ -191,6 +192,35 @@ void BM_NormalizeByMax(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n) * n);
 }
 BENCHMARK(BM_NormalizeByMax)->Arg(3576)->Unit(benchmark::kMillisecond);
+
+// The dense matrix of a run of two traversals of 1788 frames (as Nordland's) with LDB rows
+// (32 bytes), L = 10, forward, Sequence_partial ahead, before Eq. 5's scaling: in two passes
+// (every distance, then the sequence sums; Args 0) or in one (FusedSequenceMatrix; Args 1).
+// Items: matrix cells, to hold against the kernel's pairs per second (BM_HammingKernel).
+void BM_DenseSequenceMatrix(benchmark::State& state) {
+  const int n = 3576, L = 10;
+  const cv::Mat rows = RandomRows(n, 32, CV_8U);
+  const std::vector<int> starts = {0, n / 2};
+  for (auto _ : state) {
+    cv::Mat1f m;
+    if (state.range(0) == 0) {
+      m = openable::HammingDistances(rows, cv::Mat(), 2);
+      openable::SequenceDistancesInPlace(m, L, starts, starts,
+                                         openable::SequenceDirection::kForward, 2);
+      benchmark::DoNotOptimize(openable::LargestFiniteEntry(m));
+    } else {
+      float largest = 0.0f;
+      m = openable::FusedSequenceMatrix(rows, openable::Metric::kHamming, L,
+                                        openable::SequenceDirection::kForward,
+                                        openable::SequencePartial::kAhead, starts, 2, largest);
+      benchmark::DoNotOptimize(largest);
+    }
+    benchmark::DoNotOptimize(m.data);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n) * n);
+  state.SetLabel(state.range(0) == 0 ? "two passes" : "one pass");
+}
+BENCHMARK(BM_DenseSequenceMatrix)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

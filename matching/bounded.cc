@@ -173,17 +173,19 @@ float LargestFinite(const float* s, int n, float seen) {
   return out;
 }
 
-}  // namespace
-
 // The fused pipeline: each thread takes ranges of query rows in turn and, for every row,
 // computes its distances, the running sequence sums over a ring of the last L + 1 rows, the
 // row's largest value and its kept matches, in one pass with no barrier between threads. A
 // range starts L - 1 rows early so that its first row has a full sequence behind it, exactly as
 // when the block is computed from its first row.
-std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& block,
-                                  const KeepRules& rules, const BoundedOptions& options,
-                                  float& max_distance,
-                                  const std::function<void(int, int)>& progress) {
+//
+// Each finished row i of query sums (m cells, unnormalised) goes to sink(range, i, sums) on the
+// thread of its range; `ranges` receives the number of ranges before the first row.
+using RowSink = std::function<void(int range, int row, const float* sums)>;
+
+void SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
+                  const BoundedOptions& options, const std::function<void(int)>& ranges_known,
+                  const RowSink& sink, const std::function<void(int, int)>& progress) {
   const int L = options.sequence_length;
   if (L < 1) throw std::logic_error("BoundedMatches: sequence length < 1");
   const int m = block.reference_count;
@@ -204,13 +206,12 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
                              ? options.range_rows
                              : std::clamp(queries / (8 * threads), 64, 1024);
   const int ranges = queries <= 0 ? 0 : (queries + range_rows - 1) / range_rows;
+  ranges_known(ranges);
   const bool forward = options.direction != SequenceDirection::kReverse;
   const bool backward = options.direction != SequenceDirection::kForward;
   // Rows of D computed at once: one for the Hamming kernel, which writes straight into the
   // ring; blocks for the matrix products of L2 and the L1 kernel.
   const int block_rows = packed ? 1 : 16;
-  std::vector<std::vector<Match>> kept(static_cast<std::size_t>(ranges));
-  std::vector<float> range_max(static_cast<std::size_t>(ranges), 0.0f);
   std::atomic<int> rows_done{0};
   std::mutex progress_mutex;
   // Sequence_partial ahead: a cell with fewer than L terms takes the cell AheadShift steps
@@ -235,12 +236,7 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
     std::vector<float> sums_r(ahead && backward ? L * width : 0);
     std::vector<float> done_f(ahead ? width : 0), done_r(ahead && forward && backward ? width : 0);
     cv::Mat1f computed;
-    float largest = 0.0f;
-    std::vector<Match>& out = kept[static_cast<std::size_t>(c)];
-    const auto keep = [&](int i, const float* s) {
-      largest = LargestFinite(s, m, largest);
-      KeepRow(s, m, i, rules, out);
-    };
+    const auto keep = [&](int i, const float* s) { sink(c, i, s); };
     // Row e of one direction with its early cells taken from the rows ahead (kept in `sums`).
     const auto finish = [&](int e, const std::vector<float>& sums, bool rev, float* into) {
       const float* own = &sums[static_cast<std::size_t>(e % L) * width];
@@ -312,7 +308,6 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
       }
     }
     for (int e = std::max(r0, rows_end - look); ahead && e < r1; ++e) keep_ahead(e);
-    range_max[static_cast<std::size_t>(c)] = largest;
     rows_done += r1 - r0;
     // Progress from whichever thread gets the lock (the reporter is not thread-safe); the count
     // read under the lock only grows.
@@ -322,6 +317,30 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
     }
   });
   if (progress) progress(queries, queries);
+}
+
+}  // namespace
+
+std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& block,
+                                  const KeepRules& rules, const BoundedOptions& options,
+                                  float& max_distance,
+                                  const std::function<void(int, int)>& progress) {
+  // Per range: its kept matches and largest value, merged in the order of the ranges.
+  std::vector<std::vector<Match>> kept;
+  std::vector<float> range_max;
+  const int m = block.reference_count;
+  SequenceRows(
+      descriptors, block, options,
+      [&](int ranges) {
+        kept.resize(static_cast<std::size_t>(ranges));
+        range_max.assign(static_cast<std::size_t>(ranges), 0.0f);
+      },
+      [&](int c, int i, const float* s) {
+        float& largest = range_max[static_cast<std::size_t>(c)];
+        largest = LargestFinite(s, m, largest);
+        KeepRow(s, m, i, rules, kept[static_cast<std::size_t>(c)]);
+      },
+      progress);
   std::vector<Match> all;
   std::size_t total = 0;
   for (const auto& k : kept) total += k.size();
@@ -332,6 +351,28 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
   max_distance = max_seen;
   if (options.normalize) NormalizeMatches(all, max_seen, rules.score);
   return all;
+}
+
+float SequenceMatrix(const cv::Mat& descriptors, const MatchBlock& block,
+                     const BoundedOptions& options, cv::Mat1f& out,
+                     const std::function<void(int, int)>& progress) {
+  std::vector<float> range_max;
+  const int m = block.reference_count;
+  BoundedOptions every_query = options;
+  every_query.query_begin = 0;
+  every_query.query_end = -1;
+  SequenceRows(
+      descriptors, block, every_query,
+      [&](int ranges) { range_max.assign(static_cast<std::size_t>(ranges), 0.0f); },
+      [&](int c, int i, const float* s) {
+        float& largest = range_max[static_cast<std::size_t>(c)];
+        largest = LargestFinite(s, m, largest);
+        std::copy_n(s, m, out.ptr<float>(block.query_first + i) + block.reference_first);
+      },
+      progress);
+  float largest = 0.0f;
+  for (const float v : range_max) largest = std::max(largest, v);
+  return largest;
 }
 
 std::vector<std::uint8_t> AcceptedMatches(const std::vector<Match>& matches, int queries,

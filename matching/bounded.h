@@ -113,6 +113,15 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
                                   float& max_distance,
                                   const std::function<void(int, int)>& progress = {});
 
+// The same pipeline writing each row's sequence sums (unnormalised) into rows
+// block.query_first + i, columns from block.reference_first, of `out` (which holds them): the
+// dense matrix of the block in one pass over the descriptors, with no single-frame matrix.
+// Returns the largest finite sum. Every query of the block is computed (options.query_begin,
+// query_end and normalize are not used).
+float SequenceMatrix(const cv::Mat& descriptors, const MatchBlock& block,
+                     const BoundedOptions& options, cv::Mat1f& out,
+                     const std::function<void(int, int)>& progress = {});
+
 // Approximate_search: the index of `approximate` (its engine and search budget; its k and
 // threads are set here: matching/search/approximate.h) gives Best_matches candidates per query (with
 // one traversal, Best_matches + 2 x Exclusion, of which those Exclusion frames back are kept),

@@ -7,6 +7,8 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/option_checks.h"
 #include "OpenABLE/base/strings.h"
+#include "matching/bounded.h"
+#include "matching/large_matrix.h"
 #include "matching/normalize.h"
 
 namespace openable {
@@ -70,17 +72,68 @@ cv::Mat1f PairwiseDistances(const cv::Mat& rows, int strips, PanoramaMatching mo
   return PairwiseDistances(rows, MetricOfType(rows.type()), strips, mode, threads, progress);
 }
 
+cv::Mat1f FusedSequenceMatrix(const cv::Mat& rows, Metric metric, int sequence_length,
+                              SequenceDirection direction, SequencePartial partial,
+                              const std::vector<int>& traversal_starts, int threads,
+                              float& largest, const std::function<void(int, int)>& progress) {
+  if (metric == Metric::kL2)
+    throw std::logic_error("FusedSequenceMatrix: L2 rows take PairwiseDistances");
+  const int n = rows.rows;
+  CheckTraversalStarts(traversal_starts, n, "traversal_starts");
+  std::vector<int> bounds = traversal_starts.empty() ? std::vector<int>{0} : traversal_starts;
+  bounds.push_back(n);
+  const int traversals = static_cast<int>(bounds.size()) - 1;
+  cv::Mat1f out = LargeMatrix(n, n);
+  BoundedOptions options;
+  options.metric = metric;
+  options.sequence_length = sequence_length;
+  options.direction = direction;
+  options.partial = partial;
+  options.threads = threads;
+  largest = 0.0f;
+  // Each block of (query traversal, reference traversal) apart: sums never cross traversals.
+  // Progress in rows of the whole matrix.
+  int rows_before = 0;
+  for (int r = 0; r < traversals; ++r) {
+    for (int c = 0; c < traversals; ++c) {
+      MatchBlock block;
+      block.query_first = bounds[static_cast<size_t>(r)];
+      block.query_count = bounds[static_cast<size_t>(r) + 1] - block.query_first;
+      block.reference_first = bounds[static_cast<size_t>(c)];
+      block.reference_count = bounds[static_cast<size_t>(c) + 1] - block.reference_first;
+      block.one_traversal = r == c;
+      const int share = traversals;  // each query row is computed once per reference traversal
+      const auto block_progress = [&](int done, int) {
+        if (progress) progress((rows_before + done) / share, n);
+      };
+      largest = std::max(largest, SequenceMatrix(rows, block, options, out, block_progress));
+      rows_before += block.query_count;
+    }
+  }
+  if (progress) progress(n, n);
+  return out;
+}
+
 cv::Mat1f NormalizedDistanceMatrix(const cv::Mat& rows, int sequence_length,
                                    SequenceDirection direction,
                                    const std::vector<int>& traversal_starts, int threads,
                                    float* max_distance, std::optional<Metric> metric,
                                    SequencePartial partial) {
-  cv::Mat1f d = PairwiseDistances(rows, metric.value_or(MetricOfType(rows.type())), 1,
-                                  PanoramaMatching::kAligned, threads);
-  if (sequence_length > 1 || direction != SequenceDirection::kForward)
-    SequenceDistancesInPlace(d, sequence_length, traversal_starts, traversal_starts, direction,
-                             threads, partial);
-  const float m = NormalizeByMax(d);
+  const Metric kind = metric.value_or(MetricOfType(rows.type()));
+  cv::Mat1f d;
+  float m = 0.0f;
+  if (kind != Metric::kL2) {
+    // Distances, sums and the largest value in one pass, then one scaling pass.
+    d = FusedSequenceMatrix(rows, kind, sequence_length, direction, partial, traversal_starts,
+                            threads, m);
+    DivideByLargest(d, m);
+  } else {
+    d = PairwiseDistances(rows, kind, 1, PanoramaMatching::kAligned, threads);
+    if (sequence_length > 1 || direction != SequenceDirection::kForward)
+      SequenceDistancesInPlace(d, sequence_length, traversal_starts, traversal_starts,
+                               direction, threads, partial);
+    m = NormalizeByMax(d);
+  }
   if (max_distance != nullptr) *max_distance = m;
   return d;
 }

@@ -2,6 +2,7 @@
 // compared (Hamming, L2 or the sub-panorama comparison), sequences summed, Eq. 5 applied.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -62,6 +63,18 @@ cv::Mat1f PairwiseDistances(const cv::Mat& rows, Metric metric, int strips = 1,
 cv::Mat1f PairwiseDistances(const cv::Mat& rows, int strips = 1,
                             PanoramaMatching mode = PanoramaMatching::kAligned, int threads = 0,
                             const PairProgress& progress = {});
+
+// The sequence matrix of a run in one pass (SequenceMatrix of matching/bounded.h, traversal
+// by traversal): the distances of rows of `rows` are computed a few at a time while they are
+// in cache, summed along their diagonals as they come and the largest finite sum kept, with no
+// single-frame matrix in memory. The same floats as PairwiseDistances followed by
+// SequenceDistancesInPlace for the integer distances (Hamming, L1: their double sums are
+// exact); L2 rows keep the two passes, whose tiles a run spread over processes computes the
+// same way (matching/distances.h). `largest` receives the largest finite sum.
+cv::Mat1f FusedSequenceMatrix(const cv::Mat& rows, Metric metric, int sequence_length,
+                              SequenceDirection direction, SequencePartial partial,
+                              const std::vector<int>& traversal_starts, int threads,
+                              float& largest, const std::function<void(int, int)>& progress = {});
 
 // M' of Eq. 5 of a single-camera run: PairwiseDistances (with `metric`, or the rows' type's),
 // the sequence sums of sequence.h over

@@ -339,6 +339,8 @@ void TakeSingleFrames(const std::vector<const SingleFrame*>& singles, bool fused
   }
 }
 
+void FinishNormalized(const Config& config, const std::vector<int>& starts, RunResult& result);
+
 // Steps 2 to 6 of a dense run on `distances`, the fused and enhanced single-frame matrix:
 // sequences, Eq. 5 (over every process's largest value, the rows gathered on process 0), the
 // threshold of Eq. 9, the matches kept and the answers accepted. Returns false on the
@@ -385,6 +387,14 @@ bool FinishDense(const Config& config, cv::Mat1f distances, const std::vector<in
                      direction == SequenceDirection::kReverse);
     }
   }
+  FinishNormalized(config, starts, result);
+  return true;
+}
+
+// Steps 4 to 6 of a dense run on its normalised matrix: the threshold of Eq. 9, the matches
+// kept and the answers accepted.
+void FinishNormalized(const Config& config, const std::vector<int>& starts, RunResult& result) {
+  const MatchingOptions& matching = config.matching;
   if (matching.partial != SequencePartial::kScale)
     result.empty_cells = static_cast<std::int64_t>(result.normalized.total()) -
                          cv::countNonZero(result.normalized <= 1.0f);
@@ -401,7 +411,54 @@ bool FinishDense(const Config& config, cv::Mat1f distances, const std::vector<in
     best.band = -1;
     CountAccepted(result, matching, MatchesFromMatrix(result.normalized, block, best));
   }
-  return true;
+}
+
+// Whether a dense run can compute its matrix in one pass (FusedSequenceMatrix): nothing needs
+// its single-frame matrix (no store keeping it for other runs, no fusion, no contrast
+// enhancement), the frames are compared whole in one process, and their distances are integers
+// (the L2 matrices keep the tiles a run spread over processes computes the same way).
+bool OnePassFits(const RunPlan& plan, const SingleFrameStore* store) {
+  return store == nullptr && !plan.Fused() && plan.strips == 1 &&
+         !plan.config.matching.contrast_enhancement && !Cluster::Get().Distributed() &&
+         plan.head.descriptors.front().metric != Metric::kL2;
+}
+
+// A dense run in one pass: the frames described, then distances, sequence sums and the
+// largest value computed together a few rows at a time (no single-frame matrix), one scaling
+// pass (Eq. 5), and steps 4 to 6 as for any dense run. The same matrix as the other path.
+RunResult ComputeOnePass(const RunPlan& plan, ProgressReporter& progress,
+                         Clock::time_point run_start) {
+  const Config& config = plan.config;
+  const MatchingOptions& matching = config.matching;
+  RunResult result = plan.head;
+  Described described = DescribeSources(config, *plan.describers.front(), plan.names.front(),
+                                        plan.specs, plan.sources, progress);
+  std::vector<int> starts;
+  SetTraversals(result, starts, described.traversals);
+  result.cache = described.cache;
+  AddLines(result.warnings, described.warnings);
+  AddLines(result.notes, described.notes);
+  result.timings.describe_seconds = described.seconds;
+  result.timings.frames = described.frames;
+  const int n = described.rows.rows;
+  result.timings.pairs = static_cast<std::int64_t>(n) * (n - 1) / 2;
+  const auto t = Clock::now();
+  progress.Begin("matching", n, "rows (distances and sequences in one pass)");
+  float largest = 0.0f;
+  result.normalized = FusedSequenceMatrix(
+      described.rows, result.descriptors.front().metric, matching.sequence_length,
+      matching.direction, matching.partial, starts, matching.threads, largest,
+      [&](int done, int) { progress.Update(done); });
+  progress.End();
+  result.timings.match_seconds = SecondsSince(t);
+  const auto t2 = Clock::now();
+  described.rows.release();
+  DivideByLargest(result.normalized, largest);
+  result.max_distance = largest;
+  FinishNormalized(config, starts, result);
+  result.timings.sequence_seconds = SecondsSince(t2);
+  result.timings.total_seconds = SecondsSince(run_start);
+  return result;
 }
 
 // A run from its plan, to its single-frame matrices alone (`single_frames_only`) or to the end.
@@ -414,6 +471,8 @@ RunResult ComputePlanned(const RunPlan& plan, ProgressReporter& progress, Single
     result.timings.total_seconds = SecondsSince(run_start);
     return result;
   }
+  if (!single_frames_only && OnePassFits(plan, store))
+    return ComputeOnePass(plan, progress, run_start);
   std::vector<SingleFrame> computed;  // without a store
   const std::vector<const SingleFrame*> singles =
       DenseSingleFrames(plan, progress, store, computed);
