@@ -31,6 +31,12 @@ cv::Mat1f TwoPasses(const cv::Mat& rows, Metric metric, int L, SequenceDirection
 TEST(FusedSequenceMatrix, IsTheTwoPassMatrixBitForBit) {
   const cv::Mat rows = RandomBytes(700, 32, 3);
   const cv::Mat sad = RandomBytes(300, 48, 4);
+  // Bytes of 0 or 255 and 2048 of them: L1 distances near 261,000 (odd ones too), whose sums of
+  // L = 80 pass 2^24, where float no longer holds every integer: the sums must be kept in
+  // double there to stay exact.
+  cv::Mat extremes = RandomBytes(200, 2048, 5);
+  for (auto it = extremes.begin<std::uint8_t>(); it != extremes.end<std::uint8_t>(); ++it)
+    *it = *it < 128 ? static_cast<std::uint8_t>(*it % 3) : static_cast<std::uint8_t>(255 - *it % 3);
   struct Case {
     const cv::Mat* rows;
     Metric metric;
@@ -50,6 +56,7 @@ TEST(FusedSequenceMatrix, IsTheTwoPassMatrixBitForBit) {
       {&rows, Metric::kHamming, 30, SequenceDirection::kBoth, SequencePartial::kAhead,
        {0, 333}},
       {&sad, Metric::kL1, 4, SequenceDirection::kForward, SequencePartial::kAhead, {0, 100}},
+      {&extremes, Metric::kL1, 80, SequenceDirection::kForward, SequencePartial::kScale, {}},
   };
   for (const Case& c : cases) {
     const std::string what = "L " + std::to_string(c.L) + ", direction " +
