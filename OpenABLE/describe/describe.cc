@@ -26,11 +26,25 @@ std::string SizeText(const cv::Size& s) {
 DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescriber& describer,
                                    const DescribeOptions& options,
                                    const std::function<void(int, int)>& progress) {
+  return std::move(DescribeSequences(source, {&describer}, {options.cache}, options, progress)
+                       .front());
+}
+
+std::vector<DescribedSequence> DescribeSequences(
+    const FrameSource& source, const std::vector<const FrameDescriber*>& describers,
+    const std::vector<RowCache*>& caches, const DescribeOptions& options,
+    const std::function<void(int, int)>& progress) {
+  if (describers.empty() || caches.size() != describers.size())
+    throw std::logic_error("DescribeSequences: one cache (or nullptr) per descriptor");
   const int n = source.Size();
+  const int kinds = static_cast<int>(describers.size());
   const std::string prefix = options.key.empty() ? "" : options.key + ": ";
-  cv::Mat rows(n, describer.RowWidth(), describer.RowType(), cv::Scalar(0));
+  std::vector<cv::Mat> rows;
+  for (const FrameDescriber* d : describers)
+    rows.emplace_back(n, d->RowWidth(), d->RowType(), cv::Scalar(0));
   std::vector<char> ok(n, 0);
   std::vector<std::string> read_errors(n);
+  const bool use_caches = !options.show_images;
 
   std::mutex mutex;  // guards the first size, the first error and progress
   std::optional<cv::Size> first_size;
@@ -43,7 +57,6 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
     if (i < error_index) error_index = i, error_message = message;
   };
 
-  // Describes frame i once it is in memory; records a size mismatch as a failure.
   // Records the first frame size; a frame of another size is a failure (false).
   auto check_size = [&](int i, cv::Size size) {
     std::lock_guard<std::mutex> lock(mutex);
@@ -62,37 +75,49 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
   const bool illumination_invariance = options.preprocess.illumination_invariance;
   const double alpha = options.preprocess.Alpha();
   const std::vector<int> side_window_radii = options.preprocess.SideWindowRadii();
-  auto describe = [&](int i, const cv::Mat& frame) {
+  // Describes frame i once it is in memory with the descriptors whose rows are not cached
+  // (`needed`); records a size mismatch as a failure. The frame is converted once for all of
+  // them: grey (or Eq. 6) for every descriptor, grey + disparity (a stereo frame) for D-LDB.
+  auto describe = [&](int i, const cv::Mat& frame, const std::vector<char>& needed) {
     if (!check_size(i, frame.size())) return;
-    // Grey (or Eq. 6) for every descriptor; grey + disparity (a stereo frame) for D-LDB.
     // Noise (robustness studies) on the frame as read, before any conversion.
     const cv::Mat input =
         noise.Any() ? AddNoise(frame, noise,
                                NoiseState(noise.seed, options.noise_stream,
                                           options.share_first + i))
                     : frame;
-    cv::Mat image;
-    try {
-      image = describer.Channels() == 2          ? ToGrayDisparity8(input)
-              : illumination_invariance ? cv::Mat(IlluminationInvariant(input, alpha))
-                                                : cv::Mat(ToGray8(input));
-    } catch (const InputError& e) {
-      fail(i, "image " + Quoted(source.FrameName(i)) + ": " + e.what());
-      return;
+    cv::Mat images[2];  // [0]: grey or Eq. 6, then side-window fusion; [1]: grey + disparity
+    for (int k = 0; k < kinds; ++k) {
+      if (!needed[static_cast<size_t>(k)]) continue;
+      const FrameDescriber& describer = *describers[static_cast<size_t>(k)];
+      const int kind = describer.Channels() == 2 ? 1 : 0;
+      cv::Mat& image = images[kind];
+      if (image.empty()) {
+        try {
+          image = kind == 1                  ? ToGrayDisparity8(input)
+                  : illumination_invariance ? cv::Mat(IlluminationInvariant(input, alpha))
+                                            : cv::Mat(ToGray8(input));
+        } catch (const InputError& e) {
+          fail(i, "image " + Quoted(source.FrameName(i)) + ": " + e.what());
+          return;
+        }
+        if (!side_window_radii.empty()) image = SideWindowFusion(image, side_window_radii);
+      }
+      const cv::Size need = describer.MinimumFrame();
+      if (image.cols < need.width || image.rows < need.height) {
+        fail(i, "image " + Quoted(source.FrameName(i)) + " is " + SizeText(image.size()) +
+                    "; the grid and sub-panoramas need at least " + SizeText(need) +
+                    " (Grid_x x Panoramas by Grid_y pixels)");
+        return;
+      }
+      describer.Describe(image, rows[static_cast<size_t>(k)].row(i));
+      if (caches[static_cast<size_t>(k)] != nullptr && use_caches)
+        caches[static_cast<size_t>(k)]->Store(source, i, rows[static_cast<size_t>(k)].row(i),
+                                             frame.size());
     }
-    const cv::Size need = describer.MinimumFrame();
-    if (image.cols < need.width || image.rows < need.height) {
-      fail(i, "image " + Quoted(source.FrameName(i)) + " is " + SizeText(image.size()) +
-                  "; the grid and sub-panoramas need at least " + SizeText(need) +
-                  " (Grid_x x Panoramas by Grid_y pixels)");
-      return;
-    }
-    if (!side_window_radii.empty()) image = SideWindowFusion(image, side_window_radii);
-    describer.Describe(image, rows.row(i));
     ok[i] = 1;
-    if (options.cache != nullptr && !options.show_images)
-      options.cache->Store(source, i, rows.row(i), frame.size());
   };
+  const std::vector<char> all_needed(static_cast<size_t>(kinds), 1);
   auto report = [&]() {
     std::lock_guard<std::mutex> lock(mutex);
     ++done;
@@ -136,18 +161,35 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
         }
       }
       ParallelFor(static_cast<int>(frames.size()), threads, [&](int k) {
-        describe(frames[k].first, frames[k].second);
+        describe(frames[k].first, frames[k].second, all_needed);
         report();
       });
     }
   } else {
     ParallelFor(n, threads, [&](int i) {
       if (stopped()) return;
-      cv::Size cached_size;
-      if (options.cache != nullptr && options.cache->Lookup(source, i, rows.row(i), &cached_size)) {
-        if (check_size(i, cached_size)) ok[i] = 1;
+      // Rows of the caches first; the frame is read only when a descriptor still needs it.
+      std::vector<char> needed(static_cast<size_t>(kinds), 1);
+      bool any_needed = false, sizes_agree = true;
+      for (int k = 0; k < kinds; ++k) {
+        RowCache* cache = caches[static_cast<size_t>(k)];
+        cv::Size cached_size;
+        if (cache != nullptr && use_caches &&
+            cache->Lookup(source, i, rows[static_cast<size_t>(k)].row(i), &cached_size)) {
+          needed[static_cast<size_t>(k)] = 0;
+          sizes_agree &= check_size(i, cached_size);
+        } else {
+          any_needed = true;
+        }
+      }
+      if (!sizes_agree) {
+        report();
+        return;
+      }
+      if (!any_needed) {
+        ok[i] = 1;
       } else if (auto f = read(i)) {
-        describe(i, *f);
+        describe(i, *f, needed);
       }
       report();
     });
@@ -155,25 +197,30 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
 
   if (error_index < n) throw InputError(prefix + error_message);
 
-  DescribedSequence out;
+  DescribedSequence kept;
   for (int i = 0; i < n; ++i) {
     if (ok[i]) {
-      out.kept.push_back(i);
+      kept.kept.push_back(i);
     } else {
-      out.skipped.push_back(read_errors[i]);
+      kept.skipped.push_back(read_errors[i]);
     }
   }
-  if (out.kept.empty() && !options.share)
+  if (kept.kept.empty() && !options.share)
     throw InputError(prefix + "none of the " + std::to_string(n) +
                      " frames could be read (first failure: " +
-                     (out.skipped.empty() ? std::string("none") : out.skipped.front()) + ")");
-  if (out.kept.size() == static_cast<size_t>(n)) {
-    out.rows = rows;
-  } else {
-    out.rows.create(static_cast<int>(out.kept.size()), rows.cols, rows.type());
-    for (size_t k = 0; k < out.kept.size(); ++k) rows.row(out.kept[k]).copyTo(out.rows.row(k));
+                     (kept.skipped.empty() ? std::string("none") : kept.skipped.front()) + ")");
+  kept.frame_size = first_size.value_or(cv::Size());
+  std::vector<DescribedSequence> out(static_cast<size_t>(kinds), kept);
+  for (int k = 0; k < kinds; ++k) {
+    const cv::Mat& all = rows[static_cast<size_t>(k)];
+    cv::Mat& into = out[static_cast<size_t>(k)].rows;
+    if (kept.kept.size() == static_cast<size_t>(n)) {
+      into = all;
+    } else {
+      into.create(static_cast<int>(kept.kept.size()), all.cols, all.type());
+      for (size_t r = 0; r < kept.kept.size(); ++r) all.row(kept.kept[r]).copyTo(into.row(r));
+    }
   }
-  out.frame_size = first_size.value_or(cv::Size());
   return out;
 }
 

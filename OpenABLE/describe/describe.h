@@ -63,4 +63,13 @@ DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescrib
                                    const DescribeOptions& options,
                                    const std::function<void(int, int)>& progress = {});
 
+// Several descriptors of every frame of `source`, each frame read (decoded) and converted once
+// for all of them: one result per descriptor, with the same frames kept and skipped. `caches`
+// holds one cache (or nullptr) per descriptor; options.cache is not used. A frame is read only
+// when a descriptor's cache lacks its row. Errors and threads as DescribeSequence.
+std::vector<DescribedSequence> DescribeSequences(
+    const FrameSource& source, const std::vector<const FrameDescriber*>& describers,
+    const std::vector<RowCache*>& caches, const DescribeOptions& options,
+    const std::function<void(int, int)>& progress = {});
+
 }  // namespace openable

@@ -39,51 +39,93 @@ struct Described {
   int frames = 0;
 };
 
-// Describes every source with `describer`; `config` is the run's with Image_descriptor the one
-// descriptor described (it keys the descriptor cache).
-Described DescribeSources(const Config& config, const FrameDescriber& describer,
-                          const std::string& name, const std::vector<SourceSpec>& specs,
-                          const std::vector<std::unique_ptr<FrameSource>>& sources,
-                          ProgressReporter& progress) {
+// One descriptor of a run to describe: `config` is the run's with Image_descriptor that one
+// descriptor (it keys the descriptor cache).
+struct ToDescribe {
+  const Config* config;
+  const FrameDescriber* describer;
+  std::string name;
+};
+
+// The descriptor cache of one descriptor, or nullptr with a note saying why it is not used.
+std::unique_ptr<DescriptorCache> OpenDescriptorCache(const ToDescribe& d, const SourceSpec& first,
+                                                     const DescribeOptions& options,
+                                                     Described& out) {
+  const ScaleOptions& scale = d.config->scale;
+  if (scale.descriptor_cache.empty()) return nullptr;
+  if (first.kind != SourceKind::kFolder) {
+    out.notes.push_back("Descriptor_cache: not used: the cache keeps rows of image "
+                        "files (Frame_mode 0, Camera_type 0 or 2), not of videos, bags "
+                        "or stereo pairs");
+    return nullptr;
+  }
+  if (options.show_images) {
+    out.notes.push_back("Descriptor_cache: not used with Show_images 1");
+    return nullptr;
+  }
+  if (options.preprocess.noise.Any()) {
+    // The noise of a frame depends on its position in the run, not only on its bytes.
+    out.notes.push_back("Descriptor_cache: not used with Noise_* (a frame's noise depends "
+                        "on its position in the run, not only on the image)");
+    return nullptr;
+  }
+  // Spread over processes, each process keeps its own cache (its share of the frames) in a
+  // folder of the cache named after it.
+  const Cluster& cluster = Cluster::Get();
+  return DescriptorCache::Open(
+      cluster.Distributed() ? scale.descriptor_cache + "/process-" +
+                                  std::to_string(cluster.Rank()) + "-of-" +
+                                  std::to_string(cluster.Size())
+                            : scale.descriptor_cache,
+      DescriptionSettingsText(*d.config, d.name, d.describer->RowWidth(),
+                              d.describer->RowType()),
+      d.describer->RowWidth(), d.describer->RowType(), out.warnings);
+}
+
+// Describes every source with each descriptor of `all`. In one process, each frame is read and
+// converted once for all of them (DescribeSequences: decoding a KITTI frame costs more than
+// describing it with LDB or HOG); spread over processes, one descriptor after the other
+// (DescribeShared gathers the rows of one descriptor). The seconds of the shared pass are
+// divided among the descriptors.
+std::vector<Described> DescribeSources(const std::vector<ToDescribe>& all,
+                                       const std::vector<SourceSpec>& specs,
+                                       const std::vector<std::unique_ptr<FrameSource>>& sources,
+                                       ProgressReporter& progress) {
+  Cluster& cluster = Cluster::Get();
+  if (all.size() > 1 && cluster.Distributed()) {
+    std::vector<Described> out;
+    for (const ToDescribe& d : all) {
+      std::vector<Described> one = DescribeSources({d}, specs, sources, progress);
+      out.push_back(std::move(one.front()));
+    }
+    return out;
+  }
+  const Config& config = *all.front().config;
   const InputOptions& input = config.input;
-  Described out;
+  const int count = static_cast<int>(all.size());
+  std::vector<Described> out(static_cast<size_t>(count));
   DescribeOptions options;
   options.threads = config.matching.threads;
   options.skip_unreadable = input.skip_unreadable;
   options.show_images = config.output.show_images && HasDisplay();
   options.preprocess = config.preprocess;
 
-  // Descriptor cache: image folders only (a video frame or a stereo pair has no one file).
-  std::unique_ptr<DescriptorCache> cache;
-  const ScaleOptions& scale = config.scale;
-  if (!scale.descriptor_cache.empty()) {
-    if (specs.front().kind != SourceKind::kFolder) {
-      out.notes.push_back("Descriptor_cache: not used: the cache keeps rows of image "
-                          "files (Frame_mode 0, Camera_type 0 or 2), not of videos, bags "
-                          "or stereo pairs");
-    } else if (options.show_images) {
-      out.notes.push_back("Descriptor_cache: not used with Show_images 1");
-    } else if (options.preprocess.noise.Any()) {
-      // The noise of a frame depends on its position in the run, not only on its bytes.
-      out.notes.push_back("Descriptor_cache: not used with Noise_* (a frame's noise depends "
-                          "on its position in the run, not only on the image)");
-    } else {
-      // Spread over processes, each process keeps its own cache (its share of the frames) in
-      // a folder of the cache named after it.
-      const Cluster& cluster = Cluster::Get();
-      cache = DescriptorCache::Open(
-          cluster.Distributed() ? scale.descriptor_cache + "/process-" +
-                                      std::to_string(cluster.Rank()) + "-of-" +
-                                      std::to_string(cluster.Size())
-                                : scale.descriptor_cache,
-          DescriptionSettingsText(config, name, describer.RowWidth(), describer.RowType()),
-          describer.RowWidth(), describer.RowType(), out.warnings);
-      options.cache = cache.get();
-    }
+  // Descriptor caches: image folders only (a video frame or a stereo pair has no one file).
+  std::vector<std::unique_ptr<DescriptorCache>> caches;
+  std::vector<const FrameDescriber*> describers;
+  std::vector<RowCache*> row_caches;
+  std::string names;
+  for (int k = 0; k < count; ++k) {
+    const ToDescribe& d = all[static_cast<size_t>(k)];
+    caches.push_back(OpenDescriptorCache(d, specs.front(), options, out[static_cast<size_t>(k)]));
+    describers.push_back(d.describer);
+    row_caches.push_back(caches.back().get());
+    names += (k ? ", " : "") + d.name;
   }
+  options.cache = row_caches.front();  // the one descriptor of DescribeShared
 
   const auto t = Clock::now();
-  std::vector<cv::Mat> blocks;
+  std::vector<std::vector<cv::Mat>> blocks(static_cast<size_t>(count));
   int row = 0;
   for (size_t s = 0; s < sources.size(); ++s) {
     const bool stereo =
@@ -91,15 +133,22 @@ Described DescribeSources(const Config& config, const FrameDescriber& describer,
     options.key = stereo ? "" : specs[s].key;  // stereo read errors name their own key
     options.noise_stream = static_cast<int>(s);  // each traversal its own noise
     // Spread over processes: process 0's progress counts its share.
-    const auto [share_first, share_last] = Cluster::Get().Share(sources[s]->Size());
+    const auto [share_first, share_last] = cluster.Share(sources[s]->Size());
     progress.Begin("describing", share_last - share_first,
                    stereo ? "stereo pairs (rectify" +
-                                std::string(describer.Channels() == 2 ? ", SGBM" : "") + ", " +
-                                name + ")"
-                          : "frames of " + specs[s].key + " (" + name + ")");
-    DescribedSequence seq = DescribeShared(Cluster::Get(), *sources[s], describer, options,
-                                           [&](int done, int) { progress.Update(done); });
+                                std::string(describers.front()->Channels() == 2 ? ", SGBM" : "") +
+                                ", " + names + ")"
+                          : "frames of " + specs[s].key + " (" + names + ")");
+    const auto on_frames = [&](int done, int) { progress.Update(done); };
+    std::vector<DescribedSequence> seqs;
+    if (count == 1) {
+      seqs.push_back(
+          DescribeShared(cluster, *sources[s], *describers.front(), options, on_frames));
+    } else {
+      seqs = DescribeSequences(*sources[s], describers, row_caches, options, on_frames);
+    }
     progress.End();
+    const DescribedSequence& seq = seqs.front();
     Traversal tr;
     tr.key = specs[s].key;
     tr.path = specs[s].path;
@@ -114,20 +163,36 @@ Described DescribeSources(const Config& config, const FrameDescriber& describer,
     if (std::any_of(tr.times.begin(), tr.times.end(), [](double t) { return std::isnan(t); }))
       tr.times.clear();  // a source without times
     row += tr.frames;
-    out.frames += sources[s]->Size();
-    out.traversals.push_back(std::move(tr));
-    blocks.push_back(seq.rows);
+    for (int k = 0; k < count; ++k) {
+      Described& o = out[static_cast<size_t>(k)];
+      o.frames += sources[s]->Size();
+      o.traversals.push_back(tr);
+      blocks[static_cast<size_t>(k)].push_back(seqs[static_cast<size_t>(k)].rows);
+    }
   }
-  out.seconds = SecondsSince(t);
-  if (cache) {
-    out.cache = std::to_string(cache->Hits()) + " of " +
-                std::to_string(out.frames) + " frames from the cache, " +
-                std::to_string(cache->Stored()) + " added (\"" + cache->Path() + "\")";
-    const std::string problem = cache->WriteProblem();
-    if (!problem.empty()) out.warnings.push_back(problem);
+  const double seconds = SecondsSince(t) / count;
+  for (int k = 0; k < count; ++k) {
+    Described& o = out[static_cast<size_t>(k)];
+    o.seconds = seconds;
+    if (const DescriptorCache* cache = caches[static_cast<size_t>(k)].get()) {
+      o.cache = std::to_string(cache->Hits()) + " of " + std::to_string(o.frames) +
+                " frames from the cache, " + std::to_string(cache->Stored()) + " added (\"" +
+                cache->Path() + "\")";
+      const std::string problem = cache->WriteProblem();
+      if (!problem.empty()) o.warnings.push_back(problem);
+    }
+    cv::vconcat(blocks[static_cast<size_t>(k)], o.rows);
   }
-  cv::vconcat(blocks, out.rows);
   return out;
+}
+
+// Describes every source with `describer` (DescribeSources of one descriptor).
+Described DescribeSources(const Config& config, const FrameDescriber& describer,
+                          const std::string& name, const std::vector<SourceSpec>& specs,
+                          const std::vector<std::unique_ptr<FrameSource>>& sources,
+                          ProgressReporter& progress) {
+  return std::move(
+      DescribeSources({ToDescribe{&config, &describer, name}}, specs, sources, progress).front());
 }
 
 // The best matches a run answered and accepted (Match_threshold, Match_consistency), from its
@@ -271,17 +336,30 @@ std::vector<const SingleFrame*> DenseSingleFrames(const RunPlan& plan, ProgressR
   const std::vector<std::string>& names = plan.names;
   std::vector<const SingleFrame*> singles;
   computed.reserve(names.size());
+  // The descriptors whose matrices are not kept already are described together, each frame
+  // read once for all of them (fused descriptors).
+  std::vector<std::string> keys(names.size());
+  std::vector<Config> ones(names.size(), config);
+  std::vector<ToDescribe> to_describe;
+  std::vector<size_t> described_index(names.size(), names.size());
   for (size_t k = 0; k < names.size(); ++k) {
-    const std::string key = store ? SingleFrameKey(config, names[k]) : std::string();
+    if (store) keys[k] = SingleFrameKey(config, names[k]);
+    if (store && store->Find(keys[k])) continue;
+    ones[k].descriptor.name = names[k];
+    described_index[k] = to_describe.size();
+    to_describe.push_back({&ones[k], plan.describers[k].get(), names[k]});
+  }
+  std::vector<Described> all_described =
+      to_describe.empty() ? std::vector<Described>()
+                          : DescribeSources(to_describe, plan.specs, plan.sources, progress);
+  for (size_t k = 0; k < names.size(); ++k) {
+    const std::string& key = keys[k];
     if (store)
       if (const SingleFrame* kept = store->Find(key)) {
         singles.push_back(kept);
         continue;
       }
-    Config one = config;
-    one.descriptor.name = names[k];
-    Described described =
-        DescribeSources(one, *plan.describers[k], names[k], plan.specs, plan.sources, progress);
+    Described described = std::move(all_described[described_index[k]]);
     SingleFrame frame;
     frame.descriptor = plan.head.descriptors[k];
     frame.traversals = described.traversals;

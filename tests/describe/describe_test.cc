@@ -1,5 +1,9 @@
 #include "OpenABLE/describe/describe.h"
 
+#include <algorithm>
+#include <array>
+#include <atomic>
+
 #include <gtest/gtest.h>
 
 #include "OpenABLE/base/error.h"
@@ -127,6 +131,83 @@ TEST(DescribeSequence, SkipModeDropsUnreadableFrames) {
 
   MemorySource all_bad(frames, {0, 1, 2, 3, 4, 5}, true);
   EXPECT_THROW(DescribeSequence(all_bad, d, opt), InputError);
+}
+
+// Counts the reads of each frame (from several threads).
+class CountingSource : public MemorySource {
+ public:
+  using MemorySource::MemorySource;
+  cv::Mat Read(int i) const override {
+    ++reads_[static_cast<size_t>(i)];
+    return MemorySource::Read(i);
+  }
+  int Reads(int i) const { return reads_[static_cast<size_t>(i)].load(); }
+
+ private:
+  mutable std::array<std::atomic<int>, 64> reads_{};
+};
+
+// A cache in memory holding the rows of the frames listed.
+class MemoryCache : public RowCache {
+ public:
+  MemoryCache(const cv::Mat& rows, std::vector<int> held) : rows_(rows), held_(std::move(held)) {}
+  bool Lookup(const FrameSource&, int i, cv::Mat row, cv::Size* size) override {
+    if (std::find(held_.begin(), held_.end(), i) == held_.end()) return false;
+    rows_.row(i).copyTo(row);
+    *size = cv::Size(40, 24);
+    return true;
+  }
+  void Store(const FrameSource&, int, const cv::Mat&, cv::Size) override { ++stored; }
+  std::atomic<int> stored{0};
+
+ private:
+  cv::Mat rows_;
+  std::vector<int> held_;
+};
+
+// Several descriptors of one source: each frame read once for all of them, each descriptor's
+// rows those it gets alone; with a cache holding some rows of one descriptor, the frames are
+// still read for the other, and rows come from the cache where it has them.
+TEST(DescribeSequences, ReadEachFrameOnceAndGiveEachDescriptorsOwnRows) {
+  std::vector<cv::Mat> frames;
+  for (int i = 0; i < 30; ++i) frames.push_back(Constant(24, 40, (5 * i + 0.25f) / 255.f));
+  MeanDescriptor small(16), large(32);
+  const FrameDescriber global(large, DescriptionType::kGlobal);
+  const FrameDescriber grid(small, DescriptionType::kGrid, 2, 1);
+  for (const bool parallel : {true, false}) {
+    CountingSource src(frames, {}, parallel);
+    DescribeOptions opt;
+    opt.threads = 3;
+    const std::vector<DescribedSequence> both =
+        DescribeSequences(src, {&global, &grid}, {nullptr, nullptr}, opt);
+    for (int i = 0; i < 30; ++i) EXPECT_EQ(src.Reads(i), 1) << i;
+    ASSERT_EQ(both.size(), 2u);
+    MemorySource plain(frames, {}, parallel);
+    EXPECT_EQ(cv::norm(both[0].rows, DescribeSequence(plain, global, opt).rows, cv::NORM_INF), 0);
+    EXPECT_EQ(cv::norm(both[1].rows, DescribeSequence(plain, grid, opt).rows, cv::NORM_INF), 0);
+    EXPECT_EQ(both[1].rows.cols, 2);
+    EXPECT_EQ(both[0].kept, both[1].kept);
+  }
+  // The cache of the first descriptor holds frames 0-9 with other values (-1): they are kept.
+  CountingSource src(frames, {}, true);
+  MemoryCache cache(cv::Mat(30, 1, CV_32F, cv::Scalar(-1)), {0, 1, 2, 3, 4, 5, 6, 7, 8, 9});
+  DescribeOptions opt;
+  const std::vector<DescribedSequence> both =
+      DescribeSequences(src, {&global, &grid}, {&cache, nullptr}, opt);
+  for (int i = 0; i < 30; ++i) EXPECT_EQ(src.Reads(i), 1) << i;  // the grid needs every frame
+  EXPECT_EQ(both[0].rows.at<float>(3, 0), -1.0f);
+  EXPECT_NEAR(both[0].rows.at<float>(12, 0), 60.0f, 1e-4);
+  EXPECT_EQ(cache.stored.load(), 20);  // the rows it lacked
+  // Both descriptors cached for every frame: nothing is read.
+  std::vector<int> every(30);
+  for (int i = 0; i < 30; ++i) every[static_cast<size_t>(i)] = i;
+  MemoryCache first(cv::Mat(30, 1, CV_32F, cv::Scalar(7)), every);
+  MemoryCache second(cv::Mat(30, 2, CV_32F, cv::Scalar(8)), every);
+  CountingSource unread(frames, {}, true);
+  const std::vector<DescribedSequence> cached =
+      DescribeSequences(unread, {&global, &grid}, {&first, &second}, opt);
+  for (int i = 0; i < 30; ++i) EXPECT_EQ(unread.Reads(i), 0) << i;
+  EXPECT_EQ(cached[1].rows.at<float>(29, 1), 8.0f);
 }
 
 TEST(DescribeSequence, FramesOfDifferentSizesAreAnError) {
