@@ -114,14 +114,17 @@ namespace {
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
-void SequenceBulk(const float* __restrict row, const float* __restrict old,
-                  const double* __restrict prev, double* __restrict cur, float* __restrict out,
-                  int n) {
+float SequenceBulk(const float* __restrict row, const float* __restrict old,
+                   const double* __restrict prev, double* __restrict cur, float* __restrict out,
+                   int n) {
+  float largest = 0.0f;  // the sums are finite and >= 0: the plain comparison vectorises
   for (int j = 0; j < n; ++j) {
     const double w = static_cast<double>(row[j]) + prev[j] - static_cast<double>(old[j]);
     cur[j] = w;
     out[j] = static_cast<float>(w);
+    largest = out[j] > largest ? out[j] : largest;
   }
+  return largest;
 }
 
 // The same in float, for distances that are small integers (Hamming, L1) whose sums stay below
@@ -131,14 +134,17 @@ void SequenceBulk(const float* __restrict row, const float* __restrict old,
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
-void SequenceBulk(const float* __restrict row, const float* __restrict old,
-                  const float* __restrict prev, float* __restrict cur, float* __restrict out,
-                  int n) {
+float SequenceBulk(const float* __restrict row, const float* __restrict old,
+                   const float* __restrict prev, float* __restrict cur, float* __restrict out,
+                   int n) {
+  float largest = 0.0f;
   for (int j = 0; j < n; ++j) {
     const float w = row[j] + prev[j] - old[j];
     cur[j] = w;
     out[j] = w;
+    largest = w > largest ? w : largest;
   }
+  return largest;
 }
 
 // Whether the running sums of L distances of `metric` between rows of `width` bytes are
@@ -155,10 +161,11 @@ bool SumsAreExactInFloat(Metric metric, int width, int L) {
 // D(i, j) + w(i - 1, j -+ 1) - D(i - L, j -+ L), in double (or in float where that is exact:
 // Acc), finished by ScaleSequenceSum. `steps` is how far row i can go back (i minus the first
 // row of the rows summed), `prev` the sums of row i - 1, `old` row i - L of D (read only when
-// steps >= L).
+// steps >= L). Returns the largest finite value written to `out` (0 when none).
 template <typename Acc>
-void SequenceRow(const float* row, const float* old, const Acc* prev, Acc* cur, float* out, int m,
-                 int steps, int L, bool reverse, SequencePartial partial) {
+float SequenceRow(const float* row, const float* old, const Acc* prev, Acc* cur, float* out,
+                  int m, int steps, int L, bool reverse, SequencePartial partial) {
+  float largest = 0.0f;
   // Columns whose sums reach back a full L - 1 steps along the columns too: [L, m) going
   // forward, [0, m - L) in reverse; the other L columns go through the general case.
   const int bulk0 = reverse ? 0 : std::min(L, m), bulk1 = reverse ? std::max(0, m - L) : m;
@@ -171,15 +178,18 @@ void SequenceRow(const float* row, const float* old, const Acc* prev, Acc* cur, 
     }
     cur[j] = static_cast<Acc>(w);
     out[j] = ScaleSequenceSum(w, SequenceTerms(L, t), L, partial);
+    if (std::isfinite(out[j])) largest = std::max(largest, out[j]);
   };
   if (steps < L) {
     for (int j = 0; j < m; ++j) general(j);
-    return;
+    return largest;
   }
   for (int j = 0; j < bulk0; ++j) general(j);
-  SequenceBulk(row + bulk0, old + bulk0 + (reverse ? L : -L), prev + bulk0 + (reverse ? 1 : -1),
-               cur + bulk0, out + bulk0, bulk1 - bulk0);
+  largest = std::max(largest, SequenceBulk(row + bulk0, old + bulk0 + (reverse ? L : -L),
+                                           prev + bulk0 + (reverse ? 1 : -1), cur + bulk0,
+                                           out + bulk0, bulk1 - bulk0));
   for (int j = bulk1; j < m; ++j) general(j);
+  return largest;
 }
 
 // The largest finite value of s[0, n), or `seen` when larger; `seen` >= 0. Compared as the
@@ -208,12 +218,14 @@ float LargestFinite(const float* s, int n, float seen) {
 // when the block is computed from its first row.
 //
 // Each finished row i of query sums (m cells, unnormalised) goes to sink(range, i, sums) on the
-// thread of its range; `ranges` receives the number of ranges before the first row.
+// thread of its range. Returns the largest finite sum of the rows computed: taken from the
+// running sums as they are written where a row's cells are its sums (one direction), from
+// the finished rows otherwise (L = 1, both directions: the smaller of two sums).
 using RowSink = std::function<void(int range, int row, const float* sums)>;
 
-void SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
-                  const BoundedOptions& options, const std::function<void(int)>& ranges_known,
-                  const RowSink& sink, const std::function<void(int, int)>& progress) {
+float SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
+                   const BoundedOptions& options, const std::function<void(int)>& ranges_known,
+                   const RowSink& sink, const std::function<void(int, int)>& progress) {
   const int L = options.sequence_length;
   if (L < 1) throw std::logic_error("BoundedMatches: sequence length < 1");
   const int m = block.reference_count;
@@ -235,6 +247,7 @@ void SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
                              : std::clamp(queries / (8 * threads), 64, 1024);
   const int ranges = queries <= 0 ? 0 : (queries + range_rows - 1) / range_rows;
   ranges_known(ranges);
+  std::vector<float> range_max(static_cast<std::size_t>(ranges), 0.0f);
   const bool forward = options.direction != SequenceDirection::kReverse;
   const bool backward = options.direction != SequenceDirection::kForward;
   // Rows of D computed at once, into the ring: the Hamming kernel takes 16 queries over each
@@ -277,7 +290,17 @@ void SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
     std::vector<float> sums_f(ahead && forward ? L * width : 0);
     std::vector<float> sums_r(ahead && backward ? L * width : 0);
     cv::Mat1f computed;
-    const auto keep = [&](int i, const float* s) { sink(c, i, s); };
+    // The rows' largest value: from the running sums of the rows of this range (the rows
+    // before r0 are its history, whose sums are partial), or from the finished rows.
+    float largest = 0.0f;
+    const bool largest_from_sums = L > 1 && !(forward && backward);
+    const auto keep = [&](int i, const float* s) {
+      if (!largest_from_sums) largest = LargestFinite(s, m, largest);
+      sink(c, i, s);
+    };
+    const auto summed = [&](int i, float row_largest) {
+      if (largest_from_sums && i >= r0) largest = std::max(largest, row_largest);
+    };
     // Row e of one direction, finished in place: its early cells (fewer than L terms) take the
     // cells ahead along their diagonals, in the rows kept in `sums`. Those are cells of L terms,
     // which no row changes, and row e is not read again once finished (later rows read only
@@ -327,12 +350,12 @@ void SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
                                          : sum_f.data();
           if (forward) {
             if (exact) {
-              SequenceRow(d, old, prev_ef.data(), cur_ef.data(), sums, m, steps, L, false,
-                          options.partial);
+              summed(i, SequenceRow(d, old, prev_ef.data(), cur_ef.data(), sums, m, steps, L,
+                                    false, options.partial));
               std::swap(prev_ef, cur_ef);
             } else {
-              SequenceRow(d, old, prev_f.data(), cur_f.data(), sums, m, steps, L, false,
-                          options.partial);
+              summed(i, SequenceRow(d, old, prev_f.data(), cur_f.data(), sums, m, steps, L,
+                                    false, options.partial));
               std::swap(prev_f, cur_f);
             }
           }
@@ -340,12 +363,12 @@ void SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
             float* into = ahead ? &sums_r[static_cast<std::size_t>(i % L) * width]
                                 : (forward ? sum_r.data() : sum_f.data());
             if (exact) {
-              SequenceRow(d, old, prev_er.data(), cur_er.data(), into, m, steps, L, true,
-                          options.partial);
+              summed(i, SequenceRow(d, old, prev_er.data(), cur_er.data(), into, m, steps, L,
+                                    true, options.partial));
               std::swap(prev_er, cur_er);
             } else {
-              SequenceRow(d, old, prev_r.data(), cur_r.data(), into, m, steps, L, true,
-                          options.partial);
+              summed(i, SequenceRow(d, old, prev_r.data(), cur_r.data(), into, m, steps, L,
+                                    true, options.partial));
               std::swap(prev_r, cur_r);
             }
             if (forward && !ahead)  // both directions: the smaller of the two sums
@@ -361,6 +384,7 @@ void SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
       }
     }
     for (int e = std::max(r0, rows_end - look); ahead && e < r1; ++e) keep_ahead(e);
+    range_max[static_cast<std::size_t>(c)] = largest;
     rows_done += r1 - r0;
     // Progress from whichever thread gets the lock (the reporter is not thread-safe); the count
     // read under the lock only grows.
@@ -370,6 +394,9 @@ void SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
     }
   });
   if (progress) progress(queries, queries);
+  float largest = 0.0f;
+  for (const float v : range_max) largest = std::max(largest, v);
+  return largest;
 }
 
 }  // namespace
@@ -378,19 +405,13 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
                                   const KeepRules& rules, const BoundedOptions& options,
                                   float& max_distance,
                                   const std::function<void(int, int)>& progress) {
-  // Per range: its kept matches and largest value, merged in the order of the ranges.
+  // Per range: its kept matches, merged in the order of the ranges.
   std::vector<std::vector<Match>> kept;
-  std::vector<float> range_max;
   const int m = block.reference_count;
-  SequenceRows(
+  const float max_seen = SequenceRows(
       descriptors, block, options,
-      [&](int ranges) {
-        kept.resize(static_cast<std::size_t>(ranges));
-        range_max.assign(static_cast<std::size_t>(ranges), 0.0f);
-      },
+      [&](int ranges) { kept.resize(static_cast<std::size_t>(ranges)); },
       [&](int c, int i, const float* s) {
-        float& largest = range_max[static_cast<std::size_t>(c)];
-        largest = LargestFinite(s, m, largest);
         KeepRow(s, m, i, rules, kept[static_cast<std::size_t>(c)]);
       },
       progress);
@@ -399,8 +420,6 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
   for (const auto& k : kept) total += k.size();
   all.reserve(total);
   for (auto& k : kept) all.insert(all.end(), k.begin(), k.end());
-  float max_seen = 0.0f;
-  for (const float v : range_max) max_seen = std::max(max_seen, v);
   max_distance = max_seen;
   if (options.normalize) NormalizeMatches(all, max_seen, rules.score);
   return all;
@@ -409,23 +428,16 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
 float SequenceMatrix(const cv::Mat& descriptors, const MatchBlock& block,
                      const BoundedOptions& options, cv::Mat1f& out,
                      const std::function<void(int, int)>& progress) {
-  std::vector<float> range_max;
   const int m = block.reference_count;
   BoundedOptions every_query = options;
   every_query.query_begin = 0;
   every_query.query_end = -1;
-  SequenceRows(
-      descriptors, block, every_query,
-      [&](int ranges) { range_max.assign(static_cast<std::size_t>(ranges), 0.0f); },
-      [&](int c, int i, const float* s) {
-        float& largest = range_max[static_cast<std::size_t>(c)];
-        largest = LargestFinite(s, m, largest);
+  return SequenceRows(
+      descriptors, block, every_query, [](int) {},
+      [&](int, int i, const float* s) {
         std::copy_n(s, m, out.ptr<float>(block.query_first + i) + block.reference_first);
       },
       progress);
-  float largest = 0.0f;
-  for (const float v : range_max) largest = std::max(largest, v);
-  return largest;
 }
 
 std::vector<std::uint8_t> AcceptedMatches(const std::vector<Match>& matches, int queries,
