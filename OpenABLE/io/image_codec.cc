@@ -173,9 +173,9 @@ struct CompressorDeleter {
 
 // libdeflate's level for the PNG files. On the 3,576 x 3,576 colour image of a Nordland matrix
 // (Matrix_color 4; docs/benchmarks.md, "Exports"), on one thread, level 1 wrote 10.81 MB in
-// 0.38 times the time of zlib's level 1 with the run-length strategy (21.35 MB, how the files
-// were written before); levels 2, 3 and 4 took 1.7 to 2.8 times as long as level 1 for files
-// 4-6% smaller.
+// about 0.35-0.38 times the time of zlib's level 1 with the run-length strategy (21.35 MB, how
+// the files were written before); levels 2, 3 and 4 took 1.7 to 2.9 times as long as level 1
+// for files 4-6% smaller.
 constexpr int kDeflateLevel = 1;
 
 // ---------------------------------------------------------------------------------------------
