@@ -29,14 +29,15 @@ usage() { awk 'NR == 1 { next } /^#/ { sub(/^# ?/, ""); print; next } { exit }' 
 
 # What the configuration requires (CMakeLists.txt's find_package ... REQUIRED): OpenCV (its
 # libopencv-dev depends on libopencv-contrib-dev, which holds ximgproc), Eigen, OpenImageIO,
-# libpng, zlib, libjpeg, nlohmann-json (header-only; every JSON document, OpenABLE/io/json.h),
-# OpenBLAS (the float distance matrices, matching/blas.h).
+# libpng, zlib, libdeflate (PNG writing, OpenABLE/io/image_codec.cc), libjpeg, nlohmann-json
+# (header-only; every JSON document, OpenABLE/io/json.h), OpenBLAS (the float distance
+# matrices, matching/blas.h).
 # openimageio-tools too: Debian's OpenImageIO CMake package names its programs (iconvert, ...)
 # as targets and stops the configuration when they are absent.
 # ninja-build: Make builds a target's sources only once the targets it links are built, which
 # with one unity group per library left one of two cores idle most of the time.
 core=(cmake g++ make ninja-build libopencv-dev libeigen3-dev libopenblas-dev libopenimageio-dev
-      openimageio-tools libpng-dev zlib1g-dev libjpeg-dev nlohmann-json3-dev)
+      openimageio-tools libpng-dev zlib1g-dev libdeflate-dev libjpeg-dev nlohmann-json3-dev)
 all_parts=(tests python mpi faiss rosbag chromium fuzz)
 part_packages() {
   case "$1" in

@@ -3,7 +3,7 @@
 #   include/openable/{OpenABLE,descriptors,matching,config}/...h   every header, paths kept
 #   lib/libOpenABLE.a, lib/libopenable_*.a                          the static libraries
 #   lib/openable/libopenable_{oiio,video,gui,codecs,...}.so          the run-time modules
-#   lib/cmake/OpenABLE/OpenABLE{Config,ConfigVersion,Targets*}.cmake
+#   lib/cmake/OpenABLE/OpenABLE{Config,ConfigVersion,Targets*}.cmake, FindLibdeflate.cmake
 #   bin/Test_OpenABLE, bin/openable_evaluate, bin/openable_snaps
 #
 # (lib/ stands for CMAKE_INSTALL_LIBDIR.) Tests, benchmarks and fuzzers are not installed.
@@ -72,4 +72,5 @@ write_basic_package_version_file(
   COMPATIBILITY SameMajorVersion)
 install(FILES "${PROJECT_BINARY_DIR}/OpenABLEConfig.cmake"
               "${PROJECT_BINARY_DIR}/OpenABLEConfigVersion.cmake"
+              "${CMAKE_CURRENT_LIST_DIR}/FindLibdeflate.cmake"
         DESTINATION "${OPENABLE_INSTALL_CMAKEDIR}")

@@ -1,7 +1,7 @@
 // Image files as bytes, without OpenCV's imgcodecs for the common cases: recognising PNG, JPEG,
 // PGM/PPM and BMP from their first bytes; checking a PNG's chunks and a JPEG's end before
 // decoding; decoding PNG with libpng and JPEG with libjpeg in the program; writing PNG with
-// zlib. imgcodecs brings GDAL, GDCM, OpenEXR and about 120 other shared libraries that every
+// libdeflate. imgcodecs brings GDAL, GDCM, OpenEXR and about 120 other shared libraries that every
 // run would load at start-up (about 80 ms on the development machines), while the frames of
 // almost every data set are PNG or JPEG; other formats load imgcodecs on first use
 // (module_loader.h). Frame sources (frame_source.h) read files and hand their bytes here.
@@ -33,10 +33,10 @@ cv::Mat DecodeCommonFormat(const std::vector<unsigned char>& bytes, bool& grey_a
 bool DecodePng(const std::vector<unsigned char>& bytes, cv::Mat& image, std::string& why);
 
 // The bytes of a PNG file of `image` (CV_8U or CV_16U; 1 channel grey, 3 BGR, 4 BGRA). Rows go
-// through the Sub filter and deflate at level 1 with the run-length strategy (OpenCV's default
-// settings); bands of rows are compressed in parallel as independent deflate blocks, joined
-// into one zlib stream, so the file decodes anywhere as an ordinary PNG. `threads` as in
-// EffectiveThreads (0 = all cores). Throws std::logic_error on another type.
+// through the Sub filter, in bands of rows in parallel, and the whole is compressed by
+// libdeflate at level 1 into one zlib stream on one thread (IDAT chunks of 1 MiB). `threads`
+// (for the filter) as in EffectiveThreads (0 = all cores). Throws std::logic_error on another
+// type.
 std::string EncodePngFile(const cv::Mat& image, int threads = 0);
 
 // The bytes of a baseline JPEG file of an 8-bit grey (CV_8UC1) or BGR (CV_8UC3) image at

@@ -14,6 +14,11 @@
 namespace openable {
 namespace {
 
+// The texts of the cells, each followed by a space, in slots of kSlot bytes: a cell is written
+// by copying a whole slot (a fixed-size copy, no loop over its characters) and moving on by its
+// length, so the buffer written into keeps kSlot bytes of room past a row's last cell.
+constexpr std::size_t kSlot = 16;
+
 // The text of a float as printf's "%.6g" writes it (std::to_chars with a precision: no locale,
 // no format string), remembered by its bits: a matrix of Hamming sums divided by their largest
 // holds a few thousand distinct values (at most L x bits + 1), so most cells are a lookup.
@@ -21,47 +26,73 @@ namespace {
 // either way.
 class FloatTexts {
  public:
+  struct Entry {
+    std::uint32_t bits = 0;
+    std::uint32_t length = 0;  // with the space; 0: empty
+    char text[kSlot];          // "-1.23457e-05 " and the like: at most 13 characters
+  };
   FloatTexts() : entries_(kSize) {}
-  std::string_view Of(float v) {
+  const Entry& Of(float v) {
     std::uint32_t bits;
     std::memcpy(&bits, &v, sizeof bits);
     Entry& e = entries_[(bits * 2654435761u) >> (32 - kBits)];
     if (e.length == 0 || e.bits != bits) {
       const std::to_chars_result r =
-          std::to_chars(e.text, e.text + sizeof e.text, v, std::chars_format::general, 6);
+          std::to_chars(e.text, e.text + sizeof e.text - 1, v, std::chars_format::general, 6);
+      *r.ptr = ' ';
       e.bits = bits;
-      e.length = static_cast<std::uint8_t>(r.ptr - e.text);
+      e.length = static_cast<std::uint32_t>(r.ptr + 1 - e.text);
     }
-    return {e.text, e.length};
+    return e;
   }
 
  private:
   static constexpr int kBits = 14;
   static constexpr std::size_t kSize = std::size_t{1} << kBits;
-  struct Entry {
-    std::uint32_t bits = 0;
-    std::uint8_t length = 0;  // 0: empty
-    char text[19];            // "-1.23457e-05" and the like: at most 13 characters
-  };
   std::vector<Entry> entries_;
 };
 
-// Rows [r0, r1) of `m` as text into `out` (appended).
-void FormatRows(const cv::Mat& m, int r0, int r1, FloatTexts& texts, std::string& out) {
-  char buf[8];
+// The texts of 0-255 with their space, for thresholded (CV_8U) matrices.
+struct ByteTexts {
+  ByteTexts() {
+    for (int v = 0; v < 256; ++v) {
+      char* end = std::to_chars(text[v], text[v] + kSlot - 1, v).ptr;
+      *end = ' ';
+      length[v] = static_cast<std::uint8_t>(end + 1 - text[v]);
+    }
+  }
+  char text[256][kSlot];
+  std::uint8_t length[256];
+};
+
+// Rows [r0, r1) of `m` as text into `out` from its start (grown when needed, never shrunk: it
+// is reused for the next rows); returns the length of the text.
+std::size_t FormatRows(const cv::Mat& m, int r0, int r1, FloatTexts& texts, std::string& out) {
+  static const ByteTexts bytes;
+  std::size_t used = 0;
+  const std::size_t row_room = static_cast<std::size_t>(m.cols) * kSlot + 1;
   for (int i = r0; i < r1; ++i) {
-    for (int j = 0; j < m.cols; ++j) {
-      if (j) out.push_back(' ');
-      if (m.depth() == CV_8U) {
-        const std::to_chars_result res =
-            std::to_chars(buf, buf + sizeof buf, int{m.at<std::uint8_t>(i, j)});
-        out.append(buf, res.ptr);
-      } else {
-        out.append(texts.Of(m.at<float>(i, j)));
+    if (out.size() < used + row_room) out.resize(std::max(used + row_room, 2 * out.size()));
+    char* p = &out[used];
+    if (m.depth() == CV_8U) {
+      const std::uint8_t* row = m.ptr<std::uint8_t>(i);
+      for (int j = 0; j < m.cols; ++j) {
+        std::memcpy(p, bytes.text[row[j]], kSlot);
+        p += bytes.length[row[j]];
+      }
+    } else {
+      const float* row = m.ptr<float>(i);
+      for (int j = 0; j < m.cols; ++j) {
+        const FloatTexts::Entry& e = texts.Of(row[j]);
+        std::memcpy(p, e.text, kSlot);
+        p += e.length;
       }
     }
-    out.push_back('\n');
+    if (m.cols > 0) --p;  // the last cell's space
+    *p++ = '\n';
+    used = static_cast<std::size_t>(p - out.data());
   }
+  return used;
 }
 
 }  // namespace
@@ -72,25 +103,25 @@ TextChunks::TextChunks(const cv::Mat& m) : m_(m) {
 }
 
 bool TextChunks::Next(std::string_view& piece) {
-  if (next_row_ >= m_.rows) return false;
-  // A chunk is kBlocks blocks of kBlockRows rows, formatted in parallel (one block per task)
-  // and written while the next is formatted: the whole text is never in memory.
-  constexpr int kBlockRows = 32, kBlocks = 16;
-  const int r0 = next_row_, r1 = std::min(m_.rows, r0 + kBlockRows * kBlocks);
-  const int blocks = (r1 - r0 + kBlockRows - 1) / kBlockRows;
-  parts_.resize(static_cast<std::size_t>(blocks));
-  cv::parallel_for_(cv::Range(0, blocks), [&](const cv::Range& range) {
-    thread_local FloatTexts texts;
-    for (int b = range.start; b < range.end; ++b) {
-      std::string& out = parts_[static_cast<std::size_t>(b)];
-      out.clear();
-      FormatRows(m_, r0 + b * kBlockRows, std::min(r1, r0 + (b + 1) * kBlockRows), texts, out);
-    }
-  });
-  chunk_.clear();
-  for (const std::string& part : parts_) chunk_ += part;
-  next_row_ = r1;
-  piece = chunk_;
+  if (next_block_ == blocks_) {
+    if (next_row_ >= m_.rows) return false;
+    // kBlocks blocks of kBlockRows rows at a time, formatted in parallel (one block per task),
+    // then handed out one block per call: the whole text is never in memory.
+    const int r0 = next_row_, r1 = std::min(m_.rows, r0 + kBlockRows * kBlocks);
+    blocks_ = (r1 - r0 + kBlockRows - 1) / kBlockRows;
+    next_block_ = 0;
+    cv::parallel_for_(cv::Range(0, blocks_), [&](const cv::Range& range) {
+      thread_local FloatTexts texts;
+      for (int b = range.start; b < range.end; ++b) {
+        const std::size_t k = static_cast<std::size_t>(b);
+        lengths_[k] = FormatRows(m_, r0 + b * kBlockRows, std::min(r1, r0 + (b + 1) * kBlockRows),
+                                 texts, parts_[k]);
+      }
+    });
+    next_row_ = r1;
+  }
+  const std::size_t k = static_cast<std::size_t>(next_block_++);
+  piece = std::string_view(parts_[k].data(), lengths_[k]);
   return true;
 }
 

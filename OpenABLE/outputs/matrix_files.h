@@ -15,9 +15,9 @@ namespace openable {
 // with 6 significant digits; CV_8U matrices (thresholded) as integers.
 std::string EncodeText(const cv::Mat& m);
 
-// The same text in pieces of a few hundred rows, each formatted in parallel when asked for,
-// for writing a large matrix without holding its whole text (OutputBatch::Stage with a
-// producer). `m` must outlive the object.
+// The same text in pieces of 32 rows, formatted 16 pieces at a time in parallel, for writing a
+// large matrix without holding its whole text (OutputBatch::Stage with a producer). `m` must
+// outlive the object.
 class TextChunks {
  public:
   explicit TextChunks(const cv::Mat& m);
@@ -25,10 +25,12 @@ class TextChunks {
   bool Next(std::string_view& piece);
 
  private:
+  static constexpr int kBlockRows = 32, kBlocks = 16;
   cv::Mat m_;
   int next_row_ = 0;
-  std::vector<std::string> parts_;
-  std::string chunk_;
+  int blocks_ = 0, next_block_ = 0;  // formatted pieces, and the next one handed out
+  std::vector<std::string> parts_ = std::vector<std::string>(kBlocks);  // buffers, reused
+  std::vector<std::size_t> lengths_ = std::vector<std::size_t>(kBlocks);
 };
 
 // Bytes of the matches file: .npy (structured array: query, reference int32; distance

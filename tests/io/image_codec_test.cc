@@ -1,12 +1,15 @@
 // image_codec.h: the formats recognised from their bytes, and PNG decoding (libpng) and writing
-// (zlib) against OpenCV's own codecs.
+// (libdeflate) against OpenCV's own codecs.
 #include "OpenABLE/io/image_codec.h"
 
 #include <png.h>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -145,11 +148,13 @@ TEST(DecodePng, DamagedDataIsRefusedWithAReason) {
   EXPECT_TRUE(got.empty());
 }
 
-// Written in bands compressed in parallel, read back by OpenCV (libpng) pixel for pixel, for
-// every type the exports write and for images of one band and of many.
+// Filtered in bands of rows in parallel, read back by OpenCV (libpng) pixel for pixel, for
+// every type the exports write and for images of one pixel, one row, one column, odd widths,
+// one band and many.
 TEST(EncodePngFile, OpenCvReadsBackTheSamePixels) {
-  for (int type : {CV_8UC1, CV_8UC3, CV_8UC4, CV_16UC1, CV_16UC3}) {
-    for (const cv::Size size : {cv::Size(1, 1), cv::Size(37, 5), cv::Size(130, 301)}) {
+  for (int type : {CV_8UC1, CV_8UC3, CV_8UC4, CV_16UC1, CV_16UC3, CV_16UC4}) {
+    for (const cv::Size size : {cv::Size(1, 1), cv::Size(37, 5), cv::Size(9, 1), cv::Size(1, 9),
+                                cv::Size(130, 301), cv::Size(3, 129)}) {
       SCOPED_TRACE(cv::typeToString(type) + " " + std::to_string(size.width) + "x" +
                    std::to_string(size.height));
       const cv::Mat image = Random(size.height, size.width, type, size.area());
@@ -162,6 +167,52 @@ TEST(EncodePngFile, OpenCvReadsBackTheSamePixels) {
   }
   EXPECT_THROW(EncodePngFile(cv::Mat(3, 3, CV_32F)), std::logic_error);
   EXPECT_THROW(EncodePngFile(cv::Mat()), std::logic_error);
+}
+
+std::uint32_t BigEndian(const std::string& s, std::size_t at) {
+  return (std::uint32_t{static_cast<unsigned char>(s[at])} << 24) |
+         (std::uint32_t{static_cast<unsigned char>(s[at + 1])} << 16) |
+         (std::uint32_t{static_cast<unsigned char>(s[at + 2])} << 8) |
+         std::uint32_t{static_cast<unsigned char>(s[at + 3])};
+}
+
+// A file whose compressed rows fill several IDAT chunks (noise does not compress) and a smooth
+// one like a matrix image: the chunks are IHDR, IDATs of at most 1 MiB, IEND, and both libpng
+// through OpenCV and the program's own decoder (libpng too) give the pixels back.
+TEST(EncodePngFile, SeveralIdatChunksDecodeToTheSamePixels) {
+  cv::Mat3b smooth(1000, 1001);
+  for (int y = 0; y < smooth.rows; ++y)
+    for (int x = 0; x < smooth.cols; ++x)
+      smooth(y, x) = cv::Vec3b(static_cast<std::uint8_t>(std::abs(x - y) / 4),
+                               static_cast<std::uint8_t>(x * 255 / 1000), 40);
+  for (const cv::Mat& image : {Random(700, 901, CV_8UC3, 7), cv::Mat(smooth)}) {
+    const std::string file = EncodePngFile(image);
+    std::vector<std::string> types;
+    std::size_t at = 8;
+    while (at + 12 <= file.size()) {
+      const std::uint32_t length = BigEndian(file, at);
+      types.push_back(file.substr(at + 4, 4));
+      if (types.back() == "IDAT") {
+        EXPECT_LE(length, 1u << 20);
+      }
+      at += 12 + length;
+    }
+    EXPECT_EQ(at, file.size());
+    ASSERT_GE(types.size(), 3u);
+    EXPECT_EQ(types.front(), "IHDR");
+    EXPECT_EQ(types.back(), "IEND");
+    const std::size_t idats = types.size() - 2;
+    EXPECT_EQ(std::count(types.begin(), types.end(), "IDAT"), static_cast<long>(idats));
+    if (image.data != smooth.data) {
+      EXPECT_GE(idats, 2u);  // the noise
+    }
+    const std::vector<unsigned char> bytes(file.begin(), file.end());
+    ExpectEqualImages(cv::imdecode(bytes, cv::IMREAD_UNCHANGED), image);
+    cv::Mat decoded;
+    std::string why;
+    ASSERT_TRUE(DecodePng(bytes, decoded, why)) << why;
+    ExpectEqualImages(decoded, image);
+  }
 }
 
 // The first bytes decide the decoder: sound PNG and JPEG in the program (grey + alpha said),

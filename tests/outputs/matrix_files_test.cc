@@ -4,7 +4,10 @@
 #include "OpenABLE/reports/figures.h"
 
 #include <atomic>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <thread>
 #include <vector>
 #include <cstring>
@@ -290,6 +293,82 @@ TEST(EncodeText, PiecesMatchPrintfWithRepeatedAndManyDistinctValues) {
     EXPECT_GT(pieces, 1);
     EXPECT_EQ(joined, PrintfText(*m));
   }
+}
+
+// Every kind of float against printf's "%.6g": zeros of both signs, 1, the infinities and NaNs,
+// subnormals, the extremes, values that round up at the sixth digit (to a new power of ten
+// too) and those either side of the switch between fixed and scientific notation; then
+// random bit patterns (every exponent) and every float near the values of a Hamming run.
+TEST(EncodeText, MatchesPrintfOnSpecialAndBoundaryValues) {
+  using limits = std::numeric_limits<float>;
+  const float inf = limits::infinity(), nan = limits::quiet_NaN();
+  const float tiny = limits::denorm_min(), normal = limits::min();
+  const float below_normal = std::nextafter(normal, 0.f), big = limits::max();
+  const float below_one = std::nextafter(1.f, 0.f), above_one = std::nextafter(1.f, 2.f);
+  std::vector<float> values = {0.f, -0.f, 1.f, -1.f, inf, -inf, nan, -nan, tiny, -tiny};
+  values.insert(values.end(), {below_normal, normal, big, -big, below_one, above_one});
+  values.insert(values.end(), {0.1234565f, 0.1234575f, 9.999995f, 9.999994f, 99999.95f});
+  values.insert(values.end(), {999999.4f, 999999.5f, 1e6f, 123456.5f, 1234567.f, 1e-5f});
+  values.insert(values.end(), {0.0001f, 0.00009999995f, 0.00009999994f, 0.5f, 0.25f});
+  values.insert(values.end(), {1.f / 3.f, 2.f / 3.f, 1e-7f, 1e-38f, 3e38f});
+  // Either side of every number of the form d.ddddd5 x 10^e that the sixth digit rounds.
+  cv::RNG rng(11);
+  for (int i = 0; i < 2000; ++i) {
+    const double half = (std::floor(rng.uniform(100000.0, 1000000.0)) + 0.5) *
+                        std::pow(10.0, rng.uniform(-12, 8) - 5);
+    const float near = static_cast<float>(half);
+    values.insert(values.end(), {near, std::nextafter(near, 0.f), std::nextafter(near, inf)});
+  }
+  for (int i = 0; i < 20000; ++i) {  // any bit pattern: every exponent, subnormals, NaNs
+    const std::uint32_t bits = static_cast<std::uint32_t>(rng.next());
+    float v;
+    std::memcpy(&v, &bits, sizeof v);
+    values.push_back(v);
+  }
+  for (int k = 0; k <= 7680; ++k) {  // k / 7680 (L = 30, 256 bits) and its neighbours
+    const float v = static_cast<float>(k) / 7680.0f;
+    values.insert(values.end(), {v, std::nextafter(v, 0.f), std::nextafter(v, 2.f)});
+  }
+  values.resize(values.size() / 97 * 97);
+  const cv::Mat1f m(static_cast<int>(values.size() / 97), 97, values.data());
+  EXPECT_EQ(EncodeText(m), PrintfText(m));
+  // One value a row and one row: the first and the last cell of a row are the same one.
+  for (const float v : {0.f, -0.f, inf, -nan, 1e-7f, 0.1234565f})
+    EXPECT_EQ(EncodeText(cv::Mat1f(1, 1, v)), PrintfText(cv::Mat1f(1, 1, v)));
+}
+
+// Thresholded matrices (CV_8U): every byte value, as printf's "%d", in one long row (longer than
+// a piece's first buffer) and in many short ones.
+TEST(EncodeText, BytesMatchPrintf) {
+  cv::Mat1b long_row(1, 9000), rows(700, 3);
+  cv::RNG rng(12);
+  for (int j = 0; j < long_row.cols; ++j) long_row(0, j) = static_cast<std::uint8_t>(j % 256);
+  rng.fill(rows, cv::RNG::UNIFORM, 0, 256);
+  for (const cv::Mat1b* m : {&long_row, &rows}) {
+    std::string expected;
+    char buf[8];
+    for (int i = 0; i < m->rows; ++i) {
+      for (int j = 0; j < m->cols; ++j) {
+        std::snprintf(buf, sizeof buf, "%s%d", j ? " " : "", (*m)(i, j));
+        expected += buf;
+      }
+      expected += "\n";
+    }
+    EXPECT_EQ(EncodeText(*m), expected);
+  }
+}
+
+// A row far wider than the others before it: the piece's buffer grows in the middle of a piece.
+TEST(EncodeText, WideRowsGrowThePieceBuffer) {
+  cv::Mat1f m(40, 20000);
+  cv::RNG rng(13);
+  rng.fill(m, cv::RNG::UNIFORM, -1e6, 1e6);
+  TextChunks chunks(m);
+  std::string joined;
+  int pieces = 0;
+  for (std::string_view piece; chunks.Next(piece); ++pieces) joined += piece;
+  EXPECT_EQ(pieces, 2);  // rows 0-31 and 32-39
+  EXPECT_EQ(joined, PrintfText(m));
 }
 
 TEST(EncodeMatches, NpyRecordsAndCsvText) {

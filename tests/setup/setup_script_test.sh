@@ -11,8 +11,7 @@ has() { [[ " $1 " == *" $2 "* ]]; }
 
 demo=$(bash "$setup" --print-packages) || fail "--print-packages exited with $?"
 for p in cmake g++ make ninja-build libopencv-dev libeigen3-dev libopenblas-dev libopenimageio-dev \
-         openimageio-tools \
-         libpng-dev zlib1g-dev libjpeg-dev nlohmann-json3-dev; do
+         openimageio-tools libpng-dev zlib1g-dev libdeflate-dev libjpeg-dev nlohmann-json3-dev; do
   has "$demo" "$p" || fail "the demo's packages lack $p: $demo"
 done
 optional=(libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-dev pybind11-dev
