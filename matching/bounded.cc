@@ -117,14 +117,21 @@ __attribute__((target_clones("avx512f", "avx2", "default")))
 float SequenceBulk(const float* __restrict row, const float* __restrict old,
                    const double* __restrict prev, double* __restrict cur, float* __restrict out,
                    int n) {
-  float largest = 0.0f;  // the sums are finite and >= 0: the plain comparison vectorises
+  // The largest sum, compared as the integers of its bits (the sums are finite and >= 0, which
+  // the bits order as the values): GCC vectorises an integer maximum, not a float one without
+  // -ffinite-math-only.
+  std::int32_t largest = 0;
   for (int j = 0; j < n; ++j) {
     const double w = static_cast<double>(row[j]) + prev[j] - static_cast<double>(old[j]);
     cur[j] = w;
     out[j] = static_cast<float>(w);
-    largest = out[j] > largest ? out[j] : largest;
+    std::int32_t bits = 0;
+    std::memcpy(&bits, &out[j], sizeof bits);
+    largest = bits > largest ? bits : largest;
   }
-  return largest;
+  float value = 0.0f;
+  std::memcpy(&value, &largest, sizeof value);
+  return value;
 }
 
 // The same in float, for distances that are small integers (Hamming, L1) whose sums stay below
@@ -137,14 +144,18 @@ __attribute__((target_clones("avx512f", "avx2", "default")))
 float SequenceBulk(const float* __restrict row, const float* __restrict old,
                    const float* __restrict prev, float* __restrict cur, float* __restrict out,
                    int n) {
-  float largest = 0.0f;
+  std::int32_t largest = 0;  // as above
   for (int j = 0; j < n; ++j) {
     const float w = row[j] + prev[j] - old[j];
     cur[j] = w;
     out[j] = w;
-    largest = w > largest ? w : largest;
+    std::int32_t bits = 0;
+    std::memcpy(&bits, &w, sizeof bits);
+    largest = bits > largest ? bits : largest;
   }
-  return largest;
+  float value = 0.0f;
+  std::memcpy(&value, &largest, sizeof value);
+  return value;
 }
 
 // Whether the running sums of L distances of `metric` between rows of `width` bytes are
