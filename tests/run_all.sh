@@ -86,8 +86,12 @@ if ! command -v clang++ > /dev/null ||
   echo "== Fuzzers skipped: clang++ with libFuzzer is not available (examples/setup.sh --all installs it)"
   exit 0
 fi
-CXX=clang++ cmake -S . -B build_fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DOPENABLE_BUILD_FUZZERS=ON \
-      -DOPENABLE_BUILD_TESTS=OFF -DOPENABLE_BUILD_BENCHMARKS=OFF
+# A new fuzz tree is a Ninja tree with unity builds too, as build_asan above: with clang on 2
+# cores the fuzzers built in 130 s against about 180 s with Make, file by file.
+fuzz_settings=()
+[ -f build_fuzz/CMakeCache.txt ] || fuzz_settings+=(-G Ninja -DOPENABLE_UNITY_BUILD=ON)
+CXX=clang++ cmake -S . -B build_fuzz "${fuzz_settings[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+      -DOPENABLE_BUILD_FUZZERS=ON -DOPENABLE_BUILD_TESTS=OFF -DOPENABLE_BUILD_BENCHMARKS=OFF
 cmake --build build_fuzz -j"$jobs" --target fuzzers
 # The fuzzers the build made (the bag fuzzer only with the rosbag module), each <name>_fuzzer
 # with its corpus tests/fuzz/corpus/<name>/.
