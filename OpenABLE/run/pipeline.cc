@@ -263,6 +263,21 @@ void SetTraversals(RunResult& result, std::vector<int>& starts,
                        "frames for each");
 }
 
+// The frames of a run of one descriptor described, and what the run's result says of them:
+// traversals (their first rows into `starts`), cache, warnings, notes and timings.
+Described DescribeOne(const RunPlan& plan, ProgressReporter& progress, RunResult& result,
+                      std::vector<int>& starts) {
+  Described described = DescribeSources(plan.config, *plan.describers.front(),
+                                        plan.names.front(), plan.specs, plan.sources, progress);
+  SetTraversals(result, starts, described.traversals);
+  result.cache = described.cache;
+  AddLines(result.warnings, described.warnings);
+  AddLines(result.notes, described.notes);
+  result.timings.describe_seconds = described.seconds;
+  result.timings.frames = described.frames;
+  return described;
+}
+
 // What the run keeps of its matches: Best_matches and the band, with the evaluation's
 // exclusion and the score of Match_score.
 KeepRules KeepRulesOf(const Config& config, const MatchBlock& block) {
@@ -280,16 +295,8 @@ void ComputeBounded(const RunPlan& plan, ProgressReporter& progress, RunResult& 
   const Config& config = plan.config;
   const MatchingOptions& matching = config.matching;
   const ScaleOptions& scale = config.scale;
-  const Described described = DescribeSources(config, *plan.describers.front(),
-                                              plan.names.front(), plan.specs, plan.sources,
-                                              progress);
   std::vector<int> starts;
-  SetTraversals(result, starts, described.traversals);
-  result.cache = described.cache;
-  AddLines(result.warnings, described.warnings);
-  AddLines(result.notes, described.notes);
-  result.timings.describe_seconds = described.seconds;
-  result.timings.frames = described.frames;
+  const Described described = DescribeOne(plan, progress, result, starts);
   const std::int64_t n = described.rows.rows;
   const MatchBlock block = BlockOf(starts, static_cast<int>(n));
   const KeepRules rules = KeepRulesOf(config, block);
@@ -509,15 +516,8 @@ RunResult ComputeOnePass(const RunPlan& plan, ProgressReporter& progress,
   const Config& config = plan.config;
   const MatchingOptions& matching = config.matching;
   RunResult result = plan.head;
-  Described described = DescribeSources(config, *plan.describers.front(), plan.names.front(),
-                                        plan.specs, plan.sources, progress);
   std::vector<int> starts;
-  SetTraversals(result, starts, described.traversals);
-  result.cache = described.cache;
-  AddLines(result.warnings, described.warnings);
-  AddLines(result.notes, described.notes);
-  result.timings.describe_seconds = described.seconds;
-  result.timings.frames = described.frames;
+  Described described = DescribeOne(plan, progress, result, starts);
   const int n = described.rows.rows;
   result.timings.pairs = static_cast<std::int64_t>(n) * (n - 1) / 2;
   const auto t = Clock::now();
