@@ -356,32 +356,26 @@ float SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
         if (L > 1) {
           const int steps = i - h0;
           const float* old = steps >= L ? ring_row(i - L) : d;  // read only when steps >= L
+          // One direction's row of sums into `into`, its running sums (float or double) moved
+          // on by one row; returns the row's largest value.
+          const auto step = [&](auto& prev, auto& cur, float* into, bool reverse) {
+            const float row_largest = SequenceRow(d, old, prev.data(), cur.data(), into, m,
+                                                  steps, L, reverse, options.partial);
+            std::swap(prev, cur);
+            return row_largest;
+          };
           // With Sequence_partial ahead, the sums go straight into the rows kept for it.
           float* sums = ahead && forward ? &sums_f[static_cast<std::size_t>(i % L) * width]
                                          : sum_f.data();
           if (forward) {
-            if (exact) {
-              summed(i, SequenceRow(d, old, prev_ef.data(), cur_ef.data(), sums, m, steps, L,
-                                    false, options.partial));
-              std::swap(prev_ef, cur_ef);
-            } else {
-              summed(i, SequenceRow(d, old, prev_f.data(), cur_f.data(), sums, m, steps, L,
-                                    false, options.partial));
-              std::swap(prev_f, cur_f);
-            }
+            summed(i, exact ? step(prev_ef, cur_ef, sums, false)
+                            : step(prev_f, cur_f, sums, false));
           }
           if (backward) {
             float* into = ahead ? &sums_r[static_cast<std::size_t>(i % L) * width]
                                 : (forward ? sum_r.data() : sum_f.data());
-            if (exact) {
-              summed(i, SequenceRow(d, old, prev_er.data(), cur_er.data(), into, m, steps, L,
-                                    true, options.partial));
-              std::swap(prev_er, cur_er);
-            } else {
-              summed(i, SequenceRow(d, old, prev_r.data(), cur_r.data(), into, m, steps, L,
-                                    true, options.partial));
-              std::swap(prev_r, cur_r);
-            }
+            summed(i, exact ? step(prev_er, cur_er, into, true)
+                            : step(prev_r, cur_r, into, true));
             if (forward && !ahead)  // both directions: the smaller of the two sums
               for (int j = 0; j < m; ++j) sum_f[j] = std::min(sum_f[j], sum_r[j]);
           }

@@ -263,24 +263,24 @@ AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress, Sing
   // fused, so that each frame is read and decoded once for all of them (the run's
   // single-frame matrices are kept per descriptor, as each candidate's run would keep them).
   const int kept_before = store.Size();
-  std::vector<std::pair<Config, std::vector<std::string>>> groups;
+  struct Group {
+    std::string settings;  // SingleFrameKey without the descriptor
+    Config config;         // the first candidate's
+    std::vector<std::string> names;
+  };
+  std::vector<Group> groups;
   for (const Config& c : configs) {
-    Config settings = c;
-    settings.descriptor.name.clear();
-    const std::string key = SingleFrameKey(settings, "");
-    auto group = std::find_if(groups.begin(), groups.end(), [&](const auto& g) {
-      Config other = g.first;
-      other.descriptor.name.clear();
-      return SingleFrameKey(other, "") == key;
-    });
-    if (group == groups.end()) group = groups.insert(groups.end(), {c, {}});
+    const std::string settings = SingleFrameKey(c, "");
+    auto group = std::find_if(groups.begin(), groups.end(),
+                              [&](const Group& g) { return g.settings == settings; });
+    if (group == groups.end()) group = groups.insert(groups.end(), {settings, c, {}});
     for (const std::string& name : DescriptorList(c.descriptor.name))
-      if (std::find(group->second.begin(), group->second.end(), name) == group->second.end())
-        group->second.push_back(name);
+      if (std::find(group->names.begin(), group->names.end(), name) == group->names.end())
+        group->names.push_back(name);
   }
   std::vector<int> starts;
   int references = 0, queries = 0;
-  for (auto& [c, names] : groups) {
+  for (const auto& [settings, c, names] : groups) {
     Config together = c;
     together.descriptor.name.clear();
     for (const std::string& name : names)
