@@ -173,16 +173,22 @@ bool SumsAreExactInFloat(Metric metric, int width, int L) {
 // Acc), finished by ScaleSequenceSum. `steps` is how far row i can go back (i minus the first
 // row of the rows summed), `prev` the sums of row i - 1, `old` row i - L of D (read only when
 // steps >= L). Returns the largest finite value written to `out` (0 when none).
+//
+// Going forward, the row may be a slice of columns: the m cells start at column `first` of
+// the traversal, and prev[-1] and old[-L .. -1] hold the cells of the columns before it (read
+// where a sum reaches back there), so that a slice gives the same floats as the whole row.
 template <typename Acc>
 float SequenceRow(const float* row, const float* old, const Acc* prev, Acc* cur, float* out,
-                  int m, int steps, int L, bool reverse, SequencePartial partial) {
+                  int m, int steps, int L, bool reverse, SequencePartial partial,
+                  int first = 0) {
   float largest = 0.0f;
   // Columns whose sums reach back a full L - 1 steps along the columns too: [L, m) going
   // forward, [0, m - L) in reverse; the other L columns go through the general case.
-  const int bulk0 = reverse ? 0 : std::min(L, m), bulk1 = reverse ? std::max(0, m - L) : m;
+  const int bulk0 = reverse ? 0 : std::clamp(L - first, 0, m);
+  const int bulk1 = reverse ? std::max(0, m - L) : m;
   auto general = [&](int j) {
     double w = row[j];
-    const int t = std::min(steps, reverse ? m - 1 - j : j);
+    const int t = std::min(steps, reverse ? m - 1 - j : first + j);
     if (t > 0) {
       w += prev[reverse ? j + 1 : j - 1];
       if (t >= L) w -= old[reverse ? j + L : j - L];
@@ -234,29 +240,40 @@ float LargestFinite(const float* s, int n, float seen) {
 // the finished rows otherwise (L = 1, both directions: the smaller of two sums).
 using RowSink = std::function<void(int range, int row, const float* sums)>;
 
+// The queries computed (rows [begin, end) of the block) in ranges of range_rows rows, taken in
+// turn by `threads` threads: several ranges per thread for balance, large enough that the
+// L - 1 rows computed twice (once as history) cost little.
+struct RangePlan {
+  int begin = 0, end = 0, threads = 1, range_rows = 1, ranges = 0;
+};
+
+RangePlan PlanRanges(const MatchBlock& block, const BoundedOptions& options) {
+  RangePlan p;
+  p.begin = std::clamp(options.query_begin, 0, block.query_count);
+  p.end = options.query_end < 0 ? block.query_count
+                                : std::clamp(options.query_end, p.begin, block.query_count);
+  const int queries = p.end - p.begin;
+  p.threads = EffectiveThreads(options.threads);
+  p.range_rows = options.range_rows > 0 ? options.range_rows
+                                        : std::clamp(queries / (8 * p.threads), 64, 1024);
+  p.ranges = queries <= 0 ? 0 : (queries + p.range_rows - 1) / p.range_rows;
+  return p;
+}
+
 float SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
                    const BoundedOptions& options, const std::function<void(int)>& ranges_known,
                    const RowSink& sink, const std::function<void(int, int)>& progress) {
   const int L = options.sequence_length;
   if (L < 1) throw std::logic_error("BoundedMatches: sequence length < 1");
   const int m = block.reference_count;
-  const int q_begin = std::clamp(options.query_begin, 0, block.query_count);
-  const int q_end = options.query_end < 0 ? block.query_count
-                                          : std::clamp(options.query_end, q_begin,
-                                                       block.query_count);
-  const int queries = q_end - q_begin;
+  const RangePlan plan = PlanRanges(block, options);
+  const int q_begin = plan.begin, q_end = plan.end, queries = q_end - q_begin;
   const cv::Mat references = descriptors.rowRange(block.reference_first,
                                                   block.reference_first + m);
   const Metric metric = options.metric.value_or(MetricOfType(descriptors.type()));
   std::unique_ptr<HammingReferences> packed;
   if (metric == Metric::kHamming) packed = std::make_unique<HammingReferences>(references);
-  const int threads = EffectiveThreads(options.threads);
-  // Ranges of query rows: several per thread for balance, large enough that the L - 1 rows
-  // computed twice (once as history) cost little.
-  const int range_rows = options.range_rows > 0
-                             ? options.range_rows
-                             : std::clamp(queries / (8 * threads), 64, 1024);
-  const int ranges = queries <= 0 ? 0 : (queries + range_rows - 1) / range_rows;
+  const int threads = plan.threads, range_rows = plan.range_rows, ranges = plan.ranges;
   ranges_known(ranges);
   std::vector<float> range_max(static_cast<std::size_t>(ranges), 0.0f);
   const bool forward = options.direction != SequenceDirection::kReverse;
@@ -404,12 +421,265 @@ float SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
   return largest;
 }
 
+
+// The kept matches of one query row (KeepRow's) from slices of its columns given in
+// increasing order. KeepRow's heap keeps the k smallest cells by (distance, column), a set
+// that does not depend on how the row is cut, and so does this one. For the ratio score it
+// keeps the 2 window + 2 smallest: a kept match's best rival (the smallest cell more than
+// window columns away) is among them, since at most 2 window + 1 cells lie within its window.
+class SlicedKeep {
+ public:
+  SlicedKeep(int q, int references, const KeepRules& rules)
+      : q_(q),
+        limit_(rules.one_traversal ? std::min(references, q - rules.exclusion + 1)
+                                   : references),
+        kept_(KeptCells(rules)),
+        rules_(&rules) {}
+
+  // Cells kept per query: KeepRules::best, more for the ratio score.
+  static int KeptCells(const KeepRules& rules) {
+    return rules.score == MatchScore::kRatio ? std::max(rules.best, 2 * rules.score_window + 2)
+                                             : rules.best;
+  }
+
+  // Columns [c0, c1) of the row, s[0] being column c0.
+  void Add(const float* s, int c0, int c1) {
+    const int end = std::min(c1, limit_);
+    int j = c0;
+    for (; kept_ > 0 && j < end && static_cast<int>(heap_.size()) < kept_; ++j)
+      if (std::isfinite(s[j - c0])) Push(s[j - c0], j);
+    if (kept_ > 0 && j < end) {
+      // The heap is full, as in KeepRow: a cell enters when below the worst kept, blocks of 16
+      // cells tested together first.
+      float worst = heap_.front().first;
+      const auto visit = [&](int c) {
+        const float v = s[c - c0];
+        if (v < worst && std::isfinite(v)) {
+          std::pop_heap(heap_.begin(), heap_.end());
+          heap_.back() = {v, c};
+          std::push_heap(heap_.begin(), heap_.end());
+          worst = heap_.front().first;
+        }
+      };
+      for (; j + 16 <= end; j += 16) {
+        const float* b = s + (j - c0);
+        const cv::v_float32x4 w = cv::v_setall_f32(worst);
+        const cv::v_float32x4 below = (cv::v_load(b) < w) | (cv::v_load(b + 4) < w) |
+                                      (cv::v_load(b + 8) < w) | (cv::v_load(b + 12) < w);
+        if (cv::v_check_any(below))
+          for (int u = 0; u < 16; ++u) visit(j + u);
+      }
+      for (; j < end; ++j) visit(j);
+    }
+    if (rules_->band >= 0) {
+      const int j0 = std::max(c0, q_ - rules_->band);
+      const int j1 = std::min(c1, q_ + rules_->band + 1);
+      for (int c = j0; c < j1; ++c)
+        if (std::isfinite(s[c - c0])) band_.push_back({s[c - c0], c});
+    }
+  }
+
+  // The row's matches, in KeepRow's order: ranks 1 .. k, then the band's other cells.
+  void Finish(std::vector<Match>& out) {
+    std::sort_heap(heap_.begin(), heap_.end());  // (distance, column) increasing
+    const int ranked = std::min(rules_->best, static_cast<int>(heap_.size()));
+    std::vector<std::pair<float, int>> candidates;
+    const auto score = [&](float v, int j) {
+      if (rules_->score == MatchScore::kDistance) return v;
+      // Among the kept cells and the match itself (in its own window: never its rival).
+      candidates.assign(heap_.begin(), heap_.end());
+      candidates.push_back({v, j});
+      return ScoreOfCandidate(candidates, candidates.size() - 1, rules_->score,
+                              rules_->score_window);
+    };
+    for (int r = 0; r < ranked; ++r)
+      out.push_back({q_, heap_[r].second, heap_[r].first, r + 1,
+                     score(heap_[r].first, heap_[r].second)});
+    for (const auto& [v, j] : band_) {
+      const bool is_ranked = std::any_of(heap_.begin(), heap_.begin() + ranked,
+                                         [&](const auto& e) { return e.second == j; });
+      if (!is_ranked) out.push_back({q_, j, v, 0, score(v, j)});
+    }
+  }
+
+ private:
+  void Push(float v, int j) {
+    heap_.push_back({v, j});
+    std::push_heap(heap_.begin(), heap_.end());
+  }
+
+  int q_, limit_, kept_;
+  const KeepRules* rules_;
+  std::vector<std::pair<float, int>> heap_;  // max-heap of (distance, column)
+  std::vector<std::pair<float, int>> band_;  // (distance, column), columns increasing
+};
+
+// Columns per tile for TiledMatches, 0 when it does not apply: sums along diagonals only (a
+// tile reaches back to the columns before it, which the tiles before it computed) of exact
+// distances (Hamming, L1: a slice of the references gives the floats of the whole row; an L2
+// product may round otherwise), with few cells kept per query.
+int TileColumns(const BoundedOptions& options, Metric metric, const KeepRules& rules) {
+  if (options.tile_columns < 0 || options.direction != SequenceDirection::kForward ||
+      metric == Metric::kL2 || SlicedKeep::KeptCells(rules) > 4096)
+    return 0;
+  const int chosen = options.tile_columns > 0 ? options.tile_columns : 1024;
+  return (std::max(chosen, 2 * options.sequence_length) + 3) / 4 * 4;
+}
+
+// BoundedMatches in column tiles. SequenceRows holds whole rows of references: 100k of them
+// are 400 KB a row, the ring of rows is megabytes, and every step (distances, sums, ahead
+// cells, selection) streamed rows from memory (measured: the sums were bound by memory).
+// Here each range of queries is computed one tile of `tile` references at a time, for all its
+// rows: the tile's ring of distances, its sums and the rows finished by the ahead rule stay in
+// the core's cache, and the rows' kept matches are gathered across tiles (SlicedKeep). Each
+// row carries, from one tile to the next, the running sum at the tile's last column and its
+// last L distances, which the sums of the next tile's first columns read: every sum is the
+// same float as SequenceRows gives.
+std::vector<Match> TiledMatches(const cv::Mat& descriptors, const MatchBlock& block,
+                                const KeepRules& rules, const BoundedOptions& options,
+                                int tile, float& max_distance,
+                                const std::function<void(int, int)>& progress) {
+  const int L = options.sequence_length;
+  if (L < 1) throw std::logic_error("BoundedMatches: sequence length < 1");
+  const int m = block.reference_count;
+  const RangePlan plan = PlanRanges(block, options);
+  const cv::Mat references = descriptors.rowRange(block.reference_first,
+                                                  block.reference_first + m);
+  const Metric metric = options.metric.value_or(MetricOfType(descriptors.type()));
+  std::unique_ptr<HammingReferences> packed;
+  if (metric == Metric::kHamming) packed = std::make_unique<HammingReferences>(references);
+  const bool ahead = L > 1 && options.partial == SequencePartial::kAhead;
+  const int look = ahead ? L - 1 : 0;
+  const bool exact = SumsAreExactInFloat(metric, descriptors.cols, L);
+  constexpr int block_rows = 16;  // queries per call of the distance kernel, as SequenceRows
+  std::vector<std::vector<Match>> kept(static_cast<std::size_t>(plan.ranges));
+  std::vector<float> range_max(kept.size(), 0.0f);
+  std::atomic<int> rows_done{0};
+  std::mutex progress_mutex;
+  ParallelFor(plan.ranges, plan.threads, [&](int c) {
+    const int r0 = plan.begin + c * plan.range_rows, r1 = std::min(plan.end, r0 + plan.range_rows);
+    const int h0 = std::max(0, r0 - (L - 1));
+    const int rows_end = std::min(block.query_count, r1 + look);
+    const int rows = rows_end - h0;
+    // A tile computes its own columns and `look` beyond them, which the ahead rule reads
+    // (the kernel writes whole blocks of four references); a ring row holds the L columns
+    // before the tile, then the tile.
+    const int span = (tile + look + 3) / 4 * 4;
+    const std::size_t width = static_cast<std::size_t>(L + span);
+    const int slots = ((L + block_rows - 1) / block_rows + 1) * block_rows;
+    std::vector<float> ring(static_cast<std::size_t>(slots) * width);
+    const auto ring_row = [&](int i) {
+      return &ring[static_cast<std::size_t>((i - h0) % slots) * width];
+    };
+    // Carried from tile to tile, per row: its last L distances and its running sum.
+    std::vector<float> edge_d(static_cast<std::size_t>(rows) * L);
+    std::vector<double> edge_w(exact ? 0 : rows), prev_w(exact ? 0 : span + 1), cur_w(prev_w.size());
+    std::vector<float> edge_e(exact ? rows : 0), prev_e(exact ? span + 1 : 0), cur_e(prev_e.size());
+    std::vector<float> sums(L > 1 ? static_cast<std::size_t>(ahead ? L : 1) * span : 0);
+    std::vector<SlicedKeep> keep;
+    keep.reserve(static_cast<std::size_t>(r1 - r0));
+    for (int q = r0; q < r1; ++q) keep.emplace_back(q, m, rules);
+    float largest = 0.0f;
+    cv::Mat1f computed;
+    for (int c0 = 0; c0 < m; c0 += tile) {
+      const int c1 = std::min(m, c0 + tile), ce = std::min(m, c1 + look);
+      const bool more = c1 < m;
+      const auto hand = [&](int e, const float* s) {
+        if (L == 1) largest = LargestFinite(s, c1 - c0, largest);  // else from the sums
+        keep[static_cast<std::size_t>(e - r0)].Add(s, c0, c1);
+      };
+      // Row e finished in place by the ahead rule, as SequenceRows's finish going forward:
+      // its early cells (column or row before L - 1) take the cell `shift` steps ahead along
+      // the diagonal, within the last L rows of sums and the `look` columns past the tile.
+      const auto finish = [&](int e) {
+        float* own = &sums[static_cast<std::size_t>(e % L) * span];
+        const int forward_rows = block.query_count - 1 - e;
+        const int x1 = e < L - 1 ? c1 - c0 : std::clamp(L - 1 - c0, 0, c1 - c0);
+        for (int x = 0; x < x1; ++x) {
+          const int j = c0 + x, t = std::min(e, j);
+          if (t >= L - 1) continue;
+          const int shift = AheadShift(L, t, std::min(forward_rows, m - 1 - j));
+          own[x] = shift < 0 ? std::numeric_limits<float>::infinity()
+                             : sums[static_cast<std::size_t>((e + shift) % L) * span +
+                                    static_cast<std::size_t>(x + shift)];
+        }
+        return own;
+      };
+      for (int b0 = h0; b0 < rows_end; b0 += block_rows) {
+        const int b1 = std::min(rows_end, b0 + block_rows);
+        const cv::Mat queries =
+            descriptors.rowRange(block.query_first + b0, block.query_first + b1);
+        if (packed) {
+          packed->DistancesInto(queries, c0, ce, ring_row(b0) + L, width);
+        } else {
+          computed = Distances(queries, references.rowRange(c0, ce), metric, 1);
+          for (int i = b0; i < b1; ++i)
+            std::copy_n(computed.ptr<float>(i - b0), ce - c0, ring_row(i) + L);
+        }
+        for (int i = b0; i < b1; ++i) {
+          float* d = ring_row(i) + L;
+          float* edge = &edge_d[static_cast<std::size_t>(i - h0) * L];
+          if (c0 > 0) std::copy_n(edge, L, d - L);
+          if (more) std::copy_n(d + (c1 - c0 - L), L, edge);
+          const float* s = d;
+          if (L > 1) {
+            const int steps = i - h0;
+            const float* old = steps >= L ? ring_row(i - L) + L : d;
+            float* into = &sums[static_cast<std::size_t>(ahead ? i % L : 0) * span];
+            // Slot 0 of the running sums: the row's sum at column c0 - 1 (from the tile before),
+            // read as prev[-1] by the next row.
+            const auto step = [&](auto& prev, auto& cur, auto& edge_sum) {
+              cur[0] = edge_sum[static_cast<std::size_t>(i - h0)];
+              const float row_largest =
+                  SequenceRow(d, old, prev.data() + 1, cur.data() + 1, into, ce - c0, steps, L,
+                              false, options.partial, c0);
+              if (more) edge_sum[static_cast<std::size_t>(i - h0)] = cur[c1 - c0];
+              std::swap(prev, cur);
+              return row_largest;
+            };
+            const float row_largest =
+                exact ? step(prev_e, cur_e, edge_e) : step(prev_w, cur_w, edge_w);
+            if (i >= r0) largest = std::max(largest, row_largest);
+            s = into;
+          }
+          if (ahead) {
+            if (i - look >= r0 && i - look < r1) hand(i - look, finish(i - look));
+          } else if (i >= r0 && i < r1) {
+            hand(i, s);
+          }
+        }
+      }
+      for (int e = std::max(r0, rows_end - look); ahead && e < r1; ++e) hand(e, finish(e));
+    }
+    for (SlicedKeep& k : keep) k.Finish(kept[static_cast<std::size_t>(c)]);
+    range_max[static_cast<std::size_t>(c)] = largest;
+    rows_done += r1 - r0;
+    if (progress && progress_mutex.try_lock()) {  // as SequenceRows
+      progress(rows_done.load(), plan.end - plan.begin);
+      progress_mutex.unlock();
+    }
+  });
+  if (progress) progress(plan.end - plan.begin, plan.end - plan.begin);
+  std::vector<Match> all;
+  std::size_t total = 0;
+  for (const auto& k : kept) total += k.size();
+  all.reserve(total);
+  for (auto& k : kept) all.insert(all.end(), k.begin(), k.end());
+  max_distance = 0.0f;
+  for (const float v : range_max) max_distance = std::max(max_distance, v);
+  if (options.normalize) NormalizeMatches(all, max_distance, rules.score);
+  return all;
+}
+
 }  // namespace
 
 std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& block,
                                   const KeepRules& rules, const BoundedOptions& options,
                                   float& max_distance,
                                   const std::function<void(int, int)>& progress) {
+  const Metric metric = options.metric.value_or(MetricOfType(descriptors.type()));
+  if (const int tile = TileColumns(options, metric, rules); tile > 0)
+    return TiledMatches(descriptors, block, rules, options, tile, max_distance, progress);
   // Per range: its kept matches, merged in the order of the ranges.
   std::vector<std::vector<Match>> kept;
   const int m = block.reference_count;

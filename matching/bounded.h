@@ -90,6 +90,11 @@ struct BoundedOptions {
   // Query rows per range of the fused pipeline (each thread takes ranges in turn); 0 chooses
   // from the rows and threads (64 to 1024). Tests set a few rows to cross many range starts.
   int range_rows = 0;
+  // BoundedMatches along diagonals (Sequence_direction 0) of Hamming or L1 rows: references
+  // per column tile, each range's rows being computed tile by tile so that distances, sums and
+  // the kept matches stay in cache. 0 chooses (1024 columns); -1 whole rows. Tests set a few
+  // columns to cross many tile edges. A multiple of 4, at least 2 L (rounded up to that).
+  int tile_columns = 0;
   // The queries computed: rows [query_begin, query_end) of the block (end -1: to the last),
   // with the sequence history read from the rows before query_begin. A distributed run gives
   // each process one share (OpenABLE/cluster/cluster.h); the matches are those the whole block

@@ -47,7 +47,8 @@ PackedRows Pack(const cv::Mat& m) {
   return p;
 }
 
-// One query (`words` words) against references [4 * b0, 4 * b1), written to out[4 * b0 ...]
+// One query (`words` words) against references [4 * b0, 4 * b1), written to out[0 ...] (out[i]:
+// reference 4 * b0 + i)
 // (only rows < refs.rows are written).
 using Kernel = void (*)(const std::uint64_t* q, const PackedRows& refs, int b0, int b1, float* out);
 
@@ -65,7 +66,8 @@ inline __attribute__((always_inline)) void ScalarBlocks(const std::uint64_t* q,
       for (int lane = 0; lane < 4; ++lane)
         bits[lane] += __builtin_popcountll(q[k] ^ block[4 * k + lane]);
     const int valid = std::min(4, refs.rows - 4 * b);
-    for (int lane = 0; lane < valid; ++lane) out[4 * b + lane] = static_cast<float>(bits[lane]);
+    for (int lane = 0; lane < valid; ++lane)
+      out[4 * (b - b0) + lane] = static_cast<float>(bits[lane]);
   }
 }
 
@@ -153,13 +155,13 @@ __attribute__((target("avx2,popcnt"))) void Avx2FixedKernel(const std::uint64_t*
       s3 += static_cast<std::uint64_t>(__builtin_popcountll(q[k] ^ block4[4 * k + 3]));
     }
     StoreCounts(c, _mm256_sad_epu8(bytes0, c.zero), _mm256_sad_epu8(bytes1, c.zero), 8,
-                out + 4 * b);
+                out + 4 * (b - b0));
     StoreCounts(c, _mm256_sad_epu8(bytes2, c.zero), _mm256_sad_epu8(bytes3, c.zero), 8,
-                out + 4 * b + 8);
+                out + 4 * (b - b0) + 8);
     const int valid = std::min(4, refs.rows - 4 * (b + 4));
     const float counts[4] = {static_cast<float>(s0), static_cast<float>(s1),
                              static_cast<float>(s2), static_cast<float>(s3)};
-    std::copy(counts, counts + valid, out + 4 * (b + 4));
+    std::copy(counts, counts + valid, out + 4 * (b + 4 - b0));
   }
   for (; b + 1 < b1; b += 2) {
     const std::uint64_t* block0 = refs.Block(b);
@@ -170,9 +172,9 @@ __attribute__((target("avx2,popcnt"))) void Avx2FixedKernel(const std::uint64_t*
       bytes1 = AddCounts(c, bytes1, qk[k], block1 + 4 * k);
     }
     StoreCounts(c, _mm256_sad_epu8(bytes0, c.zero), _mm256_sad_epu8(bytes1, c.zero),
-                std::min(8, refs.rows - 4 * b), out + 4 * b);
+                std::min(8, refs.rows - 4 * b), out + 4 * (b - b0));
   }
-  if (b < b1) PopcntKernel(q, refs, b, b1, out);  // an odd last block
+  if (b < b1) PopcntKernel(q, refs, b, b1, out + 4 * (b - b0));  // an odd last block
 }
 
 __attribute__((target("avx2,popcnt"))) void Avx2Kernel(const std::uint64_t* q,
@@ -202,9 +204,9 @@ __attribute__((target("avx2,popcnt"))) void Avx2Kernel(const std::uint64_t* q,
       total0 = _mm256_add_epi64(total0, _mm256_sad_epu8(bytes0, c.zero));
       total1 = _mm256_add_epi64(total1, _mm256_sad_epu8(bytes1, c.zero));
     }
-    StoreCounts(c, total0, total1, std::min(8, refs.rows - 4 * b), out + 4 * b);
+    StoreCounts(c, total0, total1, std::min(8, refs.rows - 4 * b), out + 4 * (b - b0));
   }
-  if (b < b1) PopcntKernel(q, refs, b, b1, out);  // an odd last block
+  if (b < b1) PopcntKernel(q, refs, b, b1, out + 4 * (b - b0));  // an odd last block
 }
 
 // AVX-512 with VPOPCNTQ (Ice Lake, Zen 4 and later): one 512-bit load holds words k and k+1
@@ -230,7 +232,7 @@ OPENABLE_AVX512 __attribute__((always_inline)) inline __m512i BlockPair(
                        : _mm512_maskz_loadu_epi64(0x0F, block + 4 * k);
 }
 
-// out[4 * b ...]: the counts of blocks b (acc0) and b + 1 (acc1), `valid` of the 8 floats.
+// out[0 ...]: the counts of blocks b (acc0) and b + 1 (acc1), `valid` of the 8 floats.
 OPENABLE_AVX512 __attribute__((always_inline)) inline void StorePair(__m512i acc0, __m512i acc1,
                                                                      int valid, float* out) {
   const __m512i lo_lanes = _mm512_setr_epi64(0, 1, 2, 3, 8, 9, 10, 11);
@@ -270,8 +272,9 @@ OPENABLE_AVX512 void Avx512Blocks(const std::uint64_t* q, const PackedRows& refs
       a2 = AddPairCount(a2, qv, block + 2 * stride, k, words);
       a3 = AddPairCount(a3, qv, block + 3 * stride, k, words);
     }
-    StorePair(a0, a1, std::min(8, refs.rows - 4 * b), out + 4 * b);
-    StorePair(a2, a3, std::max(0, std::min(8, refs.rows - 4 * (b + 2))), out + 4 * b + 8);
+    StorePair(a0, a1, std::min(8, refs.rows - 4 * b), out + 4 * (b - b0));
+    StorePair(a2, a3, std::max(0, std::min(8, refs.rows - 4 * (b + 2))),
+              out + 4 * (b - b0) + 8);
   }
   for (; b < b1; b += 2) {  // the last one to three blocks, two at a time
     const std::uint64_t* block = refs.Block(b);
@@ -283,7 +286,7 @@ OPENABLE_AVX512 void Avx512Blocks(const std::uint64_t* q, const PackedRows& refs
       a0 = AddPairCount(a0, qv, block, k, words);
       if (two) a1 = AddPairCount(a1, qv, refs.Block(b + 1), k, words);
     }
-    StorePair(a0, a1, std::min(two ? 8 : 4, refs.rows - 4 * b), out + 4 * b);
+    StorePair(a0, a1, std::min(two ? 8 : 4, refs.rows - 4 * b), out + 4 * (b - b0));
   }
 }
 
@@ -331,18 +334,20 @@ KernelChoice Current() {
   }
 }
 
-// Rows [r0, r1) of `queries` against every reference, into out rows (stride in floats).
+// Rows [r0, r1) of `queries` against the references of blocks [first, last) (every block by
+// default), into out rows (stride in floats; column 0 = reference 4 * first).
 // Blocked: a group of queries runs over a slice of references that stays in L1/L2 cache.
 void QueryRange(const std::vector<std::uint64_t>& qwords, int r0, int r1, const PackedRows& refs,
-                float* out, size_t stride) {
+                float* out, size_t stride, int first = 0, int last = -1) {
   const Kernel kernel = Current().kernel;
   const int words = refs.words;
   const int slice = std::max(8, 65536 / (32 * std::max(1, words)));  // 64 KB of references
-  for (int b0 = 0; b0 < refs.blocks; b0 += slice) {
-    const int b1 = std::min(refs.blocks, b0 + slice);
+  const int end = last < 0 ? refs.blocks : last;
+  for (int b0 = first; b0 < end; b0 += slice) {
+    const int b1 = std::min(end, b0 + slice);
     for (int r = r0; r < r1; ++r)
       kernel(qwords.data() + static_cast<size_t>(r) * words, refs, b0, b1,
-             out + static_cast<size_t>(r - r0) * stride);
+             out + static_cast<size_t>(r - r0) * stride + 4 * static_cast<size_t>(b0 - first));
   }
 }
 
@@ -594,6 +599,17 @@ void HammingReferences::DistancesInto(const cv::Mat& queries, cv::Mat1f& out,
   InTasksOfRows(n, m, threads, {}, [&](int r0, int r1) {
     QueryRange(qwords, r0, r1, packed_->rows, out.ptr<float>(r0), out.step1());
   });
+}
+
+void HammingReferences::DistancesInto(const cv::Mat& queries, int first, int last, float* out,
+                                      std::size_t stride) const {
+  if (queries.depth() != CV_8U || queries.cols != bytes_)
+    throw std::logic_error("HammingReferences::DistancesInto: queries of another width/type");
+  if (first % 4 != 0 || first < 0 || last < first || last > Size())
+    throw std::logic_error("HammingReferences::DistancesInto: columns not a range of blocks");
+  if (queries.rows == 0 || last == first) return;
+  const std::vector<std::uint64_t> qwords = RowWords(queries);
+  QueryRange(qwords, 0, queries.rows, packed_->rows, out, stride, first / 4, (last + 3) / 4);
 }
 
 const char* HammingKernelName() { return Current().name; }

@@ -3,6 +3,7 @@
 // (Eq. 8).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -83,6 +84,12 @@ class HammingReferences {
   // Every row of `queries` (CV_8U, same width) against every reference, into `out` (resized
   // to queries.rows x Size(), reused when already that size). Blocks of rows in parallel.
   void DistancesInto(const cv::Mat& queries, cv::Mat1f& out, int threads = 0) const;
+  // Every row of `queries` against references [first, last) only, on the calling thread: row r
+  // of the queries at out + r * stride, column 0 = reference `first`. `first` is a multiple of
+  // 4 (references are packed in blocks of four) and the last block is written whole: `out`
+  // holds round_up(last - first, 4) columns, or up to the last reference.
+  void DistancesInto(const cv::Mat& queries, int first, int last, float* out,
+                     std::size_t stride) const;
 
  private:
   struct Packed;

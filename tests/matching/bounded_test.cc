@@ -88,15 +88,21 @@ TEST(BoundedMatches, EqualsBruteForceSelectionOfTheDenseMatrix) {
                                           block.reference_count, rules))
             expected.push_back(m);
         }
-        BoundedOptions options;
-        options.sequence_length = L;
-        options.direction = dir;
-        options.partial = partial;
-        options.range_rows = 7;  // many ranges, each starting L - 1 rows early
-        float max_distance = 0;
-        const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
-        EXPECT_FLOAT_EQ(max_distance, block_max);
-        ExpectSame(got, expected, 1.0f / block_max);
+        // Whole rows, and (along diagonals) tiles of 2 L or 12 columns rounded to blocks of
+        // four: many tile edges, with sums and ahead cells reaching across them.
+        for (const int tile : {-1, 9}) {
+          SCOPED_TRACE("tile " + std::to_string(tile));
+          BoundedOptions options;
+          options.sequence_length = L;
+          options.direction = dir;
+          options.partial = partial;
+          options.range_rows = 7;  // many ranges, each starting L - 1 rows early
+          options.tile_columns = tile;
+          float max_distance = 0;
+          const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
+          EXPECT_FLOAT_EQ(max_distance, block_max);
+          ExpectSame(got, expected, 1.0f / block_max);
+        }
       }
     }
   }
@@ -277,12 +283,15 @@ TEST(BoundedMatches, SkipAndAheadCellsAndRatioScoresEqualBruteForce) {
           expected.push_back({q, all[r].second, all[r].first, r + 1, ratio});
         }
       }
+      for (const int tile : {-1, 5}) {
+      SCOPED_TRACE("tile " + std::to_string(tile));
       BoundedOptions options;
       options.metric = Metric::kL1;
       options.sequence_length = L;
       options.direction = dir;
       options.partial = partial;
       options.range_rows = 7;
+      options.tile_columns = tile;  // along diagonals: tiles of 2 L = 12 columns
       float max_distance = 0;
       const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
       EXPECT_FLOAT_EQ(max_distance, block_max);
@@ -297,6 +306,7 @@ TEST(BoundedMatches, SkipAndAheadCellsAndRatioScoresEqualBruteForce) {
         ASSERT_NE(first, got.end());
         // skip: none before L - 1; ahead: the first query is answered.
         EXPECT_EQ(first->query, partial == SequencePartial::kSkip ? L - 1 : 0);
+      }
       }
     }
   }
