@@ -573,8 +573,11 @@ std::vector<Match> TiledMatches(const cv::Mat& descriptors, const MatchBlock& bl
     };
     // Carried from tile to tile, per row: its last L distances and its running sum.
     std::vector<float> edge_d(static_cast<std::size_t>(rows) * L);
-    std::vector<double> edge_w(exact ? 0 : rows), prev_w(exact ? 0 : span + 1), cur_w(prev_w.size());
-    std::vector<float> edge_e(exact ? rows : 0), prev_e(exact ? span + 1 : 0), cur_e(prev_e.size());
+    // Running sums in double, or in float where exact (as SequenceRows); slot 0 is column c0 - 1.
+    std::vector<double> edge_w(exact ? 0 : rows), prev_w(exact ? 0 : span + 1);
+    std::vector<double> cur_w(prev_w.size());
+    std::vector<float> edge_e(exact ? rows : 0), prev_e(exact ? span + 1 : 0);
+    std::vector<float> cur_e(prev_e.size());
     std::vector<float> sums(L > 1 ? static_cast<std::size_t>(ahead ? L : 1) * span : 0);
     std::vector<SlicedKeep> keep;
     keep.reserve(static_cast<std::size_t>(r1 - r0));

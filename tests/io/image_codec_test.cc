@@ -50,9 +50,12 @@ void ExpectEqualImages(const cv::Mat& a, const cv::Mat& b) {
 
 // A PNG written by libpng itself, for the layouts OpenCV's encoder does not write: palettes
 // (with transparency), grey of 2 and 4 bits, grey + alpha, Adam7 interlacing.
+// `filters`: libpng's PNG_FILTER_* flags it may choose among for each row (0: its default);
+// `idat_bytes`: the size of its IDAT chunks (0: libpng's 8 KB).
 std::vector<unsigned char> LibpngFile(int width, int height, int bit_depth, int color_type,
                                       bool interlaced, const std::vector<unsigned char>& data,
-                                      bool palette_alpha = false) {
+                                      bool palette_alpha = false, int filters = 0,
+                                      std::size_t idat_bytes = 0) {
   std::vector<unsigned char> out;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png_create_info_struct(png);
@@ -63,6 +66,8 @@ std::vector<unsigned char> LibpngFile(int width, int height, int bit_depth, int 
         o->insert(o->end(), d, d + n);
       },
       nullptr);
+  if (filters != 0) png_set_filter(png, PNG_FILTER_TYPE_BASE, filters);
+  if (idat_bytes != 0) png_set_compression_buffer_size(png, idat_bytes);
   png_set_IHDR(png, info, width, height, bit_depth, color_type,
                interlaced ? PNG_INTERLACE_ADAM7 : PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                PNG_FILTER_TYPE_DEFAULT);
@@ -135,6 +140,105 @@ TEST(DecodePng, SamePixelsAsOpenCvForEveryLayout) {
     ASSERT_TRUE(DecodePng(c.bytes, got, why)) << why;
     ExpectEqualImages(got, OpenCvPixels(c.bytes, c.grey_alpha));
   }
+}
+
+// 8-bit PNGs that are not interlaced are decoded from their whole zlib stream, with the
+// filters undone in the program: every filter type alone and libpng's own choice per row, for
+// each layout of 8-bit samples, sizes from one pixel to rows longer than zlib's fast loop
+// needs, one IDAT chunk and many, against OpenCV's decoder (libpng).
+TEST(DecodePng, EveryFilterOfEightBitLayoutsAsOpenCv) {
+  const int kFilters[] = {PNG_FILTER_NONE, PNG_FILTER_SUB, PNG_FILTER_UP, PNG_FILTER_AVG,
+                          PNG_FILTER_PAETH, PNG_ALL_FILTERS};
+  const int kColours[] = {PNG_COLOR_TYPE_GRAY, PNG_COLOR_TYPE_GRAY_ALPHA, PNG_COLOR_TYPE_RGB,
+                          PNG_COLOR_TYPE_RGB_ALPHA};
+  const cv::Size kSizes[] = {{1, 1}, {3, 2}, {64, 32}, {301, 7}};
+  cv::RNG rng(11);
+  for (const int colour : kColours)
+    for (const cv::Size size : kSizes)
+      for (const int filters : kFilters)
+        for (const std::size_t idat : {std::size_t{0}, std::size_t{64}}) {
+          const int channels = colour == PNG_COLOR_TYPE_GRAY         ? 1
+                               : colour == PNG_COLOR_TYPE_GRAY_ALPHA ? 2
+                               : colour == PNG_COLOR_TYPE_RGB        ? 3
+                                                                     : 4;
+          // Smooth rows with noise, so that every filter is worth choosing somewhere.
+          std::vector<unsigned char> data(static_cast<std::size_t>(size.area()) * channels);
+          for (std::size_t i = 0; i < data.size(); ++i)
+            data[i] = static_cast<unsigned char>((i * 7 / 3) % 256 + rng.uniform(0, 9));
+          SCOPED_TRACE("colour " + std::to_string(colour) + " size " +
+                       std::to_string(size.width) + "x" + std::to_string(size.height) +
+                       " filters " + std::to_string(filters) + " idat " + std::to_string(idat));
+          const std::vector<unsigned char> bytes = LibpngFile(
+              size.width, size.height, 8, colour, false, data, false, filters, idat);
+          cv::Mat got;
+          std::string why;
+          ASSERT_TRUE(DecodePng(bytes, got, why)) << why;
+          ExpectEqualImages(got, OpenCvPixels(bytes, colour == PNG_COLOR_TYPE_GRAY_ALPHA));
+        }
+}
+
+// Image data that is not the image's, in chunks whose CRCs match: a filter type that does not
+// exist, and a zlib stream one row short. Neither decoder takes it.
+TEST(DecodePng, ImageDataThatIsNotTheImagesIsRefused) {
+  const int w = 5, h = 4;
+  std::vector<unsigned char> data(w * h, 100);
+  // A file of libpng's with its IDAT chunk replaced by one holding `filtered` (filter-type
+  // byte and bytes of each row) in a stored zlib stream (no compression: header, one final
+  // stored block, Adler-32), with the CRC computed bit by bit (ISO 3309).
+  const auto be32 = [](std::vector<unsigned char>& v, std::uint32_t x) {
+    for (int k = 3; k >= 0; --k) v.push_back(static_cast<unsigned char>(x >> (8 * k)));
+  };
+  const auto file_of = [&](const std::vector<unsigned char>& filtered) {
+    const std::vector<unsigned char> png = LibpngFile(w, h, 8, PNG_COLOR_TYPE_GRAY, false, data);
+    const std::size_t idat = 8 + 25;  // after the signature and the IHDR chunk
+    const std::size_t length = (std::size_t{png[idat]} << 24) |
+                               (std::size_t{png[idat + 1]} << 16) |
+                               (std::size_t{png[idat + 2]} << 8) | png[idat + 3];
+    const std::size_t n = filtered.size();
+    std::vector<unsigned char> zlib = {0x78, 0x01, 0x01, static_cast<unsigned char>(n & 0xFF),
+                                       static_cast<unsigned char>(n >> 8),
+                                       static_cast<unsigned char>(~n & 0xFF),
+                                       static_cast<unsigned char>((~n >> 8) & 0xFF)};
+    zlib.insert(zlib.end(), filtered.begin(), filtered.end());
+    std::uint32_t a = 1, b = 0;
+    for (const unsigned char c : filtered) {
+      a = (a + c) % 65521;
+      b = (b + a) % 65521;
+    }
+    be32(zlib, (b << 16) | a);
+    std::vector<unsigned char> chunk;
+    be32(chunk, static_cast<std::uint32_t>(zlib.size()));
+    chunk.insert(chunk.end(), {'I', 'D', 'A', 'T'});
+    chunk.insert(chunk.end(), zlib.begin(), zlib.end());
+    std::uint32_t crc = 0xFFFFFFFFu;
+    for (std::size_t i = 4; i < chunk.size(); ++i) {
+      crc ^= chunk[i];
+      for (int bit = 0; bit < 8; ++bit) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+    }
+    be32(chunk, ~crc);
+    std::vector<unsigned char> out(png.begin(), png.begin() + idat);
+    out.insert(out.end(), chunk.begin(), chunk.end());
+    out.insert(out.end(), png.begin() + idat + 12 + length, png.end());
+    return out;
+  };
+  std::vector<unsigned char> rows;
+  for (int y = 0; y < h; ++y) {
+    rows.push_back(0);  // filter None
+    rows.insert(rows.end(), w, 100);
+  }
+  cv::Mat got;
+  std::string why;
+  ASSERT_TRUE(DecodePng(file_of(rows), got, why)) << why;  // the stored stream itself is sound
+  ExpectEqualImages(got, cv::Mat(h, w, CV_8UC1, cv::Scalar(100)));
+  std::vector<unsigned char> bad_filter = rows;
+  bad_filter[(w + 1) * 2] = 9;  // third row: filter type 9
+  got.release();
+  EXPECT_FALSE(DecodePng(file_of(bad_filter), got, why));
+  EXPECT_TRUE(got.empty());
+  std::vector<unsigned char> short_rows(rows.begin(), rows.end() - (w + 1));
+  got.release();
+  EXPECT_FALSE(DecodePng(file_of(short_rows), got, why));
+  EXPECT_TRUE(got.empty());
 }
 
 TEST(DecodePng, DamagedDataIsRefusedWithAReason) {
