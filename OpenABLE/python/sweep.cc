@@ -71,6 +71,8 @@ Attributes:
         of an earlier run).
     rank_by (str): the figure runs are ranked by.
     descriptions (int): single-frame matrices computed (frames described that many times).
+    frame_reads (int): times the frames were read and decoded (once per description setting,
+        for all its descriptors).
     seconds (float): wall time of the sweep.
     written (list[str]): paths written (output given).
 
@@ -89,6 +91,9 @@ Methods: table() (the ranked table openable_sweep prints), to_csv(), to_json().)
       .def_property_readonly(
           "descriptions", [](const Sweep& s) { return s.result.descriptions; },
           "int: single-frame matrices computed (frames described that many times).")
+      .def_property_readonly(
+          "frame_reads", [](const Sweep& s) { return s.result.frame_reads; },
+          "int: times the frames were read and decoded (once per description setting).")
       .def_property_readonly(
           "seconds", [](const Sweep& s) { return s.result.seconds; },
           "float: wall time of the sweep.")

@@ -591,6 +591,40 @@ RunResult ComputeSingleFrames(const Config& config, ProgressReporter& progress,
   return ComputePlanned(PlanRun(config, PlanScope::kSingleFrames), progress, &store, true);
 }
 
+std::vector<RunResult> ComputeSingleFramesTogether(const std::vector<Config>& configs,
+                                                   ProgressReporter& progress,
+                                                   SingleFrameStore& store) {
+  struct Group {
+    std::string settings;  // SingleFrameKey without the descriptor
+    Config config;         // the first run's
+    std::vector<std::string> names;
+  };
+  std::vector<Group> groups;
+  for (const Config& c : configs) {
+    const std::string settings = SingleFrameKey(c, "");
+    auto group = std::find_if(groups.begin(), groups.end(),
+                              [&](const Group& g) { return g.settings == settings; });
+    if (group == groups.end()) group = groups.insert(groups.end(), {settings, c, {}});
+    for (const std::string& name : DescriptorList(c.descriptor.name))
+      if (std::find(group->names.begin(), group->names.end(), name) == group->names.end())
+        group->names.push_back(name);
+  }
+  std::vector<RunResult> out;
+  for (const Group& g : groups) {
+    Config together = g.config;
+    together.descriptor.name.clear();
+    for (const std::string& name : g.names)
+      together.descriptor.name += (together.descriptor.name.empty() ? "" : "+") + name;
+    // Weights only to make the fused run valid: the fused matrix is not computed.
+    together.matching.fusion_weights.clear();
+    if (g.names.size() > 1)
+      for (size_t k = 0; k < g.names.size(); ++k)
+        together.matching.fusion_weights += std::string(k ? "," : "") + "1";
+    out.push_back(ComputeSingleFrames(together, progress, store));
+  }
+  return out;
+}
+
 const SingleFrame* SingleFrameStore::Find(const std::string& key) const {
   for (const auto& [k, frame] : kept_)
     if (k == key) return frame.get();

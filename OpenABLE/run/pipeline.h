@@ -67,6 +67,16 @@ RunResult ComputeRun(const Config& config, ProgressReporter& progress,
 RunResult ComputeSingleFrames(const Config& config, ProgressReporter& progress,
                               SingleFrameStore& store);
 
+// ComputeSingleFrames for several dense runs over the same frames (the auto mode's candidates,
+// a sweep's combinations): the descriptors of the runs that share every other description
+// setting (SingleFrameKey without the descriptor) are described in one run, as if fused, so
+// that each frame is read and decoded once for all of them (DescribeSequences); their
+// single-frame matrices are kept per descriptor, as each run would keep them. Returns the
+// result of each such group, in the order of their first run.
+std::vector<RunResult> ComputeSingleFramesTogether(const std::vector<Config>& configs,
+                                                   ProgressReporter& progress,
+                                                   SingleFrameStore& store);
+
 // The single-frame matrix of a dense run of `config` from the matrices `store` holds (its
 // descriptors' matrices fused with Fusion_weights, then contrast-enhanced): the matrix
 // ComputeRun sums sequences over, on one process. `starts` are the traversals' first rows.

@@ -258,39 +258,12 @@ AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress, Sing
     configs.push_back(AutoCandidateConfig(config, choice.candidates.back().settings));
   }
 
-  // Every descriptor of every candidate, described and compared once. The descriptors of
-  // candidates that share every other description setting are described in one run as if
-  // fused, so that each frame is read and decoded once for all of them (the run's
-  // single-frame matrices are kept per descriptor, as each candidate's run would keep them).
+  // Every descriptor of every candidate, described and compared once, each frame read once
+  // for all the descriptors of candidates that share their description settings.
   const int kept_before = store.Size();
-  struct Group {
-    std::string settings;  // SingleFrameKey without the descriptor
-    Config config;         // the first candidate's
-    std::vector<std::string> names;
-  };
-  std::vector<Group> groups;
-  for (const Config& c : configs) {
-    const std::string settings = SingleFrameKey(c, "");
-    auto group = std::find_if(groups.begin(), groups.end(),
-                              [&](const Group& g) { return g.settings == settings; });
-    if (group == groups.end()) group = groups.insert(groups.end(), {settings, c, {}});
-    for (const std::string& name : DescriptorList(c.descriptor.name))
-      if (std::find(group->names.begin(), group->names.end(), name) == group->names.end())
-        group->names.push_back(name);
-  }
   std::vector<int> starts;
   int references = 0, queries = 0;
-  for (const auto& [settings, c, names] : groups) {
-    Config together = c;
-    together.descriptor.name.clear();
-    for (const std::string& name : names)
-      together.descriptor.name += (together.descriptor.name.empty() ? "" : "+") + name;
-    // Weights only to make the fused run valid: the fused matrix is not computed.
-    together.matching.fusion_weights.clear();
-    if (names.size() > 1)
-      for (size_t k = 0; k < names.size(); ++k)
-        together.matching.fusion_weights += std::string(k ? "," : "") + "1";
-    const RunResult r = ComputeSingleFrames(together, progress, store);
+  for (const RunResult& r : ComputeSingleFramesTogether(configs, progress, store)) {
     if (starts.empty()) {
       for (const Traversal& t : r.traversals) starts.push_back(t.first_row);
       references = r.traversals.at(0).frames;

@@ -17,6 +17,7 @@
 #include "OpenABLE/run/evaluate.h"
 #include "OpenABLE/run/pipeline.h"
 #include "OpenABLE/run/verify.h"
+#include "descriptors/registry.h"
 
 namespace openable {
 namespace {
@@ -226,6 +227,13 @@ SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressRe
   if (out.evaluated) out.settings = EvaluationSettingsFrom(base);
   const auto start = Clock::now();
   SingleFrameStore store;
+  // Every descriptor of every combination described before the first run, each frame read and
+  // decoded once for all the descriptors of combinations that share their description
+  // settings; the runs then take their single-frame matrices from the store. A run is marked
+  // as having described the frames for the descriptors no earlier run used.
+  out.frame_reads =
+      static_cast<int>(ComputeSingleFramesTogether(configs, progress, store).size());
+  std::set<std::string> credited;  // single-frame keys an earlier run used
   std::set<std::string> said;
   const int n = static_cast<int>(configs.size());
   for (int i = 0; i < n; ++i) {
@@ -237,9 +245,9 @@ SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressRe
     CheckForInterrupt();
     log("run " + std::to_string(i + 1) + " of " + std::to_string(n) + ": " + run.label);
     const auto t = Clock::now();
-    const int kept_before = store.Size();
     const RunResult result = ComputeRun(config, progress, &store);
-    run.described = store.Size() > kept_before;
+    for (const std::string& name : DescriptorList(config.descriptor.name))
+      run.described = credited.insert(SingleFrameKey(config, name)).second || run.described;
     for (const std::string& w : result.warnings)
       if (said.insert("warning: " + w).second) log("warning: " + w);
     for (const std::string& note : result.notes)
@@ -293,8 +301,9 @@ std::string FormatSweepTable(const SweepResult& r) {
   for (const SweepAxis& a : r.axes) keys += (keys.empty() ? "" : " x ") + a.key;
   o << "Sweep: " << r.runs.size() << " runs (" << keys << "), ranked by "
     << RankTitle(r.rank_by) << "; frames described " << r.descriptions
-    << (r.descriptions == 1 ? " time" : " times") << " (once per description setting), "
-    << FormatFixed(r.seconds, 1) << " s\n";
+    << (r.descriptions == 1 ? " time" : " times") << " (once per descriptor), read "
+    << r.frame_reads << (r.frame_reads == 1 ? " time" : " times")
+    << " (once per description setting), " << FormatFixed(r.seconds, 1) << " s\n";
   const bool loop = !r.runs.empty() && r.runs[0].evaluation.layout.kind ==
                                            EvaluationLayout::Kind::kLoopClosure;
   if (r.evaluated) {
@@ -416,6 +425,7 @@ Json SweepJson(const SweepResult& r, const std::string& version) {
   for (const SweepAxis& a : r.axes)
     varied.push_back({{"key", a.key}, {"values", json::Strings(a.values)}});
   o["descriptions"] = r.descriptions;
+  o["frame_reads"] = r.frame_reads;
   o["seconds"] = json::Number(r.seconds);
   o["evaluation"] = r.evaluated ? EvaluationSettingsJson(r.settings) : Json();
   const std::vector<int> by_auc =

@@ -1,8 +1,10 @@
 // A sweep over settings (openable_sweep, openable.sweep): every combination of a few keys'
 // values, each run as Test_OpenABLE would run it and evaluated against the same ground truth,
-// ranked by one figure. Frames are described once per description setting: runs that differ
-// only in what acts after the single-frame matrix (sequences, scores, contrast, fusion weights,
-// threshold) share it through a SingleFrameStore.
+// ranked by one figure. Frames are described once per descriptor and description setting,
+// before the first run, and read once per description setting for all its descriptors
+// (ComputeSingleFramesTogether): runs that differ only in what acts after the single-frame
+// matrix (sequences, scores, contrast, fusion weights, threshold) share it through a
+// SingleFrameStore.
 #pragma once
 
 #include <functional>
@@ -77,6 +79,8 @@ struct SweepResult {
   EvaluationSettings settings;  // of the base configuration (runs may vary evaluation keys)
   std::vector<SweepRun> runs;   // ranked: best first; ties keep the order of the combinations
   int descriptions = 0;         // single-frame matrices computed (frames described that often)
+  int frame_reads = 0;          // times the frames were read and decoded: once per description
+                                // setting, for all its descriptors
   double seconds = 0;           // wall time of the whole sweep
 };
 

@@ -66,8 +66,9 @@ TEST(Sweep, FiguresEqualTheSingleRunsAndAreRanked) {
   const std::string json = ReadAll(dir + "/out/sweep.json");
   ASSERT_FALSE(json.empty());
   EXPECT_TRUE(fs::exists(dir + "/out/sweep_pr.png"));
-  // Frames described once per descriptor, not once per combination.
+  // Frames described once per descriptor, not once per combination, and read once for both.
   EXPECT_EQ(JsonNumber(json, "descriptions"), 2);
+  EXPECT_EQ(JsonNumber(json, "frame_reads"), 1);
 
   const char* metrics[] = {"auc", "recall_at_100p", "max_f1", "recall_at_1", "recall_at_5",
                            "average_precision_percent", "unanswered_queries"};

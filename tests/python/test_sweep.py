@@ -28,6 +28,7 @@ class SweepTest(TempDirTestCase):
                                 output=self.tmp / "py")
         self.assertEqual(len(result.runs), 8)
         self.assertEqual(result.descriptions, 2)
+        self.assertEqual(result.frame_reads, 1)
         self.assertEqual(len(result.written), 3)
         args = [CONFIG, "--quiet", "--vary", "Image_descriptor=LDB,HOG",
                 "--vary", "Image_sequences=1,5", "--vary", "Match_score=distance,ratio",
