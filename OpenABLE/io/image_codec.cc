@@ -399,8 +399,9 @@ bool Unfilter(unsigned char* data, int rows, std::size_t row_bytes, int bpp) {
 // rather than by libpng, which inflates into a buffer of one row at a time: rows shorter than
 // 258 bytes (64 x 32 frames, the size Nordland is commonly used at) keep zlib's inflate out of
 // its fast loop, and inflate took a fifth of a bounded run over 200,000 such frames
-// (docs/benchmarks.md, "Frames read"). The pixels are libpng's: alpha dropped, BGR order.
-// Returns false, leaving the file to libpng, for any other layout, a chunk whose CRC does not
+// (docs/benchmarks.md, "PNG frames decoded whole"). The pixels are libpng's: alpha dropped,
+// BGR order. The five filters are undone here because libpng offers no call that unfilters a
+// buffer it did not inflate itself. Returns false, leaving the file to libpng, for any other layout, a chunk whose CRC does not
 // match, an unknown critical chunk, or image data that is not exactly the image's: libpng then
 // decodes the file or gives its own reason.
 bool DecodeWholeStream(const std::vector<unsigned char>& bytes, cv::Mat& image) {

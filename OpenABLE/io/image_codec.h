@@ -25,11 +25,12 @@ namespace openable {
 // megapixels ..." for a larger PNG or JPEG, before decoding it (docs/robustness.md).
 cv::Mat DecodeCommonFormat(const std::vector<unsigned char>& bytes, bool& grey_alpha);
 
-// Decodes the bytes of a PNG file whose chunks are sound into 8- or 16-bit pixels, grey
-// (grey, grey + alpha) or BGR (colour, palette, colour + alpha); alpha is dropped, bit depths
-// 1, 2 and 4 are scaled to 8 bits, no gamma is applied: the pixels OpenCV's decoder gives for
-// IMREAD_UNCHANGED once its alpha channel is dropped. Returns false with `why` set when libpng
-// refuses the data.
+// Decodes the bytes of a PNG file whose chunks are sound (8-bit samples without interlacing
+// from the whole zlib stream by libdeflate, anything else by libpng) into 8- or 16-bit
+// pixels, grey (grey, grey + alpha) or BGR (colour, palette, colour + alpha); alpha is
+// dropped, bit depths 1, 2 and 4 are scaled to 8 bits, no gamma is applied: the pixels
+// OpenCV's decoder gives for IMREAD_UNCHANGED once its alpha channel is dropped. Returns false
+// with `why` set when libpng refuses the data.
 bool DecodePng(const std::vector<unsigned char>& bytes, cv::Mat& image, std::string& why);
 
 // The bytes of a PNG file of `image` (CV_8U or CV_16U; 1 channel grey, 3 BGR, 4 BGRA). Rows go
