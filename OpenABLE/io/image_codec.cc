@@ -451,6 +451,10 @@ bool DecodeWholeStream(const std::vector<unsigned char>& bytes, cv::Mat& image) 
   if (idat_chunks == 0) return false;
   const std::size_t row_bytes = static_cast<std::size_t>(width) * channels;
   const std::size_t size = (row_bytes + 1) * height;
+  // Deflate expands at most about 1032 to 1: a header claiming more than its data can hold is
+  // left to libpng, which refuses it, rather than given a buffer of that size.
+  const std::size_t compressed = idat_chunks == 1 ? single_size : stream.size();
+  if (size / 1032 > compressed + 64) return false;
   thread_local std::unique_ptr<libdeflate_decompressor, void (*)(libdeflate_decompressor*)>
       decompressor(libdeflate_alloc_decompressor(), libdeflate_free_decompressor);
   if (decompressor == nullptr) return false;
