@@ -122,18 +122,34 @@ std::mutex& OneAtATime() {
 
 }  // namespace
 
+BlasOnOneThread::BlasOnOneThread() {
+  const OpenBlas* blas = nullptr;
+  try {
+    blas = &Library();
+  } catch (const InputError&) {
+    return;  // no OpenBLAS: nothing to set
+  }
+  ThreadSetting& s = Setting();
+  std::lock_guard<std::mutex> lock(s.mutex);
+  if (s.running++ == 0) {
+    s.host_threads = blas->get_num_threads();
+    if (s.host_threads != 1) blas->set_num_threads(1);
+  }
+  active_ = true;
+}
+
+BlasOnOneThread::~BlasOnOneThread() {
+  if (!active_) return;
+  ThreadSetting& s = Setting();
+  std::lock_guard<std::mutex> lock(s.mutex);
+  if (--s.running == 0 && s.host_threads != 1) Library().set_num_threads(s.host_threads);
+}
+
 void MultiplyTransposed(const float* a, int rows, int lda, const float* b, int cols, int ldb,
                         int width, float* c, int ldc) {
   if (rows <= 0 || cols <= 0) return;
   const OpenBlas& blas = Library();
-  ThreadSetting& s = Setting();
-  {
-    std::lock_guard<std::mutex> lock(s.mutex);
-    if (s.running++ == 0) {
-      s.host_threads = blas.get_num_threads();
-      if (s.host_threads != 1) blas.set_num_threads(1);
-    }
-  }
+  const BlasOnOneThread one_thread;
   const auto call = [&] {
     blas.sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, rows, cols, width, 1.0f, a, lda, b, ldb,
                0.0f, c, ldc);
@@ -144,8 +160,14 @@ void MultiplyTransposed(const float* a, int rows, int lda, const float* b, int c
     std::lock_guard<std::mutex> lock(OneAtATime());
     call();
   }
-  std::lock_guard<std::mutex> lock(s.mutex);
-  if (--s.running == 0 && s.host_threads != 1) blas.set_num_threads(s.host_threads);
+}
+
+void UseBestBlasKernels() {
+  try {
+    Library();
+  } catch (const InputError&) {
+    // No OpenBLAS to load: whatever BLAS the caller's library uses stays as it is.
+  }
 }
 
 std::string BlasDescription() {

@@ -10,6 +10,7 @@
 
 #include "OpenABLE/base/module_loader.h"
 #include "matching/distances.h"
+#include "matching/blas.h"
 #include "matching/search/faiss_index.h"
 
 namespace openable {
@@ -55,6 +56,13 @@ FaissSettings SettingsOf(const ApproximateOptions& o, const cv::Mat& refs, bool 
 
 std::unique_ptr<FaissIndex> BuildFaiss(const ApproximateOptions& o, const cv::Mat& refs,
                                        bool hnsw) {
+  // FAISS trains IVF cells by float k-means on OpenBLAS: on a CPU newer than Debian's OpenBLAS
+  // it would run its SSE3 kernels (measured: 36 % of building a 100,000-row map, in
+  // sgemm_kernel_PRESCOTT).
+  // FAISS spreads k-means over its OpenMP threads, each calling sgemm: OpenBLAS's own threads
+  // would compete with them for the cores.
+  UseBestBlasKernels();
+  const BlasOnOneThread one_thread;
   const auto build =
       reinterpret_cast<OpenableFaissBuild>(ModuleSymbol("faiss", "openable_faiss_build"));
   return std::unique_ptr<FaissIndex>(build(SettingsOf(o, refs, hnsw), refs.data, refs.rows));

@@ -218,6 +218,42 @@ TEST_P(OnlineDetectorEngine, SearchesBlocksBeyondTheExactLimit) {
   EXPECT_EQ(background.Blocks(), approximate.Blocks());
 }
 
+// Rows added at once (AddToMap) get their final blocks built directly: the same blocks, and so
+// the same candidates, as rows added one by one through every merge, and as rows added in two
+// parts (the first part's leading blocks kept).
+TEST_P(OnlineDetectorEngine, RowsAddedAtOnceGetTheBlocksOfTheMerges) {
+  const std::vector<cv::Mat> frames = ReadKitti00Frames(2, 999);  // 500 frames
+  OnlineOptions options;
+  options.approximate.engine = GetParam();
+  options.exclusion = 50;
+  options.candidates = 3;
+  options.exact_limit = 100;
+  options.block_frames = 64;
+  options.background_merges = false;
+  OnlineDetector one_by_one(options);
+  for (int q = 0; q < 420; ++q) one_by_one.AddFrame(frames[q]);
+  const cv::Mat rows = one_by_one.Descriptors().clone();
+  OnlineDetector at_once(options), in_parts(options);
+  at_once.AddToMap(rows);
+  in_parts.AddToMap(rows.rowRange(0, 233));
+  in_parts.AddToMap(rows.rowRange(233, 420));
+  EXPECT_GE(one_by_one.Blocks(), 2);
+  EXPECT_EQ(at_once.Blocks(), one_by_one.Blocks());
+  EXPECT_EQ(in_parts.Blocks(), one_by_one.Blocks());
+  for (int q = 420; q < static_cast<int>(frames.size()); ++q) {
+    const OnlineResult a = one_by_one.AddFrame(frames[q]);
+    const OnlineResult b = at_once.AddFrame(frames[q]);
+    const OnlineResult c = in_parts.AddFrame(frames[q]);
+    ASSERT_EQ(a.candidates.size(), b.candidates.size()) << q;
+    ASSERT_EQ(a.candidates.size(), c.candidates.size()) << q;
+    for (std::size_t i = 0; i < a.candidates.size(); ++i) {
+      EXPECT_EQ(a.candidates[i].frame, b.candidates[i].frame) << q;
+      EXPECT_EQ(a.candidates[i].frame, c.candidates[i].frame) << q;
+      EXPECT_EQ(a.candidates[i].distance, b.candidates[i].distance) << q;
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Index, OnlineDetectorEngine, online_test::IndexEngines(),
                          online_test::EngineName);
 
