@@ -339,8 +339,8 @@ void AddScaleKeys(OptionTable& t, Config& c) {
         "(efSearch; raised to Best_matches when smaller). More: better recall, slower.");
   t.Add("Approximate_nprobe", kScale, c.scale, approximate.nprobe, A::kNprobeRange.min,
         A::kNprobeRange.max,
-        "Approximate_engine ivf: k-means cells scanned per query (nprobe; the index has about "
-        "2 sqrt(N) cells for N references). More: better recall, slower.");
+        "Approximate_engine ivf and binary_ivf: cells scanned per query (nprobe; the index has "
+        "about 2 sqrt(N) cells for N references). More: better recall, slower.");
   t.Add("Descriptor_cache", kScale, c.scale, c.scale.descriptor_cache,
         "Folder of the descriptor cache; empty = off. Each frame's descriptor row is kept under a"
         " hash of the image file's bytes and of every setting that changes the row "

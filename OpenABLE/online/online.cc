@@ -264,6 +264,7 @@ void OnlineDetector::AddToMap(const cv::Mat& rows) {
                      s.describer.descriptor->Name() + ")");
   if (s.type == CV_32F && !cv::checkRange(rows))
     throw InputError("map rows hold a value that is not finite");
+  s.map->Reserve(s.map->Size() + rows.rows);
   for (int i = 0; i < rows.rows; ++i) s.map->Append(rows.row(i));
   s.map->Update(s.map->Size() - s.options.exclusion, /*background=*/false);
 }

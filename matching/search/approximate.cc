@@ -66,6 +66,8 @@ void ApproximateOptions::Check() const {
 struct ApproximateIndex::Impl {
   ApproximateOptions options;  // engine resolved
   cv::Mat references;          // owned copy, continuous: the engine's index may point into it
+                               // (released once built when the engine owns its rows)
+  int rows = 0, width = 0, type = CV_8U;  // of the references
   std::unique_ptr<EngineIndex> index;
 };
 
@@ -82,18 +84,27 @@ ApproximateIndex::ApproximateIndex(const cv::Mat& references, const ApproximateO
   impl_->options = options;
   impl_->options.engine = ResolvedEngine(options.engine, references.depth());
   CheckEngineAvailable(impl_->options.engine, "ApproximateOptions::engine");
+  const ApproximateEngineEntry& entry =
+      FindApproximateEngine(impl_->options.engine, references.depth());
+  if (entry.binary_only && references.depth() != CV_8U)
+    Fail(std::string("ApproximateOptions::engine = ") + entry.name +
+         " indexes binary rows only; expected binary descriptors (LDB, ORB, BRISK, FREAK, "
+         "BRIEF) or another engine for float rows");
   impl_->references = references.clone();
-  impl_->index = FindApproximateEngine(impl_->options.engine, references.depth())
-                     .build(impl_->references, impl_->options, saved);
+  impl_->index = entry.build(impl_->references, impl_->options, saved);
+  impl_->rows = references.rows;
+  impl_->width = references.cols;
+  impl_->type = references.depth();
+  if (entry.owns_rows) impl_->references.release();
 }
 
 ApproximateIndex::~ApproximateIndex() = default;
 ApproximateIndex::ApproximateIndex(ApproximateIndex&&) noexcept = default;
 ApproximateIndex& ApproximateIndex::operator=(ApproximateIndex&&) noexcept = default;
 
-int ApproximateIndex::Size() const { return impl_->references.rows; }
-int ApproximateIndex::Width() const { return impl_->references.cols; }
-int ApproximateIndex::Type() const { return impl_->references.depth(); }
+int ApproximateIndex::Size() const { return impl_->rows; }
+int ApproximateIndex::Width() const { return impl_->width; }
+int ApproximateIndex::Type() const { return impl_->type; }
 const ApproximateOptions& ApproximateIndex::Options() const { return impl_->options; }
 
 void ApproximateIndex::SetSearchBudget(const ApproximateOptions& options) {
@@ -109,8 +120,7 @@ std::vector<std::uint8_t> ApproximateIndex::Serialize() const {
 }
 
 CandidateLists ApproximateIndex::Search(const cv::Mat& queries) const {
-  const cv::Mat& refs = impl_->references;
-  CheckQueries(queries, refs.depth(), refs.cols, "ApproximateIndex::Search");
+  CheckQueries(queries, impl_->type, impl_->width, "ApproximateIndex::Search");
   if (queries.empty()) return CandidateLists(static_cast<size_t>(queries.rows));
   return impl_->index->Search(Continuous(queries), impl_->options);
 }

@@ -45,6 +45,11 @@ struct ApproximateEngineEntry {
   // Built in the run-time module libopenable_faiss.so: a build without FAISS refuses it
   // (CheckEngineAvailable).
   bool needs_faiss;
+  // Indexes binary (CV_8U) rows only: ApproximateIndex refuses float rows for it.
+  bool binary_only;
+  // Its index keeps what it needs of the references (a copy of its own), so that
+  // ApproximateIndex frees the copy it handed to the build once the index is built.
+  bool owns_rows;
   // Builds the index over `references` (continuous CV_8UC1 or CV_32FC1 rows, at least one,
   // finite; held by ApproximateIndex as long as the index lives, so the index may keep a
   // header of them) with `options` (checked, engine resolved to this one). `saved` is empty,

@@ -8,6 +8,7 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
 #include "matching/search/approximate_engine.h"
+#include "matching/search/binary_ivf.h"
 #include "matching/search/faiss_engines.h"
 #include "matching/search/flann_engine.h"
 
@@ -19,6 +20,7 @@ const ApproximateEngineEntry* const kEngines[] = {
     &kFlannEngine,  // matching/search/flann_engine.h
     &kHnswEngine,   // matching/search/faiss_engines.h
     &kIvfEngine,    // matching/search/faiss_engines.h
+    &kBinaryIvfEngine,  // matching/search/binary_ivf.h
 };
 
 // What auto stands for, measured by bench/bench_approximate (docs/matching.md, "Choosing an

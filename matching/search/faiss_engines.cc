@@ -12,6 +12,7 @@
 #include "matching/distances.h"
 #include "matching/blas.h"
 #include "matching/search/faiss_index.h"
+#include "matching/search/ivf_cells.h"
 
 namespace openable {
 namespace {
@@ -19,18 +20,12 @@ namespace {
 [[noreturn]] void FailFaiss(const std::string& message) { throw std::invalid_argument(message); }
 
 // Binary IVF: the cells FAISS trained and filled, scanned here with OpenABLE's Hamming
-// kernels rather than by FAISS's search. Debian's libfaiss is built for baseline x86-64: its
-// Hamming distances count bits without the POPCNT instruction (let alone AVX-512's
-// VPOPCNTQ), several times slower per row than the kernels of matching/distances.h that the
-// exact scan uses, which would eat most of what probing a few cells saves. The cells and the
-// probing rule (the rows of the nprobe cells whose centres are nearest the query) are those of
-// FAISS's IVF search; the distances are ours, exact, with ties broken by the lower cell and
-// the lower row.
-struct IvfCells {
-  std::unique_ptr<HammingReferences> centres;            // one row per cell
-  std::vector<std::unique_ptr<HammingReferences>> rows;  // each cell's rows (null: empty)
-  std::vector<std::vector<int>> ids;                     // their rows of `references`
-};
+// kernels rather than by FAISS's search (IvfCells, matching/search/ivf_cells.h). Debian's
+// libfaiss is built for baseline x86-64: its Hamming distances count bits without the POPCNT
+// instruction (let alone AVX-512's VPOPCNTQ), several times slower per row than the kernels
+// of matching/distances.h that the exact scan uses, which would eat most of what probing a
+// few cells saves. The cells and the probing rule are those of FAISS's IVF search; the
+// distances are ours, exact, with ties broken by the lower cell and the lower row.
 
 // The module's settings of an index of `options` over `refs`: the one place FaissSettings are
 // made, every field from ApproximateOptions or the rows.
@@ -96,30 +91,21 @@ std::unique_ptr<IvfCells> CellsOf(const FaissIndex& index, const cv::Mat& refs) 
   if (centres.size() != cells.size() * width)
     FailFaiss("ApproximateIndex: the IVF index has " + std::to_string(centres.size()) +
          " bytes of cell centres, expected " + std::to_string(cells.size() * width));
-  auto out = std::make_unique<IvfCells>();
-  const cv::Mat centre_rows(static_cast<int>(cells.size()), refs.cols, CV_8U, centres.data());
-  out->centres = std::make_unique<HammingReferences>(centre_rows);
-  out->rows.resize(cells.size());
-  out->ids.resize(cells.size());
-  std::int64_t total = 0;
-  for (std::size_t l = 0; l < cells.size(); ++l) {
-    const std::vector<std::int64_t>& ids = cells[l];
-    total += static_cast<std::int64_t>(ids.size());
-    if (ids.empty()) continue;
-    cv::Mat rows(static_cast<int>(ids.size()), refs.cols, CV_8U);
-    for (std::size_t i = 0; i < ids.size(); ++i) {
-      if (ids[i] < 0 || ids[i] >= refs.rows)
-        FailFaiss("ApproximateIndex: the IVF index names row " + std::to_string(ids[i]) +
-             ", expected 0 to " + std::to_string(refs.rows - 1));
-      refs.row(static_cast<int>(ids[i])).copyTo(rows.row(static_cast<int>(i)));
-      out->ids[l].push_back(static_cast<int>(ids[i]));
+  std::vector<std::vector<int>> ids(cells.size());
+  for (std::size_t l = 0; l < cells.size(); ++l)
+    for (const std::int64_t id : cells[l]) {
+      if (id < 0 || id >= refs.rows)
+        FailFaiss("ApproximateIndex: the IVF index names row " + std::to_string(id) +
+                  ", expected 0 to " + std::to_string(refs.rows - 1));
+      ids[l].push_back(static_cast<int>(id));
     }
-    out->rows[l] = std::make_unique<HammingReferences>(rows);
+  const cv::Mat centre_rows(static_cast<int>(cells.size()), refs.cols, CV_8U, centres.data());
+  try {
+    return MakeIvfCells(refs, centre_rows, ids);
+  } catch (const std::invalid_argument& e) {
+    FailFaiss(std::string("ApproximateIndex: the IVF index does not fit its references: ") +
+              e.what());
   }
-  if (total != refs.rows)
-    FailFaiss("ApproximateIndex: the IVF index's cells hold " + std::to_string(total) +
-         " rows, expected " + std::to_string(refs.rows));
-  return out;
 }
 
 // A FAISS index over the references; binary IVF scanned through its cells (IvfCells).
@@ -133,50 +119,9 @@ class FaissEngineIndex final : public EngineIndex {
         cells_(CellsOf(*faiss_, refs_)) {}
 
   CandidateLists Search(const cv::Mat& queries, const ApproximateOptions& options) const override {
-    CandidateLists out(static_cast<size_t>(queries.rows));
     const int knn = std::min(options.k, refs_.rows);
-    if (cells_) {
-      // The nprobe cells whose centres are nearest the query (ties: the lower cell), then the k
-      // nearest of their rows (ties: the lower row), kept in a max-heap of k.
-      const IvfCells& cells = *cells_;
-      const int lists = static_cast<int>(cells.ids.size());
-      const int probes = std::min(options.nprobe, lists);
-      ParallelBlocks(queries.rows, kQueryBlock, options.threads, [&](int q0, int q1) {
-        std::vector<float> centre(static_cast<size_t>(lists)), d;
-        std::vector<int> order(static_cast<size_t>(lists));
-        for (int q = q0; q < q1; ++q) {
-          const std::uint8_t* query = queries.ptr<std::uint8_t>(q);
-          cells.centres->Distances(query, centre.data());
-          std::iota(order.begin(), order.end(), 0);
-          std::partial_sort(order.begin(), order.begin() + probes, order.end(), [&](int a, int b) {
-            return centre[static_cast<size_t>(a)] < centre[static_cast<size_t>(b)] ||
-                   (centre[static_cast<size_t>(a)] == centre[static_cast<size_t>(b)] && a < b);
-          });
-          std::vector<Candidate>& heap = out[static_cast<size_t>(q)];
-          heap.reserve(static_cast<size_t>(knn));
-          for (int p = 0; p < probes; ++p) {
-            const int l = order[static_cast<size_t>(p)];
-            const std::vector<int>& ids = cells.ids[static_cast<size_t>(l)];
-            if (ids.empty()) continue;
-            d.resize(ids.size());
-            cells.rows[static_cast<size_t>(l)]->Distances(query, d.data());
-            for (std::size_t i = 0; i < ids.size(); ++i) {
-              const Candidate c{ids[i], d[i]};
-              if (static_cast<int>(heap.size()) < knn) {
-                heap.push_back(c);
-                std::push_heap(heap.begin(), heap.end(), CandidateBefore);
-              } else if (CandidateBefore(c, heap.front())) {
-                std::pop_heap(heap.begin(), heap.end(), CandidateBefore);
-                heap.back() = c;
-                std::push_heap(heap.begin(), heap.end(), CandidateBefore);
-              }
-            }
-          }
-          SortCandidates(heap);
-        }
-      });
-      return out;
-    }
+    if (cells_) return SearchIvfCells(*cells_, queries, knn, options.nprobe, options.threads);
+    CandidateLists out(static_cast<size_t>(queries.rows));
     // FAISS spreads the queries over its OpenMP threads itself; only the exact distances are
     // recomputed here, over OpenABLE's.
     std::vector<std::int64_t> labels(static_cast<size_t>(queries.rows) * static_cast<size_t>(knn));
@@ -239,6 +184,8 @@ const ApproximateEngineEntry kHnswEngine = {
     "hnsw",                 // name
     "FAISS's HNSW graphs",  // summary
     /*needs_faiss=*/true,
+    /*binary_only=*/false,
+    /*owns_rows=*/false,
     &BuildHnsw,
     &HnswBytesPerRow,
 };
@@ -247,6 +194,8 @@ const ApproximateEngineEntry kIvfEngine = {
     "ivf",                                     // name
     "FAISS's inverted files (k-means cells)",  // summary
     /*needs_faiss=*/true,
+    /*binary_only=*/false,
+    /*owns_rows=*/false,
     &BuildIvf,
     &IvfBytesPerRow,
 };

@@ -165,6 +165,8 @@ const ApproximateEngineEntry kFlannEngine = {
     "flann",                                                                   // name
     "OpenCV's FLANN (LSH for binary descriptors, k-d trees for vector ones)",  // summary
     /*needs_faiss=*/false,
+    /*binary_only=*/false,
+    /*owns_rows=*/false,
     &Build,
     &BytesPerRow,
 };

@@ -99,6 +99,14 @@ IncrementalIndex::IncrementalIndex(int width, int type, const IncrementalIndexOp
 
 IncrementalIndex::~IncrementalIndex() = default;
 
+void IncrementalIndex::Reserve(int rows) {
+  State& s = *state_;
+  if (rows <= s.buffer.rows) return;
+  cv::Mat bigger(rows, s.width, s.type);
+  if (s.size > 0) s.buffer.rowRange(0, s.size).copyTo(bigger.rowRange(0, s.size));
+  s.buffer = bigger;
+}
+
 void IncrementalIndex::Append(const cv::Mat& row) {
   State& s = *state_;
   if (s.size == s.buffer.rows) {
@@ -231,8 +239,8 @@ std::int64_t IncrementalIndex::MemoryBytes() const {
   const std::int64_t row_bytes = s.width * static_cast<std::int64_t>(s.buffer.elemSize());
   const ApproximateEngineEntry& engine =
       FindApproximateEngine(s.options.approximate.engine, s.type);
-  const std::int64_t per_row =
-      row_bytes + engine.bytes_per_row(s.options.approximate, s.type, row_bytes);
+  const std::int64_t per_row = (engine.owns_rows ? 0 : row_bytes) +
+                               engine.bytes_per_row(s.options.approximate, s.type, row_bytes);
   auto index_bytes = [&](std::int64_t rows) { return rows * per_row; };
   for (const auto& b : s.blocks) bytes += index_bytes(b.count);
   // A merge being built: its index and the copy of its rows handed to the build.

@@ -37,6 +37,9 @@ class IncrementalIndex {
 
   // Appends one row (1 x width, type) as row Size(); the buffer doubles when full.
   void Append(const cv::Mat& row);
+  // Room for `rows` rows in all without growing (rows added at once: the doubling would leave
+  // up to half the buffer unused).
+  void Reserve(int rows);
   // Indexes full blocks of the rows [0, searchable) once `searchable` exceeds exact_limit.
   // `background` false builds every merge here (a map loaded all at once).
   void Update(int searchable, bool background = true);

@@ -200,7 +200,7 @@ TEST(Config, ApproximateEngineValues) {
   const std::string bad = ErrorOf([&] { ApplyOverride(c, "Approximate_engine=annoy"); });
   EXPECT_NE(bad.find("Approximate_engine"), std::string::npos) << bad;
   EXPECT_NE(bad.find("annoy"), std::string::npos) << bad;
-  EXPECT_NE(bad.find("flann, hnsw, ivf or auto"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("flann, hnsw, ivf, binary_ivf or auto"), std::string::npos) << bad;
   EXPECT_EQ(bad.find('\n'), std::string::npos) << bad;
   EXPECT_EQ(c.scale.approximate.engine, "hnsw");  // unchanged
   // Read from a file as well.

@@ -628,7 +628,7 @@ TEST(ApproximateIndex, RejectsBadFaissOptions) {
   };
   const std::pair<ApproximateOptions, const char*> bad[] = {
       {with([](ApproximateOptions& o) { o.engine = "annoy"; }),
-       "engine = \"annoy\", expected one of flann, hnsw, ivf or auto"},
+       "engine = \"annoy\", expected one of flann, hnsw, ivf, binary_ivf or auto"},
       {with([](ApproximateOptions& o) { o.hnsw_m = 2; }), "hnsw_m = 2, expected 4..128"},
       {with([](ApproximateOptions& o) { o.hnsw_ef_construction = 0; }),
        "hnsw_ef_construction = 0"},
@@ -666,6 +666,77 @@ TEST(ApproximateIndex, FaissEnginesNeedFaissInTheBuild) {
     }
     EXPECT_THROW(ApproximateIndex(RandomBytes(10, 32, 161), EngineOptions(engine)), InputError);
   }
+}
+
+// The binary_ivf engine against brute force: probing every cell gives the exact k nearest
+// (the same rows, distances and tie order as ExactNearest); a few cells find the near
+// duplicates planted in the references; the index is the same on one and two threads, and the
+// index read back from its bytes gives the same candidates.
+TEST(BinaryIvf, EveryCellProbedIsExactAndFewCellsFindNearDuplicates) {
+  std::mt19937 rng(3);
+  cv::Mat refs(5000, 32, CV_8U);
+  for (int i = 0; i < refs.rows; ++i)
+    for (int b = 0; b < refs.cols; ++b)
+      refs.at<std::uint8_t>(i, b) = static_cast<std::uint8_t>(rng());
+  // Queries: 60 references with 8 of their 256 bits flipped, and 20 random rows.
+  cv::Mat queries(80, 32, CV_8U);
+  std::vector<int> planted;
+  for (int q = 0; q < 60; ++q) {
+    const int r = static_cast<int>(rng() % 5000);
+    planted.push_back(r);
+    refs.row(r).copyTo(queries.row(q));
+    for (int f = 0; f < 8; ++f) {
+      const int bit = static_cast<int>(rng() % 256);
+      queries.at<std::uint8_t>(q, bit / 8) ^= static_cast<std::uint8_t>(1u << (bit % 8));
+    }
+  }
+  for (int q = 60; q < 80; ++q)
+    for (int b = 0; b < 32; ++b) queries.at<std::uint8_t>(q, b) = static_cast<std::uint8_t>(rng());
+  ApproximateOptions options;
+  options.engine = "binary_ivf";
+  options.k = 7;
+  options.ivf_lists = 40;
+  options.nprobe = 40;
+  options.threads = 1;
+  const ApproximateIndex index(refs, options);
+  const CandidateLists exact = ExactNearest(refs, queries, 7, 1);
+  const CandidateLists all = index.Search(queries);
+  ASSERT_EQ(all.size(), exact.size());
+  for (std::size_t q = 0; q < all.size(); ++q) {
+    ASSERT_EQ(all[q].size(), exact[q].size()) << q;
+    for (std::size_t i = 0; i < all[q].size(); ++i) {
+      EXPECT_EQ(all[q][i].reference, exact[q][i].reference) << q << " " << i;
+      EXPECT_EQ(all[q][i].distance, exact[q][i].distance) << q << " " << i;
+    }
+  }
+  // Two cells of 40: the planted row is its query's nearest by far (8 bits against about 128)
+  // and lies in a cell near it.
+  ApproximateOptions few = options;
+  few.nprobe = 2;
+  const ApproximateIndex narrow(refs, few);
+  const CandidateLists found = narrow.Search(queries);
+  int hits = 0;
+  for (int q = 0; q < 60; ++q)
+    hits += !found[static_cast<std::size_t>(q)].empty() &&
+            found[static_cast<std::size_t>(q)][0].reference == planted[static_cast<std::size_t>(q)];
+  EXPECT_GE(hits, 40) << "planted rows found with 2 of 40 cells";
+  // One thread or two: the same index; read back: the same candidates.
+  ApproximateOptions two = options;
+  two.threads = 2;
+  EXPECT_EQ(ApproximateIndex(refs, two).Serialize(), index.Serialize());
+  const ApproximateIndex read(refs, few, narrow.Serialize());
+  const CandidateLists again = read.Search(queries);
+  for (std::size_t q = 0; q < found.size(); ++q) {
+    ASSERT_EQ(again[q].size(), found[q].size());
+    for (std::size_t i = 0; i < found[q].size(); ++i)
+      EXPECT_EQ(again[q][i].reference, found[q][i].reference);
+  }
+  // Bytes of another index, or of these cut short: refused.
+  std::vector<std::uint8_t> bytes = index.Serialize();
+  bytes.resize(bytes.size() - 4);
+  EXPECT_THROW(ApproximateIndex(refs, options, bytes), std::invalid_argument);
+  EXPECT_THROW(ApproximateIndex(refs.rowRange(0, 4000), options, index.Serialize()),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -81,6 +81,10 @@ TEST(EngineRegistry, EveryEngineSearchesBothKindsOfRowsAndReadsItselfBack) {
         }
         continue;
       }
+      if (entry.binary_only && depth != CV_8U) {
+        EXPECT_THROW(ApproximateIndex(refs, options), std::invalid_argument);
+        continue;
+      }
       const ApproximateIndex index(refs, options);
       EXPECT_EQ(index.Options().engine, entry.name);
       const CandidateLists lists = index.Search(queries);
