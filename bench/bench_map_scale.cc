@@ -12,8 +12,14 @@
 // default 500). A query agrees when its best candidate's distance equals the exact nearest
 // distance (ties count).
 //
+// Then the map is saved as a map file (OpenABLE/online/map_file.h, the file SaveMap writes:
+// its rows and the index blocks' saved forms) to --map-file (default a file in /tmp, removed
+// after) and loaded again (read, checksum checked, blocks restored from their saved forms):
+// the file's size, both times, and whether the loaded map gives every query the same
+// candidates.
+//
 // Usage: bench_map_scale [--rows N] [--engine binary_ivf|ivf|flann|hnsw] [--nprobe P]
-//                        [--flip F] [--queries Q] [--datasets DIR]
+//                        [--flip F] [--queries Q] [--datasets DIR] [--map-file PATH]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -26,6 +32,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/io/frame_source.h"
+#include "OpenABLE/online/map_file.h"
 #include "OpenABLE/online/online.h"
 #include "matching/distances.h"
 #include "matching/search/incremental_index.h"
@@ -56,6 +63,8 @@ int main(int argc, char** argv) {
   int rows = 1000000, queries = 500, nprobe = 64;
   double flip = 0.05;
   std::string engine = "binary_ivf", datasets = OPENABLE_DATASETS_DIR;
+  std::string map_file = "/tmp/bench_map_scale.map";
+  bool keep_file = false;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
     if (a == "--rows") rows = std::atoi(v.c_str());
@@ -64,6 +73,7 @@ int main(int argc, char** argv) {
     else if (a == "--flip") flip = std::atof(v.c_str());
     else if (a == "--queries") queries = std::atoi(v.c_str());
     else if (a == "--datasets") datasets = v;
+    else if (a == "--map-file") map_file = v, keep_file = true;
     else {
       std::fprintf(stderr, "bench_map_scale: unknown argument %s (see the top of the source)\n",
                    a.c_str());
@@ -150,5 +160,34 @@ int main(int argc, char** argv) {
   std::printf("  of a query: %.3f ms in the blocks' search, the rest scoring %.0f candidates "
               "(the blocks' k best and the rows not in a block yet)\n",
               1e3 * searching / queries, static_cast<double>(scored) / queries);
+
+  // Saved and loaded as a map file.
+  t = std::chrono::steady_clock::now();
+  openable::MapFile file;
+  file.settings = {{"frames", std::to_string(rows)},
+                   {"row_width", std::to_string(map.cols)},
+                   {"row_type", "CV_8U"},
+                   {"engine", engine}};
+  file.rows = stored;
+  file.blocks = index.SaveBlocks();
+  openable::WriteMapFile(map_file, file);
+  const double save = Seconds(t);
+  std::ifstream sized(map_file, std::ios::binary | std::ios::ate);
+  const double megabytes = static_cast<double>(sized.tellg()) / 1e6;
+  file = openable::MapFile();
+  t = std::chrono::steady_clock::now();
+  const openable::MapFile read = openable::ReadMapFile(map_file);
+  openable::IncrementalIndex loaded(map.cols, CV_8U, index_options);
+  loaded.Restore(read.rows, read.blocks);
+  const double load = Seconds(t);
+  int same = 0;
+  for (int q = 0; q < queries; ++q) {
+    bool a = false, b = false;
+    same += index.Candidates(winter.row(q), rows, &a) == loaded.Candidates(winter.row(q), rows, &b);
+  }
+  if (!keep_file) std::remove(map_file.c_str());
+  std::printf("  saved in %.1f s (%.0f MB), loaded in %.1f s (read, checksum, blocks restored); "
+              "the same candidates after loading for %d of %d queries\n",
+              save, megabytes, load, same, queries);
   return 0;
 }
