@@ -1,5 +1,7 @@
 #include "matching/blas.h"
 
+#include <dlfcn.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -144,6 +146,31 @@ TEST(Blas, RunsKernelsOfTheCpusInstructionSets) {
                            "kernels Cooperlake", "kernels SapphireRapids"})
     avx2_kernels |= d.find(core) != std::string::npos;
   EXPECT_TRUE(avx2_kernels) << d;
+}
+
+// While a BlasOnOneThread lives (FAISS's k-means runs), OpenBLAS's process-wide thread count is
+// 1; the host's own count comes back when the last one ends, also when they overlap.
+TEST(BlasOnOneThread, SetsOneThreadAndPutsTheHostsCountBack) {
+  void* handle = dlopen("libopenblas.so.0", RTLD_NOW | RTLD_LOCAL);
+  if (handle == nullptr) GTEST_SKIP() << "no OpenBLAS";
+  const auto set = reinterpret_cast<void (*)(int)>(dlsym(handle, "openblas_set_num_threads"));
+  const auto get = reinterpret_cast<int (*)()>(dlsym(handle, "openblas_get_num_threads"));
+  ASSERT_TRUE(set != nullptr && get != nullptr);
+  const int before = get();
+  set(3);
+  ASSERT_EQ(get(), 3) << "this OpenBLAS does not take a thread count";
+  {
+    const BlasOnOneThread outer;
+    EXPECT_EQ(get(), 1);
+    {
+      const BlasOnOneThread inner;
+      EXPECT_EQ(get(), 1);
+    }
+    EXPECT_EQ(get(), 1);  // the outer one still runs
+  }
+  EXPECT_EQ(get(), 3);
+  set(before);
+  dlclose(handle);
 }
 
 }  // namespace
