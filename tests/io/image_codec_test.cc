@@ -7,6 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <iterator>
+#include <fstream>
+#include <filesystem>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -17,6 +20,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "tests/test_support.h"
 
 namespace openable {
 namespace {
@@ -239,6 +243,34 @@ TEST(DecodePng, ImageDataThatIsNotTheImagesIsRefused) {
   got.release();
   EXPECT_FALSE(DecodePng(file_of(short_rows), got, why));
   EXPECT_TRUE(got.empty());
+}
+
+// The frames of the real data sets (grey KITTI and EuRoC frames, RGB Nordland and Sussex
+// panoramas, every one written by another encoder than libpng's defaults here), decoded from
+// their whole stream, against OpenCV's decoder: every tenth file of each folder.
+TEST(DecodePng, RealFramesAsOpenCv) {
+  const std::string root = testing::DatasetsDir();
+  if (!std::filesystem::is_directory(root)) GTEST_SKIP() << "no ../shared/datasets";
+  int compared = 0;
+  for (const char* folder : {"kitti00_first1700", "euroc_stereo_pairs", "nordland_trimmed",
+                             "sussex_panoramas"}) {
+    std::vector<std::string> files;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(root + "/" + folder))
+      if (e.path().extension() == ".png") files.push_back(e.path().string());
+    std::sort(files.begin(), files.end());
+    for (std::size_t i = 0; i < files.size(); i += 10) {
+      SCOPED_TRACE(files[i]);
+      std::ifstream in(files[i], std::ios::binary);
+      const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
+                                             std::istreambuf_iterator<char>());
+      cv::Mat got;
+      std::string why;
+      ASSERT_TRUE(DecodePng(bytes, got, why)) << why;
+      ExpectEqualImages(got, OpenCvPixels(bytes, false));
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 500);
 }
 
 TEST(DecodePng, DamagedDataIsRefusedWithAReason) {
