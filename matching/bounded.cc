@@ -495,10 +495,12 @@ class SlicedKeep {
     for (int r = 0; r < ranked; ++r)
       out.push_back({q_, heap_[r].second, heap_[r].first, r + 1,
                      score(heap_[r].first, heap_[r].second)});
-    for (const auto& [v, j] : band_) {
+    for (const std::pair<float, int>& cell : band_) {
+      // (Not a structured binding: C++17 does not let a lambda capture one; clang refuses.)
+      const int j = cell.second;
       const bool is_ranked = std::any_of(heap_.begin(), heap_.begin() + ranked,
                                          [&](const auto& e) { return e.second == j; });
-      if (!is_ranked) out.push_back({q_, j, v, 0, score(v, j)});
+      if (!is_ranked) out.push_back({q_, j, cell.first, 0, score(cell.first, j)});
     }
   }
 
