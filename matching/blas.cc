@@ -162,14 +162,6 @@ void MultiplyTransposed(const float* a, int rows, int lda, const float* b, int c
   }
 }
 
-void UseBestBlasKernels() {
-  try {
-    Library();
-  } catch (const InputError&) {
-    // No OpenBLAS to load: whatever BLAS the caller's library uses stays as it is.
-  }
-}
-
 std::string BlasDescription() {
   const OpenBlas& blas = Library();
   const int parallel = blas.get_parallel();

@@ -30,16 +30,12 @@ namespace openable {
 void MultiplyTransposed(const float* a, int rows, int lda, const float* b, int cols, int ldb,
                         int width, float* c, int ldc);
 
-// Loads OpenBLAS and has it run this CPU's kernels (as above) before a library that calls
-// BLAS itself does: FAISS's k-means, whose products go through Debian's libblas.so.3, the same
-// OpenBLAS. Best effort: without OpenBLAS nothing changes (that library then uses the BLAS the
-// system chose).
-void UseBestBlasKernels();
-
-// While one lives, OpenBLAS's process-wide thread count is 1 (as while MultiplyTransposed
-// runs; the host's count is put back when the last ends): for a library that spreads its own
-// work over threads and calls BLAS from them (FAISS's k-means, on OpenMP), where OpenBLAS's
-// threads would compete with its own for the cores. Nothing when OpenBLAS cannot be loaded.
+// While one lives, OpenBLAS runs this CPU's kernels (loaded as above) and its process-wide
+// thread count is 1 (as while MultiplyTransposed runs; the host's count is put back when the
+// last ends): for a library that calls BLAS itself from threads of its own (FAISS's k-means on
+// OpenMP, whose products go through Debian's libblas.so.3, the same OpenBLAS), where
+// OpenBLAS's threads would compete with its own for the cores. Nothing when OpenBLAS cannot be
+// loaded: that library then uses the BLAS the system chose.
 class BlasOnOneThread {
  public:
   BlasOnOneThread();

@@ -8,7 +8,6 @@
 #include <functional>
 #include <limits>
 #include <mutex>
-#include <queue>
 #include <stdexcept>
 
 #include <opencv2/core/hal/intrin.hpp>
@@ -41,59 +40,113 @@ MatchBlock BlockOf(const std::vector<int>& starts, int n) {
   return b;
 }
 
+namespace {
+
+// The kept matches of one query row (KeepRow), from slices of its columns given in increasing
+// order (the whole row at once, or the tiles of TiledMatches). A max-heap keeps the k smallest
+// cells by (distance, column), a set that does not depend on how the row is cut; ties go to the
+// smaller column. For the ratio score it keeps the 2 window + 2 smallest: a kept match's best
+// rival (the smallest cell more than window columns away) is among them, since at most
+// 2 window + 1 cells lie within its window.
+class SlicedKeep {
+ public:
+  SlicedKeep(int q, int references, const KeepRules& rules)
+      : q_(q),
+        limit_(rules.one_traversal ? std::min(references, q - rules.exclusion + 1)
+                                   : references),
+        kept_(KeptCells(rules)),
+        rules_(&rules) {}
+
+  // Cells kept per query: KeepRules::best, more for the ratio score.
+  static int KeptCells(const KeepRules& rules) {
+    return rules.score == MatchScore::kRatio ? std::max(rules.best, 2 * rules.score_window + 2)
+                                             : rules.best;
+  }
+
+  // Columns [c0, c1) of the row, s[0] being column c0.
+  void Add(const float* s, int c0, int c1) {
+    const int end = std::min(c1, limit_);
+    int j = c0;
+    for (; kept_ > 0 && j < end && static_cast<int>(heap_.size()) < kept_; ++j)
+      if (std::isfinite(s[j - c0])) Push(s[j - c0], j);
+    if (kept_ > 0 && j < end) {
+      // The heap is full: a cell enters when it is below the worst kept (a tie loses, being at
+      // a larger column than every kept one). Most cells do not, so blocks of 16 cells are
+      // first tested together, with OpenCV's universal intrinsics (SSE2 at the x86-64
+      // baseline, NEON on ARM): the compiler leaves this test scalar when written as a loop.
+      // NaN is never below; visit() decides exactly for the cells of a block that has one.
+      float worst = heap_.front().first;
+      const auto visit = [&](int c) {
+        const float v = s[c - c0];
+        if (v < worst && std::isfinite(v)) {
+          std::pop_heap(heap_.begin(), heap_.end());
+          heap_.back() = {v, c};
+          std::push_heap(heap_.begin(), heap_.end());
+          worst = heap_.front().first;
+        }
+      };
+      for (; j + 16 <= end; j += 16) {
+        const float* b = s + (j - c0);
+        const cv::v_float32x4 w = cv::v_setall_f32(worst);
+        const cv::v_float32x4 below = (cv::v_load(b) < w) | (cv::v_load(b + 4) < w) |
+                                      (cv::v_load(b + 8) < w) | (cv::v_load(b + 12) < w);
+        if (cv::v_check_any(below))
+          for (int u = 0; u < 16; ++u) visit(j + u);
+      }
+      for (; j < end; ++j) visit(j);
+    }
+    if (rules_->band >= 0) {
+      const int j0 = std::max(c0, q_ - rules_->band);
+      const int j1 = std::min(c1, q_ + rules_->band + 1);
+      for (int c = j0; c < j1; ++c)
+        if (std::isfinite(s[c - c0])) band_.push_back({s[c - c0], c});
+    }
+  }
+
+  // The row's matches, in KeepRow's order: ranks 1 .. k, then the band's other cells.
+  void Finish(std::vector<Match>& out) {
+    std::sort_heap(heap_.begin(), heap_.end());  // (distance, column) increasing
+    const int ranked = std::min(rules_->best, static_cast<int>(heap_.size()));
+    std::vector<std::pair<float, int>> candidates;
+    const auto score = [&](float v, int j) {
+      if (rules_->score == MatchScore::kDistance) return v;
+      // Among the kept cells and the match itself (in its own window: never its rival).
+      candidates.assign(heap_.begin(), heap_.end());
+      candidates.push_back({v, j});
+      return ScoreOfCandidate(candidates, candidates.size() - 1, rules_->score,
+                              rules_->score_window);
+    };
+    for (int r = 0; r < ranked; ++r)
+      out.push_back({q_, heap_[r].second, heap_[r].first, r + 1,
+                     score(heap_[r].first, heap_[r].second)});
+    for (const std::pair<float, int>& cell : band_) {
+      // (Not a structured binding: C++17 does not let a lambda capture one; clang refuses.)
+      const int j = cell.second;
+      const bool is_ranked = std::any_of(heap_.begin(), heap_.begin() + ranked,
+                                         [&](const auto& e) { return e.second == j; });
+      if (!is_ranked) out.push_back({q_, j, cell.first, 0, score(cell.first, j)});
+    }
+  }
+
+ private:
+  void Push(float v, int j) {
+    heap_.push_back({v, j});
+    std::push_heap(heap_.begin(), heap_.end());
+  }
+
+  int q_, limit_, kept_;
+  const KeepRules* rules_;
+  std::vector<std::pair<float, int>> heap_;  // max-heap of (distance, column)
+  std::vector<std::pair<float, int>> band_;  // (distance, column), columns increasing
+};
+
+}  // namespace
+
 void KeepRow(const float* s, int references, int q, const KeepRules& rules,
              std::vector<Match>& out) {
-  // k best: a max-heap of (distance, reference) holding the k smallest seen; ties go to the
-  // smaller reference number.
-  const int limit = rules.one_traversal ? std::min(references, q - rules.exclusion + 1)
-                                        : references;
-  using Entry = std::pair<float, int>;
-  std::priority_queue<Entry> heap;
-  if (rules.best > 0) {
-    int j = 0;
-    for (; j < limit && static_cast<int>(heap.size()) < rules.best; ++j)
-      if (std::isfinite(s[j])) heap.push({s[j], j});
-    // The heap is full: a cell enters when it is below the worst kept (a tie loses, being at a
-    // larger reference than every kept one). Most rows' cells do not, so blocks of 16 cells
-    // are first tested together.
-    float worst = heap.empty() ? 0.0f : heap.top().first;
-    auto visit = [&](int c) {
-      if (s[c] < worst && std::isfinite(s[c])) {
-        heap.pop();
-        heap.push({s[c], c});
-        worst = heap.top().first;
-      }
-    };
-    // Blocks of 16 cells tested with OpenCV's universal intrinsics (SSE2 at the x86-64
-    // baseline, NEON on ARM): the compiler leaves this test scalar when written as a loop.
-    // NaN is never below; visit() decides exactly for the cells of a block that has one.
-    for (; j + 16 <= limit; j += 16) {
-      const cv::v_float32x4 w = cv::v_setall_f32(worst);
-      const cv::v_float32x4 below = (cv::v_load(s + j) < w) | (cv::v_load(s + j + 4) < w) |
-                                    (cv::v_load(s + j + 8) < w) | (cv::v_load(s + j + 12) < w);
-      if (cv::v_check_any(below))
-        for (int u = 0; u < 16; ++u) visit(j + u);
-    }
-    for (; j < limit; ++j) visit(j);
-  }
-  std::vector<Entry> best;
-  best.reserve(heap.size());
-  for (; !heap.empty(); heap.pop()) best.push_back(heap.top());
-  std::reverse(best.begin(), best.end());
-  const auto score = [&](int j) {
-    return ScoreOfCandidate(s, std::max(0, limit), j, rules.score, rules.score_window);
-  };
-  for (size_t r = 0; r < best.size(); ++r)
-    out.push_back({q, best[r].second, best[r].first, static_cast<int>(r + 1),
-                   score(best[r].second)});
-  if (rules.band >= 0) {
-    const int j0 = std::max(0, q - rules.band), j1 = std::min(references - 1, q + rules.band);
-    for (int j = j0; j <= j1; ++j) {
-      const bool ranked = std::any_of(best.begin(), best.end(),
-                                      [&](const Entry& e) { return e.second == j; });
-      if (!ranked && std::isfinite(s[j])) out.push_back({q, j, s[j], 0, score(j)});
-    }
-  }
+  SlicedKeep keep(q, references, rules);
+  keep.Add(s, 0, references);
+  keep.Finish(out);
 }
 
 std::vector<Match> MatchesFromMatrix(const cv::Mat1f& normalized, const MatchBlock& block,
@@ -422,99 +475,15 @@ float SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
 }
 
 
-// The kept matches of one query row (KeepRow's) from slices of its columns given in
-// increasing order. KeepRow's heap keeps the k smallest cells by (distance, column), a set
-// that does not depend on how the row is cut, and so does this one. For the ratio score it
-// keeps the 2 window + 2 smallest: a kept match's best rival (the smallest cell more than
-// window columns away) is among them, since at most 2 window + 1 cells lie within its window.
-class SlicedKeep {
- public:
-  SlicedKeep(int q, int references, const KeepRules& rules)
-      : q_(q),
-        limit_(rules.one_traversal ? std::min(references, q - rules.exclusion + 1)
-                                   : references),
-        kept_(KeptCells(rules)),
-        rules_(&rules) {}
-
-  // Cells kept per query: KeepRules::best, more for the ratio score.
-  static int KeptCells(const KeepRules& rules) {
-    return rules.score == MatchScore::kRatio ? std::max(rules.best, 2 * rules.score_window + 2)
-                                             : rules.best;
-  }
-
-  // Columns [c0, c1) of the row, s[0] being column c0.
-  void Add(const float* s, int c0, int c1) {
-    const int end = std::min(c1, limit_);
-    int j = c0;
-    for (; kept_ > 0 && j < end && static_cast<int>(heap_.size()) < kept_; ++j)
-      if (std::isfinite(s[j - c0])) Push(s[j - c0], j);
-    if (kept_ > 0 && j < end) {
-      // The heap is full, as in KeepRow: a cell enters when below the worst kept, blocks of 16
-      // cells tested together first.
-      float worst = heap_.front().first;
-      const auto visit = [&](int c) {
-        const float v = s[c - c0];
-        if (v < worst && std::isfinite(v)) {
-          std::pop_heap(heap_.begin(), heap_.end());
-          heap_.back() = {v, c};
-          std::push_heap(heap_.begin(), heap_.end());
-          worst = heap_.front().first;
-        }
-      };
-      for (; j + 16 <= end; j += 16) {
-        const float* b = s + (j - c0);
-        const cv::v_float32x4 w = cv::v_setall_f32(worst);
-        const cv::v_float32x4 below = (cv::v_load(b) < w) | (cv::v_load(b + 4) < w) |
-                                      (cv::v_load(b + 8) < w) | (cv::v_load(b + 12) < w);
-        if (cv::v_check_any(below))
-          for (int u = 0; u < 16; ++u) visit(j + u);
-      }
-      for (; j < end; ++j) visit(j);
-    }
-    if (rules_->band >= 0) {
-      const int j0 = std::max(c0, q_ - rules_->band);
-      const int j1 = std::min(c1, q_ + rules_->band + 1);
-      for (int c = j0; c < j1; ++c)
-        if (std::isfinite(s[c - c0])) band_.push_back({s[c - c0], c});
-    }
-  }
-
-  // The row's matches, in KeepRow's order: ranks 1 .. k, then the band's other cells.
-  void Finish(std::vector<Match>& out) {
-    std::sort_heap(heap_.begin(), heap_.end());  // (distance, column) increasing
-    const int ranked = std::min(rules_->best, static_cast<int>(heap_.size()));
-    std::vector<std::pair<float, int>> candidates;
-    const auto score = [&](float v, int j) {
-      if (rules_->score == MatchScore::kDistance) return v;
-      // Among the kept cells and the match itself (in its own window: never its rival).
-      candidates.assign(heap_.begin(), heap_.end());
-      candidates.push_back({v, j});
-      return ScoreOfCandidate(candidates, candidates.size() - 1, rules_->score,
-                              rules_->score_window);
-    };
-    for (int r = 0; r < ranked; ++r)
-      out.push_back({q_, heap_[r].second, heap_[r].first, r + 1,
-                     score(heap_[r].first, heap_[r].second)});
-    for (const std::pair<float, int>& cell : band_) {
-      // (Not a structured binding: C++17 does not let a lambda capture one; clang refuses.)
-      const int j = cell.second;
-      const bool is_ranked = std::any_of(heap_.begin(), heap_.begin() + ranked,
-                                         [&](const auto& e) { return e.second == j; });
-      if (!is_ranked) out.push_back({q_, j, cell.first, 0, score(cell.first, j)});
-    }
-  }
-
- private:
-  void Push(float v, int j) {
-    heap_.push_back({v, j});
-    std::push_heap(heap_.begin(), heap_.end());
-  }
-
-  int q_, limit_, kept_;
-  const KeepRules* rules_;
-  std::vector<std::pair<float, int>> heap_;  // max-heap of (distance, column)
-  std::vector<std::pair<float, int>> band_;  // (distance, column), columns increasing
-};
+// The kept matches of every range, in the order of the ranges.
+std::vector<Match> Concatenated(const std::vector<std::vector<Match>>& kept) {
+  std::vector<Match> all;
+  std::size_t total = 0;
+  for (const auto& k : kept) total += k.size();
+  all.reserve(total);
+  for (const auto& k : kept) all.insert(all.end(), k.begin(), k.end());
+  return all;
+}
 
 // Columns per tile for TiledMatches, 0 when it does not apply: sums along diagonals only (a
 // tile reaches back to the columns before it, which the tiles before it computed) of exact
@@ -665,13 +634,9 @@ std::vector<Match> TiledMatches(const cv::Mat& descriptors, const MatchBlock& bl
     }
   });
   if (progress) progress(plan.end - plan.begin, plan.end - plan.begin);
-  std::vector<Match> all;
-  std::size_t total = 0;
-  for (const auto& k : kept) total += k.size();
-  all.reserve(total);
-  for (auto& k : kept) all.insert(all.end(), k.begin(), k.end());
   max_distance = 0.0f;
   for (const float v : range_max) max_distance = std::max(max_distance, v);
+  std::vector<Match> all = Concatenated(kept);
   if (options.normalize) NormalizeMatches(all, max_distance, rules.score);
   return all;
 }
@@ -695,11 +660,7 @@ std::vector<Match> BoundedMatches(const cv::Mat& descriptors, const MatchBlock& 
         KeepRow(s, m, i, rules, kept[static_cast<std::size_t>(c)]);
       },
       progress);
-  std::vector<Match> all;
-  std::size_t total = 0;
-  for (const auto& k : kept) total += k.size();
-  all.reserve(total);
-  for (auto& k : kept) all.insert(all.end(), k.begin(), k.end());
+  std::vector<Match> all = Concatenated(kept);
   max_distance = max_seen;
   if (options.normalize) NormalizeMatches(all, max_seen, rules.score);
   return all;

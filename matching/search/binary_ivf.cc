@@ -1,7 +1,6 @@
 #include "matching/search/binary_ivf.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -21,13 +20,6 @@ constexpr int kSamplePerCell = 32;    // sample rows per cell
 constexpr int kMinSample = 65536;     // sample rows at least (all rows when fewer)
 constexpr int kRowsPerTask = 1024;    // rows assigned per task
 const char kMagic[8] = {'O', 'A', 'B', 'I', 'V', 'F', '1', '\0'};
-
-// Cells for n rows: the ivf engine's rule, so that the two engines compare at equal sizes.
-int Lists(const ApproximateOptions& o, int n) {
-  if (o.ivf_lists > 0) return std::min(o.ivf_lists, n);
-  const int lists = static_cast<int>(std::lround(2.0 * std::sqrt(static_cast<double>(n))));
-  return std::max(1, std::min(lists, n / 39));
-}
 
 // The index of the first smallest of n >= 1 distances (non-negative whole numbers as floats).
 // Their bits order them as integers, and the smallest of integers is a loop the compiler
@@ -143,7 +135,8 @@ class BinaryIvfIndex final : public EngineIndex {
     const int n = references.rows;
     std::vector<int> cell;
     if (saved.empty()) {
-      centres_ = TrainCentres(references, Lists(options, n), options.seed, options.threads);
+      centres_ = TrainCentres(references, IvfCellCount(options.ivf_lists, n), options.seed,
+                              options.threads);
       cell = NearestCentres(HammingReferences(centres_), references, options.threads);
     } else {
       Read(saved, references, cell);

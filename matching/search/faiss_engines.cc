@@ -51,12 +51,10 @@ FaissSettings SettingsOf(const ApproximateOptions& o, const cv::Mat& refs, bool 
 
 std::unique_ptr<FaissIndex> BuildFaiss(const ApproximateOptions& o, const cv::Mat& refs,
                                        bool hnsw) {
-  // FAISS trains IVF cells by float k-means on OpenBLAS: on a CPU newer than Debian's OpenBLAS
-  // it would run its SSE3 kernels (measured: 36 % of building a 100,000-row map, in
-  // sgemm_kernel_PRESCOTT).
-  // FAISS spreads k-means over its OpenMP threads, each calling sgemm: OpenBLAS's own threads
-  // would compete with them for the cores.
-  UseBestBlasKernels();
+  // FAISS trains IVF cells by float k-means on OpenBLAS, spread over its OpenMP threads, each
+  // calling sgemm: OpenBLAS then runs this CPU's kernels (on a CPU newer than Debian's OpenBLAS
+  // it ran its SSE3 ones: 36 % of building a 100,000-row map, in sgemm_kernel_PRESCOTT) on one
+  // thread (its own threads competed with FAISS's for the cores).
   const BlasOnOneThread one_thread;
   const auto build =
       reinterpret_cast<OpenableFaissBuild>(ModuleSymbol("faiss", "openable_faiss_build"));

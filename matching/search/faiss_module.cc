@@ -20,6 +20,7 @@
 #include <faiss/index_io.h>
 
 #include "matching/search/faiss_index.h"
+#include "matching/search/ivf_cells.h"
 
 namespace openable {
 namespace {
@@ -39,13 +40,6 @@ class OmpThreads {
  private:
   int saved_;
 };
-
-// IVF cells: 2 sqrt(n), capped so that every cell has FAISS's minimum of 39 training rows.
-int Lists(const FaissSettings& s, int n) {
-  if (s.ivf_lists > 0) return std::min(s.ivf_lists, n);
-  const int lists = static_cast<int>(std::lround(2.0 * std::sqrt(static_cast<double>(n))));
-  return std::max(1, std::min(lists, n / 39));
-}
 
 // k-means of the IVF cells: seeded, 10 iterations (FAISS's IVF default) on at most 64 rows
 // a cell (a sample drawn with the seed), so that training stays a small part of the build.
@@ -160,7 +154,7 @@ FaissIndex* BuildAs(const FaissSettings& s, int d, const Element* x, int n) {
     h->add(n, x);
     index = std::move(h);
   } else {
-    auto v = std::make_unique<Ivf>(new Flat(d), d, static_cast<size_t>(Lists(s, n)));
+    auto v = std::make_unique<Ivf>(new Flat(d), d, static_cast<size_t>(IvfCellCount(s.ivf_lists, n)));
     v->own_fields = true;
     SetClustering(v->cp, s.seed);
     const OmpThreads omp(s.threads);

@@ -109,11 +109,7 @@ void IncrementalIndex::Reserve(int rows) {
 
 void IncrementalIndex::Append(const cv::Mat& row) {
   State& s = *state_;
-  if (s.size == s.buffer.rows) {
-    cv::Mat bigger(std::max(64, 2 * s.buffer.rows), s.width, s.type);
-    if (s.size > 0) s.buffer.rowRange(0, s.size).copyTo(bigger.rowRange(0, s.size));
-    s.buffer = bigger;
-  }
+  if (s.size == s.buffer.rows) Reserve(std::max(64, 2 * s.buffer.rows));
   row.copyTo(s.buffer.row(s.size));
   ++s.size;
 }

@@ -6,6 +6,8 @@
 // of their rows by exact Hamming distance (ties: the lower row).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -16,6 +18,15 @@
 #include "matching/search/approximate.h"
 
 namespace openable {
+
+// Cells of an inverted file over `rows` rows: `requested` when given (> 0, at most the rows),
+// else 2 sqrt(rows), capped so that every cell has FAISS's minimum of 39 training rows. The
+// rule of both IVF engines, so that they compare at equal sizes.
+inline int IvfCellCount(int requested, int rows) {
+  if (requested > 0) return std::min(requested, rows);
+  const int cells = static_cast<int>(std::lround(2.0 * std::sqrt(static_cast<double>(rows))));
+  return std::max(1, std::min(cells, rows / 39));
+}
 
 struct IvfCells {
   std::unique_ptr<HammingReferences> centres;            // one row per cell
