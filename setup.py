@@ -5,7 +5,8 @@ The wheel holds, under openable/:
   _openable.cpython-3X-<arch>.so   the extension (OpenABLE/python/*.cc)
   __init__.py, __main__.py         OpenABLE/python/openable/
   bin/                             Test_OpenABLE, openable_evaluate, openable_sweep,
-                                   openable_snaps (python3 -m openable run|evaluate|sweep|snaps)
+                                   openable_snaps, openable_map (python3 -m openable
+                                   run|evaluate|sweep|snaps|map)
   modules/                         the run-time modules (libopenable_*.so), where the
                                    module loader looks beside bin/ and the extension
 Environment:
@@ -25,7 +26,8 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 ROOT = os.path.dirname(os.path.abspath(__file__))
-PROGRAMS = ["Test_OpenABLE", "openable_evaluate", "openable_snaps", "openable_sweep"]
+PROGRAMS = ["Test_OpenABLE", "openable_evaluate", "openable_snaps", "openable_sweep",
+            "openable_map"]
 
 
 BUILD_COMMANDS = {"build", "build_ext", "bdist_wheel", "install", "develop", "egg_info",

@@ -21,13 +21,16 @@ namespace {
 // Descriptor rows as 64-bit words (zero-padded) in blocks of 4 references, word-major inside a
 // block: block b holds word k of references 4b..4b+3 at [b][k][0..3]. The AVX2 kernel loads
 // word k of four references in one register; the scalar kernels read the same layout.
+// `base` is `data`, or words held elsewhere (HammingReferences over packed words in place, a
+// mapped map file): the kernels read `base` only.
 struct PackedRows {
   int words = 0;
   int rows = 0;
   int blocks = 0;
   std::vector<std::uint64_t> data;
+  const std::uint64_t* base = nullptr;
   const std::uint64_t* Block(int b) const {
-    return data.data() + static_cast<size_t>(b) * words * 4;
+    return base + static_cast<size_t>(b) * words * 4;
   }
 };
 
@@ -44,6 +47,7 @@ PackedRows Pack(const cv::Mat& m) {
     for (int k = 0; k < p.words; ++k)
       p.data[(static_cast<size_t>(i / 4) * p.words + k) * 4 + i % 4] = row[k];
   }
+  p.base = p.data.data();
   return p;
 }
 
@@ -569,6 +573,24 @@ HammingReferences::HammingReferences(const cv::Mat& references)
   CheckInputs(references, cv::Mat(), CV_8U, "HammingReferences");
   packed_->rows = Pack(references);
 }
+
+HammingReferences::HammingReferences(const std::uint64_t* packed, int rows, int bytes)
+    : packed_(std::make_unique<Packed>()), bytes_(bytes) {
+  if (rows < 0 || bytes < 1)
+    throw std::invalid_argument("HammingReferences: " + std::to_string(rows) + " rows of " +
+                                std::to_string(bytes) + " bytes");
+  PackedRows& p = packed_->rows;
+  p.rows = rows;
+  p.words = (bytes + 7) / 8;
+  p.blocks = (rows + 3) / 4;
+  p.base = packed;
+}
+
+std::size_t HammingReferences::PackedWords(int rows, int bytes) {
+  return static_cast<std::size_t>((rows + 3) / 4) * static_cast<std::size_t>((bytes + 7) / 8) * 4;
+}
+
+const std::uint64_t* HammingReferences::PackedData() const { return packed_->rows.base; }
 
 HammingReferences::~HammingReferences() = default;
 

@@ -75,7 +75,15 @@ bool ForceHammingKernel(HammingKernel kernel);
 class HammingReferences {
  public:
   explicit HammingReferences(const cv::Mat& references);  // N x W, CV_8U
+  // References already packed (the words of PackedData() of `rows` rows of `bytes` bytes,
+  // PackedWords(rows, bytes) of them, in this host's byte order), read in place: `packed`
+  // must outlive this object (a saved index used where a mapped file holds it).
+  HammingReferences(const std::uint64_t* packed, int rows, int bytes);
   ~HammingReferences();
+  // The packed form the kernels read: 64-bit words, in blocks of four references word-major
+  // inside a block, each row zero-padded to whole words. PackedWords(Size(), width) words.
+  const std::uint64_t* PackedData() const;
+  static std::size_t PackedWords(int rows, int bytes);
   HammingReferences(const HammingReferences&) = delete;
   HammingReferences& operator=(const HammingReferences&) = delete;
   int Size() const;

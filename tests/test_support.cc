@@ -120,6 +120,7 @@ std::string OpenableEvaluateExe() { return OPENABLE_EVALUATE_EXE; }
 
 std::string OpenableSnapsExe() { return OPENABLE_SNAPS_EXE; }
 std::string OpenableSweepExe() { return OPENABLE_SWEEP_EXE; }
+std::string OpenableMapExe() { return OPENABLE_MAP_EXE; }
 
 std::string TempDir() {
   static std::atomic<int> counter{0};

@@ -61,6 +61,8 @@ std::string OpenableEvaluateExe();
 std::string OpenableSnapsExe();
 // The openable_sweep program built with the tests.
 std::string OpenableSweepExe();
+// The openable_map program built with the tests.
+std::string OpenableMapExe();
 
 }  // namespace openable::testing
 

@@ -57,7 +57,7 @@ if(TARGET openable_rosbag)  # ROS 1 bags (Frame_mode 3)
 endif()
 
 # The command-line programs of examples/.
-install(TARGETS Test_OpenABLE openable_evaluate openable_snaps openable_sweep
+install(TARGETS Test_OpenABLE openable_evaluate openable_snaps openable_sweep openable_map
   RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}")
 
 # find_package(OpenABLE): the config file finds the dependencies, then loads the targets.

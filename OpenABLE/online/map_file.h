@@ -1,20 +1,35 @@
-// The file of a saved online map (OnlineDetector::SaveMap / LoadMap, docs/output_formats.md,
-// "Saved maps"): the settings the map was made with, every frame's descriptor row, the index
-// blocks (FAISS's serialisation of each), and the local features kept for verification.
+// The file of a saved online map (OnlineDetector::SaveMap / LoadMap, openable_map,
+// docs/output_formats.md, "Saved maps"): the settings the map was made with, its sessions,
+// every frame's descriptor row, the index blocks, and the local features kept for
+// verification.
+//
+// Version 2 (written now) is laid out to be used where it lies once memory-mapped: a table of
+// sections, each at a 64-byte aligned offset with its own CRC-32, so that opening a map of ten
+// million places reads only the small sections (header, settings, sessions) and the index
+// structure, while the rows and the blocks are used in place and their checksums are computed
+// in the background (or before returning, MapReadOptions::check_in_background = false).
 //
 // Layout, integers little-endian:
 //   16 bytes  signature "OpenABLE-map\r\n\x1a\n" (the \r\n and \x1a catch a file mangled by a
 //             text-mode copy, as PNG's signature does)
-//   u32       format version (kMapFormatVersion)
-//   u64 + n   settings: text lines "key value"
-//   u64 + n   descriptor rows: frames x row bytes, row after row
-//   u32       index blocks; each: u32 first row, u32 rows, u64 + n serialised index
-//   u32       1 when local features follow, else 0; each frame: u32 points, 2 f32 a point,
-//             i32 rows, i32 cols, i32 OpenCV type, the descriptor bytes
-//   u64       FNV-1a 64 of every byte before it
+//   u32       format version (2)
+//   u32       section count S
+//   S x 32    sections: u32 kind, u32 a, u64 offset, u64 bytes, u32 CRC-32, u32 b
+//   u32       CRC-32 of every byte above
+//   sections, each at a multiple of 64 bytes, zero bytes between them:
+//     kind 1  settings: text lines "key value"
+//     kind 2  sessions: text lines "first<TAB>frames<TAB>time<TAB>name", in frame order
+//     kind 3  descriptor rows: frames x row bytes, row after row
+//     kind 4  one index block over rows [a, a + b): the engine's saved index
+//     kind 5  local features, each frame: u32 points, 2 f32 a point, i32 rows, i32 cols,
+//             i32 OpenCV type, the descriptor bytes
+// Version 1 (one session, no table, one FNV-1a 64 checksum at the end) is still read: its
+// frames become one session named "default".
 #pragma once
 
 #include <cstdint>
+#include <future>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,26 +41,61 @@
 
 namespace openable {
 
-inline constexpr std::uint32_t kMapFormatVersion = 1;
+inline constexpr std::uint32_t kMapFormatVersion = 2;
+
+// One traversal of a map: frames [first, first + count), its name (unique in the map) and the
+// time it was added (ISO 8601 UTC, "" when unknown).
+struct MapSession {
+  std::string name;
+  std::string time;
+  int first = 0, count = 0;
+};
+
+// A session name: 1 to 200 printable characters (no control characters, no tab or line
+// break), not beginning or ending with a space. Throws InputError beginning with `what`.
+void CheckSessionName(const std::string& name, const std::string& what);
 
 struct MapFile {
+  std::uint32_t version = kMapFormatVersion;  // of the file read
   std::vector<std::pair<std::string, std::string>> settings;  // in the file's order
+  std::vector<MapSession> sessions;  // tiling frames 0 .. rows.rows - 1 in order
   cv::Mat rows;  // frames x width, CV_8U or CV_32F, continuous
   std::vector<IncrementalIndex::SavedBlock> blocks;
   bool has_features = false;
   std::vector<FrameFeatures> features;  // one per frame when has_features
+  // When read in place: the mapped file, which `rows` and the blocks' bytes point into.
+  std::shared_ptr<const void> mapping;
+  // The check of the sections used in place (rows, blocks): "" when they match their
+  // checksums, else the one-line error beginning with the path. Ready at once when the read
+  // checked them itself.
+  std::shared_future<std::string> check;
 
   // The value of setting `key`; "" when absent.
   std::string Setting(const std::string& key) const;
 };
 
-// Writes `map` to `path` through a temporary file renamed into place when complete (an
-// interrupted save leaves the old file, or none). Throws InputError naming the path.
+struct MapReadOptions {
+  // Map the file and use its rows and index blocks where they lie (no copy): a map of ten
+  // million places opens in well under a second. Otherwise they are copied into memory.
+  bool in_place = true;
+  // Verify the checksums of the rows and blocks on a background thread (MapFile::check)
+  // rather than before returning. The header, settings, sessions, features and each index's
+  // structure (sizes, row numbers) are always checked before returning, so a damaged file can
+  // give wrong distances until the check reports it, never a read out of bounds.
+  bool check_in_background = true;
+  // Read the settings and sessions only (MapFile::rows stays empty, no blocks, no check): what
+  // a program needs to know which options a map was made with (MapOptions, online.h).
+  bool header_only = false;
+};
+
+// Writes `map` (format version 2) to `path` through a temporary file renamed into place when
+// complete (an interrupted save leaves the old file, or none). Throws InputError naming the
+// path.
 void WriteMapFile(const std::string& path, const MapFile& map);
 
-// Reads a map written by WriteMapFile. Every defect is one InputError beginning with the
-// path: unreadable, not a map, another format version, damaged (checksum) or truncated, or
-// inconsistent sizes.
-MapFile ReadMapFile(const std::string& path);
+// Reads a map written by WriteMapFile (version 2, or 1). Every defect found before returning
+// is one InputError beginning with the path: unreadable, not a map, a newer format version,
+// damaged (checksum) or truncated, inconsistent sizes or sessions.
+MapFile ReadMapFile(const std::string& path, const MapReadOptions& options = {});
 
 }  // namespace openable

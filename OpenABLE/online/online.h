@@ -25,6 +25,7 @@
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/describe/describe.h"
+#include "OpenABLE/online/map_file.h"
 #include "descriptors/descriptor.h"
 #include "OpenABLE/verification/verification.h"
 #include "matching/search/approximate.h"
@@ -90,7 +91,9 @@ struct OnlineOptions {
 
 // One loop candidate of a frame.
 struct LoopCandidate {
-  int frame = -1;         // the earlier frame
+  int frame = -1;         // the earlier frame (its number in the whole map)
+  int session = -1;       // its session (an index of OnlineDetector::Sessions())
+  int session_frame = -1; // its frame within that session (frame - the session's first)
   double distance = 0;    // raw sequence distance S(q, j) (Hamming bits or L2, summed over L
                           // frames; early frames scaled as in matching/sequence.h)
   // distance / (L x unit): unit = the descriptor's bit count for binary descriptors (so it is
@@ -114,7 +117,9 @@ struct LoopCandidate {
 };
 
 struct OnlineResult {
-  int frame = -1;                            // index of the frame just added (0, 1, ...)
+  int frame = -1;                            // index of the frame just added (0, 1, ...);
+                                             // Query: the query's row
+  int session = -1;                          // the session it was added to (Query: -1)
   std::vector<LoopCandidate> candidates;     // best first (ties: earlier frame first); empty
                                              // while no frame is old enough
   bool approximate = false;                  // the search used the index blocks
@@ -148,6 +153,42 @@ class OnlineDetector {
   // searching for them: a map saved from an earlier run (see Descriptors()). Later frames find
   // them as candidates like any other frame.
   void AddToMap(const cv::Mat& rows);
+  // Describes `images` (as AddFrame takes them, spread over the cores) and appends them as
+  // AddToMap does: a traversal added to a map in bulk. Every image must be of the map's frame
+  // size (FrameSize; the first sets it); `names` (one per image, or empty) name them in
+  // messages. Throws InputError naming the first image that does not fit, adding none.
+  void AddImagesToMap(const std::vector<cv::Mat>& images,
+                      const std::vector<std::string>& names = {});
+
+  // Sessions: a map holds one or more traversals, each a run of consecutive frames with a
+  // name and a time (MapSession). StartSession begins one at frame Size() (an empty session
+  // begun before is replaced); frames added before any session belong to one named
+  // "default". A frame's candidates are every frame of the earlier sessions and the frames of
+  // its own session at least `exclusion` frames back; sequences (L) never run across the
+  // start of a session. `time`: ISO 8601 UTC, by default now. Throws InputError on a name
+  // that is empty, not printable text (CheckSessionName) or already in the map.
+  void StartSession(const std::string& name, const std::string& time = "");
+  const std::vector<MapSession>& Sessions() const;
+  int SessionOf(int frame) const;   // the session holding `frame` (0 .. Size() - 1)
+
+  // Searches the map for each row of `rows` (n x RowWidth(), RowType(): a query traversal, row
+  // i its frame i, whose sequences use its own earlier rows) without adding them: every frame
+  // of the map is a candidate (no exclusion), or with `sessions` given only the frames of the
+  // sessions so named. With a session filter the frames of those sessions are scanned exactly
+  // when they number at most exact_limit; beyond, the index's candidates in other sessions
+  // are dropped (a query may then get fewer than `candidates`). Rows spread over the cores.
+  // Refused with verification (it needs each query's image). Throws InputError on rows of
+  // another width or type, an unknown session name, or a damaged loaded map (CheckMap).
+  std::vector<OnlineResult> Query(const cv::Mat& rows,
+                                  const std::vector<std::string>& sessions = {}) const;
+  // Describes `images` (as AddFrame takes them; the map's frame size, see FrameSize) and
+  // queries them.
+  std::vector<OnlineResult> QueryImages(const std::vector<cv::Mat>& images,
+                                        const std::vector<std::string>& sessions = {}) const;
+
+  // "WxH" of the frames given to AddFrame (set by the first one, kept in saved maps; "" when
+  // unknown). AddFrame and QueryImages refuse frames of another size.
+  const std::string& FrameSize() const;
 
   const OnlineOptions& Options() const;
   int Size() const;                 // frames added
@@ -186,12 +227,37 @@ class OnlineDetector {
   // exclusion), the saved blocks are set aside and the index built from the rows. Throws
   // InputError beginning with the path: unreadable, not a map, another format version,
   // damaged or truncated (checksum), or made with other description settings.
-  LoadedMap LoadMap(const std::string& path);
+  //
+  // `read` chooses how (map_file.h): by default the file is memory-mapped and its rows and
+  // binary_ivf blocks are used where they lie (no copy; other engines' blocks are read from
+  // the mapping), and the checksums of the rows and blocks are verified on a background
+  // thread: a damaged map is then reported by CheckMap, and by the next call that adds,
+  // queries or saves (SaveMap and AppendMap wait for the check). Everything else (header,
+  // settings, sessions, features, each index's structure) is checked before returning. Maps
+  // of format version 1 are read too, as one session named "default".
+  LoadedMap LoadMap(const std::string& path, const MapReadOptions& read = {});
+  // Waits for the background check of a loaded map; throws its InputError when the map is
+  // damaged. Returns at once when no map was loaded or it was checked.
+  void CheckMap() const;
+
+  // Appends the sessions of the map at `path` (made with the same description settings and
+  // frame size; session names not already here) after this detector's frames, as frames
+  // Size() ..; their rows are indexed as AddToMap does. The merge of two maps: load one,
+  // append the other, save. Throws InputError naming the path and what differs, changing
+  // nothing.
+  void AppendMap(const std::string& path);
 
  private:
   struct State;
   std::unique_ptr<State> state_;
 };
+
+// The options of a detector that loads the map at `path` with its saved index: the
+// description settings (descriptor, description, patch size, LDB bits, grid) and the index
+// settings (exclusion, exact_limit, block_frames, engine and its build settings) the map was
+// made with, everything else from `base`. Reads the map's settings only. Throws InputError as
+// LoadMap does.
+OnlineOptions MapOptions(const std::string& path, const OnlineOptions& base = {});
 
 // ---- Batch helpers -------------------------------------------------------------------------
 

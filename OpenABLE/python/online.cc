@@ -77,6 +77,45 @@ py::tuple ResultTuple(const OnlineResult& r, bool verification) {
 
 OnlineOptions OnlineOptionsOf(const py::kwargs& kwargs);
 
+// The candidates of each query (OnlineDetector::Query) as lists of dicts, best first.
+py::list QueryResults(const std::vector<OnlineResult>& results,
+                      const std::vector<MapSession>& sessions) {
+  py::list out;
+  for (const OnlineResult& r : results) {
+    py::list candidates;
+    for (const LoopCandidate& c : r.candidates) {
+      py::dict d;
+      d["session"] = sessions[static_cast<std::size_t>(c.session)].name;
+      d["frame"] = c.session_frame;
+      d["map_frame"] = c.frame;
+      d["distance"] = c.distance;
+      d["normalized"] = c.normalized;
+      d["score"] = c.score;
+      d["accepted"] = c.accepted;
+      candidates.append(d);
+    }
+    out.append(candidates);
+  }
+  return out;
+}
+
+std::vector<std::string> SessionNames(const py::object& sessions) {
+  if (sessions.is_none()) return {};
+  if (py::isinstance<py::str>(sessions)) return {sessions.cast<std::string>()};
+  return sessions.cast<std::vector<std::string>>();
+}
+
+const char* const kQueryDoc = R"doc(
+Returns:
+    list[list[dict]]: for each query, its candidates best first, each {"session": the
+    session's name, "frame": the frame within that session, "map_frame": the frame in the
+    whole map, "distance": raw sequence distance, "normalized", "score", "accepted": score <=
+    threshold}; empty when the sessions searched hold no frame.
+
+Raises:
+    openable.InputError: rows of another width or dtype, an unknown session, images of another
+    size than the map's frames, or a damaged loaded map.)doc";
+
 // openable.OnlineOptions: OnlineOptions with one property per keyword argument of
 // OnlineDetector, in the flat names of the Python API (grid as a pair, description by name,
 // the approximate search's fields at the top level). The properties are the one list of options:
@@ -498,7 +537,165 @@ Saves the map (the settings it was made with, every frame's descriptor row, the 
 and with verification every frame's local features) to `path`, so that a later session starts
 from it with load_map(). Versioned and checksummed; written through a temporary file renamed
 into place when complete. Raises openable.InputError naming the path when it cannot be
-written.)doc");
+written.)doc")
+      .def(
+          "add_images_to_map",
+          [](Detector& det, const py::object& images, const std::string& color_order) {
+            const std::vector<MatView> views = Images(images, "images", IsRgbOrder(color_order));
+            std::vector<cv::Mat> mats;
+            for (const MatView& v : views) mats.push_back(v.mat);
+            py::gil_scoped_release release;
+            std::lock_guard<std::mutex> lock(det.mutex);
+            det.detector->AddImagesToMap(mats);
+          },
+          py::arg("images"), py::arg("color_order") = "bgr",
+          R"doc(add_images_to_map(images, color_order="bgr")
+
+Describes `images` (in parallel) and appends them as the next frames without searching for
+them: a traversal added to a map in bulk (start_session() first names it). Every image must be
+of the map's frame size (frame_size). Raises openable.InputError naming the first image that
+does not fit, adding none.)doc")
+      .def(
+          "start_session",
+          [](Detector& det, const std::string& name, const std::string& time) {
+            std::lock_guard<std::mutex> lock(det.mutex);
+            det.detector->StartSession(name, time);
+          },
+          py::arg("name"), py::arg("time") = "",
+          R"doc(start_session(name, time="")
+
+Begins a session (a traversal) at the next frame: its frames find every frame of the earlier
+sessions, and those of their own session at least `exclusion` frames back; sequences never run
+across a session's start. `time`: ISO 8601 UTC, by default now. Frames added before any
+session belong to one named "default". Raises openable.InputError on a name already in the
+map, empty, or not printable text.)doc")
+      .def(
+          "query",
+          [](Detector& det, const py::object& rows, const py::object& sessions) {
+            const MatView v = Matrix2D(rows, Elements::kUint8OrFloat32, "rows");
+            const std::vector<std::string> names = SessionNames(sessions);
+            std::vector<OnlineResult> results;
+            {
+              py::gil_scoped_release release;
+              std::lock_guard<std::mutex> lock(det.mutex);
+              results = det.detector->Query(v.mat, names);
+            }
+            return QueryResults(results, det.detector->Sessions());
+          },
+          py::arg("rows"), py::arg("sessions") = py::none(),
+          (std::string(R"doc(query(rows, sessions=None) -> list[list[dict]]
+
+Searches the map for each descriptor row of `rows` (a query traversal: row i is its frame i,
+whose sequences use its own earlier rows) without adding them. Every frame of the map is a
+candidate, or with `sessions` (a name or a list of names) only the frames of those sessions.
+
+Args:
+    rows (numpy.ndarray): (n, row_width) of row_dtype, e.g. describe_images()'s rows.
+    sessions (str | list[str] | None): the sessions searched; None: all.
+)doc") + kQueryDoc).c_str())
+      .def(
+          "query_images",
+          [](Detector& det, const py::object& images, const py::object& sessions,
+             const std::string& color_order) {
+            const std::vector<MatView> views = Images(images, "images", IsRgbOrder(color_order));
+            std::vector<cv::Mat> mats;
+            for (const MatView& v : views) mats.push_back(v.mat);
+            const std::vector<std::string> names = SessionNames(sessions);
+            std::vector<OnlineResult> results;
+            {
+              py::gil_scoped_release release;
+              std::lock_guard<std::mutex> lock(det.mutex);
+              results = det.detector->QueryImages(mats, names);
+            }
+            return QueryResults(results, det.detector->Sessions());
+          },
+          py::arg("images"), py::arg("sessions") = py::none(), py::arg("color_order") = "bgr",
+          (std::string(R"doc(query_images(images, sessions=None, color_order="bgr") -> list[list[dict]]
+
+Describes `images` (a query traversal, of the map's frame size) and queries them as query()
+does.
+)doc") + kQueryDoc).c_str())
+      .def(
+          "append_map",
+          [](Detector& det, const py::object& path_object) {
+            const std::string path = FileSystemPath(path_object, "append_map: path");
+            py::gil_scoped_release release;
+            std::lock_guard<std::mutex> lock(det.mutex);
+            det.detector->AppendMap(path);
+          },
+          py::arg("path"),
+          R"doc(append_map(path)
+
+Appends the sessions of the map saved at `path` after this detector's frames (the same
+description options and frame size; session names not already here), indexed as
+add_to_map() indexes rows: with load_map() and save_map(), the merge of two maps. Raises
+openable.InputError naming the path and what differs, changing nothing.)doc")
+      .def(
+          "check_map",
+          [](Detector& det) {
+            py::gil_scoped_release release;
+            std::lock_guard<std::mutex> lock(det.mutex);
+            det.detector->CheckMap();
+          },
+          R"doc(check_map()
+
+Waits for the background check of a loaded map's checksums; raises openable.InputError when
+the map is damaged. Returns at once when no map was loaded or it was checked.)doc")
+      .def_property_readonly(
+          "sessions",
+          [](Detector& d) {
+            std::lock_guard<std::mutex> lock(d.mutex);
+            py::list out;
+            for (const MapSession& m : d.detector->Sessions()) {
+              py::dict s;
+              s["name"] = m.name;
+              s["time"] = m.time;
+              s["first"] = m.first;
+              s["frames"] = m.count;
+              out.append(s);
+            }
+            return out;
+          },
+          "The map's sessions in frame order, each {\"name\", \"time\" (ISO 8601 UTC), "
+          "\"first\" (its first frame in the map), \"frames\"}.")
+      .def(
+          "session_of",
+          [](Detector& d, int frame) {
+            std::lock_guard<std::mutex> lock(d.mutex);
+            const int s = d.detector->SessionOf(frame);
+            const MapSession& m = d.detector->Sessions()[static_cast<std::size_t>(s)];
+            return py::make_tuple(m.name, frame - m.first);
+          },
+          py::arg("frame"),
+          "session_of(frame) -> tuple[str, int]\n\nThe session holding map frame `frame` and "
+          "the frame's number within it.")
+      .def_property_readonly(
+          "frame_size",
+          [](Detector& d) {
+            std::lock_guard<std::mutex> lock(d.mutex);
+            return d.detector->FrameSize();
+          },
+          "\"WxH\" of the map's frames (\"\" until the first image is added).");
+  c.def_static(
+      "open",
+      [](const py::object& path_object, const py::kwargs& kwargs) {
+        const std::string path = FileSystemPath(path_object, "OnlineDetector.open: path");
+        const OnlineOptions base = OnlineOptionsOf(kwargs);
+        auto d = std::make_unique<Detector>();
+        {
+          py::gil_scoped_release release;
+          d->detector = std::make_unique<OnlineDetector>(MapOptions(path, base));
+          d->detector->LoadMap(path);
+        }
+        return d;
+      },
+      py::arg("path"),
+      R"doc(OnlineDetector.open(path, **options) -> OnlineDetector
+
+A detector holding the map saved at `path`, with the description and index options the map
+was made with (the other options, such as sequence_length, candidates and threshold, from
+`options` or the defaults). The file is memory-mapped: its rows and binary_ivf index blocks
+are used where they lie, and its checksums are verified in the background (check_map()).)doc");
   BindDetectorMapAndState(c);
 }
 
@@ -506,13 +703,17 @@ written.)doc");
 void BindDetectorMapAndState(py::class_<Detector>& c) {
   c.def(
           "load_map",
-          [](Detector& det, const py::object& path_object) {
+          [](Detector& det, const py::object& path_object, bool in_place,
+             bool check_in_background) {
             const std::string path = FileSystemPath(path_object, "load_map: path");
             OnlineDetector::LoadedMap info;
+            MapReadOptions read;
+            read.in_place = in_place;
+            read.check_in_background = check_in_background;
             {
               py::gil_scoped_release release;
               std::lock_guard<std::mutex> lock(det.mutex);
-              info = det.detector->LoadMap(path);
+              info = det.detector->LoadMap(path, read);
             }
             py::dict out;
             out["frames"] = info.frames;
@@ -521,15 +722,22 @@ void BindDetectorMapAndState(py::class_<Detector>& c) {
             out["reason"] = info.reason;
             return out;
           },
-          py::arg("path"),
-          R"doc(load_map(path) -> dict
+          py::arg("path"), py::arg("in_place") = true, py::arg("check_in_background") = true,
+          R"doc(load_map(path, in_place=True, check_in_background=True) -> dict
 
 Loads a map written by save_map() into this detector, which must be empty: its frames become
 frames 0 .. frames - 1, and later frames find them as candidates; with the options of the
 detector that saved it, every later frame gets the candidates that detector would give. The
 description options (descriptor, description, patch_size, ldb_bits, grid) must be the map's.
 When an index option differs (engine and its build settings, exact_limit, block_frames,
-exclusion), the index is built from the rows instead of read.
+exclusion), the index is built from the rows instead of read. The sessions come with the map
+(a map of the first format version is one session, "default").
+
+in_place: memory-map the file and use its rows and binary_ivf blocks where they lie (a map of
+ten million places opens in well under a second); False copies them. check_in_background:
+verify the rows' and blocks' checksums on a background thread (check_map() waits for it; a
+damaged map is reported by the next call that adds, queries or saves); False verifies them
+before returning.
 
 Returns:
     {"frames": frames loaded, "blocks": index blocks in use, "rebuilt": whether the blocks
@@ -618,6 +826,26 @@ installs its index.)doc")
 void RegisterOnline(py::module_& m) {
   RegisterOnlineHelpers(m);
   RegisterDetector(m);
+  m.def(
+      "merge_maps",
+      [](const py::object& a_object, const py::object& b_object, const py::object& out_object) {
+        const std::string a = FileSystemPath(a_object, "merge_maps: a");
+        const std::string b = FileSystemPath(b_object, "merge_maps: b");
+        const std::string out = FileSystemPath(out_object, "merge_maps: output");
+        py::gil_scoped_release release;
+        OnlineDetector d(MapOptions(a));
+        d.LoadMap(a);
+        d.AppendMap(b);
+        d.SaveMap(out);
+        return d.Size();
+      },
+      py::arg("a"), py::arg("b"), py::arg("output"),
+      R"doc(merge_maps(a, b, output) -> int
+
+Writes to `output` the map of the sessions of map `a`, then those of map `b` (saved maps of the
+same description options and frame size, with distinct session names), indexed with a's index
+options: openable_map merge A B -o C. Returns the frames of the merged map. Raises
+openable.InputError naming the map and what differs; `output` is then not written.)doc");
 }
 
 }  // namespace openable::python

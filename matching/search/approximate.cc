@@ -75,7 +75,7 @@ ApproximateIndex::ApproximateIndex(const cv::Mat& references, const ApproximateO
     : ApproximateIndex(references, options, {}) {}
 
 ApproximateIndex::ApproximateIndex(const cv::Mat& references, const ApproximateOptions& options,
-                                   const std::vector<std::uint8_t>& saved)
+                                   const SavedIndex& saved)
     : impl_(std::make_unique<Impl>()) {
   options.Check();
   CheckRows(references, "ApproximateIndex");
@@ -90,7 +90,10 @@ ApproximateIndex::ApproximateIndex(const cv::Mat& references, const ApproximateO
     Fail(std::string("ApproximateOptions::engine = ") + entry.name +
          " indexes binary rows only; expected binary descriptors (LDB, ORB, BRISK, FREAK, "
          "BRIEF) or another engine for float rows");
-  impl_->references = references.clone();
+  // An index read in place from bytes that outlive it reads the references during the build
+  // only (the engine keeps what it needs): no copy of them is made.
+  const bool in_place = saved.owner && entry.owns_rows;
+  impl_->references = in_place ? Continuous(references) : references.clone();
   impl_->index = entry.build(impl_->references, impl_->options, saved);
   impl_->rows = references.rows;
   impl_->width = references.cols;

@@ -35,6 +35,22 @@ struct Candidate {
 // Candidates of each query, sorted by increasing distance, ties by increasing reference row.
 using CandidateLists = std::vector<std::vector<Candidate>>;
 
+// The bytes of a saved index (ApproximateIndex::Serialize) handed to a build. `owner`, when
+// set, keeps them alive and unchanged as long as it is held (a memory-mapped map file): an
+// engine whose saved form can be searched as it is (binary_ivf) then keeps `owner` and reads
+// the bytes in place instead of copying them. Without it the bytes are read during the build
+// only.
+struct SavedIndex {
+  const std::uint8_t* data = nullptr;
+  std::size_t size = 0;
+  std::shared_ptr<const void> owner;
+  SavedIndex() = default;
+  SavedIndex(const std::vector<std::uint8_t>& bytes) : data(bytes.data()), size(bytes.size()) {}
+  SavedIndex(const std::uint8_t* bytes, std::size_t n, std::shared_ptr<const void> keep)
+      : data(bytes), size(n), owner(std::move(keep)) {}
+  bool empty() const { return size == 0; }
+};
+
 // The valid values of an integer field of ApproximateOptions, inclusive.
 struct ApproximateRange {
   int min;
@@ -124,8 +140,10 @@ class ApproximateIndex {
   // second to read); one whose Serialize() is empty (FLANN) builds it (deterministic, so the
   // same index). Throws std::invalid_argument when the bytes hold another kind of index or
   // another row count.
+  // With `saved.owner` set and an engine that reads its saved form in place, `references` are
+  // not copied either (the index keeps no rows of its own then).
   ApproximateIndex(const cv::Mat& references, const ApproximateOptions& options,
-                   const std::vector<std::uint8_t>& saved);
+                   const SavedIndex& saved);
   ~ApproximateIndex();
   ApproximateIndex(ApproximateIndex&&) noexcept;
   ApproximateIndex& operator=(ApproximateIndex&&) noexcept;

@@ -55,10 +55,11 @@ struct ApproximateEngineEntry {
   // header of them) with `options` (checked, engine resolved to this one). `saved` is empty,
   // or the bytes of Serialize() of an index built over the same references with the same
   // options: the index is then read from them when the engine can (std::invalid_argument when
-  // they hold another index). Deterministic for given references and options.
+  // they hold another index), in place when saved.owner is set and its form allows.
+  // Deterministic for given references and options.
   std::unique_ptr<EngineIndex> (*build)(const cv::Mat& references,
                                         const ApproximateOptions& options,
-                                        const std::vector<std::uint8_t>& saved);
+                                        const SavedIndex& saved);
   // Bytes the index holds per reference row besides ApproximateIndex's own copy of the rows
   // (an estimate, for IncrementalIndex::MemoryBytes); `row_bytes` is one row's size.
   std::int64_t (*bytes_per_row)(const ApproximateOptions& options, int depth,

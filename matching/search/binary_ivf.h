@@ -11,9 +11,10 @@
 // ivf engine), nprobe cells searched, seed of the sample and of the first centres. The
 // training: 8 rounds on a sample of 32 rows a cell (at least 65,536 rows, at most all).
 // Deterministic for given rows and settings, whatever the thread count. Saved (Serialize) as
-// the centres and each row's cell, 4 bytes a row: reading it back fills the cells without
-// training. Memory: the rows again, packed by cell for the kernels, and a 4-byte row number
-// each.
+// the centres, the cells' row numbers and their rows packed for the kernels, about 4 bytes a
+// row more than the rows themselves, in 8-byte aligned sections: a memory-mapped map file's
+// index is searched where it lies (SavedIndex::owner), with no training and no copy. Memory:
+// the rows again, packed by cell for the kernels, and a 4-byte row number each.
 #pragma once
 
 #include "matching/search/approximate_engine.h"

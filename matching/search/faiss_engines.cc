@@ -64,12 +64,12 @@ std::unique_ptr<FaissIndex> BuildFaiss(const ApproximateOptions& o, const cv::Ma
 // The index saved by Serialize(): FAISS's message (a damaged or foreign serialisation) and a
 // row count that is not the references' become std::invalid_argument.
 std::unique_ptr<FaissIndex> ReadFaiss(const ApproximateOptions& o, const cv::Mat& refs, bool hnsw,
-                                      const std::vector<std::uint8_t>& saved) {
+                                      const SavedIndex& saved) {
   const auto read =
       reinterpret_cast<OpenableFaissRead>(ModuleSymbol("faiss", "openable_faiss_read"));
   std::unique_ptr<FaissIndex> index;
   try {
-    index.reset(read(SettingsOf(o, refs, hnsw), saved.data(), saved.size()));
+    index.reset(read(SettingsOf(o, refs, hnsw), saved.data, saved.size));
   } catch (const std::runtime_error& e) {
     FailFaiss(std::string("ApproximateIndex: the saved index cannot be read: ") + e.what());
   }
@@ -110,7 +110,7 @@ std::unique_ptr<IvfCells> CellsOf(const FaissIndex& index, const cv::Mat& refs) 
 class FaissEngineIndex final : public EngineIndex {
  public:
   FaissEngineIndex(const cv::Mat& references, const ApproximateOptions& options, bool hnsw,
-                   const std::vector<std::uint8_t>& saved)
+                   const SavedIndex& saved)
       : refs_(references),
         faiss_(saved.empty() ? BuildFaiss(options, refs_, hnsw)
                              : ReadFaiss(options, refs_, hnsw, saved)),
@@ -153,12 +153,12 @@ class FaissEngineIndex final : public EngineIndex {
 };
 
 std::unique_ptr<EngineIndex> BuildHnsw(const cv::Mat& references, const ApproximateOptions& options,
-                                       const std::vector<std::uint8_t>& saved) {
+                                       const SavedIndex& saved) {
   return std::make_unique<FaissEngineIndex>(references, options, /*hnsw=*/true, saved);
 }
 
 std::unique_ptr<EngineIndex> BuildIvf(const cv::Mat& references, const ApproximateOptions& options,
-                                      const std::vector<std::uint8_t>& saved) {
+                                      const SavedIndex& saved) {
   return std::make_unique<FaissEngineIndex>(references, options, /*hnsw=*/false, saved);
 }
 

@@ -148,7 +148,7 @@ class FlannIndex final : public EngineIndex {
 
 // FLANN's structure is not serialised: `saved` (empty) is not read.
 std::unique_ptr<EngineIndex> Build(const cv::Mat& references, const ApproximateOptions& options,
-                                   const std::vector<std::uint8_t>& /*saved*/) {
+                                   const SavedIndex& /*saved*/) {
   return std::make_unique<FlannIndex>(references, options);
 }
 

@@ -16,9 +16,12 @@ struct IncrementalIndex::State {
   IncrementalIndexOptions options;
   int width = 0, type = CV_8U;
 
-  // Rows of every frame, in a buffer that doubles when full (amortised O(1) per row).
+  // Rows of every frame, in a buffer that doubles when full (amortised O(1) per row). A
+  // restored map's rows may lie in a mapped file (rows_owner keeps it): the buffer is then
+  // exactly full, so the first Append copies them into a buffer of our own.
   cv::Mat buffer;
   int size = 0;
+  std::shared_ptr<const void> rows_owner;
 
   // Index blocks over rows [first, first + count), contiguous and in order from row 0; counts
   // are block_frames x 2^m, non-increasing along the vector.
@@ -105,6 +108,7 @@ void IncrementalIndex::Reserve(int rows) {
   cv::Mat bigger(rows, s.width, s.type);
   if (s.size > 0) s.buffer.rowRange(0, s.size).copyTo(bigger.rowRange(0, s.size));
   s.buffer = bigger;
+  s.rows_owner.reset();
 }
 
 void IncrementalIndex::Append(const cv::Mat& row) {
@@ -181,11 +185,12 @@ void IncrementalIndex::FinishMerges() {
 std::vector<IncrementalIndex::SavedBlock> IncrementalIndex::SaveBlocks() {
   FinishMerges();
   std::vector<SavedBlock> out;
-  for (const auto& b : state_->blocks) out.push_back({b.first, b.count, b.index->Serialize()});
+  for (const auto& b : state_->blocks) out.push_back({b.first, b.count, b.index->Serialize(), {}});
   return out;
 }
 
-void IncrementalIndex::Restore(const cv::Mat& rows, const std::vector<SavedBlock>& blocks) {
+void IncrementalIndex::Restore(const cv::Mat& rows, const std::vector<SavedBlock>& blocks,
+                               std::shared_ptr<const void> rows_owner) {
   State& s = *state_;
   if (s.size != 0) throw std::invalid_argument("IncrementalIndex::Restore: the index is not empty");
   if (!rows.empty() && (rows.cols != s.width || rows.depth() != s.type))
@@ -205,7 +210,10 @@ void IncrementalIndex::Restore(const cv::Mat& rows, const std::vector<SavedBlock
           "the layout of blocks of " + std::to_string(s.options.block_frames) + " x 2^m rows");
     next += b.count;
   }
-  if (rows.rows > 0) {
+  if (rows.rows > 0 && rows_owner && rows.isContinuous()) {
+    s.buffer = rows;  // a header: the rows stay where they lie
+    s.rows_owner = std::move(rows_owner);
+  } else if (rows.rows > 0) {
     s.buffer = cv::Mat(std::max(64, rows.rows), s.width, s.type);
     rows.copyTo(s.buffer.rowRange(0, rows.rows));
   }
@@ -214,7 +222,7 @@ void IncrementalIndex::Restore(const cv::Mat& rows, const std::vector<SavedBlock
     s.blocks.push_back({b.first, b.count,
                         std::make_unique<ApproximateIndex>(
                             s.buffer.rowRange(b.first, b.first + b.count), s.options.approximate,
-                            b.index)});
+                            b.Bytes())});
   s.indexed = next;
 }
 

@@ -55,6 +55,10 @@ class IncrementalIndex {
   struct SavedBlock {
     int first = 0, count = 0;
     std::vector<std::uint8_t> index;
+    // Instead of `index` (when that is empty): the same bytes where a mapped map file holds
+    // them, read in place by an engine that can (SavedIndex).
+    SavedIndex in_place;
+    SavedIndex Bytes() const { return index.empty() ? in_place : SavedIndex(index); }
   };
   // The blocks in use, after waiting for a background merge (FinishMerges).
   std::vector<SavedBlock> SaveBlocks();
@@ -62,8 +66,11 @@ class IncrementalIndex {
   // building them (FAISS indexes are read; FLANN's are built). The blocks must tile rows
   // [0, indexed) in order with sizes block_frames x 2^m, non-increasing, at most one of each,
   // as this index builds them; otherwise std::invalid_argument. Empty `blocks` leaves the
-  // rows unindexed (Update indexes them).
-  void Restore(const cv::Mat& rows, const std::vector<SavedBlock>& blocks);
+  // rows unindexed (Update indexes them). With `rows_owner` set, `rows` (continuous) are used
+  // where they lie, kept alive and unchanged by it (a memory-mapped map file), until the first
+  // Append copies them into a buffer of the index's own.
+  void Restore(const cv::Mat& rows, const std::vector<SavedBlock>& blocks,
+               std::shared_ptr<const void> rows_owner = {});
 
   cv::Mat Rows() const;              // Size() x width, a view of the stored rows
   int Size() const;                  // rows appended

@@ -20,7 +20,13 @@ std::unique_ptr<IvfCells> MakeIvfCells(const cv::Mat& references, const cv::Mat&
   auto out = std::make_unique<IvfCells>();
   out->centres = std::make_unique<HammingReferences>(centres);
   out->rows.resize(cells.size());
-  out->ids = cells;
+  out->offsets.assign(cells.size() + 1, 0);
+  for (std::size_t c = 0; c < cells.size(); ++c)
+    out->offsets[c + 1] = out->offsets[c] + static_cast<std::uint32_t>(cells[c].size());
+  out->owned_ids.reserve(out->offsets.back());
+  for (const std::vector<int>& ids : cells)
+    out->owned_ids.insert(out->owned_ids.end(), ids.begin(), ids.end());
+  out->ids = out->owned_ids.data();
   std::vector<std::uint8_t> seen(static_cast<std::size_t>(references.rows), 0);
   std::int64_t total = 0;
   for (std::size_t c = 0; c < cells.size(); ++c) {
@@ -50,7 +56,7 @@ std::unique_ptr<IvfCells> MakeIvfCells(const cv::Mat& references, const cv::Mat&
 CandidateLists SearchIvfCells(const IvfCells& cells, const cv::Mat& queries, int k, int nprobe,
                               int threads) {
   CandidateLists out(static_cast<size_t>(queries.rows));
-  const int lists = static_cast<int>(cells.ids.size());
+  const int lists = cells.Cells();
   const int probes = std::min(nprobe, lists);
   ParallelBlocks(queries.rows, kQueryBlock, threads, [&](int q0, int q1) {
     std::vector<float> centre(static_cast<size_t>(lists)), d;
@@ -68,11 +74,12 @@ CandidateLists SearchIvfCells(const IvfCells& cells, const cv::Mat& queries, int
       heap.reserve(static_cast<size_t>(k));
       for (int p = 0; p < probes; ++p) {
         const int l = order[static_cast<size_t>(p)];
-        const std::vector<int>& ids = cells.ids[static_cast<size_t>(l)];
-        if (ids.empty()) continue;
-        d.resize(ids.size());
+        const int count = cells.Count(l);
+        if (count == 0) continue;
+        const std::int32_t* ids = cells.Ids(l);
+        d.resize(static_cast<std::size_t>(count));
         cells.rows[static_cast<size_t>(l)]->Distances(query, d.data());
-        for (std::size_t i = 0; i < ids.size(); ++i) {
+        for (int i = 0; i < count; ++i) {
           const Candidate c{ids[i], d[i]};
           if (static_cast<int>(heap.size()) < k) {
             heap.push_back(c);

@@ -28,10 +28,23 @@ inline int IvfCellCount(int requested, int rows) {
   return std::max(1, std::min(cells, rows / 39));
 }
 
+// Cell c holds the rows ids[offsets[c]] .. ids[offsets[c + 1] - 1] of the references, in
+// that order, packed for the kernel in rows[c] (null when the cell is empty). `ids` points
+// into `owned_ids`, or into bytes that `owner` keeps alive (an index read in place from a
+// mapped map file), as the packed rows may.
 struct IvfCells {
   std::unique_ptr<HammingReferences> centres;            // one row per cell
   std::vector<std::unique_ptr<HammingReferences>> rows;  // each cell's rows (null: empty)
-  std::vector<std::vector<int>> ids;                     // their rows of the references
+  std::vector<std::uint32_t> offsets;                    // cells + 1, from 0 to the rows
+  const std::int32_t* ids = nullptr;
+  std::vector<std::int32_t> owned_ids;
+  std::shared_ptr<const void> owner;
+  int Cells() const { return static_cast<int>(rows.size()); }
+  int Count(int c) const {
+    return static_cast<int>(offsets[static_cast<std::size_t>(c) + 1] -
+                            offsets[static_cast<std::size_t>(c)]);
+  }
+  const std::int32_t* Ids(int c) const { return ids + offsets[static_cast<std::size_t>(c)]; }
 };
 
 // The cells of `centres` (one CV_8U row per cell, the references' width) holding the rows

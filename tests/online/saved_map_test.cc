@@ -197,6 +197,16 @@ TEST(SavedMap, VerificationFeaturesAreSavedWithTheMap) {
 }
 
 // Every defect of a map file is one line naming the file, and leaves the detector empty.
+// Where the settings, the first section of a saved map, begin: the u64 at byte 32, in the
+// first entry of the table after the 16-byte signature, the version and the section count
+// (map_file.h).
+std::size_t FirstSectionOffset(const std::string& map) {
+  std::uint64_t offset = 0;
+  for (int i = 0; i < 8; ++i)
+    offset |= static_cast<std::uint64_t>(static_cast<unsigned char>(map[32 + i])) << (8 * i);
+  return static_cast<std::size_t>(offset);
+}
+
 TEST(SavedMap, DefectsAreOneLineErrors) {
   OnlineOptions options;
   options.exclusion = 5;
@@ -234,16 +244,45 @@ TEST(SavedMap, DefectsAreOneLineErrors) {
   testing::WriteBytes(dir + "/text.map", "frames 40\n");
   ExpectInputError([&] { load(dir + "/text.map"); }, {"text.map", "not an OpenABLE map"});
   std::string newer = good;
-  newer[16] = 2;  // the format version, little-endian
+  newer[16] = 3;  // the format version, little-endian
   testing::WriteBytes(dir + "/newer.map", newer);
   ExpectInputError([&] { load(dir + "/newer.map"); },
-                   {"newer.map", "map format version 2", "expected version 1"});
+                   {"newer.map", "map format version 3", "reads versions 1 and 2",
+                    "written by a newer OpenABLE"});
+  // A bit flipped in the rows, which a mapped map uses in place: found before LoadMap returns
+  // when asked, else by the background check, which CheckMap, the next search and a save
+  // report; the damaged map is never written out again.
   std::string flipped = good;
   flipped[good.size() / 2] ^= 0x10;
   testing::WriteBytes(dir + "/flipped.map", flipped);
-  ExpectInputError([&] { load(dir + "/flipped.map"); }, {"flipped.map", "damaged or truncated"});
+  ExpectInputError(
+      [&] {
+        OnlineDetector d(options);
+        d.LoadMap(dir + "/flipped.map", {true, /*check_in_background=*/false});
+      },
+      {"flipped.map", "damaged", "descriptor rows"});
+  {
+    OnlineDetector d(options);
+    d.LoadMap(dir + "/flipped.map");
+    ExpectInputError([&] { d.CheckMap(); }, {"flipped.map", "damaged", "descriptor rows"});
+    ExpectInputError([&] { d.AddDescriptor(rows.row(0)); }, {"flipped.map", "damaged"});
+    ExpectInputError([&] { d.Query(rows.rowRange(0, 2)); }, {"flipped.map", "damaged"});
+    ExpectInputError([&] { d.SaveMap(dir + "/copy.map"); }, {"flipped.map", "damaged"});
+    EXPECT_FALSE(std::filesystem::exists(dir + "/copy.map"));
+  }
+  // A bit flipped in the settings, or in the table of sections: found on opening.
+  std::string header = good;
+  ASSERT_EQ(FirstSectionOffset(good) % 64, 0u);
+  ASSERT_EQ(good.compare(FirstSectionOffset(good), 9, "openable "), 0);
+  header[FirstSectionOffset(good) + 2] ^= 0x01;
+  testing::WriteBytes(dir + "/header.map", header);
+  ExpectInputError([&] { load(dir + "/header.map"); }, {"header.map", "damaged", "settings"});
+  std::string table = good;
+  table[30] ^= 0x01;
+  testing::WriteBytes(dir + "/table.map", table);
+  ExpectInputError([&] { load(dir + "/table.map"); }, {"table.map", "damaged", "table"});
   testing::WriteBytes(dir + "/short.map", good.substr(0, good.size() - 100));
-  ExpectInputError([&] { load(dir + "/short.map"); }, {"short.map", "damaged or truncated"});
+  ExpectInputError([&] { load(dir + "/short.map"); }, {"short.map", "truncated"});
   testing::WriteBytes(dir + "/tiny.map", good.substr(0, 18));
   ExpectInputError([&] { load(dir + "/tiny.map"); }, {"tiny.map", "truncated"});
 

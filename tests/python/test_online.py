@@ -159,15 +159,19 @@ class OnlineAgainstBatchTest(unittest.TestCase):
             np.testing.assert_array_equal(today.descriptors, yesterday.descriptors)
             for row in self.rows[300:]:
                 self.assertEqual(today.add_descriptor(row)[1], yesterday.add_descriptor(row)[1])
-            # A damaged file: one line naming it, and the detector stays empty.
+            # A damaged file: one line naming it; checked before loading, the detector stays
+            # empty; checked in the background (the default), check_map() reports it.
             data = bytearray(open(path, "rb").read())
             data[len(data) // 2] ^= 1
             with open(path, "wb") as f:
                 f.write(data)
             fresh = openable.OnlineDetector(**options)
             with self.assertRaisesRegex(openable.InputError, "kitti.map: the map is damaged"):
-                fresh.load_map(path)
+                fresh.load_map(path, check_in_background=False)
             self.assertEqual(fresh.size, 0)
+            fresh.load_map(path)
+            with self.assertRaisesRegex(openable.InputError, "kitti.map: the map is damaged"):
+                fresh.check_map()
 
     def test_threads_share_a_detector(self):
         # add_descriptor releases the GIL; the detector's lock keeps frames whole.

@@ -21,7 +21,8 @@ import support
 
 BUILD_TREE = os.environ.get("OPENABLE_BUILD_TREE", str(support.SOURCE_DIR / "build"))
 PACKAGE_FILES = {"__init__.py", "__main__.py", "bin", "modules"}
-PROGRAMS = {"Test_OpenABLE", "openable_evaluate", "openable_snaps", "openable_sweep"}
+PROGRAMS = {"Test_OpenABLE", "openable_evaluate", "openable_snaps", "openable_sweep",
+            "openable_map"}
 
 
 def clean_env(**extra):

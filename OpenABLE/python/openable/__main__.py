@@ -18,6 +18,7 @@ COMMANDS = {
                                 "evaluated and ranked"),
     "snaps": ("openable_snaps", "SNAPS: a drifting visual-odometry trajectory plus loops -> "
                                 "a corrected one"),
+    "map": ("openable_map", "maps of places that grow by sessions: add, info, merge, query"),
 }
 
 USAGE = """usage: python3 -m openable COMMAND [ARGS...]   (or: openable COMMAND [ARGS...])
