@@ -9,6 +9,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <deque>
 #include <limits>
@@ -138,6 +139,16 @@ struct RowShape {
   std::uint64_t bytes = 0;
 };
 RowShape RowShapeOf(const MapFile& map, const std::string& path) {
+  // The frames' size: "" (unknown) or "WxH", each a whole number from 1.
+  const std::string size = map.Setting("frame_size");
+  if (!size.empty()) {
+    int w = 0, h = 0, used = 0;
+    if (std::sscanf(size.c_str(), "%9dx%9d%n", &w, &h, &used) != 2 ||
+        used != static_cast<int>(size.size()) || w < 1 || h < 1 ||
+        size != std::to_string(w) + "x" + std::to_string(h))
+      throw InputError(path + ": setting \"frame_size\" of the map is " + Quoted(size) +
+                       ": expected WxH (e.g. 640x480) or nothing");
+  }
   RowShape shape;
   shape.frames = ParseInt(map, "frames", path, 0);
   shape.width = ParseInt(map, "row_width", path, 1);

@@ -190,6 +190,20 @@ std::string FileName(const std::string& path) {
   return std::filesystem::path(path).filename().string();
 }
 
+// A map saved with verification holds each frame's local features, which this program (no
+// verification) would not write back: adding to it or merging it is refused, not done while
+// dropping them.
+void RequireNoFeatures(const std::string& path) {
+  MapReadOptions read;
+  read.header_only = true;
+  const std::string features = ReadMapFile(path, read).Setting("features");
+  if (!features.empty() && features != "none")
+    throw InputError(path + ": the map holds " + features + " features for verified loops, "
+                     "which openable_map does not keep; expected a map saved without "
+                     "verification (add to this one with OnlineDetector::AddFrame and "
+                     "verification on)");
+}
+
 // A detector holding the map at `path`, with its own settings and `base`'s others.
 std::unique_ptr<OnlineDetector> Open(const std::string& path, const OnlineOptions& base) {
   auto d = std::make_unique<OnlineDetector>(MapOptions(path, base));
@@ -211,6 +225,7 @@ int Add(const Arguments& a) {
   std::unique_ptr<OnlineDetector> d;
   const bool exists = std::filesystem::exists(path);
   if (exists) {
+    RequireNoFeatures(path);
     d = Open(path, wanted);
     const OnlineOptions& have = d->Options();
     if (configured && DescriptionOf(have) != DescriptionOf(wanted))
@@ -287,6 +302,7 @@ int Info(const Arguments& a) {
 }
 
 int Merge(const Arguments& a) {
+  for (const std::string& path : a.positional) RequireNoFeatures(path);
   std::unique_ptr<OnlineDetector> d = Open(a.positional[0], OnlineOptions());
   d->AppendMap(a.positional[1]);
   d->SaveMap(a.output);

@@ -6,8 +6,9 @@
 // ReadMapFile and OnlineDetector::LoadMap into the detector whose settings the map names
 // (tests/fuzz/map_detectors.h), and, when it loads, one more frame is searched among the
 // loaded ones (and verified against their saved features). The expected outcomes are a loaded
-// map or one InputError line naming the file; any other exception, a crash or a sanitizer
-// report is a finding. Built with -DOPENABLE_BUILD_FUZZERS=ON (clang); see docs/robustness.md.
+// map or one InputError line naming the file (and for the frame added, a refusal of a frame of
+// another size than the map's); any other exception, a crash or a sanitizer report is a
+// finding. Built with -DOPENABLE_BUILD_FUZZERS=ON (clang); see docs/robustness.md.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -83,7 +84,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   openable::OnlineDetector detector(openable::fuzz::MapDetectorOptions(kind));
   if (Refuses([&] { detector.LoadMap(file.Path()); }, file.Path())) return 0;
   if (kind == MapKind::kVerifying) {
-    detector.AddFrame(openable::fuzz::MapFrame(0));
+    // A map whose frames are of another size refuses the frame (one line).
+    Refuses([&] { detector.AddFrame(openable::fuzz::MapFrame(0)); });
   } else {
     detector.AddDescriptor(cv::Mat::zeros(1, detector.RowWidth(), detector.RowType()));
   }

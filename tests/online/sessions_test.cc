@@ -282,23 +282,30 @@ TEST(MappedMap, FirstVersionIsOneSession) {
   cv::Mat rows(12, 32, CV_8U);
   cv::RNG rng(3);
   rng.fill(rows, cv::RNG::UNIFORM, 0, 256);
-  std::string f("OpenABLE-map\r\n\x1a\n", 16);
-  auto put = [&](std::uint64_t v, int bytes) {
-    for (int i = 0; i < bytes; ++i) f.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
+  const auto file = [&](const std::string& extra) {
+    std::string f("OpenABLE-map\r\n\x1a\n", 16);
+    auto put = [&](std::uint64_t v, int bytes) {
+      for (int i = 0; i < bytes; ++i) f.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
+    };
+    put(1, 4);
+    const std::string settings =
+        "openable 0\nframes 12\nrow_width 32\nrow_type CV_8U\nunit 256\ndescriptor LDB\n"
+        "description global\npatch_size 64\nldb_bits 256\ngrid_x 1\ngrid_y 1\n" + extra;
+    put(settings.size(), 8);
+    f += settings;
+    put(rows.total(), 8);
+    f.append(reinterpret_cast<const char*>(rows.data), rows.total());
+    put(0, 4);  // blocks
+    put(0, 4);  // features
+    put(Fnv1a64(f.data(), f.size()), 8);
+    return f;
   };
-  put(1, 4);
-  const std::string settings =
-      "openable 0\nframes 12\nrow_width 32\nrow_type CV_8U\nunit 256\ndescriptor LDB\n"
-      "description global\npatch_size 64\nldb_bits 256\ngrid_x 1\ngrid_y 1\n";
-  put(settings.size(), 8);
-  f += settings;
-  put(rows.total(), 8);
-  f.append(reinterpret_cast<const char*>(rows.data), rows.total());
-  put(0, 4);  // blocks
-  put(0, 4);  // features
-  put(Fnv1a64(f.data(), f.size()), 8);
   const std::string path = testing::TempDir() + "/v1.map";
-  testing::WriteBytes(path, f);
+  testing::WriteBytes(path, file(""));
+  // A frame size that is not WxH is refused by name.
+  testing::WriteBytes(path + "2", file("frame_size 2\n"));
+  ExpectInputError([&] { OnlineDetector(o).LoadMap(path + "2"); },
+                   {"v1.map2", "setting \"frame_size\" of the map is \"2\"", "expected WxH"});
   OnlineDetector d(o);
   EXPECT_EQ(d.LoadMap(path).frames, 12);
   ASSERT_EQ(d.Sessions().size(), 1u);
