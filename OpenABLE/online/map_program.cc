@@ -278,10 +278,10 @@ int Info(const Arguments& a) {
     return 0;
   }
   std::cout << path << ": OpenABLE map, format version " << map.version << ", " << map.rows.rows
-            << " frames, " << bytes << " bytes (" << std::fixed
-            << (map.rows.rows > 0 ? static_cast<double>(bytes) / map.rows.rows : 0.0)
+            << " frames, " << bytes << " bytes ("
+            << cv::format("%.1f", map.rows.rows > 0 ? static_cast<double>(bytes) / map.rows.rows
+                                                     : 0.0)
             << " a frame); checksums match\n";
-  std::cout.unsetf(std::ios::fixed);
   std::cout << "Description: " << map.Setting("descriptor") << ", patch "
             << map.Setting("patch_size") << ", " << map.Setting("ldb_bits") << " LDB bits, "
             << map.Setting("description") << " (grid " << map.Setting("grid_x") << "x"
