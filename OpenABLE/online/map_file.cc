@@ -213,7 +213,7 @@ std::shared_future<std::string> Ready(std::string error) {
 
 // ---- Version 1 ------------------------------------------------------------------------------
 
-MapFile ReadFirstVersion(const std::string& path, const std::string& data) {
+MapFile ReadFirstVersion(const std::string& path, std::string_view data) {
   Reader r{data.data(), kSignatureBytes + 4, data.size(), path};
   if (data.size() < r.pos + 8)
     throw InputError(path + ": the map is truncated (" + std::to_string(data.size()) +
@@ -425,7 +425,7 @@ MapFile ReadMapFile(const std::string& path, const MapReadOptions& options) {
                      ", which begins with \"OpenABLE-map\")");
   Reader r{data, kSignatureBytes, size, path};
   const auto version = r.Get<std::uint32_t>("the format version");
-  if (version == 1) return ReadFirstVersion(path, std::string(data, size));  // small maps
+  if (version == 1) return ReadFirstVersion(path, std::string_view(data, size));
   if (version != kMapFormatVersion)
     throw InputError(path + ": map format version " + std::to_string(version) + "; this " +
                      "OpenABLE reads versions 1 and " + std::to_string(kMapFormatVersion) +

@@ -321,15 +321,7 @@ int Query(const Arguments& a) {
   std::vector<std::string> names;
   ForImagesOf(a.images, a.quiet || a.json, "describing queries",
               [&](const std::vector<cv::Mat>& images, const std::vector<std::string>& chunk) {
-                for (std::size_t i = 0; i < images.size(); ++i) {
-                  if (!d->FrameSize().empty() &&
-                      cv::format("%dx%d", images[i].cols, images[i].rows) != d->FrameSize())
-                    throw InputError("frame " + Quoted(chunk[i]) + " is " +
-                                     cv::format("%dx%d", images[i].cols, images[i].rows) +
-                                     "; the map's frames are " + d->FrameSize() +
-                                     " (expected frames of the map's camera at its size)");
-                }
-                rows.push_back(DescribeImages(images, d->Options()));
+                rows.push_back(d->DescribeFrames(images, chunk));
                 names.insert(names.end(), chunk.begin(), chunk.end());
               });
   cv::Mat all;

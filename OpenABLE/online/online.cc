@@ -39,6 +39,14 @@ std::string SizeText(cv::Size s) {
   return std::to_string(s.width) + "x" + std::to_string(s.height);
 }
 
+// A frame (`what`) of size `size` joining a map whose frames are `map_size` ("" = unknown).
+void CheckFrameSize(const std::string& what, const std::string& size,
+                    const std::string& map_size) {
+  if (!map_size.empty() && size != map_size)
+    throw InputError(what + " is " + size + "; the map's frames are " + map_size +
+                     " (expected frames of one camera at one size)");
+}
+
 }  // namespace
 
 void OnlineOptions::Check() const {
@@ -108,19 +116,24 @@ void DescribeInto(const FrameDescriber& describer, const cv::Mat1b& grey, const 
 
 }  // namespace
 
-cv::Mat DescribeImages(const std::vector<cv::Mat>& images, const OnlineOptions& options,
-                       int threads) {
-  const Describer d = MakeDescriber(options);
+namespace {
+
+// One row per image, described in parallel by `describer`; image i is named `names[i]` in
+// messages (quoted, as a file), or "image i" when `names` is empty. The first image that
+// cannot be described gives the error.
+cv::Mat DescribeNamed(const FrameDescriber& describer, const std::vector<cv::Mat>& images,
+                      const std::vector<std::string>& names, int threads) {
   const int n = static_cast<int>(images.size());
-  cv::Mat rows(n, d.frame->RowWidth(), d.frame->RowType());
+  cv::Mat rows(n, describer.RowWidth(), describer.RowType());
   if (n == 0) return rows;
   std::mutex mutex;
   int error_index = n;
   std::string error;
   ParallelFor(n, threads, [&](int i) {
     try {
-      const std::string what = "image " + std::to_string(i);
-      DescribeInto(*d.frame, GreyOfImage(images[i], what), what, rows.row(i));
+      const std::string what = names.empty() ? "image " + std::to_string(i)
+                                             : "frame " + Quoted(names[static_cast<size_t>(i)]);
+      DescribeInto(describer, GreyOfImage(images[i], what), what, rows.row(i));
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex);
       if (i < error_index) error_index = i, error = e.what();
@@ -128,6 +141,14 @@ cv::Mat DescribeImages(const std::vector<cv::Mat>& images, const OnlineOptions& 
   });
   if (error_index < n) throw InputError(error);
   return rows;
+}
+
+}  // namespace
+
+cv::Mat DescribeImages(const std::vector<cv::Mat>& images, const OnlineOptions& options,
+                       int threads) {
+  const Describer d = MakeDescriber(options);
+  return DescribeNamed(*d.frame, images, {}, threads);
 }
 
 cv::Mat1f DistanceMatrix(const cv::Mat& rows, int sequence_length, SequenceDirection direction,
@@ -258,9 +279,7 @@ OnlineResult OnlineDetector::AddFrame(const cv::Mat& image) {
   const std::string what = "frame " + std::to_string(Size());
   const cv::Mat1b grey = GreyOfImage(image, what);
   const std::string size = SizeText(grey.size());
-  if (!s.frame_size.empty() && size != s.frame_size)
-    throw InputError(what + " is " + size + "; the map's frames are " + s.frame_size +
-                     " (expected frames of one camera at one size)");
+  CheckFrameSize(what, size, s.frame_size);
   DescribeInto(*s.describer.frame, grey, what, row);
   s.frame_size = size;
   const double describe = Seconds(start);
@@ -324,35 +343,28 @@ void OnlineDetector::AddToMap(const cv::Mat& rows) {
   s.map->Update(s.map->Size() - s.options.exclusion, /*background=*/false);
 }
 
+cv::Mat OnlineDetector::DescribeFrames(const std::vector<cv::Mat>& images,
+                                       const std::vector<std::string>& names) const {
+  const State& s = *state_;
+  if (!names.empty() && names.size() != images.size())
+    throw std::invalid_argument("OnlineDetector::DescribeFrames: " +
+                                std::to_string(names.size()) + " names for " +
+                                std::to_string(images.size()) + " images");
+  std::string size = s.frame_size;
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    const std::string mine = SizeText(images[i].size());
+    CheckFrameSize(names.empty() ? "image " + std::to_string(i) : "frame " + Quoted(names[i]),
+                   mine, size);
+    size = mine;
+  }
+  return DescribeNamed(*s.describer.frame, images, names, 0);
+}
+
 void OnlineDetector::AddImagesToMap(const std::vector<cv::Mat>& images,
                                     const std::vector<std::string>& names) {
   State& s = *state_;
-  std::string size = s.frame_size;
-  for (std::size_t i = 0; i < images.size(); ++i) {
-    const std::string what =
-        i < names.size() ? "frame " + Quoted(names[i]) : "image " + std::to_string(i);
-    const std::string mine = SizeText(images[i].size());
-    if (!size.empty() && mine != size)
-      throw InputError(what + " is " + mine + "; the map's frames are " + size +
-                       " (expected frames of one camera at one size)");
-    size = mine;
-  }
-  cv::Mat rows;
-  try {
-    rows = DescribeImages(images, s.options);
-  } catch (const InputError& e) {
-    // DescribeImages names the image by its index; the caller's name is clearer.
-    const std::string text = e.what();
-    if (!names.empty() && text.rfind("image ", 0) == 0) {
-      const std::size_t end = text.find_first_not_of("0123456789", 6);
-      const std::size_t i = std::stoul(text.substr(6, end - 6));
-      if (i < names.size())
-        throw InputError("frame " + Quoted(names[i]) + text.substr(end));
-    }
-    throw;
-  }
-  AddToMap(rows);
-  if (!images.empty()) s.frame_size = size;
+  AddToMap(DescribeFrames(images, names));
+  if (!images.empty()) s.frame_size = SizeText(images.front().size());
 }
 
 OnlineResult OnlineDetector::AddDescriptor(const cv::Mat& row) {
@@ -528,15 +540,7 @@ std::vector<OnlineResult> OnlineDetector::Query(const cv::Mat& rows,
 
 std::vector<OnlineResult> OnlineDetector::QueryImages(
     const std::vector<cv::Mat>& images, const std::vector<std::string>& sessions) const {
-  const State& s = *state_;
-  for (std::size_t i = 0; i < images.size(); ++i) {
-    const std::string size = SizeText(images[i].size());
-    if (!images[i].empty() && !s.frame_size.empty() && size != s.frame_size)
-      throw InputError("query image " + std::to_string(i) + " is " + size +
-                       "; the map's frames are " + s.frame_size +
-                       " (expected frames of the map's camera at its size)");
-  }
-  return Query(DescribeImages(images, s.options), sessions);
+  return Query(DescribeFrames(images), sessions);
 }
 
 // ---- Saved maps ----------------------------------------------------------------------------

@@ -159,6 +159,13 @@ class OnlineDetector {
   // messages. Throws InputError naming the first image that does not fit, adding none.
   void AddImagesToMap(const std::vector<cv::Mat>& images,
                       const std::vector<std::string>& names = {});
+  // The rows of `images` (as AddFrame takes them, described on every core) without adding
+  // them: frames of a traversal to query (Query) or to add (AddToMap). Every image must be of
+  // the map's frame size (FrameSize; when unknown, of the first image's); `names` (one per
+  // image, or empty) name them in messages. Throws InputError naming the first image that
+  // does not fit.
+  cv::Mat DescribeFrames(const std::vector<cv::Mat>& images,
+                         const std::vector<std::string>& names = {}) const;
 
   // Sessions: a map holds one or more traversals, each a run of consecutive frames with a
   // name and a time (MapSession). StartSession begins one at frame Size() (an empty session
@@ -181,8 +188,7 @@ class OnlineDetector {
   // another width or type, an unknown session name, or a damaged loaded map (CheckMap).
   std::vector<OnlineResult> Query(const cv::Mat& rows,
                                   const std::vector<std::string>& sessions = {}) const;
-  // Describes `images` (as AddFrame takes them; the map's frame size, see FrameSize) and
-  // queries them.
+  // Query(DescribeFrames(images), sessions).
   std::vector<OnlineResult> QueryImages(const std::vector<cv::Mat>& images,
                                         const std::vector<std::string>& sessions = {}) const;
 

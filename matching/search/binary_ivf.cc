@@ -152,7 +152,7 @@ bool LittleEndianHost() {
 // is still read; its cells are packed again from the references.
 struct Layout {
   std::uint32_t cells = 0, width = 0, rows = 0;
-  std::size_t centres = 0, offsets = 0, ids = 0, packed = 0, end = 0;  // byte offsets
+  std::size_t centres = 0, offsets = 0, ids = 0, packed = 0;  // byte offsets of the sections
   Layout(std::uint32_t k, std::uint32_t w, std::uint32_t n) : cells(k), width(w), rows(n) {
     centres = 24;
     offsets = centres + Padded8(std::size_t{k} * w);
