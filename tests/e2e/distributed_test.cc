@@ -221,21 +221,39 @@ TEST(SpreadFailure, AFrameOfOneShareEndsTheRunInOneLineWithNoOutput) {
   EXPECT_FALSE(fs::exists(dir + "/out")) << "an output of the failed run was left";
 }
 
-// Ctrl-C on mpirun while KITTI 00's frames are described (twice, as two traversals): mpirun ends every process with
-// SIGTERM; the user reads one line (process 0's), not one per process, and no output is left.
+// Ctrl-C on mpirun while the frames are described: mpirun ends every process with SIGTERM;
+// the user reads at most one line (process 0's), never one per process, and no output is left.
+// At most: Open MPI's mpirun (4.1) sends SIGCONT, waits a second, then SIGTERM and SIGKILL
+// about 2 ms apart, so on a busy machine process 0 may be killed before its handler runs and
+// the line is not printed (measured: 6 runs of 10 with the other core busy; docs/distributed.md).
 // The other processes, silent by design, are also what mpirun ends when process 0 has already
 // reported a failure (the case above), so this guards that one line too.
-TEST(SpreadFailure, CtrlCOnMpirunPrintsOneLineAndLeavesNoOutput) {
+TEST(SpreadFailure, CtrlCOnMpirunPrintsAtMostOneLineAndLeavesNoOutput) {
   const std::string missing = MissingMpi();
   if (!missing.empty()) GTEST_SKIP() << missing;
   const std::string data = testing::DatasetsDir() + "/kitti00_first1700/image_0";
   OPENABLE_REQUIRE_PATH(data);
   const std::string dir = testing::TempDir();
-  // The same frames as a second traversal: the progress line of the first traversal (written
-  // when it is described, stderr not being a terminal) says the second is being described.
+  // The interrupt comes 300 ms after the progress line of the first traversal (KITTI 00's 1700
+  // frames; the line is written when a traversal is described, stderr not being a terminal).
+  // The second traversal lists every frame six times (links), six times as long to
+  // describe as the first on any machine, so that the interrupt lands while it is described
+  // and never after the run has written its output.
+  const std::string repeated = dir + "/repeated";
+  fs::create_directories(repeated);
+  std::vector<fs::path> frames;
+  for (const auto& e : fs::directory_iterator(data)) frames.push_back(e.path());
+  std::sort(frames.begin(), frames.end());
+  int link = 0;
+  for (int copy = 0; copy < 6; ++copy)
+    for (const fs::path& frame : frames) {
+      char name[32];
+      std::snprintf(name, sizeof name, "%06d.png", link++);
+      fs::create_symlink(frame, repeated + "/" + name);
+    }
   const std::string config = dir + "/Config.txt";
   std::ofstream(config) << "%YAML:1.0\nImages_path: \"" << data << "\"\nImages_path_2: \""
-                        << data << "\"\nImage_descriptor: LDB\nThreads: 1\n"
+                        << repeated << "\"\nImage_descriptor: LDB\nThreads: 1\n"
                         << "Npy_name: \"out/matrix.npy\"\n";
   const std::string err = dir + "/stderr.log";
   const pid_t child = StartRunToInterrupt(
@@ -254,7 +272,7 @@ TEST(SpreadFailure, CtrlCOnMpirunPrintsOneLineAndLeavesNoOutput) {
   const std::string line = "Test_OpenABLE: interrupted by SIGTERM (temporary files removed)\n";
   size_t count = 0;
   for (size_t at = e.find(line); at != std::string::npos; at = e.find(line, at + 1)) ++count;
-  EXPECT_EQ(count, 1u) << e;
+  EXPECT_LE(count, 1u) << e;
   EXPECT_EQ(e.find("(process 1 of 2)"), std::string::npos) << e;
   EXPECT_FALSE(fs::exists(dir + "/out")) << "an output of the interrupted run was left";
 }
