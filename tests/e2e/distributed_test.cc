@@ -1,6 +1,6 @@
 // Runs spread over processes with mpirun (OpenABLE/cluster/cluster.h, docs/distributed.md): every
 // output equals the single-process run's, byte for byte for Hamming distances and within
-// 1e-6 for L2 (whose matrix products sum in another order when the rows are split), in the
+// 1e-5 for L2 (whose matrix products sum in another order when the rows are split), in the
 // dense and the bounded mode, for one and two traversals, L = 1 and L = 10, with 1, 2 and 3
 // processes; a process that fails ends the run with one line naming it and leaves no output.
 // Skipped, saying why, when mpirun or the MPI module is absent.
@@ -102,7 +102,12 @@ std::vector<std::vector<std::string>> CsvRows(const std::string& path) {
   return rows;
 }
 
-// The matches of two runs: equal, or (L2) equal frames and ranks with values within 1e-6.
+// The matches of two runs: equal, or (L2) equal frames and ranks with values within 1e-5.
+// L2 distances come from |a|^2 + |b|^2 - 2 a.b in float32, and the bounded pipeline's blocks of
+// 16 query rows start at each process's first row, so OpenBLAS may sum a.b with another kernel
+// (the edge kernels of a partial block): a difference of a few units in the last place of a.b
+// (HOG rows: |a|^2 near 49) is 1e-6 to 1e-5 of a normalised distance after the cancellation
+// (1.5e-6 measured on an AMD EPYC with OpenBLAS's Zen kernels, 2e-7 on an Intel Xeon).
 void ExpectSameMatches(const std::string& a, const std::string& b, bool exact) {
   if (exact) {
     EXPECT_EQ(ReadAll(a), ReadAll(b)) << a << " and " << b << " differ";
@@ -114,7 +119,7 @@ void ExpectSameMatches(const std::string& a, const std::string& b, bool exact) {
     ASSERT_EQ(ra[i].size(), rb[i].size()) << "line " << i;
     for (size_t k = 0; k < ra[i].size(); ++k) {
       if (i > 0 && ra[i][k].find('.') != std::string::npos) {
-        EXPECT_NEAR(std::stod(ra[i][k]), std::stod(rb[i][k]), 1e-6) << "line " << i;
+        EXPECT_NEAR(std::stod(ra[i][k]), std::stod(rb[i][k]), 1e-5) << "line " << i;
       } else {
         EXPECT_EQ(ra[i][k], rb[i][k]) << "line " << i;
       }
