@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "OpenABLE/base/error.h"
@@ -216,15 +217,15 @@ bool ParseDescr(const std::string& descr, NpyKind* kind, int* size) {
   return false;
 }
 
-std::string ShapeText(const std::vector<std::int64_t>& shape) {
+}  // namespace
+
+std::string NpyShapeText(const std::vector<std::int64_t>& shape) {
   std::string s = "(";
   for (std::size_t k = 0; k < shape.size(); ++k) {
     s += (k ? ", " : "") + std::to_string(shape[k]);
   }
   return s + (shape.size() == 1 ? ",)" : ")");
 }
-
-}  // namespace
 
 std::string NpyHeaderOf(const std::string& descr, const std::string& shape) {
   // The .npy format: magic, version 1.0, a little-endian uint16 header length, then a Python
@@ -258,7 +259,7 @@ std::string EncodeNpy(const cv::Mat1f& m) {
   return out;
 }
 
-cv::Mat1f DecodeNpyMatrix(std::string_view data, const std::string& where) {
+NpyHeaderInfo ReadNpyHeader(std::string_view data, const std::string& where) {
   const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
   if (data.size() < 10 || data.substr(0, 6) != std::string_view("\x93NUMPY", 6)) {
     throw InputError(where + ": not a NumPy .npy file (no \\x93NUMPY magic at the start)");
@@ -275,8 +276,21 @@ cv::Mat1f DecodeNpyMatrix(std::string_view data, const std::string& where) {
     throw InputError(where + ": truncated .npy header (" + std::to_string(header_len) +
                      " bytes announced, the file has " + std::to_string(data.size()) + ")");
   }
-  const NpyHeaderFields h = NpyHeaderParser(data.substr(prefix, header_len), where).Parse();
+  NpyHeaderFields fields = NpyHeaderParser(data.substr(prefix, header_len), where).Parse();
+  NpyHeaderInfo info;
+  info.descr = std::move(fields.descr);
+  info.fortran_order = fields.fortran_order;
+  info.shape = std::move(fields.shape);
+  info.data_offset = prefix + header_len;
+  return info;
+}
 
+cv::Mat1f DecodeNpyMatrix(std::string_view data, const std::string& where) {
+  const NpyHeaderInfo h = ReadNpyHeader(data, where);
+  if (h.descr == "|O") {
+    throw InputError(where +
+                     ": holds Python objects (dtype object, pickled); expected a numeric matrix");
+  }
   NpyKind kind{};
   int item = 0;
   if (!ParseDescr(h.descr, &kind, &item)) {
@@ -286,24 +300,24 @@ cv::Mat1f DecodeNpyMatrix(std::string_view data, const std::string& where) {
   }
   if (h.shape.size() != 2) {
     throw InputError(
-        where + ": shape " + ShapeText(h.shape) + " has " + std::to_string(h.shape.size()) +
+        where + ": shape " + NpyShapeText(h.shape) + " has " + std::to_string(h.shape.size()) +
         (h.shape.size() == 1 ? " dimension" : " dimensions") + "; expected 2 (a matrix)");
   }
   const std::int64_t rows = h.shape[0], cols = h.shape[1];
   constexpr std::int64_t kMaxInt = std::numeric_limits<int>::max();
   if (rows > kMaxInt || cols > kMaxInt || (cols > 0 && rows > kMaxInt / cols)) {
-    throw InputError(where + ": shape " + ShapeText(h.shape) + " is too large");
+    throw InputError(where + ": shape " + NpyShapeText(h.shape) + " is too large");
   }
   const std::uint64_t count = static_cast<std::uint64_t>(rows) * static_cast<std::uint64_t>(cols);
   const std::uint64_t needed = count * static_cast<std::uint64_t>(item);
-  const std::size_t offset = prefix + header_len;
+  const std::size_t offset = h.data_offset;
   if (data.size() - offset < needed) {
     throw InputError(where + ": truncated data: " + std::to_string(data.size() - offset) +
                      " bytes, expected " + std::to_string(needed) + " for shape " +
-                     ShapeText(h.shape) + " of " + h.descr);
+                     NpyShapeText(h.shape) + " of " + h.descr);
   }
   cv::Mat1f m(static_cast<int>(rows), static_cast<int>(cols));
-  const unsigned char* src = bytes + offset;
+  const auto* src = reinterpret_cast<const unsigned char*>(data.data()) + offset;
   for (int r = 0; r < m.rows; ++r) {
     float* out = m[r];
     for (int c = 0; c < m.cols; ++c) {

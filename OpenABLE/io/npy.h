@@ -1,12 +1,16 @@
 // NumPy .npy files (https://numpy.org/doc/stable/reference/generated/numpy.lib.format.html):
 // the one place that writes and reads them. Test_OpenABLE's matrices (Npy_name) and matches
 // (Matches_name) are written here; openable_evaluate, the ground truth and SNAPS read matrices
-// through DecodeNpyMatrix (OpenABLE/evaluation/matrix_file.h reads the file).
+// through DecodeNpyMatrix (OpenABLE/evaluation/matrix_file.h reads the file). Object arrays
+// (pickled) and .npz archives are read by npy_objects.h.
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace openable {
 
@@ -22,10 +26,25 @@ std::string EncodeNpy(const cv::Mat1f& m);
 // follows it in C order.
 std::string NpyHeader(int rows, int cols);
 
+// What the header of a .npy file says: the dtype ("<f4", "|b1", "|O"), the order, the shape
+// and where the data start.
+struct NpyHeaderInfo {
+  std::string descr;
+  bool fortran_order = false;
+  std::vector<std::int64_t> shape;
+  std::size_t data_offset = 0;
+};
+// Reads the magic, the version (1.0, 2.0 or 3.0), the header length and the dict of a .npy
+// file. Throws InputError with one line beginning with `where` on a bad magic, version or
+// dict, or a header longer than the file.
+NpyHeaderInfo ReadNpyHeader(std::string_view data, const std::string& where);
+// A shape as Python writes it: "(3, 4)", "(5,)", "()".
+std::string NpyShapeText(const std::vector<std::int64_t>& shape);
+
 // A 2-D numeric matrix from the bytes of a .npy file, as float: versions 1.0-3.0; dtypes bool,
 // u1, i1, u2, i2, u4, i4, u8, i8, f4, f8, little-endian or '|'; C or Fortran order. Throws
-// InputError with one line beginning with `where` on a bad magic, version, header, dtype,
-// shape or truncated data.
+// InputError with one line beginning with `where` on a bad magic, version, header, dtype
+// (an object array, '|O', is read by DecodeNpyObjects, npy_objects.h), shape or truncated data.
 cv::Mat1f DecodeNpyMatrix(std::string_view data, const std::string& where);
 
 }  // namespace openable

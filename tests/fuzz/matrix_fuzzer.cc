@@ -1,6 +1,8 @@
 // libFuzzer target: the matrix readers of openable_evaluate, the ground truth and SNAPS. The
 // rest of the input after its first byte is decoded as a NumPy file from memory
-// (DecodeNpyMatrix, OpenABLE/io/npy.h), then written to a temporary file whose extension the
+// (DecodeNpyMatrix, OpenABLE/io/npy.h), as a NumPy file of Python objects (DecodeNpyObjects,
+// the restricted pickle reader of OpenABLE/io/npy_objects.h) and as a .npz archive (every
+// member listed and read by NpzMember, then decoded as a matrix), then written to a temporary file whose extension the
 // first byte chooses (modulo 4: .npy, .txt, .csv, .png) and read by ReadMatrixFile
 // (OpenABLE/evaluation/matrix_file.h: the .npy reader, the text reader, or an image through
 // OpenCV's codecs). A .npy file must read as the same matrix as its bytes decode to. The
@@ -13,11 +15,13 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/io/npy.h"
+#include "OpenABLE/io/npy_objects.h"
 #include "tests/fuzz/frame_check.h"
 #include "tests/fuzz/fuzz_support.h"
 
@@ -46,6 +50,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string bytes = openable::fuzz::Bytes(data + 1, size - 1);
   cv::Mat1f decoded;
   const bool refused = Refuses([&] { decoded = openable::DecodeNpyMatrix(bytes, "fuzz.npy"); });
+  Refuses([&] { openable::DecodeNpyObjects(bytes, "fuzz.npy"); });
+  std::vector<std::string> members;
+  if (!Refuses([&] { members = openable::NpzMemberNames(bytes, "fuzz.npz"); }))
+    for (const std::string& name : members) {
+      std::string member;
+      if (!Refuses([&] { member = openable::NpzMember(bytes, name, "fuzz.npz"); }))
+        Refuses([&] { openable::DecodeNpyMatrix(member, "fuzz.npz"); });
+    }
   const openable::fuzz::TempFile file(bytes, kExtensions[choice]);
   cv::Mat1f read;
   if (Refuses([&] { read = openable::ReadMatrixFile(file.Path()); }, file.Path())) return 0;

@@ -1,0 +1,76 @@
+// NumPy files that hold Python objects, and .npz archives.
+//
+// An object array (dtype '|O') is stored in a .npy file as a pickle. Such files come with
+// place-recognition benchmarks: VPR-Bench's ground_truth_new.npy is a (Q, 2) object array whose
+// rows are [query index, list of true reference indices]. Unpickling runs whatever callables a
+// file names, so DecodeNpyObjects does not unpickle: a small interpreter reads the opcodes plain
+// data use and calls none but the few NumPy and builtin constructors that make arrays, dtypes,
+// numbers, bytes and ranges; a file naming anything else is refused.
+//
+// A .npz file (np.savez, np.savez_compressed) is a ZIP archive of .npy members: VPR_Tutorial's
+// GT.npz holds the boolean matrices GThard.npy and GTsoft.npy.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace openable {
+
+// A value read from a pickled NumPy object array. Values may be shared (a list the pickle
+// refers to twice, small numbers): treat them as read-only.
+struct PyValue {
+  enum class Kind { kNone, kBool, kInt, kFloat, kText, kBytes, kList, kTuple, kDict, kArray };
+  Kind kind = Kind::kNone;
+  std::int64_t integer = 0;  // kBool (0 or 1), kInt
+  double real = 0;           // kFloat
+  std::string text;          // kText (UTF-8), kBytes (Python 2 strings are bytes)
+  // kList (also a materialised range), kTuple; kArray: the elements in C order;
+  // kDict: key, value, key, value, ...
+  std::vector<std::shared_ptr<PyValue>> items;
+  std::vector<std::int64_t> shape;  // kArray
+};
+
+// The elements of a .npy file's array, in C order, with its shape: an object array ('|O',
+// pickled) or a numeric one (then each element is a kBool/kInt/kFloat value).
+struct NpyObjects {
+  std::vector<std::int64_t> shape;
+  std::vector<std::shared_ptr<const PyValue>> items;
+};
+
+// Limits that keep a small hostile file from taking much memory or time. The numbers the range
+// objects of one file make in all (each a value of some 120 bytes: 250 MB at most), and the
+// elements its object arrays hold in all (each a pointer):
+constexpr std::int64_t kNpyMaxRangeNumbers = 2'000'000;
+constexpr std::int64_t kNpyMaxObjectItems = 10'000'000;
+// The values an object array may unfold into, a list it refers to from several places counted
+// at each place (what a program walking it visits):
+constexpr std::int64_t kNpyMaxUnfoldedValues = 100'000'000;
+// The deepest nesting of lists, tuples, dicts and arrays read.
+constexpr int kNpyMaxDepth = 100;
+
+// Reads the array of a .npy file (versions 1.0-3.0). Pickles of protocols 0-5 are read as
+// Python 2 and 3 and NumPy 1 and 2 write them; the callables allowed are
+// numpy(.core|._core).multiarray._reconstruct and .scalar, numpy.dtype, numpy.ndarray (as an
+// argument), numpy(.core|._core).numeric._frombuffer (protocol 5 arrays), _codecs.encode to
+// latin-1, builtins.bytes, and builtins.range / __builtin__.xrange (materialised as lists).
+// Numeric dtypes: b1, i1/u1, i2/u2, i4/u4, i8/u8 (u8 values must fit int64), f4, f8,
+// little-endian or '|'; C or Fortran order. Throws InputError with one line beginning with
+// `where` (the file name as given, e.g. "\"gt.npy\"") on anything it cannot read: not .npy, a
+// bad header, a refused callable ("refuses to call posix.system: ..."), truncation ("truncated
+// pickle at byte N", counted from the pickle's first byte), a refused or unknown opcode, limits
+// above exceeded.
+NpyObjects DecodeNpyObjects(std::string_view data, const std::string& where);
+
+// The member names of a .npz (ZIP) archive, in archive order.
+std::vector<std::string> NpzMemberNames(std::string_view zip, const std::string& where);
+// The bytes of the member `name` ("GThard.npy"; "GThard", as np.load names it, finds
+// "GThard.npy" too), stored or deflated, checked against its CRC-32. Throws InputError with
+// one line beginning with `where` on a file that is not a ZIP archive, a missing member (the
+// message lists the members there are), a compression method other than stored and deflate,
+// encryption, a CRC-32 mismatch, sizes or offsets beyond the file.
+std::string NpzMember(std::string_view zip, const std::string& name, const std::string& where);
+
+}  // namespace openable
