@@ -30,10 +30,15 @@ const std::string& GroundTruthTypeHelp() {
     for (const GroundTruthFormat& f : GroundTruthFormats())
       text += std::string(&f == &GroundTruthFormats().front() ? "" : "; ") + f.name + ": " +
               f.summary;
-    return text + ". The run's matrix is evaluated against it with both protocols of "
-                  "docs/evaluation.md.";
+    return text + ". The run's matrix is evaluated against it with the protocols of "
+                  "Evaluation_protocol (docs/evaluation.md).";
   }();
   return help;
+}
+
+// Evaluation_protocol as Config.txt writes it.
+std::string EvaluationProtocolsValue(EvaluationProtocols protocols) {
+  return EvaluationProtocolsText(protocols);
 }
 
 // Ground_truth_type as Config.txt writes it: empty for no evaluation.
@@ -362,6 +367,10 @@ void AddEvaluationKeys(OptionTable& t, Config& c) {
   t.Add("Ground_truth_2", kEvaluation, c.evaluation, c.evaluation.truth.path_2,
         "Poses of the query traversal (Images_path_2 or Video_path_2) for kitti, tum and "
         "positions ground truth of two traversals.");
+  t.Add("Ground_truth_soft", kEvaluation, c.evaluation, c.evaluation.truth.soft_path,
+        "vpr_tutorial: VPR_Tutorial's GTsoft (.npy, database x queries): cells outside GThard "
+        "that VPR_Tutorial's protocol counts neither right nor wrong. Empty: the GTsoft of a "
+        "Ground_truth .npz, or none.");
   t.Add("Ground_truth_base", kEvaluation, c.evaluation, c.evaluation.truth.base, -1, 1,
         "Pairs: 0 or 1 for 0- or 1-based frame numbers; -1 reads a comment line saying "
         "\"0-based\" or \"1-based\", else 0.");
@@ -392,6 +401,14 @@ void AddEvaluationKeys(OptionTable& t, Config& c) {
   t.Add("Vicinity", kEvaluation, c.evaluation, c.evaluation.protocol.vicinity, 0, kNoLimit,
         "ABLE-P protocol: a detected cell is a true positive when a ground-truth loop lies within"
         " this many frames of it in both directions (7 in the ABLE-P paper).");
+  t.AddEnumName("Evaluation_protocol", kEvaluation, c.evaluation,
+                c.evaluation.protocol.protocols, &ParseEvaluationProtocols,
+                &EvaluationProtocolsValue,
+                "Protocols reported: openable (the toolbox's own: per query and ABLE-P), "
+                "vpr_bench (VPR-Bench's AUC-PR, R@100P, extended precision and RecallRate@N), "
+                "vpr_tutorial (VPR_Tutorial's multi- and single-match AUC and R@100P, R@K), "
+                "several joined by commas, or all. Each computes its figures as that code does "
+                "(docs/evaluation.md); Tolerance widens every ground truth.");
   t.Add("Evaluation_name", kEvaluation, c.evaluation, c.evaluation.name,
         "Output prefix of the evaluation: <name>.json (figures and settings), "
         "<name>_per_query.csv and <name>_ablep.csv (curves), <name>_pr.png (precision-recall "

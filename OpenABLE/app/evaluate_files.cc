@@ -34,6 +34,8 @@ const std::pair<const char*, const char*> kFlagKeys[] = {
     {"--heading", "Ground_truth_heading"},
     {"--min-gap", "Ground_truth_min_gap"},
     {"--axes", "Ground_truth_axes"},
+    {"--ground-truth-soft", "Ground_truth_soft"},
+    {"--protocol", "Evaluation_protocol"},
     {"--tolerance", "Tolerance"},
     {"--exclusion", "Exclusion"},
     {"--vicinity", "Vicinity"},
@@ -108,7 +110,7 @@ std::string ParseEvaluateCommandLine(int argc, const char* const* argv, Evaluate
   // The shared command line (command_line.h), with the flags that stand for keys and the
   // program's own options; a configuration is optional (--config, or a file given alone).
   ProgramOptions program;
-  program.value_options = {"--matrix", "--label", "--reference-frames", "--config"};
+  program.value_options = {"--matrix", "--label", "--reference-frames", "--layout", "--config"};
   for (const auto& [flag, key] : kFlagKeys) program.key_flags.emplace_back(flag, key);
   program.needs_configuration = false;
   CommandLine line;
@@ -146,6 +148,14 @@ std::string ParseEvaluateCommandLine(int argc, const char* const* argv, Evaluate
       if (used != value.size() || out.reference_frames < 1)
         return refuse("--reference-frames: \"" + value +
                       "\" is not valid; expected a number of frames >= 1");
+    } else if (option == "--layout") {
+      if (value == "query_reference") {
+        out.query_reference = true;
+      } else if (value != "auto") {
+        return refuse("--layout: \"" + value +
+                      "\" is not valid; expected query_reference (a square matrix of queries x "
+                      "references) or auto (the default: by its shape and --reference-frames)");
+      }
     } else if (!out.config_path.empty()) {  // --config, after a file or another --config
       return refuse("more than one configuration file (\"" + out.config_path + "\" and \"" +
                     value + "\"); expected one");
@@ -238,7 +248,13 @@ EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line) {
                      "evaluated with the settings the matrix's run had (" +
                          remembered.begin()->second.second + ")" +
                          (applied.empty() ? "" : ": " + applied));
-  out.matrices = EvaluateMatrixFiles(out.evaluation, command_line.matrices, reference_frames);
+  if (command_line.query_reference && reference_frames > 0)
+    throw InputError("--layout query_reference: the matrix is queries x references as a whole, "
+                     "but --reference-frames (or its run's settings) says it holds two traversals "
+                     "of " + std::to_string(reference_frames) + " reference frames; expected one "
+                     "of them");
+  out.matrices = EvaluateMatrixFiles(out.evaluation, command_line.matrices, reference_frames,
+                                     command_line.query_reference);
   return out;
 }
 

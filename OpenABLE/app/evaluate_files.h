@@ -18,6 +18,7 @@ struct EvaluateCommandLine {
   std::vector<std::string> overrides;  // "Key=Value" of the flags and of --set, in order
   std::string config_path;             // --config
   int reference_frames = 0;            // --reference-frames
+  bool query_reference = false;        // --layout query_reference: square, yet queries x references
   bool quiet = false, json = false, help = false, version = false;
   bool help_keys = false;  // --help-keys [GROUP]
   std::string help_group;
@@ -25,7 +26,7 @@ struct EvaluateCommandLine {
 
 // Parses argv. Returns an empty string, or one line ("openable_evaluate: ... (see --help)")
 // naming the bad argument: an unknown option, a missing value, --label before any --matrix, a
-// bad --reference-frames, or no --matrix. --help, --help-keys and --version end the parsing
+// bad --reference-frames or --layout, or no --matrix. --help, --help-keys and --version end the parsing
 // (answered whatever follows, as before any other argument is read).
 std::string ParseEvaluateCommandLine(int argc, const char* const* argv, EvaluateCommandLine& out);
 

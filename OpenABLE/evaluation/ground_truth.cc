@@ -26,6 +26,8 @@
 #include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/evaluation/pairs_file.h"
 #include "OpenABLE/evaluation/pose_file.h"
+#include "OpenABLE/io/npy.h"
+#include "OpenABLE/io/npy_objects.h"
 
 namespace openable {
 namespace {
@@ -387,6 +389,144 @@ void LoadAligned(const GroundTruthOptions&, const EvaluationLayout& layout, int,
   }
 }
 
+
+// VPR-Bench's ground_truth_new.npy: an object array, row q = [query index, the indices of
+// its true references] (a list, tuple, range or integer array). The row's position is the
+// query, as performance_comparison.py reads it (ground_truth_info[query][1]); indices count
+// from the start of each traversal, as Initial_image does.
+std::int64_t IntegerOf(const PyValue& v, bool* ok) {
+  *ok = true;
+  if (v.kind == PyValue::Kind::kInt || v.kind == PyValue::Kind::kBool) return v.integer;
+  if (v.kind == PyValue::Kind::kFloat && std::floor(v.real) == v.real &&
+      std::fabs(v.real) < 9.0e15)
+    return static_cast<std::int64_t>(v.real);
+  *ok = false;
+  return 0;
+}
+
+void LoadVprBench(const GroundTruthOptions& o, const EvaluationLayout& layout, int, int,
+                  GroundTruth* gt) {
+  if (layout.kind == EvaluationLayout::Kind::kLoopClosure)
+    throw InputError(
+        "Ground_truth_type: vpr_bench needs two traversals (Images_path_2 or Frame_mode 2): "
+        "its file lists the true references of each query");
+  const std::string where = "VPR-Bench ground truth " + Quoted(o.path);
+  const std::string bytes = ReadWholeFile(o.path, "VPR-Bench ground truth");
+  const NpyObjects gt_file = DecodeNpyObjects(bytes, where);
+  const bool pairs = gt_file.shape.size() == 2 && gt_file.shape[1] == 2;
+  if (!pairs)
+    throw InputError(where + ": an array of shape (" +
+                     [&] {
+                       std::string s;
+                       for (std::size_t k = 0; k < gt_file.shape.size(); ++k)
+                         s += (k ? ", " : "") + std::to_string(gt_file.shape[k]);
+                       return s + (gt_file.shape.size() == 1 ? ",)" : ")");
+                     }() +
+                     "; expected (queries, 2): per query its index and the list of its true "
+                     "references, as VPR-Bench's ground_truth_new.npy");
+  const std::int64_t rows = gt_file.shape[0];
+  const std::int64_t first = o.first_frame;
+  const bool ranged = first > 0 || o.range_selected;
+  if (!ranged && rows != layout.queries)
+    throw InputError(where + ": " + std::to_string(rows) + " queries; expected " +
+                     std::to_string(layout.queries) + ", the frames of the query traversal");
+  for (std::int64_t i = 0; i < rows; ++i) {
+    const PyValue& list = *gt_file.items[static_cast<std::size_t>(2 * i + 1)];
+    std::vector<std::int64_t> refs;
+    bool ok = false;
+    if (list.kind == PyValue::Kind::kList || list.kind == PyValue::Kind::kTuple ||
+        list.kind == PyValue::Kind::kArray) {
+      for (const auto& item : list.items) {
+        refs.push_back(IntegerOf(*item, &ok));
+        if (!ok) break;
+      }
+      ok = ok || list.items.empty();
+    } else {
+      refs.push_back(IntegerOf(list, &ok));  // one index alone
+    }
+    if (!ok)
+      throw InputError(where + ": row " + std::to_string(i) +
+                       " does not list reference indices (integers) in its second column");
+    const std::int64_t q = i - first;
+    for (std::int64_t r : refs) {
+      if (r < 0)
+        throw InputError(where + ": row " + std::to_string(i) + " names reference " +
+                         std::to_string(r) + "; expected indices >= 0");
+      // An index past the last reference is dropped, not refused: VPR-Bench's own files list
+      // them (Gardens Point's last queries name references 200 and 201 of 0-199), and its
+      // code only asks whether a retrieved index is in the list.
+      const std::int64_t c = r - first;
+      if (q < 0 || q >= layout.queries || c < 0 || c >= layout.references) {
+        ++gt->dropped;
+        continue;
+      }
+      gt->matches[static_cast<std::size_t>(q)].push_back(static_cast<int>(c));
+    }
+  }
+}
+
+// VPR_Tutorial's ground truth: GThard and GTsoft, boolean matrices of the database
+// (reference traversal, rows) by the queries (columns), as .npy files or members GThard.npy
+// and GTsoft.npy of a .npz (its datasets' GT.npz).
+cv::Mat1f ReadTutorialMatrix(const std::string& path, const char* member, bool* found) {
+  const std::string bytes = ReadWholeFile(path, "VPR_Tutorial ground truth");
+  const std::string where = "VPR_Tutorial ground truth " + Quoted(path);
+  *found = true;
+  if (bytes.size() >= 4 && bytes.compare(0, 4, "PK\x03\x04", 4) == 0) {
+    const std::vector<std::string> names = NpzMemberNames(bytes, where);
+    const std::string wanted = std::string(member) + ".npy";
+    if (std::find(names.begin(), names.end(), wanted) == names.end()) {
+      if (std::string(member) == "GTsoft") {
+        *found = false;
+        return {};
+      }
+    }
+    return DecodeNpyMatrix(NpzMember(bytes, wanted, where), where + " (" + wanted + ")");
+  }
+  return DecodeNpyMatrix(bytes, where);
+}
+
+// Adds the cells of `m` (references x queries, non-zero = same place) to `out` per query.
+void TutorialCells(const cv::Mat1f& m, const std::string& what, const EvaluationLayout& layout,
+                   const GroundTruthOptions& o, std::vector<std::vector<int>>* out) {
+  if (m.rows != layout.references || m.cols != layout.queries)
+    throw InputError(what + ": " + std::to_string(m.rows) + "x" + std::to_string(m.cols) +
+                     " (database x queries); expected " + std::to_string(layout.references) +
+                     "x" + std::to_string(layout.queries) + ": the " +
+                     std::to_string(layout.references) +
+                     " reference frames (rows, VPR_Tutorial's database) by the " +
+                     std::to_string(layout.queries) + " queries" +
+                     (o.first_frame > 0 || o.range_selected
+                          ? "; a matrix is not cut at Initial_image or Final_image"
+                          : ""));
+  for (int r = 0; r < m.rows; ++r)
+    for (int q = 0; q < m.cols; ++q) {
+      const float v = m(r, q);
+      if (!std::isfinite(v))
+        throw InputError(what + ": cell (" + std::to_string(r) + ", " + std::to_string(q) +
+                         ") is " + FormatNumber(v) + "; expected 0 or 1");
+      if (v != 0.f) (*out)[static_cast<std::size_t>(q)].push_back(r);
+    }
+}
+
+void LoadVprTutorial(const GroundTruthOptions& o, const EvaluationLayout& layout, int, int,
+                     GroundTruth* gt) {
+  if (layout.kind == EvaluationLayout::Kind::kLoopClosure)
+    throw InputError(
+        "Ground_truth_type: vpr_tutorial needs two traversals (Images_path_2 or Frame_mode 2): "
+        "its matrices are the database (reference traversal) by the queries");
+  bool found = false;
+  TutorialCells(ReadTutorialMatrix(o.path, "GThard", &found),
+                "VPR_Tutorial ground truth " + Quoted(o.path), layout, o, &gt->matches);
+  const bool npz = o.path.size() >= 4 && Lower(o.path.substr(o.path.size() - 4)) == ".npz";
+  const std::string soft_path = !o.soft_path.empty() ? o.soft_path : npz ? o.path : "";
+  if (soft_path.empty()) return;
+  std::vector<std::vector<int>> soft(static_cast<std::size_t>(layout.queries));
+  const cv::Mat1f m = ReadTutorialMatrix(soft_path, "GTsoft", &found);
+  if (!found) return;  // a .npz without GTsoft
+  TutorialCells(m, "VPR_Tutorial soft ground truth " + Quoted(soft_path), layout, o, &soft);
+  gt->soft = std::move(soft);
+}
 }  // namespace
 
 GroundTruthType ParseGroundTruthType(const std::string& name) {
@@ -416,6 +556,8 @@ const GroundTruthType GroundTruthType::kAligned{"aligned"};
 const GroundTruthType GroundTruthType::kKitti{"kitti"};
 const GroundTruthType GroundTruthType::kTum{"tum"};
 const GroundTruthType GroundTruthType::kPositions{"positions"};
+const GroundTruthType GroundTruthType::kVprBench{"vpr_bench"};
+const GroundTruthType GroundTruthType::kVprTutorial{"vpr_tutorial"};
 
 const std::vector<GroundTruthFormat>& GroundTruthFormats() {
   static const std::vector<GroundTruthFormat> formats = {
@@ -431,6 +573,12 @@ const std::vector<GroundTruthFormat>& GroundTruthFormats() {
        true, &ReadTumPoses, true, true, nullptr},
       {"positions", "positions x,y[,z] per line (no orientation)", "positions", true,
        &ReadPositions, false, false, nullptr},
+      {"vpr_bench",
+       "VPR-Bench's ground_truth_new.npy: per query, the list of its true references",
+       "VPR-Bench ground truth", true, nullptr, false, false, &LoadVprBench},
+      {"vpr_tutorial",
+       "VPR_Tutorial's GThard (database x queries, .npy, or GT.npz with GTsoft)",
+       "VPR_Tutorial ground truth", true, nullptr, false, false, &LoadVprTutorial},
   };
   return formats;
 }
@@ -452,6 +600,10 @@ void GroundTruthOptions::Check() const {
         "(Ground_truth_type " +
         GroundTruthTypeName(type) + ")");
   }
+  if (!soft_path.empty() && type != GroundTruthType::kVprTutorial)
+    throw InputError("Ground_truth_soft: " + Quoted(soft_path) +
+                     " is VPR_Tutorial's soft ground truth; expected Ground_truth_type "
+                     "vpr_tutorial (it is " + GroundTruthTypeName(type) + "), or an empty value");
   if (base < -1 || base > 1) {
     throw InputError("Ground_truth_base: " + std::to_string(base) +
                      " is not valid; expected -1 (from a comment of the file), 0 or 1");
@@ -502,6 +654,13 @@ GroundTruth LoadGroundTruth(const GroundTruthOptions& options, const EvaluationL
   for (auto& m : gt.matches) {
     std::sort(m.begin(), m.end());
     m.erase(std::unique(m.begin(), m.end()), m.end());
+  }
+  // GTsoft keeps the cells outside GThard: those the protocol ignores.
+  for (std::size_t q = 0; q < gt.soft.size(); ++q) {
+    std::vector<int> only;
+    for (int c : gt.soft[q])
+      if (!std::binary_search(gt.matches[q].begin(), gt.matches[q].end(), c)) only.push_back(c);
+    gt.soft[q] = std::move(only);
   }
   return gt;
 }

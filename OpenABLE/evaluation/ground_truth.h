@@ -20,6 +20,9 @@ struct GroundTruth {
   // matches[q]: sorted, distinct column indices (0 .. references-1) of the block that are the
   // same place as query row q. Size = layout.queries.
   std::vector<std::vector<int>> matches;
+  // soft[q]: sorted columns of VPR_Tutorial's GTsoft that are not in GThard, the cells its
+  // protocol counts neither right nor wrong; empty (no row at all) without a GTsoft.
+  std::vector<std::vector<int>> soft;
   int references = 0;
   // Pairs dropped while loading: pairs on the diagonal (q, q) of a loop-closure layout, and,
   // when a frame range was selected (first_frame > 0 or range_selected), pairs outside it
@@ -51,7 +54,8 @@ class GroundTruthType {
   constexpr GroundTruthType() = default;  // none
   // The format named `name` (a name of GroundTruthFormats(); Format() checks it).
   constexpr explicit GroundTruthType(std::string_view name) : name_(name) {}
-  static const GroundTruthType kNone, kMatrix, kPairs, kAligned, kKitti, kTum, kPositions;
+  static const GroundTruthType kNone, kMatrix, kPairs, kAligned, kKitti, kTum, kPositions,
+      kVprBench, kVprTutorial;
 
   // The format; throws std::logic_error for none or a name outside the registry.
   const GroundTruthFormat& Format() const;
@@ -73,6 +77,7 @@ struct GroundTruthOptions {
   GroundTruthType type = GroundTruthType::kNone;
   std::string path;        // the file (matrix, pairs; poses of the reference or only sequence)
   std::string path_2;      // poses of the query traversal (pose types, two traversals)
+  std::string soft_path;   // vpr_tutorial: GTsoft (.npy); "" = the GTsoft of a .npz, or none
   int base = -1;           // pairs: 0- or 1-based indices; -1 = from a header comment that says
                            // "0-based" or "1-based", else 0
   int first_frame = 0;     // frame number of row 0 (Initial_image): pair indices and pose lines

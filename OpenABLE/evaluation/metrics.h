@@ -10,6 +10,7 @@
 
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/layout.h"
+#include "OpenABLE/evaluation/reference_protocols.h"
 #include "matching/agreement.h"
 #include "matching/score.h"
 
@@ -34,6 +35,9 @@ struct EvaluationOptions {
   AgreementOptions agreement;
   // The auto mode found no setting it could trust (Auto_min_consistency): nothing is accepted.
   bool accept_none = false;
+  // The protocols reported (Evaluation_protocol): the toolbox's own are always computed (its
+  // files and figures need them); VPR-Bench's and VPR_Tutorial's when chosen.
+  EvaluationProtocols protocols;
 
   // Throws InputError naming Tolerance, Exclusion, Vicinity or Match_score_window.
   void Check() const;

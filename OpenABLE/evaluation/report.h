@@ -29,6 +29,12 @@ struct EvaluatedRun {
   PerQueryResult per_query;
   PerQueryResult per_query_unverified;
   AblePResult able_p;
+  // The matrix (never the verified answers) under the protocols of VPR-Bench and VPR_Tutorial,
+  // when Evaluation_protocol names them.
+  bool has_vpr_bench = false;
+  VprBenchResult vpr_bench;
+  bool has_vpr_tutorial = false;
+  VprTutorialResult vpr_tutorial;
 };
 
 // The settings every run of one evaluation shares.
@@ -39,6 +45,11 @@ struct EvaluationSettings {
 
 // "threshold,precision,recall,f1,tp,fp" then one line per point, 9 significant digits.
 std::string EncodeCurveCsv(const std::vector<CurvePoint>& curve);
+// The curves of the reference protocols: "precision,recall" then one line per point, in the
+// reference code's order (VPR-Bench: "precision,recall"; VPR_Tutorial: "matching,precision,
+// recall" with the multi-match points, then the single-match ones).
+std::string EncodeVprBenchCsv(const VprBenchResult& r);
+std::string EncodeVprTutorialCsv(const VprTutorialResult& r);
 
 // A number of the CSV files: 9 significant digits (FormatNumber), "null" when it is not finite.
 std::string CsvNumber(double value);
@@ -65,7 +76,8 @@ nlohmann::ordered_json EvaluationSettingsJson(const EvaluationSettings& settings
 void AddEvaluatedRunJson(nlohmann::ordered_json& object, const EvaluatedRun& run);
 
 // A few lines for a terminal: the protocol settings, then one row per run with AUC, R@100P,
-// max F1 (threshold), R@1/5/10 and ABLE-P AP. Text that is not valid UTF-8 (the ground truth's
+// max F1 (threshold), R@1/5/10 and ABLE-P AP; with VPR-Bench's or VPR_Tutorial's protocol, a
+// table of each run under each protocol chosen (AUC, R@100P, R@1/5/10 as each defines them). Text that is not valid UTF-8 (the ground truth's
 // path, a label) is shown by ToValidUtf8.
 std::string FormatEvaluationTable(const EvaluationSettings& settings,
                                   const std::vector<EvaluatedRun>& runs);

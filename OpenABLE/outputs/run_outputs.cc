@@ -205,6 +205,10 @@ const std::vector<RunOutput>& RunOutputs() {
            out.emplace_back("Evaluation_name", prefix + suffix);
          for (const char* suffix : kEvaluationRunSuffixes)
            out.emplace_back("Evaluation_name", prefix + suffix);
+         const EvaluationProtocols& protocols = c.evaluation.protocol.protocols;
+         if (protocols.vpr_bench) out.emplace_back("Evaluation_name", prefix + kVprBenchSuffix);
+         if (protocols.vpr_tutorial)
+           out.emplace_back("Evaluation_name", prefix + kVprTutorialSuffix);
          return out;
        },
        [](const OutputInput& in) -> Stager {

@@ -45,7 +45,8 @@ auto WithArgumentNames(F f) {
       {"Tolerance:", "tolerance:"},          {"Exclusion:", "exclusion:"},
       {"Vicinity:", "vicinity:"},            {"Ground_truth_2:", "truth_file_2:"},
       {"Ground_truth:", "truth_file:"},      {"Ground_truth_type:", "truth_type:"},
-      {"Match_score_window:", "score_window:"}};
+      {"Match_score_window:", "score_window:"}, {"Evaluation_protocol:", "protocol:"},
+      {"Ground_truth_soft:", "truth_file_soft:"}};
   try {
     return f();
   } catch (const InputError& e) {
@@ -242,10 +243,11 @@ const std::string& EvaluateDoc() {
     vicinity=7, able_thresholds=100, radius=5.0, heading_limit=-1.0, min_frame_gap=None, axes="xyz",
     normalize=True, label="python", score="distance", score_window=10,
     accept_threshold=None, accept_consistency=0, sequence_length=1, partial="ahead",
-    direction="forward") -> EvaluationResult
+    direction="forward", protocol="openable", truth_file_soft="", truth_soft_matrix=None)
+    -> EvaluationResult
 
-Evaluates a distance matrix against ground truth with both protocols of docs/evaluation.md,
-exactly as Test_OpenABLE (Ground_truth_type) and openable_evaluate do.
+Evaluates a distance matrix against ground truth with the protocols of docs/evaluation.md,
+exactly as Test_OpenABLE (Ground_truth_type, Evaluation_protocol) and openable_evaluate do.
 
 Args:
     matrix (numpy.ndarray): distances (small = similar), shape (N, N) or (Q, R); float32 is
@@ -294,6 +296,14 @@ Args:
         answers of n independent queries (one sequence apart) agree with it (0: the score
         alone); sequence_length, partial and direction are those of the matrix (L,
         Sequence_partial, Sequence_direction), which say which queries are independent.
+    protocol (str): the protocols reported besides the toolbox's own, always computed
+        (Evaluation_protocol): "openable", "vpr_bench", "vpr_tutorial", a comma list or
+        "all"; their figures are the vpr_bench and vpr_tutorial properties, and table()
+        shows every protocol asked for side by side.
+    truth_file_soft (str): truth_type "vpr_tutorial": VPR_Tutorial's GTsoft (.npy, database
+        x queries); "" takes the GTsoft of a .npz truth_file, if any.
+    truth_soft_matrix (numpy.ndarray): with truth_matrix (queries x references, so
+        VPR_Tutorial's GThard.T): GTsoft.T, cells VPR_Tutorial's protocol ignores.
 
 Returns:
     EvaluationResult: figures (auc, recall_at_100p, max_f1, recall_at_1/5/10,
@@ -476,6 +486,58 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
           "truth_matches() -> numpy.ndarray\n\nThe ground truth used: int64 (P, 2) pairs "
           "(query row, reference column) in the block's indices (loop closure: later frame "
           "first).")
+      .def_property_readonly(
+          "vpr_bench",
+          [](const Result& r) -> py::object {
+            if (!r.run.has_vpr_bench) return py::none();
+            const VprBenchResult& b = r.run.vpr_bench;
+            py::dict d;
+            d["auc_pr"] = b.auc_pr;
+            d["recall_at_100p"] = b.recall_at_100p;
+            d["extended_precision"] = b.extended_precision;
+            d["recall_at_n"] = b.recall_at_n;
+            d["precision"] = b.precision;
+            d["recall"] = b.recall;
+            d["queries"] = b.queries;
+            d["queries_with_truth"] = b.queries_with_truth;
+            d["right_best_matches"] = b.right_best_matches;
+            return std::move(d);
+          },
+          "VPR-Bench's figures (protocol \"vpr_bench\"): dict with auc_pr, recall_at_100p, "
+          "extended_precision, recall_at_n (N = 1, 2, ...), the curve (precision, recall) and "
+          "counts; None when not asked for.")
+      .def_property_readonly(
+          "vpr_tutorial",
+          [](const Result& r) -> py::object {
+            if (!r.run.has_vpr_tutorial) return py::none();
+            const VprTutorialResult& t = r.run.vpr_tutorial;
+            py::dict d;
+            d["auc_multi"] = t.auc_multi;
+            d["recall_at_100p_multi"] = t.recall_at_100p_multi;
+            d["precision_multi"] = t.precision_multi;
+            d["recall_multi"] = t.recall_multi;
+            if (t.single) {
+              d["auc_single"] = t.auc_single;
+              d["recall_at_100p_single"] = t.recall_at_100p_single;
+              d["precision_single"] = t.precision_single;
+              d["recall_single"] = t.recall_single;
+            }
+            py::dict at_k;
+            for (std::size_t k = 0; k < t.k.size() && k < t.recall_at_k.size(); ++k)
+              at_k[py::int_(t.k[k])] = t.recall_at_k[k];
+            d["recall_at_k"] = at_k;
+            d["soft_ground_truth"] = t.soft;
+            d["queries_with_truth"] = t.queries_with_truth;
+            return std::move(d);
+          },
+          "VPR_Tutorial's figures (protocol \"vpr_tutorial\"): dict with auc_multi, "
+          "recall_at_100p_multi, their curve, the same for single-match (not with a GTsoft), "
+          "recall_at_k {1, 5, 10}; None when not asked for.")
+      .def(
+          "table",
+          [](const Result& r) { return FormatEvaluationTable(r.settings, {r.run}); },
+          "table() -> str\n\nThe table openable_evaluate prints: the figures of each protocol "
+          "asked for, one row each.")
       .def(
           "to_json",
           [](const Result& r) { return EncodeEvaluationJson(r.settings, {r.run}, kVersion); },
@@ -514,11 +576,13 @@ void RegisterEvaluate(py::module_& m) {
          const py::object& min_frame_gap, const std::string& axes, bool normalize,
          const std::string& label, const std::string& score, int score_window,
          const py::object& accept_threshold, int accept_consistency, int sequence_length,
-         const std::string& partial, const std::string& direction) {
+         const std::string& partial, const std::string& direction, const std::string& protocol,
+         const std::string& truth_file_soft, const py::object& truth_soft_matrix) {
         const MatView view = Matrix2D(matrix, Elements::kFloat32, "matrix");
         const int full_rows = view.mat.rows, full_cols = view.mat.cols;
         Result result;
         EvaluationSettings& s = result.settings;
+        s.options.protocols = WithArgumentNames([&] { return ParseEvaluationProtocols(protocol); });
         s.options.tolerance = tolerance;
         s.options.exclusion = exclusion;
         s.options.vicinity = vicinity;
@@ -563,6 +627,7 @@ void RegisterEvaluate(py::module_& m) {
         if (!truth_file.is_none()) {
           t.path = truth_file.cast<std::string>();
           t.path_2 = truth_file_2;
+          t.soft_path = truth_file_soft;
           if (truth_type.is_none())
             throw py::value_error(
                 "truth_type: expected with truth_file (" + GroundTruthFormatList() + ")");
@@ -633,6 +698,19 @@ void RegisterEvaluate(py::module_& m) {
           std::sort(mm.begin(), mm.end());
           mm.erase(std::unique(mm.begin(), mm.end()), mm.end());
         }
+        if (!truth_soft_matrix.is_none()) {
+          if (loop)
+            throw py::value_error(
+                "truth_soft_matrix: needs a query-reference layout (two traversals)");
+          // Queries x references like truth_matrix (VPR_Tutorial's GTsoft transposed); the
+          // cells outside the hard ground truth are those its protocol ignores.
+          const GroundTruth soft = FromMatrix(truth_soft_matrix, layout, full_rows, full_cols);
+          gt.soft.assign(gt.matches.size(), {});
+          for (std::size_t q = 0; q < gt.matches.size(); ++q)
+            for (int c : soft.matches[q])
+              if (!std::binary_search(gt.matches[q].begin(), gt.matches[q].end(), c))
+                gt.soft[q].push_back(c);
+        }
 
         EvaluatedRun& run = result.run;
         run.label = label;
@@ -657,6 +735,16 @@ void RegisterEvaluate(py::module_& m) {
           run.per_query =
               WithArgumentNames([&] { return EvaluatePerQuery(m, layout, gt, s.options); });
           run.able_p = EvaluateAbleP(m, layout, gt, s.options);
+          WithArgumentNames([&] {
+            if (s.options.protocols.vpr_bench) {
+              run.has_vpr_bench = true;
+              run.vpr_bench = EvaluateVprBench(m, layout, gt, s.options.tolerance);
+            }
+            if (s.options.protocols.vpr_tutorial) {
+              run.has_vpr_tutorial = true;
+              run.vpr_tutorial = EvaluateVprTutorial(m, layout, gt, s.options.tolerance);
+            }
+          });
         }
         return result;
       },
@@ -678,6 +766,8 @@ void RegisterEvaluate(py::module_& m) {
       py::arg("sequence_length") = kMatching.sequence_length,
       py::arg("partial") = EnumName(kMatching.partial),
       py::arg("direction") = EnumName(kMatching.direction),
+      py::arg("protocol") = EvaluationProtocolsText(kOptions.protocols),
+      py::arg("truth_file_soft") = kTruth.soft_path, py::arg("truth_soft_matrix") = py::none(),
       EvaluateDoc().c_str());
 }
 

@@ -69,6 +69,15 @@ void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
     run.per_query = EvaluateAnswers(layout, truth, verified->accepted, options);
   }
   run.able_p = EvaluateAbleP(normalized, layout, truth, evaluation.settings.options);
+  const EvaluationOptions& options = evaluation.settings.options;
+  if (options.protocols.vpr_bench) {
+    run.has_vpr_bench = true;
+    run.vpr_bench = EvaluateVprBench(normalized, layout, truth, options.tolerance);
+  }
+  if (options.protocols.vpr_tutorial) {
+    run.has_vpr_tutorial = true;
+    run.vpr_tutorial = EvaluateVprTutorial(normalized, layout, truth, options.tolerance);
+  }
   evaluation.runs.push_back(std::move(run));
   evaluation.truths.push_back(std::move(truth));
   evaluation.rejected.push_back(verified != nullptr ? verified->rejected
@@ -110,7 +119,7 @@ cv::Mat1f DistancesForEvaluation(const cv::Mat1f& matrix, const std::string& wha
 
 std::vector<cv::Mat1f> EvaluateMatrixFiles(Evaluation& evaluation,
                                            const std::vector<MatrixFile>& files,
-                                           int reference_frames) {
+                                           int reference_frames, bool query_reference) {
   std::vector<cv::Mat1f> loaded;
   loaded.reserve(files.size());
   for (const MatrixFile& m : files) {
@@ -118,7 +127,7 @@ std::vector<cv::Mat1f> EvaluateMatrixFiles(Evaluation& evaluation,
     matrix = DistancesForEvaluation(matrix, "matrix " + Quoted(m.path));
     NormalizeByMax(matrix);
     EvaluationLayout layout;
-    if (matrix.rows != matrix.cols) {
+    if (matrix.rows != matrix.cols || query_reference) {
       layout = EvaluationLayout::QueryReference(matrix.rows, matrix.cols);
     } else if (reference_frames > 0) {
       if (reference_frames >= matrix.rows)

@@ -70,11 +70,12 @@ struct MatrixFile {
 // Reads each matrix (ReadMatrixFile: .npy, text or image), checks it (DistancesForEvaluation),
 // normalises it by its maximum (Eq. 5; no change for Test_OpenABLE's M'), takes its
 // layout (not square: queries x references; square: two traversals of which the first
-// `reference_frames` frames are the reference when reference_frames > 0, else one sequence)
-// and evaluates it into `evaluation` (EvaluateMatrix). Returns the normalised matrices in the
-// order of `files`. Throws InputError naming the file.
+// `reference_frames` frames are the reference when reference_frames > 0, queries x references
+// with `query_reference`, else one sequence) and evaluates it into `evaluation`
+// (EvaluateMatrix). Returns the normalised matrices in the order of `files`. Throws InputError
+// naming the file.
 std::vector<cv::Mat1f> EvaluateMatrixFiles(Evaluation& evaluation,
                                            const std::vector<MatrixFile>& files,
-                                           int reference_frames);
+                                           int reference_frames, bool query_reference = false);
 
 }  // namespace openable

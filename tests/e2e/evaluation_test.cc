@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "OpenABLE/io/npy.h"
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
 
@@ -95,6 +96,67 @@ TEST(Evaluation, OpenableEvaluateComparesRunsInOneFigureAndAgreesWithTheRun) {
                           "average_precision_percent"})
     EXPECT_EQ(JsonNumber(run, key), JsonNumber(cmp, key)) << key;
   EXPECT_NE(cmp.find("\"label\": \"HOG\""), std::string::npos);
+}
+
+// In a run: Evaluation_protocol all adds the two tables' rows and the two curve files to the
+// evaluation's files, and the JSON records the protocols.
+TEST(Evaluation, RunWithEveryProtocolWritesTheirCurves) {
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunProgram(
+      testing::TestOpenableExe(),
+      {SampleConfig(dir, "Ground_truth_type: aligned\nEvaluation_protocol: all\n"
+                         "Evaluation_name: out/eval\n"),
+       "--quiet"},
+      dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_NE(o.out.find("vpr_tutorial    "), std::string::npos) << o.out;
+  for (const char* f : {"eval.json", "eval_vpr_bench.csv", "eval_vpr_tutorial.csv",
+                        "eval_per_query.csv"})
+    EXPECT_TRUE(fs::exists(dir + "/out/" + f)) << f;
+  const std::string json = ReadAll(dir + "/out/eval.json");
+  EXPECT_NE(json.find("\"protocols\": \"openable,vpr_bench,vpr_tutorial\""), std::string::npos);
+  // 300 winter queries, each with its summer frame: VPR-Bench and VPR_Tutorial count them all.
+  EXPECT_EQ(JsonNumber(json, "queries_with_truth", json.find("\"vpr_bench\"")), 300);
+}
+
+// A saved square matrix of queries x references scored three ways in one table, against
+// VPR-Bench's own ground-truth file: the figures of VPR-Bench's and VPR_Tutorial's code
+// (tests/data/reference_protocols/expected.json, made by their metric functions), each
+// protocol's row in the table, and the curve files.
+TEST(Evaluation, OpenableEvaluateScoresAMatrixAsVprBenchAndVprTutorialDo) {
+  const std::string dir = testing::TempDir();
+  const std::string data = testing::SourceDir() + "/tests/data/reference_protocols/";
+  const Outcome o = RunProgram(
+      testing::OpenableEvaluateExe(),
+      {"--matrix", data + "gardens_point_hog.npy", "--label", "HOG", "--layout",
+       "query_reference", "--gt-type", "vpr_bench", "--ground-truth",
+       data + "vpr_bench_gardens_point_ground_truth_new.npy", "--tolerance", "0", "--protocol",
+       "all", "--output", "out/e"},
+      dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  for (const char* row : {"HOG                openable", "HOG                vpr_bench",
+                          "HOG                vpr_tutorial"})
+    EXPECT_NE(o.out.find(row), std::string::npos) << row << "\n" << o.out;
+  EXPECT_NE(o.out.find("3 ground-truth pairs dropped"), std::string::npos) << o.out;
+  const std::string json = ReadAll(dir + "/out/e.json");
+  const std::string expected = ReadAll(data + "expected.json");
+  const std::size_t real = expected.find("\"real\"");
+  const std::size_t tutorial = expected.find("\"vpr_tutorial\"", real);
+  const std::size_t bench_at = json.find("\"vpr_bench\": {");
+  const std::size_t tutorial_at = json.find("\"vpr_tutorial\": {");
+  ASSERT_NE(bench_at, std::string::npos) << json;
+  ASSERT_NE(tutorial_at, std::string::npos) << json;
+  for (const char* key : {"auc_pr", "extended_precision", "recall_at_100p"})
+    EXPECT_NEAR(JsonNumber(json, key, bench_at), JsonNumber(expected, key, real), 1e-8) << key;
+  EXPECT_NEAR(JsonNumber(json, "auc", tutorial_at), JsonNumber(expected, "auc_multi", tutorial),
+              1e-8);
+  EXPECT_NE(json.find("\"protocols\": \"openable,vpr_bench,vpr_tutorial\""), std::string::npos);
+  // The curves: VPR-Bench's points, then VPR_Tutorial's 101 multi- and 101 single-match ones.
+  const std::string bench_csv = ReadAll(dir + "/out/e_vpr_bench.csv");
+  EXPECT_EQ(bench_csv.rfind("precision,recall\n", 0), 0u);
+  const std::string tutorial_csv = ReadAll(dir + "/out/e_vpr_tutorial.csv");
+  EXPECT_EQ(std::count(tutorial_csv.begin(), tutorial_csv.end(), '\n'), 1 + 101 + 101);
+  EXPECT_EQ(tutorial_csv.find("single,"), tutorial_csv.find("\nsingle,") + 1);
 }
 
 // A saved matrix remembers its run's settings (out/matrix.npy.json): openable_evaluate given
@@ -207,6 +269,13 @@ TEST_P(BadTruthInputs, OneLineNonZeroExitNoOutput) {
     std::ofstream(dir + "/gt5.txt") << "0 1 0 0 0\n1 0 0 0 0\n0 0 0 0 0\n0 0 0 0 0\n0 0 0 0 0\n";
     std::ofstream(dir + "/far.csv") << "3,1\n25,2\n";
     std::ofstream(dir + "/xy.csv") << "0,0\n1,0\n2,0\n";
+    std::ofstream(dir + "/near.csv") << "3,1\n";
+    // A pickle (protocol 2) that would call posix.system("touch pwned") if unpickled.
+    const std::string pickle("\x80\x02" "cposix\nsystem\n" "X\x0b\x00\x00\x00touch pwned"
+                             "\x85R.", 35);
+    std::ofstream(dir + "/evil.npy", std::ios::binary)
+        << NpyHeaderOf("'|O'", "(10, 2)") << pickle;
+    std::ofstream(dir + "/numeric.npy", std::ios::binary) << EncodeNpy(cv::Mat1f(3, 4, 1.f));
   }
   std::vector<std::string> args = {"--matrix", "m.txt", "--output", "out/e"};
   args.insert(args.end(), GetParam().args.begin(), GetParam().args.end());
@@ -215,6 +284,7 @@ TEST_P(BadTruthInputs, OneLineNonZeroExitNoOutput) {
   EXPECT_TRUE(OneLine(o.err)) << o.err;
   EXPECT_NE(o.err.find(GetParam().expect), std::string::npos) << o.err;
   EXPECT_FALSE(fs::exists(dir + "/out")) << "output left behind";
+  EXPECT_FALSE(fs::exists(dir + "/pwned")) << "a pickled call ran";
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -239,7 +309,29 @@ INSTANTIATE_TEST_SUITE_P(
         BadTruth{"UnknownType", {"--gt-type", "gps"}, "Ground_truth_type"},
         BadTruth{"NegativeVicinity",
                  {"--gt-type", "aligned", "--reference-frames", "10", "--vicinity", "-2"},
-                 "Vicinity"}));
+                 "Vicinity"},
+        BadTruth{"ReferenceProtocolOnOneSequence",
+                 {"--gt-type", "pairs", "--ground-truth", "near.csv", "--protocol", "vpr_bench"},
+                 "Evaluation_protocol: vpr_bench needs two traversals"},
+        BadTruth{"UnknownProtocol",
+                 {"--gt-type", "aligned", "--reference-frames", "10", "--protocol", "recall"},
+                 "Evaluation_protocol: \"recall\" is not valid"},
+        BadTruth{"PickleThatRunsCode",
+                 {"--gt-type", "vpr_bench", "--reference-frames", "10", "--ground-truth",
+                  "evil.npy"},
+                 "posix.system"},
+        BadTruth{"NumericMatrixAsVprBenchFile",
+                 {"--gt-type", "vpr_bench", "--reference-frames", "10", "--ground-truth",
+                  "numeric.npy"},
+                 "numeric.npy"},
+        BadTruth{"SoftGroundTruthOfAnotherType",
+                 {"--gt-type", "aligned", "--reference-frames", "10", "--ground-truth-soft",
+                  "numeric.npy"},
+                 "Ground_truth_soft"},
+        BadTruth{"TutorialMatrixOfWrongSize",
+                 {"--gt-type", "vpr_tutorial", "--reference-frames", "10", "--ground-truth",
+                  "numeric.npy"},
+                 "expected 10x10"}));
 
 // --- Real data, checked against the independent numpy implementation -------------------------
 

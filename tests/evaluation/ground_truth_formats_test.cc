@@ -27,7 +27,7 @@ TEST(GroundTruthFormats, EachParsesFromItsNameAndIsOneKindOfFormat) {
     EXPECT_NE(GroundTruthFormatList().find(f.name), std::string::npos);
   }
   EXPECT_EQ(names, (std::set<std::string>{"matrix", "pairs", "aligned", "kitti", "tum",
-                                          "positions"}));
+                                          "positions", "vpr_bench", "vpr_tutorial"}));
 }
 
 TEST(GroundTruthFormats, NamedConstantsAreTheRegistrysEntries) {
@@ -45,11 +45,14 @@ TEST(GroundTruthFormats, NamedConstantsAreTheRegistrysEntries) {
 }
 
 TEST(GroundTruthFormats, ListsAndMessagesComeFromTheRegistry) {
-  EXPECT_EQ(GroundTruthFormatList(), "matrix, pairs, aligned, kitti, tum or positions");
-  EXPECT_EQ(GroundTruthFormatList(", "), "matrix, pairs, aligned, kitti, tum, positions");
+  EXPECT_EQ(GroundTruthFormatList(),
+            "matrix, pairs, aligned, kitti, tum, positions, vpr_bench or vpr_tutorial");
+  EXPECT_EQ(GroundTruthFormatList(", "),
+            "matrix, pairs, aligned, kitti, tum, positions, vpr_bench, vpr_tutorial");
   testing::ExpectInputError([] { ParseGroundTruthType("gps"); },
                             {"Ground_truth_type: \"gps\" is not valid; expected matrix, pairs, "
-                             "aligned, kitti, tum or positions (or empty: no evaluation)"});
+                             "aligned, kitti, tum, positions, vpr_bench or vpr_tutorial (or "
+                             "empty: no evaluation)"});
   // The heading limit names the formats that have orientations.
   GroundTruthOptions o;
   o.type = GroundTruthType::kPositions;

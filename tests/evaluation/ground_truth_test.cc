@@ -25,6 +25,7 @@ namespace openable {
 namespace {
 
 using openable::testing::DatasetsDir;
+using openable::testing::SourceDir;
 using openable::testing::ExpectInputError;
 using openable::testing::InputErrorMessage;
 using openable::testing::Q;
@@ -662,6 +663,87 @@ TEST(GroundTruthRtabmap, OneBasedPairsEqualTheMatrixAndTheBmp) {
   EXPECT_EQ(pairs.matches[40], std::vector<int>({0, 1, 2}));
   EXPECT_EQ(pairs.dropped, 0);
   EXPECT_EQ(matrix.dropped, 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// VPR-Bench's and VPR_Tutorial's files (tests/data/reference_protocols/make.py and
+// tests/data/npy_objects/make.py wrote them; their contents are stated here)
+
+std::string ProtocolData(const std::string& file) {
+  return SourceDir() + "/tests/data/reference_protocols/" + file;
+}
+
+GroundTruth LoadQueryReference(const GroundTruthOptions& o, int queries, int references) {
+  return LoadGroundTruth(o, EvaluationLayout::QueryReference(queries, references), queries,
+                         references);
+}
+
+TEST(GroundTruthVprBench, ListsPerQueryAndReferencesPastTheLastDropped) {
+  const GroundTruthOptions o =
+      Options(GroundTruthType::kVprBench, ProtocolData("hand_ground_truth.npy"));
+  // make.py's lists: [0, 1], [2], [3, 4, 5], [8], [], [1], [6, 7].
+  const std::vector<std::vector<int>> lists = {{0, 1}, {2}, {3, 4, 5}, {8}, {}, {1}, {6, 7}};
+  GroundTruth gt = LoadQueryReference(o, 7, 9);
+  EXPECT_EQ(gt.matches, lists);
+  EXPECT_EQ(gt.dropped, 0);
+  EXPECT_TRUE(gt.soft.empty());
+  // With 5 references, 5, 8, 6 and 7 are past the last: dropped, not refused.
+  gt = LoadQueryReference(o, 7, 5);
+  EXPECT_EQ(gt.matches, (std::vector<std::vector<int>>{{0, 1}, {2}, {3, 4}, {}, {}, {1}, {}}));
+  EXPECT_EQ(gt.dropped, 4);
+  // From frame 1 on (Initial_image 1): row i is query i - 1, reference r is column r - 1.
+  GroundTruthOptions ranged = o;
+  ranged.first_frame = 1;
+  gt = LoadQueryReference(ranged, 6, 8);
+  EXPECT_EQ(gt.matches, (std::vector<std::vector<int>>{{1}, {2, 3, 4}, {7}, {}, {0}, {5, 6}}));
+  EXPECT_EQ(gt.dropped, 2);  // query 0's references 0 and 1
+}
+
+TEST(GroundTruthVprBench, BadFilesAndLayoutsAreOneLineNamingTheFile) {
+  const std::string hand = ProtocolData("hand_ground_truth.npy");
+  testing::ExpectInputError(
+      [&] { LoadQueryReference(Options(GroundTruthType::kVprBench, hand), 6, 9); },
+      {"VPR-Bench ground truth \"" + hand + "\": 7 queries; expected 6"});
+  testing::ExpectInputError(
+      [&] { LoadLoop(Options(GroundTruthType::kVprBench, hand), 9); },
+      {"Ground_truth_type: vpr_bench needs two traversals"});
+  // gt_lists.npy's last row names reference -5.
+  const std::string lists = SourceDir() + "/tests/data/npy_objects/gt_lists.npy";
+  testing::ExpectInputError(
+      [&] { LoadQueryReference(Options(GroundTruthType::kVprBench, lists), 4, 9); },
+      {"gt_lists.npy\": row 3 names reference -5; expected indices >= 0"});
+  // A numeric matrix is not a list per query; a pickle that calls a function is refused.
+  const std::string numeric = ProtocolData("hand_distances.npy");
+  testing::ExpectInputError(
+      [&] { LoadQueryReference(Options(GroundTruthType::kVprBench, numeric), 7, 9); },
+      {"an array of shape (7, 9); expected (queries, 2)"});
+  const std::string evil = SourceDir() + "/tests/data/npy_objects/evil.npy";
+  testing::ExpectInputError(
+      [&] { LoadQueryReference(Options(GroundTruthType::kVprBench, evil), 1, 9); },
+      {"evil.npy", "posix.system"});
+}
+
+TEST(GroundTruthVprTutorial, MatricesAreDatabaseByQueries) {
+  GroundTruthOptions o = Options(GroundTruthType::kVprTutorial, ProtocolData("hand_gt_hard.npy"));
+  const GroundTruth gt = LoadQueryReference(o, 7, 9);
+  EXPECT_EQ(gt.matches,
+            (std::vector<std::vector<int>>{{0, 1}, {2}, {3, 4, 5}, {8}, {}, {1}, {6, 7}}));
+  // The matrix transposed (queries x references) is not VPR_Tutorial's orientation.
+  testing::ExpectInputError([&] { LoadQueryReference(o, 9, 7); },
+                            {"hand_gt_hard.npy\": 9x7 (database x queries); expected 7x9"});
+  o.soft_path = ProtocolData("hand_distances.npy");  // 7 x 9: the wrong orientation too
+  testing::ExpectInputError([&] { LoadQueryReference(o, 7, 9); },
+                            {"soft ground truth", "hand_distances.npy"});
+  GroundTruthOptions pairs = Options(GroundTruthType::kPairs, "gt.txt");
+  pairs.soft_path = ProtocolData("hand_gt_soft.npy");
+  testing::ExpectInputError([&] { pairs.Check(); },
+                            {"Ground_truth_soft: ", "expected Ground_truth_type vpr_tutorial"});
+  // A zip64 archive holding GThard = eye(3) and no GTsoft.
+  const GroundTruth eye = LoadQueryReference(
+      Options(GroundTruthType::kVprTutorial, SourceDir() + "/tests/data/npy_objects/zip64.npz"),
+      3, 3);
+  EXPECT_EQ(eye.matches, (std::vector<std::vector<int>>{{0}, {1}, {2}}));
+  EXPECT_TRUE(eye.soft.empty());
 }
 
 }  // namespace

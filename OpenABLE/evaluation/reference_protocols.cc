@@ -1,0 +1,317 @@
+#include "OpenABLE/evaluation/reference_protocols.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
+
+namespace openable {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The block of `layout` as distances with +inf (a cell without a value) replaced by the
+// block's largest finite distance; both protocols need a finite similarity everywhere.
+cv::Mat1f FiniteBlock(const cv::Mat1f& normalized, const EvaluationLayout& layout,
+                      const GroundTruth& truth, const char* protocol) {
+  if (layout.kind != EvaluationLayout::Kind::kQueryReference)
+    throw InputError(std::string("Evaluation_protocol: ") + protocol +
+                     " needs two traversals (a query traversal against a reference one: "
+                     "Images_path_2, Frame_mode 2 or a non-square matrix); a loop-closure run "
+                     "is evaluated by the toolbox's own protocol (openable)");
+  if (layout.row_offset + layout.queries > normalized.rows ||
+      layout.col_offset + layout.references > normalized.cols ||
+      static_cast<int>(truth.matches.size()) != layout.queries)
+    throw std::logic_error("reference protocol: layout, matrix and ground truth disagree");
+  cv::Mat1f block =
+      normalized(cv::Rect(layout.col_offset, layout.row_offset, layout.references, layout.queries))
+          .clone();
+  float largest = 0.f;
+  for (int q = 0; q < block.rows; ++q)
+    for (int c = 0; c < block.cols; ++c)
+      if (std::isfinite(block(q, c))) largest = std::max(largest, block(q, c));
+  for (int q = 0; q < block.rows; ++q)
+    for (int c = 0; c < block.cols; ++c)
+      if (!std::isfinite(block(q, c))) block(q, c) = largest;
+  return block;
+}
+
+// The true columns of each query: the ground truth widened by `tolerance` frames, as a 0/1
+// row per query.
+std::vector<std::vector<std::uint8_t>> TrueCells(const GroundTruth& truth, int references,
+                                                 int tolerance) {
+  std::vector<std::vector<std::uint8_t>> cells(truth.matches.size(),
+                                               std::vector<std::uint8_t>(references, 0));
+  for (std::size_t q = 0; q < truth.matches.size(); ++q)
+    for (int m : truth.matches[q])
+      for (int c = std::max(0, m - tolerance); c <= std::min(references - 1, m + tolerance); ++c)
+        cells[q][static_cast<std::size_t>(c)] = 1;
+  return cells;
+}
+
+// The rank (0 = first) of column b in the order of increasing distance, lower column first
+// among equal distances: the columns before it in that order.
+int RankOf(const float* row, int columns, int b) {
+  int rank = 0;
+  for (int c = 0; c < columns; ++c)
+    if (row[c] < row[b] || (row[c] == row[b] && c < b)) ++rank;
+  return rank;
+}
+
+// The rank of the best-ranked true column of a query, or -1 without a true column.
+int BestTrueRank(const float* row, const std::vector<std::uint8_t>& is_true, int columns) {
+  int best = -1;
+  for (int c = 0; c < columns; ++c)
+    if (is_true[static_cast<std::size_t>(c)] && (best < 0 || row[c] < row[best])) best = c;
+  return best < 0 ? -1 : RankOf(row, columns, best);
+}
+
+// The first column of the smallest distance (numpy.argmax of the similarity).
+int BestColumn(const float* row, int columns) {
+  int best = 0;
+  for (int c = 1; c < columns; ++c)
+    if (row[c] < row[best]) best = c;
+  return best;
+}
+
+// numpy.trapz(y, x): the sum of (x[i+1] - x[i]) * (y[i+1] + y[i]) / 2.
+double Trapezoids(const std::vector<double>& y, const std::vector<double>& x) {
+  double area = 0;
+  for (std::size_t i = 1; i < x.size(); ++i) area += (x[i] - x[i - 1]) * (y[i] + y[i - 1]) / 2.0;
+  return area;
+}
+
+// numpy.linspace(start, stop, n) for n > 1: start + i * (stop - start) / (n - 1) in double,
+// the last value exactly `stop`.
+std::vector<double> Linspace(double start, double stop, int n) {
+  std::vector<double> out(static_cast<std::size_t>(n));
+  const double step = (stop - start) / (n - 1);
+  for (int i = 0; i < n; ++i)
+    out[static_cast<std::size_t>(i)] =
+        step == 0 ? start + (static_cast<double>(i) / (n - 1)) * (stop - start) : i * step + start;
+  out.back() = stop;
+  return out;
+}
+
+// Values of `sorted` (increasing) that are >= t.
+std::int64_t CountAtLeast(const std::vector<float>& sorted, float t) {
+  return static_cast<std::int64_t>(sorted.end() -
+                                   std::lower_bound(sorted.begin(), sorted.end(), t));
+}
+
+// createPR's loop over its thresholds: the similarities of the true cells (`right`) and of
+// the others (`wrong`), each sorted increasingly, `positives` the GTP. The similarities are
+// float32 as the matrix is, so NumPy 1.x compares them with each float64 threshold rounded to
+// float32 (value-based casting), as here.
+void ThresholdCurve(const std::vector<float>& right, const std::vector<float>& wrong,
+                    std::int64_t positives, std::vector<double>& precision,
+                    std::vector<double>& recall) {
+  precision = {1.0};
+  recall = {0.0};
+  float hi = -std::numeric_limits<float>::infinity(), lo = std::numeric_limits<float>::infinity();
+  for (const auto* v : {&right, &wrong})
+    if (!v->empty()) {
+      hi = std::max(hi, v->back());
+      lo = std::min(lo, v->front());
+    }
+  for (double t : Linspace(hi, lo, VprTutorialResult::kThresholds)) {
+    const auto t32 = static_cast<float>(t);
+    const std::int64_t tp = CountAtLeast(right, t32), fp = CountAtLeast(wrong, t32);
+    precision.push_back(tp + fp > 0 ? static_cast<double>(tp) / static_cast<double>(tp + fp)
+                                    : kNaN);
+    recall.push_back(positives > 0 ? static_cast<double>(tp) / static_cast<double>(positives)
+                                   : kNaN);
+  }
+}
+
+double MaxRecallAtPrecisionOne(const std::vector<double>& precision,
+                               const std::vector<double>& recall) {
+  double best = 0;
+  for (std::size_t i = 0; i < precision.size(); ++i)
+    if (precision[i] == 1.0) best = std::max(best, recall[i]);
+  return best;
+}
+
+}  // namespace
+
+VprBenchResult EvaluateVprBench(const cv::Mat1f& normalized, const EvaluationLayout& layout,
+                                const GroundTruth& truth, int tolerance) {
+  const cv::Mat1f block = FiniteBlock(normalized, layout, truth, "vpr_bench");
+  const auto cells = TrueCells(truth, layout.references, tolerance);
+  VprBenchResult r;
+  r.queries = layout.queries;
+  const int nq = layout.queries, nr = layout.references;
+  if (nq == 0 || nr == 0) return r;
+  std::vector<float> score(static_cast<std::size_t>(nq));
+  std::vector<std::uint8_t> match(static_cast<std::size_t>(nq));
+  const int max_n = std::min(19, nr);
+  std::vector<int> hits(static_cast<std::size_t>(max_n), 0);
+  for (int q = 0; q < nq; ++q) {
+    const float* row = block[q];
+    const auto& is_true = cells[static_cast<std::size_t>(q)];
+    const int best = BestColumn(row, nr);
+    score[static_cast<std::size_t>(q)] = -row[best];
+    match[static_cast<std::size_t>(q)] = is_true[static_cast<std::size_t>(best)];
+    r.right_best_matches += match[static_cast<std::size_t>(q)];
+    const int rank = BestTrueRank(row, is_true, nr);
+    if (rank >= 0) ++r.queries_with_truth;
+    for (int n = 1; n <= max_n; ++n)
+      if (rank >= 0 && rank < n) ++hits[static_cast<std::size_t>(n - 1)];
+  }
+  for (int h : hits) r.recall_at_n.push_back(static_cast<double>(h) / nq);
+
+  // scikit-learn's _binary_clf_curve: the scores in decreasing order; one point at the last
+  // position of each distinct score, with the true and false positives up to it.
+  std::vector<int> order(static_cast<std::size_t>(nq));
+  for (int q = 0; q < nq; ++q) order[static_cast<std::size_t>(q)] = q;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return score[static_cast<std::size_t>(a)] > score[static_cast<std::size_t>(b)];
+  });
+  std::vector<double> tps, fps;
+  std::int64_t tp = 0;
+  for (int i = 0; i < nq; ++i) {
+    tp += match[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+    const bool last_of_value =
+        i + 1 == nq || score[static_cast<std::size_t>(order[static_cast<std::size_t>(i + 1)])] !=
+                           score[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+    if (!last_of_value) continue;
+    tps.push_back(static_cast<double>(tp));
+    fps.push_back(static_cast<double>(i + 1 - tp));
+  }
+  // precision_recall_curve (scikit-learn 0.20): precision tps / (tps + fps), recall
+  // tps / tps[-1]; the points from the first that reaches full recall back to the first,
+  // then (recall 0, precision 1).
+  const double total = tps.back();
+  const std::size_t last = static_cast<std::size_t>(
+      std::lower_bound(tps.begin(), tps.end(), total) - tps.begin());
+  for (std::size_t k = last + 1; k-- > 0;) {
+    r.precision.push_back(tps[k] / (tps[k] + fps[k]));
+    r.recall.push_back(total > 0 ? tps[k] / total : kNaN);
+  }
+  r.precision.push_back(1.0);
+  r.recall.push_back(0.0);
+  // sklearn.metrics.auc(recall, precision): recall decreases, so the area is -trapz.
+  r.auc_pr = total > 0 ? -Trapezoids(r.precision, r.recall) : kNaN;
+  const double p_r0 = r.precision[r.precision.size() - 2];
+  double r_p100 = 0;
+  if (p_r0 >= 1.0) {
+    for (std::size_t k = 0; k < r.precision.size(); ++k)
+      if (r.precision[k] == 1.0) {
+        r_p100 = r.recall[k];
+        break;
+      }
+  }
+  r.recall_at_100p = total > 0 ? r_p100 : kNaN;
+  r.extended_precision = total > 0 ? (p_r0 + r_p100) / 2 : kNaN;
+  return r;
+}
+
+VprTutorialResult EvaluateVprTutorial(const cv::Mat1f& normalized,
+                                      const EvaluationLayout& layout, const GroundTruth& truth,
+                                      int tolerance) {
+  const cv::Mat1f block = FiniteBlock(normalized, layout, truth, "vpr_tutorial");
+  const auto cells = TrueCells(truth, layout.references, tolerance);
+  VprTutorialResult r;
+  const int nq = layout.queries, nr = layout.references;
+  r.soft = !truth.soft.empty();
+  if (nq == 0 || nr == 0) return r;
+
+  // Multi-match: every cell. S = -D; cells only in GTsoft take min(S), the similarity of the
+  // largest distance.
+  float largest = 0.f;
+  for (int q = 0; q < nq; ++q)
+    for (int c = 0; c < nr; ++c) largest = std::max(largest, block(q, c));
+  std::vector<float> right, wrong;
+  right.reserve(static_cast<std::size_t>(truth.PairCount()) * (2 * tolerance + 1));
+  wrong.reserve(static_cast<std::size_t>(nq) * nr);
+  for (int q = 0; q < nq; ++q) {
+    std::vector<std::uint8_t> soft_only(static_cast<std::size_t>(nr), 0);
+    if (r.soft)
+      for (int c : truth.soft[static_cast<std::size_t>(q)]) soft_only[static_cast<std::size_t>(c)] = 1;
+    const auto& is_true = cells[static_cast<std::size_t>(q)];
+    for (int c = 0; c < nr; ++c) {
+      const auto cu = static_cast<std::size_t>(c);
+      if (is_true[cu])
+        right.push_back(-block(q, c));
+      else
+        wrong.push_back(soft_only[cu] ? -largest : -block(q, c));
+    }
+  }
+  std::sort(right.begin(), right.end());
+  std::sort(wrong.begin(), wrong.end());
+  ThresholdCurve(right, wrong, static_cast<std::int64_t>(right.size()), r.precision_multi,
+                 r.recall_multi);
+  r.auc_multi = Trapezoids(r.precision_multi, r.recall_multi);
+  r.recall_at_100p_multi = MaxRecallAtPrecisionOne(r.precision_multi, r.recall_multi);
+
+  // Single-match (without GTsoft) and recallAtK: each query's best match and the rank of its
+  // best-ranked true reference.
+  std::vector<float> best_right, best_wrong;
+  int hits[3] = {0, 0, 0};
+  for (int q = 0; q < nq; ++q) {
+    const float* row = block[q];
+    const auto& is_true = cells[static_cast<std::size_t>(q)];
+    const int best = BestColumn(row, nr);
+    (is_true[static_cast<std::size_t>(best)] ? best_right : best_wrong).push_back(-row[best]);
+    const int rank = BestTrueRank(row, is_true, nr);
+    if (rank < 0) continue;
+    ++r.queries_with_truth;
+    for (std::size_t k = 0; k < r.k.size(); ++k)
+      if (rank < r.k[k]) ++hits[k];
+  }
+  // recallAtK fails for K above the database's size (NaN here).
+  for (std::size_t k = 0; k < r.k.size(); ++k)
+    r.recall_at_k.push_back(r.queries_with_truth > 0 && r.k[k] <= nr
+                                ? static_cast<double>(hits[k]) / r.queries_with_truth
+                                : kNaN);
+  if (!r.soft) {
+    r.single = true;
+    std::sort(best_right.begin(), best_right.end());
+    std::sort(best_wrong.begin(), best_wrong.end());
+    ThresholdCurve(best_right, best_wrong, r.queries_with_truth, r.precision_single,
+                   r.recall_single);
+    r.auc_single = Trapezoids(r.precision_single, r.recall_single);
+    r.recall_at_100p_single = MaxRecallAtPrecisionOne(r.precision_single, r.recall_single);
+  }
+  return r;
+}
+
+EvaluationProtocols ParseEvaluationProtocols(const std::string& text) {
+  const std::string all = Trim(Lower(text));
+  if (all == "all") return {true, true, true};
+  EvaluationProtocols p{false, false, false};
+  for (const std::string& name : SplitTrimmed(all, ',')) {
+    if (name == "openable") {
+      p.openable = true;
+    } else if (name == "vpr_bench") {
+      p.vpr_bench = true;
+    } else if (name == "vpr_tutorial") {
+      p.vpr_tutorial = true;
+    } else {
+      throw InputError("Evaluation_protocol: " + Quoted(text) + " is not valid" +
+                       (name == all ? std::string() : " (" + Quoted(name) + ")") +
+                       "; expected openable, vpr_bench, vpr_tutorial, several of them joined by "
+                       "commas, or all");
+    }
+  }
+  return p;
+}
+
+std::string EvaluationProtocolsText(const EvaluationProtocols& p) {
+  std::string out;
+  auto add = [&](bool on, const char* name) {
+    if (on) out += (out.empty() ? "" : ",") + std::string(name);
+  };
+  add(p.openable, "openable");
+  add(p.vpr_bench, "vpr_bench");
+  add(p.vpr_tutorial, "vpr_tutorial");
+  return out;
+}
+
+}  // namespace openable
