@@ -20,7 +20,7 @@ const std::vector<std::string>& MatrixEvaluationKeys() {
       "Ground_truth_time_tolerance", "Ground_truth_axes", "Tolerance", "Exclusion", "Vicinity",
       "Initial_image", "Final_image", "Match_score", "Match_score_window", "Match_threshold",
       "Match_consistency", "Image_sequences", "Sequence_partial", "Sequence_direction",
-      "Ground_truth_soft", "Evaluation_protocol"};
+      "Ground_truth_soft"};
   return keys;
 }
 
