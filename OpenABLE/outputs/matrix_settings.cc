@@ -68,6 +68,7 @@ std::string EncodeMatrixSettings(const Config& config, const RunResult& result,
     py["truth_type"] = GroundTruthTypeName(s.truth.type);
     py["truth_file"] = s.truth.path;
     if (!s.truth.path_2.empty()) py["truth_file_2"] = s.truth.path_2;
+    if (!s.truth.soft_path.empty()) py["truth_file_soft"] = s.truth.soft_path;
   }
   py["base"] = s.truth.base;
   py["first_frame"] = s.truth.first_frame;
