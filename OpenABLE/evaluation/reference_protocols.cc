@@ -42,17 +42,17 @@ cv::Mat1f FiniteBlock(const cv::Mat1f& normalized, const EvaluationLayout& layou
   return block;
 }
 
-// The true columns of each query: the ground truth widened by `tolerance` frames, as a 0/1
-// row per query.
-std::vector<std::vector<std::uint8_t>> TrueCells(const GroundTruth& truth, int references,
-                                                 int tolerance) {
-  std::vector<std::vector<std::uint8_t>> cells(truth.matches.size(),
-                                               std::vector<std::uint8_t>(references, 0));
-  for (std::size_t q = 0; q < truth.matches.size(); ++q)
-    for (int m : truth.matches[q])
-      for (int c = std::max(0, m - tolerance); c <= std::min(references - 1, m + tolerance); ++c)
-        cells[q][static_cast<std::size_t>(c)] = 1;
-  return cells;
+// The true columns of a query, 0/1 per reference: its ground truth widened by `tolerance`
+// frames. One row at a time: a block of many queries and references is never held twice.
+void TrueRow(const std::vector<int>& matches, int references, int tolerance,
+             std::vector<std::uint8_t>& row) {
+  row.assign(static_cast<std::size_t>(references), 0);
+  for (int m : matches) {
+    const int from = std::max(0, m - tolerance);  // m >= 0: no overflow
+    const int to = static_cast<int>(std::min<std::int64_t>(references - 1,
+                                                           std::int64_t{m} + tolerance));
+    for (int c = from; c <= to; ++c) row[static_cast<std::size_t>(c)] = 1;
+  }
 }
 
 // The rank (0 = first) of column b in the order of increasing distance, lower column first
@@ -99,30 +99,37 @@ std::vector<double> Linspace(double start, double stop, int n) {
   return out;
 }
 
-// Values of `sorted` (increasing) that are >= t.
-std::int64_t CountAtLeast(const std::vector<float>& sorted, float t) {
-  return static_cast<std::int64_t>(sorted.end() -
-                                   std::lower_bound(sorted.begin(), sorted.end(), t));
-}
-
-// createPR's loop over its thresholds: the similarities of the true cells (`right`) and of
-// the others (`wrong`), each sorted increasingly, `positives` the GTP. The similarities are
-// float32 as the matrix is, so NumPy 1.x compares them with each float64 threshold rounded to
-// float32 (value-based casting), as here.
-void ThresholdCurve(const std::vector<float>& right, const std::vector<float>& wrong,
-                    std::int64_t positives, std::vector<double>& precision,
+// createPR's loop over its thresholds. `visit(f)` calls f(similarity, is_true) for every cell
+// (multi-match) or every query's best match (single-match); `positives` is the GTP. The
+// thresholds run from the largest similarity to the smallest (numpy.linspace in double); the
+// similarities are float32 as the matrix is, so NumPy 1.x compares them with each threshold
+// rounded to float32 (value-based casting), as here. Each value is counted once, at the first
+// threshold it reaches (the thresholds never increase), so no value is kept.
+template <typename Visit>
+void ThresholdCurve(const Visit& visit, std::int64_t positives, std::vector<double>& precision,
                     std::vector<double>& recall) {
   precision = {1.0};
   recall = {0.0};
   float hi = -std::numeric_limits<float>::infinity(), lo = std::numeric_limits<float>::infinity();
-  for (const auto* v : {&right, &wrong})
-    if (!v->empty()) {
-      hi = std::max(hi, v->back());
-      lo = std::min(lo, v->front());
-    }
-  for (double t : Linspace(hi, lo, VprTutorialResult::kThresholds)) {
-    const auto t32 = static_cast<float>(t);
-    const std::int64_t tp = CountAtLeast(right, t32), fp = CountAtLeast(wrong, t32);
+  visit([&](float s, bool) {
+    hi = std::max(hi, s);
+    lo = std::min(lo, s);
+  });
+  if (!(hi >= lo)) return;  // nothing to threshold
+  const int n = VprTutorialResult::kThresholds;
+  std::vector<float> thresholds;
+  for (double t : Linspace(hi, lo, n)) thresholds.push_back(static_cast<float>(t));
+  std::vector<std::int64_t> right(static_cast<std::size_t>(n) + 1, 0), wrong = right;
+  visit([&](float s, bool is_true) {
+    const auto k = std::lower_bound(thresholds.begin(), thresholds.end(), s,
+                                    [](float t, float v) { return t > v; }) -
+                   thresholds.begin();
+    ++(is_true ? right : wrong)[static_cast<std::size_t>(k)];
+  });
+  std::int64_t tp = 0, fp = 0;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
+    tp += right[k];
+    fp += wrong[k];
     precision.push_back(tp + fp > 0 ? static_cast<double>(tp) / static_cast<double>(tp + fp)
                                     : kNaN);
     recall.push_back(positives > 0 ? static_cast<double>(tp) / static_cast<double>(positives)
@@ -143,7 +150,6 @@ double MaxRecallAtPrecisionOne(const std::vector<double>& precision,
 VprBenchResult EvaluateVprBench(const cv::Mat1f& normalized, const EvaluationLayout& layout,
                                 const GroundTruth& truth, int tolerance) {
   const cv::Mat1f block = FiniteBlock(normalized, layout, truth, "vpr_bench");
-  const auto cells = TrueCells(truth, layout.references, tolerance);
   VprBenchResult r;
   r.queries = layout.queries;
   const int nq = layout.queries, nr = layout.references;
@@ -152,9 +158,10 @@ VprBenchResult EvaluateVprBench(const cv::Mat1f& normalized, const EvaluationLay
   std::vector<std::uint8_t> match(static_cast<std::size_t>(nq));
   const int max_n = std::min(19, nr);
   std::vector<int> hits(static_cast<std::size_t>(max_n), 0);
+  std::vector<std::uint8_t> is_true;
   for (int q = 0; q < nq; ++q) {
     const float* row = block[q];
-    const auto& is_true = cells[static_cast<std::size_t>(q)];
+    TrueRow(truth.matches[static_cast<std::size_t>(q)], nr, tolerance, is_true);
     const int best = BestColumn(row, nr);
     score[static_cast<std::size_t>(q)] = -row[best];
     match[static_cast<std::size_t>(q)] = is_true[static_cast<std::size_t>(best)];
@@ -216,49 +223,25 @@ VprTutorialResult EvaluateVprTutorial(const cv::Mat1f& normalized,
                                       const EvaluationLayout& layout, const GroundTruth& truth,
                                       int tolerance) {
   const cv::Mat1f block = FiniteBlock(normalized, layout, truth, "vpr_tutorial");
-  const auto cells = TrueCells(truth, layout.references, tolerance);
   VprTutorialResult r;
   const int nq = layout.queries, nr = layout.references;
   r.soft = !truth.soft.empty();
   if (nq == 0 || nr == 0) return r;
 
-  // Multi-match: every cell. S = -D; cells only in GTsoft take min(S), the similarity of the
-  // largest distance.
-  float largest = 0.f;
-  for (int q = 0; q < nq; ++q)
-    for (int c = 0; c < nr; ++c) largest = std::max(largest, block(q, c));
-  std::vector<float> right, wrong;
-  right.reserve(static_cast<std::size_t>(truth.PairCount()) * (2 * tolerance + 1));
-  wrong.reserve(static_cast<std::size_t>(nq) * nr);
-  for (int q = 0; q < nq; ++q) {
-    std::vector<std::uint8_t> soft_only(static_cast<std::size_t>(nr), 0);
-    if (r.soft)
-      for (int c : truth.soft[static_cast<std::size_t>(q)]) soft_only[static_cast<std::size_t>(c)] = 1;
-    const auto& is_true = cells[static_cast<std::size_t>(q)];
-    for (int c = 0; c < nr; ++c) {
-      const auto cu = static_cast<std::size_t>(c);
-      if (is_true[cu])
-        right.push_back(-block(q, c));
-      else
-        wrong.push_back(soft_only[cu] ? -largest : -block(q, c));
-    }
-  }
-  std::sort(right.begin(), right.end());
-  std::sort(wrong.begin(), wrong.end());
-  ThresholdCurve(right, wrong, static_cast<std::int64_t>(right.size()), r.precision_multi,
-                 r.recall_multi);
-  r.auc_multi = Trapezoids(r.precision_multi, r.recall_multi);
-  r.recall_at_100p_multi = MaxRecallAtPrecisionOne(r.precision_multi, r.recall_multi);
-
-  // Single-match (without GTsoft) and recallAtK: each query's best match and the rank of its
-  // best-ranked true reference.
-  std::vector<float> best_right, best_wrong;
+  // Each query's best match, whether it is true, and the rank of its best-ranked true
+  // reference (single-match and recallAtK); the true cells (multi-match's GTP).
+  std::vector<float> best_score(static_cast<std::size_t>(nq));
+  std::vector<std::uint8_t> best_true(static_cast<std::size_t>(nq));
+  std::int64_t true_cells = 0;
   int hits[3] = {0, 0, 0};
+  std::vector<std::uint8_t> is_true;
   for (int q = 0; q < nq; ++q) {
     const float* row = block[q];
-    const auto& is_true = cells[static_cast<std::size_t>(q)];
+    TrueRow(truth.matches[static_cast<std::size_t>(q)], nr, tolerance, is_true);
+    true_cells += std::count(is_true.begin(), is_true.end(), std::uint8_t{1});
     const int best = BestColumn(row, nr);
-    (is_true[static_cast<std::size_t>(best)] ? best_right : best_wrong).push_back(-row[best]);
+    best_score[static_cast<std::size_t>(q)] = -row[best];
+    best_true[static_cast<std::size_t>(q)] = is_true[static_cast<std::size_t>(best)];
     const int rank = BestTrueRank(row, is_true, nr);
     if (rank < 0) continue;
     ++r.queries_with_truth;
@@ -270,12 +253,38 @@ VprTutorialResult EvaluateVprTutorial(const cv::Mat1f& normalized,
     r.recall_at_k.push_back(r.queries_with_truth > 0 && r.k[k] <= nr
                                 ? static_cast<double>(hits[k]) / r.queries_with_truth
                                 : kNaN);
+
+  // Multi-match: every cell, S = -D; cells only in GTsoft take min(S), the similarity of the
+  // largest distance.
+  float largest = 0.f;
+  for (int q = 0; q < nq; ++q)
+    for (int c = 0; c < nr; ++c) largest = std::max(largest, block(q, c));
+  const auto every_cell = [&](const auto& f) {
+    std::vector<std::uint8_t> row_true, soft_only;
+    for (int q = 0; q < nq; ++q) {
+      TrueRow(truth.matches[static_cast<std::size_t>(q)], nr, tolerance, row_true);
+      soft_only.assign(static_cast<std::size_t>(nr), 0);
+      if (r.soft)
+        for (int c : truth.soft[static_cast<std::size_t>(q)])
+          soft_only[static_cast<std::size_t>(c)] = 1;
+      for (int c = 0; c < nr; ++c) {
+        const auto cu = static_cast<std::size_t>(c);
+        const bool right = row_true[cu] != 0;
+        f(!right && soft_only[cu] ? -largest : -block(q, c), right);
+      }
+    }
+  };
+  ThresholdCurve(every_cell, true_cells, r.precision_multi, r.recall_multi);
+  r.auc_multi = Trapezoids(r.precision_multi, r.recall_multi);
+  r.recall_at_100p_multi = MaxRecallAtPrecisionOne(r.precision_multi, r.recall_multi);
+
+  // Single-match, without GTsoft: each query's best match.
   if (!r.soft) {
     r.single = true;
-    std::sort(best_right.begin(), best_right.end());
-    std::sort(best_wrong.begin(), best_wrong.end());
-    ThresholdCurve(best_right, best_wrong, r.queries_with_truth, r.precision_single,
-                   r.recall_single);
+    const auto every_query = [&](const auto& f) {
+      for (std::size_t q = 0; q < best_score.size(); ++q) f(best_score[q], best_true[q] != 0);
+    };
+    ThresholdCurve(every_query, r.queries_with_truth, r.precision_single, r.recall_single);
     r.auc_single = Trapezoids(r.precision_single, r.recall_single);
     r.recall_at_100p_single = MaxRecallAtPrecisionOne(r.precision_single, r.recall_single);
   }
