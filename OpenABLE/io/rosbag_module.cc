@@ -109,7 +109,7 @@ class BagSource final : public FrameSource {
     try {
       bag_.open(path, rosbag::bagmode::Read);
     } catch (const rosbag::BagException& e) {
-      throw InputError(key + ": " + bag_text + " cannot be read (" + e.what() +
+      throw InputError(key + ": " + bag_text + " cannot be read (" + Escaped(e.what()) +
                        "); expected a complete ROS 1 bag (rosbag record; a recording cut short "
                        "has no index: rosbag reindex repairs it)");
     }
@@ -128,7 +128,7 @@ class BagSource final : public FrameSource {
       std::string images, others;
       for (const auto& [t, datatype] : topics) {
         std::string& list = datatype == kImage || datatype == kCompressed ? images : others;
-        list += (list.empty() ? "" : ", ") + t + " (" + datatype + ")";
+        list += (list.empty() ? "" : ", ") + Escaped(t) + " (" + Escaped(datatype) + ")";
       }
       throw InputError(topic_key + ": topic " + Quoted(topic) + " is not in " + bag_text +
                        "; expected an image topic of the bag: " +
@@ -137,26 +137,27 @@ class BagSource final : public FrameSource {
     }
     if (const std::set<std::string>& types = types_of_topic[topic]; types.size() > 1) {
       std::string list;
-      for (const std::string& t : types) list += (list.empty() ? "" : ", ") + t;
+      for (const std::string& t : types) list += (list.empty() ? "" : ", ") + Escaped(t);
       throw InputError(topic_key + ": topic " + Quoted(topic) + " of " + bag_text + " carries " +
                        std::to_string(types.size()) + " message types (" + list +
                        "); expected one: " + kImage + " or " + kCompressed);
     }
     if (type->second != kImage && type->second != kCompressed)
       throw InputError(topic_key + ": topic " + Quoted(topic) + " of " + bag_text + " holds " +
-                       type->second + "; expected " + kImage + " or " + kCompressed);
+                       Escaped(type->second) + "; expected " + kImage + " or " + kCompressed);
     compressed_ = type->second == kCompressed;
     try {
       rosbag::View view(bag_, rosbag::TopicQuery(std::vector<std::string>{topic}));
       for (const rosbag::MessageInstance& m : view) messages_.push_back(m);
     } catch (const rosbag::BagException& e) {
-      throw InputError(key + ": " + bag_text + " cannot be read (" + e.what() +
+      throw InputError(key + ": " + bag_text + " cannot be read (" + Escaped(e.what()) +
                        "); expected a complete ROS 1 bag");
     }
     const int count = static_cast<int>(messages_.size());
     if (count == 0)
       throw InputError(topic_key + ": topic " + Quoted(topic) + " of " + bag_text +
-                       " holds no message; expected at least one " + type->second + " message");
+                       " holds no message; expected at least one " + Escaped(type->second) +
+                       " message");
     const int end = last < 0 ? count : std::min(last, count);
     if (count == 0 || first >= end)
       throw InputError(topic_key + ": topic " + Quoted(topic) + " of " + bag_text + " holds " +
@@ -186,11 +187,11 @@ class BagSource final : public FrameSource {
       if (compressed_) {
         const sensor_msgs::CompressedImage& m = *message.compressed;
         const std::string bytes(m.data.begin(), m.data.end());
-        return DecodeImageBytes(bytes, what + " (" + m.format + ")");
+        return DecodeImageBytes(bytes, what + " (" + Escaped(m.format) + ")");
       }
       return DecodeImage(*message.image, what);
     } catch (const ros::Exception& e) {
-      throw InputError(what + " cannot be decoded (" + e.what() + ")");
+      throw InputError(what + " cannot be decoded (" + Escaped(e.what()) + ")");
     }
   }
 
@@ -228,7 +229,7 @@ class BagSource final : public FrameSource {
         stamp = out.image->header.stamp;
       }
     } catch (const rosbag::BagException& e) {
-      throw InputError(what + " cannot be read (" + e.what() +
+      throw InputError(what + " cannot be read (" + Escaped(e.what()) +
                        "); expected a complete message (a damaged or truncated bag?)");
     } catch (const ros::Exception& e) {
       // The bytes do not fit the type the topic's connection declares. A bag cannot tell which
@@ -237,7 +238,8 @@ class BagSource final : public FrameSource {
       // own connection header), or damage.
       const std::string type = compressed_ ? kCompressed : kImage;
       throw InputError(what + " does not decode as " + type + ", the type its connection " +
-                       "declares (" + e.what() + "); expected " + type + " messages only: a " +
+                       "declares (" + Escaped(e.what()) + "); expected " + type +
+                       " messages only: a " +
                        "message of another type written on the topic, or a damaged bag");
     }
     if (stamp.isZero()) stamp = m.getTime();  // no header stamp: the record time

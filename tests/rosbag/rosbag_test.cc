@@ -576,6 +576,19 @@ TEST(RosBag, DamagedBagsAreRefusedBeforeRosbagStorageReadsThem) {
         {testing::Q(dir + "/" + name) + " cannot be read (" + defect});
 }
 
+// A connection whose type holds control characters (a damaged bag the fuzzer found) is named
+// in one line, its bytes escaped.
+TEST(RosBag, TextOfTheBagIsEscapedInMessages) {
+  const std::string path = FuzzBag("datatype_with_control_characters.bag");
+  const std::string message = testing::InputErrorMessage(
+      [&] { OpenBag(path, "/image", 0, -1, "Bag_path", "Bag_topic"); });
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  EXPECT_NE(message.find("Bag_topic: topic \"/image\" of bag " + testing::Q(path) + " holds s"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("\\n\\x00"), std::string::npos) << message;  // escaped
+}
+
 // The bags rosbag_storage writes pass the walk, whatever their chunks' compression and the
 // messages' encodings: every frame of the fuzzer's seeds is read, with its time.
 TEST(RosBag, FuzzerSeedsWrittenByRosbagAreRead) {
