@@ -97,12 +97,30 @@ cmake --build build_fuzz -j"$jobs" --target fuzzers
 # with its corpus tests/fuzz/corpus/<name>/.
 mapfile -t fuzzers < build_fuzz/tests/fuzz/fuzzers.txt
 echo "== Fuzzers (${fuzz_seconds} s each, two at a time) in build_fuzz: ${fuzzers[*]}"
+# LeakSanitizer's own fault: its thread-suspending tracer can crash during the leak check at
+# the end of a run whose inputs all passed ("Tracer caught signal 11" then "LeakSanitizer has
+# encountered a fatal error", with no report of ASan, UBSan or libFuzzer; seen once in the
+# image fuzzer, whose OpenCV and OpenImageIO threads are alive at exit, in a clean-clone CI run
+# of 2026-11-27, as GCC's tracer did in the suite above). Such a run is made once more, so that
+# the leak check still runs; a real finding fails as before.
+lsan_tool_fault() {
+  grep -aq 'LeakSanitizer has encountered a fatal error' "$1" &&
+    ! grep -aq -e 'ERROR: AddressSanitizer' -e 'ERROR: libFuzzer' -e 'runtime error:' \
+      -e 'ERROR: LeakSanitizer: detected' "$1"
+}
 run_fuzzer() {
-  local name=$1 status=0
+  local name=$1 status=0 attempt
   cp -r "tests/fuzz/corpus/$name" "$probe/$name"  # new inputs go to the copy, never the committed corpus
-  "build_fuzz/tests/fuzz/${name}_fuzzer" -max_total_time="$fuzz_seconds" -max_len=65536 \
-    -timeout=30 -rss_limit_mb=3072 -print_final_stats=1 -artifact_prefix="$probe/${name}-" \
-    "$probe/$name" > "$probe/${name}.log" 2>&1 || status=$?
+  for attempt in 1 2; do
+    status=0
+    rm -f "$probe/${name}-"*
+    "build_fuzz/tests/fuzz/${name}_fuzzer" -max_total_time="$fuzz_seconds" -max_len=65536 \
+      -timeout=30 -rss_limit_mb=3072 -print_final_stats=1 -artifact_prefix="$probe/${name}-" \
+      "$probe/$name" > "$probe/${name}.log" 2>&1 || status=$?
+    [ "$status" -ne 0 ] && lsan_tool_fault "$probe/${name}.log" || break
+    cp "$probe/${name}.log" "$probe/${name}.first.log"
+    echo "== ${name}_fuzzer: LeakSanitizer's tracer failed at exit (a fault of the tool); run again"
+  done
   echo "$status" > "$probe/${name}.status"
 }
 # Two side by side (one core each): a new one starts when one ends. Then each log is read in turn.
