@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -415,13 +416,7 @@ void LoadVprBench(const GroundTruthOptions& o, const EvaluationLayout& layout, i
   const NpyObjects gt_file = DecodeNpyObjects(bytes, where);
   const bool pairs = gt_file.shape.size() == 2 && gt_file.shape[1] == 2;
   if (!pairs)
-    throw InputError(where + ": an array of shape (" +
-                     [&] {
-                       std::string s;
-                       for (std::size_t k = 0; k < gt_file.shape.size(); ++k)
-                         s += (k ? ", " : "") + std::to_string(gt_file.shape[k]);
-                       return s + (gt_file.shape.size() == 1 ? ",)" : ")");
-                     }() +
+    throw InputError(where + ": an array of shape " + NpyShapeText(gt_file.shape) +
                      "; expected (queries, 2): per query its index and the list of its true "
                      "references, as VPR-Bench's ground_truth_new.npy");
   const std::int64_t rows = gt_file.shape[0];
@@ -467,23 +462,33 @@ void LoadVprBench(const GroundTruthOptions& o, const EvaluationLayout& layout, i
 
 // VPR_Tutorial's ground truth: GThard and GTsoft, boolean matrices of the database
 // (reference traversal, rows) by the queries (columns), as .npy files or members GThard.npy
-// and GTsoft.npy of a .npz (its datasets' GT.npz).
-cv::Mat1f ReadTutorialMatrix(const std::string& path, const char* member, bool* found) {
-  const std::string bytes = ReadWholeFile(path, "VPR_Tutorial ground truth");
-  const std::string where = "VPR_Tutorial ground truth " + Quoted(path);
-  *found = true;
-  if (bytes.size() >= 4 && bytes.compare(0, 4, "PK\x03\x04", 4) == 0) {
-    const std::vector<std::string> names = NpzMemberNames(bytes, where);
-    const std::string wanted = std::string(member) + ".npy";
-    if (std::find(names.begin(), names.end(), wanted) == names.end()) {
-      if (std::string(member) == "GTsoft") {
-        *found = false;
-        return {};
-      }
-    }
-    return DecodeNpyMatrix(NpzMember(bytes, wanted, where), where + " (" + wanted + ")");
+// and GTsoft.npy of a .npz (its datasets' GT.npz), told apart by the ZIP signature. A file is
+// read once, whichever of its members are taken.
+struct TutorialFile {
+  std::string bytes;
+  std::string where;  // "VPR_Tutorial ground truth \"GT.npz\"" in messages
+  bool npz = false;
+};
+
+TutorialFile ReadTutorialFile(const std::string& path, const std::string& what) {
+  TutorialFile f;
+  f.bytes = ReadWholeFile(path, what);
+  f.where = what + " " + Quoted(path);
+  f.npz = f.bytes.compare(0, 4, "PK\x03\x04", 4) == 0;
+  return f;
+}
+
+// The matrix of a .npy file, or the member `member` of a .npz; none when an optional member
+// is not in the archive (a required one: NpzMember's error, naming those there are).
+std::optional<cv::Mat1f> TutorialMatrix(const TutorialFile& f, const std::string& member,
+                                        bool required) {
+  if (!f.npz) return DecodeNpyMatrix(f.bytes, f.where);
+  const std::string wanted = member + ".npy";
+  if (!required) {
+    const std::vector<std::string> names = NpzMemberNames(f.bytes, f.where);
+    if (std::find(names.begin(), names.end(), wanted) == names.end()) return std::nullopt;
   }
-  return DecodeNpyMatrix(bytes, where);
+  return DecodeNpyMatrix(NpzMember(f.bytes, wanted, f.where), f.where + " (" + wanted + ")");
 }
 
 // Adds the cells of `m` (references x queries, non-zero = same place) to `out` per query.
@@ -515,16 +520,22 @@ void LoadVprTutorial(const GroundTruthOptions& o, const EvaluationLayout& layout
     throw InputError(
         "Ground_truth_type: vpr_tutorial needs two traversals (Images_path_2 or Frame_mode 2): "
         "its matrices are the database (reference traversal) by the queries");
-  bool found = false;
-  TutorialCells(ReadTutorialMatrix(o.path, "GThard", &found),
-                "VPR_Tutorial ground truth " + Quoted(o.path), layout, o, &gt->matches);
-  const bool npz = o.path.size() >= 4 && Lower(o.path.substr(o.path.size() - 4)) == ".npz";
-  const std::string soft_path = !o.soft_path.empty() ? o.soft_path : npz ? o.path : "";
-  if (soft_path.empty()) return;
+  const TutorialFile file = ReadTutorialFile(o.path, "VPR_Tutorial ground truth");
+  TutorialCells(*TutorialMatrix(file, "GThard", true), file.where, layout, o, &gt->matches);
+  // GTsoft: Ground_truth_soft, else the archive's own when it has one.
+  std::optional<cv::Mat1f> soft_matrix;
+  std::string soft_path = o.soft_path;
+  if (!soft_path.empty()) {
+    soft_matrix = TutorialMatrix(ReadTutorialFile(soft_path, "VPR_Tutorial soft ground truth"),
+                                 "GTsoft", true);
+  } else if (file.npz) {
+    soft_matrix = TutorialMatrix(file, "GTsoft", false);
+    soft_path = o.path;
+  }
+  if (!soft_matrix) return;
   std::vector<std::vector<int>> soft(static_cast<std::size_t>(layout.queries));
-  const cv::Mat1f m = ReadTutorialMatrix(soft_path, "GTsoft", &found);
-  if (!found) return;  // a .npz without GTsoft
-  TutorialCells(m, "VPR_Tutorial soft ground truth " + Quoted(soft_path), layout, o, &soft);
+  TutorialCells(*soft_matrix, "VPR_Tutorial soft ground truth " + Quoted(soft_path), layout, o,
+                &soft);
   gt->soft = std::move(soft);
 }
 }  // namespace

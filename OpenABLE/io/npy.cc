@@ -147,12 +147,6 @@ class NpyHeaderParser {
   std::size_t i_ = 0;
 };
 
-// Little-endian unsigned integer of `n` bytes.
-std::uint64_t LoadLe(const unsigned char* p, int n) {
-  std::uint64_t v = 0;
-  for (int k = n - 1; k >= 0; --k) v = (v << 8) | p[k];
-  return v;
-}
 
 enum class NpyKind { kBool, kU1, kI1, kU2, kI2, kU4, kI4, kU8, kI8, kF4, kF8 };
 
@@ -165,25 +159,25 @@ float ElementAsFloat(NpyKind kind, const unsigned char* p) {
     case NpyKind::kI1:
       return static_cast<float>(static_cast<std::int8_t>(p[0]));
     case NpyKind::kU2:
-      return static_cast<float>(LoadLe(p, 2));
+      return static_cast<float>(LittleEndianAt(p, 2));
     case NpyKind::kI2:
-      return static_cast<float>(static_cast<std::int16_t>(LoadLe(p, 2)));
+      return static_cast<float>(static_cast<std::int16_t>(LittleEndianAt(p, 2)));
     case NpyKind::kU4:
-      return static_cast<float>(LoadLe(p, 4));
+      return static_cast<float>(LittleEndianAt(p, 4));
     case NpyKind::kI4:
-      return static_cast<float>(static_cast<std::int32_t>(LoadLe(p, 4)));
+      return static_cast<float>(static_cast<std::int32_t>(LittleEndianAt(p, 4)));
     case NpyKind::kU8:
-      return static_cast<float>(LoadLe(p, 8));
+      return static_cast<float>(LittleEndianAt(p, 8));
     case NpyKind::kI8:
-      return static_cast<float>(static_cast<std::int64_t>(LoadLe(p, 8)));
+      return static_cast<float>(static_cast<std::int64_t>(LittleEndianAt(p, 8)));
     case NpyKind::kF4: {
-      const auto bits = static_cast<std::uint32_t>(LoadLe(p, 4));
+      const auto bits = static_cast<std::uint32_t>(LittleEndianAt(p, 4));
       float f;
       std::memcpy(&f, &bits, 4);
       return f;
     }
     case NpyKind::kF8: {
-      const std::uint64_t bits = LoadLe(p, 8);
+      const std::uint64_t bits = LittleEndianAt(p, 8);
       double d;
       std::memcpy(&d, &bits, 8);
       return static_cast<float>(d);
@@ -218,6 +212,12 @@ bool ParseDescr(const std::string& descr, NpyKind* kind, int* size) {
 }
 
 }  // namespace
+
+std::uint64_t LittleEndianAt(const unsigned char* p, int n) {
+  std::uint64_t v = 0;
+  for (int k = n - 1; k >= 0; --k) v = (v << 8) | p[k];
+  return v;
+}
 
 std::string NpyShapeText(const std::vector<std::int64_t>& shape) {
   std::string s = "(";
@@ -271,7 +271,7 @@ NpyHeaderInfo ReadNpyHeader(std::string_view data, const std::string& where) {
   }
   const std::size_t prefix = major == 1 ? 10 : 12;
   if (data.size() < prefix) throw InputError(where + ": truncated .npy header");
-  const std::size_t header_len = LoadLe(bytes + 8, major == 1 ? 2 : 4);
+  const std::size_t header_len = LittleEndianAt(bytes + 8, major == 1 ? 2 : 4);
   if (data.size() - prefix < header_len) {
     throw InputError(where + ": truncated .npy header (" + std::to_string(header_len) +
                      " bytes announced, the file has " + std::to_string(data.size()) + ")");

@@ -40,6 +40,10 @@ struct NpyHeaderInfo {
 NpyHeaderInfo ReadNpyHeader(std::string_view data, const std::string& where);
 // A shape as Python writes it: "(3, 4)", "(5,)", "()".
 std::string NpyShapeText(const std::vector<std::int64_t>& shape);
+// The little-endian unsigned integer of the `n` (<= 8) bytes at `p`: the lengths of .npy
+// headers, the elements of '<' dtypes and, in npy_objects.h, pickles' and ZIP archives'
+// fields.
+std::uint64_t LittleEndianAt(const unsigned char* p, int n);
 
 // A 2-D numeric matrix from the bytes of a .npy file, as float: versions 1.0-3.0; dtypes bool,
 // u1, i1, u2, i2, u4, i4, u8, i8, f4, f8, little-endian or '|'; C or Fortran order. Throws

@@ -25,13 +25,6 @@ namespace {
 using Value = std::shared_ptr<PyValue>;
 using Kind = PyValue::Kind;
 
-// Little-endian unsigned integer of `n` bytes (n <= 8).
-std::uint64_t LittleEndianAt(const unsigned char* p, int n) {
-  std::uint64_t v = 0;
-  for (int k = n - 1; k >= 0; --k) v = (v << 8) | p[k];
-  return v;
-}
-
 // ---------------------------------------------------------------------------------------------
 // Values
 
