@@ -50,6 +50,10 @@ bool Agree(int qa, int a, int qb, int b, const AgreementOptions& o) {
 
 }  // namespace
 
+bool AnswersAgree(int qa, int a, int qb, int b, const AgreementOptions& options) {
+  return Agree(qa, a, qb, b, options);
+}
+
 int AgreementPartner(int q, int queries, const AgreementOptions& options) {
   const int back = BackPartner(q, options);
   return back >= 0 ? back : ForwardPartner(q, queries, options);

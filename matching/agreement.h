@@ -61,6 +61,12 @@ std::vector<std::uint8_t> AgreeingAnswers(const std::vector<int>& best,
 
 // The partner of query q among `queries` queries (see above), or -1 when there is none: the
 // nearest p <= q - Gap() whose window ends before q's starts, else the nearest such p forward.
+// With queries = q + 1 (online: no later query is known) only the one back.
 int AgreementPartner(int q, int queries, const AgreementOptions& options);
+
+// Whether answer a of query qa and answer b of query qb (qa < qb) advance as the queries do:
+// b - a within Tolerance() of qb - qa (of qa - qb for the reverse direction; either for
+// both). False when an answer is -1.
+bool AnswersAgree(int qa, int a, int qb, int b, const AgreementOptions& options);
 
 }  // namespace openable

@@ -10,11 +10,11 @@
 
 namespace openable {
 
-void EnhanceContrast(cv::Mat1f& d, int window, const std::vector<int>& col_starts,
-                     int threads) {
+float EnhanceContrastUnshifted(cv::Mat1f& d, int window, const std::vector<int>& col_starts,
+                               int threads) {
   if (window < 1) throw std::logic_error("EnhanceContrast: window below 1");
   const int n = d.rows, m = d.cols;
-  if (n == 0 || m == 0) return;
+  if (n == 0 || m == 0) return std::numeric_limits<float>::infinity();
   // The traversal of each column: [first, end).
   std::vector<int> first(static_cast<size_t>(m)), end(static_cast<size_t>(m));
   std::vector<int> starts = col_starts.empty() ? std::vector<int>{0} : col_starts;
@@ -56,6 +56,13 @@ void EnhanceContrast(cv::Mat1f& d, int window, const std::vector<int>& col_start
     std::lock_guard<std::mutex> lock(mutex);
     smallest = std::min(smallest, local);
   });
+  return smallest;
+}
+
+void EnhanceContrast(cv::Mat1f& d, int window, const std::vector<int>& col_starts,
+                     int threads) {
+  const float smallest = EnhanceContrastUnshifted(d, window, col_starts, threads);
+  const int n = d.rows, m = d.cols;
   if (!std::isfinite(smallest) || smallest == 0.0f) return;
   ParallelFor(n, threads, [&](int i) {
     float* row = d.ptr<float>(i);

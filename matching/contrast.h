@@ -25,4 +25,12 @@ namespace openable {
 void EnhanceContrast(cv::Mat1f& d, int window, const std::vector<int>& col_starts = {},
                      int threads = 0);
 
+// The same without the final shift: each cell is its z-score within its window, and the
+// smallest of them is returned (+inf when no cell is finite). For searches that enhance a few
+// rows at a time and shift them by a value fixed beforehand (a map's tuned settings, online.h).
+// A z-score among the 2R + 1 values of a window is at least -sqrt(2R) (Samuelson's
+// inequality), so a shift of sqrt(2 window) never leaves a cell below 0.
+float EnhanceContrastUnshifted(cv::Mat1f& d, int window,
+                               const std::vector<int>& col_starts = {}, int threads = 0);
+
 }  // namespace openable

@@ -71,6 +71,30 @@ class SpinBarrier {
   std::atomic<int> generation_{0};
 };
 
+// One row i of the running sums over columns [c0, c1): `row` holds D(i, j) and receives S(i, j);
+// `keep` receives D(i, j) (row i of the ring); `old` is row i - L of D, read only where the
+// diagonal holds L earlier terms; `prev` and `cur` are the raw (unscaled, double) sums of rows
+// i - 1 and i; `ti` the steps back within the traversal of i and steps(j) those within the
+// traversal of column j. Shared by the sweep and SequenceRowSums, so both give the same floats.
+template <typename Steps>
+inline void SumRow(float* row, float* keep, const float* old, const double* prev, double* cur,
+                   int c0, int c1, int ti, int L, bool reverse, SequencePartial partial,
+                   Steps steps) {
+  for (int j = c0; j < c1; ++j) {
+    const float dij = row[j];
+    keep[j] = dij;
+    // Steps the run can go back from (i, j) without leaving either traversal.
+    const int t = std::min(ti, steps(j));
+    double w = dij;
+    if (t > 0) {
+      w += prev[reverse ? j + 1 : j - 1];
+      if (t >= L) w -= old[reverse ? j + L : j - L];
+    }
+    cur[j] = w;
+    row[j] = ScaleSequenceSum(w, SequenceTerms(L, t), L, partial);
+  }
+}
+
 // One direction, in place. step = +1: diagonals (predecessor (i-1, j-1)); -1: anti-diagonals
 // (predecessor (i-1, j+1)).
 void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, bool reverse,
@@ -98,21 +122,11 @@ void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, 
       float* keep = &ring[static_cast<size_t>(i % R) * m];
       const float* old = &ring[static_cast<size_t>((i + 1) % R) * m];  // row i - L
       const int ti = i - rows.first[static_cast<size_t>(i)];  // steps back within i's traversal
-      for (int j = c0; j < c1; ++j) {
-        const float dij = row[j];
-        keep[j] = dij;
-        // Steps the run can go back from (i, j) without leaving either traversal.
-        const int tj = reverse ? cols.last[static_cast<size_t>(j)] - j
-                               : j - cols.first[static_cast<size_t>(j)];
-        const int t = std::min(ti, tj);
-        double w = dij;
-        if (t > 0) {
-          w += prev[static_cast<size_t>(reverse ? j + 1 : j - 1)];
-          if (t >= L) w -= old[reverse ? j + L : j - L];
-        }
-        cur[static_cast<size_t>(j)] = w;
-        row[j] = ScaleSequenceSum(w, SequenceTerms(L, t), L, partial);
-      }
+      SumRow(row, keep, old, prev.data(), cur.data(), c0, c1, ti, L, reverse, partial,
+             [&](int j) {
+               return reverse ? cols.last[static_cast<size_t>(j)] - j
+                              : j - cols.first[static_cast<size_t>(j)];
+             });
       if (c0 == 0) {
         const auto now = std::chrono::steady_clock::now();
         if (now - last_check >= std::chrono::milliseconds(50)) {
@@ -242,6 +256,55 @@ float SequenceCellDistance(const cv::Mat& queries, int q, const cv::Mat& referen
     sum += d;
   }
   return ScaleSequenceSum(sum, terms, sequence_length, partial);
+}
+
+
+SequenceRowSums::SequenceRowSums(int sequence_length, SequencePartial partial)
+    : length_(sequence_length), partial_(partial) {
+  if (sequence_length < 1) throw std::logic_error("SequenceRowSums: sequence length < 1");
+  if (partial == SequencePartial::kAhead)
+    throw std::logic_error("SequenceRowSums: kAhead reads query frames not given yet");
+  ring_.resize(static_cast<size_t>(sequence_length) + 1);
+}
+
+void SequenceRowSums::Restart() { rows_ = 0; }
+
+void SequenceRowSums::Push(float* d, int columns, const std::vector<int>& col_starts) {
+  const bool grows = columns == columns_ || columns == columns_ + 1;
+  // New traversals only begin at new columns.
+  bool extends = col_starts.size() >= starts_.size() &&
+                 std::equal(starts_.begin(), starts_.end(), col_starts.begin());
+  for (size_t k = starts_.size(); extends && k < col_starts.size(); ++k)
+    extends = col_starts[k] >= columns_;
+  if (rows_ > 0 && (!grows || !extends))
+    throw std::logic_error("SequenceRowSums::Push: " + std::to_string(columns) + " columns after " +
+                           std::to_string(columns_) + ", or other traversals; expected as many "
+                           "columns or one more, and the same traversals (Restart first)");
+  CheckTraversalStarts(col_starts, columns + 1, "SequenceRowSums: column starts");
+  if (rows_ == 0) columns_ = 0;
+  starts_ = col_starts;
+  if (length_ == 1) {  // S = D, as the sweep leaves it
+    columns_ = columns;
+    ++rows_;
+    return;
+  }
+  first_.resize(static_cast<size_t>(columns));
+  for (int j = columns_; j < columns; ++j) {
+    int f = 0;
+    for (const int s : starts_)
+      if (s <= j) f = s;
+    first_[static_cast<size_t>(j)] = f;
+  }
+  const int L = length_, R = L + 1, i = rows_;
+  std::vector<float>& keep = ring_[static_cast<size_t>(i % R)];
+  const std::vector<float>& old = ring_[static_cast<size_t>((i + 1) % R)];
+  keep.resize(static_cast<size_t>(columns));
+  cur_.resize(static_cast<size_t>(columns));
+  SumRow(d, keep.data(), old.data(), prev_.data(), cur_.data(), 0, columns, i, L, false,
+         partial_, [&](int j) { return j - first_[static_cast<size_t>(j)]; });
+  std::swap(prev_, cur_);
+  columns_ = columns;
+  ++rows_;
 }
 
 }  // namespace openable

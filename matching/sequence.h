@@ -94,6 +94,38 @@ float SequenceCellDistance(const cv::Mat& queries, int q, const cv::Mat& referen
                            int sequence_length, bool reverse, double* largest_term = nullptr,
                            SequencePartial partial = SequencePartial::kAhead);
 
+// The sums of the sweep below one query row at a time, for searches whose query frames arrive
+// in order (the online detector, a map's queries): S(q, .) of query frame q from its
+// single-frame row D(q, .) and what the rows before it left, in O(columns) whatever L (the last
+// L rows of D and the running sums of the previous row are kept). Forward diagonals; the query
+// rows are one traversal (Restart begins another), the columns form traversals that no sum
+// crosses (`col_starts`: a map's sessions). Cells with fewer than L terms are scaled (kScale)
+// or skipped (kSkip); kAhead would read query frames not given yet. Each cell is the float
+// SequenceDistancesInPlace gives for the same D (the same operations in double).
+class SequenceRowSums {
+ public:
+  // Throws std::logic_error when L < 1 or `partial` is kAhead.
+  explicit SequenceRowSums(int sequence_length,
+                        SequencePartial partial = SequencePartial::kScale);
+  // The next row pushed is the first of a new query traversal.
+  void Restart();
+  // Row Rows() of the query traversal: `d` holds D(q, j) for the columns 0 .. columns - 1 and
+  // receives S(q, j). `col_starts`: the first column of each column traversal, increasing from
+  // 0 (empty: one). From one row to the next the columns may stay or grow by one (a frame
+  // that becomes a candidate), and the starts may only gain new ones at the end; else
+  // std::logic_error (Restart first). Memory: L + 1 rows of floats and two of doubles.
+  void Push(float* d, int columns, const std::vector<int>& col_starts);
+  int Rows() const { return rows_; }  // rows pushed since the last Restart
+
+ private:
+  int length_;
+  SequencePartial partial_;
+  int rows_ = 0, columns_ = 0;
+  std::vector<int> starts_, first_;
+  std::vector<std::vector<float>> ring_;  // row r of D in slot r % (L + 1)
+  std::vector<double> prev_, cur_;
+};
+
 // kAhead after a sweep that left every cell with fewer than L terms +inf (kSkip): each such
 // cell takes the value of the cell AheadShift steps forward along its diagonal (a cell with L
 // terms, never changed here), or stays +inf. `row_starts`/`col_starts` and `reverse` as for

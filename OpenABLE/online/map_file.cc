@@ -7,12 +7,14 @@
 
 #include <libdeflate.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <deque>
 #include <limits>
+#include <sstream>
 #include <string_view>
 
 #include "OpenABLE/base/error.h"
@@ -36,6 +38,7 @@ enum SectionKind : std::uint32_t {
   kRows = 3,
   kBlock = 4,
   kFeatures = 5,
+  kFrameFiles = 6,
 };
 
 // Little-endian integers, byte by byte (the file does not depend on the host's order).
@@ -160,6 +163,45 @@ RowShape RowShapeOf(const MapFile& map, const std::string& path) {
   shape.bytes = static_cast<std::uint64_t>(shape.frames) *
                 static_cast<std::uint64_t>(shape.width) * CV_ELEM_SIZE(shape.type);
   return shape;
+}
+
+// The shapes of the rows of the other descriptors of a map of several (format 3): settings
+// "channel_widths" and "channel_types" list every descriptor's, the first being `first`'s.
+std::vector<RowShape> MoreRowShapes(const MapFile& map, const RowShape& first,
+                                    const std::string& path) {
+  const std::string widths = map.Setting("channel_widths"), types = map.Setting("channel_types");
+  if (widths.empty() && types.empty()) return {};
+  std::vector<std::string> w, t;
+  std::istringstream wi(widths), ti(types);
+  for (std::string x; wi >> x;) w.push_back(x);
+  for (std::string x; ti >> x;) t.push_back(x);
+  const auto bad = [&](const std::string& why) {
+    return InputError(path + ": settings \"channel_widths\" " + Quoted(widths) +
+                      " and \"channel_types\" " + Quoted(types) + " of the map: " + why);
+  };
+  if (w.size() != t.size() || w.empty() || w.size() > 64)
+    throw bad("expected one width and one type (CV_8U or CV_32F) per descriptor");
+  std::vector<RowShape> out;
+  for (size_t k = 0; k < w.size(); ++k) {
+    RowShape shape = first;
+    long long v = -1;
+    try {
+      size_t used = 0;
+      v = std::stoll(w[k], &used);
+      if (used != w[k].size()) v = -1;
+    } catch (const std::exception&) {
+    }
+    if (v < 1 || v > (1 << 24) || (t[k] != "CV_8U" && t[k] != "CV_32F"))
+      throw bad("expected widths from 1 and types CV_8U or CV_32F");
+    shape.width = static_cast<int>(v);
+    shape.type = t[k] == "CV_8U" ? CV_8U : CV_32F;
+    shape.bytes = static_cast<std::uint64_t>(shape.frames) *
+                  static_cast<std::uint64_t>(shape.width) * CV_ELEM_SIZE(shape.type);
+    if (k == 0 && (shape.width != first.width || shape.type != first.type))
+      throw bad("expected the first to be row_width and row_type");
+    if (k > 0) out.push_back(shape);
+  }
+  return out;
 }
 
 void CheckRowBytes(std::uint64_t bytes, const RowShape& shape, const MapFile& map,
@@ -308,7 +350,9 @@ std::string CheckSection(const char* base, const Section& s, const std::string& 
 
 std::string SectionName(const Section& s) {
   switch (s.kind) {
-    case kRows: return "its descriptor rows";
+    case kRows:
+      return s.a == 0 ? "its descriptor rows" : "the rows of its descriptor " + std::to_string(s.a);
+    case kFrameFiles: return "its frames' file names";
     case kBlock:
       return "the index block of rows " + std::to_string(s.a) + " to " +
              std::to_string(static_cast<std::uint64_t>(s.a) + s.b - 1);
@@ -351,10 +395,26 @@ void WriteMapFile(const std::string& path, const MapFile& map) {
                 (s.time.empty() ? "-" : s.time) + "\t" + s.name + "\n";
   pieces.push_back({kSessions, 0, 0, {small.emplace_back(std::move(sessions))}});
   pieces.push_back({kRows, 0, 0, {View(rows.data, rows.total() * rows.elemSize())}});
+  std::deque<cv::Mat> continuous;  // rows that were not continuous
+  for (size_t k = 0; k < map.more_rows.size(); ++k) {
+    const cv::Mat* m = &map.more_rows[k];
+    if (!m->isContinuous()) m = &continuous.emplace_back(m->clone());
+    pieces.push_back({kRows, static_cast<std::uint32_t>(k + 1), 0,
+                      {View(m->data, m->total() * m->elemSize())}});
+  }
   for (const auto& b : map.blocks) {
     const SavedIndex bytes = b.Bytes();
     pieces.push_back({kBlock, static_cast<std::uint32_t>(b.first),
                       static_cast<std::uint32_t>(b.count), {View(bytes.data, bytes.size)}});
+  }
+  if (!map.frame_files.empty()) {
+    std::string files;
+    for (const std::string& f : map.frame_files) {
+      // A name that would break the line structure is not kept.
+      const bool plain = std::none_of(f.begin(), f.end(), IsControl);
+      files += (plain ? f : std::string()) + "\n";
+    }
+    pieces.push_back({kFrameFiles, 0, 0, {small.emplace_back(std::move(files))}});
   }
   std::deque<cv::Mat> copies;  // descriptors that were not continuous
   if (map.has_features) {
@@ -426,9 +486,9 @@ MapFile ReadMapFile(const std::string& path, const MapReadOptions& options) {
   Reader r{data, kSignatureBytes, size, path};
   const auto version = r.Get<std::uint32_t>("the format version");
   if (version == 1) return ReadFirstVersion(path, std::string_view(data, size));
-  if (version != kMapFormatVersion)
+  if (version != 2 && version != kMapFormatVersion)
     throw InputError(path + ": map format version " + std::to_string(version) + "; this " +
-                     "OpenABLE reads versions 1 and " + std::to_string(kMapFormatVersion) +
+                     "OpenABLE reads versions 1 to " + std::to_string(kMapFormatVersion) +
                      (version > kMapFormatVersion ? " (the map was written by a newer OpenABLE)"
                                                   : ""));
   const auto count = r.Get<std::uint32_t>("the section count");
@@ -441,6 +501,7 @@ MapFile ReadMapFile(const std::string& path, const MapReadOptions& options) {
   if (stored != Crc32(data, r.pos - 4))
     throw InputError(path + ": the map is damaged: the checksum of its table of sections does "
                      "not match (expected the file exactly as it was saved)");
+  const std::uint32_t last_kind = version == 2 ? kFeatures : kFrameFiles;
   for (std::uint32_t i = 0; i < count; ++i) {
     const char* e = data + kSignatureBytes + 8 + static_cast<size_t>(i) * kEntryBytes;
     Section& s = sections[i];
@@ -456,19 +517,33 @@ MapFile ReadMapFile(const std::string& path, const MapReadOptions& options) {
                        std::to_string(s.offset + s.bytes) + " of a file of " +
                        std::to_string(size) + " bytes (expected the file exactly as it was "
                        "saved)");
-    if (s.kind < kSettings || s.kind > kFeatures)
+    if (s.kind < kSettings || s.kind > last_kind)
       throw InputError(path + ": the map's section " + std::to_string(i) + " is of kind " +
-                       std::to_string(s.kind) + "; expected kinds 1 to 5");
+                       std::to_string(s.kind) + "; expected kinds 1 to " +
+                       std::to_string(last_kind));
   }
-  // The layout WriteMapFile gives: settings, sessions, rows, blocks, features (optional).
+  // The layout WriteMapFile gives: settings, sessions, the rows of each descriptor in order,
+  // the index blocks, the frames' files (optional) and the features (optional, last).
   if (count < 3 || sections[0].kind != kSettings || sections[1].kind != kSessions ||
-      sections[2].kind != kRows)
+      sections[2].kind != kRows || sections[2].a != 0)
     throw InputError(path + ": the map's sections are not settings, sessions and rows first");
-  for (std::uint32_t i = 3; i < count; ++i)
-    if (sections[i].kind != kBlock && !(sections[i].kind == kFeatures && i + 1 == count))
+  std::uint32_t channels = 1;
+  while (2 + channels < count && sections[2 + channels].kind == kRows &&
+         sections[2 + channels].a == channels)
+    ++channels;
+  std::uint32_t i_files = 0;
+  for (std::uint32_t i = 2 + channels; i < count; ++i) {
+    const std::uint32_t k = sections[i].kind;
+    const bool ok = (k == kBlock && i_files == 0) ||
+                    (k == kFrameFiles && i_files == 0 &&
+                     (i + 1 == count || sections[i + 1].kind == kFeatures)) ||
+                    (k == kFeatures && i + 1 == count);
+    if (!ok)
       throw InputError(path + ": the map's section " + std::to_string(i) + " is of kind " +
-                       std::to_string(sections[i].kind) + "; expected index blocks, then the "
-                       "features last");
+                       std::to_string(k) + "; expected the rows of each descriptor, index "
+                       "blocks, the frames' files, then the features last");
+    if (k == kFrameFiles) i_files = i;
+  }
 
   MapFile map;
   map.version = version;
@@ -480,6 +555,16 @@ MapFile ReadMapFile(const std::string& path, const MapReadOptions& options) {
   ParseSettings(View(data + sections[0].offset, sections[0].bytes), path, map);
   const RowShape shape = RowShapeOf(map, path);
   CheckRowBytes(sections[2].bytes, shape, map, path);
+  const std::vector<RowShape> more = MoreRowShapes(map, shape, path);
+  if (more.size() + 1 != channels)
+    throw InputError(path + ": the map holds the rows of " + std::to_string(channels) +
+                     " descriptors; its settings name " + std::to_string(more.size() + 1));
+  for (size_t k = 0; k < more.size(); ++k)
+    if (sections[3 + k].bytes != more[k].bytes)
+      throw InputError(path + ": the rows of the map's descriptor " + std::to_string(k + 1) +
+                       " take " + std::to_string(sections[3 + k].bytes) + " bytes; expected " +
+                       std::to_string(more[k].bytes) + " (" + std::to_string(shape.frames) +
+                       " frames of " + std::to_string(more[k].width) + ")");
 
   // Sessions: tiling the frames in order.
   int next = 0;
@@ -543,19 +628,36 @@ MapFile ReadMapFile(const std::string& path, const MapReadOptions& options) {
                        std::to_string(fr.end - fr.pos) + " bytes after the last frame's");
   }
 
-  // Rows and blocks: in place (the mapping kept alive by whoever holds them) or copied.
-  const Section& rows = sections[2];
-  const std::shared_ptr<const void> keep = options.in_place ? file : nullptr;
-  if (options.in_place) {
-    map.rows = cv::Mat(shape.frames, shape.width, shape.type,
-                       const_cast<char*>(data + rows.offset));
-    map.mapping = file;
-  } else {
-    map.rows = cv::Mat(shape.frames, shape.width, shape.type);
-    if (rows.bytes > 0) std::memcpy(map.rows.data, data + rows.offset, rows.bytes);
+  // The frames' files: small, checked and parsed here.
+  if (i_files > 0) {
+    const Section& f = sections[i_files];
+    const std::string error = CheckSection(data, f, path, "its frames' file names");
+    if (!error.empty()) throw InputError(error);
+    // A line each, each ending with a line break.
+    map.frame_files = TextLines(View(data + f.offset, f.bytes), path, "file name");
+    if (map.frame_files.size() != static_cast<size_t>(shape.frames))
+      throw InputError(path + ": the map names the files of " +
+                       std::to_string(map.frame_files.size()) + " frames; expected its " +
+                       std::to_string(shape.frames));
   }
-  std::vector<Section> checked{rows};
-  for (std::uint32_t i = 3; i < count; ++i) {
+
+  // Rows and blocks: in place (the mapping kept alive by whoever holds them) or copied.
+  const std::shared_ptr<const void> keep = options.in_place ? file : nullptr;
+  if (options.in_place) map.mapping = file;
+  const auto rows_of = [&](const Section& rows, const RowShape& sh) {
+    if (options.in_place)
+      return cv::Mat(sh.frames, sh.width, sh.type, const_cast<char*>(data + rows.offset));
+    cv::Mat m(sh.frames, sh.width, sh.type);
+    if (rows.bytes > 0) std::memcpy(m.data, data + rows.offset, rows.bytes);
+    return m;
+  };
+  map.rows = rows_of(sections[2], shape);
+  std::vector<Section> checked{sections[2]};
+  for (size_t k = 0; k < more.size(); ++k) {
+    map.more_rows.push_back(rows_of(sections[3 + k], more[k]));
+    checked.push_back(sections[3 + k]);
+  }
+  for (std::uint32_t i = 2 + channels; i < count; ++i) {
     const Section& s = sections[i];
     if (s.kind != kBlock) continue;
     checked.push_back(s);

@@ -9,21 +9,27 @@
 // structure, while the rows and the blocks are used in place and their checksums are computed
 // in the background (or before returning, MapReadOptions::check_in_background = false).
 //
+// Version 3 adds the rows of a map of several descriptors (one rows section per descriptor,
+// settings "channels", "channel_widths", "channel_types") and the image file of each frame;
+// the settings of a tuned map are settings lines too (tuned_*).
+//
 // Layout, integers little-endian:
 //   16 bytes  signature "OpenABLE-map\r\n\x1a\n" (the \r\n and \x1a catch a file mangled by a
 //             text-mode copy, as PNG's signature does)
-//   u32       format version (2)
+//   u32       format version (3)
 //   u32       section count S
 //   S x 32    sections: u32 kind, u32 a, u64 offset, u64 bytes, u32 CRC-32, u32 b
 //   u32       CRC-32 of every byte above
 //   sections, each at a multiple of 64 bytes, zero bytes between them:
 //     kind 1  settings: text lines "key value"
 //     kind 2  sessions: text lines "first<TAB>frames<TAB>time<TAB>name", in frame order
-//     kind 3  descriptor rows: frames x row bytes, row after row
+//     kind 3  descriptor rows of descriptor a (0, 1, ... in order): frames x row bytes, row
+//             after row
 //     kind 4  one index block over rows [a, a + b): the engine's saved index
+//     kind 6  (optional) the image file of each frame, a line each ("" when not known)
 //     kind 5  local features, each frame: u32 points, 2 f32 a point, i32 rows, i32 cols,
 //             i32 OpenCV type, the descriptor bytes
-// Version 1 (one session, no table, one FNV-1a 64 checksum at the end) is still read: its
+// Version 2 (one descriptor, no files) and version 1 (one session, no table, one FNV-1a 64 checksum at the end) is still read: its
 // frames become one session named "default".
 #pragma once
 
@@ -41,7 +47,7 @@
 
 namespace openable {
 
-inline constexpr std::uint32_t kMapFormatVersion = 2;
+inline constexpr std::uint32_t kMapFormatVersion = 3;
 
 // One traversal of a map: frames [first, first + count), its name (unique in the map) and the
 // time it was added (ISO 8601 UTC, "" when unknown).
@@ -59,7 +65,12 @@ struct MapFile {
   std::uint32_t version = kMapFormatVersion;  // of the file read
   std::vector<std::pair<std::string, std::string>> settings;  // in the file's order
   std::vector<MapSession> sessions;  // tiling frames 0 .. rows.rows - 1 in order
-  cv::Mat rows;  // frames x width, CV_8U or CV_32F, continuous
+  cv::Mat rows;  // frames x width, CV_8U or CV_32F, continuous: the first descriptor's
+  // The rows of the map's other descriptors (format 3), each as `rows`; settings
+  // "channel_widths" and "channel_types" give their shapes.
+  std::vector<cv::Mat> more_rows;
+  // The image file of each frame ("" when not known); empty: none kept.
+  std::vector<std::string> frame_files;
   std::vector<IncrementalIndex::SavedBlock> blocks;
   bool has_features = false;
   std::vector<FrameFeatures> features;  // one per frame when has_features
@@ -88,12 +99,12 @@ struct MapReadOptions {
   bool header_only = false;
 };
 
-// Writes `map` (format version 2) to `path` through a temporary file renamed into place when
+// Writes `map` (format version 3) to `path` through a temporary file renamed into place when
 // complete (an interrupted save leaves the old file, or none). Throws InputError naming the
 // path.
 void WriteMapFile(const std::string& path, const MapFile& map);
 
-// Reads a map written by WriteMapFile (version 2, or 1). Every defect found before returning
+// Reads a map written by WriteMapFile (version 3, 2 or 1). Every defect found before returning
 // is one InputError beginning with the path: unreadable, not a map, a newer format version,
 // damaged (checksum) or truncated, inconsistent sizes or sessions.
 MapFile ReadMapFile(const std::string& path, const MapReadOptions& options = {});

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -18,8 +19,15 @@
 #include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/io/json.h"
 #include "OpenABLE/online/map_file.h"
+#include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/evaluation/report.h"
 #include "OpenABLE/online/online.h"
+#include "OpenABLE/reports/evaluation_files.h"
+#include "OpenABLE/reports/html_report.h"
+#include "OpenABLE/run/evaluate.h"
+#include "OpenABLE/tuning/auto.h"
 #include "config/config.h"
+#include "descriptors/registry.h"
 
 namespace openable {
 namespace {
@@ -27,42 +35,67 @@ namespace {
 const char* const kUsageText =
     "Usage: openable_map add MAP --images FOLDER --session NAME [--time T] [--config FILE]\n"
     "                        [--set Key=Value ...]\n"
+    "       openable_map tune MAP [--session REFERENCE --session QUERY] [--frames N]\n"
+    "                         [--threshold X] [--config FILE] [--set Key=Value ...] [--json]\n"
     "       openable_map info MAP [--json]\n"
     "       openable_map merge A B -o C\n"
     "       openable_map query MAP --images FOLDER [--session NAME ...] [--config FILE]\n"
     "                          [--set Key=Value ...] [--threshold X] [--json]\n"
+    "                          [--output PREFIX]\n"
     "\n"
     "A map holds the places of one or more sessions (traversals of a route): each frame's\n"
-    "descriptor row and the index that finds them again (docs/library.md, \"Maps that grow\").\n"
+    "descriptor rows and the index that finds them again (docs/library.md, \"Maps that grow\").\n"
     "\n"
     "  add    describes the images of FOLDER and appends them to MAP as session NAME (a new\n"
     "         name), creating MAP when it does not exist. A new map takes its description and\n"
     "         index settings from --config FILE (a Config.txt) and --set, else the defaults\n"
-    "         (LDB 256 bits, global); an existing map keeps its own, and a --config that\n"
-    "         describes otherwise is refused. The frames must be of the map's size. MAP is\n"
-    "         replaced whole when the new one is written (an interrupted add leaves it as it\n"
-    "         was).\n"
-    "  info   prints the map's settings, sessions (name, time, frames), index blocks and size,\n"
-    "         after verifying every checksum.\n"
+    "         (LDB 256 bits, global). With the auto preset (--config config/presets/auto.txt,\n"
+    "         Auto 1) the map keeps the rows of every descriptor of its candidates, so that\n"
+    "         tune can choose among them. An existing map keeps its own settings, and a\n"
+    "         --config that describes otherwise is refused. The frames must be of the map's\n"
+    "         size. MAP is replaced whole when the new one is written (an interrupted add leaves\n"
+    "         it as it was).\n"
+    "  tune   chooses the map's search settings from its data, with no ground truth, as\n"
+    "         Test_OpenABLE's auto mode does (docs/evaluation.md, \"Without ground truth\"): the\n"
+    "         frames of the second session (or the QUERY one) are matched against those of the\n"
+    "         first (REFERENCE) with every candidate of Auto_candidates that the map's\n"
+    "         descriptors allow, the best by agreement is kept in MAP with its verdict, and\n"
+    "         query then uses it: the ratio score <= 0.9 (--threshold X), confirmed by an\n"
+    "         earlier independent query (Match_consistency 1). When no candidate can be trusted\n"
+    "         (consistency below Auto_min_consistency) the map is UNRELIABLE and accepts\n"
+    "         nothing. --frames N judges on the first N frames of each session.\n"
+    "  info   prints the map's settings, sessions (name, time, frames), tuned settings and\n"
+    "         verdict, index blocks and size, after verifying every checksum.\n"
     "  merge  writes C: the sessions of A, then those of B (same description settings and\n"
     "         frame size, distinct session names), indexed with A's index settings.\n"
     "  query  describes the images of FOLDER (a traversal of its own) and finds each one's best\n"
-    "         match in MAP, in every session or only those named by --session. Sequences\n"
-    "         (Image_sequences) run over the query frames before each one. Prints a table, or\n"
-    "         with --json one object whose \"queries\" list holds, for each image, \"query\"\n"
-    "         (its file name), \"session\", \"frame\" (within the session; null when nothing\n"
-    "         was found), \"map_frame\", \"score\", \"distance\" and \"accepted\".\n"
+    "         match in MAP, in every session or only those named by --session, with the map's\n"
+    "         tuned settings unless --config or --set say otherwise. Sequences (L) run over\n"
+    "         the query frames before each one. Prints a table, or with --json one object whose\n"
+    "         \"queries\" list holds, for each image, \"query\" (its file name), \"session\",\n"
+    "         \"frame\" (within the session; null when nothing was found), \"map_frame\",\n"
+    "         \"score\", \"distance\", \"accepted\" and \"confirmed\". --output PREFIX writes\n"
+    "         PREFIX.csv and PREFIX.json (the same), and PREFIX.html: a page with the matrix\n"
+    "         to explore and the accepted matches' frames side by side; with Ground_truth_type\n"
+    "         (one session searched) the evaluation Test_OpenABLE gives too\n"
+    "         (PREFIX_eval.json, ...).\n"
     "\n"
-    "Keys read from --config/--set: Image_descriptor, Patch_size, Ldb_bits, Description_type,\n"
-    "Grid_x, Grid_y (the description), Exclusion and Approximate_* (the index), and for query\n"
-    "Image_sequences, Match_score, Score_window, Threads. --threshold X: a best match is\n"
-    "accepted when its score is <= X (default 0.13: the mean fraction of differing bits).\n"
+    "Keys read from --config/--set: the description (Image_descriptor, Patch_size, Ldb_bits,\n"
+    "Sad_patch, Description_type, Grid_x, Grid_y; Auto and Auto_candidates for add), the index\n"
+    "(Exclusion, Approximate_*), the search (Image_descriptor among the map's descriptors,\n"
+    "Fusion_weights, Image_sequences, Contrast_enhancement, Contrast_window, Match_score,\n"
+    "Match_score_window, Match_threshold, Match_consistency), tune's Auto_candidates and\n"
+    "Auto_min_consistency, and query's evaluation keys (Ground_truth_type, Ground_truth,\n"
+    "Tolerance, ...). --threshold X: a best match is accepted when its score is <= X (default:\n"
+    "the score's, 0.9 for the ratio, 0.13 for the distance).\n"
     "\n"
-    "Example (two seasons of one route as sessions of one map):\n"
-    "  openable_map add route.map --images nordland/summer --session summer\n"
+    "Example (two seasons of one route as sessions of one map, the settings chosen from them):\n"
+    "  openable_map add route.map --images nordland/summer --session summer \\\n"
+    "      --config config/presets/auto.txt\n"
     "  openable_map add route.map --images nordland/winter --session winter\n"
+    "  openable_map tune route.map\n"
     "  openable_map info route.map\n"
-    "  openable_map query route.map --images nordland/spring --session summer --json\n"
+    "  openable_map query route.map --images nordland/spring --session summer --output spring\n"
     "\n"
     "Exit status: 0 success, 1 bad input (one line on stderr, the map unchanged), 2 bad\n"
     "command line, 3 internal error.\n";
@@ -71,9 +104,9 @@ using Arguments = MapCommandLine;
 
 // One line naming the bad argument, or "".
 std::string Parse(int argc, const char* const* argv, Arguments& a) {
-  const std::vector<std::string> with_value = {"--images", "--session", "--time", "--config",
-                                               "--set",    "-o",        "--output",
-                                               "--threshold"};
+  const std::vector<std::string> with_value = {"--images", "--session",   "--time",
+                                               "--config", "--set",       "-o",
+                                               "--output", "--threshold", "--frames"};
   for (int i = 1; i < argc; ++i) {
     std::string arg = argv[i], value;
     const std::size_t eq = arg.find('=');
@@ -93,6 +126,7 @@ std::string Parse(int argc, const char* const* argv, Arguments& a) {
       else if (arg == "--config") a.config = value;
       else if (arg == "--set") a.sets.push_back(value);
       else if (arg == "--threshold") a.threshold = value;
+      else if (arg == "--frames") a.frames = value;
       else a.output = value;
     } else if (arg == "--json") {
       a.json = true;
@@ -106,10 +140,10 @@ std::string Parse(int argc, const char* const* argv, Arguments& a) {
       a.positional.push_back(arg);
     }
   }
-  const std::vector<std::string> commands = {"add", "info", "merge", "query"};
-  if (a.command.empty()) return "a command is needed: add, info, merge or query";
+  const std::vector<std::string> commands = {"add", "tune", "info", "merge", "query"};
+  if (a.command.empty()) return "a command is needed: add, tune, info, merge or query";
   if (std::find(commands.begin(), commands.end(), a.command) == commands.end())
-    return "unknown command " + Quoted(a.command) + "; expected add, info, merge or query";
+    return "unknown command " + Quoted(a.command) + "; expected add, tune, info, merge or query";
   const std::size_t maps = a.command == "merge" ? 2 : 1;
   if (a.positional.size() != maps)
     return a.command + " takes " + (maps == 1 ? "one map" : "two maps (A B)") + ", got " +
@@ -119,14 +153,100 @@ std::string Parse(int argc, const char* const* argv, Arguments& a) {
   if (a.command == "add" && a.sessions.size() != 1)
     return "add needs one --session NAME (the new session's name)";
   if (a.command == "merge" && a.output.empty()) return "merge needs -o C (the merged map)";
+  if (a.command == "tune" && a.sessions.size() != 0 && a.sessions.size() != 2)
+    return "tune takes two --session (the reference, then the query) or none (the first two)";
+  // Options that only one command reads are refused elsewhere rather than ignored.
+  const auto only = [&](bool given, const char* option, std::vector<std::string> takers) {
+    if (given && std::find(takers.begin(), takers.end(), a.command) == takers.end())
+      return std::string(option) + " is not an option of " + a.command;
+    return std::string();
+  };
+  for (const std::string& problem :
+       {only(!a.images.empty(), "--images", {"add", "query"}),
+        only(!a.time.empty(), "--time", {"add"}),
+        only(!a.frames.empty(), "--frames", {"tune"}),
+        only(!a.threshold.empty(), "--threshold", {"tune", "query"}),
+        only(!a.config.empty() || !a.sets.empty(), "--config/--set", {"add", "tune", "query"}),
+        only(!a.output.empty() && a.command != "merge", "--output", {"query"}),
+        only(!a.sessions.empty(), "--session", {"add", "tune", "query"})})
+    if (!problem.empty()) return problem;
   return "";
 }
 
-// The options a Config.txt and --set give (description, index, sequences and score).
-OnlineOptions OptionsOfConfig(const Arguments& a, bool* given) {
-  *given = !a.config.empty() || !a.sets.empty();
+// The configuration of --config and --set: the defaults, the file, then each --set.
+Config ConfigOf(const Arguments& a) {
   Config c = a.config.empty() ? Config() : LoadConfig(a.config);
   for (const std::string& s : a.sets) ApplyOverride(c, s, "--set");
+  return c;
+}
+
+// The keys of the search (the settings Tune chooses and a query may set otherwise).
+const std::vector<std::string>& SearchKeys() {
+  static const std::vector<std::string> keys = {
+      "Image_descriptor", "Fusion_weights", "Image_sequences", "Contrast_enhancement",
+      "Contrast_window", "Match_score", "Match_score_window", "Match_threshold",
+      "Match_consistency"};
+  return keys;
+}
+
+// The search keys the command line sets: all with --config, else those of --set.
+std::vector<std::string> SearchKeysGiven(const Arguments& a) {
+  if (!a.config.empty()) return SearchKeys();
+  std::vector<std::string> out;
+  for (const std::string& assignment : a.sets) {
+    const std::string key = Lower(Trim(assignment.substr(0, assignment.find('='))));
+    for (const std::string& k : SearchKeys())
+      if (Lower(k) == key) out.push_back(k);
+  }
+  return out;
+}
+
+// The value of search key `key` of `c` onto `o`.
+void SetSearchKey(const Config& c, const std::string& key, OnlineOptions& o) {
+  const MatchingOptions& m = c.matching;
+  if (key == "Image_descriptor") {
+    o.descriptor.name = c.descriptor.name;
+    if (o.fusion_weights.size() != DescriptorList(o.descriptor.name).size())
+      o.fusion_weights.clear();
+  } else if (key == "Fusion_weights") {
+    const int names = static_cast<int>(DescriptorList(o.descriptor.name).size());
+    o.fusion_weights = m.fusion_weights.empty() || names < 2 ? std::vector<double>{}
+                                                            : m.FusionWeights(names);
+  } else if (key == "Image_sequences") {
+    o.sequence_length = m.sequence_length;
+  } else if (key == "Contrast_enhancement") {
+    o.contrast_enhancement = m.contrast_enhancement;
+  } else if (key == "Contrast_window") {
+    o.contrast_window = m.contrast_window;
+  } else if (key == "Match_score") {
+    o.score = m.score;
+  } else if (key == "Match_score_window") {
+    o.score_window = m.score_window;
+  } else if (key == "Match_threshold") {
+    o.threshold = m.match_threshold;  // -1: the score's default
+  } else if (key == "Match_consistency") {
+    o.consistency = m.match_consistency;
+  }
+}
+
+// --threshold X onto `o`.
+void SetThreshold(const Arguments& a, OnlineOptions& o) {
+  if (a.threshold.empty()) return;
+  std::size_t used = 0;
+  double t = -1;
+  try {
+    t = std::stod(a.threshold, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != a.threshold.size() || !std::isfinite(t) || t < 0)
+    throw InputError("--threshold " + Quoted(a.threshold) + ": expected a number >= 0");
+  o.threshold = t;
+}
+
+// The options of a new map from a Config.txt and --set: description, index and search. With
+// Auto 1 (the auto preset) the map keeps the rows of every descriptor of its candidates.
+OnlineOptions OptionsOfConfig(const Config& c) {
   OnlineOptions o;
   o.descriptor = c.descriptor;
   o.description = c.description.type;
@@ -134,23 +254,21 @@ OnlineOptions OptionsOfConfig(const Arguments& a, bool* given) {
     o.grid_x = c.description.grid_x;
     o.grid_y = c.description.grid_y;
   }
-  o.sequence_length = c.matching.sequence_length;
+  for (const std::string& key : SearchKeys()) SetSearchKey(c, key, o);
   o.exclusion = c.evaluation.protocol.exclusion;
-  o.score = c.matching.score;
-  o.score_window = c.matching.score_window;
   o.approximate = c.scale.approximate;
   o.approximate.k = std::max(o.approximate.k, o.candidates);
-  if (!a.threshold.empty()) {
-    std::size_t used = 0;
-    double t = -1;
-    try {
-      t = std::stod(a.threshold, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != a.threshold.size() || !std::isfinite(t) || t < 0)
-      throw InputError("--threshold " + Quoted(a.threshold) + ": expected a number >= 0");
-    o.threshold = t;
+  if (c.automatic.enabled) {
+    std::vector<std::string> kept;
+    for (const AutoSettings& candidate : ParseAutoCandidates(c.automatic.candidates))
+      for (const auto& [key, value] : candidate)
+        if (key == "Image_descriptor")
+          for (const std::string& name : DescriptorList(value))
+            if (std::find(kept.begin(), kept.end(), Upper(name)) == kept.end())
+              kept.push_back(Upper(name));
+    std::string text;
+    for (const std::string& name : kept) text += (text.empty() ? "" : "+") + name;
+    o.kept_descriptors = text;
   }
   return o;
 }
@@ -186,6 +304,12 @@ void ForImagesOf(const std::string& folder, bool quiet, const char* what, Body b
   progress.End();
 }
 
+std::string JoinedChannels(const OnlineDetector& d) {
+  std::string out;
+  for (const std::string& c : d.Channels()) out += (out.empty() ? "" : "+") + c;
+  return out;
+}
+
 std::string FileName(const std::string& path) {
   return std::filesystem::path(path).filename().string();
 }
@@ -204,24 +328,53 @@ void RequireNoFeatures(const std::string& path) {
                      "verification on)");
 }
 
-// A detector holding the map at `path`, with its own settings and `base`'s others.
+// A detector holding the map at `path` with its own settings (its tuned search when tuned) and
+// `base`'s others.
 std::unique_ptr<OnlineDetector> Open(const std::string& path, const OnlineOptions& base) {
   auto d = std::make_unique<OnlineDetector>(MapOptions(path, base));
   d->LoadMap(path);
   return d;
 }
 
-// The description settings of `o` that a map must share, as "key value" lines.
+// The description settings of `o` that a map must share, as one line.
 std::string DescriptionOf(const OnlineOptions& o) {
-  return o.descriptor.name + " " + std::to_string(o.descriptor.patch_size) + " " +
+  std::vector<std::string> names;
+  for (const std::string& n : DescriptorList(o.descriptor.name)) names.push_back(Upper(n));
+  if (!o.kept_descriptors.empty())
+    for (const std::string& n : DescriptorList(o.kept_descriptors))
+      if (std::find(names.begin(), names.end(), Upper(n)) == names.end())
+        names.push_back(Upper(n));
+  std::sort(names.begin(), names.end());
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : "+") + n;
+  return list + " " + std::to_string(o.descriptor.patch_size) + " " +
          std::to_string(o.descriptor.ldb_bits) + " " + EnumName(o.description) + " " +
          std::to_string(o.grid_x) + "x" + std::to_string(o.grid_y);
 }
 
+// The search settings as a person reads them.
+std::string SearchText(const OnlineOptions& o) {
+  std::string text = o.descriptor.name;
+  if (!o.fusion_weights.empty()) {
+    text += " (weights";
+    for (const double w : o.fusion_weights) text += " " + FormatNumber(w);
+    text += ")";
+  }
+  if (o.contrast_enhancement)
+    text += ", contrast enhancement +-" + std::to_string(o.contrast_window);
+  text += ", L = " + std::to_string(o.sequence_length) + ", " + EnumName(o.score) + " score";
+  if (o.score == MatchScore::kRatio) text += " (window +-" + std::to_string(o.score_window) + ")";
+  text += " <= " + FormatNumber(o.Threshold());
+  if (o.consistency > 0)
+    text += ", confirmed by " + std::to_string(o.consistency) + " earlier independent quer" +
+            (o.consistency == 1 ? "y" : "ies");
+  return text;
+}
+
 int Add(const Arguments& a) {
   const std::string& path = a.positional[0];
-  bool configured = false;
-  const OnlineOptions wanted = OptionsOfConfig(a, &configured);
+  const bool configured = !a.config.empty() || !a.sets.empty();
+  const OnlineOptions wanted = OptionsOfConfig(ConfigOf(a));
   std::unique_ptr<OnlineDetector> d;
   const bool exists = std::filesystem::exists(path);
   if (exists) {
@@ -230,7 +383,7 @@ int Add(const Arguments& a) {
     const OnlineOptions& have = d->Options();
     if (configured && DescriptionOf(have) != DescriptionOf(wanted))
       throw InputError(path + ": the map describes frames with " + DescriptionOf(have) +
-                       " (descriptor, patch, LDB bits, description, grid); --config/--set ask "
+                       " (descriptors, patch, LDB bits, description, grid); --config/--set ask "
                        "for " + DescriptionOf(wanted) + " (expected the map's own settings)");
   } else {
     d = std::make_unique<OnlineDetector>(wanted);
@@ -242,12 +395,51 @@ int Add(const Arguments& a) {
     d->AddImagesToMap(images, names);
   });
   d->SaveMap(path);
-  if (!a.quiet)
+  if (!a.quiet) {
     std::cout << (exists ? "Appended" : "Created") << " session " << Quoted(a.sessions[0])
               << ": " << d->Size() - before << " frames; " << path << " holds "
               << d->Size() << " frames in " << d->Sessions().size() << " session"
-              << (d->Sessions().size() == 1 ? "" : "s") << ".\n";
+              << (d->Sessions().size() == 1 ? "" : "s") << " (descriptors "
+              << JoinedChannels(*d) << ").\n";
+    if (d->Sessions().size() >= 2 && !d->Tuning().tuned)
+      std::cout << "Next: openable_map tune " << path
+                << " chooses the search settings from its first two sessions.\n";
+  }
   return 0;
+}
+
+// The candidates of a tuned map, ranked, as JSON (AutoJson's list).
+Json TunedCandidates(const MapTuning& t) {
+  if (t.candidates_json.empty()) return Json::array();
+  return Json::parse(t.candidates_json);
+}
+
+Json TuningJson(const MapTuning& t) {
+  if (!t.tuned) return Json();
+  return {{"verdict", t.reliable ? "reliable" : "unreliable"},
+          {"reference", t.reference},
+          {"query", t.query},
+          {"time", t.time},
+          {"chosen", t.chosen},
+          {"search", SearchText(t.search)},
+          {"consistency", json::Number(t.consistency)},
+          {"distinctiveness", json::Number(t.distinctiveness)},
+          {"agreement", json::Number(t.agreement)},
+          {"min_consistency", json::Number(t.min_consistency)},
+          {"candidates", TunedCandidates(t)}};
+}
+
+// The lines a person reads of a map's tuning.
+std::string TuningText(const MapTuning& t) {
+  if (!t.tuned) return "";
+  std::ostringstream o;
+  o << "Tuned " << t.time << " on session " << Quoted(t.query) << " against " << Quoted(t.reference)
+    << ": " << t.chosen << "\n  search: " << SearchText(t.search) << "\n  "
+    << (t.reliable ? "reliable: " : "UNRELIABLE (accepts nothing): ")
+    << FormatFixed(100.0 * t.consistency, 1)
+    << " % of its best matches agree with an independent query's (Auto_min_consistency "
+    << FormatNumber(t.min_consistency) << ")\n";
+  return o.str();
 }
 
 int Info(const Arguments& a) {
@@ -255,10 +447,13 @@ int Info(const Arguments& a) {
   MapReadOptions read;
   read.check_in_background = false;  // info says the checksums match
   const MapFile map = ReadMapFile(path, read);
+  std::unique_ptr<OnlineDetector> d = Open(path, OnlineOptions());
+  const MapTuning& tuning = d->Tuning();
   std::uintmax_t bytes = std::filesystem::file_size(path);
   if (a.json) {
     Json settings = Json::object();
-    for (const auto& [k, v] : map.settings) settings[k] = v;
+    for (const auto& [k, v] : map.settings)
+      if (k != "tuned_candidates") settings[k] = v;
     Json sessions = Json::array();
     for (const MapSession& s : map.sessions)
       sessions.push_back({{"name", s.name}, {"time", s.time}, {"first", s.first},
@@ -268,13 +463,15 @@ int Info(const Arguments& a) {
       blocks.push_back({{"first", b.first}, {"frames", b.count},
                         {"bytes", b.Bytes().size}});
     std::cout << json::Dump({{"map", path},
-                                       {"format_version", map.version},
-                                       {"frames", map.rows.rows},
-                                       {"bytes", bytes},
-                                       {"checksums", "ok"},
-                                       {"settings", settings},
-                                       {"sessions", sessions},
-                                       {"blocks", blocks}});
+                             {"format_version", map.version},
+                             {"frames", map.rows.rows},
+                             {"bytes", bytes},
+                             {"checksums", "ok"},
+                             {"descriptors", json::Strings(d->Channels())},
+                             {"settings", settings},
+                             {"sessions", sessions},
+                             {"tuning", TuningJson(tuning)},
+                             {"blocks", blocks}});
     return 0;
   }
   std::cout << path << ": OpenABLE map, format version " << map.version << ", " << map.rows.rows
@@ -282,12 +479,15 @@ int Info(const Arguments& a) {
             << cv::format("%.1f", map.rows.rows > 0 ? static_cast<double>(bytes) / map.rows.rows
                                                      : 0.0)
             << " a frame); checksums match\n";
-  std::cout << "Description: " << map.Setting("descriptor") << ", patch "
-            << map.Setting("patch_size") << ", " << map.Setting("ldb_bits") << " LDB bits, "
-            << map.Setting("description") << " (grid " << map.Setting("grid_x") << "x"
-            << map.Setting("grid_y") << "); frames "
+  std::cout << "Descriptors: " << JoinedChannels(*d) << ", patch " << map.Setting("patch_size")
+            << ", " << map.Setting("ldb_bits") << " LDB bits, " << map.Setting("description")
+            << " (grid " << map.Setting("grid_x") << "x" << map.Setting("grid_y") << "); frames "
             << (map.Setting("frame_size").empty() ? "of unknown size" : map.Setting("frame_size"))
             << "\n";
+  std::cout << "Search: " << SearchText(d->Options())
+            << (tuning.tuned ? "" : " (not tuned: openable_map tune chooses it from the data)")
+            << "\n";
+  std::cout << TuningText(tuning);
   std::cout << "Index: " << map.Setting("engine") << ", exact up to "
             << map.Setting("exact_limit") << " frames, blocks of " << map.Setting("block_frames")
             << " x 2^m frames (" << map.blocks.size() << " block"
@@ -312,71 +512,331 @@ int Merge(const Arguments& a) {
   return 0;
 }
 
+int Tune(const Arguments& a) {
+  const std::string& path = a.positional[0];
+  RequireNoFeatures(path);
+  const Config c = ConfigOf(a);
+  std::unique_ptr<OnlineDetector> d = Open(path, OnlineOptions());
+  OnlineDetector::TuneOptions t;
+  if (a.sessions.size() == 2) {
+    t.reference = a.sessions[0];
+    t.query = a.sessions[1];
+  }
+  // Auto_candidates when the command line sets it; else the defaults the map's rows allow.
+  if (c.automatic.candidates != AutoOptions::kDefaultCandidates)
+    t.candidates = c.automatic.candidates;
+  t.min_consistency = c.automatic.min_consistency;
+  OnlineOptions threshold;
+  SetThreshold(a, threshold);
+  t.threshold = threshold.threshold;
+  if (!a.frames.empty()) {
+    std::size_t used = 0;
+    long long n = -1;
+    try {
+      n = std::stoll(a.frames, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != a.frames.size() || n < 1 || n > 100000000)
+      throw InputError("--frames " + Quoted(a.frames) + ": expected a whole number >= 1 (the "
+                       "first frames of each session to judge on)");
+    t.max_frames = static_cast<int>(n);
+  }
+  const bool log = !a.quiet && !a.json;
+  const MapTuning tuning = d->Tune(t, [&](const std::string& line) {
+    if (log) std::cerr << line << "\n";
+  });
+  d->SaveMap(path);
+  if (a.json) {
+    std::cout << json::Dump({{"map", path}, {"tuning", TuningJson(tuning)}});
+    return 0;
+  }
+  if (a.quiet) return 0;
+  std::cout << "    rank  consistency  distinctiveness  agreement  settings\n";
+  Json ranked = TunedCandidates(tuning);
+  std::vector<Json> rows(ranked.begin(), ranked.end());
+  std::stable_sort(rows.begin(), rows.end(), [](const Json& x, const Json& y) {
+    return x["rank"].get<int>() < y["rank"].get<int>();
+  });
+  for (const Json& r : rows) {
+    char line[96];
+    std::snprintf(line, sizeof line, "    %4d  %11.3f  %15.3f  %9.3f  ", r["rank"].get<int>(),
+                  r["consistency"].get<double>(), r["distinctiveness"].get<double>(),
+                  r["agreement"].get<double>());
+    const std::string settings = r["settings"].get<std::string>();
+    std::cout << line << settings << (settings == tuning.chosen ? "  <- chosen" : "") << "\n";
+  }
+  std::cout << TuningText(tuning) << "Saved in " << path << ".\n";
+  return 0;
+}
+
+// One query's best match as the outputs give it.
+struct QueryRow {
+  std::string query;  // file name
+  const LoopCandidate* best = nullptr;
+};
+
+Json QueryJson(const QueryRow& row, const std::vector<MapSession>& sessions) {
+  Json q = {{"query", row.query}};
+  const LoopCandidate* c = row.best;
+  q["session"] = c ? Json(sessions[static_cast<std::size_t>(c->session)].name) : Json();
+  q["frame"] = c ? Json(c->session_frame) : Json();
+  q["map_frame"] = c ? Json(c->frame) : Json();
+  q["score"] = c ? json::Number(c->score) : Json();
+  q["distance"] = c ? json::Number(c->distance) : Json();
+  q["accepted"] = c != nullptr && c->accepted;
+  q["confirmed"] = c != nullptr && c->confirmed;
+  return q;
+}
+
+// A CSV field: quoted when it holds a comma, a quote or a line break (RFC 4180).
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (const char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+std::string EncodeQueryCsv(const Json& queries) {
+  std::string csv = "query,session,frame,map_frame,distance,score,accepted,confirmed\n";
+  for (const Json& q : queries) {
+    const auto field = [&](const char* key) {
+      const Json& v = q[key];
+      if (v.is_null()) return std::string();
+      if (v.is_string()) return CsvField(v.get<std::string>());
+      if (v.is_boolean()) return std::string(v.get<bool>() ? "1" : "0");
+      if (v.is_number_integer()) return std::to_string(v.get<long long>());
+      return CsvNumber(v.get<double>());
+    };
+    csv += field("query") + "," + field("session") + "," + field("frame") + "," +
+           field("map_frame") + "," + field("distance") + "," + field("score") + "," +
+           field("accepted") + "," + field("confirmed") + "\n";
+  }
+  return csv;
+}
+
+// Frames for the page: rows are the query images, columns the map frames searched, read from
+// the files the map names (a frame whose file is gone is shown grey and named so).
+ReportFrames QueryFrames(const std::vector<std::string>& names, const OnlineDetector& d,
+                         const std::vector<int>& columns) {
+  ReportFrames frames;
+  const std::vector<std::string>& files = d.FrameFiles();
+  if (files.empty()) {
+    frames.missing = "the map keeps no image file of its frames (a map saved before format 3, "
+                     "or frames added without names)";
+    return frames;
+  }
+  const auto file = [&names, &files, columns](bool row, int index) {
+    return row ? names[static_cast<std::size_t>(index)]
+               : files[static_cast<std::size_t>(columns[static_cast<std::size_t>(index)])];
+  };
+  frames.read = [file](bool row, int index) {
+    try {
+      const std::string path = file(row, index);
+      if (!path.empty()) return ReadImageFile(path);
+    } catch (const InputError&) {
+    }
+    return cv::Mat(cv::Mat1b(48, 64, static_cast<unsigned char>(128)));
+  };
+  frames.name = [file](bool row, int index) {
+    const std::string path = file(row, index);
+    if (path.empty()) return std::string(row ? "query " : "map frame ") + std::to_string(index);
+    std::error_code error;
+    const bool there = std::filesystem::exists(path, error);
+    return FileName(path) + (there ? "" : " (file not found)");
+  };
+  return frames;
+}
+
+// PREFIX.csv, PREFIX.json and PREFIX.html of a query, with ground truth the evaluation's files
+// too, all or nothing. Returns the paths written.
+std::vector<std::string> WriteQueryOutputs(const std::string& prefix, const Config& config,
+                                           const OnlineDetector& d,
+                                           const std::vector<std::string>& names,
+                                           const std::vector<OnlineResult>& results,
+                                           const OnlineDetector::QueryMatrix& matrix,
+                                           const Json& document, const Arguments& a) {
+  CheckOutputPrefix("--output", prefix);
+  OutputBatch batch;
+  batch.Stage("--output", prefix + ".csv", EncodeQueryCsv(document["queries"]));
+  batch.Stage("--output", prefix + ".json", json::Dump(document));
+  const OnlineOptions& o = d.Options();
+  // The block searched, normalised by its largest value (Eq. 5) as a run's matrix.
+  cv::Mat1f block;
+  if (!matrix.sums.empty()) {
+    block = matrix.sums.clone();
+    double largest = 0;
+    for (int i = 0; i < block.rows; ++i)
+      for (int j = 0; j < block.cols; ++j)
+        if (std::isfinite(block(i, j))) largest = std::max<double>(largest, block(i, j));
+    if (largest > 0) block /= largest;
+  }
+  const EvaluationLayout layout = EvaluationLayout::QueryReference(block.rows, block.cols);
+  const std::string label = "map " + o.descriptor.name + " L=" + std::to_string(o.sequence_length);
+  ReportInput report;
+  report.program = "openable_map query";
+  report.title = "OpenABLE map query: " + FileName(a.images) + " against " +
+                 FileName(a.positional[0]);
+  report.settings = {{"map", a.positional[0]},
+                     {"queries", a.images},
+                     {"sessions searched", a.sessions.empty() ? "all" : json::Strings(a.sessions).dump()},
+                     {"search", SearchText(o)},
+                     {"tuned", d.Tuning().tuned ? (d.UsesTuning() ? "yes, used" : "yes, replaced")
+                                                : "no"}};
+  report.examples = config.evaluation.report_examples;
+  Evaluation evaluation;
+  if (EvaluationRequested(config)) {
+    if (a.sessions.size() != 1)
+      throw InputError("Ground_truth_type " + Quoted(GroundTruthTypeName(config.evaluation.truth.type)) +
+                       " with " + (a.sessions.empty() ? "every session" : "several sessions") +
+                       " searched: expected one --session NAME, the reference traversal the "
+                       "ground truth is of");
+    if (block.empty())
+      throw InputError("Ground_truth_type: the query used the map's index (the session holds "
+                       "more than exact_limit frames), so there is no matrix to evaluate; "
+                       "expected a session of at most " + std::to_string(o.exact_limit) +
+                       " frames");
+    Config c = config;
+    c.matching.score = o.score;
+    c.matching.score_window = o.score_window;
+    c.matching.match_threshold = o.Threshold();
+    c.matching.match_consistency = 0;
+    evaluation.settings = EvaluationSettingsFrom(c);
+    EvaluateMatrix(evaluation, block, layout, label, a.positional[0]);
+    // The operating point is the map's own: its accepted answers (consistency online).
+    PerQueryResult& p = evaluation.runs.front().per_query;
+    const GroundTruth& truth = evaluation.truths.front();
+    p.accepted.assign(static_cast<std::size_t>(block.rows), 0);
+    CurvePoint& op = p.operating_point;
+    op.tp = op.fp = 0;
+    for (int q = 0; q < block.rows; ++q) {
+      const LoopCandidate* c0 = results[static_cast<std::size_t>(q)].candidates.empty()
+                                    ? nullptr
+                                    : &results[static_cast<std::size_t>(q)].candidates[0];
+      if (c0 == nullptr || !c0->accepted) continue;
+      p.accepted[static_cast<std::size_t>(q)] = 1;
+      const int column = c0->session_frame;
+      bool right = false;
+      for (const int t : truth.matches.at(static_cast<std::size_t>(q)))
+        right = right || std::abs(t - column) <= evaluation.settings.options.tolerance;
+      ++(right ? op.tp : op.fp);
+    }
+    op.precision = op.tp + op.fp > 0 ? static_cast<double>(op.tp) / (op.tp + op.fp) : 1.0;
+    op.recall = p.positive_queries > 0 ? static_cast<double>(op.tp) / p.positive_queries : 0.0;
+    op.f1 = op.precision + op.recall > 0 ? 2 * op.precision * op.recall / (op.precision + op.recall)
+                                         : 0.0;
+    p.has_operating_point = true;
+    StageEvaluation(batch, "--output", prefix + "_eval", evaluation, {&block});
+    report.evaluation = &evaluation;
+  }
+  if (!block.empty()) {
+    report.matrices = {&block};
+    report.frames = QueryFrames(names, d, matrix.frames);
+    if (report.evaluation != nullptr)
+      batch.Stage("--output", prefix + ".html", EncodeHtmlReport(report));
+  }
+  const std::vector<std::string> paths = batch.Paths();
+  batch.Commit();
+  if (report.evaluation != nullptr)
+    std::cerr << FormatEvaluationTable(evaluation.settings, evaluation.runs);
+  return paths;
+}
+
 int Query(const Arguments& a) {
   const std::string& path = a.positional[0];
-  bool configured = false;
-  const OnlineOptions base = OptionsOfConfig(a, &configured);
-  std::unique_ptr<OnlineDetector> d = Open(path, base);
+  const Config config = ConfigOf(a);
+  OnlineOptions options = MapOptions(path, OptionsOfConfig(config));
+  // The map's search (tuned, or the one it was made with) unless the command line sets it.
+  for (const std::string& key : SearchKeysGiven(a)) SetSearchKey(config, key, options);
+  SetThreshold(a, options);
+  if (a.json && !a.output.empty())
+    throw InputError("--json and --output: expected one of them (--output writes " + a.output +
+                     ".json)");
+  std::unique_ptr<OnlineDetector> d = std::make_unique<OnlineDetector>(options);
+  d->LoadMap(path);
+  const bool quiet = a.quiet || a.json;
+  const MapTuning& tuning = d->Tuning();
+  if (!quiet) {
+    std::cerr << "search: " << SearchText(d->Options()) << "\n";
+    if (!tuning.tuned)
+      std::cerr << "note: the map's settings were not chosen from the data (openable_map tune "
+                << path << " chooses them from two of its sessions)\n";
+    else if (!d->UsesTuning())
+      std::cerr << "note: --config/--set/--threshold replace the map's tuned settings ("
+                << tuning.chosen << "); its verdict does not apply to them\n";
+    else if (!tuning.reliable)
+      std::cerr << "UNRELIABLE: the map's tuned settings could not be trusted (consistency "
+                << FormatFixed(tuning.consistency, 3) << " below " << FormatNumber(tuning.min_consistency)
+                << "): no match is accepted\n";
+  }
   std::vector<cv::Mat> rows;
   std::vector<std::string> names;
-  ForImagesOf(a.images, a.quiet || a.json, "describing queries",
+  ForImagesOf(a.images, quiet, "describing queries",
               [&](const std::vector<cv::Mat>& images, const std::vector<std::string>& chunk) {
                 rows.push_back(d->DescribeFrames(images, chunk));
                 names.insert(names.end(), chunk.begin(), chunk.end());
               });
   cv::Mat all;
   cv::vconcat(rows, all);
-  const std::vector<OnlineResult> results = d->Query(all, a.sessions);
+  ProgressReporter progress(std::cerr, !quiet, isatty(STDERR_FILENO) != 0);
+  progress.Begin("matching queries", all.rows, "frames");
+  OnlineDetector::QueryMatrix out;
+  const std::vector<OnlineResult> results =
+      d->Query(all, a.sessions, [&](int done, int) { progress.Update(done); },
+               a.output.empty() ? nullptr : &out);
+  progress.End();
   // Nothing is printed from a map whose checksums do not match.
   d->CheckMap();
   const auto& sessions = d->Sessions();
+  std::vector<QueryRow> table;
+  for (std::size_t i = 0; i < results.size(); ++i)
+    table.push_back({FileName(names[i]),
+                     results[i].candidates.empty() ? nullptr : &results[i].candidates[0]});
+  Json queries = Json::array();
+  for (const QueryRow& row : table) queries.push_back(QueryJson(row, sessions));
+  const Json document = {{"map", path},
+                         {"sessions", json::Strings(a.sessions)},
+                         {"search", SearchText(d->Options())},
+                         {"threshold", json::Number(d->Options().Threshold())},
+                         {"consistency", d->Options().consistency},
+                         {"tuning", TuningJson(tuning)},
+                         {"uses_tuning", d->UsesTuning()},
+                         {"queries", queries}};
   if (a.json) {
-    Json queries = Json::array();
-    for (std::size_t i = 0; i < results.size(); ++i) {
-      Json q = {{"query", FileName(names[i])}};
-      if (results[i].candidates.empty()) {
-        q["session"] = nullptr;
-        q["frame"] = nullptr;
-        q["map_frame"] = nullptr;
-        q["score"] = nullptr;
-        q["distance"] = nullptr;
-        q["accepted"] = false;
-      } else {
-        const LoopCandidate& c = results[i].candidates[0];
-        q["session"] = sessions[static_cast<std::size_t>(c.session)].name;
-        q["frame"] = c.session_frame;
-        q["map_frame"] = c.frame;
-        q["score"] = json::Number(c.score);
-        q["distance"] = json::Number(c.distance);
-        q["accepted"] = c.accepted;
-      }
-      queries.push_back(std::move(q));
-    }
-    std::cout << json::Dump({{"map", path},
-                                       {"sessions", json::Strings(a.sessions)},
-                                       {"threshold", json::Number(d->Options().threshold)},
-                                       {"queries", queries}});
+    std::cout << json::Dump(document);
     return 0;
   }
-  int accepted = 0;
+  int accepted = 0, answered = 0;
+  for (const QueryRow& row : table) {
+    answered += row.best != nullptr;
+    accepted += row.best != nullptr && row.best->accepted;
+  }
+  if (!a.output.empty()) {
+    const std::vector<std::string> written =
+        WriteQueryOutputs(a.output, config, *d, names, results, out, document, a);
+    if (!a.quiet) {
+      std::cout << accepted << " of " << answered << " best matches accepted ("
+                << SearchText(d->Options()) << ").\nWrote:\n";
+      for (const std::string& w : written) std::cout << "  " << w << "\n";
+    }
+    return 0;
+  }
   std::cout << "query  session  frame  score  accepted\n";
-  for (std::size_t i = 0; i < results.size(); ++i) {
-    std::cout << ToValidUtf8(FileName(names[i])) << "  ";
-    if (results[i].candidates.empty()) {
+  for (const QueryRow& row : table) {
+    std::cout << ToValidUtf8(row.query) << "  ";
+    if (row.best == nullptr) {
       std::cout << "-  -  -  no\n";
       continue;
     }
-    const LoopCandidate& c = results[i].candidates[0];
-    accepted += c.accepted;
+    const LoopCandidate& c = *row.best;
     std::cout << ToValidUtf8(sessions[static_cast<std::size_t>(c.session)].name) << "  "
               << c.session_frame << "  " << cv::format("%.4f", c.score) << "  "
               << (c.accepted ? "yes" : "no") << "\n";
   }
-  std::cout << accepted << " of " << results.size() << " queries accepted (score <= "
-            << d->Options().threshold << ").\n";
+  std::cout << accepted << " of " << answered << " best matches accepted ("
+            << SearchText(d->Options()) << ").\n";
   return 0;
 }
-
 }  // namespace
 
 const char* const kMapUsage = kUsageText;
@@ -387,6 +847,7 @@ std::string ParseMapCommandLine(int argc, const char* const* argv, MapCommandLin
 
 int RunMapCommand(const MapCommandLine& a) {
   if (a.command == "add") return Add(a);
+  if (a.command == "tune") return Tune(a);
   if (a.command == "info") return Info(a);
   if (a.command == "merge") return Merge(a);
   return Query(a);

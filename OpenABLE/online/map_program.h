@@ -10,9 +10,9 @@ namespace openable {
 
 // The command line of openable_map.
 struct MapCommandLine {
-  std::string command;                  // add, info, merge, query
+  std::string command;                  // add, tune, info, merge, query
   std::vector<std::string> positional;  // the map(s)
-  std::string images, config, time, output, threshold;
+  std::string images, config, time, output, threshold, frames;
   std::vector<std::string> sessions, sets;
   bool json = false, quiet = false;
 };

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -38,16 +39,30 @@ namespace openable {
 struct OnlineOptions {
   // Description: the descriptor and its settings, the struct of a run's keys Image_descriptor,
   // Patch_size, Ldb_bits and Sad_patch (descriptors/descriptor.h: name "LDB", patch 64, 256
-  // bits; sad_patch for SAD, DescribeImages only), and how a frame is cut (Description_type,
-  // Grid_x, Grid_y).
+  // bits), and how a frame is cut (Description_type, Grid_x, Grid_y). A fusion of several
+  // ("HOG+LDB") describes every frame with each and sums their single-frame distances, each
+  // divided by its unit (see below) and weighted by fusion_weights, as a run does.
   DescriptorOptions descriptor;
   DescriptionType description = DescriptionType::kGlobal;
   int grid_x = 1, grid_y = 1;
+  // Descriptors whose rows the map keeps besides those of `descriptor` ("HOG+SIFT+LDB+SAD";
+  // empty: none), so that the description can later be chosen from the data among them
+  // (OnlineDetector::Tune, openable_map tune): every frame is described with each. The map's
+  // descriptors ("channels") are those of `descriptor`, then these.
+  std::string kept_descriptors;
+  // Fusion_weights: one weight per name of `descriptor`, > 0; empty: equal weights.
+  std::vector<double> fusion_weights;
   // Matching.
   // L (the key Image_sequences): frames summed along the diagonal. A candidate among the first
   // L - 1 frames has fewer terms, scaled up to L (Sequence_partial scale): the frames after a
   // query, which a batch run's default (ahead) reads, are not known yet.
   int sequence_length = 1;
+  // SeqSLAM's local contrast enhancement of each query's single-frame distances over
+  // +-contrast_window frames of a session (matching/contrast.h; the keys Contrast_enhancement
+  // and Contrast_window). It needs every distance of the query's row, so a map searched with
+  // it is scanned exactly at any size (the index is not used).
+  bool contrast_enhancement = false;
+  int contrast_window = 10;  // >= 1
   int exclusion = 100;      // frame q's candidates are frames j <= q - exclusion (>= 1)
   int candidates = 5;       // candidates returned per frame (the k best), >= 1
   // The confidence of a candidate (matching/score.h, the key Match_score): its normalised
@@ -56,16 +71,23 @@ struct OnlineOptions {
   // frame while exact, the approximate candidates beyond).
   MatchScore score = MatchScore::kDistance;
   int score_window = 10;  // >= 0
-  // A candidate is accepted when its score is <= threshold (see LoopCandidate). Default, for
-  // the distance score: on KITTI 00 frames 0-1699 with LDB 256 bits, every top-1 candidate up
-  // to 0.137 (L = 1) and 0.17 (L = 5, 10) is a true loop (bench/bench_online.cc,
-  // docs/library.md). With the ratio score choose it anew (docs/library.md gives figures).
-  double threshold = 0.13;
+  // A candidate is accepted when its score is <= this threshold (see LoopCandidate); negative:
+  // the default of the score, DefaultThreshold(score). Threshold() gives the one in use.
+  double threshold = -1;
+  // n (the key Match_consistency): an accepted candidate also needs the best candidates of n
+  // earlier, independent queries of the same traversal to agree with it along its diagonal
+  // (matching/agreement.h: each partner at least max(L, 10) frames back, sharing no frame of
+  // its sequence, its best candidate the same number of frames back in the same session,
+  // within the tolerance). Online there is no later query to confirm with, so the first
+  // queries of a traversal (before a partner exists) are never accepted. 0: the score alone.
+  int consistency = 0;
   // Search: exact (every earlier frame) while the searchable map holds at most exact_limit
   // frames; beyond, frames are indexed by approximate.engine (an engine of
   // matching/search/engine_registry.h) in blocks of block_frames merged as they grow (sizes
   // block_frames x 2^m, at most one of each), and only the newest unindexed frames
-  // (< block_frames) are scanned exactly.
+  // (< block_frames) are scanned exactly. The index is built on the rows of the first
+  // descriptor of the map that has one (Hamming or L2; SAD's L1 has none: a map of SAD alone
+  // is scanned exactly at any size).
   int exact_limit = 20000;
   int block_frames = 4096;
   // Merges of two blocks into one are built on a background thread while the frames go on
@@ -85,8 +107,33 @@ struct OnlineOptions {
   // it is verified (the threshold is not applied). AddDescriptor and AddToMap, which give no
   // image, are refused.
   VerificationOptions verification;
+
+  // The acceptance threshold of each score when none is given: distance 0.13 (the mean
+  // fraction of differing bits of LDB 256 below which every top-1 candidate of KITTI 00 was a
+  // loop, bench/bench_online.cc), ratio 0.9 (Match_threshold of the presets, measured across
+  // datasets in docs/benchmarks.md).
+  static double DefaultThreshold(MatchScore score) {
+    return score == MatchScore::kRatio ? 0.9 : 0.13;
+  }
+  double Threshold() const { return threshold >= 0 ? threshold : DefaultThreshold(score); }
   // Throws InputError naming the field, the value and what was expected.
   void Check() const;
+};
+
+// What OnlineDetector::Tune chose for a map (openable_map tune), kept in the map: the
+// description, sequence, score and acceptance the search then uses, and the verdict.
+struct MapTuning {
+  bool tuned = false;
+  bool reliable = false;           // the choice's consistency >= min_consistency
+  std::string reference, query;    // the sessions it was judged on (reference: the columns)
+  std::string time;                // when (ISO 8601 UTC)
+  std::string chosen;              // the chosen candidate, "Key=value ..."
+  double consistency = 0, distinctiveness = 0, agreement = 0;
+  double min_consistency = 0.5;
+  std::string candidates_json;     // every candidate with its criteria (AutoJson's list)
+  OnlineOptions search;            // the options whose search settings were chosen
+  std::vector<double> units;       // the fusion's unit of each descriptor of the choice
+  double shift = 0;                // the contrast enhancement's shift of the choice
 };
 
 // One loop candidate of a frame.
@@ -104,7 +151,12 @@ struct LoopCandidate {
   // OnlineOptions::score: `normalized`, or the ratio of `distance` to the best candidate
   // outside +-score_window frames of this one (1 without one).
   double score = 0;
-  // score <= OnlineOptions::threshold; with verification: `verified`.
+  // OnlineOptions::consistency > 0: the best candidates of the n earlier independent queries
+  // agree with this one along its diagonal (see OnlineOptions::consistency).
+  bool confirmed = false;
+  // score <= OnlineOptions::Threshold() and, with consistency, `confirmed`; never on a map
+  // whose tuned settings are unreliable (MapTuning) while the search uses them; with
+  // verification: `verified`.
   bool accepted = false;
   // Verification (OnlineOptions::verification.enabled): feature matches after the ratio test,
   // inliers of the model kept, the model, whether it reached min_inliers (`geometric`), the
@@ -129,13 +181,22 @@ struct OnlineResult {
 };
 
 // Loop candidates frame by frame. Memory: the descriptor rows of every frame (row bytes x
-// frames: 32 B a frame for LDB 256 bits, 3.2 MB per 100,000 frames) plus, beyond exact_limit,
-// the approximate indices (see MemoryBytes). Latency per frame: description, plus L distances per
-// searchable frame while exact (linear in the map up to exact_limit), then one index query per
-// block (about log2(frames / block_frames) + 1 blocks; one more while a merge is built) plus
-// an exact scan of fewer than block_frames frames, plus L distances per candidate; every
-// block_frames frames one block of block_frames rows is indexed in AddFrame (milliseconds). Not
-// thread-safe for AddFrame; the const members may be called while no AddFrame runs.
+// frames: 32 B a frame for LDB 256 bits, 3.2 MB per 100,000 frames; the sum of the
+// descriptors' for a map of several) plus, beyond exact_limit, the approximate indices (see
+// MemoryBytes), plus while exact the last L single-frame distance rows of the current
+// traversal (L x 4 B a searchable frame). Latency per frame: description, plus one distance
+// per searchable frame while exact (linear in the map up to exact_limit, whatever L: the
+// sequence sums run along the diagonals as the frames come, matching/sequence.h
+// SequenceRowSums), then one index query per block (about log2(frames / block_frames) + 1
+// blocks; one more while a merge is built) plus an exact scan of fewer than block_frames
+// frames, plus L distances per candidate; every block_frames frames one block of block_frames
+// rows is indexed in AddFrame (milliseconds). Not thread-safe for AddFrame; the const members
+// may be called while no AddFrame runs.
+//
+// Rows: a map of one descriptor takes and gives its rows (CV_8U for Hamming and L1, CV_32F
+// for L2). A map of several (a fusion, or kept_descriptors) takes and gives each frame's rows
+// side by side as bytes, in the order of Channels() (CV_8U, RowWidth() bytes; a float row as
+// its 4-byte little-endian floats), as DescribeFrames makes them.
 class OnlineDetector {
  public:
   explicit OnlineDetector(const OnlineOptions& options);  // throws InputError on bad options
@@ -147,7 +208,7 @@ class OnlineDetector {
   // gives it; converted to grey as Test_OpenABLE does) and adds it. Throws InputError on an
   // empty image, another type, or an image smaller than the description needs.
   OnlineResult AddFrame(const cv::Mat& image);
-  // Adds an already computed row (1 x RowWidth(), RowType()).
+  // Adds an already computed row (1 x RowWidth(), RowType()) and searches for it.
   OnlineResult AddDescriptor(const cv::Mat& row);
   // Appends rows (n x RowWidth(), RowType()) as frames Size() .. Size() + n - 1 without
   // searching for them: a map saved from an earlier run (see Descriptors()). Later frames find
@@ -186,11 +247,27 @@ class OnlineDetector {
   // are dropped (a query may then get fewer than `candidates`). Rows spread over the cores.
   // Refused with verification (it needs each query's image). Throws InputError on rows of
   // another width or type, an unknown session name, or a damaged loaded map (CheckMap).
+  // `progress` (when set) is told the queries done and their count now and then. `matrix`
+  // (when given) receives the sequence distances of every query against every frame searched,
+  // when the search scans them exactly (QueryMatrix).
+  struct QueryMatrix {
+    // queries x frames searched: S(q, j) as the search scored it (+inf without a value); empty
+    // when the index was used or the matrix would take more than max_bytes.
+    cv::Mat1f sums;
+    std::vector<int> frames;  // the map frame of each column, in frame order
+    std::int64_t max_bytes = std::int64_t{1} << 30;
+  };
   std::vector<OnlineResult> Query(const cv::Mat& rows,
-                                  const std::vector<std::string>& sessions = {}) const;
+                                  const std::vector<std::string>& sessions = {},
+                                  const std::function<void(int, int)>& progress = {},
+                                  QueryMatrix* matrix = nullptr) const;
   // Query(DescribeFrames(images), sessions).
   std::vector<OnlineResult> QueryImages(const std::vector<cv::Mat>& images,
                                         const std::vector<std::string>& sessions = {}) const;
+
+  // The image file of each frame as AddImagesToMap was told (its `names`; "" for frames added
+  // otherwise), kept in saved maps; empty when no frame was named.
+  const std::vector<std::string>& FrameFiles() const;
 
   // "WxH" of the frames given to AddFrame (set by the first one, kept in saved maps; "" when
   // unknown). AddFrame and QueryImages refuse frames of another size.
@@ -198,9 +275,42 @@ class OnlineDetector {
 
   const OnlineOptions& Options() const;
   int Size() const;                 // frames added
-  int RowWidth() const;             // elements per row
-  int RowType() const;              // CV_8U (Hamming) or CV_32F (L2)
-  cv::Mat Descriptors() const;      // Size() x RowWidth(), a view of the stored rows
+  int RowWidth() const;             // elements per row (bytes for a map of several descriptors)
+  int RowType() const;              // CV_8U (Hamming, L1, several descriptors) or CV_32F (L2)
+  // Size() x RowWidth(): the stored rows (a view for one descriptor, a copy for several).
+  cv::Mat Descriptors() const;
+  // The descriptors the map describes every frame with (OnlineOptions::descriptor's, then
+  // kept_descriptors'), upper case as the registry names them.
+  std::vector<std::string> Channels() const;
+
+  // Chooses the search settings from the data, with no ground truth, as a run with Auto 1
+  // does (OpenABLE/tuning/auto.h): the frames of session `query` are matched against those of
+  // session `reference` (both must be in the map; the first two sessions when empty) with every
+  // candidate of `candidates` (Auto_candidates' syntax; empty: the keys of the default that the
+  // map's descriptors allow), each judged by its agreement, and the best becomes this
+  // detector's search: descriptor (among Channels()), fusion weights, contrast enhancement,
+  // L, the ratio score over +-score_window frames with `threshold` (< 0: the ratio's default)
+  // and consistency 1, as the presets accept; the fusion's units and the contrast's shift are
+  // those of the chosen matrix. When the chosen candidate's consistency is below
+  // `min_consistency` the map is unreliable (MapTuning::reliable false) and accepts nothing
+  // while these settings are used. Kept by SaveMap. Candidates may vary Image_descriptor,
+  // Fusion_weights, Image_sequences, Contrast_enhancement and Contrast_window only (the rows
+  // are described already); others are refused naming the key. Memory: one float per pair of
+  // frames of the two sessions per descriptor; `max_frames` > 0 judges on the first
+  // max_frames frames of each session. `log` gets one line per candidate. Throws InputError.
+  struct TuneOptions {
+    std::string reference, query;
+    std::string candidates;
+    double min_consistency = 0.5;
+    double threshold = -1;
+    int max_frames = 0;
+  };
+  MapTuning Tune(const TuneOptions& options,
+                 const std::function<void(const std::string&)>& log = {});
+  // The settings chosen by Tune (kept in a saved map), or tuned = false.
+  const MapTuning& Tuning() const;
+  // Whether the search uses the tuned settings (then an unreliable map accepts nothing).
+  bool UsesTuning() const;
   std::int64_t MemoryBytes() const; // rows + indices held now
   int Blocks() const;               // index blocks in use (0 while exact)
   // Waits for a background merge (background_merges) to finish and installs its index.
@@ -227,8 +337,10 @@ class OnlineDetector {
   // any other: with the options of the detector that saved the map, the candidates of every
   // later frame are those that detector would have given (the verification's temporal
   // consistency starts anew: the first frame after loading has no previous streaks). The
-  // description settings (descriptor, description, patch_size, ldb_bits, grid_x, grid_y) must
-  // be the map's, and with verification enabled the map must hold features of the same kind.
+  // description settings (description, patch_size, ldb_bits, sad_patch, grid_x, grid_y) and
+  // the descriptors (Channels()) must be the map's; the search may use any of them (a tuned
+  // map's settings: MapOptions). With verification enabled the map must hold features of the
+  // same kind.
   // When an index setting differs (engine and its build settings, exact_limit, block_frames,
   // exclusion), the saved blocks are set aside and the index built from the rows. Throws
   // InputError beginning with the path: unreadable, not a map, another format version,
@@ -259,11 +371,13 @@ class OnlineDetector {
 };
 
 // The options of a detector that loads the map at `path` with its saved index: the
-// description settings (descriptor, description, patch size, LDB bits, grid) and the index
-// settings (exclusion, exact_limit, block_frames, engine and its build settings) the map was
-// made with, everything else from `base`. Reads the map's settings only. Throws InputError as
-// LoadMap does.
-OnlineOptions MapOptions(const std::string& path, const OnlineOptions& base = {});
+// description settings (descriptors, description, patch size, LDB bits, SAD patch, grid) and
+// the index settings (exclusion, exact_limit, block_frames, engine and its build settings) the
+// map was made with; the search settings Tune chose when the map is tuned (descriptor, fusion
+// weights, contrast enhancement, L, score and its window, threshold, consistency), else
+// `base`'s; everything else from `base`. Reads the map's settings only. Throws InputError as
+// LoadMap does, and "no map at PATH (create one with openable_map add)" when there is none.
+OnlineOptions MapOptions(const std::string& path, const OnlineOptions& base = OnlineOptions());
 
 // ---- Batch helpers -------------------------------------------------------------------------
 

@@ -77,6 +77,26 @@ py::tuple ResultTuple(const OnlineResult& r, bool verification) {
 
 OnlineOptions OnlineOptionsOf(const py::kwargs& kwargs);
 
+// A map's tuning as a dict, None when not tuned.
+py::object TuningDict(const MapTuning& t) {
+  if (!t.tuned) return py::none();
+  py::dict d;
+  d["verdict"] = t.reliable ? "reliable" : "unreliable";
+  d["reliable"] = t.reliable;
+  d["reference"] = t.reference;
+  d["query"] = t.query;
+  d["time"] = t.time;
+  d["chosen"] = t.chosen;
+  d["consistency"] = t.consistency;
+  d["distinctiveness"] = t.distinctiveness;
+  d["agreement"] = t.agreement;
+  d["min_consistency"] = t.min_consistency;
+  d["search"] = py::cast(t.search);
+  d["candidates"] = py::module_::import("json").attr("loads")(
+      t.candidates_json.empty() ? std::string("[]") : t.candidates_json);
+  return d;
+}
+
 // The candidates of each query (OnlineDetector::Query) as lists of dicts, best first.
 py::list QueryResults(const std::vector<OnlineResult>& results,
                       const std::vector<MapSession>& sessions) {
@@ -92,6 +112,7 @@ py::list QueryResults(const std::vector<OnlineResult>& results,
       d["normalized"] = c.normalized;
       d["score"] = c.score;
       d["accepted"] = c.accepted;
+      d["confirmed"] = c.confirmed;
       candidates.append(d);
     }
     out.append(candidates);
@@ -109,8 +130,11 @@ const char* const kQueryDoc = R"doc(
 Returns:
     list[list[dict]]: for each query, its candidates best first, each {"session": the
     session's name, "frame": the frame within that session, "map_frame": the frame in the
-    whole map, "distance": raw sequence distance, "normalized", "score", "accepted": score <=
-    threshold}; empty when the sessions searched hold no frame.
+    whole map, "distance": raw sequence distance, "normalized", "score", "confirmed": the best
+    candidates of the earlier independent queries of the traversal agree with it (see the
+    option consistency), "accepted": score <= threshold, and confirmed when consistency > 0,
+    never on a map whose tuned settings are unreliable while they are used}; empty when the
+    sessions searched hold no frame.
 
 Raises:
     openable.InputError: rows of another width or dtype, an unknown session, images of another
@@ -147,8 +171,19 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
       .def_property(
           "sad_patch", [](const O& o) { return o.descriptor.sad_patch; },
           [](O& o, int v) { o.descriptor.sad_patch = v; },
-          "SAD: side of the normalised squares, pixels (2..64; describe_images only: "
-          "the detector needs a Hamming or L2 descriptor).")
+          "SAD: side of the normalised squares, pixels (2..64).")
+      .def_readwrite("kept_descriptors", &O::kept_descriptors,
+                     "Descriptors whose rows the map keeps besides those of descriptor "
+                     "(\"HOG+SIFT+LDB+SAD\"), so that tune() can choose among them; \"\": none.")
+      .def_readwrite("fusion_weights", &O::fusion_weights,
+                     "One weight per name of a fused descriptor (\"HOG+LDB\"), > 0; []: equal "
+                     "weights (Fusion_weights).")
+      .def_readwrite("contrast_enhancement", &O::contrast_enhancement,
+                     "SeqSLAM's local contrast enhancement of each query's distances over "
+                     "+-contrast_window frames of a session; the map is then scanned exactly "
+                     "(Contrast_enhancement).")
+      .def_readwrite("contrast_window", &O::contrast_window,
+                     "Frames on each side of the enhancement's window (>= 1).")
       .def_property(
           "grid", [](const O& o) { return std::make_pair(o.grid_x, o.grid_y); },
           [](O& o, std::pair<int, int> g) { std::tie(o.grid_x, o.grid_y) = g; },
@@ -168,12 +203,18 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
                      "Frames on each side of a candidate that are not its rivals for the ratio "
                      "score (>= 0; Match_score_window).")
       .def_readwrite("threshold", &O::threshold,
-                     "A candidate is accepted when its score is <= threshold. The distance "
-                     "score is the distance divided by L x the descriptor's bit count for "
-                     "binary descriptors (the mean fraction of differing bits), by L x the "
-                     "largest single-frame distance seen so far for float descriptors: not the "
-                     "scale of Config.txt's Threshold. The default 0.13 is for that score; "
-                     "choose another for the ratio (docs/library.md).")
+                     "A candidate is accepted when its score is <= threshold; < 0 (the "
+                     "default): the score's own default, 0.13 for the distance, 0.9 for the "
+                     "ratio. The distance score is the distance divided by L x the "
+                     "descriptor's bit count for binary descriptors (the mean fraction of "
+                     "differing bits), by L x the largest single-frame distance seen so far "
+                     "for float descriptors, by L x the sum of the weights for fused ones: not "
+                     "the scale of Config.txt's Threshold (docs/library.md).")
+      .def_readwrite("consistency", &O::consistency,
+                     "n (Match_consistency): an accepted candidate also needs the best "
+                     "candidates of n earlier independent queries of its traversal to agree "
+                     "with it along its diagonal; 0: the score alone. Online no later query "
+                     "exists, so the first queries of a traversal are never accepted.")
       .def_readwrite("exact_limit", &O::exact_limit,
                      "Exact search while the searchable map holds at most this many frames.")
       .def_readwrite("block_frames", &O::block_frames, "Frames per index block beyond it.")
@@ -808,6 +849,65 @@ installs its index.)doc")
             return d.detector->Blocks();
           },
           "Index blocks in use (0 while the search is exact).")
+      .def_property_readonly(
+          "channels", [](Detector& d) { return d.detector->Channels(); },
+          "The descriptors the map describes every frame with (descriptor's, then "
+          "kept_descriptors').")
+      .def_property_readonly(
+          "tuning",
+          [](Detector& d) -> py::object {
+            std::lock_guard<std::mutex> lock(d.mutex);
+            return TuningDict(d.detector->Tuning());
+          },
+          "What tune() chose (a dict, kept in saved maps), or None when the map is not tuned.")
+      .def_property_readonly(
+          "uses_tuning",
+          [](Detector& d) {
+            std::lock_guard<std::mutex> lock(d.mutex);
+            return d.detector->UsesTuning();
+          },
+          "Whether the search uses the tuned settings (an unreliable map then accepts "
+          "nothing).")
+      .def(
+          "tune",
+          [](Detector& det, const py::object& reference, const py::object& query,
+             const std::string& candidates, double min_consistency, double threshold,
+             int max_frames) {
+            OnlineDetector::TuneOptions t;
+            if (!reference.is_none()) t.reference = reference.cast<std::string>();
+            if (!query.is_none()) t.query = query.cast<std::string>();
+            if (reference.is_none() != query.is_none())
+              throw InputError("tune: reference and query: expected both session names, or "
+                               "neither (the map's first two sessions)");
+            t.candidates = candidates;
+            t.min_consistency = min_consistency;
+            t.threshold = threshold;
+            t.max_frames = max_frames;
+            MapTuning tuning;
+            {
+              py::gil_scoped_release release;
+              std::lock_guard<std::mutex> lock(det.mutex);
+              tuning = det.detector->Tune(t);
+            }
+            return TuningDict(tuning);
+          },
+          py::arg("reference") = py::none(), py::arg("query") = py::none(),
+          py::arg("candidates") = "", py::arg("min_consistency") = 0.5,
+          py::arg("threshold") = -1.0, py::arg("max_frames") = 0,
+          R"doc(tune(reference=None, query=None, candidates="", min_consistency=0.5, threshold=-1, max_frames=0) -> dict
+
+Chooses the search settings from the map's own frames, with no ground truth, as
+Test_OpenABLE's auto mode does: the frames of session `query` are matched against those of
+session `reference` (the first two sessions when both are None) with every candidate of
+`candidates` (Auto_candidates' syntax; "": those of the default the map's descriptors allow),
+and the one with the highest agreement becomes the search: descriptor, fusion weights,
+contrast enhancement, sequence_length, the ratio score <= `threshold` (< 0: 0.9) confirmed by
+one earlier independent query (consistency 1). save_map() keeps it. When the chosen
+candidate's consistency is below `min_consistency` the map is unreliable and accepts nothing
+while these settings are used. `max_frames` > 0 judges on the first max_frames frames of each
+session. Returns the tuning dict (see the property tuning). Raises openable.InputError on
+unknown sessions, candidates that vary how frames are described or need rows the map does not
+hold.)doc")
       .def_property_readonly(
           "options", [](Detector& d) { return d.detector->Options(); },
           "The options in effect (an openable.OnlineOptions; options[\"name\"] and "

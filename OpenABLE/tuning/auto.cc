@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
@@ -246,32 +247,27 @@ void CheckAuto(const Config& config) {
   }
 }
 
-AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress, SingleFrameStore& store,
-                          const std::function<void(const std::string&)>& log) {
-  const auto start = std::chrono::steady_clock::now();
-  CheckAuto(config);
+AutoPlan PlanCandidates(const Config& config, const std::vector<AutoSettings>& candidates) {
+  AutoPlan plan;
+  for (const AutoSettings& candidate : candidates) {
+    plan.settings.push_back(Completed(config, candidate));
+    plan.configs.push_back(AutoCandidateConfig(config, plan.settings.back()));
+  }
+  return plan;
+}
+
+AutoChoice JudgeCandidates(const AutoPlan& plan, double min_consistency,
+                           const SingleFrameStore& store, const std::vector<int>& starts,
+                           ProgressReporter& progress,
+                           const std::function<void(const std::string&)>& log) {
+  if (starts.size() != 3 || plan.configs.empty())
+    throw std::logic_error("JudgeCandidates: expected two traversals and a candidate");
   AutoChoice choice;
-  choice.min_consistency = config.automatic.min_consistency;
-  std::vector<Config> configs;
-  for (const AutoSettings& candidate : ParseAutoCandidates(config.automatic.candidates)) {
-    choice.candidates.push_back({Completed(config, candidate), {}});
-    configs.push_back(AutoCandidateConfig(config, choice.candidates.back().settings));
-  }
-
-  // Every descriptor of every candidate, described and compared once, each frame read once
-  // for all the descriptors of candidates that share their description settings.
-  const int kept_before = store.Size();
-  std::vector<int> starts;
-  int references = 0, queries = 0;
-  for (const RunResult& r : ComputeSingleFramesTogether(configs, progress, store)) {
-    if (starts.empty()) {
-      for (const Traversal& t : r.traversals) starts.push_back(t.first_row);
-      references = r.traversals.at(0).frames;
-      queries = r.traversals.at(1).frames;
-    }
-  }
-  choice.descriptions = store.Size() - kept_before;
-
+  choice.min_consistency = min_consistency;
+  for (const AutoSettings& settings : plan.settings) choice.candidates.push_back({settings, {}});
+  const int references = starts[1], queries = starts[2] - starts[1];
+  const std::vector<int> first_rows(starts.begin(), starts.end() - 1);
+  const std::vector<Config>& configs = plan.configs;
   // Each candidate's query-reference block: single-frame matrices fused and enhanced (kept for
   // the candidates that differ only in sequences), then its sequence sums and its criteria.
   std::map<std::string, cv::Mat1f> blocks;
@@ -287,7 +283,7 @@ AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress, Sing
                             std::to_string(m.contrast_window);
     auto it = blocks.find(key);
     if (it == blocks.end()) {
-      const cv::Mat1f single = SingleFrameMatrix(c, store, starts);
+      const cv::Mat1f single = SingleFrameMatrix(c, store, first_rows);
       it = blocks.emplace(key, single(cv::Rect(0, references, references, queries)).clone()).first;
     }
     cv::Mat1f sums = it->second.clone();
@@ -303,10 +299,11 @@ AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress, Sing
     f.agrees.clear();
     choice.candidates[i].figures = f;
     progress.Update(static_cast<std::int64_t>(i + 1));
-    log("auto: " + std::to_string(i + 1) + " of " + std::to_string(configs.size()) + ": " +
-        AutoSettingsText(choice.candidates[i].settings) + ": consistency " +
-        FormatFixed(f.consistency, 3) + ", distinctiveness " + FormatFixed(f.distinctiveness, 3) +
-        ", agreement " + FormatFixed(f.agreement, 3));
+    if (log)
+      log("auto: " + std::to_string(i + 1) + " of " + std::to_string(configs.size()) + ": " +
+          AutoSettingsText(choice.candidates[i].settings) + ": consistency " +
+          FormatFixed(f.consistency, 3) + ", distinctiveness " +
+          FormatFixed(f.distinctiveness, 3) + ", agreement " + FormatFixed(f.agreement, 3));
   }
   progress.End();
 
@@ -314,6 +311,28 @@ AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress, Sing
   const UnsupervisedFigures& best = choice.candidates[choice.chosen].figures;
   choice.reliable = best.consistency >= choice.min_consistency;
   choice.config = configs[choice.chosen];
+  return choice;
+}
+
+AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress, SingleFrameStore& store,
+                          const std::function<void(const std::string&)>& log) {
+  const auto start = std::chrono::steady_clock::now();
+  CheckAuto(config);
+  const AutoPlan plan = PlanCandidates(config, ParseAutoCandidates(config.automatic.candidates));
+
+  // Every descriptor of every candidate, described and compared once, each frame read once
+  // for all the descriptors of candidates that share their description settings.
+  const int kept_before = store.Size();
+  std::vector<int> starts;
+  for (const RunResult& r : ComputeSingleFramesTogether(plan.configs, progress, store)) {
+    if (starts.empty()) {
+      for (const Traversal& t : r.traversals) starts.push_back(t.first_row);
+      starts.push_back(r.traversals.at(1).first_row + r.traversals.at(1).frames);
+    }
+  }
+  AutoChoice choice =
+      JudgeCandidates(plan, config.automatic.min_consistency, store, starts, progress, log);
+  choice.descriptions = store.Size() - kept_before;
   choice.seconds = SecondsSince(start);
   return choice;
 }

@@ -63,6 +63,26 @@ struct AutoChoice {
 // one process, every candidate's configuration (CheckRun). Throws InputError naming the key.
 void CheckAuto(const Config& config);
 
+// The candidates' settings (a fused descriptor without Fusion_weights gets equal weights) and
+// the configuration each stands for, over `config`.
+struct AutoPlan {
+  std::vector<AutoSettings> settings;
+  std::vector<Config> configs;
+};
+AutoPlan PlanCandidates(const Config& config, const std::vector<AutoSettings>& candidates);
+
+// Judges every candidate of `plan` on the query-reference block of its matrix and chooses: the
+// single-frame matrix of each of its descriptors comes from `store` (SingleFrameKey of its
+// configuration; every frame of two traversals, the reference's rows first, the query's from
+// starts[1], starts = {0, references, references + queries}), fused and enhanced as a run
+// does, then summed along sequences and judged by UnsupervisedCriteria. Sets every field but
+// `descriptions` and `seconds`. Used by the auto mode and by a map's tuning (the map's rows,
+// OnlineDetector::Tune), so that both choose alike from the same frames.
+AutoChoice JudgeCandidates(const AutoPlan& plan, double min_consistency,
+                           const SingleFrameStore& store, const std::vector<int>& starts,
+                           ProgressReporter& progress,
+                           const std::function<void(const std::string&)>& log);
+
 // Describes the frames once per candidate descriptor into `store`, judges every candidate and
 // chooses (CheckAuto first). `log` receives one line per candidate ("auto: 3 of 15: HOG
 // Image_sequences=20: consistency 0.912, ..."). Throws InputError as ComputeRun does.

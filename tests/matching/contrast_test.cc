@@ -80,5 +80,34 @@ TEST(ContrastEnhancement, MatchesTheDefinitionWithTraversalsAndEmptyCells) {
   EXPECT_THROW(EnhanceContrast(bad, 0), std::logic_error);
 }
 
+
+// Without the shift: every cell the same z-score, the smallest returned; and no z-score of a
+// window of 2R + 1 values below -sqrt(2R) (Samuelson's inequality), the shift a map uses before
+// it is tuned.
+TEST(ContrastEnhancement, UnshiftedCellsAreTheShiftedOnesLessTheSmallest) {
+  cv::Mat1f d(30, 41);
+  cv::randu(d, 0.0f, 50.0f);
+  d(3, 4) = std::numeric_limits<float>::infinity();
+  cv::Mat1f shifted = d.clone(), unshifted = d.clone();
+  EnhanceContrast(shifted, 5, {0, 20});
+  const float smallest = EnhanceContrastUnshifted(unshifted, 5, {0, 20});
+  EXPECT_LT(smallest, 0.0f);
+  EXPECT_GE(smallest, -std::sqrt(2.0f * 5) - 1e-5f);
+  for (int i = 0; i < d.rows; ++i)
+    for (int j = 0; j < d.cols; ++j) {
+      if (!std::isfinite(d(i, j))) {
+        EXPECT_FALSE(std::isfinite(unshifted(i, j)));
+        continue;
+      }
+      EXPECT_NEAR(unshifted(i, j) - smallest, shifted(i, j), 1e-5f) << i << ", " << j;
+      EXPECT_GE(unshifted(i, j), -std::sqrt(2.0f * 5) - 1e-5f);
+    }
+  // The bound is reached by one value far below the others of its window.
+  cv::Mat1f one = cv::Mat1f::ones(1, 11);
+  one(0, 5) = -1000.0f;
+  EnhanceContrastUnshifted(one, 5);
+  EXPECT_NEAR(one(0, 5), -std::sqrt(10.0f), 1e-4f);
+}
+
 }  // namespace
 }  // namespace openable

@@ -1,6 +1,7 @@
 #include "matching/sequence.h"
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <limits>
 #include <random>
@@ -348,6 +349,87 @@ TEST(SequenceDistances, AnInterruptCheckStopsTheSumsWithinTheirRows) {
   cv::Mat1f whole = before.clone();
   SequenceDistancesInPlace(whole, 10, {0}, {0}, SequenceDirection::kForward, 2);
   EXPECT_GT(cv::norm(whole.rowRange(7990, 8000), before.rowRange(7990, 8000), cv::NORM_INF), 0.0);
+}
+
+
+// Row by row, with the query rows one traversal and the columns in sessions: the cells of the
+// naive definition (scaled or skipped), exactly for integer distances.
+TEST(SequenceRowSums, EqualTheNaiveDefinitionRowByRow) {
+  for (const int L : {1, 2, 5, 13}) {
+    for (const SequencePartial partial : {SequencePartial::kScale, SequencePartial::kSkip}) {
+      cv::Mat1f d = Random(40, 33, 7 + L);
+      for (auto& v : d) v = std::round(v);  // integers: the double sums are exact
+      const std::vector<int> cols = {0, 9, 20};
+      const cv::Mat1f want = NaiveSequence(d, L, {}, cols, false,
+                                           partial == SequencePartial::kSkip);
+      SequenceRowSums rows(L, partial);
+      for (int i = 0; i < d.rows; ++i) {
+        std::vector<float> row(d.ptr<float>(i), d.ptr<float>(i) + d.cols);
+        rows.Push(row.data(), d.cols, cols);
+        for (int j = 0; j < d.cols; ++j)
+          EXPECT_EQ(row[static_cast<size_t>(j)], want(i, j)) << "L " << L << " cell " << i << ", " << j;
+      }
+      EXPECT_EQ(rows.Rows(), d.rows);
+      // Restart: the next row is the first of another traversal, as a matrix of its own.
+      rows.Restart();
+      std::vector<float> first(d.ptr<float>(5), d.ptr<float>(5) + d.cols);
+      rows.Push(first.data(), d.cols, cols);
+      const cv::Mat1f alone = NaiveSequence(d.rowRange(5, 6).clone(), L, {}, cols, false,
+                                            partial == SequencePartial::kSkip);
+      for (int j = 0; j < d.cols; ++j) EXPECT_EQ(first[static_cast<size_t>(j)], alone(0, j));
+    }
+  }
+}
+
+// The same floats as the sweep over the whole matrix (the same running operations in double),
+// for real-valued distances too.
+TEST(SequenceRowSums, GiveTheSweepsFloats) {
+  const cv::Mat1f d = Random(60, 50, 3);
+  const std::vector<int> cols = {0, 25};
+  const cv::Mat1f sweep = SequenceDistances(d, 7, {}, cols, SequenceDirection::kForward, 2,
+                                            SequencePartial::kScale);
+  SequenceRowSums rows(7);
+  for (int i = 0; i < d.rows; ++i) {
+    std::vector<float> row(d.ptr<float>(i), d.ptr<float>(i) + d.cols);
+    rows.Push(row.data(), d.cols, cols);
+    for (int j = 0; j < d.cols; ++j) EXPECT_EQ(row[static_cast<size_t>(j)], sweep(i, j));
+  }
+}
+
+// Columns that become candidates one per row (the online detector: a frame of its own
+// traversal exclusion frames back), and a session start that appears among them: each row's
+// cells are those of the naive definition over the columns it has.
+TEST(SequenceRowSums, ColumnsThatGrowByOneARow) {
+  cv::Mat1f d = Random(50, 50, 11);
+  for (auto& v : d) v = std::round(v);
+  const int L = 6, first_own = 20;
+  SequenceRowSums rows(L);
+  const cv::Mat1f want = NaiveSequence(d, L, {}, {0, first_own});
+  int columns = 20;
+  for (int i = 0; i < 30; ++i) {
+    if (i >= 10) ++columns;  // from row 10 on, one more column a row
+    const std::vector<int> starts =
+        columns > first_own ? std::vector<int>{0, first_own} : std::vector<int>{0};
+    std::vector<float> row(d.ptr<float>(i), d.ptr<float>(i) + columns);
+    rows.Push(row.data(), columns, starts);
+    for (int j = 0; j < columns; ++j)
+      EXPECT_EQ(row[static_cast<size_t>(j)], want(i, j)) << "cell " << i << ", " << j;
+  }
+}
+
+TEST(SequenceRowSums, RefuseWhatTheirSumsCannotFollow) {
+  EXPECT_THROW(SequenceRowSums(0), std::logic_error);
+  EXPECT_THROW(SequenceRowSums(3, SequencePartial::kAhead), std::logic_error);
+  SequenceRowSums rows(3);
+  std::vector<float> row(10, 1.0f);
+  rows.Push(row.data(), 5, {0});
+  EXPECT_THROW(rows.Push(row.data(), 7, {0}), std::logic_error);     // two columns more
+  EXPECT_THROW(rows.Push(row.data(), 4, {0}), std::logic_error);     // one fewer
+  EXPECT_THROW(rows.Push(row.data(), 6, {0, 2}), std::logic_error);  // a start among old columns
+  rows.Push(row.data(), 6, {0, 5});                                  // a start at the new one
+  rows.Restart();
+  rows.Push(row.data(), 9, {0, 3});
+  EXPECT_EQ(rows.Rows(), 1);
 }
 
 }  // namespace

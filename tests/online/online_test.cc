@@ -106,7 +106,7 @@ TEST(OnlineDetector, GivesTheBruteForceCandidatesOnRealKittiFrames) {
       EXPECT_EQ(r.candidates[i].distance, distance);
       // Hamming: normalised = mean fraction of differing bits over the L frames.
       EXPECT_DOUBLE_EQ(r.candidates[i].normalized, distance / (5.0 * 256));
-      EXPECT_EQ(r.candidates[i].accepted, r.candidates[i].normalized <= options.threshold);
+      EXPECT_EQ(r.candidates[i].accepted, r.candidates[i].normalized <= options.Threshold());
       // The same candidates as the batch matrix, whose cells are S / max(S).
       ASSERT_EQ(batch_of[q].size(), want.size()) << "frame " << q;
       EXPECT_EQ(batch_of[q][i].reference, r.candidates[i].frame) << "frame " << q;
@@ -297,8 +297,9 @@ TEST(OnlineDetector, BadOptionsAndFramesAreOneLineErrors) {
                    {"SURF"});
   ExpectInputError([&] { OnlineDetector d(with([](OnlineOptions& o) { o.sequence_length = 0; })); },
                    {"OnlineOptions.sequence_length", "0", "1..1000"});
-  ExpectInputError([&] { OnlineDetector d(with([](OnlineOptions& o) { o.threshold = -1; })); },
-                   {"OnlineOptions.threshold", ">= 0"});
+  ExpectInputError([&] {
+    OnlineDetector d(with([](OnlineOptions& o) { o.threshold = std::nan(""); }));
+  }, {"OnlineOptions.threshold", ">= 0"});
   ExpectInputError([&] { OnlineDetector d(with([](OnlineOptions& o) { o.exclusion = 0; })); },
                    {"OnlineOptions.exclusion", "0"});
   ExpectInputError(
