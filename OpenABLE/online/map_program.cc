@@ -205,9 +205,20 @@ std::vector<std::string> SearchKeysGiven(const Arguments& a) {
 void SetSearchKey(const Config& c, const std::string& key, OnlineOptions& o) {
   const MatchingOptions& m = c.matching;
   if (key == "Image_descriptor") {
+    // Another search among the map's descriptors: the others stay kept.
+    std::vector<std::string> all;
+    for (const std::string& list : {o.descriptor.name, o.kept_descriptors})
+      for (const std::string& n : list.empty() ? std::vector<std::string>{} : DescriptorList(list))
+        if (std::find(all.begin(), all.end(), Upper(n)) == all.end()) all.push_back(Upper(n));
     o.descriptor.name = c.descriptor.name;
-    if (o.fusion_weights.size() != DescriptorList(o.descriptor.name).size())
-      o.fusion_weights.clear();
+    std::vector<std::string> searched;
+    for (const std::string& n : DescriptorList(o.descriptor.name)) searched.push_back(Upper(n));
+    std::string kept;
+    for (const std::string& n : all)
+      if (std::find(searched.begin(), searched.end(), n) == searched.end())
+        kept += (kept.empty() ? "" : "+") + n;
+    o.kept_descriptors = kept;
+    if (o.fusion_weights.size() != searched.size()) o.fusion_weights.clear();
   } else if (key == "Fusion_weights") {
     const int names = static_cast<int>(DescriptorList(o.descriptor.name).size());
     o.fusion_weights = m.fusion_weights.empty() || names < 2 ? std::vector<double>{}

@@ -220,14 +220,12 @@ TEST(MapSearch, FramesAddedOneByOneAreConfirmedAlike) {
   }
 }
 
-// The auto mode's configuration of the sample's two seasons, its candidates judged as a map
-// judges them (Sequence_partial scale).
+// The auto mode's configuration of the sample's two seasons (the defaults, Auto 1).
 Config SampleAutoConfig() {
   Config c;
   ApplyOverride(c, "Images_path=" + SeasonDir("summer"), "test");
   ApplyOverride(c, "Images_path_2=" + SeasonDir("winter"), "test");
   ApplyOverride(c, "Auto=1", "test");
-  ApplyOverride(c, "Sequence_partial=scale", "test");
   return c;
 }
 

@@ -62,7 +62,7 @@ class OpenableMapTest(TempDirTestCase):
 
     def test_info_lists_the_sessions(self):
         info = json.loads(run("openable_map", ["info", self.map, "--json"], self.tmp).stdout)
-        self.assertEqual(info["format_version"], 2)
+        self.assertEqual(info["format_version"], 3)
         self.assertEqual(info["checksums"], "ok")
         self.assertEqual([(s["name"], s["first"], s["frames"]) for s in info["sessions"]],
                          [("summer", 0, len(self.summer)),

@@ -81,8 +81,8 @@ class OnlineAgainstBatchTest(unittest.TestCase):
             openable.OnlineDetector(score="confidence")
         with self.assertRaisesRegex(openable.InputError, "score_window"):
             openable.OnlineDetector(score_window=-1)
-        with self.assertRaisesRegex(openable.InputError, "SAD"):
-            openable.OnlineDetector(descriptor="SAD")
+        with self.assertRaisesRegex(openable.InputError, "stereo"):
+            openable.OnlineDetector(descriptor="D-LDB")
 
     def test_batch_matrix_is_the_sums_over_their_maximum(self):
         np.testing.assert_allclose(self.matrix * self.peak, self.sums, rtol=1e-6, atol=1e-3)
