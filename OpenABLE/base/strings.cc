@@ -28,6 +28,15 @@ std::string Trim(std::string_view s) {
   return std::string(s.substr(b, e - b + 1));
 }
 
+std::string JoinStrings(const std::vector<std::string>& parts, std::string_view separator) {
+  std::string out;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (i > 0) out += separator;
+    out += parts[i];
+  }
+  return out;
+}
+
 std::vector<std::string> SplitTrimmed(std::string_view s, char separator) {
   std::vector<std::string> pieces;
   for (std::size_t start = 0;;) {

@@ -20,6 +20,9 @@ std::string Trim(std::string_view s);
 // "a", "", "b"; "" gives one empty piece).
 std::vector<std::string> SplitTrimmed(std::string_view s, char separator);
 
+// `parts` with `separator` between them ("HOG+LDB"; "" for none).
+std::string JoinStrings(const std::vector<std::string>& parts, std::string_view separator);
+
 // The formatter of numbers in the text outputs (messages, reports, CSV and JSON files): printf's
 // %g with `significant` digits. With the default six, a number as users read it in messages and
 // in Config.txt ("0.47", "2500", "1e+06"); nine in the CSV and JSON figures, seventeen where a

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <deque>
 #include <limits>
 #include <sstream>
@@ -361,6 +362,15 @@ std::string SectionName(const Section& s) {
 }
 
 }  // namespace
+
+std::string MapTimeNow() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
 
 void CheckSessionName(const std::string& name, const std::string& what) {
   bool ok = !name.empty() && name.size() <= 200 && name.front() != ' ' && name.back() != ' ';

@@ -57,6 +57,9 @@ struct MapSession {
   int first = 0, count = 0;
 };
 
+// Now, as sessions and tunings keep their times: ISO 8601 UTC ("2026-11-29T09:30:00Z").
+std::string MapTimeNow();
+
 // A session name: 1 to 200 printable characters (no control characters, no tab or line
 // break), not beginning or ending with a space. Throws InputError beginning with `what`.
 void CheckSessionName(const std::string& name, const std::string& what);

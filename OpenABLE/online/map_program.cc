@@ -315,11 +315,7 @@ void ForImagesOf(const std::string& folder, bool quiet, const char* what, Body b
   progress.End();
 }
 
-std::string JoinedChannels(const OnlineDetector& d) {
-  std::string out;
-  for (const std::string& c : d.Channels()) out += (out.empty() ? "" : "+") + c;
-  return out;
-}
+std::string JoinedChannels(const OnlineDetector& d) { return JoinStrings(d.Channels(), "+"); }
 
 std::string FileName(const std::string& path) {
   return std::filesystem::path(path).filename().string();

@@ -24,11 +24,7 @@
 #include "OpenABLE/base/threading.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/image/preprocess.h"
-#include "OpenABLE/io/json.h"
 #include "OpenABLE/online/map_file.h"
-#include "OpenABLE/run/pipeline.h"
-#include "OpenABLE/tuning/auto.h"
-#include "config/config.h"
 #include "descriptors/registry.h"
 #include "matching/agreement.h"
 #include "matching/contrast.h"
@@ -62,14 +58,6 @@ void CheckFrameSize(const std::string& what, const std::string& size,
                      " (expected frames of one camera at one size)");
 }
 
-std::string NowUtc() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return text;
-}
 
 // The names of `descriptor` (a fusion "HOG+LDB" or one name), then those of `kept` not among
 // them, upper case as the registry names them.
@@ -83,12 +71,6 @@ std::vector<std::string> ChannelNames(const std::string& descriptor, const std::
     }
   }
   return names;
-}
-
-std::string JoinNames(const std::vector<std::string>& names, const char* separator) {
-  std::string out;
-  for (const std::string& n : names) out += (out.empty() ? "" : separator) + n;
-  return out;
 }
 
 Metric MetricOf(const Descriptor& d) {
@@ -257,7 +239,7 @@ namespace {
 
 // The rows of the frames of one query traversal, one matrix per channel of the map (row i:
 // frame i).
-using ChannelRows = std::vector<cv::Mat>;
+using RowsByChannel = std::vector<cv::Mat>;
 
 // The map frames a search scores: ranges [first, first + count) of whole or partial sessions,
 // in frame order, laid side by side as the columns of its single-frame rows.
@@ -353,7 +335,7 @@ struct OnlineDetector::State {
   }
   // `n` frames appended: they join the last session (one named "default" when none).
   void Appended(int n) {
-    if (sessions.empty()) sessions.push_back({"default", NowUtc(), 0, 0});
+    if (sessions.empty()) sessions.push_back({"default", MapTimeNow(), 0, 0});
     sessions.back().count += n;
   }
 
@@ -361,27 +343,27 @@ struct OnlineDetector::State {
   void SetSearch();
   // Rows given by the caller (packed for several channels) as one matrix per channel.
   // `rows_text`: the rows expected, as messages name them ("n", or "1" for one row).
-  ChannelRows Split(const cv::Mat& rows, const std::string& what,
+  RowsByChannel Split(const cv::Mat& rows, const std::string& what,
                     const std::string& rows_text = "n") const;
-  cv::Mat Pack(const ChannelRows& rows) const;
-  void Append(const ChannelRows& rows);
+  cv::Mat Pack(const RowsByChannel& rows) const;
+  void Append(const RowsByChannel& rows);
   // The fusion's units from the map's first frames when not known yet (several channels).
   void EnsureUnits();
   std::vector<double> UnitsNow() const;
   // The fused single-frame distances of query rows [a, b) of `queries` against `columns`,
   // contrast-enhanced as the options say: (b - a) x columns.count.
-  cv::Mat1f SingleFrameRows(const ChannelRows& queries, int a, int b, const Columns& columns,
+  cv::Mat1f SingleFrameRows(const RowsByChannel& queries, int a, int b, const Columns& columns,
                             const std::vector<double>& units) const;
   // The fused single-frame distance of query row q and map frame j.
-  double PairDistance(const ChannelRows& queries, int q, int j,
+  double PairDistance(const RowsByChannel& queries, int q, int j,
                       const std::vector<double>& units) const;
   // S(q, j) straight from the rows (the approximate path), the query's traversal starting at
   // its row q_first, the map frame's at its session's first frame; neither sequence runs
   // across its start. `largest` is raised to the largest single-frame distance summed.
-  double CellDistance(const ChannelRows& queries, int q, int q_first, int j,
+  double CellDistance(const RowsByChannel& queries, int q, int q_first, int j,
                       const std::vector<double>& units, double* largest) const;
   // The search of the frame just appended (AddDescriptor, AddFrame).
-  OnlineResult Search(const ChannelRows& row);
+  OnlineResult Search(const RowsByChannel& row);
   // The candidates kept of `scored` (distance, frame) and their scores, into r.candidates.
   void Choose(std::vector<std::pair<double, int>>& scored, double unit_now,
               OnlineResult& r) const;
@@ -457,7 +439,7 @@ void OnlineDetector::State::SetSearch() {
     while (c < channels.size() && channels[c].name != name) ++c;
     if (c == channels.size())
       throw InputError("OnlineOptions.descriptor = " + Quoted(options.descriptor.name) +
-                       ": the map holds rows of " + JoinNames(ChannelList(), ", ") + " only; " +
+                       ": the map holds rows of " + JoinStrings(ChannelList(), ", ") + " only; " +
                        "expected descriptors among them");
     search.push_back(static_cast<int>(c));
   }
@@ -480,7 +462,7 @@ void OnlineDetector::State::SetSearch() {
   answers.clear();
 }
 
-ChannelRows OnlineDetector::State::Split(const cv::Mat& rows, const std::string& what,
+RowsByChannel OnlineDetector::State::Split(const cv::Mat& rows, const std::string& what,
                                          const std::string& rows_text) const {
   const bool rows_ok = rows_text != "1" || rows.rows == 1;
   if (!Several()) {
@@ -498,8 +480,8 @@ ChannelRows OnlineDetector::State::Split(const cv::Mat& rows, const std::string&
     throw InputError(what + " of " + std::to_string(rows.rows) + "x" + std::to_string(rows.cols) +
                      " " + cv::typeToString(rows.type()) + ": expected " + rows_text + "x" +
                      std::to_string(packed_width) + " CV_8UC1 (the rows of " +
-                     JoinNames(ChannelList(), ", ") + " side by side)");
-  ChannelRows out;
+                     JoinStrings(ChannelList(), ", ") + " side by side)");
+  RowsByChannel out;
   int offset = 0;
   for (const Channel& c : channels) {
     const int bytes = c.width * static_cast<int>(CV_ELEM_SIZE(c.type));
@@ -514,7 +496,7 @@ ChannelRows OnlineDetector::State::Split(const cv::Mat& rows, const std::string&
   return out;
 }
 
-cv::Mat OnlineDetector::State::Pack(const ChannelRows& rows) const {
+cv::Mat OnlineDetector::State::Pack(const RowsByChannel& rows) const {
   if (!Several()) return rows.front();
   const int n = rows.front().rows;
   cv::Mat out(n, packed_width, CV_8UC1);
@@ -527,7 +509,7 @@ cv::Mat OnlineDetector::State::Pack(const ChannelRows& rows) const {
   return out;
 }
 
-void OnlineDetector::State::Append(const ChannelRows& rows) {
+void OnlineDetector::State::Append(const RowsByChannel& rows) {
   const int n = rows.front().rows;
   if (!files.empty()) files.resize(files.size() + static_cast<size_t>(n));
   for (size_t c = 0; c < channels.size(); ++c) {
@@ -556,7 +538,7 @@ void OnlineDetector::State::EnsureUnits() {
   if (Fused() && units.empty() && Size() > 1) units = UnitsNow();
 }
 
-double OnlineDetector::State::PairDistance(const ChannelRows& queries, int q, int j,
+double OnlineDetector::State::PairDistance(const RowsByChannel& queries, int q, int j,
                                            const std::vector<double>& u) const {
   if (!Fused()) {
     const State::Channel& c = channels[static_cast<size_t>(search.front())];
@@ -573,7 +555,7 @@ double OnlineDetector::State::PairDistance(const ChannelRows& queries, int q, in
   return sum;
 }
 
-double OnlineDetector::State::CellDistance(const ChannelRows& queries, int q, int q_first,
+double OnlineDetector::State::CellDistance(const RowsByChannel& queries, int q, int q_first,
                                            int j, const std::vector<double>& u,
                                            double* largest) const {
   const MapSession& sj = sessions[static_cast<size_t>(SessionOf(j))];
@@ -588,7 +570,7 @@ double OnlineDetector::State::CellDistance(const ChannelRows& queries, int q, in
   return ScaleSequenceSum(sum, terms, L, SequencePartial::kScale);
 }
 
-cv::Mat1f OnlineDetector::State::SingleFrameRows(const ChannelRows& queries, int a, int b,
+cv::Mat1f OnlineDetector::State::SingleFrameRows(const RowsByChannel& queries, int a, int b,
                                                  const Columns& columns,
                                                  const std::vector<double>& u) const {
   cv::Mat1f out = cv::Mat1f::zeros(b - a, columns.count);
@@ -649,7 +631,7 @@ int OnlineDetector::RowType() const {
 cv::Mat OnlineDetector::Descriptors() const {
   const State& s = *state_;
   if (!s.Several()) return s.channels.front().rows->Rows();
-  ChannelRows rows;
+  RowsByChannel rows;
   for (const State::Channel& c : s.channels) rows.push_back(c.rows->Rows());
   return s.Pack(rows);
 }
@@ -681,7 +663,7 @@ OnlineResult OnlineDetector::AddFrame(const cv::Mat& image) {
   const cv::Mat1b grey = GreyOfImage(image, what);
   const std::string size = SizeText(grey.size());
   CheckFrameSize(what, size, s.frame_size);
-  ChannelRows rows;
+  RowsByChannel rows;
   for (const State::Channel& c : s.channels) {
     rows.emplace_back(1, c.width, c.type);
     DescribeInto(*c.describer.frame, grey, what, rows.back());
@@ -734,7 +716,7 @@ void OnlineDetector::AddToMap(const cv::Mat& rows) {
                      "verification.enabled) and needs each frame's image: add the frames with "
                      "AddFrame");
   if (rows.empty()) return;
-  const ChannelRows split = s.Split(rows, "map rows");
+  const RowsByChannel split = s.Split(rows, "map rows");
   s.ThrowIfDamaged(false);
   s.Append(split);
   s.Appended(rows.rows);
@@ -775,7 +757,7 @@ void OnlineDetector::AddImagesToMap(const std::vector<cv::Mat>& images,
 
 OnlineResult OnlineDetector::AddDescriptor(const cv::Mat& row) {
   State& s = *state_;
-  const ChannelRows split = s.Split(row, "descriptor row", "1");
+  const RowsByChannel split = s.Split(row, "descriptor row", "1");
   if (s.verifier)
     throw InputError("OnlineDetector::AddDescriptor: verification is on (OnlineOptions::"
                      "verification.enabled) and needs each frame's image: use AddFrame");
@@ -801,7 +783,7 @@ Columns ColumnsUpTo(const std::vector<MapSession>& sessions, int end) {
 
 }  // namespace
 
-OnlineResult OnlineDetector::State::Search(const ChannelRows& row) {
+OnlineResult OnlineDetector::State::Search(const RowsByChannel& row) {
   State& s = *this;
   const auto start = Clock::now();
   s.Append(row);
@@ -820,7 +802,7 @@ OnlineResult OnlineDetector::State::Search(const ChannelRows& row) {
     s.EnsureUnits();
     if (IncrementalIndex* index = s.Index()) index->Update(searchable);
     // The rows of the map hold this traversal's rows too: frames first .. q.
-    ChannelRows mine;
+    RowsByChannel mine;
     for (const State::Channel& c : s.channels) mine.push_back(c.rows->Rows());
     std::vector<std::pair<double, int>> scored;
     double* largest = s.UnitFixed() ? nullptr : &s.unit;
@@ -942,7 +924,7 @@ void OnlineDetector::StartSession(const std::string& name, const std::string& ti
     if (static_cast<unsigned char>(c) <= 0x20 || c == 0x7f)
       throw InputError("OnlineDetector::StartSession: session time " + Quoted(time) +
                        ": expected a time without spaces, e.g. 2026-11-27T09:30:00Z");
-  s.sessions.push_back({name, time.empty() ? NowUtc() : time, Size(), 0});
+  s.sessions.push_back({name, time.empty() ? MapTimeNow() : time, Size(), 0});
   s.answers.clear();
   s.running_last = -1;
 }
@@ -969,7 +951,7 @@ std::vector<OnlineResult> OnlineDetector::Query(const cv::Mat& rows,
     throw InputError("OnlineDetector::Query: verification is on (OnlineOptions::verification."
                      "enabled) and needs each query's image and features: add the frames with "
                      "AddFrame, or query with a detector without verification");
-  const ChannelRows queries = s.Split(rows, "query rows");
+  const RowsByChannel queries = s.Split(rows, "query rows");
   s.ThrowIfDamaged(false);
   // The sessions searched, and whether their frames are few enough to scan exactly.
   std::vector<char> allowed(s.sessions.size(), sessions.empty() ? 1 : 0);
@@ -1141,8 +1123,8 @@ std::vector<std::pair<std::string, std::string>> SearchSettings(const OnlineOpti
 // Whether two options search alike (SearchSettings; the descriptors' names in any case).
 bool SameSearch(const OnlineOptions& a, const OnlineOptions& b) {
   auto x = SearchSettings(a), y = SearchSettings(b);
-  x[0].second = JoinNames(ChannelNames(a.descriptor.name, ""), "+");
-  y[0].second = JoinNames(ChannelNames(b.descriptor.name, ""), "+");
+  x[0].second = JoinStrings(ChannelNames(a.descriptor.name, ""), "+");
+  y[0].second = JoinStrings(ChannelNames(b.descriptor.name, ""), "+");
   return x == y;
 }
 
@@ -1167,7 +1149,7 @@ void OnlineDetector::SaveMap(const std::string& path) {
     widths += (widths.empty() ? "" : " ") + std::to_string(c.width);
     types += (types.empty() ? "" : " ") + std::string(c.type == CV_8U ? "CV_8U" : "CV_32F");
   }
-  map.settings.insert(map.settings.end(), {{"channels", JoinNames(s.ChannelList(), " ")},
+  map.settings.insert(map.settings.end(), {{"channels", JoinStrings(s.ChannelList(), " ")},
                                            {"channel_widths", widths},
                                            {"channel_types", types},
                                            {"indexed_channel", std::to_string(s.indexed)}});
@@ -1317,8 +1299,8 @@ double CheckMapFits(const MapFile& map, const std::string& path, const OnlineOpt
   };
   const std::vector<std::string> theirs = MapChannels(map);
   if (theirs != channels)
-    throw InputError(path + ": " + what + "the descriptors " + JoinNames(theirs, "+") +
-                     "; this detector has " + JoinNames(channels, "+") +
+    throw InputError(path + ": " + what + "the descriptors " + JoinStrings(theirs, "+") +
+                     "; this detector has " + JoinStrings(channels, "+") +
                      " (expected the same descriptors: MapOptions gives a map's own)");
   require_same(DescriptionSettings(options), "has",
                "expected the same description settings: description, patch_size, ldb_bits, "
@@ -1388,7 +1370,7 @@ OnlineOptions MapOptions(const std::string& path, const OnlineOptions& base) {
   const std::vector<std::string> searched = ChannelNames(o.descriptor.name, "");
   for (const std::string& c : channels)
     if (std::find(searched.begin(), searched.end(), c) == searched.end()) kept.push_back(c);
-  o.kept_descriptors = JoinNames(kept, "+");
+  o.kept_descriptors = JoinStrings(kept, "+");
   if (!o.fusion_weights.empty() && o.fusion_weights.size() != searched.size())
     o.fusion_weights.clear();
   o.description = ParseEnum<DescriptionType>(map.Setting("description"),
@@ -1518,7 +1500,7 @@ void OnlineDetector::AppendMap(const std::string& path) {
   if (map.rows.rows == 0) return;
   const int first = Size();
   if (!s.sessions.empty() && s.sessions.back().count == 0) s.sessions.pop_back();
-  ChannelRows rows{map.rows};
+  RowsByChannel rows{map.rows};
   for (const cv::Mat& m : map.more_rows) rows.push_back(m);
   s.Append(rows);
   if (!s.files.empty() || !map.frame_files.empty()) {
@@ -1541,209 +1523,45 @@ void OnlineDetector::AppendMap(const std::string& path) {
 
 const std::vector<std::string>& OnlineDetector::FrameFiles() const { return state_->files; }
 
-// ---- Settings chosen from the data -----------------------------------------------------------
+// ---- Settings chosen from the data (OnlineDetector::Tune is in map_tuning.cc) ------------
 
-namespace {
-
-// The keys a map's tuning may vary: the rows are described already, so only what is computed
-// from them.
-const std::set<std::string>& TunableKeys() {
-  static const std::set<std::string> keys = {"Image_descriptor", "Fusion_weights",
-                                             "Image_sequences", "Contrast_enhancement",
-                                             "Contrast_window"};
-  return keys;
+cv::Mat OnlineDetector::ChannelRows(int channel) const {
+  const State& s = *state_;
+  if (channel < 0 || channel >= static_cast<int>(s.channels.size()))
+    throw std::out_of_range("OnlineDetector::ChannelRows: no descriptor " +
+                            std::to_string(channel));
+  return s.channels[static_cast<size_t>(channel)].rows->Rows();
 }
 
-const MapSession& SessionNamed(const std::vector<MapSession>& sessions, const std::string& name,
-                               const char* role) {
-  for (const MapSession& m : sessions)
-    if (m.name == name) return m;
-  std::string names;
-  for (const MapSession& m : sessions) names += (names.empty() ? "" : ", ") + m.name;
-  throw InputError(std::string("tune: ") + role + " session " + Quoted(name) +
-                   " is not in the map; its sessions: " + (names.empty() ? "none" : names));
-}
-
-}  // namespace
-
-MapTuning OnlineDetector::Tune(const TuneOptions& t,
-                               const std::function<void(const std::string&)>& log) {
+void OnlineDetector::UseTuning(const MapTuning& tuning) {
   State& s = *state_;
-  s.ThrowIfDamaged(true);
-  if (s.verifier)
-    throw InputError("tune: verification is on (OnlineOptions::verification.enabled), which "
-                     "decides the accepted loops itself; expected a detector without it");
-  std::vector<MapSession> nonempty;
-  for (const MapSession& m : s.sessions)
-    if (m.count > 0) nonempty.push_back(m);
-  if ((t.reference.empty() || t.query.empty()) && nonempty.size() < 2)
-    throw InputError("tune: the map holds " + std::to_string(nonempty.size()) + " session" +
-                     (nonempty.size() == 1 ? "" : "s") + " with frames; expected two "
-                     "traversals of the route (add a second session first)");
-  const MapSession& ref =
-      t.reference.empty() ? nonempty[0] : SessionNamed(s.sessions, t.reference, "reference");
-  const MapSession& qry =
-      t.query.empty() ? nonempty[1] : SessionNamed(s.sessions, t.query, "query");
-  if (ref.name == qry.name)
-    throw InputError("tune: reference and query are both session " + Quoted(ref.name) +
-                     "; expected two sessions (two traversals of the route)");
-  if (!(t.min_consistency >= 0 && t.min_consistency <= 1))
-    throw InputError("tune: min_consistency = " + FormatNumber(t.min_consistency) +
-                     ": expected a number in [0, 1] (Auto_min_consistency)");
-  if (t.max_frames < 0)
-    throw InputError("tune: max_frames = " + std::to_string(t.max_frames) +
-                     ": expected >= 0 (0: every frame)");
-  const int references = t.max_frames > 0 ? std::min(ref.count, t.max_frames) : ref.count;
-  const int queries = t.max_frames > 0 ? std::min(qry.count, t.max_frames) : qry.count;
-
-  // The configuration the candidates start from: the map's description and the ratio's
-  // window of the detector. Candidates are judged as the auto mode judges them, with a whole
-  // sequence for every query (Sequence_partial ahead), so that both choose alike from the same
-  // frames: judged with the shorter sums the search gives the first L - 1 frames of a
-  // traversal (scale), long sequences lose to short ones on short traversals for their first
-  // frames alone (on the bundled sample, SAD with contrast enhancement and L = 40 fell from
-  // consistency 0.873 to 0.680, below LDB's 0.703, though its R@1 is 0.933 against 0.833).
-  Config base;
-  base.descriptor = s.options.descriptor;
-  base.descriptor.name = JoinNames(s.ChannelList(), "+");
-  base.description.type = s.options.description;
-  base.description.grid_x = s.options.grid_x;
-  base.description.grid_y = s.options.grid_y;
-  base.matching.partial = SequencePartial::kAhead;
-  base.matching.score_window = s.options.score_window;
-  const std::vector<std::string> channels = s.ChannelList();
-  const auto held = [&](const Config& c) {
-    for (const std::string& name : DescriptorList(c.descriptor.name))
-      if (std::find(channels.begin(), channels.end(), Upper(name)) == channels.end())
-        return false;
-    return true;
-  };
-  const bool given = !t.candidates.empty();
-  std::vector<AutoSettings> candidates;
-  for (const AutoSettings& candidate :
-       ParseAutoCandidates(given ? t.candidates : AutoOptions::kDefaultCandidates)) {
-    for (const auto& [key, value] : candidate)
-      if (TunableKeys().count(key) == 0)
-        throw InputError("tune: Auto_candidates: " + key + " changes how frames are described, "
-                         "and the map's rows are described already; expected candidates of "
-                         "Image_descriptor (among " + JoinNames(channels, ", ") + "), "
-                         "Fusion_weights, Image_sequences, Contrast_enhancement and "
-                         "Contrast_window");
-    Config c = AutoCandidateConfig(base, candidate);
-    if (held(c)) {
-      candidates.push_back(candidate);
-    } else if (given) {
-      throw InputError("tune: Auto_candidates: " + Quoted(AutoSettingsText(candidate)) +
-                       " needs rows the map does not hold (it holds " +
-                       JoinNames(channels, ", ") + "); expected descriptors among them, or a "
-                       "map made with their rows (openable_map add --config "
-                       "config/presets/auto.txt keeps those of the auto preset)");
-    } else if (log) {
-      log("tune: skipped " + AutoSettingsText(candidate) + " (the map holds no rows of its "
-          "descriptor; a map made with config/presets/auto.txt keeps them)");
-    }
-  }
-  if (candidates.empty())
-    throw InputError("tune: none of the default candidates uses the map's descriptors (" +
-                     JoinNames(channels, ", ") + "); expected candidates given with "
-                     "--candidates (Auto_candidates' syntax)");
-  const AutoPlan plan = PlanCandidates(base, candidates);
-
-  // The single-frame matrix of every descriptor over both sessions, the reference's frames
-  // first: the matrices a run of the two traversals compares (PairwiseDistances).
-  std::set<std::string> names;
-  for (const Config& c : plan.configs)
-    for (const std::string& name : DescriptorList(c.descriptor.name)) names.insert(Upper(name));
-  const double cells = static_cast<double>(references + queries) * (references + queries);
-  const double bytes = cells * 4.0 * (static_cast<double>(names.size()) + 2);
-  if (bytes > 16e9)
-    throw InputError("tune: sessions of " + std::to_string(references) + " and " +
-                     std::to_string(queries) + " frames need " +
-                     FormatFixed(bytes / 1e9, 1) + " GB to compare every pair with " +
-                     std::to_string(names.size()) + " descriptors; expected at most 16 GB (judge "
-                     "on the first frames of each: max_frames, openable_map tune --frames N)");
-  SingleFrameStore store;
-  std::map<std::string, cv::Mat1f> matrices;
-  for (const std::string& name : names) {
-    const size_t c = static_cast<size_t>(
-        std::find(channels.begin(), channels.end(), name) - channels.begin());
-    const cv::Mat all = s.channels[c].rows->Rows();
-    cv::Mat rows;
-    cv::vconcat(all.rowRange(ref.first, ref.first + references),
-                all.rowRange(qry.first, qry.first + queries), rows);
-    if (log) log("tune: comparing every pair of frames with " + name);
-    matrices[name] = PairwiseDistances(rows, s.channels[c].metric);
-  }
-  for (const Config& c : plan.configs)
-    for (const std::string& name : DescriptorList(c.descriptor.name)) {
-      const std::string key = SingleFrameKey(c, name);
-      if (store.Find(key) != nullptr) continue;
-      SingleFrame f;
-      f.distances = matrices.at(Upper(name));
-      store.Keep(key, std::move(f));
-    }
-  const std::vector<int> starts = {0, references, references + queries};
-  ProgressReporter quiet(std::cerr, false, false);
-  AutoChoice choice = JudgeCandidates(plan, t.min_consistency, store, starts, quiet, log);
-
-  // The search of the chosen candidate, with the units and shift of its matrix.
-  const MatchingOptions& m = choice.config.matching;
+  if (!tuning.tuned) throw std::invalid_argument("OnlineDetector::UseTuning: not tuned");
   OnlineOptions search = s.options;
-  search.descriptor.name = choice.config.descriptor.name;
-  const std::vector<std::string> chosen = DescriptorList(search.descriptor.name);
-  search.fusion_weights =
-      chosen.size() > 1 ? m.FusionWeights(static_cast<int>(chosen.size())) : std::vector<double>{};
-  search.contrast_enhancement = m.contrast_enhancement;
-  search.contrast_window = m.contrast_window;
-  search.sequence_length = m.sequence_length;
-  search.score = MatchScore::kRatio;
-  search.threshold = t.threshold >= 0 ? t.threshold : OnlineOptions::DefaultThreshold(MatchScore::kRatio);
-  search.consistency = 1;
+  const OnlineOptions& t = tuning.search;
+  search.descriptor.name = t.descriptor.name;
+  search.fusion_weights = t.fusion_weights;
+  search.contrast_enhancement = t.contrast_enhancement;
+  search.contrast_window = t.contrast_window;
+  search.sequence_length = t.sequence_length;
+  search.score = t.score;
+  search.score_window = t.score_window;
+  search.threshold = t.threshold;
+  search.consistency = t.consistency;
   search.Check();
-  MapTuning tuning;
-  tuning.tuned = true;
-  tuning.reliable = choice.reliable;
-  tuning.reference = ref.name;
-  tuning.query = qry.name;
-  tuning.time = NowUtc();
-  tuning.chosen = AutoSettingsText(choice.candidates[static_cast<size_t>(choice.chosen)].settings);
-  const UnsupervisedFigures& f = choice.candidates[static_cast<size_t>(choice.chosen)].figures;
-  tuning.consistency = f.consistency;
-  tuning.distinctiveness = f.distinctiveness;
-  tuning.agreement = f.agreement;
-  tuning.min_consistency = t.min_consistency;
-  tuning.candidates_json = json::DumpLine(AutoJson(choice)["candidates"]);
-  tuning.search = search;
-  cv::Mat1f fused;
-  for (size_t k = 0; k < chosen.size(); ++k) {
-    const cv::Mat1f& d = matrices.at(Upper(chosen[k]));
-    double largest = 0;
-    cv::minMaxLoc(d, nullptr, &largest);
-    tuning.units.push_back(largest);
-    if (search.contrast_enhancement) {
-      const double w = chosen.size() > 1 ? search.fusion_weights[k] : 1.0;
-      if (fused.empty()) fused = cv::Mat1f::zeros(d.size());
-      if (chosen.size() == 1)
-        d.copyTo(fused);
-      else if (largest > 0)
-        cv::scaleAdd(d, w / largest, fused, fused);
-    }
-  }
-  if (chosen.size() == 1) tuning.units.clear();
-  tuning.shift = 0;
-  if (search.contrast_enhancement) {
-    const float smallest = EnhanceContrastUnshifted(fused, search.contrast_window,
-                                                    {0, references});
-    tuning.shift = std::isfinite(smallest) ? -smallest : 0.0;
-  }
-
+  const OnlineOptions before = s.options;
   s.options = search;
+  try {
+    s.SetSearch();
+  } catch (...) {
+    s.options = before;
+    s.SetSearch();
+    throw;
+  }
   s.tuning = tuning;
-  s.SetSearch();
+  s.tuning.search = search;
   s.units = tuning.units;
   s.shift = tuning.shift;
   s.uses_tuning = true;
-  return tuning;
 }
 
 }  // namespace openable

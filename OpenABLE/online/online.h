@@ -309,6 +309,12 @@ class OnlineDetector {
                  const std::function<void(const std::string&)>& log = {});
   // The settings chosen by Tune (kept in a saved map), or tuned = false.
   const MapTuning& Tuning() const;
+  // Makes `tuning`'s search this detector's, with its fusion units and contrast shift (what
+  // Tune does once it has chosen; `tuning` of a map of the same descriptors). Throws
+  // InputError when its descriptors are not among Channels().
+  void UseTuning(const MapTuning& tuning);
+  // The rows of descriptor `channel` of Channels() (Size() x its width), a view.
+  cv::Mat ChannelRows(int channel) const;
   // Whether the search uses the tuned settings (then an unreliable map accepts nothing).
   bool UsesTuning() const;
   std::int64_t MemoryBytes() const; // rows + indices held now
