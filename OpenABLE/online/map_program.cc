@@ -34,7 +34,7 @@ namespace {
 
 const char* const kUsageText =
     "Usage: openable_map add MAP --images FOLDER --session NAME [--time T] [--config FILE]\n"
-    "                        [--set Key=Value ...]\n"
+    "                        [--set Key=Value ...] [--threshold X]\n"
     "       openable_map tune MAP [--session REFERENCE --session QUERY] [--frames N]\n"
     "                         [--threshold X] [--config FILE] [--set Key=Value ...] [--json]\n"
     "       openable_map info MAP [--json]\n"
@@ -49,7 +49,8 @@ const char* const kUsageText =
     "  add    describes the images of FOLDER and appends them to MAP as session NAME (a new\n"
     "         name), creating MAP when it does not exist. A new map takes its description and\n"
     "         index settings from --config FILE (a Config.txt) and --set, else the defaults\n"
-    "         (LDB 256 bits, global). With the auto preset (--config config/presets/auto.txt,\n"
+    "         (LDB 256 bits, global), and keeps the search they give (L, score, threshold,\n"
+    "         confirmation) for its queries. With the auto preset (--config config/presets/auto.txt,\n"
     "         Auto 1) the map keeps the rows of every descriptor of its candidates, so that\n"
     "         tune can choose among them. An existing map keeps its own settings, and a\n"
     "         --config that describes otherwise is refused. The frames must be of the map's\n"
@@ -87,7 +88,9 @@ const char* const kUsageText =
     "Match_score_window, Match_threshold, Match_consistency), tune's Auto_candidates and\n"
     "Auto_min_consistency, and query's evaluation keys (Ground_truth_type, Ground_truth,\n"
     "Tolerance, ...). --threshold X: a best match is accepted when its score is <= X (default:\n"
-    "the score's, 0.9 for the ratio, 0.13 for the distance).\n"
+    "the score's, 0.9 for the ratio, 0.13 for the distance; Match_threshold -1 means that\n"
+    "default). By default an accepted match is also confirmed by the best match of an earlier\n"
+    "query of the traversal, one sequence apart (Match_consistency 1; 0: the score alone).\n"
     "\n"
     "Example (two seasons of one route as sessions of one map, the settings chosen from them):\n"
     "  openable_map add route.map --images nordland/summer --session summer \\\n"
@@ -165,7 +168,7 @@ std::string Parse(int argc, const char* const* argv, Arguments& a) {
        {only(!a.images.empty(), "--images", {"add", "query"}),
         only(!a.time.empty(), "--time", {"add"}),
         only(!a.frames.empty(), "--frames", {"tune"}),
-        only(!a.threshold.empty(), "--threshold", {"tune", "query"}),
+        only(!a.threshold.empty(), "--threshold", {"add", "tune", "query"}),
         only(!a.config.empty() || !a.sets.empty(), "--config/--set", {"add", "tune", "query"}),
         only(!a.output.empty() && a.command != "merge", "--output", {"query"}),
         only(!a.sessions.empty(), "--session", {"add", "tune", "query"})})
@@ -255,9 +258,10 @@ void SetThreshold(const Arguments& a, OnlineOptions& o) {
   o.threshold = t;
 }
 
-// The options of a new map from a Config.txt and --set: description, index and search. With
+// The options of a new map from a Config.txt and --set: description, index, and the search
+// keys `search` (those the command line gives; the others keep the detector's defaults). With
 // Auto 1 (the auto preset) the map keeps the rows of every descriptor of its candidates.
-OnlineOptions OptionsOfConfig(const Config& c) {
+OnlineOptions OptionsOfConfig(const Config& c, const std::vector<std::string>& search) {
   OnlineOptions o;
   o.descriptor = c.descriptor;
   o.description = c.description.type;
@@ -265,7 +269,7 @@ OnlineOptions OptionsOfConfig(const Config& c) {
     o.grid_x = c.description.grid_x;
     o.grid_y = c.description.grid_y;
   }
-  for (const std::string& key : SearchKeys()) SetSearchKey(c, key, o);
+  for (const std::string& key : search) SetSearchKey(c, key, o);
   o.exclusion = c.evaluation.protocol.exclusion;
   o.approximate = c.scale.approximate;
   o.approximate.k = std::max(o.approximate.k, o.candidates);
@@ -381,7 +385,8 @@ std::string SearchText(const OnlineOptions& o) {
 int Add(const Arguments& a) {
   const std::string& path = a.positional[0];
   const bool configured = !a.config.empty() || !a.sets.empty();
-  const OnlineOptions wanted = OptionsOfConfig(ConfigOf(a));
+  OnlineOptions wanted = OptionsOfConfig(ConfigOf(a), SearchKeysGiven(a));
+  SetThreshold(a, wanted);
   std::unique_ptr<OnlineDetector> d;
   const bool exists = std::filesystem::exists(path);
   if (exists) {
@@ -744,15 +749,15 @@ std::vector<std::string> WriteQueryOutputs(const std::string& prefix, const Conf
   }
   const std::vector<std::string> paths = batch.Paths();
   batch.Commit();
-  if (report.evaluation != nullptr)
-    std::cerr << FormatEvaluationTable(evaluation.settings, evaluation.runs);
+  if (report.evaluation != nullptr && !a.quiet)
+    std::cout << FormatEvaluationTable(evaluation.settings, evaluation.runs);
   return paths;
 }
 
 int Query(const Arguments& a) {
   const std::string& path = a.positional[0];
   const Config config = ConfigOf(a);
-  OnlineOptions options = MapOptions(path, OptionsOfConfig(config));
+  OnlineOptions options = MapOptions(path, OptionsOfConfig(config, SearchKeysGiven(a)));
   // The map's search (tuned, or the one it was made with) unless the command line sets it.
   for (const std::string& key : SearchKeysGiven(a)) SetSearchKey(config, key, options);
   SetThreshold(a, options);

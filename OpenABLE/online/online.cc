@@ -1107,7 +1107,8 @@ std::vector<std::pair<std::string, std::string>> FeatureSettings(const OnlineOpt
           {"max_features", std::to_string(o.verification.max_features)}};
 }
 
-// The search settings Tune chooses, as the map keeps them ("tuned_" before each key).
+// The search settings, as the map keeps those it searches with ("search_" before each key) and
+// those Tune chose ("tuned_"). The threshold as given (< 0: the score's default).
 std::vector<std::pair<std::string, std::string>> SearchSettings(const OnlineOptions& o) {
   return {{"descriptor", o.descriptor.name},
           {"fusion_weights", Numbers(o.fusion_weights)},
@@ -1116,7 +1117,7 @@ std::vector<std::pair<std::string, std::string>> SearchSettings(const OnlineOpti
           {"sequence_length", std::to_string(o.sequence_length)},
           {"score", EnumName(o.score)},
           {"score_window", std::to_string(o.score_window)},
-          {"threshold", Exact(o.Threshold())},
+          {"threshold", Exact(o.threshold)},
           {"consistency", std::to_string(o.consistency)}};
 }
 
@@ -1125,6 +1126,8 @@ bool SameSearch(const OnlineOptions& a, const OnlineOptions& b) {
   auto x = SearchSettings(a), y = SearchSettings(b);
   x[0].second = JoinStrings(ChannelNames(a.descriptor.name, ""), "+");
   y[0].second = JoinStrings(ChannelNames(b.descriptor.name, ""), "+");
+  x[7].second = Exact(a.Threshold());
+  y[7].second = Exact(b.Threshold());
   return x == y;
 }
 
@@ -1156,6 +1159,8 @@ void OnlineDetector::SaveMap(const std::string& path) {
   for (const auto& list : {DescriptionSettings(s.options), IndexSettings(s.options),
                            FeatureSettings(s.options)})
     map.settings.insert(map.settings.end(), list.begin(), list.end());
+  for (const auto& [key, value] : SearchSettings(s.options))
+    map.settings.emplace_back("search_" + key, value);
   if (s.tuning.tuned) {
     const MapTuning& t = s.tuning;
     map.settings.insert(
@@ -1242,17 +1247,19 @@ std::vector<std::string> MapChannels(const MapFile& map) {
   return out;
 }
 
-// The search settings of a tuned map (its tuned_ keys) over `o`.
-void ReadTunedSearch(const MapFile& map, const std::string& path, OnlineOptions& o) {
-  o.descriptor.name = map.Setting("tuned_descriptor");
-  o.fusion_weights = ParseNumbers(map, "tuned_fusion_weights", path);
-  o.contrast_enhancement = map.Setting("tuned_contrast_enhancement") == "1";
-  ParseWhole(map, "tuned_contrast_window", path, o.contrast_window);
-  ParseWhole(map, "tuned_sequence_length", path, o.sequence_length);
-  o.score = ParseEnum<MatchScore>(map.Setting("tuned_score"), path + ": setting \"tuned_score\"");
-  ParseWhole(map, "tuned_score_window", path, o.score_window);
-  o.threshold = ParseNumber(map, "tuned_threshold", path);
-  ParseWhole(map, "tuned_consistency", path, o.consistency);
+// The search settings a map keeps under `prefix` ("search_", "tuned_") over `o`.
+void ReadSearch(const MapFile& map, const std::string& path, const std::string& prefix,
+                OnlineOptions& o) {
+  o.descriptor.name = map.Setting(prefix + "descriptor");
+  o.fusion_weights = ParseNumbers(map, prefix + "fusion_weights", path);
+  o.contrast_enhancement = map.Setting(prefix + "contrast_enhancement") == "1";
+  ParseWhole(map, prefix + "contrast_window", path, o.contrast_window);
+  ParseWhole(map, prefix + "sequence_length", path, o.sequence_length);
+  o.score = ParseEnum<MatchScore>(map.Setting(prefix + "score"),
+                                  path + ": setting \"" + prefix + "score\"");
+  ParseWhole(map, prefix + "score_window", path, o.score_window);
+  o.threshold = ParseNumber(map, prefix + "threshold", path);
+  ParseWhole(map, prefix + "consistency", path, o.consistency);
 }
 
 MapTuning ReadTuning(const MapFile& map, const std::string& path) {
@@ -1275,7 +1282,7 @@ MapTuning ReadTuning(const MapFile& map, const std::string& path) {
   t.units = ParseNumbers(map, "tuned_fusion_units", path);
   t.shift = ParseNumber(map, "tuned_contrast_shift", path);
   t.candidates_json = map.Setting("tuned_candidates");
-  ReadTunedSearch(map, path, t.search);
+  ReadSearch(map, path, "tuned_", t.search);
   return t;
 }
 
@@ -1392,7 +1399,11 @@ OnlineOptions MapOptions(const std::string& path, const OnlineOptions& base) {
   ParseWhole(map, "lsh_probe_level", path, o.approximate.lsh_probe_level);
   ParseWhole(map, "kd_trees", path, o.approximate.kd_trees);
   ParseWhole(map, "seed", path, o.approximate.seed);
-  if (!map.Setting("tuned").empty()) ReadTunedSearch(map, path, o);
+  // The search: Tune's choice, else the one the map was saved with (format 3), else base's.
+  if (!map.Setting("tuned").empty())
+    ReadSearch(map, path, "tuned_", o);
+  else if (!map.Setting("search_sequence_length").empty())
+    ReadSearch(map, path, "search_", o);
   try {
     o.Check();
   } catch (const InputError& e) {

@@ -80,7 +80,11 @@ struct OnlineOptions {
   // its sequence, its best candidate the same number of frames back in the same session,
   // within the tolerance). Online there is no later query to confirm with, so the first
   // queries of a traversal (before a partner exists) are never accepted. 0: the score alone.
-  int consistency = 0;
+  // The default, 1: on the shared Nordland seasons an untuned map of LDB rows accepted 2 best
+  // matches, 1 wrong, without it and none with it; on KITTI 00 frames 0-1699, one traversal
+  // with the distance score, 42 loops instead of 52, every one right either way
+  // (docs/benchmarks.md, "Maps").
+  int consistency = 1;
   // Search: exact (every earlier frame) while the searchable map holds at most exact_limit
   // frames; beyond, frames are indexed by approximate.engine (an engine of
   // matching/search/engine_registry.h) in blocks of block_frames merged as they grow (sizes
@@ -379,10 +383,11 @@ class OnlineDetector {
 // The options of a detector that loads the map at `path` with its saved index: the
 // description settings (descriptors, description, patch size, LDB bits, SAD patch, grid) and
 // the index settings (exclusion, exact_limit, block_frames, engine and its build settings) the
-// map was made with; the search settings Tune chose when the map is tuned (descriptor, fusion
-// weights, contrast enhancement, L, score and its window, threshold, consistency), else
-// `base`'s; everything else from `base`. Reads the map's settings only. Throws InputError as
-// LoadMap does, and "no map at PATH (create one with openable_map add)" when there is none.
+// map was made with; the search settings (descriptor, fusion weights, contrast enhancement, L,
+// score and its window, threshold, consistency) Tune chose when the map is tuned, else those
+// it was saved with (maps of format 3; `base`'s for older maps); everything else from `base`.
+// Reads the map's settings only. Throws InputError as LoadMap does, and "no map at PATH
+// (create one with openable_map add ...)" when there is none.
 OnlineOptions MapOptions(const std::string& path, const OnlineOptions& base = OnlineOptions());
 
 // ---- Batch helpers -------------------------------------------------------------------------

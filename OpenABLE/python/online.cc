@@ -721,11 +721,28 @@ the map is damaged. Returns at once when no map was loaded or it was checked.)do
       "open",
       [](const py::object& path_object, const py::kwargs& kwargs) {
         const std::string path = FileSystemPath(path_object, "OnlineDetector.open: path");
+        // The map's own options (MapOptions), then each keyword given, as the constructor
+        // sets them.
         const OnlineOptions base = OnlineOptionsOf(kwargs);
+        OnlineOptions own;
+        {
+          py::gil_scoped_release release;
+          own = MapOptions(path, base);
+        }
+        const std::vector<std::string> names = PropertyNames(py::type::of<OnlineOptions>());
+        py::object options = py::cast(own);
+        for (const auto item : kwargs) {
+          const std::string name = item.first.cast<std::string>();
+          if (std::find(names.begin(), names.end(), name) == names.end())
+            throw py::type_error("unexpected keyword argument \"" + name + "\"; expected one of " +
+                                 py::str(py::cast(names)).cast<std::string>());
+          options.attr(name.c_str()) = item.second;
+        }
+        const OnlineOptions chosen = options.cast<OnlineOptions>();
         auto d = std::make_unique<Detector>();
         {
           py::gil_scoped_release release;
-          d->detector = std::make_unique<OnlineDetector>(MapOptions(path, base));
+          d->detector = std::make_unique<OnlineDetector>(chosen);
           d->detector->LoadMap(path);
         }
         return d;
@@ -733,10 +750,13 @@ the map is damaged. Returns at once when no map was loaded or it was checked.)do
       py::arg("path"),
       R"doc(OnlineDetector.open(path, **options) -> OnlineDetector
 
-A detector holding the map saved at `path`, with the description and index options the map
-was made with (the other options, such as sequence_length, candidates and threshold, from
-`options` or the defaults). The file is memory-mapped: its rows and binary_ivf index blocks
-are used where they lie, and its checksums are verified in the background (check_map()).)doc");
+A detector holding the map saved at `path`, with the options the map keeps: the description
+and index options it was made with, and its search (the one tune() chose, else the one it was
+saved with: descriptor, sequence_length, score, threshold, consistency, ...); each keyword
+given replaces the map's (a search of the keyword's, whose tuned verdict then does not apply;
+description options other than the map's are refused on loading). The file is memory-mapped:
+its rows and binary_ivf index blocks are used where they lie, and its checksums are verified in
+the background (check_map()).)doc");
   BindDetectorMapAndState(c);
 }
 

@@ -75,6 +75,7 @@ TEST(OnlineDetector, GivesTheBruteForceCandidatesOnRealKittiFrames) {
   options.sequence_length = 5;
   options.exclusion = 25;
   options.candidates = 4;
+  options.consistency = 0;  // the score alone (the confirmation: tests/online/map_tuning_test.cc)
   OnlineDetector detector(options);
   const cv::Mat batch_rows = DescribeImages(frames, options);
   // The batch path of Test_OpenABLE: the normalised sequence matrix and its kept matches (the
@@ -163,6 +164,7 @@ TEST_P(OnlineDetectorEngine, SearchesBlocksBeyondTheExactLimit) {
   OnlineOptions exact_options;
   exact_options.exclusion = 50;
   exact_options.candidates = 1;
+  exact_options.consistency = 0;  // the score alone: what the index finds is measured
   OnlineOptions options = exact_options;
   options.approximate.engine = engine;
   options.exact_limit = 100;

@@ -30,8 +30,9 @@ class OnlineAgainstBatchTest(unittest.TestCase):
         cls.sums = openable.sequence_distances(openable.hamming_distances(cls.rows), L,
                                                partial="scale")
         cls.sums = cls.sums.astype(np.float64)
+        # consistency=0: the score alone decides (test_map_tuning checks the confirmation).
         cls.detector = openable.OnlineDetector(sequence_length=L, exclusion=EXCLUSION,
-                                               candidates=K, threshold=THRESHOLD)
+                                               candidates=K, threshold=THRESHOLD, consistency=0)
         cls.results = [cls.detector.add_descriptor(row) for row in cls.rows]
 
     def expected(self, q):
@@ -63,7 +64,8 @@ class OnlineAgainstBatchTest(unittest.TestCase):
         # ratio of candidate j is S(q, j) over the smallest S(q, j') with |j' - j| > W.
         W, ratio_threshold = 10, 0.9
         d = openable.OnlineDetector(sequence_length=L, exclusion=EXCLUSION, candidates=K,
-                                    score="ratio", score_window=W, threshold=ratio_threshold)
+                                    score="ratio", score_window=W, threshold=ratio_threshold,
+                                    consistency=0)
         self.assertEqual(d.options["score"], "ratio")
         checked = 0
         for q, row in enumerate(self.rows):
