@@ -615,7 +615,7 @@ std::string EncodeQueryCsv(const Json& queries) {
     const auto field = [&](const char* key) {
       const Json& v = q[key];
       if (v.is_null()) return std::string();
-      if (v.is_string()) return CsvField(v.get<std::string>());
+      if (v.is_string()) return CsvField(ToValidUtf8(v.get<std::string>()));
       if (v.is_boolean()) return std::string(v.get<bool>() ? "1" : "0");
       if (v.is_number_integer()) return std::to_string(v.get<long long>());
       return CsvNumber(v.get<double>());

@@ -10,12 +10,14 @@
 
 namespace openable::fuzz {
 
-enum class MapKind { kRows, kFloat, kVerifying };
+enum class MapKind { kRows, kFloat, kVerifying, kSeveral };
 
 // kRows: LDB rows (CV_8U) with index blocks from 16 searchable frames on (exact_limit 0,
 // block_frames 16; FLANN's LSH, kept small, which a loaded map builds again). kFloat: HOG rows
 // of a 16-pixel patch (36 CV_32F), exact search. kVerifying: LDB rows and each frame's ORB
-// features (10 a frame), candidates verified with 5 inliers.
+// features (10 a frame), candidates verified with 5 inliers. kSeveral: LDB rows and SAD's
+// (a 16-pixel patch, 128 bytes) kept beside them, exact search, the contrast enhancement of the
+// search and a tuned search in its seed.
 inline OnlineOptions MapDetectorOptions(MapKind kind) {
   OnlineOptions o;
   o.exclusion = 2;
@@ -30,6 +32,10 @@ inline OnlineOptions MapDetectorOptions(MapKind kind) {
   } else if (kind == MapKind::kFloat) {
     o.descriptor.name = "HOG";
     o.descriptor.patch_size = 16;
+  } else if (kind == MapKind::kSeveral) {
+    o.descriptor.patch_size = 16;
+    o.kept_descriptors = "SAD";
+    o.contrast_enhancement = true;
   } else {
     o.exclusion = 1;
     o.verification.enabled = true;

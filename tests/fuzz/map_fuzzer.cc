@@ -1,7 +1,7 @@
 // libFuzzer target: arbitrary bytes as a saved online map (the file of OnlineDetector::SaveMap,
 // OpenABLE/online/map_file.h), written to a temporary file. ReadMapFile reads the bytes as
 // they are; then the same bytes with their checksums made right (format version 2: each
-// section's CRC-32 named by the table, then the table's own; version 1: the last 8 bytes, the
+// section's CRC-32 named by the table, then the table's own (versions 2 and 3); version 1: the last 8 bytes, the
 // FNV-1a of the rest), so that mutations reach the sections behind the checksums, go through
 // ReadMapFile and OnlineDetector::LoadMap into the detector whose settings the map names
 // (tests/fuzz/map_detectors.h), and, when it loads, one more frame is searched among the
@@ -62,6 +62,7 @@ bool FixChecksums(std::string& b) {
 }
 
 MapKind KindOf(const openable::MapFile& map) {
+  if (!map.more_rows.empty()) return MapKind::kSeveral;
   if (map.Setting("row_type") == "CV_32F") return MapKind::kFloat;
   return map.Setting("features") == "none" ? MapKind::kRows : MapKind::kVerifying;
 }

@@ -77,6 +77,23 @@ void WriteMaps(const std::string& dir) {
     OnlineDetector d(MapDetectorOptions(MapKind::kRows));
     d.SaveMap(dir + "/empty.map");
   }
+  {  // 24 frames of LDB and SAD rows in two sessions, with their files, tuned.
+    OnlineDetector d(MapDetectorOptions(MapKind::kSeveral));
+    for (const char* session : {"a", "b"}) {
+      d.StartSession(session, "2026-11-29T00:00:00Z");
+      std::vector<cv::Mat> frames;
+      std::vector<std::string> names;
+      for (int i = 0; i < 12; ++i) {
+        frames.push_back(MapFrame(i));
+        names.push_back(std::string(session) + std::to_string(i) + ".png");
+      }
+      d.AddImagesToMap(frames, names);
+    }
+    OnlineDetector::TuneOptions tune;
+    tune.candidates = "Image_descriptor=LDB,SAD Image_sequences=2";
+    d.Tune(tune);
+    d.SaveMap(dir + "/several.map");
+  }
 }
 
 // ---- Bags
