@@ -130,6 +130,34 @@ class SampleMapTest(TempDirTestCase):
         self.assertIn("create one with openable_map add", done.stderr)
 
 
+class PresetMapTest(TempDirTestCase):
+    """A map made with the across-conditions preset: a fused descriptor (HOG+LDB), whose
+    search (L = 40, the ratio <= 0.9, confirmed) the map keeps for its queries."""
+
+    def test_fused_preset_map_keeps_its_search(self):
+        preset = SOURCE_DIR / "config" / "presets" / "across_conditions.txt"
+        path = self.tmp / "fused.map"
+        run("openable_map", ["add", path, "--images", SAMPLE / "summer", "--session", "summer",
+                             "--config", preset, "--quiet"], self.tmp)
+        info = json.loads(run("openable_map", ["info", path, "--json"], self.tmp).stdout)
+        self.assertEqual(info["descriptors"], ["HOG", "LDB"])
+        self.assertEqual(info["settings"]["search_sequence_length"], "40")
+        self.assertEqual(info["settings"]["search_score"], "ratio")
+        self.assertIsNone(info["tuning"])
+        rows = query_rows(self.tmp, path, SAMPLE, "fused")
+        recall, accepted, wrong = figures(rows)
+        self.assertGreaterEqual(recall, 0.8)
+        self.assertGreater(accepted, 100)
+        self.assertEqual(wrong, 0)
+        # Told otherwise on the command line: L = 10, the score alone.
+        other = query_rows(self.tmp, path, SAMPLE, "l10", "--set", "Image_sequences=10",
+                           "--set", "Match_consistency=0")
+        document = json.load(open(self.tmp / "l10.json"))
+        self.assertIn("L = 10", document["search"])
+        self.assertNotIn("confirmed by", document["search"])
+        self.assertNotEqual([r["frame"] for r in other], [r["frame"] for r in rows])
+
+
 class UnrelatedMapTest(TempDirTestCase):
     """Two sessions of different stretches of the route: tune says UNRELIABLE, nothing is
     accepted."""
