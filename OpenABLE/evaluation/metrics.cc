@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/evaluation/answers.h"
 
 namespace openable {
 namespace {
@@ -145,22 +146,18 @@ void Summarize(PerQueryResult& r, const std::vector<std::uint8_t>& has_candidate
   r.auc = CurveArea(r.curve);
   if (options.accept_threshold >= 0) {
     // The answers accepted: score <= threshold, and, with Match_consistency, confirmed by
-    // their partners; counted over the queries with candidates, as the curve counts them.
+    // their partners (AcceptAnswers, the rule shown without ground truth too); counted over
+    // the queries with candidates, as the curve counts them.
     r.has_operating_point = true;
-    r.accepted.assign(static_cast<std::size_t>(nq), 0);
-    std::vector<std::uint8_t> agree;
-    if (options.accept_consistency > 0) {
-      AgreementOptions a = options.agreement;
-      a.partners = options.accept_consistency;
-      agree = AgreeingAnswers(r.best, a);
-    }
+    std::vector<std::uint8_t> within;
+    AcceptAnswers(r.best, r.score, options, within, r.accepted);
     CurvePoint& p = r.operating_point;
     p.threshold = options.accept_threshold;
     for (int q = 0; q < nq; ++q) {
-      if (!has_candidates[q] || r.best[q] < 0 || options.accept_none) continue;
-      if (!(r.score[q] <= options.accept_threshold)) continue;
-      if (!agree.empty() && !agree[q]) continue;
-      r.accepted[q] = 1;
+      if (!has_candidates[q] || !r.accepted[q]) {
+        r.accepted[q] = 0;
+        continue;
+      }
       if (r.correct[q])
         ++p.tp;
       else

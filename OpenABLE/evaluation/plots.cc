@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -208,6 +209,7 @@ const cv::Vec3b kTruthTint(255, 128, 0);
 const cv::Vec3b kCorrect(0, 200, 0);
 const cv::Vec3b kWrong(0, 0, 230);
 const cv::Vec3b kRejected(220, 0, 220);  // magenta: apart from green, red and the blue tint
+const cv::Vec3b kAccepted(0, 140, 255);  // orange: an answer accepted without ground truth
 
 // Grey level of a normalised value: 255 v rounded, clamped to [0, 255]; NaN is white.
 inline std::uint8_t Grey(float v) {
@@ -217,18 +219,26 @@ inline std::uint8_t Grey(float v) {
 }
 
 // The legend strip: swatches and texts, flowing onto further lines when `width` is too small.
-cv::Mat3b OverlayLegend(int width, bool verification) {
+// With the ground truth (`truth`): its tint and the answers right or wrong; without: the
+// accepted answers, not judged.
+cv::Mat3b OverlayLegend(int width, bool truth, bool verification) {
   struct Item {
     std::string text;
     bool swatch;
     cv::Vec3b colour;
   };
-  const std::vector<Item> items = {
-      {"ground truth", true, cv::Vec3b(192, 128, 64)},  // the tint over mid grey
-      {verification ? "verified, correct" : "accepted, correct", true, kCorrect},
-      {verification ? "verified, wrong" : "accepted, wrong", true, kWrong},
-  };
-  std::vector<Item> all = items;
+  std::vector<Item> all;
+  if (truth) {
+    all = {
+        {"ground truth", true, cv::Vec3b(192, 128, 64)},  // the tint over mid grey
+        {verification ? "verified, correct" : "accepted, correct", true, kCorrect},
+        {verification ? "verified, wrong" : "accepted, wrong", true, kWrong},
+    };
+  } else {
+    all = {{verification ? "verified and accepted (no ground truth: not judged)"
+                         : "accepted best match (no ground truth: not judged)",
+            true, kAccepted}};
+  }
   if (verification) all.push_back({"rejected by verification", true, kRejected});
   all.push_back({"rows: queries, columns: references", false, cv::Vec3b()});
   const double scale = 0.5;
@@ -300,9 +310,16 @@ void DrawOverlayAxes(cv::Mat3b& img, int rows, int cols, int k) {
 
 }  // namespace
 
-cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
-                        const GroundTruth& truth, const PerQueryResult& result,
-                        double accept_threshold, const std::vector<cv::Point>* rejected) {
+namespace {
+
+// The figure of RenderOverlay: the block in grey with the ground truth tinted when `truth` is
+// given, enlarged, with its axes and legend, the cells of `rejected` in magenta, then the
+// answers `marks` draws (given the block's image, the enlargement k and how much a mark grows
+// on each side).
+using DrawMarks = std::function<void(cv::Mat3b& img, int k, int grow)>;
+cv::Mat3b DrawOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                      const GroundTruth* truth, const std::vector<cv::Point>* rejected,
+                      const DrawMarks& marks) {
   const int rows = layout.queries, cols = layout.references;
   if (rows <= 0 || cols <= 0 || layout.row_offset < 0 || layout.col_offset < 0 ||
       layout.row_offset + rows > matrix.rows || layout.col_offset + cols > matrix.cols) {
@@ -325,10 +342,11 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
       out[c] = cv::Vec3b(g, g, g);
     }
   }
-  const int truth_rows = std::min(rows, static_cast<int>(truth.matches.size()));
+  const int truth_rows =
+      truth != nullptr ? std::min(rows, static_cast<int>(truth->matches.size())) : 0;
   for (int q = 0; q < truth_rows; ++q) {
     cv::Vec3b* out = cells.ptr<cv::Vec3b>(q);
-    for (int c : truth.matches[q]) {
+    for (int c : truth->matches[q]) {
       if (c < 0 || c >= cols) continue;
       cv::Vec3b& p = out[c];
       for (int ch = 0; ch < 3; ++ch)
@@ -340,8 +358,8 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
   const int k = std::max(1, (kOverlayTarget + std::max(rows, cols) - 1) / std::max(rows, cols));
   const int image_w = cols * k, image_h = rows * k;
   const int left = kOverlayAxisLeft, top = kOverlayAxisTop;
-  const cv::Mat3b legend =
-      OverlayLegend(left + std::max(image_w, kOverlayTarget), rejected != nullptr);
+  const cv::Mat3b legend = OverlayLegend(left + std::max(image_w, kOverlayTarget),
+                                         truth != nullptr, rejected != nullptr);
   cv::Mat3b whole(top + image_h + legend.rows, legend.cols, cv::Vec3b(255, 255, 255));
   DrawOverlayAxes(whole, rows, cols, k);
   // The block's pixels: `img` is a view of them, so that marks are placed in cell units.
@@ -357,8 +375,8 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
     }
   }
 
-  // Accepted best matches. Marks are the enlarged cell, grown to at least 3 x 3 pixels (and to
-  // 5 x 5 and more on very large images, so they stay visible when the image is viewed whole).
+  // Marks are the enlarged cell, grown to at least 3 x 3 pixels (and to 5 x 5 and more on very
+  // large images, so they stay visible when the image is viewed whole).
   int grow = k >= 3 ? 0 : 1;
   if (k == 1) grow = std::max(grow, std::max(rows, cols) / 1200);
   const cv::Rect image_area(0, 0, image_w, image_h);
@@ -369,29 +387,59 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
           image_area)
           .setTo(kRejected);
     }
-  const int marked = std::min(
-      rows, static_cast<int>(
-                std::min({result.best.size(), result.score.size(), result.correct.size()})));
-  for (int pass = 0; pass < 2; ++pass) {  // wrong marks last, so a neighbour never hides them
-    for (int q = 0; q < marked; ++q) {
-      const int c = result.best[q];
-      const float d = result.score[q];
-      // At the operating point, the answers it accepted (Match_consistency may refuse some
-      // below its threshold); else those with a score within the threshold given.
-      const bool at_operating_point =
-          result.has_operating_point && q < static_cast<int>(result.accepted.size());
-      const bool accepted = at_operating_point ? result.accepted[q] != 0 : d <= accept_threshold;
-      if (c < 0 || c >= cols || !accepted) continue;
-      const bool correct = result.correct[q] != 0;
-      if (correct != (pass == 0)) continue;
-      const cv::Rect mark =
-          cv::Rect(c * k - grow, q * k - grow, k + 2 * grow, k + 2 * grow) & image_area;
-      img(mark).setTo(correct ? kCorrect : kWrong);
-    }
-  }
+  marks(img, k, grow);
 
   legend.copyTo(whole(cv::Rect(0, top + image_h, legend.cols, legend.rows)));
   return whole;
+}
+
+// Marks query q's answer c in `img` (enlarged k times, marks grown by `grow`).
+void Mark(cv::Mat3b& img, int k, int grow, int q, int c, const cv::Vec3b& colour) {
+  const cv::Rect mark = cv::Rect(c * k - grow, q * k - grow, k + 2 * grow, k + 2 * grow) &
+                        cv::Rect(0, 0, img.cols, img.rows);
+  img(mark).setTo(colour);
+}
+
+}  // namespace
+
+cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                        const GroundTruth& truth, const PerQueryResult& result,
+                        double accept_threshold, const std::vector<cv::Point>* rejected) {
+  const int rows = layout.queries, cols = layout.references;
+  return DrawOverlay(matrix, layout, &truth, rejected, [&](cv::Mat3b& img, int k, int grow) {
+    const int marked = std::min(
+        rows, static_cast<int>(
+                  std::min({result.best.size(), result.score.size(), result.correct.size()})));
+    for (int pass = 0; pass < 2; ++pass) {  // wrong marks last, so a neighbour never hides them
+      for (int q = 0; q < marked; ++q) {
+        const int c = result.best[q];
+        const float d = result.score[q];
+        // At the operating point, the answers it accepted (Match_consistency may refuse some
+        // below its threshold); else those with a score within the threshold given.
+        const bool at_operating_point =
+            result.has_operating_point && q < static_cast<int>(result.accepted.size());
+        const bool accepted =
+            at_operating_point ? result.accepted[q] != 0 : d <= accept_threshold;
+        if (c < 0 || c >= cols || !accepted) continue;
+        const bool correct = result.correct[q] != 0;
+        if (correct != (pass == 0)) continue;
+        Mark(img, k, grow, q, c, correct ? kCorrect : kWrong);
+      }
+    }
+  });
+}
+
+cv::Mat3b RenderAnswersOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                               const std::vector<int>& best,
+                               const std::vector<std::uint8_t>& accepted,
+                               const std::vector<cv::Point>* rejected) {
+  const int rows = layout.queries, cols = layout.references;
+  return DrawOverlay(matrix, layout, nullptr, rejected, [&](cv::Mat3b& img, int k, int grow) {
+    const int marked =
+        std::min(rows, static_cast<int>(std::min(best.size(), accepted.size())));
+    for (int q = 0; q < marked; ++q)
+      if (best[q] >= 0 && best[q] < cols && accepted[q]) Mark(img, k, grow, q, best[q], kAccepted);
+  });
 }
 
 }  // namespace openable

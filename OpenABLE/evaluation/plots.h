@@ -3,6 +3,7 @@
 // library.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -49,5 +50,13 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                         const GroundTruth& truth, const PerQueryResult& result,
                         double accept_threshold,
                         const std::vector<cv::Point>* rejected = nullptr);
+
+// The same figure without ground truth: the block in grey, no tint, and each query's answer
+// best[q] (a column of the block, -1 none) marked orange where accepted[q] is 1, not judged
+// right or wrong; the legend says so. `rejected` as above.
+cv::Mat3b RenderAnswersOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                               const std::vector<int>& best,
+                               const std::vector<std::uint8_t>& accepted,
+                               const std::vector<cv::Point>* rejected = nullptr);
 
 }  // namespace openable

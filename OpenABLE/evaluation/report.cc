@@ -90,41 +90,48 @@ double AtN(const std::vector<double>& recalls, int n) {
 // The table of each run under each protocol chosen, when a reference protocol is.
 void FormatProtocolTable(std::ostringstream& o, const EvaluationSettings& s,
                          const std::vector<EvaluatedRun>& runs) {
-  const EvaluationProtocols& p = s.options.protocols;
-  if (!p.vpr_bench && !p.vpr_tutorial) return;
+  const std::vector<ProtocolRow> rows = ProtocolRows(s, runs);
+  if (rows.empty()) return;
   o << "By protocol (docs/evaluation.md; each as its code computes it, the matrix's best "
        "matches):\n";
   char line[512];
   std::snprintf(line, sizeof line, "  %-18s %-13s %7s %7s %6s %6s %6s  %s\n", "run", "protocol",
                 "AUC", "R@100P", "R@1", "R@5", "R@10", "more");
   o << line;
-  if (s.options.tolerance > 0 && (s.truth.type == GroundTruthType::kVprBench ||
-                                  s.truth.type == GroundTruthType::kVprTutorial))
-    o << "  (Tolerance " << s.options.tolerance << " widens the file's true references by +-"
-      << s.options.tolerance << " frames; Tolerance 0 takes them as the reference code does)\n";
-  auto row = [&](const std::string& label, const char* protocol, double auc, double r100,
-                 double r1, double r5, double r10, const std::string& more) {
+  const std::string widened = ProtocolToleranceNote(s);
+  if (!widened.empty()) o << "  (" << widened << ")\n";
+  for (const ProtocolRow& r : rows) {
     std::snprintf(line, sizeof line, "  %-18s %-13s %7s %7s %6s %6s %6s  %s\n",
-                  label.substr(0, 18).c_str(), protocol, Figure(auc).c_str(),
-                  Figure(r100).c_str(), Figure(r1).c_str(), Figure(r5).c_str(),
-                  Figure(r10).c_str(), more.c_str());
+                  r.label.substr(0, 18).c_str(), r.protocol.c_str(), Figure(r.auc).c_str(),
+                  Figure(r.recall_at_100p).c_str(), Figure(r.recall_at_1).c_str(),
+                  Figure(r.recall_at_5).c_str(), Figure(r.recall_at_10).c_str(), r.more.c_str());
     o << line;
-  };
+  }
+}
+
+}  // namespace
+
+std::vector<ProtocolRow> ProtocolRows(const EvaluationSettings& s,
+                                      const std::vector<EvaluatedRun>& runs) {
+  std::vector<ProtocolRow> rows;
+  const EvaluationProtocols& p = s.options.protocols;
+  if (!p.vpr_bench && !p.vpr_tutorial) return rows;
   for (const EvaluatedRun& r : runs) {
     const PerQueryResult& q = r.verified ? r.per_query_unverified : r.per_query;
     if (p.openable) {
       char more[96];
       std::snprintf(more, sizeof more, "max F1 %.3f, ABLE-P AP %.1f%%", q.max_f1,
                     r.able_p.average_precision);
-      row(r.label, "openable", q.auc, q.recall_at_100p, q.recall_at_1, q.recall_at_5,
-          q.recall_at_10, more);
+      rows.push_back({r.label, "openable", q.auc, q.recall_at_100p, q.recall_at_1,
+                      q.recall_at_5, q.recall_at_10, more});
     }
     if (r.has_vpr_bench) {
       const VprBenchResult& b = r.vpr_bench;
-      row(r.label, "vpr_bench", b.auc_pr, b.recall_at_100p, AtN(b.recall_at_n, 1),
-          AtN(b.recall_at_n, 5), AtN(b.recall_at_n, 10),
-          "EP " + Figure(b.extended_precision) + "; " + std::to_string(b.queries) +
-              " queries, " + std::to_string(b.queries_with_truth) + " with a true reference");
+      rows.push_back({r.label, "vpr_bench", b.auc_pr, b.recall_at_100p, AtN(b.recall_at_n, 1),
+                      AtN(b.recall_at_n, 5), AtN(b.recall_at_n, 10),
+                      "EP " + Figure(b.extended_precision) + "; " + std::to_string(b.queries) +
+                          " queries, " + std::to_string(b.queries_with_truth) +
+                          " with a true reference"});
     }
     if (r.has_vpr_tutorial) {
       const VprTutorialResult& t = r.vpr_tutorial;
@@ -133,14 +140,22 @@ void FormatProtocolTable(std::ostringstream& o, const EvaluationSettings& s,
                          Figure(t.recall_at_100p_single)
                    : std::string("single-match: not with GTsoft");
       // recall_at_k holds K = 1, 5, 10 in its positions 1, 2, 3.
-      row(r.label, "vpr_tutorial", t.auc_multi, t.recall_at_100p_multi, AtN(t.recall_at_k, 1),
-          AtN(t.recall_at_k, 2), AtN(t.recall_at_k, 3),
-          "multi-match; " + single + (t.soft ? "; GTsoft cells ignored" : ""));
+      rows.push_back({r.label, "vpr_tutorial", t.auc_multi, t.recall_at_100p_multi,
+                      AtN(t.recall_at_k, 1), AtN(t.recall_at_k, 2), AtN(t.recall_at_k, 3),
+                      "multi-match; " + single + (t.soft ? "; GTsoft cells ignored" : "")});
     }
   }
+  return rows;
 }
 
-}  // namespace
+std::string ProtocolToleranceNote(const EvaluationSettings& s) {
+  if (s.options.tolerance > 0 && (s.truth.type == GroundTruthType::kVprBench ||
+                                  s.truth.type == GroundTruthType::kVprTutorial))
+    return "Tolerance " + std::to_string(s.options.tolerance) +
+           " widens the file's true references by +-" + std::to_string(s.options.tolerance) +
+           " frames; Tolerance 0 takes them as the reference code does";
+  return "";
+}
 
 std::string EncodeVprBenchCsv(const VprBenchResult& r) {
   std::string out = "precision,recall\n";
@@ -301,8 +316,10 @@ std::string FormatEvaluationTable(const EvaluationSettings& s,
           o << "    accepted: none (the auto mode found no setting consistent enough to trust, "
                "Auto_min_consistency)\n";
         } else {
-          std::snprintf(line, sizeof line, "    %s: %lld answers, precision %.3f, recall %.3f\n",
-                        at.c_str(), static_cast<long long>(p.tp + p.fp), p.precision, p.recall);
+          std::snprintf(line, sizeof line,
+                        "    %s: %lld answers, %lld right, precision %.3f, recall %.3f\n",
+                        at.c_str(), static_cast<long long>(p.tp + p.fp),
+                        static_cast<long long>(p.tp), p.precision, p.recall);
           o << line;
         }
       }
