@@ -132,9 +132,30 @@ std::string EncodeText(const cv::Mat& m) {
   return out;
 }
 
-std::string EncodeMatches(const std::vector<Match>& matches, bool csv) {
+MatchVerdicts VerdictsOf(const std::vector<Match>& matches, double threshold,
+                         const AgreementOptions* consistency, bool accept_none) {
+  MatchVerdicts v;
+  if (accept_none || threshold < 0) return v;
+  int queries = 0;
+  for (const Match& m : matches)
+    if (m.rank == 1) queries = std::max(queries, m.query + 1);
+  v.accepted = AcceptedMatches(matches, queries, threshold, nullptr);
+  v.confirmed = consistency != nullptr ? AcceptedMatches(matches, queries, threshold, consistency)
+                                       : v.accepted;
+  return v;
+}
+
+std::string EncodeMatches(const std::vector<Match>& matches, bool csv,
+                          const MatchVerdicts& verdicts) {
+  // The verdicts of a match: those of its query's best match for rank 1, else none.
+  const auto verdict = [&](const Match& k, const std::vector<std::uint8_t>& flags) {
+    return k.rank == 1 && k.query >= 0 && static_cast<std::size_t>(k.query) < flags.size() &&
+                   flags[static_cast<std::size_t>(k.query)] != 0
+               ? 1
+               : 0;
+  };
   if (csv) {
-    std::string out = "query,reference,distance,rank,score\n";
+    std::string out = "query,reference,distance,rank,score,accepted,confirmed\n";
     char buf[128];
     for (const Match& k : matches) {
       char* p = buf;
@@ -147,25 +168,33 @@ std::string EncodeMatches(const std::vector<Match>& matches, bool csv) {
       p = std::to_chars(p, buf + sizeof buf, k.rank).ptr;
       *p++ = ',';
       p = std::to_chars(p, buf + sizeof buf, k.score, std::chars_format::general, 7).ptr;
+      *p++ = ',';
+      *p++ = verdict(k, verdicts.accepted) ? '1' : '0';
+      *p++ = ',';
+      *p++ = verdict(k, verdicts.confirmed) ? '1' : '0';
       *p++ = '\n';
       out.append(buf, p);
     }
     return out;
   }
-  // A structured .npy: one record of 20 bytes per match.
+  // A structured .npy: one record of 22 bytes per match, the first 20 as files without the
+  // verdicts had them.
+  constexpr std::size_t kRecord = 22;
   std::string out = NpyHeaderOf(
       "[('query', '<i4'), ('reference', '<i4'), ('distance', '<f4'), ('rank', '<i4'), "
-      "('score', '<f4')]",
+      "('score', '<f4'), ('accepted', '|u1'), ('confirmed', '|u1')]",
       "(" + std::to_string(matches.size()) + ",)");
-  out.reserve(out.size() + matches.size() * 20);
+  out.reserve(out.size() + matches.size() * kRecord);
   for (const Match& k : matches) {
-    char rec[20];
+    char rec[kRecord];
     std::memcpy(rec, &k.query, 4);
     std::memcpy(rec + 4, &k.reference, 4);
     std::memcpy(rec + 8, &k.distance, 4);
     std::memcpy(rec + 12, &k.rank, 4);
     std::memcpy(rec + 16, &k.score, 4);
-    out.append(rec, 20);
+    rec[20] = static_cast<char>(verdict(k, verdicts.accepted));
+    rec[21] = static_cast<char>(verdict(k, verdicts.confirmed));
+    out.append(rec, kRecord);
   }
   return out;
 }

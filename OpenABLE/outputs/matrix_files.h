@@ -2,6 +2,8 @@
 // and the matches file.
 #pragma once
 
+#include <cstdint>
+
 #include <opencv2/core.hpp>
 #include <string>
 #include <string_view>
@@ -33,8 +35,25 @@ class TextChunks {
   std::vector<std::size_t> lengths_ = std::vector<std::size_t>(kBlocks);
 };
 
+// What the run's operating point made of each query's best match (the match of rank 1), per
+// query of the block: accepted (its score is <= Match_threshold) and confirmed (accepted and,
+// with Match_consistency, confirmed by independent queries; without it, every accepted match):
+// the confirmed ones are the run's matches. Empty: nothing accepted.
+struct MatchVerdicts {
+  std::vector<std::uint8_t> accepted, confirmed;
+};
+
+// The verdicts of `matches` (AcceptedMatches, matching/bounded.h, over their rank-1 matches)
+// at `threshold` (-1: none accepted), confirmed by `consistency` (null: Match_consistency 0);
+// none at all when `accept_none` (the auto mode trusted no setting).
+MatchVerdicts VerdictsOf(const std::vector<Match>& matches, double threshold,
+                         const AgreementOptions* consistency, bool accept_none);
+
 // Bytes of the matches file: .npy (structured array: query, reference int32; distance
-// float32; rank int32; score float32) or .csv (header "query,reference,distance,rank,score").
-std::string EncodeMatches(const std::vector<Match>& matches, bool csv);
+// float32; rank int32; score float32; accepted, confirmed uint8) or .csv (header
+// "query,reference,distance,rank,score,accepted,confirmed"). accepted and confirmed are those
+// of `verdicts` for a match of rank 1, 0 for the others (docs/output_formats.md).
+std::string EncodeMatches(const std::vector<Match>& matches, bool csv,
+                          const MatchVerdicts& verdicts = {});
 
 }  // namespace openable

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -374,22 +375,80 @@ TEST(EncodeText, WideRowsGrowThePieceBuffer) {
 TEST(EncodeMatches, NpyRecordsAndCsvText) {
   const std::vector<Match> m = {{1, 2, 0.5f, 1, 0.25f}, {3, 4, 0.25f, 0, 0.75f}};
   const std::string csv = EncodeMatches(m, true);
-  EXPECT_EQ(csv, "query,reference,distance,rank,score\n1,2,0.5,1,0.25\n3,4,0.25,0,0.75\n");
+  EXPECT_EQ(csv,
+            "query,reference,distance,rank,score,accepted,confirmed\n1,2,0.5,1,0.25,0,0\n"
+            "3,4,0.25,0,0.75,0,0\n");
   const std::string npy = EncodeMatches(m, false);
-  ASSERT_EQ(npy.size() % 4, 0u);
-  const size_t header = npy.size() - 40;  // 64-byte aligned header, 20-byte records
+  const size_t header = npy.size() - 44;  // 64-byte aligned header, 22-byte records
   EXPECT_EQ(header % 64, 0u);
   EXPECT_NE(npy.find("('distance', '<f4')"), std::string::npos);
-  EXPECT_NE(npy.find("('score', '<f4')"), std::string::npos);
+  EXPECT_NE(npy.find("('score', '<f4'), ('accepted', '|u1'), ('confirmed', '|u1')"),
+            std::string::npos);
   EXPECT_NE(npy.find("'shape': (2,)"), std::string::npos);
   int q = 0;
   float dist = 0, score = 0;
-  std::memcpy(&q, npy.data() + header + 20, 4);
-  std::memcpy(&dist, npy.data() + header + 20 + 8, 4);
-  std::memcpy(&score, npy.data() + header + 20 + 16, 4);
+  std::memcpy(&q, npy.data() + header + 22, 4);
+  std::memcpy(&dist, npy.data() + header + 22 + 8, 4);
+  std::memcpy(&score, npy.data() + header + 22 + 16, 4);
   EXPECT_EQ(q, 3);
   EXPECT_EQ(dist, 0.25f);
   EXPECT_EQ(score, 0.75f);
+  EXPECT_EQ(npy[header + 22 + 20], 0);
+  EXPECT_EQ(npy[header + 22 + 21], 0);
+}
+
+// The verdicts of the matches file: per query, its rank-1 match accepted when its score is at
+// most the threshold (read here from the records themselves) and confirmed when, besides,
+// AcceptedMatches with the consistency keeps it; records of other ranks 0, in both encodings.
+TEST(EncodeMatches, AcceptedAndConfirmedColumnsAreTheRankOneVerdicts) {
+  // 40 queries: query q's best match is reference q + 5 (an answer that advances with the
+  // queries), but for query 17 (reference 300: its partners disagree) and query 30 (score
+  // 0.95, above the threshold); a second-rank match and a band cell for each.
+  std::vector<Match> matches;
+  for (int q = 0; q < 40; ++q) {
+    const int best = q == 17 ? 300 : q + 5;
+    const float score = q == 30 ? 0.95f : 0.5f + 0.01f * static_cast<float>(q % 7);
+    matches.push_back({q, best, score, 1, score});
+    matches.push_back({q, best + 50, 0.99f, 2, 0.99f});
+    matches.push_back({q, q, 0.97f, 0, 0.99f});
+  }
+  const double threshold = 0.9;
+  AgreementOptions agreement;
+  agreement.sequence_length = 1;
+  agreement.partial = SequencePartial::kScale;
+  const MatchVerdicts alone = VerdictsOf(matches, threshold, nullptr, false);
+  const MatchVerdicts confirmed = VerdictsOf(matches, threshold, &agreement, false);
+  const std::vector<std::uint8_t> kept = AcceptedMatches(matches, 40, threshold, &agreement);
+  for (int q = 0; q < 40; ++q) {
+    EXPECT_EQ(alone.accepted[q], q == 30 ? 0 : 1) << q;
+    EXPECT_EQ(alone.confirmed[q], alone.accepted[q]) << q;  // nothing to confirm
+    EXPECT_EQ(confirmed.accepted[q], alone.accepted[q]) << q;
+    EXPECT_EQ(confirmed.confirmed[q], kept[q]) << q;
+  }
+  // Query 17's wrong answer is refused, and so are the queries whose partner it is (27, and 7,
+  // which looks 10 queries forward).
+  for (int q : {7, 17, 27}) EXPECT_EQ(confirmed.confirmed[q], 0) << q;
+  EXPECT_EQ(confirmed.confirmed[5], 1);
+  EXPECT_TRUE(VerdictsOf(matches, threshold, &agreement, true).confirmed.empty());
+  EXPECT_TRUE(VerdictsOf(matches, -1, nullptr, false).accepted.empty());
+
+  const std::string csv = EncodeMatches(matches, true, confirmed);
+  std::istringstream lines(csv);
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line, "query,reference,distance,rank,score,accepted,confirmed");
+  const std::string npy = EncodeMatches(matches, false, confirmed);
+  const std::size_t data = npy.size() - 22 * matches.size();
+  for (std::size_t i = 0; i < matches.size(); ++i) {
+    ASSERT_TRUE(std::getline(lines, line));
+    const Match& m = matches[i];
+    const bool best = m.rank == 1;
+    const int a = best ? confirmed.accepted[m.query] : 0, c = best ? confirmed.confirmed[m.query] : 0;
+    const std::string end = "," + std::to_string(a) + "," + std::to_string(c);
+    EXPECT_EQ(line.substr(line.size() - end.size()), end) << line;
+    EXPECT_EQ(npy[data + 22 * i + 20], a) << i;
+    EXPECT_EQ(npy[data + 22 * i + 21], c) << i;
+  }
 }
 
 }  // namespace
