@@ -418,13 +418,17 @@ void AddEvaluationKeys(OptionTable& t, Config& c) {
         "Name of this run in the figure's legend and the JSON; empty: descriptor and L, e.g. "
         "\"LDB L=10\".");
   t.Add("Report_name", kEvaluation, c.evaluation, c.evaluation.report_name,
-        "A self-contained HTML page of the evaluation (images embedded, opens offline in any "
-        "browser): the settings, the figures, the precision-recall figure, the matrix with the "
-        "ground truth, and the frames of the most confident wrong matches and of the misses "
-        "side by side (docs/output_formats.md). Needs Ground_truth_type. Empty: no report.");
+        "A self-contained HTML page of the run (images embedded, opens offline in any "
+        "browser). With Ground_truth_type: the settings, the figures, the precision-recall "
+        "figure, the matrix with the ground truth, an explorer, and the frames of the most "
+        "confident wrong matches and of the misses side by side. Without: the settings, the "
+        "operating point (best matches answered, accepted, confirmed), the matrix, the explorer "
+        "and the frames of the most and least confident accepted matches, to check by eye "
+        "(docs/output_formats.md). Not written in bounded mode. Empty: no report.");
   t.Add("Report_examples", kEvaluation, c.evaluation, c.evaluation.report_examples, 0, 100,
-        "How many most confident wrong matches, and how many misses, the report shows with "
-        "their frames (0: none).");
+        "How many frames of each kind the report shows: with ground truth the most confident "
+        "wrong matches and the misses, without it the most and the least confident accepted "
+        "matches (0: none).");
   // Verification
   t.Add("Verification", kVerification, c.verification, c.verification.enabled,
         "1: check each query's Verification_candidates best candidates geometrically (local "

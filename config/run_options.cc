@@ -145,10 +145,6 @@ void EvaluationConfig::Check() const {
   protocol.Check();
   CheckIntAtLeast("Ground_truth_min_gap", min_frame_gap, -1);
   CheckIntRange("Report_examples", report_examples, 0, 100);
-  if (!report_name.empty() && !Requested())
-    throw InputError("Report_name: " + Quoted(report_name) +
-                     " needs an evaluation, but Ground_truth_type is not set; expected a "
-                     "Ground_truth_type (the report shows the evaluation), or Report_name empty");
 }
 
 }  // namespace openable

@@ -118,8 +118,12 @@ struct EvaluationConfig {
   EvaluationOptions protocol;  // Tolerance, Exclusion, Vicinity
   std::string name;          // output prefix (Evaluation_name); empty: the table only
   std::string label;         // legend label (Evaluation_label); empty: descriptor and L
-  std::string report_name;   // self-contained HTML report (Report_name); empty: none
-  int report_examples = 6;   // worst cases shown per kind in the report (Report_examples)
+  // Self-contained HTML report (Report_name): of the evaluation with Ground_truth_type, else
+  // of the run's answers; empty: none.
+  std::string report_name;
+  // Frames shown per kind in the report (Report_examples): worst cases with ground truth,
+  // most and least confident accepted matches without.
+  int report_examples = 6;
 
   bool Requested() const { return truth.type != GroundTruthType::kNone; }
   // Throws InputError naming the key of a bad value (GroundTruthOptions::Check,

@@ -92,10 +92,8 @@ RunOutcome Run(const Config& base, ProgressReporter& progress,
     result.timings.total_seconds += out.verification->seconds;
   }
   if (out.evaluation && result.bounded) {
-    log(std::string("note: Ground_truth_type: no evaluation in bounded mode (the protocols "
-                    "need the dense matrix)") +
-        (config.evaluation.report_name.empty() ? "" : ", and so no Report_name") +
-        "; evaluate Matches_name yourself or use Matrix_mode 1");
+    log("note: Ground_truth_type: no evaluation in bounded mode (the protocols need the dense "
+        "matrix); evaluate Matches_name yourself or use Matrix_mode 1");
     out.evaluation.reset();
   }
   if (out.evaluation) {
@@ -119,7 +117,7 @@ RunOutcome Run(const Config& base, ProgressReporter& progress,
   }
   if (out.automatic) result.timings.total_seconds += out.automatic->seconds;
   out.written = WriteOutputs(config, result, out.evaluation.get(), out.verification.get(),
-                             out.automatic.get());
+                             out.automatic.get(), &progress);
   return out;
 }
 

@@ -1,5 +1,6 @@
 #include "OpenABLE/outputs/run_outputs.h"
 
+#include <algorithm>
 #include <chrono>
 #include <functional>
 #include <future>
@@ -39,6 +40,7 @@ struct OutputInput {
   const Evaluation* evaluation;
   const RunVerification* verification;
   const AutoChoice* automatic;
+  ProgressReporter* progress;  // null: no progress lines
 };
 
 // Stages a file in the batch; empty when the run writes no such file.
@@ -69,6 +71,27 @@ Stager EncodedInBackground(const std::string& key, const std::string& path,
   auto bytes = std::make_shared<std::future<std::string>>(
       std::async(std::launch::async, std::move(encode)));
   return [key, path, bytes](OutputBatch& batch) { batch.Stage(key, path, bytes->get()); };
+}
+
+// The answers of a run without ground truth for its report: the matrix's best matches, or
+// with verification the verified answers (every one accepted unless Match_threshold is set),
+// accepted at the run's operating point (none when the auto mode trusted no setting).
+ReportAnswers RunAnswersForReport(const OutputInput& in) {
+  const Config& config = in.config;
+  EvaluationOptions options = EvaluationSettingsFrom(config).options;
+  options.accept_none = in.automatic != nullptr && !in.automatic->reliable;
+  const EvaluationLayout layout = LayoutOf(in.result);
+  ReportAnswers report =
+      AnswersForReport(in.result.normalized, layout, RunLabel(config), "Test_OpenABLE run", options);
+  if (in.verification != nullptr) {
+    if (options.accept_threshold < 0)
+      options.accept_threshold = std::numeric_limits<double>::infinity();
+    report.answers =
+        AnswersOfCandidates(layout, AnswersOf(*in.verification, layout).accepted, options);
+    report.threshold = options.accept_threshold;
+    report.verified = true;
+  }
+  return report;
 }
 
 const std::vector<RunOutput>& RunOutputs() {
@@ -161,7 +184,15 @@ const std::vector<RunOutput>& RunOutputs() {
          if (path.empty()) return {};
          return [&in, path](OutputBatch& batch) {
            const bool csv = path.size() >= 4 && path.compare(path.size() - 4, 4, ".csv") == 0;
-           batch.Stage("Matches_name", path, EncodeMatches(in.result.matches, csv));
+           // The verdicts of Match_threshold and Match_consistency on each best match, as the
+           // run counted them (none when the auto mode trusted no setting).
+           const MatchingOptions& m = in.config.matching;
+           const AgreementOptions agreement = AgreementOf(m);
+           const MatchVerdicts verdicts = VerdictsOf(
+               in.result.matches, m.match_threshold,
+               m.match_consistency > 0 ? &agreement : nullptr,
+               in.automatic != nullptr && !in.automatic->reliable);
+           batch.Stage("Matches_name", path, EncodeMatches(in.result.matches, csv, verdicts));
          };
        }},
       {false, false,
@@ -218,14 +249,15 @@ const std::vector<RunOutput>& RunOutputs() {
                            {&in.result.normalized});
          };
        }},
-      {false, false,
-       [](const Config& c) {
-         return EvaluationRequested(c) ? One("Report_name", c.evaluation.report_name)
-                                       : Planned();
-       },
+      // Report_name: with ground truth the page of the evaluation, else the page of the run's
+      // answers (html_report.h). It shows the matrix: a bounded run writes none.
+      {true, false, [](const Config& c) { return One("Report_name", c.evaluation.report_name); },
        [](const OutputInput& in) -> Stager {
-         if (in.evaluation == nullptr || in.config.evaluation.report_name.empty()) return {};
-         return [&in](OutputBatch& batch) {
+         if (in.config.evaluation.report_name.empty()) return {};
+         // Made here, before the other files are staged (the images encode meanwhile), with a
+         // progress line of its own: reading the frames it shows is the long part.
+         auto page = std::make_shared<std::string>();
+         {
            const Config& config = in.config;
            ReportInput report;
            report.program = "Test_OpenABLE";
@@ -234,6 +266,7 @@ const std::vector<RunOutput>& RunOutputs() {
            report.all_settings = FormatConfig(config);
            report.evaluation = in.evaluation;
            report.matrices = {&in.result.normalized};
+           if (in.evaluation == nullptr) report.answers = {RunAnswersForReport(in)};
            report.examples = config.evaluation.report_examples;
            if (in.automatic != nullptr) report.tables.push_back(AutoReportTable(*in.automatic));
            if (report.examples > 0) {
@@ -247,7 +280,18 @@ const std::vector<RunOutput>& RunOutputs() {
                    std::string("the frames of the rows could not be found (") + e.what() + ")";
              }
            }
-           batch.Stage("Report_name", config.evaluation.report_name, EncodeHtmlReport(report));
+           bool begun = false;
+           if (in.progress != nullptr)
+             report.on_progress = [&](std::int64_t done, std::int64_t total) {
+               if (!begun) in.progress->Begin("report", total, "steps (frames and figures)");
+               begun = true;
+               in.progress->Update(done);
+             };
+           *page = EncodeHtmlReport(report);
+           if (begun) in.progress->End();
+         }
+         return [&in, page](OutputBatch& batch) {
+           batch.Stage("Report_name", in.config.evaluation.report_name, *page);
          };
        }},
   };
@@ -279,7 +323,7 @@ std::vector<std::string> UnwrittenOutputNotes(const Config& config, const RunRes
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
                                       const Evaluation* evaluation,
                                       const RunVerification* verification,
-                                      const AutoChoice* automatic) {
+                                      const AutoChoice* automatic, ProgressReporter* progress) {
   const auto t = Clock::now();
   const OutputOptions& out = config.output;
   const bool dense = !result.bounded;  // bounded runs keep no matrix: only Matches_name
@@ -296,18 +340,27 @@ std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
       shown.setTo(largest, empty);
     }
   }
-  const OutputInput in{config, result, shown, evaluation, verification, automatic};
+  const OutputInput in{config, result, shown, evaluation, verification, automatic, progress};
   // Declared after the matrices the encoders read: when a write fails and the exception
   // unwinds, the stagers (which hold the encoders' futures, whose destructors wait for their
   // threads) go first, so no encoder is left reading a freed matrix.
   std::vector<Stager> stagers;
   for (const RunOutput& output : RunOutputs())
     if (dense || !output.dense_only) stagers.push_back(output.prepare(in));
+  // One step per kind of output staged, then the commit (files synced and renamed).
+  const auto steps = std::count_if(stagers.begin(), stagers.end(),
+                                   [](const Stager& stage) { return static_cast<bool>(stage); });
+  if (progress != nullptr) progress->Begin("writing", steps + 1, "steps (outputs, then commit)");
   OutputBatch batch;
+  std::int64_t done = 0;
   for (const Stager& stage : stagers)
-    if (stage) stage(batch);
+    if (stage) {
+      stage(batch);
+      if (progress != nullptr) progress->Update(++done);
+    }
   const std::vector<std::string> paths = batch.Paths();
   batch.Commit();
+  if (progress != nullptr) progress->End();
   const double seconds = SecondsSince(t);
   result.timings.export_seconds += seconds;
   result.timings.total_seconds += seconds;

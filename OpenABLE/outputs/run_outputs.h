@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "OpenABLE/base/progress.h"
 #include "OpenABLE/run/result.h"
 #include "config/config.h"
 
@@ -16,17 +17,20 @@ struct RunVerification;  // OpenABLE/run/verify.h
 struct AutoChoice;       // OpenABLE/tuning/auto.h
 
 // Writes the outputs the configuration asks for (Txt_name, Npy_name, Png_name,
-// Png_threshold_name, Loops_name when `verification` is given, and the files of
-// Evaluation_name and Report_name when `evaluation` is given; the report lists the auto
-// mode's candidates when `automatic` is given)
-// all-or-nothing. Cells without a value (+inf, Sequence_partial skip) are written as the
-// largest finite value in Txt_name and the PNG images and as +inf in Npy_name. Returns the
-// paths written. Adds the time spent to result.timings.export_seconds. Throws InputError
-// naming the key and path on failure.
+// Png_threshold_name, Matches_name, Loops_name when `verification` is given, the files of
+// Evaluation_name when `evaluation` is given, and Report_name: the page of the evaluation, or
+// without `evaluation` that of the run's answers; it lists the auto mode's candidates when
+// `automatic` is given, whose untrusted choice accepts no match in the report and the matches
+// file) all-or-nothing. Cells without a value (+inf, Sequence_partial skip) are written as the
+// largest finite value in Txt_name and the PNG images and as +inf in Npy_name. With
+// `progress`, a stage "report" while the report reads its frames and a stage "writing" over
+// the outputs and the commit. Returns the paths written. Adds the time spent to
+// result.timings.export_seconds. Throws InputError naming the key and path on failure.
 std::vector<std::string> WriteOutputs(const Config& config, RunResult& result,
                                       const Evaluation* evaluation = nullptr,
                                       const RunVerification* verification = nullptr,
-                                      const AutoChoice* automatic = nullptr);
+                                      const AutoChoice* automatic = nullptr,
+                                      ProgressReporter* progress = nullptr);
 
 // Every file a run of `config` may write, as (key, path), in the order WriteOutputs writes
 // them: the matrix files, the images, the matches, the loops (Verification), the frame times

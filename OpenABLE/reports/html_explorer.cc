@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <tuple>
 #include <vector>
@@ -56,13 +57,15 @@ std::string FrameName(const ReportFrames& frames, bool row, int index) {
 }
 
 // Fills the names and, when the frames can be read, the sheets of `set`, each thumbnail at most
-// `max_pixels` pixels.
-void MakeSheets(const ReportFrames& frames, double max_pixels, FrameSet& set) {
+// `max_pixels` pixels; `read_one` is called after each frame read.
+void MakeSheets(const ReportFrames& frames, double max_pixels, FrameSet& set,
+                const std::function<void()>& read_one) {
   for (int i = 0; i < set.count; ++i) set.names.push_back(FrameName(frames, set.row, set.first + i));
   if (!frames.read || set.count == 0) return;
   // The cell: the first frame's shape, at most kExploreThumbHeight high and kExploreThumbWidth
   // across, smaller when the report's budget asks.
   const cv::Mat first = EightBit(frames.read(set.row, set.first));
+  read_one();
   double scale = std::min({1.0, double(kExploreThumbHeight) / first.rows,
                            double(kExploreThumbWidth) / first.cols});
   if (first.rows * first.cols * scale * scale > max_pixels)
@@ -78,7 +81,11 @@ void MakeSheets(const ReportFrames& frames, double max_pixels, FrameSet& set) {
     cv::Mat sheet(rows * set.cell_height, columns * set.cell_width, colour ? CV_8UC3 : CV_8UC1,
                   cv::Scalar::all(128));
     for (int k = 0; k < n; ++k) {
-      cv::Mat image = start + k == 0 ? first : EightBit(frames.read(set.row, set.first + start + k));
+      cv::Mat image = first;
+      if (start + k > 0) {
+        image = EightBit(frames.read(set.row, set.first + start + k));
+        read_one();
+      }
       if (image.channels() == 3 && !colour) cv::cvtColor(image, image, cv::COLOR_BGR2GRAY);
       if (image.channels() == 1 && colour) cv::cvtColor(image, image, cv::COLOR_GRAY2BGR);
       // Fitted into the cell, centred (frames of another shape are letterboxed).
@@ -96,11 +103,11 @@ void MakeSheets(const ReportFrames& frames, double max_pixels, FrameSet& set) {
   }
 }
 
-// The block in grey (dark = small distance, no value white) with the ground truth tinted, at
-// most kExploreImageSide pixels a side: larger blocks are averaged down (INTER_AREA), and a
-// pixel is tinted when any of its cells is a true pair.
+// The block in grey (dark = small distance, no value white) with the ground truth tinted (when
+// given), at most kExploreImageSide pixels a side: larger blocks are averaged down
+// (INTER_AREA), and a pixel is tinted when any of its cells is a true pair.
 cv::Mat3b MatrixImage(const cv::Mat1f& matrix, const EvaluationLayout& layout,
-                      const GroundTruth& truth) {
+                      const GroundTruth* truth) {
   const int rows = layout.queries, cols = layout.references;
   cv::Mat1f block = matrix(cv::Rect(layout.col_offset, layout.row_offset, cols, rows)).clone();
   for (int q = 0; q < rows; ++q) {
@@ -108,8 +115,9 @@ cv::Mat3b MatrixImage(const cv::Mat1f& matrix, const EvaluationLayout& layout,
     for (int c = 0; c < cols; ++c) p[c] = std::isfinite(p[c]) ? std::clamp(p[c], 0.0f, 1.0f) : 1.0f;
   }
   cv::Mat1f mask(rows, cols, 0.0f);
-  for (int q = 0; q < std::min(rows, static_cast<int>(truth.matches.size())); ++q)
-    for (const int c : truth.matches[q])
+  const int truth_rows = truth ? std::min(rows, static_cast<int>(truth->matches.size())) : 0;
+  for (int q = 0; q < truth_rows; ++q)
+    for (const int c : truth->matches[q])
       if (c >= 0 && c < cols) mask(q, c) = 1.0f;
   const int side = std::max(rows, cols);
   if (side > kExploreImageSide) {
@@ -194,12 +202,22 @@ window.addEventListener('load', function () {
     slider.min = 0;
     slider.max = maxScore > 0 ? maxScore : 1;
     slider.step = 'any';
-    slider.value = Math.min(run.threshold, slider.max);
+    // The run's operating point; without a threshold (no ground truth, no Match_threshold),
+    // every answer.
+    function start() {
+      return run.threshold === null || run.threshold < 0 ? slider.max
+                                                        : Math.min(run.threshold, slider.max);
+    }
+    slider.value = start();
     var pinned = null, shown = null;
+    // Without ground truth nothing is right or wrong: no precision, recall or curve.
+    var truth = run.truth;
 
     function threshold() { return parseFloat(slider.value); }
     function accepted(q, t) { return run.best[q] >= 0 && run.score[q] <= t; }
     function correct(q) { return run.correct.charAt(q) === '1'; }
+    // Accepted by the run itself (Match_threshold, and Match_consistency's confirmation).
+    function runAccepted(q) { return run.accepted.charAt(q) === '1'; }
 
     // Accepted answers at t, their precision (1 when none, as the evaluation counts it) and
     // recall (over the positive queries).
@@ -212,38 +230,42 @@ window.addEventListener('load', function () {
     }
 
     // Precision-recall curve (per query, from the run's curve) with a marker at the threshold.
-    var pr = root.querySelector('.ex-pr');
+    var pr = root.querySelector('.ex-pr'), marker = null;
     var W = 300, H = 240, L = 44, T = 12, PW = W - L - 12, PH = H - T - 36;
     function px(r) { return L + r * PW; }
     function py(p) { return T + (1 - p) * PH; }
-    // Written as markup: the HTML parser puts <svg> in its namespace (no namespace URL in the
-    // page, which holds no address at all).
-    var m = ['<svg width="' + W + '" height="' + H + '" viewBox="0 0 ' + W + ' ' + H +
-             '" role="img" aria-label="precision-recall curve">'];
-    for (var g = 0; g <= 10; ++g) {
-      var v = g / 10, colour = g % 5 === 0 ? '#bbb' : '#eee';
-      m.push('<line x1="' + px(v) + '" x2="' + px(v) + '" y1="' + py(0) + '" y2="' + py(1) +
-             '" stroke="' + colour + '"/><line x1="' + px(0) + '" x2="' + px(1) + '" y1="' +
-             py(v) + '" y2="' + py(v) + '" stroke="' + colour + '"/>');
-      if (g % 5 === 0)
-        m.push('<text x="' + px(v) + '" y="' + (py(0) + 14) + '" text-anchor="middle" ' +
-               'font-size="11">' + v + '</text><text x="' + (px(0) - 5) + '" y="' + (py(v) + 4) +
-               '" text-anchor="end" font-size="11">' + v + '</text>');
+    if (truth) {
+      // Written as markup: the HTML parser puts <svg> in its namespace (no namespace URL in the
+      // page, which holds no address at all).
+      var m = ['<svg width="' + W + '" height="' + H + '" viewBox="0 0 ' + W + ' ' + H +
+               '" role="img" aria-label="precision-recall curve">'];
+      for (var g = 0; g <= 10; ++g) {
+        var v = g / 10, colour = g % 5 === 0 ? '#bbb' : '#eee';
+        m.push('<line x1="' + px(v) + '" x2="' + px(v) + '" y1="' + py(0) + '" y2="' + py(1) +
+               '" stroke="' + colour + '"/><line x1="' + px(0) + '" x2="' + px(1) + '" y1="' +
+               py(v) + '" y2="' + py(v) + '" stroke="' + colour + '"/>');
+        if (g % 5 === 0)
+          m.push('<text x="' + px(v) + '" y="' + (py(0) + 14) + '" text-anchor="middle" ' +
+                 'font-size="11">' + v + '</text><text x="' + (px(0) - 5) + '" y="' + (py(v) + 4) +
+                 '" text-anchor="end" font-size="11">' + v + '</text>');
+      }
+      m.push('<text x="' + px(0.5) + '" y="' + (H - 4) + '" text-anchor="middle" font-size="12">' +
+             'recall</text><text x="12" y="' + py(0.5) + '" text-anchor="middle" font-size="12" ' +
+             'transform="rotate(-90 12 ' + py(0.5) + ')">precision</text>');
+      var points = [];
+      for (var k = 0; k < run.curve.length; ++k) {
+        var c = run.curve[k], n = c[1] + c[2];
+        points.push(px(run.positive_queries ? c[1] / run.positive_queries : 0).toFixed(1) + ',' +
+                    py(n ? c[1] / n : 1).toFixed(1));
+      }
+      m.push('<polyline points="' + points.join(' ') + '" fill="none" stroke="#1f5fbf" ' +
+             'stroke-width="1.5"/><circle class="ex-marker" r="5" fill="#e07000" stroke="#000"/>' +
+             '</svg>');
+      pr.innerHTML = m.join('');
+      marker = pr.querySelector('.ex-marker');
+    } else {
+      pr.hidden = true;
     }
-    m.push('<text x="' + px(0.5) + '" y="' + (H - 4) + '" text-anchor="middle" font-size="12">' +
-           'recall</text><text x="12" y="' + py(0.5) + '" text-anchor="middle" font-size="12" ' +
-           'transform="rotate(-90 12 ' + py(0.5) + ')">precision</text>');
-    var points = [];
-    for (var k = 0; k < run.curve.length; ++k) {
-      var c = run.curve[k], n = c[1] + c[2];
-      points.push(px(run.positive_queries ? c[1] / run.positive_queries : 0).toFixed(1) + ',' +
-                  py(n ? c[1] / n : 1).toFixed(1));
-    }
-    m.push('<polyline points="' + points.join(' ') + '" fill="none" stroke="#1f5fbf" ' +
-           'stroke-width="1.5"/><circle class="ex-marker" r="5" fill="#e07000" stroke="#000"/>' +
-           '</svg>');
-    pr.innerHTML = m.join('');
-    var marker = pr.querySelector('.ex-marker');
 
     function drawOverlay() {
       var rect = image.getBoundingClientRect(), ratio = window.devicePixelRatio || 1;
@@ -252,11 +274,13 @@ window.addEventListener('load', function () {
       var ctx = overlay.getContext('2d'), sx = overlay.width / R, sy = overlay.height / Q;
       var mw = Math.max(3 * ratio, sx), mh = Math.max(3 * ratio, sy), t = threshold();
       ctx.clearRect(0, 0, overlay.width, overlay.height);
-      for (var pass = 0; pass < 2; ++pass) {  // wrong marks last: never hidden by a neighbour
-        ctx.fillStyle = pass === 0 ? '#00c800' : '#e00000';
+      // With ground truth green when right, red when wrong (drawn last: never hidden by a
+      // neighbour); without, one colour.
+      for (var pass = truth ? 0 : 2; pass < (truth ? 2 : 3); ++pass) {
+        ctx.fillStyle = ['#00c800', '#e00000', '#ff8c00'][pass];
         for (var i = 0; i < answered.length; ++i) {
           var q = answered[i];
-          if (run.score[q] > t || correct(q) !== (pass === 0)) continue;
+          if (run.score[q] > t || (pass < 2 && correct(q) !== (pass === 0))) continue;
           ctx.fillRect((run.best[q] + 0.5) * sx - mw / 2, (q + 0.5) * sy - mh / 2, mw, mh);
         }
       }
@@ -272,11 +296,13 @@ window.addEventListener('load', function () {
       var t = threshold(), s = stats(t);
       root.querySelector('.ex-threshold-value').textContent = String(+t.toPrecision(6));
       root.querySelector('.ex-accepted').textContent = s.accepted;
-      root.querySelector('.ex-correct').textContent = s.tp;
-      root.querySelector('.ex-precision').textContent = fixed(s.precision, 4);
-      root.querySelector('.ex-recall').textContent = fixed(s.recall, 4);
-      marker.setAttribute('cx', px(s.recall));
-      marker.setAttribute('cy', py(s.precision));
+      if (truth) {
+        root.querySelector('.ex-correct').textContent = s.tp;
+        root.querySelector('.ex-precision').textContent = fixed(s.precision, 4);
+        root.querySelector('.ex-recall').textContent = fixed(s.recall, 4);
+        marker.setAttribute('cx', px(s.recall));
+        marker.setAttribute('cy', py(s.precision));
+      }
       drawOverlay();
       if (shown) describe(shown.q, shown.c);
       renderList();
@@ -320,15 +346,17 @@ window.addEventListener('load', function () {
         score = 'the query has no answer';
       } else if (b === c) {
         score = run.score_kind + ' score ' + num(run.score[q], 6) + ' \u00b7 the query\'s best match, ' +
-                (correct(q) ? 'right' : 'wrong') + ', ' +
-                (accepted(q, threshold()) ? 'accepted' : 'not accepted') + ' at the threshold';
+                (truth ? (correct(q) ? 'right' : 'wrong') + ', ' : '') +
+                (accepted(q, threshold()) ? 'accepted' : 'not accepted') + ' at the threshold' +
+                (truth ? '' : runAccepted(q) ? '; accepted by the run' : '; not accepted by the run');
       } else {
         score = 'not the query\'s best match (reference ' + b + ', ' + run.score_kind + ' score ' +
-                num(run.score[q], 6) + ', ' + (correct(q) ? 'right' : 'wrong') + ')';
+                num(run.score[q], 6) + (truth ? ', ' + (correct(q) ? 'right' : 'wrong') : '') + ')';
       }
       info.querySelector('.ex-cell-score').textContent = score;
       info.querySelector('.ex-cell-truth').textContent =
-          run.positive.charAt(q) === '1' ? '' : 'the query has no true place among its candidates';
+          !truth || run.positive.charAt(q) === '1' ? ''
+                                                  : 'the query has no true place among its candidates';
       root.setAttribute('data-cell', q + ',' + c);
     }
 
@@ -368,7 +396,7 @@ window.addEventListener('load', function () {
     });
     slider.addEventListener('input', update);
     root.querySelector('.ex-reset').addEventListener('click', function () {
-      slider.value = Math.min(run.threshold, slider.max);
+      slider.value = start();
       update();
     });
     window.addEventListener('resize', drawOverlay);
@@ -385,6 +413,7 @@ window.addEventListener('load', function () {
         if (f === 'right' && (b < 0 || !correct(q))) continue;
         if (f === 'wrong' && (b < 0 || correct(q))) continue;
         if (f === 'accepted' && !accepted(q, t)) continue;
+        if (f === 'run' && !runAccepted(q)) continue;
         if (f === 'unanswered' && b >= 0) continue;
         list.push(q);
       }
@@ -416,9 +445,18 @@ window.addEventListener('load', function () {
         tr.appendChild(bc);
         tr.appendChild(make('td', 'n', b >= 0 ? num(run.score[q], 6) : '\u2013'));
         tr.appendChild(make('td', 'n', b >= 0 ? num(run.distance[q], 6) : '\u2013'));
-        var verdict = b < 0 ? 'no answer' : correct(q) ? 'right' : 'wrong';
-        tr.appendChild(make('td', b < 0 ? 'note' : correct(q) ? 'right' : 'wrong', verdict));
-        tr.appendChild(make('td', '', accepted(q, t) ? 'accepted' : ''));
+        if (truth) {
+          var verdict = b < 0 ? 'no answer' : correct(q) ? 'right' : 'wrong';
+          tr.appendChild(make('td', b < 0 ? 'note' : correct(q) ? 'right' : 'wrong', verdict));
+          tr.appendChild(make('td', '', accepted(q, t) ? 'accepted' : ''));
+        } else {
+          tr.appendChild(make('td', '', accepted(q, t) ? 'accepted' : ''));
+          // The run's verdict: accepted, or within Match_threshold but not confirmed.
+          var within = !run.untrusted && run.threshold !== null && run.score[q] <= run.threshold;
+          tr.appendChild(make('td', b < 0 ? 'note' : '',
+                              b < 0 ? 'no answer' : runAccepted(q) ? 'accepted'
+                                  : within && run.consistency > 0 ? 'not confirmed' : ''));
+        }
         (function (q, b) {
           tr.addEventListener('click', function () { pin(q, b >= 0 ? b : 0); });
         })(q, b);
@@ -485,16 +523,17 @@ cv::Mat1b ExploreValues(const cv::Mat1f& matrix, const EvaluationLayout& layout,
   return out;
 }
 
-std::string ExplorerSection(const ReportInput& input) {
-  const Evaluation& evaluation = *input.evaluation;
-  const EvaluationOptions& options = evaluation.settings.options;
-  const ReportFrames& frames = input.frames;
+namespace {
 
-  // The frame sets of the runs' rows and columns, each once.
+// The frame sets of the runs' rows and columns, each once; run_sets[i]: the sets of run i's
+// rows and columns.
+std::vector<FrameSet> ExplorerFrameSets(const ReportInput& input,
+                                        const std::vector<ReportRun>& runs,
+                                        std::vector<std::pair<int, int>>& run_sets) {
   std::vector<FrameSet> sets;
   std::map<std::tuple<bool, int, int>, int> set_of;
   const auto set_index = [&](bool row, int first, int count) {
-    if (frames.same_rows_and_columns) row = false;
+    if (input.frames.same_rows_and_columns) row = false;
     const auto key = std::make_tuple(row, first, count);
     const auto found = set_of.find(key);
     if (found != set_of.end()) return found->second;
@@ -505,26 +544,50 @@ std::string ExplorerSection(const ReportInput& input) {
     sets.push_back(std::move(set));
     return set_of[key] = static_cast<int>(sets.size()) - 1;
   };
-  std::vector<std::pair<int, int>> run_sets;
-  for (const EvaluatedRun& run : evaluation.runs)
+  run_sets.clear();
+  for (const ReportRun& run : runs)
     run_sets.emplace_back(set_index(true, run.layout.row_offset, run.layout.queries),
                           set_index(false, run.layout.col_offset, run.layout.references));
+  return sets;
+}
+
+}  // namespace
+
+std::int64_t ExplorerSteps(const ReportInput& input, const std::vector<ReportRun>& runs) {
+  std::vector<std::pair<int, int>> run_sets;
+  std::int64_t frames = 0;
+  if (input.frames.read)
+    for (const FrameSet& set : ExplorerFrameSets(input, runs, run_sets)) frames += set.count;
+  return frames + static_cast<std::int64_t>(runs.size());
+}
+
+std::string ExplorerSection(const ReportInput& input, const std::vector<ReportRun>& runs,
+                            const std::function<void()>& step) {
+  const ReportFrames& frames = input.frames;
+  std::vector<std::pair<int, int>> run_sets;
+  std::vector<FrameSet> sets = ExplorerFrameSets(input, runs, run_sets);
   double frame_count = 0;
   for (const FrameSet& set : sets) frame_count += set.count;
   const double max_pixels =
       frame_count > 0 ? kExploreThumbnailPixels / frame_count : kExploreThumbnailPixels;
-  for (FrameSet& set : sets) MakeSheets(frames, max_pixels, set);
+  for (FrameSet& set : sets) MakeSheets(frames, max_pixels, set, step);
 
-  std::string h =
-      "<section id=\"explore\">\n<h2>Explore</h2>\n"
-      "<noscript><p class=\"note\">The explorer needs JavaScript; the sections above and below "
-      "show the same run without it.</p></noscript>\n"
-      "<p class=\"note\">Hover over the matrix to see a cell's two frames, click to keep it (the "
-      "arrow keys then move it one cell at a time, ten with Shift). The slider sets the "
-      "threshold on the score: the best matches with a score at or below it are accepted "
-      "(green when right, red when wrong), counted, and placed on the precision-recall curve. "
-      "Distances are those of the normalised matrix: exact for a query's best match, else "
-      "quantised to 8 bits.</p>\n";
+  const bool truth = input.evaluation != nullptr;
+  std::string h = "<section id=\"explore\">\n<h2>Explore</h2>\n"
+                  "<noscript><p class=\"note\">The explorer needs JavaScript; the sections "
+                  "above and below show the same run without it.</p></noscript>\n";
+  h += truth ? "<p class=\"note\">Hover over the matrix to see a cell's two frames, click to keep "
+               "it (the arrow keys then move it one cell at a time, ten with Shift). The slider "
+               "sets the threshold on the score: the best matches with a score at or below it "
+               "are accepted (green when right, red when wrong), counted, and placed on the "
+               "precision-recall curve. Distances are those of the normalised matrix: exact for "
+               "a query's best match, else quantised to 8 bits.</p>\n"
+             : "<p class=\"note\">Hover over the matrix to see a cell's two frames, click to keep "
+               "it (the arrow keys then move it one cell at a time, ten with Shift). The slider "
+               "sets the threshold on the score: the best matches with a score at or below it "
+               "are accepted (orange) and counted; without ground truth no answer is judged. "
+               "Distances are those of the normalised matrix: exact for a query's best match, "
+               "else quantised to 8 bits.</p>\n";
 
   // The frames: names and thumbnail sheets, shared by the runs.
   Json set_json = Json::array();
@@ -560,19 +623,19 @@ std::string ExplorerSection(const ReportInput& input) {
              : "<p class=\"note\">Frames are named, not shown: " + HtmlEscape(frames.missing) +
                    "</p>\n";
 
-  const std::string score_kind = options.score == MatchScore::kRatio ? "ratio" : "distance";
-  for (std::size_t i = 0; i < evaluation.runs.size(); ++i) {
-    const EvaluatedRun& run = evaluation.runs[i];
-    const PerQueryResult& p = run.per_query;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const ReportRun& run = runs[i];
+    const QueryAnswers& a = run.answers;
     const EvaluationLayout& layout = run.layout;
-    const cv::Mat1f& matrix = *input.matrices[i];
+    const cv::Mat1f& matrix = *run.matrix;
     const std::string n = std::to_string(i);
+    const std::string score_kind = run.score == MatchScore::kRatio ? "ratio" : "distance";
 
     Json j;
     j["label"] = run.label;
     j["kind"] = layout.kind == EvaluationLayout::Kind::kLoopClosure ? "loop-closure"
                                                                      : "query-reference";
-    j["exclusion"] = options.exclusion;
+    j["exclusion"] = run.exclusion;
     j["queries"] = layout.queries;
     j["references"] = layout.references;
     j["row_offset"] = layout.row_offset;
@@ -580,41 +643,55 @@ std::string ExplorerSection(const ReportInput& input) {
     j["rows"] = run_sets[i].first;
     j["columns"] = run_sets[i].second;
     j["score_kind"] = score_kind;
-    j["threshold"] = json::Number(OperatingThreshold(run));
-    j["positive_queries"] = p.positive_queries;
+    j["truth"] = run.evaluated != nullptr;
+    j["consistency"] = run.consistency;
+    j["untrusted"] = run.untrusted;
+    j["threshold"] = run.threshold >= 0 ? json::Number(run.threshold) : Json();
     Json best = Json::array(), score = Json::array(), distance = Json::array();
     for (int q = 0; q < layout.queries; ++q) {
-      const bool answered = q < static_cast<int>(p.best.size()) && p.best[q] >= 0;
-      best.push_back(answered ? p.best[q] : -1);
-      score.push_back(answered ? json::Number(p.score[q]) : Json());
-      distance.push_back(answered && q < static_cast<int>(p.best_distance.size())
-                             ? json::Number(p.best_distance[q])
+      const bool answered = q < static_cast<int>(a.best.size()) && a.best[q] >= 0;
+      best.push_back(answered ? a.best[q] : -1);
+      score.push_back(answered ? json::Number(a.score[q]) : Json());
+      distance.push_back(answered && q < static_cast<int>(a.distance.size())
+                             ? json::Number(a.distance[q])
                              : Json());
     }
     j["best"] = best;
     j["score"] = score;
     j["distance"] = distance;
-    j["correct"] = Digits(p.correct, layout.queries);
-    j["positive"] = Digits(p.positive, layout.queries);
+    // The run's own matches (the confirmed answers at its operating point).
+    j["accepted"] = Digits(a.confirmed, layout.queries);
     Json curve = Json::array();
-    for (const CurvePoint& c : p.curve) curve.push_back({json::Number(c.threshold), c.tp, c.fp});
+    if (run.evaluated != nullptr) {
+      const PerQueryResult& p = run.evaluated->per_query;
+      j["positive_queries"] = p.positive_queries;
+      j["correct"] = Digits(p.correct, layout.queries);
+      j["positive"] = Digits(p.positive, layout.queries);
+      for (const CurvePoint& c : p.curve) curve.push_back({json::Number(c.threshold), c.tp, c.fp});
+    } else {
+      j["positive_queries"] = 0;
+      j["correct"] = "";
+      j["positive"] = "";
+    }
     j["curve"] = curve;
     int cell_rows = 1, cell_cols = 1;
     const cv::Mat1b values = ExploreValues(matrix, layout, cell_rows, cell_cols);
     j["values"] = {{"rows", values.rows}, {"cols", values.cols}, {"cell_rows", cell_rows},
                    {"cell_cols", cell_cols}};
 
-    const cv::Mat3b image = MatrixImage(matrix, layout, evaluation.truths[i]);
+    const cv::Mat3b image = MatrixImage(matrix, layout, run.truth);
+    const std::string image_png = Base64(EncodePng(image));
+    step();
     const double longer = std::max(layout.queries, layout.references);
     const int display_w = std::max(1, static_cast<int>(std::lround(kMatrixDisplay * layout.references / longer)));
     const int display_h = std::max(1, static_cast<int>(std::lround(kMatrixDisplay * layout.queries / longer)));
 
     std::string note;
-    if (options.accept_consistency > 0)
+    if (run.consistency > 0)
       note += " The run's own operating point also asks Match_consistency " +
-              std::to_string(options.accept_consistency) +
+              std::to_string(run.consistency) +
               " to confirm each answer; the slider applies the score alone.";
-    if (options.accept_none)
+    if (run.untrusted)
       note += " The run accepted no answer (the auto mode could not trust its choice); the "
               "slider shows what a threshold would accept.";
     if (cell_rows > 1 || cell_cols > 1)
@@ -633,20 +710,30 @@ std::string ExplorerSection(const ReportInput& input) {
          "</script>\n";
     h += "<div class=\"explorer\" id=\"explorer-" + n + "\" data-data=\"explore-run-" + n +
          "\" data-values=\"explore-values-" + n + "\" hidden>\n";
+    const std::string reset =
+        run.threshold >= 0
+            ? "run's operating point (" + FormatNumber(run.threshold, 4) + ")"
+            : std::string("every answer (no Match_threshold)");
     h += "<div class=\"ex-controls\"><label>threshold (" + score_kind +
          " score) <input type=\"range\" class=\"ex-threshold\"></label> "
          "<output class=\"ex-threshold-value\"></output> "
-         "<button type=\"button\" class=\"ex-reset\">run's operating point (" +
-         FormatNumber(OperatingThreshold(run), 4) + ")</button><br>"
-         "accepted <b class=\"ex-accepted\"></b> of " + std::to_string(p.queries - p.unanswered) +
-         " answers, right <b class=\"ex-correct\"></b>; precision <b class=\"ex-precision\"></b>, "
-         "recall <b class=\"ex-recall\"></b> (of " + std::to_string(p.positive_queries) +
-         " queries with a true place)</div>\n";
+         "<button type=\"button\" class=\"ex-reset\">" + reset + "</button><br>";
+    if (run.evaluated != nullptr) {
+      const PerQueryResult& p = run.evaluated->per_query;
+      h += "accepted <b class=\"ex-accepted\"></b> of " + std::to_string(p.queries - p.unanswered) +
+           " answers, right <b class=\"ex-correct\"></b>; precision <b class=\"ex-precision\"></b>, "
+           "recall <b class=\"ex-recall\"></b> (of " + std::to_string(p.positive_queries) +
+           " queries with a true place)</div>\n";
+    } else {
+      h += "accepted <b class=\"ex-accepted\"></b> of " + std::to_string(a.answered) +
+           " answers at this threshold; the run accepted " + std::to_string(a.Confirmed()) +
+           " (no ground truth: no answer is judged)</div>\n";
+    }
     if (!note.empty()) h += "<p class=\"note\">" + HtmlEscape(note.substr(1)) + "</p>\n";
     h += "<div class=\"ex-row\">\n<div class=\"ex-matrix\" tabindex=\"0\" style=\"width:" +
          std::to_string(display_w) + "px;height:" + std::to_string(display_h) + "px\">" +
          "<img class=\"ex-image\" alt=\"matrix of " + HtmlEscape(run.label) +
-         " to explore\" src=\"data:image/png;base64," + Base64(EncodePng(image)) +
+         " to explore\" src=\"data:image/png;base64," + image_png +
          "\"><canvas class=\"ex-overlay\"></canvas></div>\n"
          "<div class=\"ex-side\"><div class=\"ex-pr\"></div>\n<div class=\"ex-cell\">"
          "<div class=\"ex-cell-frames\"></div><div class=\"ex-cell-query\"></div>"
@@ -658,14 +745,20 @@ std::string ExplorerSection(const ReportInput& input) {
          "<option value=\"doubtful\">by score, least confident first</option>"
          "<option value=\"query\">by query</option></select></label> "
          "<label>show <select class=\"ex-filter\"><option value=\"all\">every query</option>"
-         "<option value=\"answered\">answered</option><option value=\"right\">right</option>"
-         "<option value=\"wrong\">wrong</option><option value=\"accepted\">accepted at the "
-         "threshold</option><option value=\"unanswered\">no answer</option></select></label> "
+         "<option value=\"answered\">answered</option>";
+    if (run.evaluated != nullptr)
+      h += "<option value=\"right\">right</option><option value=\"wrong\">wrong</option>";
+    h += "<option value=\"accepted\">accepted at the threshold</option>";
+    if (run.evaluated == nullptr)
+      h += "<option value=\"run\">accepted by the run</option>";
+    h += "<option value=\"unanswered\">no answer</option></select></label> "
          "<span class=\"ex-listed note\"></span>\n"
          "<table class=\"ex-queries\"><thead><tr><th>#</th><th>query</th><th>best match</th>"
-         "<th>score</th><th>distance</th><th>result</th><th>at threshold</th></tr></thead>"
-         "<tbody></tbody></table><button type=\"button\" class=\"ex-more\">show more</button>"
-         "</div>\n</div>\n";
+         "<th>score</th><th>distance</th>" +
+         std::string(run.evaluated != nullptr ? "<th>result</th><th>at threshold</th>"
+                                              : "<th>at threshold</th><th>the run</th>") +
+         "</tr></thead><tbody></tbody></table><button type=\"button\" class=\"ex-more\">show "
+         "more</button></div>\n</div>\n";
   }
   h += "<script>" + std::string(kScript) + "</script>\n</section>\n";
   return h;

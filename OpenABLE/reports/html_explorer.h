@@ -9,7 +9,9 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -38,7 +40,40 @@ std::uint8_t ExploreCode(float distance);
 cv::Mat1b ExploreValues(const cv::Mat1f& matrix, const EvaluationLayout& layout, int& cell_rows,
                         int& cell_cols);
 
-// The section: its HTML, the embedded data and the script.
-std::string ExplorerSection(const ReportInput& input);
+// One run as every section of the page reads it, with ground truth (an evaluated run) or
+// without (ReportAnswers): ReportRuns(input)[i] is the run of input.matrices[i].
+struct ReportRun {
+  std::string label, source;
+  EvaluationLayout layout;
+  const cv::Mat1f* matrix = nullptr;
+  MatchScore score = MatchScore::kDistance;
+  int exclusion = 100;
+  // Per query: the answer, its distance and score, and at the operating point accepted
+  // (score <= threshold) and confirmed (the run's matches; PerQueryResult::accepted with
+  // ground truth).
+  QueryAnswers answers;
+  bool has_operating_point = false;  // Match_threshold is set (or verified answers)
+  // The threshold the page starts from: the operating point's, else (with ground truth) the
+  // max-F1 threshold; -1 without either.
+  double threshold = -1;
+  int consistency = 0;     // Match_consistency
+  bool untrusted = false;  // the auto mode accepted nothing
+  bool verified = false;
+  const EvaluatedRun* evaluated = nullptr;  // with ground truth
+  const GroundTruth* truth = nullptr;       // with ground truth
+};
+
+// The runs of the page. Throws std::logic_error when there is not one matrix per run, or a
+// run's answers do not fit its layout or its matrix.
+std::vector<ReportRun> ReportRuns(const ReportInput& input);
+
+// The steps of ExplorerSection for progress: one per frame it reads (when input.frames can be
+// read) and one per run (its matrix image).
+std::int64_t ExplorerSteps(const ReportInput& input, const std::vector<ReportRun>& runs);
+
+// The section: its HTML, the embedded data and the script; `step` is called after each of
+// its ExplorerSteps.
+std::string ExplorerSection(const ReportInput& input, const std::vector<ReportRun>& runs,
+                            const std::function<void()>& step = [] {});
 
 }  // namespace openable

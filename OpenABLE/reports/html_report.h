@@ -1,9 +1,11 @@
-// The HTML report of an evaluation (Report_name, openable_evaluate --report): one
+// The HTML report of a run or an evaluation (Report_name, openable_evaluate --report): one
 // self-contained page a person opens in a browser, offline: every image is embedded as a data
-// URI, no script or style sheet is fetched. It shows the settings, the figures of each run,
-// the precision-recall figure, the matrix with the ground truth drawn over it, and for each
-// run the frames of its worst cases side by side, as VPR_Tutorial shows them, and an
-// interactive explorer of each run (html_explorer.h):
+// URI, no script or style sheet is fetched.
+//
+// With ground truth (ReportInput::evaluation) it shows the settings, the figures of each run,
+// the precision-recall figure, the matrix with the ground truth drawn over it, an interactive
+// explorer of each run (html_explorer.h), and for each run the frames of its worst cases side
+// by side, as VPR_Tutorial shows them:
 //
 //   most confident wrong matches  answered queries whose best match is wrong, most confident
 //                                 (lowest score) first: query, wrong match, true place
@@ -13,10 +15,21 @@
 //                                 least confident first: query, best match, true place
 //
 // The true place shown is the query's ground-truth candidate with the smallest distance in
-// the matrix. A short script at the end of the page checks that every embedded image decoded
-// and says which did not in the browser's console (docs/output_formats.md, "HTML report").
+// the matrix.
+//
+// Without ground truth (ReportInput::answers, evaluation null) nothing can be judged right or
+// wrong, and the page says so and how to get figures. It shows the settings, the operating
+// point of each run (queries answered, accepted by Match_threshold, confirmed by
+// Match_consistency, or UNRELIABLE when the auto mode accepted none), the matrix with the
+// accepted answers, the same explorer without precision and recall, and the frames of the
+// accepted matches a person checks by eye: the most and the least confident.
+//
+// Both pages share the code of the settings, the tables, the matrix and the explorer. A short
+// script at the end of the page checks that every embedded image decoded and says which did
+// not in the browser's console (docs/output_formats.md, "HTML report").
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -25,6 +38,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "OpenABLE/evaluation/answers.h"
 #include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/run/evaluate.h"
 
@@ -81,20 +95,76 @@ struct ReportTable {
   int highlight = -1;                          // a row shown in bold, -1 none
 };
 
+// One run shown without ground truth: what its matrix answered and what its operating point
+// accepted, nothing judged right or wrong. For a matrix of Q queries (rows) against R
+// references (columns) taken whole: layout = EvaluationLayout::QueryReference(Q, R), and
+// answers with Q entries per query (best: a column 0 .. R-1, or -1). AnswersForReport fills
+// it from a matrix; a program that finds its answers otherwise fills `answers` itself.
+struct ReportAnswers {
+  std::string label;        // the run's name, e.g. "HOG L=10"
+  std::string source;       // where the matrix came from, e.g. "Test_OpenABLE run"
+  EvaluationLayout layout;  // the block of the matrix shown: rows queries, columns references
+  MatchScore score = MatchScore::kDistance;  // what the scores are (Match_score)
+  int score_window = 10;   // with the ratio: rivals beyond +- this many frames (shown only)
+  int exclusion = 100;     // one sequence (Kind::kLoopClosure): candidates this far back
+  double threshold = -1;   // Match_threshold: answers with a score <= it accepted; -1 none
+  int consistency = 0;     // Match_consistency n: confirmed by n independent queries; 0 none
+  bool untrusted = false;  // the auto mode could not trust its choice: nothing accepted
+  bool verified = false;   // the answers are geometric verification's (Verification 1)
+  // Per query row of the layout: best, distance, score, accepted, confirmed (answers.h;
+  // confirmed = the run's matches, equal to accepted without Match_consistency).
+  QueryAnswers answers;
+};
+
+// ReportAnswers of the block `layout` of `matrix` (normalised), scored and accepted as
+// `options` says (AnswersOfMatrix: Match_score, Match_score_window, Exclusion,
+// Match_threshold, Match_consistency with its agreement, accept_none; EvaluationSettingsFrom
+// gives them from a Config), labelled `label` and `source`.
+ReportAnswers AnswersForReport(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                               const std::string& label, const std::string& source,
+                               const EvaluationOptions& options);
+
 struct ReportInput {
   std::string program;  // "Test_OpenABLE" or "openable_evaluate"
   std::string title;    // heading of the page
   // Rows of the settings table (key, value), e.g. the keys that differ from the defaults.
   std::vector<std::pair<std::string, std::string>> settings;
   std::string all_settings;  // every key (FormatConfig), shown folded; empty: left out
+  // With ground truth: the evaluation, one run per matrix. Null: the page is made from
+  // `answers`, without ground truth.
   const Evaluation* evaluation = nullptr;
-  std::vector<const cv::Mat1f*> matrices;  // the normalised matrix of each run
+  // Without ground truth (evaluation null): the runs, one per matrix.
+  std::vector<ReportAnswers> answers;
+  // Without ground truth: what the reader can do to get precision and recall, as text (the
+  // page escapes it); empty: a sentence naming Ground_truth_type, Ground_truth and
+  // openable_evaluate.
+  std::string truth_advice;
+  // The normalised matrix of each run (evaluation->runs[i], or answers[i]); the block of the
+  // run's layout is shown.
+  std::vector<const cv::Mat1f*> matrices;
   int examples = 6;                        // Report_examples
   ReportFrames frames;
   std::vector<ReportTable> tables;         // shown after the settings
+  // Called as the page is made (done, total steps; first with done 0): a step per frame the
+  // explorer reads for its thumbnails, the long part of a page of many frames, and one per
+  // figure and section. For a progress line; unset: not called.
+  std::function<void(std::int64_t done, std::int64_t total)> on_progress;
 };
 
-// The page. Throws InputError naming the frame when a frame of a worst case cannot be read.
+// The page, with ground truth when input.evaluation is set, else without. Throws InputError
+// naming the frame when a frame it shows cannot be read, std::logic_error when there is not one
+// matrix per run (or, without ground truth, a run's answers do not fit its layout).
+//
+// A page without ground truth for a Q x R block `m` (queries x references, normalised):
+//   ReportInput input;
+//   input.program = "openable_map";
+//   input.title = "...";
+//   input.settings = {{"map", "..."}};
+//   input.answers = {AnswersForReport(m, EvaluationLayout::QueryReference(Q, R), "label",
+//                                     "source", options)};
+//   input.matrices = {&m};
+//   input.frames.read = ...;  // (row = true, q): query q; (row = false, c): reference c
+//   std::string page = EncodeHtmlReport(input);
 std::string EncodeHtmlReport(const ReportInput& input);
 
 // The keys of `config` whose value differs from the default, as (key, value) pairs in the

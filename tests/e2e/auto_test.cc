@@ -135,15 +135,35 @@ TEST(Auto, UnrelatedTraversalsAreUnreliableAndAcceptNothing) {
     fs::copy_file(summer[i], dir + "/a/" + fs::path(summer[i]).filename().string());
     fs::copy_file(winter[200 + i], dir + "/b/" + fs::path(winter[200 + i]).filename().string());
   }
+  // With the page of the run and the matches file, without ground truth (the auto preset's
+  // own case).
   const Outcome o =
       RunProgram(testing::TestOpenableExe(),
                  {AutoPreset(), "--quiet", "--set", "Images_path=a", "--set", "Images_path_2=b",
-                  "--set", "Npy_name=out/m.npy", "--set", "Png_name=", "--json"},
+                  "--set", "Npy_name=out/m.npy", "--set", "Png_name=", "--set",
+                  "Report_name=out/report.html", "--set", "Matches_name=out/matches.csv",
+                  "--json"},
                  dir);
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_NE(o.out.find("\"reliable\": false"), std::string::npos) << o.out;
   EXPECT_EQ(Json::parse(o.out).at("accepted").at("queries"), 0) << o.out;
   EXPECT_TRUE(fs::exists(dir + "/out/m.npy"));  // the outputs are still written
+  // The page says UNRELIABLE and accepts nothing; the matches file marks no best match.
+  const std::string page = ReadAll(dir + "/out/report.html");
+  EXPECT_NE(page.find("UNRELIABLE: the auto mode could not trust any candidate"),
+            std::string::npos);
+  EXPECT_NE(page.find("No match accepted: the auto mode could not trust"), std::string::npos);
+  EXPECT_NE(page.find("<section id=\"auto\">"), std::string::npos);
+  std::istringstream matches(ReadAll(dir + "/out/matches.csv"));
+  std::string line;
+  std::getline(matches, line);
+  EXPECT_EQ(line, "query,reference,distance,rank,score,accepted,confirmed");
+  int records = 0;
+  while (std::getline(matches, line)) {
+    ++records;
+    EXPECT_EQ(line.substr(line.size() - 4), ",0,0") << line;
+  }
+  EXPECT_GT(records, 100);
   // One line says so.
   EXPECT_TRUE(OneLine(o.err)) << o.err;
   EXPECT_NE(o.err.find("no candidate is consistent enough to be trusted"), std::string::npos)

@@ -22,7 +22,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "OpenABLE/io/frame_source.h"
 #include "config/config.h"
+#include "matching/bounded.h"
+#include "matching/matrix.h"
 #include "matching/search/approximate.h"
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
@@ -225,6 +228,162 @@ TEST(TestOpenABLE, BoundedModeNeedsAMatchesFile) {
                        "keeps only matches; expected a .npy or .csv path"),
             std::string::npos)
       << o.err;
+}
+
+// The records of a matches file as text: one vector of fields per line, the header first.
+std::vector<std::vector<std::string>> CsvFields(const std::string& text) {
+  std::vector<std::vector<std::string>> out;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    std::vector<std::string> fields;
+    std::istringstream cells(line);
+    for (std::string f; std::getline(cells, f, ',');) fields.push_back(f);
+    out.push_back(fields);
+  }
+  return out;
+}
+
+// Without ground truth, Report_name writes the page of the run's answers and Matches_name marks
+// the best matches accepted (ratio <= Match_threshold) and confirmed (Match_consistency): both
+// checked against a brute-force reading of the run's .npy (e2e_support.h), the matches file
+// against AcceptedMatches over its own rank-1 records, in both of its encodings. Progress lines
+// name the report and the writing of the outputs.
+TEST(TestOpenABLE, WithoutGroundTruthTheReportAndTheMatchesFileShowTheAcceptedMatches) {
+  const std::string dir = testing::TempDir();
+  const std::string preset = testing::SourceDir() + "/config/presets/across_conditions.txt";
+  const auto run = [&](const std::string& matches) {
+    return RunProgram(testing::TestOpenableExe(),
+                      {preset, "--set", "Images_path=" + testing::SampleDir() + "/summer",
+                       "--set", "Images_path_2=" + testing::SampleDir() + "/winter", "--set",
+                       "Npy_name=out/m.npy", "--set", "Png_name=", "--set",
+                       "Report_name=out/report.html", "--set", "Report_examples=3", "--set",
+                       "Matches_name=out/" + matches},
+                      dir);
+  };
+  const Outcome o = run("matches.csv");
+  ASSERT_EQ(o.status, 0) << o.err << o.out;
+  // Progress lines for the report and for writing the outputs, as for description and matching.
+  for (const char* stage : {"  describing ", "  matching ", "  report ", "  writing "})
+    EXPECT_NE(o.err.find(stage), std::string::npos) << stage << "\n" << o.err;
+  EXPECT_EQ(o.err.find("error"), std::string::npos) << o.err;
+
+  // Brute force over the winter queries (rows 300..599) against the summer references.
+  const int n = 300;
+  const cv::Mat1f m = ReadNpy(dir + "/out/m.npy");
+  ASSERT_EQ(m.rows, 2 * n);
+  const std::vector<bool> agree = AgreeingByBruteForce(m, n, n, n, 40);
+  std::vector<int> best(n, -1);
+  std::vector<float> ratio(n, 1.0f);
+  std::vector<int> within(n, 0), confirmed(n, 0);
+  for (int q = 0; q < n; ++q) {
+    for (int c = 0; c < n; ++c)
+      if (std::isfinite(m(n + q, c)) && (best[q] < 0 || m(n + q, c) < m(n + q, best[q])))
+        best[q] = c;
+    if (best[q] < 0) continue;
+    float rival = std::numeric_limits<float>::infinity();
+    for (int c = 0; c < n; ++c)
+      if (std::abs(c - best[q]) > 10 && std::isfinite(m(n + q, c)))
+        rival = std::min(rival, m(n + q, c));
+    ratio[q] = std::isfinite(rival) && rival > 0 ? m(n + q, best[q]) / rival : 1.0f;
+    within[q] = ratio[q] <= 0.9f;
+    confirmed[q] = within[q] && agree[q];
+  }
+  const int accepted = static_cast<int>(std::count(within.begin(), within.end(), 1));
+  const int kept = static_cast<int>(std::count(confirmed.begin(), confirmed.end(), 1));
+  ASSERT_GT(kept, 50);
+  ASSERT_LT(kept, accepted);  // the confirmation refuses some
+  EXPECT_NE(o.out.find("accepted: " + std::to_string(kept) + " of 300 best matches"),
+            std::string::npos)
+      << o.out;
+
+  // The matches file: rank-1 records carry the verdicts, the others 0.
+  const auto csv = CsvFields(ReadAll(dir + "/out/matches.csv"));
+  ASSERT_GT(csv.size(), 1u);
+  EXPECT_EQ(csv[0], (std::vector<std::string>{"query", "reference", "distance", "rank", "score",
+                                              "accepted", "confirmed"}));
+  std::vector<Match> records;
+  int rank_one = 0;
+  for (std::size_t i = 1; i < csv.size(); ++i) {
+    const std::vector<std::string>& f = csv[i];
+    ASSERT_EQ(f.size(), 7u) << i;
+    const Match r{std::stoi(f[0]), std::stoi(f[1]), std::stof(f[2]), std::stoi(f[3]),
+                  std::stof(f[4])};
+    records.push_back(r);
+    const int a = std::stoi(f[5]), c = std::stoi(f[6]);
+    if (r.rank != 1) {
+      EXPECT_EQ(a + c, 0) << i;
+      continue;
+    }
+    ++rank_one;
+    EXPECT_EQ(r.reference, best[r.query]) << r.query;
+    EXPECT_EQ(a, within[r.query]) << r.query;
+    EXPECT_EQ(c, confirmed[r.query]) << r.query;
+  }
+  EXPECT_EQ(rank_one, n);
+  Config config = LoadConfig(preset);
+  const AgreementOptions agreement = AgreementOf(config.matching);
+  const std::vector<std::uint8_t> rule = AcceptedMatches(records, n, 0.9, &agreement);
+  EXPECT_EQ(std::vector<int>(rule.begin(), rule.end()), confirmed);
+
+  // The same flags in the .npy form: 22-byte records, the verdicts in the last two bytes.
+  ASSERT_EQ(run("matches.npy").status, 0);
+  const std::string npy = ReadAll(dir + "/out/matches.npy");
+  const std::size_t data = npy.size() - 22 * records.size();
+  ASSERT_EQ((npy.size() - data) % 22, 0u);
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    EXPECT_EQ(npy[data + 22 * i + 20], std::stoi(csv[i + 1][5])) << i;
+    EXPECT_EQ(npy[data + 22 * i + 21], std::stoi(csv[i + 1][6])) << i;
+  }
+
+  // The page: no ground truth said plainly, the operating point, and the three most
+  // confident accepted matches with their two frames.
+  const std::string page = ReadAll(dir + "/out/report.html");
+  EXPECT_NE(page.find("<b>No ground truth.</b>"), std::string::npos);
+  for (const char* id : {"settings", "operating-point", "matrix", "explore", "accepted"})
+    EXPECT_NE(page.find("<section id=\"" + std::string(id) + "\">"), std::string::npos) << id;
+  for (const char* id : {"figures", "pr", "wrong-matches", "misses"})
+    EXPECT_EQ(page.find("<section id=\"" + std::string(id) + "\">"), std::string::npos) << id;
+  EXPECT_NE(page.find("; " + std::to_string(accepted) + " accepted with ratio score &lt;= 0.9"),
+            std::string::npos);
+  EXPECT_NE(page.find(std::to_string(kept) + " of them confirmed by 1 independent query"),
+            std::string::npos);
+  std::vector<int> order;
+  for (int q = 0; q < n; ++q)
+    if (confirmed[q]) order.push_back(q);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return ratio[a] < ratio[b]; });
+  const std::vector<std::string> winter = ListImages(testing::SampleDir() + "/winter", "");
+  const std::vector<std::string> summer = ListImages(testing::SampleDir() + "/summer", "");
+  const std::size_t table = page.find("data-kind=\"accepted-confident\"");
+  ASSERT_NE(table, std::string::npos);
+  std::size_t at = table;
+  for (int k = 0; k < 3; ++k) {
+    const int q = order[k];
+    at = page.find("<tr data-query=\"", at + 1);
+    ASSERT_NE(at, std::string::npos);
+    EXPECT_EQ(std::stoi(page.substr(at + 16)), q) << k;
+    const std::string row = page.substr(at, page.find("</tr>", at) - at);
+    EXPECT_NE(row.find("alt=\"" + fs::path(winter[q]).filename().string() + "\""),
+              std::string::npos)
+        << q;
+    EXPECT_NE(row.find("alt=\"" + fs::path(summer[best[q]]).filename().string() + "\""),
+              std::string::npos)
+        << q;
+  }
+}
+
+// A bounded run keeps no matrix: no report, and a note says so.
+TEST(TestOpenABLE, ABoundedRunWritesNoReportAndSaysSo) {
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunProgram(
+      testing::TestOpenableExe(),
+      {SampleConfig(dir), "--quiet", "--set", "Matrix_mode=2", "--set", "Matches_name=out/k.csv",
+       "--set", "Report_name=out/report.html"},
+      dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_NE(o.err.find("note: Report_name: not written: the run is bounded"), std::string::npos)
+      << o.err;
+  EXPECT_FALSE(fs::exists(dir + "/out/report.html"));
+  EXPECT_TRUE(fs::exists(dir + "/out/k.csv"));
 }
 
 // --help fits a screen for every program: at most 55 lines of at most 92 columns, with the

@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include "OpenABLE/io/image_codec.h"
+#include "OpenABLE/base/strings.h"
+#include "OpenABLE/evaluation/report.h"
 #include "OpenABLE/io/json.h"
 #include "OpenABLE/reports/html_explorer.h"
 #include "config/config.h"
@@ -317,6 +319,283 @@ TEST(HtmlReport, ExplorerCodesAndGroupsOfCells) {
   EXPECT_EQ(values(1, 0), ExploreCode(0.25f));      // rows 3-5: 0, 0.25, 0.5
   EXPECT_EQ(values(1, 2), ExploreCode(0.45f));      // plus 0.2
   EXPECT_EQ(values(values.rows - 1, 1), ExploreCode(0.225f));  // the last group: 2 rows (0.1, 0.35)
+}
+
+// The ids of the page's sections, in order.
+std::vector<std::string> Sections(const std::string& page) {
+  std::vector<std::string> ids;
+  const std::string open = "<section id=\"";
+  for (std::size_t at = page.find(open); at != std::string::npos; at = page.find(open, at + 1)) {
+    const std::size_t begin = at + open.size();
+    ids.push_back(page.substr(begin, page.find('"', begin) - begin));
+  }
+  return ids;
+}
+
+// The page without its scripts (the text and markup a reader sees).
+std::string WithoutScripts(std::string page) {
+  for (std::size_t at = page.find("<script"); at != std::string::npos; at = page.find("<script")) {
+    const std::size_t end = page.find("</script>", at);
+    page.erase(at, end + 9 - at);
+  }
+  return page;
+}
+
+// The data-query of each row of the table `<table class="cases" data-kind="KIND">`.
+std::vector<int> CaseQueries(const std::string& page, const std::string& kind) {
+  std::vector<int> out;
+  const std::size_t table = page.find("data-kind=\"" + kind + "\"");
+  if (table == std::string::npos) return out;
+  const std::size_t end = page.find("</table>", table);
+  for (std::size_t at = page.find("data-query=\"", table); at < end;
+       at = page.find("data-query=\"", at + 1))
+    out.push_back(std::stoi(page.substr(at + 12)));
+  return out;
+}
+
+// The number in the cell `column` (0-based) of the first data row of the table with `id`.
+std::string Cell(const std::string& page, const std::string& id, int column) {
+  std::size_t at = page.find("<table id=\"" + id + "\"");
+  at = page.find("<tr", page.find("</tr>", at));
+  for (int c = 0; c <= column; ++c) at = page.find("<td", at + 1);
+  const std::size_t begin = page.find('>', at) + 1;
+  return page.substr(begin, page.find("</td>", begin) - begin);
+}
+
+// A queries x references matrix taken whole (as a map's query block): 30 queries against 50
+// references, query q's place reference q + 10 small for most queries (distances 0.1 + q / 1000,
+// accepted at 0.3), random elsewhere, query 4 without any cell with a value.
+struct BlockFixture {
+  static constexpr int kQueries = 30, kReferences = 50;
+  cv::Mat1f matrix;
+  EvaluationOptions options;
+  struct Expected {
+    int best = -1;
+    float distance = 0;
+  };
+  std::vector<Expected> expected;  // by brute force
+
+  BlockFixture() {
+    matrix.create(kQueries, kReferences);
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> u(0.35f, 1.0f);
+    for (int q = 0; q < kQueries; ++q)
+      for (int c = 0; c < kReferences; ++c) matrix(q, c) = u(rng);
+    for (int q = 0; q < kQueries; ++q)
+      if (q % 5 != 2) matrix(q, q + 10) = 0.1f + 0.001f * static_cast<float>((q * 7) % 30);
+    for (int c = 0; c < kReferences; ++c) matrix(4, c) = std::numeric_limits<float>::infinity();
+    options.accept_threshold = 0.3;
+    for (int q = 0; q < kQueries; ++q) {
+      Expected e;
+      for (int c = 0; c < kReferences; ++c)
+        if (std::isfinite(matrix(q, c)) && (e.best < 0 || matrix(q, c) < matrix(q, e.best)))
+          e.best = c;
+      if (e.best >= 0) e.distance = matrix(q, e.best);
+      expected.push_back(e);
+    }
+  }
+
+  ReportInput Input(const ReportAnswers& answers) const {
+    ReportInput input;
+    input.program = "openable_map";
+    input.title = "Queries of a map";
+    input.settings = {{"map", "route.map"}};
+    input.answers = {answers};
+    input.matrices = {&matrix};
+    input.examples = 4;
+    input.frames.read = [](bool row, int index) {
+      return cv::Mat(24, 40, CV_32FC1, cv::Scalar(row ? 0.25 : 0.75 - index / 100.0));
+    };
+    input.frames.name = [](bool row, int index) {
+      return std::string(row ? "query-" : "place-") + std::to_string(index) + ".png";
+    };
+    return input;
+  }
+};
+
+TEST(HtmlReport, WithoutGroundTruthTheRunsAnswersAndAcceptedFramesAreShown) {
+  const BlockFixture f;
+  const ReportAnswers answers =
+      AnswersForReport(f.matrix, EvaluationLayout::QueryReference(30, 50), "LDB L=1", "a map",
+                       f.options);
+  // Accepted (distance <= 0.3) by brute force, most confident first.
+  std::vector<int> accepted;
+  for (int q = 0; q < 30; ++q)
+    if (f.expected[q].best >= 0 && f.expected[q].distance <= 0.3f) accepted.push_back(q);
+  std::stable_sort(accepted.begin(), accepted.end(), [&](int a, int b) {
+    return f.expected[a].distance < f.expected[b].distance;
+  });
+  ASSERT_EQ(accepted.size(), 23u);  // 24 with the place, less query 4
+  ReportInput input = f.Input(answers);
+  int reads = 0;
+  const auto read = input.frames.read;
+  input.frames.read = [&](bool row, int index) {
+    ++reads;
+    return read(row, index);
+  };
+  std::vector<std::pair<std::int64_t, std::int64_t>> progress;
+  input.on_progress = [&](std::int64_t done, std::int64_t total) {
+    progress.emplace_back(done, total);
+  };
+  const std::string page = EncodeHtmlReport(input);
+
+  EXPECT_EQ(Sections(page), (std::vector<std::string>{"settings", "operating-point", "matrix",
+                                                       "explore", "accepted"}));
+  // It says there is no ground truth, and how to get figures.
+  EXPECT_NE(page.find("<b>No ground truth.</b>"), std::string::npos);
+  EXPECT_NE(page.find("Ground_truth_type"), std::string::npos);
+  // Nothing is judged: no figures, no right or wrong, no precision or recall in what is shown.
+  const std::string shown = WithoutScripts(page);
+  for (const char* judged : {"figures-table", "class=\"right\"", "class=\"wrong\"", "ex-precision",
+                             "ex-recall", "ex-correct", "precision-recall figure", "true place",
+                             ">right<", ">wrong<", "<th>result</th>"})
+    EXPECT_EQ(shown.find(judged), std::string::npos) << judged;
+  // The operating point: 29 answered, 23 accepted, all confirmed (no Match_consistency).
+  EXPECT_EQ(Cell(page, "operating-point-table", 1), "30");
+  EXPECT_EQ(Cell(page, "operating-point-table", 2), "29");
+  EXPECT_EQ(Cell(page, "operating-point-table", 5), "23");
+  EXPECT_EQ(Cell(page, "operating-point-table", 7), "23");
+  EXPECT_NE(page.find(": the run&#39;s 23 matches."), std::string::npos);
+  // The most confident accepted matches, then the least confident, least confident first.
+  const std::vector<int> confident(accepted.begin(), accepted.begin() + 4);
+  const std::vector<int> doubtful(accepted.rbegin(), accepted.rbegin() + 4);
+  EXPECT_EQ(CaseQueries(page, "accepted-confident"), confident);
+  EXPECT_EQ(CaseQueries(page, "accepted-doubtful"), doubtful);
+  // Each row shows the query's frame beside its matched frame, by name, with its distance.
+  for (const int q : confident) {
+    const std::size_t row = page.find("<tr data-query=\"" + std::to_string(q) + "\" data-reference=\"" +
+                                      std::to_string(f.expected[q].best) + "\">");
+    ASSERT_NE(row, std::string::npos) << q;
+    const std::string text = page.substr(row, page.find("</tr>", row) - row);
+    EXPECT_NE(text.find("query-" + std::to_string(q) + ".png"), std::string::npos) << text;
+    EXPECT_NE(text.find("place-" + std::to_string(f.expected[q].best) + ".png"), std::string::npos);
+    EXPECT_NE(text.find("distance " + FormatFixed(f.expected[q].distance, 4)), std::string::npos)
+        << text;
+  }
+  // The explorer's data: no truth, each query's best match, the run's accepted answers.
+  const Json run = Json::parse(ScriptText(page, "explore-run-0"));
+  EXPECT_EQ(run["truth"], false);
+  EXPECT_EQ(run["correct"], "");
+  EXPECT_EQ(run["row_offset"], 0);
+  EXPECT_EQ(run["col_offset"], 0);
+  std::string digits(30, '0');
+  for (const int q : accepted) digits[q] = '1';
+  EXPECT_EQ(run["accepted"], digits);
+  for (int q = 0; q < 30; ++q) EXPECT_EQ(run["best"][q], f.expected[q].best) << q;
+  // Frames: the explorer's thumbnails of 30 queries and 50 references once each, and two per
+  // case (4 + 4 cases); the frame images on the page: 16.
+  EXPECT_EQ(reads, 30 + 50 + 2 * 8);
+  int frames = 0;
+  for (std::size_t at = page.find("class=\"frame\""); at != std::string::npos;
+       at = page.find("class=\"frame\"", at + 1))
+    ++frames;
+  EXPECT_EQ(frames, 16);
+  // Progress: from 0 to its total, one step at a time.
+  ASSERT_FALSE(progress.empty());
+  EXPECT_EQ(progress.front().first, 0);
+  EXPECT_EQ(progress.back().first, progress.back().second);
+  EXPECT_EQ(progress.size(), static_cast<std::size_t>(progress.back().second) + 1);
+  EXPECT_GE(progress.back().second, 30 + 50);
+}
+
+TEST(HtmlReport, WithoutGroundTruthARunThatAcceptsNothingSaysWhy) {
+  const BlockFixture f;
+  EvaluationOptions none = f.options;
+  none.accept_threshold = -1;
+  ReportAnswers answers = AnswersForReport(f.matrix, EvaluationLayout::QueryReference(30, 50),
+                                           "LDB L=1", "a map", none);
+  ReportInput input = f.Input(answers);
+  input.truth_advice = "Give openable_map a ground truth.";
+  std::string page = EncodeHtmlReport(input);
+  EXPECT_NE(page.find("Give openable_map a ground truth."), std::string::npos);
+  EXPECT_EQ(page.find("Ground_truth_type and Ground_truth"), std::string::npos);
+  EXPECT_NE(page.find("No match accepted: Match_threshold is not set (-1)"), std::string::npos);
+  EXPECT_NE(page.find("Most confident best matches"), std::string::npos);
+  // The most confident best matches stand in for the accepted ones.
+  EXPECT_EQ(CaseQueries(page, "accepted-confident").size(), 4u);
+  EXPECT_EQ(page.find("UNRELIABLE"), std::string::npos);
+
+  // The auto mode trusted no setting: UNRELIABLE, nothing accepted.
+  EvaluationOptions untrusted = f.options;
+  untrusted.accept_none = true;
+  input.answers = {AnswersForReport(f.matrix, EvaluationLayout::QueryReference(30, 50), "SAD",
+                                    "a run", untrusted)};
+  page = EncodeHtmlReport(input);
+  EXPECT_NE(page.find("UNRELIABLE: the auto mode could not trust any candidate"),
+            std::string::npos);
+  EXPECT_EQ(Cell(page, "operating-point-table", 7), "0");
+  EXPECT_NE(page.find("\"accepted\":\"" + std::string(30, '0') + "\""), std::string::npos);
+}
+
+TEST(HtmlReport, WithoutGroundTruthAnswersThatDoNotFitAreRefused) {
+  const BlockFixture f;
+  ReportAnswers answers = AnswersForReport(f.matrix, EvaluationLayout::QueryReference(30, 50),
+                                           "x", "y", f.options);
+  ReportInput input = f.Input(answers);
+  input.matrices.clear();
+  EXPECT_THROW(EncodeHtmlReport(input), std::logic_error);
+  input = f.Input(answers);
+  input.answers[0].answers.confirmed.pop_back();
+  EXPECT_THROW(EncodeHtmlReport(input), std::logic_error);
+  input = f.Input(answers);
+  input.answers[0].answers.best[3] = 50;  // not a column of the block
+  EXPECT_THROW(EncodeHtmlReport(input), std::logic_error);
+  input = f.Input(answers);
+  input.answers[0].layout = EvaluationLayout::QueryReference(31, 50);
+  EXPECT_THROW(EncodeHtmlReport(input), std::logic_error);
+}
+
+// With ground truth and Match_threshold, the figures show the run's operating point (accepted,
+// confirmed, right, precision, recall) and, with Evaluation_protocol naming them, one row per
+// reference protocol, as the text table prints them.
+TEST(HtmlReport, FiguresShowTheOperatingPointAndTheReferenceProtocols) {
+  Config config;
+  ApplyOverride(config, "Ground_truth_type=aligned");
+  ApplyOverride(config, "Tolerance=" + std::to_string(kTolerance));
+  ApplyOverride(config, "Match_threshold=0.55");
+  ApplyOverride(config, "Evaluation_protocol=all");
+  Fixture base;
+  Evaluation evaluation;
+  evaluation.settings = EvaluationSettingsFrom(config);
+  EvaluateMatrix(evaluation, base.matrix, EvaluationLayout::TwoTraversals(kFrames, kFrames),
+                 "LDB", "test");
+  // By brute force: answers with distance <= 0.55, and the right ones among them.
+  int accepted = 0, right = 0;
+  for (const Expected& e : BruteForce(base.matrix))
+    if (e.distance <= 0.55f) {
+      ++accepted;
+      right += e.correct;
+    }
+  ASSERT_GT(right, 0);
+  ASSERT_LT(right, accepted);  // some accepted answers are wrong
+  ReportInput input;
+  input.evaluation = &evaluation;
+  input.matrices = {&base.matrix};
+  input.frames.missing = "none";
+  const std::string page = EncodeHtmlReport(input);
+  EXPECT_EQ(Sections(page), (std::vector<std::string>{"settings", "figures", "pr", "matrix",
+                                                       "explore", "wrong-matches", "misses"}));
+  EXPECT_EQ(page.find("No ground truth"), std::string::npos);
+  EXPECT_EQ(Cell(page, "operating-point-table", 5), std::to_string(accepted));
+  EXPECT_EQ(Cell(page, "operating-point-table", 7), std::to_string(accepted));
+  EXPECT_EQ(Cell(page, "operating-point-table", 8), std::to_string(right));
+  EXPECT_EQ(Cell(page, "operating-point-table", 9), FormatFixed(double(right) / accepted, 4));
+  // One row per protocol, with the figures the text table prints.
+  const std::string text = FormatEvaluationTable(evaluation.settings, evaluation.runs);
+  for (const char* protocol : {"openable", "vpr_bench", "vpr_tutorial"}) {
+    EXPECT_NE(page.find("<tr data-protocol=\"" + std::string(protocol) + "\">"), std::string::npos)
+        << protocol;
+    EXPECT_NE(text.find(protocol), std::string::npos);
+  }
+  const VprBenchResult& b = evaluation.runs[0].vpr_bench;
+  const std::size_t row = page.find("<tr data-protocol=\"vpr_bench\">");
+  EXPECT_NE(page.find("<td class=\"n\">" + FormatFixed(b.auc_pr, 4) + "</td>", row),
+            std::string::npos);
+  EXPECT_NE(text.find(FormatFixed(b.auc_pr, 3)), std::string::npos);
+  // The text table's operating point names the right answers too.
+  EXPECT_NE(text.find(std::to_string(accepted) + " answers, " + std::to_string(right) + " right"),
+            std::string::npos)
+      << text;
 }
 
 TEST(HtmlReport, ChangedSettingsAreTheKeysDifferentFromTheDefaults) {
