@@ -2,10 +2,9 @@
 
 #include <algorithm>
 #include <limits>
+#include <opencv2/core/utility.hpp>
 #include <stdexcept>
 #include <string>
-
-#include <opencv2/core/utility.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "matching/agreement.h"

@@ -7,9 +7,8 @@
 #pragma once
 
 #include <cstdint>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "OpenABLE/evaluation/layout.h"
 #include "OpenABLE/evaluation/metrics.h"

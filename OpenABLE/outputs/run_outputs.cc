@@ -81,8 +81,8 @@ ReportAnswers RunAnswersForReport(const OutputInput& in) {
   EvaluationOptions options = EvaluationSettingsFrom(config).options;
   options.accept_none = in.automatic != nullptr && !in.automatic->reliable;
   const EvaluationLayout layout = LayoutOf(in.result);
-  ReportAnswers report =
-      AnswersForReport(in.result.normalized, layout, RunLabel(config), "Test_OpenABLE run", options);
+  ReportAnswers report = AnswersForReport(in.result.normalized, layout, RunLabel(config),
+                                          "Test_OpenABLE run", options);
   if (in.verification != nullptr) {
     if (options.accept_threshold < 0)
       options.accept_threshold = std::numeric_limits<double>::infinity();

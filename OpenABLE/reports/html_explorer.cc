@@ -348,15 +348,16 @@ window.addEventListener('load', function () {
         score = run.score_kind + ' score ' + num(run.score[q], 6) + ' \u00b7 the query\'s best match, ' +
                 (truth ? (correct(q) ? 'right' : 'wrong') + ', ' : '') +
                 (accepted(q, threshold()) ? 'accepted' : 'not accepted') + ' at the threshold' +
-                (truth ? '' : runAccepted(q) ? '; accepted by the run' : '; not accepted by the run');
+                (truth ? ''
+                       : runAccepted(q) ? '; accepted by the run' : '; not accepted by the run');
       } else {
         score = 'not the query\'s best match (reference ' + b + ', ' + run.score_kind + ' score ' +
                 num(run.score[q], 6) + (truth ? ', ' + (correct(q) ? 'right' : 'wrong') : '') + ')';
       }
       info.querySelector('.ex-cell-score').textContent = score;
       info.querySelector('.ex-cell-truth').textContent =
-          !truth || run.positive.charAt(q) === '1' ? ''
-                                                  : 'the query has no true place among its candidates';
+          !truth || run.positive.charAt(q) === '1'
+              ? '' : 'the query has no true place among its candidates';
       root.setAttribute('data-cell', q + ',' + c);
     }
 
@@ -720,10 +721,11 @@ std::string ExplorerSection(const ReportInput& input, const std::vector<ReportRu
          "<button type=\"button\" class=\"ex-reset\">" + reset + "</button><br>";
     if (run.evaluated != nullptr) {
       const PerQueryResult& p = run.evaluated->per_query;
-      h += "accepted <b class=\"ex-accepted\"></b> of " + std::to_string(p.queries - p.unanswered) +
-           " answers, right <b class=\"ex-correct\"></b>; precision <b class=\"ex-precision\"></b>, "
-           "recall <b class=\"ex-recall\"></b> (of " + std::to_string(p.positive_queries) +
-           " queries with a true place)</div>\n";
+      h += "accepted <b class=\"ex-accepted\"></b> of " +
+           std::to_string(p.queries - p.unanswered) +
+           " answers, right <b class=\"ex-correct\"></b>; precision <b "
+           "class=\"ex-precision\"></b>, recall <b class=\"ex-recall\"></b> (of " +
+           std::to_string(p.positive_queries) + " queries with a true place)</div>\n";
     } else {
       h += "accepted <b class=\"ex-accepted\"></b> of " + std::to_string(a.answered) +
            " answers at this threshold; the run accepted " + std::to_string(a.Confirmed()) +

@@ -471,7 +471,10 @@ std::string AcceptedSection(const ReportInput& input, const std::vector<ReportRu
            "accepted.</p>\n";
     }
     if (pool.empty() || n == 0) {
-      h += "<p class=\"note\">" + std::string(pool.empty() ? "No query has a best match." : "Report_examples is 0: no frames shown.") + "</p>\n";
+      h += "<p class=\"note\">" +
+           std::string(pool.empty() ? "No query has a best match."
+                                    : "Report_examples is 0: no frames shown.") +
+           "</p>\n";
       continue;
     }
     std::stable_sort(pool.begin(), pool.end(),
@@ -480,7 +483,7 @@ std::string AcceptedSection(const ReportInput& input, const std::vector<ReportRu
     const std::vector<int> confident(pool.begin(), pool.begin() + static_cast<long>(most));
     // The least confident among the rest, least confident first.
     std::vector<int> doubtful;
-    for (std::size_t k = pool.size(); k > most && doubtful.size() < static_cast<std::size_t>(n); --k)
+    for (std::size_t k = pool.size(); k > most && doubtful.size() < most; --k)
       doubtful.push_back(pool[k - 1]);
     const auto table = [&](const std::vector<int>& queries, const std::string& kind,
                            const std::string& title) {
@@ -690,7 +693,8 @@ std::string EncodeHtmlReport(const ReportInput& input) {
     }
     // The reference protocols (Evaluation_protocol vpr_bench, vpr_tutorial), as the text
     // table's "By protocol".
-    const std::vector<ProtocolRow> protocol_rows = ProtocolRows(evaluation.settings, evaluation.runs);
+    const std::vector<ProtocolRow> protocol_rows =
+        ProtocolRows(evaluation.settings, evaluation.runs);
     if (!protocol_rows.empty()) {
       h += "<h3>By protocol</h3>\n<table id=\"protocols-table\">\n<tr><th>run</th><th>protocol"
            "</th><th>AUC</th><th>R@100P</th><th>R@1</th><th>R@5</th><th>R@10</th><th>more</th>"

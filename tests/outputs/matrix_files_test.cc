@@ -443,7 +443,8 @@ TEST(EncodeMatches, AcceptedAndConfirmedColumnsAreTheRankOneVerdicts) {
     ASSERT_TRUE(std::getline(lines, line));
     const Match& m = matches[i];
     const bool best = m.rank == 1;
-    const int a = best ? confirmed.accepted[m.query] : 0, c = best ? confirmed.confirmed[m.query] : 0;
+    const int a = best ? confirmed.accepted[m.query] : 0;
+    const int c = best ? confirmed.confirmed[m.query] : 0;
     const std::string end = "," + std::to_string(a) + "," + std::to_string(c);
     EXPECT_EQ(line.substr(line.size() - end.size()), end) << line;
     EXPECT_EQ(npy[data + 22 * i + 20], a) << i;

@@ -463,7 +463,8 @@ TEST(HtmlReport, WithoutGroundTruthTheRunsAnswersAndAcceptedFramesAreShown) {
   EXPECT_EQ(CaseQueries(page, "accepted-doubtful"), doubtful);
   // Each row shows the query's frame beside its matched frame, by name, with its distance.
   for (const int q : confident) {
-    const std::size_t row = page.find("<tr data-query=\"" + std::to_string(q) + "\" data-reference=\"" +
+    const std::size_t row = page.find("<tr data-query=\"" + std::to_string(q) +
+                                      "\" data-reference=\"" +
                                       std::to_string(f.expected[q].best) + "\">");
     ASSERT_NE(row, std::string::npos) << q;
     const std::string text = page.substr(row, page.find("</tr>", row) - row);
