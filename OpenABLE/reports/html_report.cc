@@ -366,6 +366,9 @@ std::string PartnersText(int n) {
 // Why a run without ground truth accepted no match; empty when it accepted some.
 std::string NoneAcceptedReason(const ReportRun& run) {
   if (run.answers.Confirmed() > 0) return "";
+  if (run.answers.answered == 0)
+    return run.verified ? "no candidate of any query passed geometric verification"
+                        : "no query has a best match";
   if (run.untrusted)
     return "the auto mode could not trust any candidate's settings, so the run accepts none "
            "(UNRELIABLE)";
@@ -421,7 +424,9 @@ std::string OperatingPointTable(const std::vector<ReportRun>& runs, bool truth) 
 std::string OperatingPointSentence(const ReportRun& run) {
   const QueryAnswers& a = run.answers;
   std::string s = run.label + ": " + std::to_string(a.answered) + " of " +
-                  std::to_string(a.queries) + " queries answered (a best match with a value)";
+                  std::to_string(a.queries) + " queries answered" +
+                  (run.verified ? " (a candidate that passed geometric verification)"
+                                : " (a best match with a value)");
   if (run.untrusted)
     return s + "; UNRELIABLE: the auto mode could not trust any candidate's settings, so the "
                "run accepts no match. The explorer's slider shows what a threshold would "
@@ -431,8 +436,11 @@ std::string OperatingPointSentence(const ReportRun& run) {
                "the best matches whose " + ScoreName(run.score) +
                " score is at or below it; the explorer's slider shows how many a threshold "
                "accepts.";
-  s += "; " + std::to_string(a.Accepted()) + " accepted with " + ScoreName(run.score) +
-       " score <= " + FormatNumber(run.threshold) + " (Match_threshold)";
+  s += "; " + std::to_string(a.Accepted()) +
+       (std::isfinite(run.threshold)
+            ? " accepted with " + ScoreName(run.score) + " score <= " +
+                  FormatNumber(run.threshold) + " (Match_threshold)"
+            : std::string(" accepted (every verified answer: Match_threshold is -1)"));
   if (run.consistency > 0)
     s += ", " + std::to_string(a.Confirmed()) + " of them confirmed " +
          PartnersText(run.consistency) + " (Match_consistency)";
@@ -495,8 +503,10 @@ std::string AcceptedSection(const ReportInput& input, const std::vector<ReportRu
         const int q = queries[k];
         t += "<tr data-query=\"" + std::to_string(q) + "\" data-reference=\"" +
              std::to_string(a.best[q]) + "\"><td>" + std::to_string(k + 1) + "<br>" +
-             ScoreName(run.score) + " score " + Number(a.score[q], 4) + "<br>distance " +
-             Number(a.distance[q], 4) + "</td>" + FrameCell(frames, run.layout, true, q, "", "") +
+             (run.score == MatchScore::kRatio ? "ratio score " + Number(a.score[q], 4) + "<br>"
+                                              : std::string()) +
+             "distance " + Number(a.distance[q], 4) + "</td>" +
+             FrameCell(frames, run.layout, true, q, "", "") +
              FrameCell(frames, run.layout, false, a.best[q], "", "") + "</tr>\n";
       }
       return t + "</table>\n";
