@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -667,11 +668,15 @@ std::vector<std::string> WriteQueryOutputs(const std::string& prefix, const Conf
                                            const std::vector<std::string>& names,
                                            const std::vector<OnlineResult>& results,
                                            const OnlineDetector::QueryMatrix& matrix,
-                                           const Json& document, const Arguments& a) {
+                                           const Json& document, const Arguments& a,
+                                           ProgressReporter& progress) {
   CheckOutputPrefix("--output", prefix);
+  const bool evaluated = EvaluationRequested(config);
+  progress.Begin("writing", evaluated ? 4 : 3, "outputs");
   OutputBatch batch;
   batch.Stage("--output", prefix + ".csv", EncodeQueryCsv(document["queries"]));
   batch.Stage("--output", prefix + ".json", json::Dump(document));
+  progress.Update(1);
   const OnlineOptions& o = d.Options();
   // The block searched, normalised by its largest value (Eq. 5) as a run's matrix.
   cv::Mat1f block;
@@ -695,6 +700,8 @@ std::vector<std::string> WriteQueryOutputs(const std::string& prefix, const Conf
                      {"search", SearchText(o)},
                      {"tuned", d.Tuning().tuned ? (d.UsesTuning() ? "yes, used" : "yes, replaced")
                                                 : "no"}};
+  report.settings_note = "The map, the query's frames and the search it used (openable_map "
+                         "info gives the map's settings).";
   report.examples = config.evaluation.report_examples;
   Evaluation evaluation;
   if (EvaluationRequested(config)) {
@@ -740,15 +747,58 @@ std::vector<std::string> WriteQueryOutputs(const std::string& prefix, const Conf
     p.has_operating_point = true;
     StageEvaluation(batch, "--output", prefix + "_eval", evaluation, {&block});
     report.evaluation = &evaluation;
+    progress.Update(2);
   }
   if (!block.empty()) {
     report.matrices = {&block};
     report.frames = QueryFrames(names, d, matrix.frames);
-    if (report.evaluation != nullptr)
-      batch.Stage("--output", prefix + ".html", EncodeHtmlReport(report));
+    if (report.evaluation == nullptr) {
+      // The map's own answers: its best match, score, and what it accepted (the score, then
+      // the confirmation by earlier queries; none on an unreliable map).
+      ReportAnswers answers;
+      answers.label = label;
+      answers.source = a.positional[0];
+      answers.layout = layout;
+      answers.score = o.score;
+      answers.score_window = o.score_window;
+      answers.threshold = o.Threshold();
+      answers.consistency = o.consistency;
+      answers.untrusted = d.UsesTuning() && !d.Tuning().reliable;
+      QueryAnswers& q = answers.answers;
+      const float none = std::numeric_limits<float>::infinity();
+      q.best.assign(static_cast<std::size_t>(block.rows), -1);
+      q.distance.assign(q.best.size(), none);
+      q.score.assign(q.best.size(), none);
+      q.accepted.assign(q.best.size(), 0);
+      q.confirmed.assign(q.best.size(), 0);
+      q.queries = block.rows;
+      for (int i = 0; i < block.rows; ++i) {
+        const auto& candidates = results[static_cast<std::size_t>(i)].candidates;
+        if (candidates.empty()) continue;
+        const LoopCandidate& c = candidates.front();
+        const auto column = std::lower_bound(matrix.frames.begin(), matrix.frames.end(), c.frame);
+        const int j = static_cast<int>(column - matrix.frames.begin());
+        const std::size_t k = static_cast<std::size_t>(i);
+        q.best[k] = j;
+        q.distance[k] = block(i, j);
+        q.score[k] = static_cast<float>(c.score);
+        q.accepted[k] = c.score <= o.Threshold() && !answers.untrusted;
+        q.confirmed[k] = c.accepted;
+        ++q.answered;
+      }
+      report.answers = {answers};
+      report.truth_advice =
+          "Give the query's ground truth to openable_map query (--set Ground_truth_type=aligned, "
+          "or a file: --set Ground_truth_type=pairs --set Ground_truth=FILE, with one --session)"
+          " for R@1, AUC and the precision of the accepted matches.";
+    }
+    batch.Stage("--output", prefix + ".html", EncodeHtmlReport(report));
   }
+  progress.Update(evaluated ? 3 : 2);
   const std::vector<std::string> paths = batch.Paths();
   batch.Commit();
+  progress.Update(evaluated ? 4 : 3);
+  progress.End();
   if (report.evaluation != nullptr && !a.quiet)
     std::cout << FormatEvaluationTable(evaluation.settings, evaluation.runs);
   return paths;
@@ -825,7 +875,7 @@ int Query(const Arguments& a) {
   }
   if (!a.output.empty()) {
     const std::vector<std::string> written =
-        WriteQueryOutputs(a.output, config, *d, names, results, out, document, a);
+        WriteQueryOutputs(a.output, config, *d, names, results, out, document, a, progress);
     if (!a.quiet) {
       std::cout << accepted << " of " << answered << " best matches accepted ("
                 << SearchText(d->Options()) << ").\nWrote:\n";

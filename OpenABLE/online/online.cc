@@ -119,6 +119,14 @@ void OnlineOptions::Check() const {
   Require(exact_limit >= 0, "exact_limit", std::to_string(exact_limit), ">= 0");
   Require(block_frames >= 16, "block_frames", std::to_string(block_frames), ">= 16");
   const std::vector<std::string> names = DescriptorList(descriptor.name);
+  if (!kept_descriptors.empty()) {
+    try {
+      DescriptorList(kept_descriptors);
+    } catch (const InputError& e) {
+      throw InputError("OnlineOptions.kept_descriptors = " + Quoted(kept_descriptors) + ": " +
+                       e.what());
+    }
+  }
   if (!fusion_weights.empty()) {
     Require(fusion_weights.size() == names.size(), "fusion_weights",
             std::to_string(fusion_weights.size()) + " weights",
@@ -1365,7 +1373,32 @@ void RequireMap(const std::string& path) {
 
 }  // namespace
 
+namespace {
+
+// `f()`, its InputError naming `path` (the map's settings are checked by the same functions
+// as options are, whose messages name the option alone).
+template <typename F>
+auto NamingMap(const std::string& path, F f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    if (message.find(path) != std::string::npos) throw;
+    throw InputError(path + ": " + message);
+  }
+}
+
+OnlineOptions ReadMapOptions(const std::string& path, const OnlineOptions& base);
+
+}  // namespace
+
 OnlineOptions MapOptions(const std::string& path, const OnlineOptions& base) {
+  return NamingMap(path, [&] { return ReadMapOptions(path, base); });
+}
+
+namespace {
+
+OnlineOptions ReadMapOptions(const std::string& path, const OnlineOptions& base) {
   RequireMap(path);
   MapReadOptions read;
   read.header_only = true;
@@ -1412,8 +1445,15 @@ OnlineOptions MapOptions(const std::string& path, const OnlineOptions& base) {
   return o;
 }
 
+}  // namespace
+
 OnlineDetector::LoadedMap OnlineDetector::LoadMap(const std::string& path,
                                                   const MapReadOptions& read) {
+  return NamingMap(path, [&] { return LoadMapNamed(path, read); });
+}
+
+OnlineDetector::LoadedMap OnlineDetector::LoadMapNamed(const std::string& path,
+                                                       const MapReadOptions& read) {
   State& s = *state_;
   if (Size() != 0)
     throw InputError("OnlineDetector::LoadMap(\"" + path + "\"): the detector holds " +
@@ -1490,6 +1530,10 @@ OnlineDetector::LoadedMap OnlineDetector::LoadMap(const std::string& path,
 }
 
 void OnlineDetector::AppendMap(const std::string& path) {
+  NamingMap(path, [&] { AppendMapNamed(path); });
+}
+
+void OnlineDetector::AppendMapNamed(const std::string& path) {
   State& s = *state_;
   s.ThrowIfDamaged(true);
   RequireMap(path);

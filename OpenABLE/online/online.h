@@ -376,6 +376,8 @@ class OnlineDetector {
   void AppendMap(const std::string& path);
 
  private:
+  LoadedMap LoadMapNamed(const std::string& path, const MapReadOptions& read);
+  void AppendMapNamed(const std::string& path);
   struct State;
   std::unique_ptr<State> state_;
 };

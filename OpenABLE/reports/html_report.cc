@@ -639,9 +639,8 @@ std::string EncodeHtmlReport(const ReportInput& input) {
     h += "<tr><td><code>" + Escape(key) + "</code></td><td><code>" + Escape(value) +
          "</code></td></tr>\n";
   h += "</table>\n";
-  if (!input.settings.empty())
-    h += "<p class=\"note\">Keys of Config.txt shown above: those that differ from the "
-         "defaults.</p>\n";
+  if (!input.settings.empty() && !input.settings_note.empty())
+    h += "<p class=\"note\">" + Escape(input.settings_note) + "</p>\n";
   if (!input.all_settings.empty())
     h += "<details><summary>Every key</summary>\n<pre>" + Escape(input.all_settings) +
          "</pre>\n</details>\n";

@@ -129,6 +129,9 @@ struct ReportInput {
   std::string title;    // heading of the page
   // Rows of the settings table (key, value), e.g. the keys that differ from the defaults.
   std::vector<std::pair<std::string, std::string>> settings;
+  // The sentence under the settings table (when it has rows).
+  std::string settings_note =
+      "Keys of Config.txt shown above: those that differ from the defaults.";
   std::string all_settings;  // every key (FormatConfig), shown folded; empty: left out
   // With ground truth: the evaluation, one run per matrix. Null: the page is made from
   // `answers`, without ground truth.

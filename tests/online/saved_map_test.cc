@@ -439,5 +439,35 @@ TEST(SavedMap, InconsistentFeaturesAreRefused) {
   EXPECT_EQ(detector.Size(), 0);
 }
 
+
+// A map whose settings name a descriptor that does not exist (map fuzzer finding): one line
+// naming the map, from LoadMap, MapOptions and AppendMap alike.
+TEST(SavedMap, UnknownDescriptorsNameTheMap) {
+  OnlineOptions options;
+  OnlineDetector d(options);
+  cv::Mat row(1, d.RowWidth(), d.RowType());
+  cv::RNG rng(3);
+  for (int i = 0; i < 5; ++i) {
+    rng.fill(row, cv::RNG::UNIFORM, 0, 256);
+    d.AddDescriptor(row);
+  }
+  const std::string good = testing::TempDir() + "/good.map";
+  d.SaveMap(good);
+  for (const std::string key : {"descriptor", "channels", "search_descriptor"}) {
+    MapFile map = ReadMapFile(good, {false, false});
+    for (auto& [k, v] : map.settings)
+      if (k == key) v = "QQX";
+    const std::string path = testing::TempDir() + "/bad_" + key + ".map";
+    WriteMapFile(path, map);
+    ExpectInputError([&] { OnlineDetector other(MapOptions(path)); }, {path, "QQX"});
+    if (key != "channels") continue;  // the rows are LDB's: a detector of LDB loads them
+    OnlineDetector fresh(options);
+    ExpectInputError([&] { fresh.LoadMap(path); }, {path, "QQX"});
+    EXPECT_EQ(fresh.Size(), 0);
+    OnlineDetector appender(options);
+    ExpectInputError([&] { appender.AppendMap(path); }, {path, "QQX"});
+  }
+}
+
 }  // namespace
 }  // namespace openable
