@@ -5,6 +5,7 @@
 //
 // Usage: bench_online [--datasets DIR] [--descriptor LDB] [--sequence L] [--exclusion E]
 //                     [--threshold T] [--score distance|ratio] [--score-window W]
+//                     [--consistency N]
 //                     [--heading-limit DEG] [--prefill N] [--exact-limit N]
 //                     [--block-frames N] [--foreground-merges] [--csv FILE]
 //                     [--verify] [--verify-candidates K] [--verify-consistency N]
@@ -85,6 +86,7 @@ int main(int argc, char** argv) {
     else if (a == "--sequence") options.sequence_length = std::stoi(next());
     else if (a == "--exclusion") options.exclusion = std::stoi(next());
     else if (a == "--threshold") options.threshold = std::stod(next());
+    else if (a == "--consistency") options.consistency = std::stoi(next());
     else if (a == "--score")
       options.score = openable::ParseEnum<openable::MatchScore>(next(), "--score");
     else if (a == "--score-window") options.score_window = std::stoi(next());
@@ -191,11 +193,11 @@ int main(int argc, char** argv) {
     }
     const int positives = std::count(positive.begin(), positive.end(), 1);
     std::printf("OnlineDetector on KITTI 00 frames 0-1699: %s, L=%d, exclusion %d, score %s, "
-                "threshold %.3f, %d random rows before (map %d frames at the end), exact limit %d, %d "
+                "threshold %.3f, consistency %d, %d random rows before (map %d frames at the end), exact limit %d, %d "
                 "frames searched with %s index blocks (%d blocks at the end, merges %s), memory "
                 "%.1f MB\n",
                 options.descriptor.name.c_str(), options.sequence_length, options.exclusion,
-                openable::EnumName(options.score).c_str(), options.threshold, prefill, detector.Size(), options.exact_limit,
+                openable::EnumName(options.score).c_str(), options.Threshold(), options.consistency, prefill, detector.Size(), options.exact_limit,
                 approximate_frames, options.approximate.engine.c_str(),
                 detector.Blocks(),
                 options.background_merges ? "in the background" : "in AddFrame",
@@ -215,7 +217,7 @@ int main(int argc, char** argv) {
                     ? (", heading <= " + std::to_string(heading_limit) + " deg").c_str()
                     : ", any heading");
     std::printf("  accepted at %.3f: %d frames, %d right (precision %.3f), recall %.3f\n",
-                options.threshold, accepted, accepted_correct,
+                options.Threshold(), accepted, accepted_correct,
                 accepted ? double(accepted_correct) / accepted : 1.0,
                 positives ? double(accepted_correct) / positives : 0.0);
     // Sweep: accepting the top-1 candidate when its score (--score) <= t.
