@@ -12,8 +12,19 @@
 #include "OpenABLE/io/frame_source.h"
 #include "descriptors/descriptor.h"
 #include "descriptors/frame_describer.h"
+#include "matching/distances.h"
 
 namespace openable {
+
+// The distance the rows of `d` are compared with (its DistanceKind as a matching Metric).
+inline Metric MetricOf(const Descriptor& d) {
+  switch (d.Distance()) {
+    case DistanceKind::kHamming: return Metric::kHamming;
+    case DistanceKind::kL2: return Metric::kL2;
+    case DistanceKind::kL1: break;
+  }
+  return Metric::kL1;
+}
 
 // Descriptors of every frame of a source, and what was skipped.
 struct DescribedSequence {

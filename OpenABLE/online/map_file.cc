@@ -14,6 +14,7 @@
 #include <cstring>
 #include <ctime>
 #include <deque>
+#include <filesystem>
 #include <limits>
 #include <sstream>
 #include <string_view>
@@ -311,6 +312,10 @@ struct Mapped {
 };
 
 std::shared_ptr<Mapped> MapWholeFile(const std::string& path, const std::string& expected) {
+  std::error_code error;
+  if (std::filesystem::symlink_status(path, error).type() == std::filesystem::file_type::not_found)
+    throw InputError("no map at " + Quoted(path) + " (create one with openable_map add, or "
+                     "OnlineDetector::SaveMap)");
   CheckInputFile(path, "map " + Quoted(path), expected);
   const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0)

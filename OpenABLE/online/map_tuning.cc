@@ -29,12 +29,7 @@ namespace {
 Metric MetricOfDescriptor(const std::string& name, const OnlineOptions& options) {
   DescriptorOptions d = options.descriptor;
   d.name = name;
-  switch (CreateDescriptor(d)->Distance()) {
-    case DistanceKind::kHamming: return Metric::kHamming;
-    case DistanceKind::kL2: return Metric::kL2;
-    case DistanceKind::kL1: break;
-  }
-  return Metric::kL1;
+  return MetricOf(*CreateDescriptor(d));
 }
 
 

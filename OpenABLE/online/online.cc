@@ -58,7 +58,6 @@ void CheckFrameSize(const std::string& what, const std::string& size,
                      " (expected frames of one camera at one size)");
 }
 
-
 // The names of `descriptor` (a fusion "HOG+LDB" or one name), then those of `kept` not among
 // them, upper case as the registry names them.
 std::vector<std::string> ChannelNames(const std::string& descriptor, const std::string& kept) {
@@ -71,15 +70,6 @@ std::vector<std::string> ChannelNames(const std::string& descriptor, const std::
     }
   }
   return names;
-}
-
-Metric MetricOf(const Descriptor& d) {
-  switch (d.Distance()) {
-    case DistanceKind::kHamming: return Metric::kHamming;
-    case DistanceKind::kL2: return Metric::kL2;
-    case DistanceKind::kL1: break;
-  }
-  return Metric::kL1;
 }
 
 // The largest finite value of `m` (0 when none).
@@ -1363,14 +1353,6 @@ double CheckMapFits(const MapFile& map, const std::string& path, const OnlineOpt
   return unit;
 }
 
-// A map at `path`: "no map at PATH" when there is none, rather than the reader's message.
-void RequireMap(const std::string& path) {
-  std::error_code error;
-  if (!std::filesystem::exists(path, error) && !error)
-    throw InputError("no map at " + Quoted(path) + " (create one with openable_map add, or "
-                     "OnlineDetector::SaveMap)");
-}
-
 }  // namespace
 
 namespace {
@@ -1399,7 +1381,6 @@ OnlineOptions MapOptions(const std::string& path, const OnlineOptions& base) {
 namespace {
 
 OnlineOptions ReadMapOptions(const std::string& path, const OnlineOptions& base) {
-  RequireMap(path);
   MapReadOptions read;
   read.header_only = true;
   const MapFile map = ReadMapFile(path, read);
@@ -1459,7 +1440,6 @@ OnlineDetector::LoadedMap OnlineDetector::LoadMapNamed(const std::string& path,
     throw InputError("OnlineDetector::LoadMap(\"" + path + "\"): the detector holds " +
                      std::to_string(Size()) + " frames; expected an empty detector (load the "
                      "map before adding frames)");
-  RequireMap(path);
   MapFile map = ReadMapFile(path, read);
   // The detector's descriptors in the map's order (the same set), its index on the map's.
   std::vector<std::string> mine = s.ChannelList(), theirs = MapChannels(map);
@@ -1536,7 +1516,6 @@ void OnlineDetector::AppendMap(const std::string& path) {
 void OnlineDetector::AppendMapNamed(const std::string& path) {
   State& s = *state_;
   s.ThrowIfDamaged(true);
-  RequireMap(path);
   // Its rows are copied into this map: checked before they are.
   MapFile map = ReadMapFile(path, {/*in_place=*/true, /*check_in_background=*/false});
   std::vector<int> widths, types;

@@ -8,6 +8,7 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/cluster/cluster.h"
+#include "OpenABLE/describe/describe.h"
 #include "OpenABLE/run/verify.h"
 #include "OpenABLE/stereo/calibration.h"
 #include "OpenABLE/stereo/stereo_source.h"
@@ -73,15 +74,6 @@ std::unique_ptr<FrameSource> OpenStoredFrames(const SourceSpec& spec, const Inpu
 double PhysicalMemoryBytes() {
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
   return pages > 0 && page > 0 ? static_cast<double>(pages) * page : 8.0 * (1 << 30);
-}
-
-Metric MetricOf(const Descriptor& d) {
-  switch (d.Distance()) {
-    case DistanceKind::kHamming: return Metric::kHamming;
-    case DistanceKind::kL2: return Metric::kL2;
-    case DistanceKind::kL1: break;
-  }
-  return Metric::kL1;
 }
 
 const char* DistanceText(Metric m) {
