@@ -5,6 +5,7 @@
 #include <string>
 
 #include "OpenABLE/OpenABLE.h"
+#include "OpenABLE/base/interrupt.h"
 #include "OpenABLE/base/program.h"
 #include "OpenABLE/online/map_program.h"
 
@@ -20,6 +21,8 @@ int main(int argc, char** argv) {
       return 0;
     }
   }
+  // Signals remove the temporary of a map being written, and say whether the map changed.
+  openable::InstallInterruptCleanup("openable_map");
   openable::MapCommandLine command_line;
   const std::string usage_error = openable::ParseMapCommandLine(argc, argv, command_line);
   if (!usage_error.empty()) {

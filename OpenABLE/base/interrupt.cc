@@ -1,5 +1,6 @@
 #include "OpenABLE/base/interrupt.h"
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <cstring>
@@ -20,6 +21,11 @@ std::atomic<int> g_deferrals{0};
 std::atomic<int> g_pending{0};
 const char* g_program = "OpenABLE";
 std::atomic<bool> g_silent{false};
+// The note of SetInterruptNote: two buffers, the one in use named by g_note (-1: none), so that
+// the handler never reads a buffer being written.
+constexpr size_t kNoteMax = 4096;
+char g_notes[2][kNoteMax];
+std::atomic<int> g_note{-1};
 static_assert(std::atomic<int>::is_always_lock_free, "the handler needs lock-free atomics");
 
 void Write(const char* s) {
@@ -44,7 +50,13 @@ const char* SignalName(int sig) {
   Write(g_program);
   Write(": interrupted by ");
   Write(SignalName(sig));
-  Write(" (temporary files removed)\n");
+  Write(" (temporary files removed");
+  const int note = g_note.load(std::memory_order_acquire);
+  if (note >= 0) {
+    Write("; ");
+    Write(g_notes[note]);
+  }
+  Write(")\n");
   ::_exit(128 + sig);
 }
 
@@ -69,6 +81,18 @@ void InstallInterruptCleanup(const char* program) {
 }
 
 void SilenceInterruptMessage() { g_silent.store(true); }
+
+void SetInterruptNote(const std::string& note) {
+  if (note.empty()) {
+    g_note.store(-1, std::memory_order_release);
+    return;
+  }
+  const int next = g_note.load(std::memory_order_acquire) == 0 ? 1 : 0;
+  const size_t n = std::min(note.size(), kNoteMax - 1);
+  std::memcpy(g_notes[next], note.data(), n);
+  g_notes[next][n] = '\0';
+  g_note.store(next, std::memory_order_release);
+}
 
 int RegisterTemporary(const std::string& path) {
   if (path.size() >= kPathMax) return -1;

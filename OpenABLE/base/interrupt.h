@@ -23,6 +23,12 @@ void InstallInterruptCleanup(const char* program);
 // (or none) is what the user should see, not one per process.
 void SilenceInterruptMessage();
 
+// What an interruption now leaves besides the removed temporaries, said in its line:
+// "<program>: interrupted by SIGINT (temporary files removed; <note>)", e.g. "route.map
+// unchanged" before a file is replaced and "route.map holds session winter" after. Empty: no
+// note. Call from one thread at a time (the handler reads it without a lock).
+void SetInterruptNote(const std::string& note);
+
 // Registers a file to remove if the process is interrupted. Returns a slot for
 // UnregisterTemporary, or -1 when every slot is taken (the file is then only removed by the
 // owner or by a later run's stale-file sweep).

@@ -1,6 +1,7 @@
 #include "OpenABLE/online/map_file.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -368,6 +369,47 @@ std::string SectionName(const Section& s) {
 
 }  // namespace
 
+MapWriteLock::MapWriteLock(const std::string& path,
+                           const std::function<void(const std::string&)>& waiting) {
+  const std::string lock = path + ".lock";
+  fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0)
+    throw InputError("map lock " + Quoted(lock) + " cannot be created (" + std::strerror(errno) +
+                     "; expected a writable folder beside the map)");
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    if (errno != EWOULDBLOCK) {
+      const int error = errno;
+      ::close(fd_);
+      throw InputError("map lock " + Quoted(lock) + " cannot be taken (" +
+                       std::strerror(error) + ")");
+    }
+    if (waiting) {
+      // The holder wrote its process id there.
+      char text[32] = {0};
+      const ssize_t n = ::pread(fd_, text, sizeof text - 1, 0);
+      const std::string holder = n > 0 ? std::string(text, static_cast<size_t>(n)) : "";
+      waiting("waiting for another writer of " + Quoted(path) +
+              (holder.empty() ? "" : " (process " + holder + ")") + " to finish");
+    }
+    while (::flock(fd_, LOCK_EX) != 0) {
+      if (errno == EINTR) continue;
+      const int error = errno;
+      ::close(fd_);
+      throw InputError("map lock " + Quoted(lock) + " cannot be taken (" +
+                       std::strerror(error) + ")");
+    }
+  }
+  const std::string pid = std::to_string(::getpid());
+  if (::ftruncate(fd_, 0) == 0) {
+    const ssize_t written = ::pwrite(fd_, pid.data(), pid.size(), 0);
+    (void)written;  // the id only names the holder in another writer's message
+  }
+}
+
+MapWriteLock::~MapWriteLock() {
+  if (fd_ >= 0) ::close(fd_);  // releases the lock
+}
+
 std::string MapTimeNow() {
   const std::time_t now = std::time(nullptr);
   std::tm utc{};
@@ -375,6 +417,37 @@ std::string MapTimeNow() {
   char text[32];
   std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
   return text;
+}
+
+void CheckSessionTime(const std::string& time, const std::string& what) {
+  // Written by hand: std::get_time accepts what the locale allows and does not check the day
+  // of the month against the month; the form is fixed and short.
+  const auto digits = [&](size_t at, size_t n, int& value) {
+    if (at + n > time.size()) return false;
+    value = 0;
+    for (size_t i = at; i < at + n; ++i) {
+      if (time[i] < '0' || time[i] > '9') return false;
+      value = value * 10 + (time[i] - '0');
+    }
+    return true;
+  };
+  int year = 0, month = 0, day = 0, hour = 0, minute = 0, second = 0;
+  bool ok = time.size() >= 20 && time.size() <= 40 && digits(0, 4, year) && time[4] == '-' &&
+            digits(5, 2, month) && time[7] == '-' && digits(8, 2, day) && time[10] == 'T' &&
+            digits(11, 2, hour) && time[13] == ':' && digits(14, 2, minute) &&
+            time[16] == ':' && digits(17, 2, second) && time.back() == 'Z';
+  if (ok && time.size() > 20) {  // decimals of the second: ".d..."
+    ok = time[19] == '.' && time.size() > 21;
+    for (size_t i = 20; ok && i + 1 < time.size(); ++i) ok = time[i] >= '0' && time[i] <= '9';
+  }
+  static const int kDays[12] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  const bool leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
+  ok = ok && month >= 1 && month <= 12 && day >= 1 &&
+       day <= kDays[month - 1] + (month == 2 && leap ? 1 : 0) && hour <= 23 && minute <= 59 &&
+       second <= 60;  // 60: a leap second
+  if (!ok)
+    throw InputError(what + " " + Quoted(time) + ": expected a UTC time in ISO 8601, "
+                     "YYYY-MM-DDTHH:MM:SSZ (e.g. 2026-11-27T09:30:00Z)");
 }
 
 void CheckSessionName(const std::string& name, const std::string& what) {

@@ -34,6 +34,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <future>
 #include <memory>
 #include <string>
@@ -59,6 +60,11 @@ struct MapSession {
 
 // Now, as sessions and tunings keep their times: ISO 8601 UTC ("2026-11-29T09:30:00Z").
 std::string MapTimeNow();
+
+// A session time: ISO 8601 UTC, "YYYY-MM-DDTHH:MM:SSZ" with optional decimals of the seconds
+// ("2026-11-29T09:30:00.25Z"), a real date (a 29 February of a leap year only) and time.
+// Throws InputError beginning with `what`, quoting the value and the form expected.
+void CheckSessionTime(const std::string& time, const std::string& what);
 
 // A session name: 1 to 200 printable characters (no control characters, no tab or line
 // break), not beginning or ending with a space. Throws InputError beginning with `what`.
@@ -100,6 +106,26 @@ struct MapReadOptions {
   // Read the settings and sessions only (MapFile::rows stays empty, no blocks, no check): what
   // a program needs to know which options a map was made with (MapOptions, online.h).
   bool header_only = false;
+};
+
+// The right to replace the map at `path`, held by one writer at a time across processes: an
+// advisory lock (flock) on the file `path` + ".lock" beside it, created when missing and left
+// there (removing it while another process waits on it would let a third one in). A program
+// that reads a map, changes it and saves it (openable_map add, tune, merge) holds it from
+// before the read to after the save, so two appends at once both land, one after the other.
+// When another process holds it, `waiting` (when set) is told once, naming it, and the
+// constructor waits. Released by the destructor or when the process ends. Throws InputError
+// naming the lock file when it cannot be created or locked.
+class MapWriteLock {
+ public:
+  explicit MapWriteLock(const std::string& path,
+                        const std::function<void(const std::string&)>& waiting = {});
+  ~MapWriteLock();
+  MapWriteLock(const MapWriteLock&) = delete;
+  MapWriteLock& operator=(const MapWriteLock&) = delete;
+
+ private:
+  int fd_ = -1;
 };
 
 // Writes `map` (format version 3) to `path` through a temporary file renamed into place when

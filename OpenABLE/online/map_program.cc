@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/interrupt.h"
 #include "OpenABLE/base/progress.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/threading.h"
@@ -296,8 +297,16 @@ void ForImagesOf(const std::string& folder, bool quiet, const char* what, Body b
   const std::vector<std::string> files = ListImages(folder, "");
   ProgressReporter progress(std::cerr, !quiet, isatty(STDERR_FILENO) != 0);
   progress.Begin(what, static_cast<std::int64_t>(files.size()), "frames");
-  const std::size_t chunk = 512;
+  // At most 512 images at a time, and at most about 256 MB of them (the size of the first
+  // decoded image sets the count): large frames never sit in memory by the hundred.
+  std::size_t chunk = 512;
   for (std::size_t first = 0; first < files.size(); first += chunk) {
+    if (first == 0 && !files.empty()) {
+      const cv::Mat probe = ReadImageFile(files.front());
+      const double bytes = std::max<double>(1.0, static_cast<double>(probe.total() * probe.elemSize()));
+      const std::size_t threads = static_cast<std::size_t>(EffectiveThreads(0));
+      chunk = std::clamp<std::size_t>(static_cast<std::size_t>(256e6 / bytes), threads, 512);
+    }
     const std::size_t n = std::min(chunk, files.size() - first);
     std::vector<cv::Mat> images(n);
     std::vector<std::string> names(files.begin() + static_cast<std::ptrdiff_t>(first),
@@ -383,9 +392,21 @@ std::string SearchText(const OnlineOptions& o) {
   return text;
 }
 
+// The lock of the map at `path` for the read-change-save of a command (MapWriteLock), saying
+// on stderr when another writer holds it; an interruption from now on says the map is unchanged.
+std::unique_ptr<MapWriteLock> LockForWriting(const std::string& path, bool quiet) {
+  auto lock = std::make_unique<MapWriteLock>(path, [&](const std::string& line) {
+    if (!quiet) std::cerr << "openable_map: " << line << "\n";
+  });
+  SetInterruptNote(path + " unchanged");
+  return lock;
+}
+
 int Add(const Arguments& a) {
   const std::string& path = a.positional[0];
+  if (!a.time.empty()) CheckSessionTime(a.time, "--time");
   const bool configured = !a.config.empty() || !a.sets.empty();
+  const auto lock = LockForWriting(path, a.quiet);
   OnlineOptions wanted = OptionsOfConfig(ConfigOf(a), SearchKeysGiven(a));
   SetThreshold(a, wanted);
   std::unique_ptr<OnlineDetector> d;
@@ -408,6 +429,7 @@ int Add(const Arguments& a) {
     d->AddImagesToMap(images, names);
   });
   d->SaveMap(path);
+  SetInterruptNote(path + " holds session " + Quoted(a.sessions[0]));
   if (!a.quiet) {
     std::cout << (exists ? "Appended" : "Created") << " session " << Quoted(a.sessions[0])
               << ": " << d->Size() - before << " frames; " << path << " holds "
@@ -516,9 +538,11 @@ int Info(const Arguments& a) {
 
 int Merge(const Arguments& a) {
   for (const std::string& path : a.positional) RequireNoFeatures(path);
+  const auto lock = LockForWriting(a.output, a.quiet);
   std::unique_ptr<OnlineDetector> d = Open(a.positional[0], OnlineOptions());
   d->AppendMap(a.positional[1]);
   d->SaveMap(a.output);
+  SetInterruptNote(a.output + " written");
   if (!a.quiet)
     std::cout << "Wrote " << a.output << ": " << d->Size() << " frames in "
               << d->Sessions().size() << " sessions.\n";
@@ -529,6 +553,7 @@ int Tune(const Arguments& a) {
   const std::string& path = a.positional[0];
   RequireNoFeatures(path);
   const Config c = ConfigOf(a);
+  const auto lock = LockForWriting(path, a.quiet || a.json);
   std::unique_ptr<OnlineDetector> d = Open(path, OnlineOptions());
   OnlineDetector::TuneOptions t;
   if (a.sessions.size() == 2) {
@@ -560,6 +585,7 @@ int Tune(const Arguments& a) {
     if (log) std::cerr << line << "\n";
   });
   d->SaveMap(path);
+  SetInterruptNote(path + " holds the tuned settings");
   if (a.json) {
     std::cout << json::Dump({{"map", path}, {"tuning", TuningJson(tuning)}});
     return 0;

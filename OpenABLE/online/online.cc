@@ -918,10 +918,7 @@ void OnlineDetector::StartSession(const std::string& name, const std::string& ti
       throw InputError("OnlineDetector::StartSession: the map already has a session named " +
                        Quoted(name) + " (frames " + std::to_string(m.first) + " to " +
                        std::to_string(m.first + m.count - 1) + "); expected a new name");
-  for (const char c : time)
-    if (static_cast<unsigned char>(c) <= 0x20 || c == 0x7f)
-      throw InputError("OnlineDetector::StartSession: session time " + Quoted(time) +
-                       ": expected a time without spaces, e.g. 2026-11-27T09:30:00Z");
+  if (!time.empty()) CheckSessionTime(time, "OnlineDetector::StartSession: session time");
   s.sessions.push_back({name, time.empty() ? MapTimeNow() : time, Size(), 0});
   s.answers.clear();
   s.running_last = -1;

@@ -314,5 +314,24 @@ TEST(MappedMap, FirstVersionIsOneSession) {
   EXPECT_EQ(cv::norm(d.Descriptors(), rows, cv::NORM_INF), 0);
 }
 
+
+// Session times: ISO 8601 UTC with real dates (leap years by the Gregorian rule).
+TEST(SessionTimes, AreIsoUtcTimesOfRealDates) {
+  for (const std::string good : {"2026-11-29T09:30:00Z", "2024-02-29T00:00:00Z",
+                                 "2000-02-29T23:59:59Z", "2026-12-31T23:59:60Z",
+                                 "2026-01-01T00:00:00.125Z"})
+    EXPECT_NO_THROW(CheckSessionTime(good, "time")) << good;
+  for (const std::string& bad : std::vector<std::string>{"", "yesterday", "2026-11-29", "2026-11-29T09:30:00", "2026-11-29 09:30:00Z",
+        "2023-02-29T00:00:00Z", "1900-02-29T00:00:00Z", "2026-04-31T00:00:00Z",
+        "2026-13-01T00:00:00Z", "2026-00-10T00:00:00Z", "2026-11-29T24:00:00Z",
+        "2026-11-29T09:60:00Z", "2026-11-29T09:30:00.Z", "2026-11-29T09:30:00+01:00",
+        "+2026-11-29T09:30:00Z", std::string(100000, '1')})
+    ExpectInputError([&] { CheckSessionTime(bad, "--time"); },
+                     {"--time", "YYYY-MM-DDTHH:MM:SSZ"});
+  OnlineDetector d((OnlineOptions()));
+  ExpectInputError([&] { d.StartSession("s", "tomorrow"); }, {"session time", "tomorrow"});
+  EXPECT_TRUE(d.Sessions().empty());
+}
+
 }  // namespace
 }  // namespace openable
