@@ -953,6 +953,7 @@ void RegisterOnline(py::module_& m) {
         const std::string b = FileSystemPath(b_object, "merge_maps: b");
         const std::string out = FileSystemPath(out_object, "merge_maps: output");
         py::gil_scoped_release release;
+        const MapWriteLock lock(out);  // as openable_map merge: one writer of `output` at a time
         OnlineDetector d(MapOptions(a));
         d.LoadMap(a);
         d.AppendMap(b);
