@@ -34,17 +34,15 @@ pair() {
   local map="$out/$RANDOM.map" prefix="$out/q$RANDOM"
   "$map_exe" add "$map" --images "$reference" --session reference --config "$auto" -q
   "$map_exe" add "$map" --images "$query" --session query -q
-  local start=$SECONDS
   "$map_exe" tune "$map" --json > "$out/tune.json" 2> /dev/null
   local gt=()
   [ -n "$truth" ] && gt=(--set Ground_truth_type=aligned --set Tolerance=2)
   "$map_exe" query "$map" --images "$query" --session reference --output "$prefix" -q "${gt[@]}"
-  local seconds=$((SECONDS - start))
   "$exe" "$auto" --json --set "Images_path=$reference" --set "Images_path_2=$query" \
     --set Npy_name= --set Png_name= --set Evaluation_name= "${gt[@]}" > "$out/batch.json" 2> /dev/null
-  python3 - "$label" "$out/tune.json" "$prefix" "$out/batch.json" "$seconds" <<'EOF'
+  python3 - "$label" "$out/tune.json" "$prefix" "$out/batch.json" <<'EOF'
 import json, sys
-label, tune, prefix, batch, seconds = sys.argv[1:]
+label, tune, prefix, batch = sys.argv[1:]
 t = json.load(open(tune))["tuning"]
 b = json.load(open(batch))
 queries = json.load(open(prefix + ".json"))["queries"]
@@ -57,15 +55,15 @@ except FileNotFoundError:
     figures = "- | - | %d | -" % accepted
 bp = b.get("evaluation", {}).get("runs", [{}])[0].get("per_query") if b.get("evaluation") else None
 batch_figures = "%.3f / %.3f" % (bp["recall_at_1"], bp["auc"]) if bp else "-"
-print("| %s | %s | %s | %s | %.3f | %s | %s | %s | %s s |" % (
+print("| %s | %s | %s | %s | %.3f | %s | %s | %s |" % (
     label, t["chosen"], t["verdict"], figures, t["consistency"], b["auto"]["chosen"],
-    "reliable" if b["auto"]["reliable"] else "unreliable", batch_figures, seconds))
+    "reliable" if b["auto"]["reliable"] else "unreliable", batch_figures))
 EOF
 }
 
 accuracy() {
-  echo "| pair | map's choice | verdict | R@1 | AUC | accepted | precision | consistency | auto mode's choice | its verdict | its R@1 / AUC | tune + query |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| pair | map's choice | verdict | R@1 | AUC | accepted | precision | consistency | auto mode's choice | its verdict | its R@1 / AUC |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|"
   need_data "$nl"
   pair "Nordland winter vs summer" "$nl/summer" "$nl/winter" aligned
   pair "Nordland summer vs winter" "$nl/winter" "$nl/summer" aligned
