@@ -412,19 +412,35 @@ void LoadVprBench(const GroundTruthOptions& o, const EvaluationLayout& layout, i
         "Ground_truth_type: vpr_bench needs two traversals (Images_path_2 or Frame_mode 2): "
         "its file lists the true references of each query");
   const std::string where = "VPR-Bench ground truth " + Quoted(o.path);
-  const std::string bytes = ReadWholeFile(o.path, "VPR-Bench ground truth");
-  const NpyObjects gt_file = DecodeNpyObjects(bytes, where);
+  const std::string bytes = ReadWholeFile(o.path, where);
+  const std::int64_t first = o.first_frame;
+  const bool ranged = first > 0 || o.range_selected;
+  // The header first: the pickle is read for as many queries as the run has (for a range of
+  // frames, as many as the header says), each listing at most every reference frame up to the
+  // run's last and 64 more (VPR-Bench's files name a few past the last); larger is refused
+  // before it is made.
+  const std::vector<std::int64_t> header = ReadNpyHeader(bytes, where).shape;
+  const bool header_pairs = header.size() == 2 && header[1] == 2;
+  if (header_pairs && !ranged && header[0] != layout.queries)
+    throw InputError(where + ": " + std::to_string(header[0]) + " queries; expected " +
+                     std::to_string(layout.queries) + ", the frames of the query traversal");
+  const std::int64_t queries = header_pairs ? header[0] : layout.queries;
+  const std::int64_t listed = first + layout.references + 64;
+  NpyObjectLimits limits;
+  if (queries >= 0 && queries < (limits.values - 1) / (2 + listed))
+    limits.values = 1 + queries * (2 + listed);
+  limits.range = std::min(limits.range, listed);
+  limits.expected = std::to_string(queries) + " queries listing at most " +
+                    std::to_string(listed) + " reference indices each: the " +
+                    std::to_string(first + layout.references) +
+                    " reference frames up to the run's last, and 64 more";
+  const NpyObjects gt_file = DecodeNpyObjects(bytes, where, limits);
   const bool pairs = gt_file.shape.size() == 2 && gt_file.shape[1] == 2;
   if (!pairs)
     throw InputError(where + ": an array of shape " + NpyShapeText(gt_file.shape) +
                      "; expected (queries, 2): per query its index and the list of its true "
                      "references, as VPR-Bench's ground_truth_new.npy");
   const std::int64_t rows = gt_file.shape[0];
-  const std::int64_t first = o.first_frame;
-  const bool ranged = first > 0 || o.range_selected;
-  if (!ranged && rows != layout.queries)
-    throw InputError(where + ": " + std::to_string(rows) + " queries; expected " +
-                     std::to_string(layout.queries) + ", the frames of the query traversal");
   for (std::int64_t i = 0; i < rows; ++i) {
     const PyValue& list = *gt_file.items[static_cast<std::size_t>(2 * i + 1)];
     std::vector<std::int64_t> refs;
@@ -472,30 +488,17 @@ struct TutorialFile {
 
 TutorialFile ReadTutorialFile(const std::string& path, const std::string& what) {
   TutorialFile f;
-  f.bytes = ReadWholeFile(path, what);
   f.where = what + " " + Quoted(path);
-  f.npz = f.bytes.compare(0, 4, "PK\x03\x04", 4) == 0;
+  f.bytes = ReadWholeFile(path, f.where);
+  f.npz = IsNpzArchive(f.bytes);
   return f;
 }
 
-// The matrix of a .npy file, or the member `member` of a .npz; none when an optional member
-// is not in the archive (a required one: NpzMember's error, naming those there are).
-std::optional<cv::Mat1f> TutorialMatrix(const TutorialFile& f, const std::string& member,
-                                        bool required) {
-  if (!f.npz) return DecodeNpyMatrix(f.bytes, f.where);
-  const std::string wanted = member + ".npy";
-  if (!required) {
-    const std::vector<std::string> names = NpzMemberNames(f.bytes, f.where);
-    if (std::find(names.begin(), names.end(), wanted) == names.end()) return std::nullopt;
-  }
-  return DecodeNpyMatrix(NpzMember(f.bytes, wanted, f.where), f.where + " (" + wanted + ")");
-}
-
-// Adds the cells of `m` (references x queries, non-zero = same place) to `out` per query.
-void TutorialCells(const cv::Mat1f& m, const std::string& what, const EvaluationLayout& layout,
-                   const GroundTruthOptions& o, std::vector<std::vector<int>>* out) {
-  if (m.rows != layout.references || m.cols != layout.queries)
-    throw InputError(what + ": " + std::to_string(m.rows) + "x" + std::to_string(m.cols) +
+// Refuses a matrix of `rows` x `cols` that is not references x queries.
+void CheckTutorialSize(std::int64_t rows, std::int64_t cols, const std::string& what,
+                       const EvaluationLayout& layout, const GroundTruthOptions& o) {
+  if (rows != layout.references || cols != layout.queries)
+    throw InputError(what + ": " + std::to_string(rows) + "x" + std::to_string(cols) +
                      " (database x queries); expected " + std::to_string(layout.references) +
                      "x" + std::to_string(layout.queries) + ": the " +
                      std::to_string(layout.references) +
@@ -504,6 +507,46 @@ void TutorialCells(const cv::Mat1f& m, const std::string& what, const Evaluation
                      (o.first_frame > 0 || o.range_selected
                           ? "; a matrix is not cut at Initial_image or Final_image"
                           : ""));
+}
+
+// The matrix of a .npy file, or the member `member` of a .npz; none when an optional member
+// is not in the archive (a required one: NpzMember's error, naming those there are). Its size
+// is checked before its cells are read: a member's declared size against the most a matrix of
+// references x queries takes, then the shape its header gives (`what` names the file).
+std::optional<cv::Mat1f> TutorialMatrix(const TutorialFile& f, const std::string& member,
+                                        bool required, const std::string& what,
+                                        const EvaluationLayout& layout,
+                                        const GroundTruthOptions& o) {
+  std::string inflated;
+  std::string_view bytes = f.bytes;
+  std::string where = f.where;
+  if (f.npz) {
+    const std::string wanted = member + ".npy";
+    if (!required) {
+      const std::vector<std::string> names = NpzMemberNames(f.bytes, f.where);
+      if (std::find(names.begin(), names.end(), wanted) == names.end()) return std::nullopt;
+    }
+    NpzLimit limit;
+    const auto cells = static_cast<std::uint64_t>(layout.references) *
+                       static_cast<std::uint64_t>(layout.queries);
+    limit.bytes = 65536 + 8 * cells;
+    limit.expected = "a " + std::to_string(layout.references) + "x" +
+                     std::to_string(layout.queries) +
+                     " matrix (database x queries) takes 8 bytes a cell at most, and a header "
+                     "of 64 KiB at most";
+    inflated = NpzMember(f.bytes, wanted, f.where, limit);
+    bytes = inflated;
+    where = f.where + " (" + wanted + ")";
+  }
+  const std::vector<std::int64_t> shape = ReadNpyHeader(bytes, where).shape;
+  if (shape.size() == 2) CheckTutorialSize(shape[0], shape[1], what, layout, o);
+  return DecodeNpyMatrix(bytes, where);
+}
+
+// Adds the cells of `m` (references x queries, non-zero = same place) to `out` per query.
+void TutorialCells(const cv::Mat1f& m, const std::string& what, const EvaluationLayout& layout,
+                   const GroundTruthOptions& o, std::vector<std::vector<int>>* out) {
+  CheckTutorialSize(m.rows, m.cols, what, layout, o);
   for (int r = 0; r < m.rows; ++r)
     for (int q = 0; q < m.cols; ++q) {
       const float v = m(r, q);
@@ -521,21 +564,22 @@ void LoadVprTutorial(const GroundTruthOptions& o, const EvaluationLayout& layout
         "Ground_truth_type: vpr_tutorial needs two traversals (Images_path_2 or Frame_mode 2): "
         "its matrices are the database (reference traversal) by the queries");
   const TutorialFile file = ReadTutorialFile(o.path, "VPR_Tutorial ground truth");
-  TutorialCells(*TutorialMatrix(file, "GThard", true), file.where, layout, o, &gt->matches);
+  TutorialCells(*TutorialMatrix(file, "GThard", true, file.where, layout, o), file.where, layout,
+                o, &gt->matches);
   // GTsoft: Ground_truth_soft, else the archive's own when it has one.
   std::optional<cv::Mat1f> soft_matrix;
-  std::string soft_path = o.soft_path;
+  const std::string& soft_path = o.soft_path;
+  const std::string soft_what = "VPR_Tutorial soft ground truth " +
+                                Quoted(soft_path.empty() ? o.path : soft_path);
   if (!soft_path.empty()) {
     soft_matrix = TutorialMatrix(ReadTutorialFile(soft_path, "VPR_Tutorial soft ground truth"),
-                                 "GTsoft", true);
+                                 "GTsoft", true, soft_what, layout, o);
   } else if (file.npz) {
-    soft_matrix = TutorialMatrix(file, "GTsoft", false);
-    soft_path = o.path;
+    soft_matrix = TutorialMatrix(file, "GTsoft", false, soft_what, layout, o);
   }
   if (!soft_matrix) return;
   std::vector<std::vector<int>> soft(static_cast<std::size_t>(layout.queries));
-  TutorialCells(*soft_matrix, "VPR_Tutorial soft ground truth " + Quoted(soft_path), layout, o,
-                &soft);
+  TutorialCells(*soft_matrix, soft_what, layout, o, &soft);
   gt->soft = std::move(soft);
 }
 }  // namespace
@@ -573,23 +617,23 @@ const GroundTruthType GroundTruthType::kVprTutorial{"vpr_tutorial"};
 const std::vector<GroundTruthFormat>& GroundTruthFormats() {
   static const std::vector<GroundTruthFormat> formats = {
       {"matrix", "a binary matrix: 0/1 text, an image (non-zero = same place) or .npy",
-       "ground truth matrix file", true, nullptr, false, false, &LoadMatrix},
+       "ground truth matrix file", true, false, nullptr, false, false, &LoadMatrix},
       {"pairs", "a list of pairs row,col (CSV or whitespace)", "ground truth pairs", true,
-       nullptr, false, false, &LoadPairs},
+       false, nullptr, false, false, &LoadPairs},
       {"aligned", "two traversals frame by frame: query i is reference i (no file)",
-       "aligned traversals", false, nullptr, false, false, &LoadAligned},
+       "aligned traversals", false, true, nullptr, false, false, &LoadAligned},
       {"kitti", "KITTI poses: 12 numbers per line, a 3x4 camera-to-world matrix",
-       "KITTI poses", true, &ReadKittiPoses, true, false, nullptr},
+       "KITTI poses", true, false, &ReadKittiPoses, true, false, nullptr},
       {"tum", "a TUM trajectory: timestamp tx ty tz qx qy qz qw per line", "TUM trajectory",
-       true, &ReadTumPoses, true, true, nullptr},
+       true, false, &ReadTumPoses, true, true, nullptr},
       {"positions", "positions x,y[,z] per line (no orientation)", "positions", true,
-       &ReadPositions, false, false, nullptr},
+       false, &ReadPositions, false, false, nullptr},
       {"vpr_bench",
        "VPR-Bench's ground_truth_new.npy: per query, the list of its true references",
-       "VPR-Bench ground truth", true, nullptr, false, false, &LoadVprBench},
+       "VPR-Bench ground truth", true, true, nullptr, false, false, &LoadVprBench},
       {"vpr_tutorial",
        "VPR_Tutorial's GThard (database x queries, .npy, or GT.npz with GTsoft)",
-       "VPR_Tutorial ground truth", true, nullptr, false, false, &LoadVprTutorial},
+       "VPR_Tutorial ground truth", true, true, nullptr, false, false, &LoadVprTutorial},
   };
   return formats;
 }

@@ -139,6 +139,9 @@ struct GroundTruthFormat {
   const char* summary;  // what the file holds, in a few words (help and reference)
   const char* label;    // the file in messages: "KITTI poses", "ground truth pairs", ...
   bool needs_file;      // Ground_truth names a file
+  // The format pairs a query traversal with a reference one (a square matrix of one sequence
+  // is refused: Images_path_2, Frame_mode 2, --reference-frames, Python's layout).
+  bool two_traversals;
   // A pose format: one pose per line, line i the frame i of the source (or, with
   // `timestamps`, the pose nearest in time to a frame that carries a time).
   std::vector<FramePose> (*read_poses)(const std::string& path, const char* label);

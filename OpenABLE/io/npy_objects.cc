@@ -428,7 +428,8 @@ struct PickleSpecial {
 // the memo changes it wherever it is referred to.
 class PickleMachine {
  public:
-  PickleMachine(std::string_view pickle, const std::string& where) : s_(pickle), where_(where) {}
+  PickleMachine(std::string_view pickle, const std::string& where, const NpyObjectLimits& limits)
+      : s_(pickle), where_(where), limits_(limits) {}
   PickleMachine(const PickleMachine&) = delete;
   PickleMachine& operator=(const PickleMachine&) = delete;
 
@@ -599,16 +600,25 @@ class PickleMachine {
     }
     return shape;
   }
-  // Counts `n` more numbers made by range objects (`range` true) or elements of object arrays
-  // in `made`, against `limit`.
+  // Counts `n` more numbers made by range objects (`range` true) or elements of arrays,
+  // before they are made, against their limit and the caller's.
   void CountItems(std::uint64_t n, bool range) {
     std::int64_t& made = range ? range_numbers_ : object_items_;
-    const std::int64_t limit = range ? kNpyMaxRangeNumbers : kNpyMaxObjectItems;
+    const std::int64_t limit = std::max<std::int64_t>(
+        0, std::min(range ? kNpyMaxRangeNumbers : kNpyMaxObjectItems, limits_.values));
     if (n > static_cast<std::uint64_t>(limit - made)) {
-      Fail(Here() + (range ? ": the range objects make" : ": the object arrays hold") +
-           " more than " + std::to_string(limit) + (range ? " numbers" : " elements") + " in all");
+      // made + n may pass 2^63: said as two terms then.
+      const std::string total =
+          made == 0 ? std::to_string(n) : std::to_string(made) + " + " + std::to_string(n);
+      Fail(Here() + (range ? ": the range objects make " : ": the arrays hold ") + total +
+           (range ? " numbers" : " elements") + " in all; expected at most " +
+           std::to_string(limit) + Why());
     }
     made += static_cast<std::int64_t>(n);
+  }
+  // " (why)" of the caller's limit, or "".
+  std::string Why() const {
+    return limits_.expected.empty() ? std::string() : " (" + limits_.expected + ")";
   }
 
   void Step();
@@ -621,6 +631,7 @@ class PickleMachine {
 
   std::string_view s_;
   const std::string& where_;
+  const NpyObjectLimits& limits_;
   std::size_t pos_ = 0, op_at_ = 0;
   unsigned char op_ = 0;
   LeafValues leaves_;
@@ -982,6 +993,7 @@ Value PickleMachine::Call(const PyValue& f, const PyValue& args) {
       std::vector<std::int64_t> shape = ShapeOf(*a[2]);
       const std::string order = TextOf(*a[3], "the order");
       if (order != "C" && order != "F") Fail(Here() + ": order " + Quoted(order) + " is not read");
+      CountItems(ElementCount(shape, where_), false);
       const Value array = NewContainer(
           Kind::kArray, NumericElements(d, shape, order == "F", a[0]->text, leaves_, where_));
       array->shape = std::move(shape);
@@ -1035,6 +1047,11 @@ Value PickleMachine::Range(const std::vector<Value>& args) {
             1;
   }
   CountItems(count, true);
+  if (count > static_cast<std::uint64_t>(std::max<std::int64_t>(0, limits_.range))) {
+    Fail(Here() + ": range(" + std::to_string(start) + ", " + std::to_string(stop) + ", " +
+         std::to_string(step) + ") makes " + std::to_string(count) +
+         " numbers; expected at most " + std::to_string(limits_.range) + " in one list" + Why());
+  }
   std::vector<Value> items;
   items.reserve(count);
   // Unsigned: the step past the last number may leave the int64 range.
@@ -1096,6 +1113,7 @@ void PickleMachine::BuildArray(PyValue& array, const PyValue& state) {
     if (data.kind != Kind::kBytes) {
       Fail(Here() + ": the array's data are " + Describe(data) + ", not bytes");
     }
+    CountItems(count, false);
     array.items = NumericElements(d, shape, fortran, data.text, leaves_, where_);
   }
   array.shape = std::move(shape);
@@ -1129,9 +1147,13 @@ std::uint64_t PickleMachine::Check(const PyValue& v, int depth) {
   std::uint64_t total = 1;
   for (const Value& item : v.items) {
     total += Check(*item, depth + 1);
-    if (total > static_cast<std::uint64_t>(kNpyMaxUnfoldedValues)) {
-      Fail("the array unfolds into more than " + std::to_string(kNpyMaxUnfoldedValues) +
-           " values (lists referred to from several places count at each)");
+    const auto limit = static_cast<std::uint64_t>(
+        std::max<std::int64_t>(0, std::min(kNpyMaxUnfoldedValues, limits_.values)));
+    if (total > limit) {
+      Fail("the array unfolds into " + std::to_string(total) +
+           " values or more (lists referred to from several places count at each); expected at "
+           "most " +
+           std::to_string(limit) + Why());
     }
   }
   unfolded_[&v] = total;
@@ -1141,13 +1163,19 @@ std::uint64_t PickleMachine::Check(const PyValue& v, int depth) {
 // ---------------------------------------------------------------------------------------------
 // ZIP archives
 //
-// Read here rather than through a library: libzip and minizip are not among the Debian packages
-// OpenABLE builds with, and the archives NumPy writes are simple (one central directory, members
-// stored or deflated, zip64 fields); libdeflate inflates. The layout is PKWARE's APPNOTE.TXT.
+// Read here rather than through a library. libzip and minizip are Debian packages, but a .npz
+// must mean to this reader what it means to NumPy, which reads it with Python's zipfile: where
+// the end record is found, the zip64 end record just before its locator, an archive concatenated
+// after other bytes, the last of two members of one name. Those checks would be needed over
+// libzip as well; what is left is small (the archives NumPy writes have one central directory,
+// members stored or deflated, zip64 fields), and libdeflate, already used for PNG, inflates
+// into a buffer of the size checked beforehand. The layout is PKWARE's APPNOTE.TXT; "zipfile"
+// below is CPython's Lib/zipfile.py.
 
 constexpr std::uint32_t kZipLocalHeader = 0x04034b50, kZipCentralHeader = 0x02014b50,
                         kZipEnd = 0x06054b50, kZip64End = 0x06064b50, kZip64EndLocator = 0x07064b50;
-constexpr std::uint64_t kZipEndSize = 22, kZipMaxComment = 65535;
+constexpr std::uint64_t kZipEndSize = 22, kZipMaxComment = 65535, kZip64EndSize = 56,
+                        kZip64LocatorSize = 20;
 
 struct ZipMember {
   std::string name;
@@ -1165,20 +1193,33 @@ std::uint64_t ZipField(std::string_view zip, std::uint64_t at, int n, const std:
   return LittleEndianAt(reinterpret_cast<const unsigned char*>(zip.data()) + at, n);
 }
 
+// The name np.load gives a member: without ".npy" (NpzFile.files).
+std::string_view NumpyKey(std::string_view name) {
+  constexpr std::string_view kNpy = ".npy";
+  if (name.size() >= kNpy.size() && name.substr(name.size() - kNpy.size()) == kNpy) {
+    name.remove_suffix(kNpy.size());
+  }
+  return name;
+}
+
 std::vector<ZipMember> ZipMembers(std::string_view zip, const std::string& where) {
   const auto field = [&](std::uint64_t at, int n) { return ZipField(zip, at, n, where); };
   // The end-of-central-directory record: 22 bytes and a comment of up to 65535 at the end.
+  // As zipfile finds it: at 22 bytes from the end with no comment, else the last signature
+  // among the last 65535 + 22 bytes.
   std::uint64_t end = 0;
   bool found = false;
   if (zip.size() >= kZipEndSize) {
-    const std::uint64_t lowest =
-        zip.size() > kZipEndSize + kZipMaxComment ? zip.size() - kZipEndSize - kZipMaxComment : 0;
-    for (std::uint64_t p = zip.size() - kZipEndSize + 1; p-- > lowest;) {
-      if (field(p, 4) == kZipEnd && p + kZipEndSize + field(p + 20, 2) <= zip.size()) {
-        end = p;
-        found = true;
-        break;
-      }
+    const std::uint64_t last = zip.size() - kZipEndSize;
+    if (field(last, 4) == kZipEnd && field(last + 20, 2) == 0) {
+      end = last;
+      found = true;
+    } else {
+      const std::uint64_t lowest = last > kZipMaxComment ? last - kZipMaxComment : 0;
+      const std::string_view signature("PK\x05\x06", 4);
+      const std::size_t at = zip.rfind(signature);
+      found = at != std::string_view::npos && at >= lowest && at <= last;
+      end = found ? at : 0;
     }
   }
   if (!found) {
@@ -1190,18 +1231,22 @@ std::vector<ZipMember> ZipMembers(std::string_view zip, const std::string& where
   std::uint64_t entries = field(end + 10, 2), directory_size = field(end + 12, 4),
                 directory_offset = field(end + 16, 4);
   // Zip64: a locator just before the record points to the zip64 end record, whose fields
-  // replace those that do not fit 16 or 32 bits (then 0xFFFF or 0xFFFFFFFF).
-  if (end >= 20 && field(end - 20, 4) == kZip64EndLocator) {
-    const std::uint64_t record = field(end - 20 + 8, 8);
-    if (field(record, 4) != kZip64End) {
+  // replace those that do not fit 16 or 32 bits (then 0xFFFF or 0xFFFFFFFF). zipfile reads the
+  // zip64 record just before the locator, whatever the locator says: both must agree.
+  std::uint64_t directory_end_expected = end;
+  if (end >= kZip64LocatorSize && field(end - kZip64LocatorSize, 4) == kZip64EndLocator) {
+    const std::uint64_t record = field(end - kZip64LocatorSize + 8, 8);
+    if (end < kZip64LocatorSize + kZip64EndSize ||
+        record != end - kZip64LocatorSize - kZip64EndSize || field(record, 4) != kZip64End) {
       throw InputError(where + ": damaged ZIP archive: no zip64 end record at byte " +
-                       std::to_string(record));
+                       std::to_string(record) + " just before its locator");
     }
     disk = field(record + 16, 4);
     directory_disk = field(record + 20, 4);
     entries = field(record + 32, 8);
     directory_size = field(record + 40, 8);
     directory_offset = field(record + 48, 8);
+    directory_end_expected = record;
   } else if (entries == 0xffff || directory_size == 0xffffffff || directory_offset == 0xffffffff) {
     throw InputError(where + ": damaged ZIP archive: its zip64 end record is missing");
   }
@@ -1213,9 +1258,18 @@ std::vector<ZipMember> ZipMembers(std::string_view zip, const std::string& where
                      std::to_string(directory_size) + " bytes at byte " +
                      std::to_string(directory_offset) + ") lies beyond the file");
   }
+  const std::uint64_t directory_end = directory_offset + directory_size;
+  // zipfile takes the bytes between the directory's announced end and the end record as other
+  // data the archive was appended to, and shifts every offset by as many bytes.
+  if (directory_end != directory_end_expected) {
+    throw InputError(where + ": damaged ZIP archive: its central directory ends at byte " +
+                     std::to_string(directory_end) + ", its end record is at byte " +
+                     std::to_string(directory_end_expected) +
+                     "; expected them to meet (NumPy would read the members at offsets moved by " +
+                     "the difference)");
+  }
   std::vector<ZipMember> members;
   std::uint64_t p = directory_offset;
-  const std::uint64_t directory_end = directory_offset + directory_size;
   for (std::uint64_t i = 0; i < entries; ++i) {
     if (directory_end - p < 46 || field(p, 4) != kZipCentralHeader) {
       throw InputError(where + ": damaged ZIP archive: its central directory holds " +
@@ -1259,6 +1313,30 @@ std::vector<ZipMember> ZipMembers(std::string_view zip, const std::string& where
     members.push_back(std::move(m));
     p += 46 + name_size + extra_size + comment_size;
   }
+  // zipfile reads entries to the directory's end, whatever count the end record announces.
+  if (p != directory_end) {
+    throw InputError(where + ": damaged ZIP archive: its central directory holds " +
+                     std::to_string(directory_end - p) + " bytes after the " +
+                     std::to_string(entries) +
+                     " members its end record announces (NumPy would read them as more members)");
+  }
+  // Two members of one name: zipfile (so np.load) reads the last, this reader would read the
+  // first. Names np.load takes for one ("GThard" and "GThard.npy") are refused as well.
+  std::unordered_map<std::string_view, std::size_t> first_of;
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    const auto [it, inserted] = first_of.emplace(NumpyKey(members[k].name), k);
+    if (inserted) continue;
+    const ZipMember& first = members[it->second];
+    const std::string names = first.name == members[k].name
+                                  ? "two members named " + Quoted(first.name)
+                                  : "members named " + Quoted(first.name) + " and " +
+                                        Quoted(members[k].name) + ", which np.load takes for one";
+    throw InputError(where + ": the archive holds " + names + " (entries " +
+                     std::to_string(it->second + 1) + " and " + std::to_string(k + 1) +
+                     " of its central directory); expected one member of each name (NumPy reads "
+                     "the last of them, this reader would read the first: save the arrays "
+                     "again with np.savez or np.savez_compressed)");
+  }
   return members;
 }
 
@@ -1285,7 +1363,8 @@ struct InflaterDeleter {
 
 }  // namespace
 
-NpyObjects DecodeNpyObjects(std::string_view data, const std::string& where) {
+NpyObjects DecodeNpyObjects(std::string_view data, const std::string& where,
+                            const NpyObjectLimits& limits) {
   const NpyHeaderInfo header = ReadNpyHeader(data, where);
   std::string_view name = header.descr;
   char order = '=';
@@ -1297,9 +1376,19 @@ NpyObjects DecodeNpyObjects(std::string_view data, const std::string& where) {
   if (!DtypeFromName(name, order, dtype)) {
     throw InputError(where + ": dtype " + Quoted(header.descr) + " is not read; " + kDtypesRead);
   }
+  // The elements the header announces, before any is read.
+  const std::uint64_t count = ElementCount(header.shape, where);
+  const auto most = static_cast<std::uint64_t>(
+      std::max<std::int64_t>(0, std::min(kNpyMaxObjectItems, limits.values)));
+  if (count > most) {
+    throw InputError(where + ": shape " + NpyShapeText(header.shape) + " holds " +
+                     std::to_string(count) + " elements; expected at most " +
+                     std::to_string(most) +
+                     (limits.expected.empty() ? std::string() : " (" + limits.expected + ")"));
+  }
   NpyObjects out;
   if (dtype.kind == 'O') {
-    PickleMachine machine(data.substr(header.data_offset), where);
+    PickleMachine machine(data.substr(header.data_offset), where, limits);
     const Value array = machine.Run();
     if (array->shape != header.shape) {
       throw InputError(where + ": the pickled array has shape " + NpyShapeText(array->shape) +
@@ -1310,7 +1399,6 @@ NpyObjects DecodeNpyObjects(std::string_view data, const std::string& where) {
     return out;
   }
   CheckByteOrder(dtype, where);
-  const std::uint64_t count = ElementCount(header.shape, where);
   const std::uint64_t available = data.size() - header.data_offset;
   const auto size = static_cast<std::uint64_t>(dtype.size);
   if (count > available / size) {
@@ -1333,8 +1421,18 @@ std::vector<std::string> NpzMemberNames(std::string_view zip, const std::string&
   return names;
 }
 
-std::string NpzMember(std::string_view zip, const std::string& name, const std::string& where) {
+bool IsNpzArchive(std::string_view bytes) {
+  const std::string_view head = bytes.substr(0, 4);
+  return head == std::string_view("PK\x03\x04", 4) || head == std::string_view("PK\x05\x06", 4);
+}
+
+std::string NpzMember(std::string_view zip, const std::string& name, const std::string& where,
+                      const NpzLimit& limit) {
   const std::vector<ZipMember> members = ZipMembers(zip, where);
+  if (members.empty()) {
+    throw InputError(where + ": is an empty ZIP archive (no member); expected one holding " +
+                     Quoted(name));
+  }
   const auto named = [&](const std::string& n) {
     return std::find_if(members.begin(), members.end(),
                         [&](const ZipMember& m) { return m.name == n; });
@@ -1350,8 +1448,7 @@ std::string NpzMember(std::string_view zip, const std::string& name, const std::
     if (members.size() > kListed) {
       list += " and " + std::to_string(members.size() - kListed) + " more";
     }
-    throw InputError(where + ": has no member " + Quoted(name) +
-                     (members.empty() ? "; the archive is empty" : "; its members are " + list));
+    throw InputError(where + ": has no member " + Quoted(name) + "; its members are " + list);
   }
   const ZipMember& m = *it;
   const std::string member = where + ": member " + Quoted(m.name);
@@ -1361,12 +1458,27 @@ std::string NpzMember(std::string_view zip, const std::string& name, const std::
                      ", which is not read; expected stored or deflate (np.savez, "
                      "np.savez_compressed)");
   }
+  // The declared size bounds what is allocated: the data are inflated into a buffer of that
+  // size, and data that would inflate to more are refused as damaged.
+  if (m.uncompressed > limit.bytes) {
+    throw InputError(member + " holds " + std::to_string(m.uncompressed) +
+                     " bytes once inflated (the size the archive declares); expected at most " +
+                     std::to_string(limit.bytes) +
+                     (limit.expected.empty() ? std::string() : ": " + limit.expected));
+  }
   // The local header repeats the name and has extra fields of its own, before the data.
   if (ZipField(zip, m.local_offset, 4, where) != kZipLocalHeader) {
     throw InputError(member + ": no local header at byte " + std::to_string(m.local_offset));
   }
-  const std::uint64_t start = m.local_offset + 30 + ZipField(zip, m.local_offset + 26, 2, where) +
-                              ZipField(zip, m.local_offset + 28, 2, where);
+  const std::uint64_t local_name_size = ZipField(zip, m.local_offset + 26, 2, where);
+  const std::uint64_t start =
+      m.local_offset + 30 + local_name_size + ZipField(zip, m.local_offset + 28, 2, where);
+  // zipfile refuses a member whose local header names another file.
+  if (m.local_offset + 30 > zip.size() || local_name_size > zip.size() - m.local_offset - 30 ||
+      zip.substr(m.local_offset + 30, local_name_size) != m.name) {
+    throw InputError(member + ": its local header at byte " + std::to_string(m.local_offset) +
+                     " names another file; expected the name of the central directory");
+  }
   if (start > zip.size() || m.compressed > zip.size() - start) {
     throw InputError(member + ": truncated ZIP archive: " + std::to_string(m.compressed) +
                      " bytes at byte " + std::to_string(start) + " run past the end of the file");

@@ -40,16 +40,30 @@ struct NpyObjects {
   std::vector<std::shared_ptr<const PyValue>> items;
 };
 
-// Limits that keep a small hostile file from taking much memory or time. The numbers the range
-// objects of one file make in all (each a value of some 120 bytes: 250 MB at most), and the
-// elements its object arrays hold in all (each a pointer):
-constexpr std::int64_t kNpyMaxRangeNumbers = 2'000'000;
+// Limits that keep a small hostile file from taking much memory or time, whatever the caller
+// expects (NpyObjectLimits lowers them). The numbers the range objects of one file make in all
+// (each a value of some 130 bytes: 130 MB at most), and the elements its arrays hold in all
+// (object arrays: a pointer each; numeric arrays read from a pickle: a value each unless it is
+// a bool or an integer in [-1, 255]):
+constexpr std::int64_t kNpyMaxRangeNumbers = 1'000'000;
 constexpr std::int64_t kNpyMaxObjectItems = 10'000'000;
 // The values an object array may unfold into, a list it refers to from several places counted
-// at each place (what a program walking it visits):
-constexpr std::int64_t kNpyMaxUnfoldedValues = 100'000'000;
+// at each place (what a program walking it visits, once a visit):
+constexpr std::int64_t kNpyMaxUnfoldedValues = 20'000'000;
 // The deepest nesting of lists, tuples, dicts and arrays read.
 constexpr int kNpyMaxDepth = 100;
+
+// What the caller can use of an array, below the limits above: DecodeNpyObjects refuses a file
+// whose header announces more elements, whose ranges make more numbers, whose arrays hold more
+// elements or whose array unfolds into more values than `values`, or one of whose ranges makes
+// more numbers than `range`, each as soon as it is known (the header's before the pickle runs,
+// a range's before its numbers are made).
+struct NpyObjectLimits {
+  std::int64_t values = kNpyMaxUnfoldedValues;
+  std::int64_t range = kNpyMaxRangeNumbers;  // the numbers of one range (one list of the file)
+  // Why, for messages ("10 queries listing at most 74 reference indices each"); may be empty.
+  std::string expected;
+};
 
 // Reads the array of a .npy file (versions 1.0-3.0). Pickles of protocols 0-5 are read as
 // Python 2 and 3 and NumPy 1 and 2 write them; the callables allowed are
@@ -62,15 +76,40 @@ constexpr int kNpyMaxDepth = 100;
 // bad header, a refused callable ("refuses to call posix.system: ..."), truncation ("truncated
 // pickle at byte N", counted from the pickle's first byte), a refused or unknown opcode, limits
 // above exceeded.
-NpyObjects DecodeNpyObjects(std::string_view data, const std::string& where);
+NpyObjects DecodeNpyObjects(std::string_view data, const std::string& where,
+                            const NpyObjectLimits& limits = {});
 
-// The member names of a .npz (ZIP) archive, in archive order.
+// Whether `bytes` are to be read as a .npz (ZIP) archive, as np.load tells one: they begin with
+// a member's local header ("PK\x03\x04") or, for an archive without members, the end record
+// ("PK\x05\x06").
+bool IsNpzArchive(std::string_view bytes);
+
+// The largest member NpzMember inflates when its caller states no size (1 GiB).
+constexpr std::uint64_t kNpzMaxMemberBytes = std::uint64_t{1} << 30;
+
+// The most bytes a member may hold once inflated, and why (for messages: "a 600 x 600 matrix,
+// 8 bytes a cell at most, and its header"). NpzMember compares the size the archive declares
+// with it before allocating anything, and inflates into a buffer of the declared size only
+// (a member that would inflate to more is damaged).
+struct NpzLimit {
+  std::uint64_t bytes = kNpzMaxMemberBytes;
+  std::string expected;
+};
+
+// The member names of a .npz (ZIP) archive, in archive order. The archive must mean the same
+// to NumPy (np.load, Python's zipfile) as to this reader: two members of one name, or of names
+// that np.load takes for one ("GThard" and "GThard.npy"), a central directory that holds other
+// entries than its end record announces or does not end where that record says, are refused
+// (NumPy would read the last of two members of one name, this reader the first).
 std::vector<std::string> NpzMemberNames(std::string_view zip, const std::string& where);
 // The bytes of the member `name` ("GThard.npy"; "GThard", as np.load names it, finds
 // "GThard.npy" too), stored or deflated, checked against its CRC-32. Throws InputError with
-// one line beginning with `where` on a file that is not a ZIP archive, a missing member (the
-// message lists the members there are), a compression method other than stored and deflate,
-// encryption, a CRC-32 mismatch, sizes or offsets beyond the file.
-std::string NpzMember(std::string_view zip, const std::string& name, const std::string& where);
+// one line beginning with `where` on a file that is not a ZIP archive, an archive refused by
+// NpzMemberNames, an empty archive, a missing member (the message lists the members there
+// are), a member larger than `limit` (naming both sizes), a compression method other than
+// stored and deflate, encryption, a local header whose name is not the member's, a CRC-32
+// mismatch, sizes or offsets beyond the file.
+std::string NpzMember(std::string_view zip, const std::string& name, const std::string& where,
+                      const NpzLimit& limit = {});
 
 }  // namespace openable

@@ -40,6 +40,11 @@ TEST(GroundTruthFormats, NamedConstantsAreTheRegistrysEntries) {
   EXPECT_FALSE(GroundTruthType::kPositions.Format().orientations);
   EXPECT_TRUE(GroundTruthType::kTum.Format().timestamps);
   EXPECT_FALSE(GroundTruthType::kAligned.Format().needs_file);
+  // The formats that pair a query traversal with a reference one.
+  std::set<std::string> two;
+  for (const GroundTruthFormat& f : GroundTruthFormats())
+    if (f.two_traversals) two.insert(f.name);
+  EXPECT_EQ(two, (std::set<std::string>{"aligned", "vpr_bench", "vpr_tutorial"}));
   EXPECT_THROW(GroundTruthType::kNone.Format(), std::logic_error);
   EXPECT_THROW(GroundTruthType("gps").Format(), std::logic_error);
 }

@@ -19,6 +19,8 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/evaluation/layout.h"
+#include "OpenABLE/io/npy.h"
+#include "tests/io/zip_writer.h"
 #include "tests/test_support.h"
 
 namespace openable {
@@ -34,6 +36,7 @@ using openable::testing::SourceDir;
 using openable::testing::TempDir;
 using openable::testing::WriteBytes;
 using Matches = std::vector<std::vector<int>>;
+using namespace std::string_literals;
 
 
 
@@ -594,6 +597,12 @@ TEST(PosesErrors, MalformedFilesNameFileAndLine) {
   ExpectInputError([&] { ReadPoses(dir + "/absent.txt", GroundTruthType::kTum); },
                    {Q(dir + "/absent.txt"), "does not exist"});
   EXPECT_THROW(ReadPoses(dir + "/k.txt", GroundTruthType::kMatrix), std::logic_error);
+  // A frame number before the 12 numbers: the evaluation has no format for keyframes (one pose
+  // per frame), so the message names none.
+  WriteBytes(dir + "/ids.txt", "0 1 0 0 0 0 1 0 0 0 0 1 0\n");
+  const std::string ids = InputErrorMessage([&] { ReadPoses(dir + "/ids.txt", GroundTruthType::kKitti); });
+  EXPECT_NE(ids.find("13 numbers; expected 12"), std::string::npos) << ids;
+  EXPECT_EQ(ids.find("kitti-id"), std::string::npos) << ids;
   // The checks SNAPS applies to the same files (one reader, pose_file.h): a matrix that is not
   // a rotation, timestamps out of order.
   WriteBytes(dir + "/scaled.txt", "2 0 0 0 0 2 0 0 0 0 2 0\n");
@@ -723,6 +732,35 @@ TEST(GroundTruthVprBench, BadFilesAndLayoutsAreOneLineNamingTheFile) {
       {"evil.npy", "posix.system"});
 }
 
+TEST(GroundTruthMissingFiles, EveryFormatNamesTheFileItLookedFor) {
+  const std::string dir = TempDir();
+  for (const GroundTruthFormat& f : GroundTruthFormats()) {
+    if (!f.needs_file) continue;
+    const std::string absent = dir + "/absent_" + f.name + ".npy";
+    const std::string message = InputErrorMessage([&] {
+      LoadGroundTruth(Options(GroundTruthType(f.name), absent),
+                      EvaluationLayout::TwoTraversals(3, 3), 6, 6);
+    });
+    // Pose formats of two traversals want the query poses too; give them.
+    if (message.find("Ground_truth_2") != std::string::npos) {
+      GroundTruthOptions o = Options(GroundTruthType(f.name), absent);
+      o.path_2 = absent;
+      ExpectInputError(
+          [&] { LoadGroundTruth(o, EvaluationLayout::TwoTraversals(3, 3), 6, 6); },
+          {Q(absent), "does not exist"});
+      continue;
+    }
+    EXPECT_NE(message.find(std::string(f.label) + " " + Q(absent) + " does not exist"),
+              std::string::npos)
+        << f.name << ": " << message;
+  }
+  // VPR_Tutorial's separate GTsoft too.
+  GroundTruthOptions o = Options(GroundTruthType::kVprTutorial, ProtocolData("hand_gt_hard.npy"));
+  o.soft_path = dir + "/absent_soft.npy";
+  ExpectInputError([&] { LoadQueryReference(o, 7, 9); },
+                   {"VPR_Tutorial soft ground truth " + Q(o.soft_path) + " does not exist"});
+}
+
 TEST(GroundTruthVprTutorial, MatricesAreDatabaseByQueries) {
   GroundTruthOptions o = Options(GroundTruthType::kVprTutorial, ProtocolData("hand_gt_hard.npy"));
   const GroundTruth gt = LoadQueryReference(o, 7, 9);
@@ -744,6 +782,111 @@ TEST(GroundTruthVprTutorial, MatricesAreDatabaseByQueries) {
       3, 3);
   EXPECT_EQ(eye.matches, (std::vector<std::vector<int>>{{0}, {1}, {2}}));
   EXPECT_TRUE(eye.soft.empty());
+}
+
+// A bool .npy of rows x cols whose cell (i, i) is `diagonal`, the others false.
+std::string DiagonalNpy(int rows, int cols, bool diagonal = true) {
+  std::string data =
+      NpyHeaderOf("'|b1'", "(" + std::to_string(rows) + ", " + std::to_string(cols) + ")");
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) data += static_cast<char>(i == j && diagonal ? 1 : 0);
+  return data;
+}
+
+// GT.npz archives: a member larger than the run's references x queries can be is refused by
+// the size the archive declares, before it is inflated (np.savez_compressed of 16384 x 16384
+// zeros is 261 kB and inflates to 256 MiB); two members of one name (np.load reads the last)
+// and an archive without members are refused in one line naming the file.
+TEST(GroundTruthVprTutorial, ArchivesLargerThanTheRunOrReadOtherwiseByNumpyAreRefused) {
+  using testing::ZipArchive;
+  const std::string dir = TempDir(), path = dir + "/GT.npz";
+  const GroundTruthOptions o = Options(GroundTruthType::kVprTutorial, path);
+  // Sound: GThard = eye(10), GTsoft with nothing more.
+  WriteBytes(path, ZipArchive({{"GThard.npy", DiagonalNpy(10, 10)},
+                               {"GTsoft.npy", DiagonalNpy(10, 10, false)}}));
+  const GroundTruth eye = LoadQueryReference(o, 10, 10);
+  ASSERT_EQ(eye.matches.size(), 10u);
+  for (int q = 0; q < 10; ++q) EXPECT_EQ(eye.matches[q], std::vector<int>{q});
+  // 300 x 300: 90000 cells and the header, where 10 x 10 takes 65536 + 8 x 100 bytes at most.
+  const std::size_t large = DiagonalNpy(300, 300).size();
+  WriteBytes(path, ZipArchive({{"GThard.npy", DiagonalNpy(300, 300)}}));
+  ExpectInputError([&] { LoadQueryReference(o, 10, 10); },
+                   {"VPR_Tutorial ground truth " + Q(path) + ": member \"GThard.npy\" holds " +
+                    std::to_string(large) +
+                    " bytes once inflated (the size the archive declares); expected at most " +
+                    std::to_string(65536 + 8 * 100) + ": a 10x10 matrix (database x queries)"});
+  // GThard of the run's size, but a GTsoft of 300 x 300.
+  WriteBytes(path, ZipArchive({{"GThard.npy", DiagonalNpy(10, 10)},
+                               {"GTsoft.npy", DiagonalNpy(300, 300)}}));
+  ExpectInputError([&] { LoadQueryReference(o, 10, 10); },
+                   {"member \"GTsoft.npy\" holds " + std::to_string(large) + " bytes"});
+  // Two GThard: np.load (so VPR_Tutorial) reads the second, which holds no pair.
+  WriteBytes(path, ZipArchive({{"GThard.npy", DiagonalNpy(10, 10)},
+                               {"GThard.npy", DiagonalNpy(10, 10, false)}}));
+  ExpectInputError([&] { LoadQueryReference(o, 10, 10); },
+                   {"VPR_Tutorial ground truth " + Q(path) +
+                    ": the archive holds two members named \"GThard.npy\""});
+  // No member at all.
+  WriteBytes(path, ZipArchive({}));
+  ExpectInputError([&] { LoadQueryReference(o, 10, 10); },
+                   {"VPR_Tutorial ground truth " + Q(path) +
+                    ": is an empty ZIP archive (no member); expected one holding \"GThard.npy\""});
+}
+
+// VPR-Bench files whose lists hold more numbers than the run can use are refused before the
+// numbers are made: a range memoised once and named by every row (a 475-byte file of 49 rows
+// naming range(2000000) took 331 MB and 3 s, and was evaluated).
+TEST(GroundTruthVprBench, ListsLongerThanTheRunCanUseAreRefusedBeforeTheyAreMade) {
+  const std::string dir = TempDir(), path = dir + "/gt.npy";
+  // A (3, 2) object array as Python 2 pickles it (protocol 2), row q = [q, range(0, n)]: the
+  // range made for row 0, memoised, and named again by rows 1 and 2.
+  const auto rows_naming_one_range = [](std::uint16_t n) {
+    std::string p = "\x80\x02"
+                    "cnumpy.core.multiarray\n_reconstruct\ncnumpy\nndarray\nK\x00\x85U\x01"
+                    "b\x87R(K\x01K\x03K\x02\x86"
+                    "cnumpy\ndtype\nU\x02O8K\x00K\x01\x87R(K\x03U\x01|NNNJ\xff\xff\xff\xffJ\xff"
+                    "\xff\xff\xffK?tb\x89]("
+                    "K\x00"
+                    "c__builtin__\nxrange\nK\x00M"s;
+    p += static_cast<char>(n & 0xff);
+    p += static_cast<char>(n >> 8);
+    p += "\x86Rq\x01K\x01h\x01K\x02h\x01"
+         "etb."s;
+    return NpyHeaderOf("'|O'", "(3, 2)") + p;
+  };
+  const GroundTruthOptions o = Options(GroundTruthType::kVprBench, path);
+  // 3 queries by 3 references: at most 3 + 64 = 67 indices a query, 1 + 3 x (2 + 67) = 208
+  // values. 60 numbers named three times: 1 + 3 x (2 + 60) = 187, read.
+  WriteBytes(path, rows_naming_one_range(60));
+  const GroundTruth read = LoadQueryReference(o, 3, 3);
+  EXPECT_EQ(read.matches, (Matches{{0, 1, 2}, {0, 1, 2}, {0, 1, 2}}));
+  EXPECT_EQ(read.dropped, 3 * 57);
+  // 67 numbers, as many as a query may list: read.
+  WriteBytes(path, rows_naming_one_range(67));
+  EXPECT_EQ(LoadQueryReference(o, 3, 3).dropped, 3 * 64);
+  // Refused when the range is called, before its numbers are made: 1000 numbers, more than the
+  // whole file may hold; 100, more than one query may list.
+  WriteBytes(path, rows_naming_one_range(1000));
+  ExpectInputError([&] { LoadQueryReference(o, 3, 3); },
+                   {"VPR-Bench ground truth " + Q(path) + ": REDUCE at byte ",
+                    ": the range objects make 1000 numbers in all; expected at most 208 (3 "
+                    "queries listing at most 67 reference indices each: the 3 reference frames "
+                    "up to the run's last, and 64 more)"});
+  WriteBytes(path, rows_naming_one_range(100));
+  ExpectInputError([&] { LoadQueryReference(o, 3, 3); },
+                   {"VPR-Bench ground truth " + Q(path) + ": REDUCE at byte ",
+                    ": range(0, 100, 1) makes 100 numbers; expected at most 67 in one list (3 "
+                    "queries listing at most 67"});
+  // With a range of frames (Initial_image), the file's rows are those its header gives, and a
+  // list may name every frame up to the run's last from the traversal's start: 5 + 3 + 64.
+  GroundTruthOptions ranged = o;
+  ranged.first_frame = 5;
+  WriteBytes(path, rows_naming_one_range(70));
+  EXPECT_EQ(LoadQueryReference(ranged, 3, 3).dropped, 3 * 70);  // rows 0-2 are before frame 5
+  WriteBytes(path, rows_naming_one_range(100));
+  ExpectInputError([&] { LoadQueryReference(ranged, 3, 3); },
+                   {": range(0, 100, 1) makes 100 numbers; expected at most 72 in one list (3 "
+                    "queries listing at most 72 reference indices each: the 8 reference frames"});
 }
 
 }  // namespace

@@ -6,12 +6,15 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/io/npy.h"
+#include "tests/io/zip_writer.h"
 #include "tests/test_support.h"
 
 namespace openable {
@@ -22,6 +25,8 @@ using testing::ExpectInputError;
 using testing::InputErrorMessage;
 using testing::Q;
 using testing::ReadBytes;
+using testing::ZipArchive;
+using testing::ZipEntry;
 using Kind = PyValue::Kind;
 
 std::string DataPath(const std::string& name) {
@@ -339,24 +344,28 @@ TEST(NpyObjects, HostileStructuresAreRefused) {
   std::string doubling = "]K\x05\x61q\x00\x30"s;
   for (int k = 0; k < 40; ++k) doubling += "](h\x00h\x00\x65q\x00\x30"s;
   ExpectInputError([&] { DecodeNpyObjects(ObjectNpy(doubling + "(h\x00l"s, 1), "h"); },
-                   {"unfolds into more than 100000000 values"});
+                   {"h: the array unfolds into ", " values or more (lists referred to from "
+                    "several places count at each); expected at most 20000000"});
   // A range of 10^9 numbers (refused before any is made); the limit holds for all the ranges of
-  // a file together: two of 1,000,001 numbers.
+  // a file together: two of 500,001 numbers.
   ExpectInputError(
       [] {
         DecodeNpyObjects(ObjectNpy("(cbuiltins\nrange\nK\x00J\x00\xca\x9a\x3b\x86Rl"s, 1), "h");
       },
-      {"the range objects make more than 2000000 numbers in all"});
+      {"h: REDUCE at byte 142: the range objects make 1000000000 numbers in all; expected at "
+       "most 1000000"});
   std::string ranges = "(";
-  for (int k = 0; k < 2; ++k) ranges += "c__builtin__\nxrange\nJ\x41\x42\x0f\x00\x85R"s;
+  for (int k = 0; k < 2; ++k) ranges += "c__builtin__\nxrange\nJ\x21\xa1\x07\x00\x85R"s;
   ExpectInputError([&] { DecodeNpyObjects(ObjectNpy(ranges + "l", 2), "h"); },
-                   {"h: REDUCE at byte", "more than 2000000 numbers in all"});
+                   {"h: REDUCE at byte", "make 500001 + 500001 numbers in all; expected at "
+                    "most 1000000"});
   // 11 object arrays built from one list of a million elements: 11 million elements.
   std::string arrays = "(" + ObjectArrayOps(1000000, "(" + std::string(1000000, 'N') + "lq\x01");
   for (int k = 1; k < 11; ++k) arrays += ObjectArrayOps(1000000, "h\x01");
   ExpectInputError(
       [&] { DecodeNpyObjects(ObjectNpy(arrays + "l", 11), "h"); },
-      {"h: BUILD at byte", "the object arrays hold more than 10000000 elements in all"});
+      {"h: BUILD at byte", "the arrays hold 10000000 + 1000000 elements in all; expected at most "
+       "10000000"});
   // Integers beyond 64 bits.
   ExpectInputError(
       [] {
@@ -492,6 +501,231 @@ TEST(Npz, TruncatedAndDamagedArchives) {
       } catch (const InputError&) {
       }
     }
+  }
+}
+
+// A bool .npy of rows x cols, eye-like (cell (i, i) true).
+std::string BoolNpy(int rows, int cols) {
+  std::string data = NpyHeaderOf("'|b1'", "(" + std::to_string(rows) + ", " +
+                                               std::to_string(cols) + ")");
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) data += static_cast<char>(i == j ? 1 : 0);
+  return data;
+}
+
+// The archives of tests/io/zip_writer.h read as Python's zipfile reads them (checked once by
+// hand with zipfile.ZipFile(...).testzip() and read()).
+TEST(Npz, ReadsArchivesOfTheTestWriter) {
+  const std::string eye = BoolNpy(3, 3);
+  for (const bool deflate : {false, true}) {
+    const std::string zip = ZipArchive({{"GThard.npy", eye, deflate}, {"GTsoft.npy", "x", deflate}});
+    EXPECT_EQ(NpzMemberNames(zip, "z"), (std::vector<std::string>{"GThard.npy", "GTsoft.npy"}));
+    EXPECT_EQ(NpzMember(zip, "GThard", "z"), eye);
+    EXPECT_EQ(NpzMember(zip, "GTsoft.npy", "z"), "x");
+  }
+  // Deflate data of more than one block.
+  const std::string large(200000, '\x01');
+  EXPECT_EQ(NpzMember(ZipArchive({{"a.npy", large}}), "a.npy", "z"), large);
+}
+
+// The size a member declares is compared with what the caller can use before anything is
+// allocated or inflated; data that inflate to more than they declare are damaged.
+TEST(Npz, MemberLargerThanTheCallerExpectsIsRefusedBeforeInflating) {
+  const std::string zip = ZipArchive({{"GThard.npy", BoolNpy(300, 300)}});
+  const std::uint64_t size = BoolNpy(300, 300).size();  // 90000 cells and the header
+  NpzLimit limit;
+  limit.bytes = 66336;
+  limit.expected = "a 10x10 matrix";
+  ExpectInputError([&] { NpzMember(zip, "GThard.npy", Q("GT.npz"), limit); },
+                   {Q("GT.npz") + ": member \"GThard.npy\" holds " + std::to_string(size) +
+                    " bytes once inflated (the size the archive declares); expected at most "
+                    "66336: a 10x10 matrix"});
+  limit.bytes = size;  // exactly the size: read
+  EXPECT_EQ(NpzMember(zip, "GThard.npy", "z", limit), BoolNpy(300, 300));
+  // A declared size of 2^32 - 2 (a 4 GB allocation) with 12 bytes of data behind it: refused by
+  // the default limit (1 GiB) before the ratio of deflate is even looked at.
+  ExpectInputError(
+      [] {
+        NpzMember(ZipArchive({{"GThard.npy", "abc", true, 0xfffffffe}}), "GThard.npy", "z");
+      },
+      {"z: member \"GThard.npy\" holds 4294967294 bytes once inflated (the size the archive "
+       "declares); expected at most 1073741824"});
+  // Within the limit, but the data inflate to more than declared: damaged, the buffer is the
+  // declared size. Stored members must declare their real size.
+  ExpectInputError(
+      [] { NpzMember(ZipArchive({{"GThard.npy", std::string(5000, 'a'), true, 100}}), "GThard", "z"); },
+      {"z: member \"GThard.npy\": damaged deflate data (they do not inflate to the 100 bytes "
+       "announced)"});
+  ExpectInputError(
+      [] { NpzMember(ZipArchive({{"GThard.npy", "abcd", false, 100}}), "GThard", "z"); },
+      {"z: member \"GThard.npy\" is stored with sizes that differ (4 and 100 bytes)"});
+}
+
+// Archives that NumPy (Python's zipfile) would read otherwise than this reader are refused.
+TEST(Npz, ArchivesThatMeanSomethingElseToNumpyAreRefused) {
+  const std::string hard = BoolNpy(2, 2), other = BoolNpy(3, 3);
+  // Two members of one name: np.load reads the last, this reader would read the first.
+  const std::string twice = ZipArchive({{"GThard.npy", hard}, {"GThard.npy", other}});
+  for (const auto& read : std::vector<std::function<void()>>{
+           [&] { NpzMemberNames(twice, Q("GT.npz")); },
+           [&] { NpzMember(twice, "GThard", Q("GT.npz")); }}) {
+    ExpectInputError(read, {Q("GT.npz") + ": the archive holds two members named "
+                                          "\"GThard.npy\" (entries 1 and 2 of its central "
+                                          "directory); expected one member of each name (NumPy "
+                                          "reads the last of them, this reader would read the "
+                                          "first"});
+  }
+  // A duplicate of another member than the one asked for is refused as well.
+  ExpectInputError(
+      [] {
+        NpzMember(ZipArchive({{"GTsoft.npy", "a"}, {"GThard.npy", "b"}, {"GTsoft.npy", "c"}}),
+                  "GThard", "z");
+      },
+      {"z: the archive holds two members named \"GTsoft.npy\" (entries 1 and 3"});
+  // "GThard" and "GThard.npy": np.load's key "GThard" reads the first, this reader the second.
+  ExpectInputError(
+      [&] { NpzMember(ZipArchive({{"GThard", other}, {"GThard.npy", hard}}), "GThard", "z"); },
+      {"z: the archive holds members named \"GThard\" and \"GThard.npy\", which np.load takes "
+       "for one (entries 1 and 2"});
+  // An entry the end record does not count: zipfile reads it, and it may be a second GThard.
+  ExpectInputError(
+      [&] { NpzMemberNames(ZipArchive({{"GThard.npy", hard}, {"GThard.npy", other}}, 1), "z"); },
+      {"z: damaged ZIP archive: its central directory holds ", " bytes after the 1 members its "
+       "end record announces"});
+  // A local header that names another file (zipfile refuses it).
+  ZipEntry renamed{"GThard.npy", hard};
+  renamed.local_name = "GTsoft.npy";
+  ExpectInputError([&] { NpzMember(ZipArchive({renamed}), "GThard.npy", "z"); },
+                   {"z: member \"GThard.npy\": its local header at byte 0 names another file"});
+  // An archive appended to other bytes: zipfile moves every offset by their length.
+  ExpectInputError([&] { NpzMemberNames(ZipArchive({{"GThard.npy", hard}}, -1, "prefix"), "z"); },
+                   {"z: damaged ZIP archive: its central directory ends at byte ",
+                    "its end record is at byte ", "expected them to meet"});
+}
+
+// An archive without members (np.savez of nothing: 22 bytes) says so.
+TEST(Npz, EmptyArchiveSaysItIsEmpty) {
+  const std::string empty = ZipArchive({});
+  ASSERT_EQ(empty.size(), 22u);
+  EXPECT_TRUE(IsNpzArchive(empty));
+  EXPECT_TRUE(IsNpzArchive(ZipArchive({{"a.npy", "x"}})));
+  EXPECT_FALSE(IsNpzArchive(Data("gt_lists.npy")));
+  EXPECT_FALSE(IsNpzArchive("PK"));
+  EXPECT_TRUE(NpzMemberNames(empty, "e").empty());
+  ExpectInputError([&] { NpzMember(empty, "GThard", Q("GT.npz")); },
+                   {Q("GT.npz") + ": is an empty ZIP archive (no member); expected one holding "
+                                  "\"GThard\""});
+}
+
+// What a caller can use bounds the pickle's work: the header's element count before the pickle
+// runs, a range before its numbers are made, numeric arrays inside the pickle, and the values
+// the array unfolds into with memoised lists counted at each place.
+TEST(NpyObjects, CallersLimitsAreAppliedBeforeTheWorkIsDone) {
+  NpyObjectLimits limits;
+  limits.values = 100;
+  limits.expected = "the run's 3 queries";
+  // The header announces 200 elements.
+  ExpectInputError(
+      [&] { DecodeNpyObjects(ObjectNpy("(K\x01l"s, 1, "(100, 2)"), "h", limits); },
+      {"h: shape (100, 2) holds 200 elements; expected at most 100 (the run's 3 queries)"});
+  ExpectInputError(
+      [&] { DecodeNpyObjects(NpyHeaderOf("'<i8'", "(101,)") + std::string(808, '\0'), "h", limits); },
+      {"h: shape (101,) holds 101 elements; expected at most 100"});
+  // A range of 10^9 numbers: refused with the caller's limit, before any number is made.
+  ExpectInputError(
+      [&] {
+        DecodeNpyObjects(ObjectNpy("(cbuiltins\nrange\nK\x00J\x00\xca\x9a\x3b\x86Rl"s, 1), "h",
+                         limits);
+      },
+      {"h: REDUCE at byte ", ": the range objects make 1000000000 numbers in all; expected at "
+                              "most 100 (the run's 3 queries)"});
+  // A range longer than one list may be, however few the numbers in all.
+  NpyObjectLimits one_list;
+  one_list.range = 59;
+  one_list.expected = "a query's references";
+  ExpectInputError(
+      [&] { DecodeNpyObjects(ObjectNpy("(cbuiltins\nrange\nK\x3c\x85Rl"s, 1), "h", one_list); },
+      {"h: REDUCE at byte ", ": range(0, 60, 1) makes 60 numbers; expected at most 59 in one "
+                              "list (a query's references)"});
+  one_list.range = 60;
+  EXPECT_EQ(DecodeNpyObjects(ObjectNpy("(cbuiltins\nrange\nK\x3c\x85Rl"s, 1), "h", one_list)
+                .items[0]->items.size(),
+            60u);
+  // A range of 60 numbers held by 2 elements: 1 + 2 x 61 = 123 values once unfolded.
+  const std::string memoised = "(cbuiltins\nrange\nK\x3c\x85Rq\x01h\x01l"s;
+  ExpectInputError([&] { DecodeNpyObjects(ObjectNpy(memoised, 2), "h", limits); },
+                   {"h: the array unfolds into ", " values or more (lists referred to from "
+                    "several places count at each); expected at most 100 (the run's 3 queries)"});
+  limits.values = 123;
+  const NpyObjects read = DecodeNpyObjects(ObjectNpy(memoised, 2), "h", limits);
+  ASSERT_EQ(read.items.size(), 2u);
+  EXPECT_EQ(read.items[0], read.items[1]);  // one list, referred to twice
+  EXPECT_EQ(read.items[1]->items.size(), 60u);
+  // A numeric array inside the pickle (protocol 5's _frombuffer) counts its elements.
+  limits.values = 10;
+  const std::string buffer =
+      "(cnumpy.core.numeric\n_frombuffer\n(B\x58\x00\x00\x00"s + std::string(88, '\0') +
+      "cnumpy\ndtype\nX\x02\x00\x00\x00i8\x85RK\x0b\x85X\x01\x00\x00\x00"
+      "CtRl"s;
+  // Without a limit it is read: eleven zeros.
+  ASSERT_EQ(Ints(*DecodeNpyObjects(ObjectNpy(buffer, 1), "h").items[0]),
+            Ints64(11, 0));
+  ExpectInputError([&] { DecodeNpyObjects(ObjectNpy(buffer, 1), "h", limits); },
+                   {"h: REDUCE at byte ", ": the arrays hold 11 elements in all; expected at "
+                                          "most 10"});
+}
+
+// The matrix fuzzer's seeds (tests/fuzz/corpus/matrix; the first byte chooses the extension
+// of the fuzzer's file, the rest is the file) read as the fuzzer reads them, with the default
+// limits: a result or one line naming the source. The seeds of archives NumPy reads otherwise,
+// of an archive without members, of a size beyond the default and of a range memoised by every
+// row are refused, each by its own check.
+TEST(NpyObjects, MatrixFuzzerSeedsAreReadOrRefusedInOneLine) {
+  const std::string corpus = testing::SourceDir() + "/tests/fuzz/corpus/matrix";
+  const auto one_line = [](const std::function<void()>& read) {
+    try {
+      read();
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      EXPECT_EQ(message.find_first_of("\r\n"), std::string::npos) << message;
+      EXPECT_EQ(message.rfind("fuzz", 0), 0u) << message;
+      return message;
+    }
+    return std::string();
+  };
+  // Each seed's refusals: as a .npy file, then as an archive (listing its members, reading each,
+  // or, with none listed, the member GThard).
+  std::map<std::string, std::string> refusals;
+  for (const auto& entry : std::filesystem::directory_iterator(corpus)) {
+    const std::string name = entry.path().filename().string();
+    const std::string bytes = ReadBytes(entry.path().string()).substr(1);
+    std::string& message = refusals[name];
+    message = one_line([&] { DecodeNpyObjects(bytes, "fuzz.npy"); }) + " | ";
+    std::vector<std::string> members;
+    message += one_line([&] { members = NpzMemberNames(bytes, "fuzz.npz"); });
+    for (const std::string& member : members)
+      message += one_line([&] { NpzMember(bytes, member, "fuzz.npz"); });
+    if (members.empty()) message += one_line([&] { NpzMember(bytes, "GThard", "fuzz.npz"); });
+  }
+  const std::vector<std::pair<std::string, std::string>> expected = {
+      {"npz_duplicate_member.npz", "two members named \"GThard.npy\""},
+      {"npz_numpy_alike_names.npz", "members named \"GThard\" and \"GThard.npy\""},
+      {"npz_uncounted_entry.npz", "bytes after the 1 members its end record announces"},
+      {"npz_after_other_bytes.npz", "expected them to meet"},
+      {"npz_local_name_differs.npz", "its local header at byte 0 names another file"},
+      {"npz_declared_4gb.npz", "holds 4294967294 bytes once inflated"},
+      {"npz_empty.npz", "is an empty ZIP archive (no member)"},
+      {"objects_memoised_range.npy", "the range objects make 2000000 numbers in all; expected "
+                                     "at most 1000000"},
+  };
+  for (const auto& [seed, part] : expected) {
+    ASSERT_EQ(refusals.count(seed), 1u) << seed << " is not in " << corpus;
+    EXPECT_NE(refusals[seed].find(part), std::string::npos) << seed << ": " << refusals[seed];
+  }
+  // The archives NumPy writes are read whole.
+  for (const char* seed : {"objects_gt.npz", "objects_gt_compressed.npz", "objects_zip64.npz"}) {
+    const std::string& message = refusals[seed];
+    EXPECT_EQ(message.substr(message.find(" | ")), " | ") << seed;
   }
 }
 
