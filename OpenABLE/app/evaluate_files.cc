@@ -15,6 +15,7 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/output_batch.h"
 #include "OpenABLE/base/strings.h"
+#include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/evaluation/report.h"
 #include "OpenABLE/outputs/matrix_settings.h"
 #include "OpenABLE/reports/evaluation_files.h"
@@ -190,6 +191,10 @@ EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line) {
   for (const MatrixFile& m : command_line.matrices) {
     const std::optional<SavedMatrixSettings> saved = ReadMatrixSettings(m.path);
     if (!saved) continue;
+    // A settings file beside another run's matrix would evaluate a wrong block: refused
+    // before anything is taken from it.
+    const cv::Size size = MatrixFileSize(m.path);
+    CheckMatrixFitsSettings(*saved, m.path, size.height, size.width);
     if (saved->thresholded)
       throw InputError("--matrix " + Quoted(m.path) +
                        ": holds the thresholded matrix M'' of Eq. 9, not distances (" +

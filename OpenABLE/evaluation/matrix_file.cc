@@ -155,4 +155,24 @@ cv::Mat1f ReadMatrixFile(const std::string& path) {
                    "...)");
 }
 
+cv::Size MatrixFileSize(const std::string& path) {
+  if (ExtensionOf(path) == "npy") {
+    // NumPy's headers are a few hundred bytes; a 2-D one read from the first 64 KiB gives the
+    // size. Anything else is left to the whole read and its messages.
+    std::ifstream in(path, std::ios::binary);
+    std::string head(65536, '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(std::max<std::streamsize>(0, in.gcount())));
+    try {
+      const NpyHeaderInfo header = ReadNpyHeader(head, path);
+      if (header.shape.size() == 2 && header.shape[0] > 0 && header.shape[1] > 0 &&
+          header.shape[0] <= std::numeric_limits<int>::max() &&
+          header.shape[1] <= std::numeric_limits<int>::max())
+        return cv::Size(static_cast<int>(header.shape[1]), static_cast<int>(header.shape[0]));
+    } catch (const InputError&) {
+    }
+  }
+  return ReadMatrixFile(path).size();
+}
+
 }  // namespace openable

@@ -17,4 +17,8 @@ namespace openable {
 // is not a number.
 cv::Mat1f ReadMatrixFile(const std::string& path);
 
+// The size of the matrix ReadMatrixFile would read, without reading a .npy file's cells (its
+// header alone; other kinds are read whole). Throws as ReadMatrixFile does.
+cv::Size MatrixFileSize(const std::string& path);
+
 }  // namespace openable

@@ -3,7 +3,6 @@
 #include <filesystem>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/base/input_file.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/io/json.h"
@@ -12,19 +11,6 @@
 namespace openable {
 
 namespace fs = std::filesystem;
-
-const std::vector<std::string>& MatrixEvaluationKeys() {
-  static const std::vector<std::string> keys = {
-      "Ground_truth_type", "Ground_truth",       "Ground_truth_2",     "Ground_truth_base",
-      "Ground_truth_radius", "Ground_truth_heading", "Ground_truth_min_gap",
-      "Ground_truth_time_tolerance", "Ground_truth_axes", "Tolerance", "Exclusion", "Vicinity",
-      "Initial_image", "Final_image", "Match_score", "Match_score_window", "Match_threshold",
-      "Match_consistency", "Image_sequences", "Sequence_partial", "Sequence_direction",
-      "Ground_truth_soft"};
-  return keys;
-}
-
-std::string MatrixSettingsPath(const std::string& matrix_path) { return matrix_path + ".json"; }
 
 std::string MatrixSettingValue(const Config& config, const std::string& key) {
   std::string v = ConfigValueText(config, key);
@@ -94,43 +80,6 @@ std::string EncodeMatrixSettings(const Config& config, const RunResult& result,
   Json& all = o["settings"] = Json::object();
   for (const std::string& key : ConfigKeyNames()) all[key] = MatrixSettingValue(c, key);
   return json::Dump(o);
-}
-
-std::optional<SavedMatrixSettings> ReadMatrixSettings(const std::string& matrix_path) {
-  const std::string path = MatrixSettingsPath(matrix_path);
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return std::nullopt;
-  const std::string text = ReadInputFile(path, "settings of the matrix " + Quoted(path),
-                                         "expected the JSON file OpenABLE writes beside a matrix");
-  const auto refuse = [&](const std::string& why) {
-    return InputError("settings of the matrix " + Quoted(path) + ": " + why +
-                      "; expected the JSON file OpenABLE writes beside a matrix (delete or "
-                      "rename it to evaluate the matrix without it)");
-  };
-  Json o;
-  try {
-    o = Json::parse(text);
-  } catch (const std::exception&) {
-    throw refuse("not valid JSON");
-  }
-  if (!o.is_object() || !o.contains("evaluation_keys") || !o["evaluation_keys"].is_object())
-    throw refuse("no \"evaluation_keys\" object");
-  SavedMatrixSettings s;
-  s.path = path;
-  for (const std::string& key : MatrixEvaluationKeys()) {
-    if (!o["evaluation_keys"].contains(key)) continue;
-    const Json& v = o["evaluation_keys"][key];
-    if (!v.is_string()) throw refuse(Quoted(key) + " is not a string");
-    s.keys.emplace_back(key, v.get<std::string>());
-  }
-  if (o.contains("reference_frames")) {
-    if (!o["reference_frames"].is_number_integer() || o["reference_frames"].get<int>() < 0)
-      throw refuse("\"reference_frames\" is not a number of frames");
-    s.reference_frames = o["reference_frames"].get<int>();
-  }
-  s.thresholded = o.value("content", std::string("distances")) == "thresholded";
-  s.score = o.value("match_score", std::string());
-  return s;
 }
 
 }  // namespace openable

@@ -3,12 +3,14 @@
 // the independent numpy implementation in tests/tools/evaluate_reference.py.
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <regex>
 #include <sstream>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "OpenABLE/io/json.h"
 #include "OpenABLE/io/npy.h"
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
@@ -159,6 +161,67 @@ TEST(Evaluation, OpenableEvaluateScoresAMatrixAsVprBenchAndVprTutorialDo) {
   EXPECT_EQ(tutorial_csv.find("single,"), tutorial_csv.find("\nsingle,") + 1);
 }
 
+// A similarity given where distances are expected: OpenABLE's HOG matrix of Gardens Point
+// turned into 1 - M ranks each query's least similar place first (AUC near 0). openable_evaluate
+// says in one line, on stderr and under its table, that the ranking looks reversed, with the
+// AUC of the reversed matrix, which is the AUC of M itself (evaluated here separately).
+TEST(Evaluation, OpenableEvaluateWarnsWhenTheMatrixLooksLikeASimilarity) {
+  const std::string dir = testing::TempDir();
+  const std::string data = testing::SourceDir() + "/tests/data/reference_protocols/";
+  const cv::Mat1f m = DecodeNpyMatrix(ReadAll(data + "gardens_point_hog.npy"), "m");
+  const cv::Mat1f similarity = 1.0f - m;
+  testing::WriteBytes(dir + "/similarity.npy", EncodeNpy(similarity));
+  const std::vector<std::string> truth = {
+      "--layout", "query_reference", "--gt-type", "vpr_bench", "--ground-truth",
+      data + "vpr_bench_gardens_point_ground_truth_new.npy", "--tolerance", "0", "--json"};
+  std::vector<std::string> args = {"--matrix", data + "gardens_point_hog.npy"};
+  args.insert(args.end(), truth.begin(), truth.end());
+  const Outcome plain = RunProgram(testing::OpenableEvaluateExe(), args, dir);
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  EXPECT_EQ(plain.err.find("warning"), std::string::npos) << plain.err;
+  const double auc = JsonNumber(plain.out, "auc");
+  ASSERT_GT(auc, 0.25);
+
+  args = {"--matrix", "similarity.npy"};
+  args.insert(args.end(), truth.begin(), truth.end());
+  const Outcome reversed = RunProgram(testing::OpenableEvaluateExe(), args, dir);
+  ASSERT_EQ(reversed.status, 0) << reversed.err;
+  EXPECT_LT(JsonNumber(reversed.out, "auc"), 0.1);
+  char expected[160];
+  std::snprintf(expected, sizeof expected,
+                "openable_evaluate: warning: similarity: the ranking looks reversed: per-query "
+                "AUC %.3f with the smallest values as best matches, %.3f with the largest",
+                JsonNumber(reversed.out, "auc"), auc);
+  EXPECT_NE(reversed.err.find(expected), std::string::npos) << expected << "\n" << reversed.err;
+  EXPECT_TRUE(OneLine(reversed.err)) << reversed.err;
+  // The table says it too.
+  args.pop_back();
+  const Outcome table = RunProgram(testing::OpenableEvaluateExe(), args, dir);
+  EXPECT_NE(table.out.find("  warning: the ranking looks reversed"), std::string::npos)
+      << table.out;
+}
+
+// A ground truth with no true place among the candidates: every pair of a loop-closure file
+// lies within the exclusion window, so recall, AUC and R@N are 0 whatever the matrix; the run
+// says so in one line on stderr and under its table, and still exits 0.
+TEST(Evaluation, RunSaysWhenNoQueryHasATruePlace) {
+  const std::string dir = testing::TempDir();
+  testing::WriteBytes(dir + "/near.txt", "150,100\n200,160\n");  // 50 and 40 frames apart
+  const Outcome o = RunProgram(
+      testing::TestOpenableExe(),
+      {SampleConfig(dir, "Ground_truth_type: pairs\nGround_truth: near.txt\nExclusion: 60\n"),
+       "--quiet", "--set", "Images_path_2="},
+      dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const std::string line =
+      "no query has a true place among its candidates (240 queries; 2 pairs of the ground truth "
+      "over the evaluated block, 2 of them closer than the exclusion (60 frames))";
+  EXPECT_NE(o.err.find("Test_OpenABLE: warning: evaluation: " + line), std::string::npos)
+      << o.err;
+  EXPECT_TRUE(OneLine(o.err)) << o.err;
+  EXPECT_NE(o.out.find("  warning: " + line), std::string::npos) << o.out;
+}
+
 // A saved matrix remembers its run's settings (out/matrix.npy.json): openable_evaluate given
 // the matrix alone (no ground-truth type, no reference frames, no score) gives the run's own
 // figures; a setting given on the command line overrides the remembered one, a note says so,
@@ -246,6 +309,77 @@ TEST(Evaluation, SavedMatrixSettingsThatCannotBeUsedAreRefused) {
                                {"--matrix", "out/matrix.npy", "--matrix", "out/other.npy",
                                 "--tolerance", "4", "--reference-frames", "300"},
                                dir);
+  EXPECT_EQ(o.status, 0) << o.err;
+}
+
+// A settings file that does not fit its matrix is refused in one line naming both sizes: one
+// written beside another run's matrix, and files edited within their own sizes (whose numbers
+// no longer hold together). Otherwise the evaluation would read another block of the matrix
+// (a wrong reference_frames) without a word.
+TEST(Evaluation, SavedMatrixSettingsThatDoNotFitTheirMatrixAreRefused) {
+  const std::string dir = testing::TempDir();
+  const std::string config = SampleConfig(dir, "Ground_truth_type: aligned\n");
+  ASSERT_EQ(RunProgram(testing::TestOpenableExe(), {config, "--quiet"}, dir).status, 0);
+  // 80 frames of one traversal: an 80 x 80 matrix and its settings.
+  ASSERT_EQ(RunProgram(testing::TestOpenableExe(),
+                       {config, "--quiet", "--set", "Images_path_2=", "--set", "Final_image=80",
+                        "--set", "Exclusion=10", "--set", "Ground_truth_type=none", "--set",
+                        "Npy_name=out/small.npy"},
+                       dir)
+                .status,
+            0);
+  const std::string settings = dir + "/out/matrix.npy.json";
+  const std::string original = ReadAll(settings);
+  const openable::Json written = openable::Json::parse(original);
+  ASSERT_EQ(written["rows"], 600);
+  ASSERT_EQ(written["reference_frames"], 300);
+  const auto refused = [&](const std::string& expect) {
+    const Outcome o = RunProgram(testing::OpenableEvaluateExe(),
+                                 {"--matrix", "out/matrix.npy", "--output", "out/none"}, dir);
+    EXPECT_EQ(o.status, 1) << o.err;
+    EXPECT_TRUE(OneLine(o.err)) << o.err;
+    EXPECT_NE(o.err.find(expect), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(dir + "/out/none.json"));
+  };
+  const auto edited = [&](const std::function<void(openable::Json&)>& edit) {
+    openable::Json j = written;
+    edit(j);
+    std::ofstream(settings) << j.dump();
+  };
+  // Beside another run's matrix.
+  fs::copy_file(dir + "/out/small.npy.json", settings, fs::copy_options::overwrite_existing);
+  refused("matrix \"out/matrix.npy\": 600x600, but its settings file \"out/matrix.npy.json\" "
+          "was written with a 80x80 matrix (traversals of 80 frames)");
+  // Edited: the first traversal made shorter, the reference frames with it (500 frames in all).
+  edited([](openable::Json& j) {
+    j["traversals"][0]["frames"] = 200;
+    j["reference_frames"] = 200;
+    j["python_evaluate"]["reference_frames"] = 200;
+  });
+  refused("a 600x600 matrix of 500 frames in all; expected a square matrix of as many rows as "
+          "frames");
+  // Edited: the reference frames alone.
+  edited([](openable::Json& j) { j["reference_frames"] = 200; });
+  refused("\"reference_frames\" 200 with 2 traversals; expected 300 (the first traversal's "
+          "frames)");
+  // Edited: the reference frames of Python's keywords alone.
+  edited([](openable::Json& j) { j["python_evaluate"]["reference_frames"] = 100; });
+  refused("\"python_evaluate\" has reference_frames 100, the file 300; expected one value");
+  // Edited: sizes that agree with each other but not with the matrix.
+  edited([](openable::Json& j) {
+    j["rows"] = j["cols"] = 400;
+    j["traversals"][0]["frames"] = j["traversals"][1]["frames"] = 200;
+    j["reference_frames"] = j["python_evaluate"]["reference_frames"] = 200;
+  });
+  refused("matrix \"out/matrix.npy\": 600x600, but its settings file \"out/matrix.npy.json\" "
+          "was written with a 400x400 matrix (traversals of 200 and 200 frames)");
+  // Edited: a frame range that cannot hold the traversals' frames.
+  edited([](openable::Json& j) { j["evaluation_keys"]["Final_image"] = "100"; });
+  refused("a traversal of 300 frames within Initial_image 0 and Final_image 100; expected at "
+          "most 100");
+  // Restored: evaluated.
+  std::ofstream(settings) << original;
+  const Outcome o = RunProgram(testing::OpenableEvaluateExe(), {"--matrix", "out/matrix.npy"}, dir);
   EXPECT_EQ(o.status, 0) << o.err;
 }
 

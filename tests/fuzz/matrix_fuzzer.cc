@@ -1,8 +1,10 @@
 // libFuzzer target: the matrix readers of openable_evaluate, the ground truth and SNAPS. The
 // rest of the input after its first byte is decoded as a NumPy file from memory
 // (DecodeNpyMatrix, OpenABLE/io/npy.h), as a NumPy file of Python objects (DecodeNpyObjects,
-// the restricted pickle reader of OpenABLE/io/npy_objects.h) and as a .npz archive (every
-// member listed and read by NpzMember, then decoded as a matrix), then written to a temporary file whose extension the
+// the restricted pickle reader of OpenABLE/io/npy_objects.h), as a .npz archive (every
+// member listed and read by NpzMember, then decoded as a matrix) and as the settings file
+// beside a matrix (DecodeMatrixSettings, OpenABLE/evaluation/saved_settings.h, checked against
+// the decoded matrix by CheckMatrixFitsSettings), then written to a temporary file whose extension the
 // first byte chooses (modulo 4: .npy, .txt, .csv, .png) and read by ReadMatrixFile
 // (OpenABLE/evaluation/matrix_file.h: the .npy reader, the text reader, or an image through
 // OpenCV's codecs). A .npy file must read as the same matrix as its bytes decode to. The
@@ -20,6 +22,7 @@
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/evaluation/matrix_file.h"
+#include "OpenABLE/evaluation/saved_settings.h"
 #include "OpenABLE/io/npy.h"
 #include "OpenABLE/io/npy_objects.h"
 #include "tests/fuzz/frame_check.h"
@@ -58,6 +61,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (!Refuses([&] { member = openable::NpzMember(bytes, name, "fuzz.npz"); }))
         Refuses([&] { openable::DecodeNpyMatrix(member, "fuzz.npz"); });
     }
+  Refuses([&] {
+    const openable::SavedMatrixSettings settings =
+        openable::DecodeMatrixSettings(bytes, "fuzz.npy.json");
+    // Against the decoded matrix, or the sample's 600 x 600 when the bytes are no matrix.
+    openable::CheckMatrixFitsSettings(settings, "fuzz.npy", refused ? 600 : decoded.rows,
+                                      refused ? 600 : decoded.cols);
+  });
   const openable::fuzz::TempFile file(bytes, kExtensions[choice]);
   cv::Mat1f read;
   if (Refuses([&] { read = openable::ReadMatrixFile(file.Path()); }, file.Path())) return 0;

@@ -117,6 +117,16 @@ class SavedMatrixSettingsTest(TempDirTestCase):
         (self.tmp / "out" / "bad.npy.json").write_text("[1]")
         with self.assertRaises(openable.InputError):
             openable.read_matrix_settings(self.tmp / "out" / "bad.npy")
+        # Beside a matrix of another size: refused naming both sizes, as openable_evaluate does.
+        import numpy
+        other = self.tmp / "out" / "other.npy"
+        numpy.save(other, numpy.zeros((80, 80), numpy.float32))
+        (self.tmp / "out" / "other.npy.json").write_bytes((self.tmp / "out" / "m.npy.json").read_bytes())
+        with self.assertRaises(openable.InputError) as caught:
+            openable.read_matrix_settings(other)
+        self.assertIn("80x80, but its settings file", str(caught.exception))
+        self.assertIn("was written with a 600x600 matrix (traversals of 300 and 300 frames)",
+                      str(caught.exception))
 
 
 class SnapsJsonTest(TempDirTestCase):

@@ -54,14 +54,19 @@ def read_matrix_settings(path):
         s = openable.read_matrix_settings("results/run.npy")
         r = openable.evaluate(openable.read_matrix("results/run.npy"), **s["python_evaluate"])
 
-    Raises openable.InputError, one line naming the file, when it is not such a file.
+    Raises openable.InputError, one line naming the file, when it is not such a file, when its
+    sizes do not hold together, or when the matrix at path is not the size it was written with
+    (a settings file beside another run's matrix): the same checks as openable_evaluate's.
     """
     import json
     import os
 
+    from openable import _openable
+
     settings = os.fspath(path) + ".json"
     if not os.path.exists(settings):
         return None
+    _openable._check_matrix_settings(os.fspath(path))
     try:
         with open(settings, "rb") as f:
             document = json.loads(f.read().decode("utf-8"))
