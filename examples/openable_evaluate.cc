@@ -115,6 +115,10 @@ int main(int argc, char** argv) {
     // After the files are written: a run that fails says so in its one line alone.
     for (const std::string& note : evaluated.notes)
       std::cerr << "openable_evaluate: note: " << openable::ToValidUtf8(note) << "\n";
+    for (const openable::EvaluatedRun& run : evaluated.evaluation.runs)
+      for (const std::string& warning : run.warnings)
+        std::cerr << "openable_evaluate: warning: " << openable::ToValidUtf8(run.label) << ": "
+                  << openable::ToValidUtf8(warning) << "\n";
     if (command_line.json) {
       std::cout << openable::ProgramJson(
           "openable_evaluate",

@@ -2,6 +2,7 @@
 // shared datasets are absent.
 #pragma once
 
+#include <filesystem>
 #include <functional>
 #include <initializer_list>
 #include <string>

@@ -2,6 +2,7 @@
 #include "OpenABLE/base/output_batch.h"
 #include "OpenABLE/outputs/run_outputs.h"
 
+#include <algorithm>
 #include <chrono>
 #include <optional>
 #include <cstdio>
@@ -12,9 +13,68 @@
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/cluster/cluster.h"
+#include "OpenABLE/evaluation/metrics.h"
 #include "OpenABLE/evaluation/report.h"
 
 namespace openable {
+namespace {
+
+// A run that could yield no value, refused before any frame is read. With Sequence_partial
+// ahead or skip a cell has a value only on a diagonal of at least L frames inside one block of
+// the matrix (a traversal against itself, or one traversal against the other: sums never cross
+// from one into the other). Sequences longer than every traversal leave the whole matrix +inf;
+// with two traversals, longer than the shorter one leave the query-reference block (the
+// queries' answers, the evaluation, the matches) +inf.
+void CheckSequencesFit(const RunPlan& plan) {
+  const MatchingOptions& m = plan.config.matching;
+  if (m.partial == SequencePartial::kScale || m.sequence_length <= 1 || plan.sources.empty())
+    return;
+  int longest = 0, shortest = plan.sources.front()->Size();
+  std::string frames;
+  for (std::size_t i = 0; i < plan.sources.size(); ++i) {
+    const int n = plan.sources[i]->Size();
+    longest = std::max(longest, n);
+    shortest = std::min(shortest, n);
+    frames += (i ? " and " : "") + std::to_string(n) + " (" + plan.specs[i].key + ")";
+  }
+  const bool two = plan.sources.size() == 2;
+  const int limit = two ? shortest : longest;
+  if (m.sequence_length <= limit) return;
+  throw InputError(
+      "Image_sequences: " + std::to_string(m.sequence_length) + " frames, but the traversal" +
+      (two ? "s have " : " has ") + frames + " frames: with Sequence_partial " +
+      EnumName(m.partial) + " a cell has a value only on a diagonal of at least " +
+      std::to_string(m.sequence_length) + " frames, so " +
+      (two ? "no query of the second traversal would have a value against the first"
+           : "the matrix would hold no value") +
+      "; expected Image_sequences <= " + std::to_string(limit) + ", or Sequence_partial scale");
+}
+
+// One traversal: a run whose frames have no candidate with a value (their candidates are the
+// frames at least Exclusion back) finds no loop, though its matrix is written. One line
+// saying why; empty otherwise.
+std::string NoCandidateWarning(const Config& config, const RunResult& result) {
+  if (result.bounded || result.normalized.empty() || result.traversals.size() != 1) return "";
+  const EvaluationLayout layout = LayoutOf(result);
+  const int exclusion = config.evaluation.protocol.exclusion;
+  if (layout.queries <= exclusion)
+    return "Exclusion: " + std::to_string(exclusion) + " leaves no frame a candidate (the " +
+           std::to_string(layout.queries) +
+           " frames of the sequence; a frame's candidates are at least Exclusion frames back): "
+           "the matrix is written, but no loop can be found; expected Exclusion < " +
+           std::to_string(layout.queries);
+  if (AnyCandidateHasValue(result.normalized, layout, exclusion)) return "";
+  const MatchingOptions& m = config.matching;
+  return "Image_sequences: " + std::to_string(m.sequence_length) +
+         " leaves no candidate with a value (a frame's candidates are at least Exclusion " +
+         std::to_string(exclusion) + " frames back, and with Sequence_partial " +
+         EnumName(m.partial) + " a cell has a value only on a diagonal of at least " +
+         std::to_string(m.sequence_length) + " of the " + std::to_string(layout.queries) +
+         " frames): the matrix is written, but no loop can be found; expected a shorter "
+         "Image_sequences, a smaller Exclusion, or Sequence_partial scale";
+}
+
+}  // namespace
 
 RunOutcome Run(const Config& base, ProgressReporter& progress,
                const std::function<void(const std::string&)>& log) {
@@ -36,7 +96,10 @@ RunOutcome Run(const Config& base, ProgressReporter& progress,
       CheckOutputPrefix("Evaluation_name", base.evaluation.name);
       (void)EvaluationSettingsFrom(base);
     }
-    if (!base.automatic.enabled || cluster.Distributed()) plan.emplace(PlanRun(base));
+    if (!base.automatic.enabled || cluster.Distributed()) {
+      plan.emplace(PlanRun(base));
+      CheckSequencesFit(*plan);
+    }
     // An aligned ground truth of traversals of unequal length is refused before any frame
     // is read (the sources know their lengths).
     if (plan && plan->sources.size() == 2 &&
@@ -75,13 +138,18 @@ RunOutcome Run(const Config& base, ProgressReporter& progress,
     }
   }
   const Config& config = *chosen;
-  if (out.automatic) plan.emplace(PlanRun(config));
+  if (out.automatic) {
+    plan.emplace(PlanRun(config));
+    CheckSequencesFit(*plan);
+  }
   out.result = ComputeRun(*plan, progress, out.automatic ? &store : nullptr);
   // Process 0 evaluates, verifies and writes; the others have given it their shares.
   if (cluster.Distributed() && cluster.Rank() != 0) return out;
   RunResult& result = out.result;
   for (const std::string& note : UnwrittenOutputNotes(config, result))
     result.notes.push_back(note);
+  if (const std::string w = NoCandidateWarning(config, result); !w.empty())
+    result.warnings.push_back(w);
   if (out.automatic && !out.automatic->reliable && result.accepted_queries > 0)
     result.accepted_queries = 0;
   for (const std::string& w : result.warnings) log("warning: " + w);
@@ -111,6 +179,8 @@ RunOutcome Run(const Config& base, ProgressReporter& progress,
       EvaluateMatrix(*out.evaluation, result.normalized, layout, RunLabel(config),
                      "Test_OpenABLE run");
     }
+    for (const std::string& w : out.evaluation->runs.back().warnings)
+      log("warning: evaluation: " + w);
     result.timings.evaluate_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.timings.total_seconds += result.timings.evaluate_seconds;

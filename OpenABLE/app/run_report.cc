@@ -99,6 +99,7 @@ std::string FormatRunReport(const Config& config, const RunOutcome& outcome) {
           << (c.matching.match_consistency == 1 ? " independent query" : " independent queries")
           << " (Match_consistency)";
   }
+  for (const std::string& w : r.warnings) out << "\n  warning: " << w;
   if (outcome.automatic) {
     const std::string lines = FormatAutoReport(*outcome.automatic);
     out << "\n" << lines.substr(0, lines.size() - 1);  // each line ends the one before

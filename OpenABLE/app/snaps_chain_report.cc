@@ -147,26 +147,10 @@ std::vector<std::string> ErrorReading(const ChainResult& r) {
       break;
     }
   }
-  // The route's extent: the diagonal of the ground truth's bounding box. An input this far
-  // from it is not a drifting estimate of it, and the reading above would mislead: only the
-  // hint is given.
-  if (!r.truth.poses.empty()) {
-    Eigen::Vector3d lo = r.truth.poses.front().translation(), hi = lo;
-    for (const Eigen::Isometry3d& p : r.truth.poses) {
-      lo = lo.cwiseMin(p.translation());
-      hi = hi.cwiseMax(p.translation());
-    }
-    const double extent = (hi - lo).norm();
-    if (extent > 0 && input.aligned.mean > 0.25 * extent)
-      lines = {
-          "Hint: the input is " + FormatFixed(input.aligned.mean, 1) +
-          " m from the ground truth on average even after alignment, on a route " +
-          FormatFixed(extent, 1) +
-          " m across: more than drift. Check Snaps_world_to_camera (1 "
-          "when the file holds world-to-camera matrices, as SO-DSO's poses_history_file.txt), "
-          "Snaps_trajectory_format and Snaps_ground_truth_format, and that both cover the same "
-          "frames."};
-  }
+  // An input too far from the ground truth's route to be a drifting estimate of it
+  // (ConventionHint): the reading above would mislead, only the hint is given.
+  if (const std::string hint = ConventionHint(input.aligned, r.truth); !hint.empty())
+    lines = {"Hint: " + hint};
   return lines;
 }
 

@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/answers.h"
 
 namespace openable {
@@ -371,6 +372,87 @@ AblePResult EvaluateAbleP(const cv::Mat1f& matrix, const EvaluationLayout& layou
   }
   result.average_precision = 100.0 * CurveArea(result.curve);
   return result;
+}
+
+bool AnyCandidateHasValue(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                          int exclusion) {
+  for (int q = 0; q < layout.queries; ++q) {
+    const float* row = matrix.ptr<float>(layout.row_offset + q) + layout.col_offset;
+    const int end = layout.CandidateEnd(q, exclusion);
+    for (int c = 0; c < end; ++c)
+      if (std::isfinite(row[c])) return true;
+  }
+  return false;
+}
+
+double ReversedAuc(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                   const GroundTruth& truth, const EvaluationOptions& options) {
+  CheckShapes(matrix, layout, truth);
+  cv::Mat1f block =
+      matrix(cv::Rect(layout.col_offset, layout.row_offset, layout.references, layout.queries))
+          .clone();
+  float largest = 0.0f;
+  for (int q = 0; q < block.rows; ++q)
+    for (int c = 0; c < block.cols; ++c)
+      if (std::isfinite(block(q, c))) largest = std::max(largest, block(q, c));
+  for (int q = 0; q < block.rows; ++q)
+    for (int c = 0; c < block.cols; ++c)
+      if (std::isfinite(block(q, c))) block(q, c) = largest - block(q, c);
+  EvaluationLayout own = layout;
+  own.row_offset = 0;
+  own.col_offset = 0;
+  EvaluationOptions plain = options;
+  plain.accept_threshold = -1.0;
+  plain.accept_consistency = 0;
+  return EvaluatePerQuery(block, own, truth, plain).auc;
+}
+
+std::vector<std::string> EvaluationWarnings(const cv::Mat1f& matrix,
+                                            const EvaluationLayout& layout,
+                                            const GroundTruth& truth,
+                                            const EvaluationOptions& options,
+                                            const PerQueryResult& result) {
+  std::vector<std::string> out;
+  const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
+  if (result.queries == 0) {
+    out.push_back("no query has a candidate: " + std::to_string(layout.queries) +
+                  " frames of one sequence, and a frame's candidates are at least " +
+                  std::to_string(options.exclusion) +
+                  " frames back (the exclusion), so every figure is 0; expected an exclusion "
+                  "below the frames");
+    return out;
+  }
+  if (result.positive_queries == 0) {
+    const std::int64_t pairs = truth.PairCount();
+    std::string why = std::to_string(pairs) + (pairs == 1 ? " pair" : " pairs") +
+                      " of the ground truth over the evaluated block";
+    if (loop && result.truth_pairs_outside_candidates > 0)
+      why += ", " + std::to_string(result.truth_pairs_outside_candidates) +
+             " of them closer than the exclusion (" + std::to_string(options.exclusion) +
+             " frames)";
+    out.push_back("no query has a true place among its candidates (" +
+                  std::to_string(result.queries) + " queries; " + why +
+                  "), so recall, AUC and R@N are 0 whatever the matrix; expected a ground truth "
+                  "of the matrix's frames (its file, type and first frame)");
+    return out;
+  }
+  if (result.unanswered == result.queries) {
+    out.push_back("no query has a candidate with a value (every candidate cell of the " +
+                  std::to_string(layout.queries) + "x" + std::to_string(layout.references) +
+                  " block is +inf: sequences longer than the frames, or skipped), so every "
+                  "figure is 0; expected a matrix with values among the candidates");
+    return out;
+  }
+  if (result.auc < kReversedAucBelow) {
+    const double reversed = ReversedAuc(matrix, layout, truth, options);
+    if (reversed >= kReversedAucAtLeast)
+      out.push_back("the ranking looks reversed: per-query AUC " + FormatFixed(result.auc, 3) +
+                    " with the smallest values as best matches, " + FormatFixed(reversed, 3) +
+                    " with the largest (the matrix reversed, max - M): the matrix looks like a "
+                    "similarity (large = same place), but OpenABLE reads distances (small = "
+                    "same place); expected distances, e.g. 1 - S for a similarity S in [0, 1]");
+  }
+  return out;
 }
 
 }  // namespace openable

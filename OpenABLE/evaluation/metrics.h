@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -123,5 +124,37 @@ PerQueryResult EvaluateAnswers(const EvaluationLayout& layout, const GroundTruth
                                const EvaluationOptions& options);
 AblePResult EvaluateAbleP(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                           const GroundTruth& truth, const EvaluationOptions& options);
+
+// Whether a candidate cell of the block of `layout` (the earlier frames at least `exclusion`
+// back for one sequence) holds a value (is finite).
+bool AnyCandidateHasValue(const cv::Mat1f& matrix, const EvaluationLayout& layout, int exclusion);
+
+// An evaluation whose ranking looks reversed: the per-query AUC of `matrix` is below
+// kReversedAucBelow while the same evaluation of the matrix reversed (each finite cell d of the
+// block replaced by max - d, max the block's largest finite cell; cells without a value stay
+// without) reaches at least kReversedAucAtLeast, two and a half times as much or more. A
+// similarity (large = same place) read as a distance ranks so: each query's "best match" is
+// its least similar place, which is almost never right, while the most similar often is. A
+// poor distance matrix ranks badly both ways (random distances: about the share of right
+// answers by chance either way), so a low AUC alone is no reason to warn.
+inline constexpr double kReversedAucBelow = 0.1;
+inline constexpr double kReversedAucAtLeast = 0.25;
+
+// The per-query AUC of the matrix reversed as above, with the settings of `options` (its
+// operating point and confirmation left out: they do not change the AUC).
+double ReversedAuc(const cv::Mat1f& matrix, const EvaluationLayout& layout,
+                   const GroundTruth& truth, const EvaluationOptions& options);
+
+// What makes the figures of an evaluation say little about the matrix, one line each (none
+// when nothing does), for Test_OpenABLE, openable_evaluate and Python's evaluate alike: no
+// query has a candidate (one sequence shorter than the exclusion), no query has a true place
+// among its candidates (the figures are 0 whatever the matrix), no query has a candidate with a
+// value (every candidate cell +inf), and a ranking that looks reversed (above). `result` is
+// EvaluatePerQuery's on the same matrix, layout, truth and options.
+std::vector<std::string> EvaluationWarnings(const cv::Mat1f& matrix,
+                                            const EvaluationLayout& layout,
+                                            const GroundTruth& truth,
+                                            const EvaluationOptions& options,
+                                            const PerQueryResult& result);
 
 }  // namespace openable

@@ -78,7 +78,7 @@ Eigen::Matrix3d CheckedRotationMatrix(const Eigen::Matrix3d& m, const std::strin
 }
 
 std::vector<PoseFileLine> ReadPoseFile(const std::string& path, PoseFileFormat format,
-                                       const std::string& what) {
+                                       const std::string& what, bool both_kitti) {
   const std::string file = what + " " + Quoted(path);
   const std::string data = evaluation_internal::ReadWholeFile(path, file);
   const std::size_t expected = format == PoseFileFormat::kKitti         ? 12
@@ -101,9 +101,17 @@ std::vector<PoseFileLine> ReadPoseFile(const std::string& path, PoseFileFormat f
     if (first == std::string::npos || text[first] == '#') continue;  // blank or comment
     const std::string where = file + ":" + std::to_string(line_number);
     const std::vector<std::string> tokens = Tokens(text);
-    if (tokens.size() != expected)
+    if (tokens.size() != expected) {
+      // The other KITTI format, when the caller reads it too and the line has its count.
+      std::string other;
+      if (both_kitti && format == PoseFileFormat::kKitti && tokens.size() == 13)
+        other = "; a frame number then 12 numbers is the format kitti-id";
+      else if (both_kitti && format == PoseFileFormat::kKittiWithId && tokens.size() == 12)
+        other = "; 12 numbers without a frame number are the format kitti";
       throw InputError(where + ": line has " + std::to_string(tokens.size()) +
-                       (tokens.size() == 1 ? " number" : " numbers") + "; expected " + layout);
+                       (tokens.size() == 1 ? " number" : " numbers") + "; expected " + layout +
+                       other);
+    }
     PoseFileLine pose;
     pose.line = line_number;
     pose.frame_id = static_cast<long>(out.size());

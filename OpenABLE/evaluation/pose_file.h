@@ -38,8 +38,10 @@ struct PoseFileLine {
 // finite number, a frame number that is not a non-negative integer or does not increase, a
 // timestamp that does not increase, a matrix that is not a rotation (orthonormal with
 // determinant +1), a quaternion that is not of unit norm, and a file with no pose.
+// `both_kitti`: the caller reads kitti and kitti-id alike (SNAPS' trajectories), so a line
+// with the other one's count of numbers (13 for kitti, 12 for kitti-id) names that format.
 std::vector<PoseFileLine> ReadPoseFile(const std::string& path, PoseFileFormat format,
-                                       const std::string& what);
+                                       const std::string& what, bool both_kitti = false);
 
 // The nearest rotation to `m` when it is one within kPoseRotationTolerance (orthonormal,
 // determinant +1); throws InputError "<where>: the 3x3 part is not a rotation ..." otherwise.

@@ -250,6 +250,17 @@ std::string EncodeEvaluationJson(const EvaluationSettings& s, const std::vector<
   return json::Dump(EvaluationJson(s, runs, version));
 }
 
+namespace {
+
+// Each run's warnings, one line each, the run named when there are several.
+void FormatWarnings(std::ostream& o, const std::vector<EvaluatedRun>& runs) {
+  for (const EvaluatedRun& r : runs)
+    for (const std::string& w : r.warnings)
+      o << "  warning: " << (runs.size() > 1 ? r.label + ": " : std::string()) << w << "\n";
+}
+
+}  // namespace
+
 std::string FormatEvaluationTable(const EvaluationSettings& s,
                                   const std::vector<EvaluatedRun>& runs) {
   std::ostringstream o;
@@ -263,6 +274,7 @@ std::string FormatEvaluationTable(const EvaluationSettings& s,
   o << "; ABLE-P vicinity " << s.options.vicinity << "\n";
   if (!s.options.protocols.openable) {
     FormatProtocolTable(o, s, runs);
+    FormatWarnings(o, runs);
     return ToValidUtf8(o.str());
   }
   char line[512];
@@ -326,6 +338,7 @@ std::string FormatEvaluationTable(const EvaluationSettings& s,
     }
   }
   FormatProtocolTable(o, s, runs);
+  FormatWarnings(o, runs);
   return ToValidUtf8(o.str());
 }
 

@@ -35,6 +35,9 @@ struct EvaluatedRun {
   VprBenchResult vpr_bench;
   bool has_vpr_tutorial = false;
   VprTutorialResult vpr_tutorial;
+  // What makes the figures say little about the matrix, one line each (EvaluationWarnings, on
+  // the matrix's own answers): printed by the programs on stderr and under the table.
+  std::vector<std::string> warnings;
 };
 
 // The settings every run of one evaluation shares.
@@ -95,8 +98,9 @@ std::string ProtocolToleranceNote(const EvaluationSettings& settings);
 // A few lines for a terminal: the protocol settings, then one row per run with AUC, R@100P,
 // max F1 (threshold), R@1/5/10 and ABLE-P AP, the operating point (Match_threshold: answers
 // accepted, right, precision, recall); with VPR-Bench's or VPR_Tutorial's protocol, a
-// table of each run under each protocol chosen (AUC, R@100P, R@1/5/10 as each defines them). Text that is not valid UTF-8 (the ground truth's
-// path, a label) is shown by ToValidUtf8.
+// table of each run under each protocol chosen (AUC, R@100P, R@1/5/10 as each defines them);
+// last, each run's warnings ("  warning: ..."). Text that is not valid UTF-8 (the ground
+// truth's path, a label) is shown by ToValidUtf8.
 std::string FormatEvaluationTable(const EvaluationSettings& settings,
                                   const std::vector<EvaluatedRun>& runs);
 

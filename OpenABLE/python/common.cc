@@ -5,6 +5,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "config/config.h"
+
 namespace openable::python {
 namespace {
 
@@ -280,6 +282,16 @@ py::dict PropertiesAsDict(const py::handle& object, bool arrays) {
     }
   }
   return out;
+}
+
+void Warn(const std::string& message) {
+  if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 2) != 0) throw py::error_already_set();
+}
+
+std::string TableDefault(const char* key) {
+  std::string v = ConfigValueText(Config(), key);
+  if (v.size() >= 2 && v.front() == '"' && v.back() == '"') v = v.substr(1, v.size() - 2);
+  return v;
 }
 
 }  // namespace openable::python

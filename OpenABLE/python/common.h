@@ -3,7 +3,9 @@
 // string options that the bindings take instead of C++ enums.
 #pragma once
 
+#include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -74,6 +76,30 @@ py::dict PropertiesAsDict(const py::handle& object, bool arrays = false);
 // (os.fsencode: a name that is not UTF-8, decoded with surrogateescape, gets its bytes back).
 // Throws ValueError naming `what` for anything else.
 std::string FileSystemPath(const py::handle& path, const char* what);
+
+// `message` as a UserWarning of the caller's line (warnings.warn; an exception when the
+// warnings filter makes it one). Level 2: the caller of the module's one-line wrapper of every
+// function (module.cc).
+void Warn(const std::string& message);
+
+// The default of Config.txt's `key` in the option table (ConfigTable over a default Config),
+// as Config.txt writes it, unquoted: the programs' default, which the keywords that stand for
+// the key share (their signatures and docstrings are filled from it).
+std::string TableDefault(const char* key);
+
+// `text` with each placeholder ("@tolerance@") of `values` replaced by its value: docstrings
+// that show the option table's defaults.
+template <std::size_t N>
+std::string FillPlaceholders(std::string text,
+                             const std::pair<const char*, std::string> (&values)[N]) {
+  for (const auto& [name, value] : values) {
+    const std::string placeholder = name;
+    for (std::size_t at = text.find(placeholder); at != std::string::npos;
+         at = text.find(placeholder, at))
+      text.replace(at, placeholder.size(), value);
+  }
+  return text;
+}
 
 void RegisterImages(py::module_& m);
 void RegisterMatching(py::module_& m);

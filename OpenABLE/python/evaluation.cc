@@ -1,8 +1,11 @@
 // Evaluation against ground truth (docs/evaluation.md): evaluate() and its result.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdint>
+#include <cstring>
+#include <optional>
 #include <utility>
 
 #include <pybind11/stl.h>
@@ -11,9 +14,11 @@
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/layout.h"
+#include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/evaluation/metrics.h"
 #include "OpenABLE/evaluation/report.h"
 #include "OpenABLE/evaluation/unsupervised.h"
+#include "OpenABLE/evaluation/saved_settings.h"
 #include "OpenABLE/python/common.h"
 #include "OpenABLE/run/evaluate.h"
 #include "matching/matrix.h"
@@ -34,8 +39,9 @@ struct Result {
   GroundTruth truth;
 };
 
-// Runs `f`; an InputError whose message starts with a Config.txt key is re-thrown naming the
-// Python argument instead ("Ground_truth_radius: 0 ..." -> "radius: 0 ...").
+// Runs `f`; an InputError that names Config.txt keys is re-thrown naming the Python arguments
+// instead ("Ground_truth_radius: 0 ..." -> "radius: 0 ...", "(Ground_truth_type kitti)" ->
+// "(truth_type kitti)"), wherever in the line they stand.
 template <typename F>
 auto WithArgumentNames(F f) {
   static const std::pair<const char*, const char*> kNames[] = {
@@ -47,16 +53,43 @@ auto WithArgumentNames(F f) {
       {"Ground_truth:", "truth_file:"},      {"Ground_truth_type:", "truth_type:"},
       {"Match_score_window:", "score_window:"}, {"Evaluation_protocol:", "protocol:"},
       {"Ground_truth_soft:", "truth_file_soft:"}};
+  const auto word = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_';
+  };
   try {
     return f();
   } catch (const InputError& e) {
-    const std::string message = e.what();
-    for (const auto& [key, name] : kNames) {
-      const std::string k = key;
-      if (message.compare(0, k.size(), k) == 0) throw InputError(name + message.substr(k.size()));
+    std::string message = e.what();
+    bool renamed = false;
+    for (const auto& [key_colon, name_colon] : kNames) {
+      const std::string key(key_colon, std::strlen(key_colon) - 1);
+      const std::string name(name_colon, std::strlen(name_colon) - 1);
+      for (std::size_t at = message.find(key); at != std::string::npos;
+           at = message.find(key, at)) {
+        const std::size_t end = at + key.size();
+        if ((at > 0 && word(message[at - 1])) || (end < message.size() && word(message[end]))) {
+          at = end;
+          continue;
+        }
+        message.replace(at, key.size(), name);
+        at += name.size();
+        renamed = true;
+      }
     }
-    throw;
+    if (!renamed) throw;
+    throw InputError(message);
   }
+}
+
+// InputError for a ground truth or protocol (`what`: 'truth_type: "vpr_bench"') that pairs a
+// query traversal with a reference one, given a square matrix evaluated as one sequence.
+[[noreturn]] void NeedsTwoTraversals(const std::string& what, int rows, int cols) {
+  throw InputError(what + " needs two traversals, but the " + std::to_string(rows) + "x" +
+                   std::to_string(cols) +
+                   " matrix is evaluated as one sequence (a square matrix without layout or "
+                   "reference_frames); expected layout=\"query_reference\" (rows are queries, "
+                   "columns references) or reference_frames=N (the first N frames of a square "
+                   "matrix over both traversals are the reference)");
 }
 
 // Poses as FramePose: (N, 3, 4) or (N, 4, 4) camera-to-world matrices (forward = third column
@@ -102,6 +135,56 @@ std::vector<FramePose> PosesOf(const py::handle& object, const char* what) {
 
 bool HaveOrientations(const std::vector<FramePose>& poses) {
   return std::all_of(poses.begin(), poses.end(), [](const FramePose& p) { return p.has_forward; });
+}
+
+// The keywords' defaults that are Config.txt keys, from the option table.
+struct KeyDefaults {
+  int base = std::stoi(TableDefault("Ground_truth_base"));
+  int first_frame = std::stoi(TableDefault("Initial_image"));
+  int tolerance = std::stoi(TableDefault("Tolerance"));
+  int exclusion = std::stoi(TableDefault("Exclusion"));
+  int vicinity = std::stoi(TableDefault("Vicinity"));
+  double radius = std::stod(TableDefault("Ground_truth_radius"));
+  double heading_limit = std::stod(TableDefault("Ground_truth_heading"));
+  std::string axes = TableDefault("Ground_truth_axes");
+  std::string score = TableDefault("Match_score");
+  int score_window = std::stoi(TableDefault("Match_score_window"));
+  int accept_consistency = std::stoi(TableDefault("Match_consistency"));
+  int sequence_length = std::stoi(TableDefault("Image_sequences"));
+  std::string partial = TableDefault("Sequence_partial");
+  // Sequence_direction is read by number, as the original's keys are; Python takes its name.
+  std::string direction =
+      EnumName(static_cast<SequenceDirection>(std::stoi(TableDefault("Sequence_direction"))));
+  std::string protocol = TableDefault("Evaluation_protocol");
+  std::string truth_file_soft = TableDefault("Ground_truth_soft");
+
+  // `text` with each "@name@" replaced by the default of that keyword.
+  std::string Fill(std::string text) const {
+    const std::pair<const char*, std::string> values[] = {
+        {"@base@", std::to_string(base)},
+        {"@first_frame@", std::to_string(first_frame)},
+        {"@tolerance@", std::to_string(tolerance)},
+        {"@exclusion@", std::to_string(exclusion)},
+        {"@vicinity@", std::to_string(vicinity)},
+        {"@able_thresholds@", std::to_string(EvaluationOptions().able_thresholds)},
+        {"@radius@", FormatNumber(radius)},
+        {"@heading_limit@", FormatNumber(heading_limit)},
+        {"@axes@", axes},
+        {"@score@", score},
+        {"@score_window@", std::to_string(score_window)},
+        {"@accept_consistency@", std::to_string(accept_consistency)},
+        {"@sequence_length@", std::to_string(sequence_length)},
+        {"@partial@", partial},
+        {"@direction@", direction},
+        {"@protocol@", protocol},
+        {"@truth_file_soft@", truth_file_soft}};
+    return FillPlaceholders(std::move(text), values);
+  }
+};
+
+const KeyDefaults& Defaults() {
+  static const KeyDefaults defaults;
+  return defaults;
 }
 
 // The layout of `layout` ("loop_closure", "query_reference" or None) on a rows x cols matrix.
@@ -238,16 +321,20 @@ const std::string& EvaluateDoc() {
   static const std::string doc = [] {
     std::string text =
         R"doc(evaluate(matrix, *, truth_matrix=None, pairs=None, poses=None, reference_poses=None,
-    aligned=False, truth_file=None, truth_type=None, truth_file_2="", base=-1, first_frame=0,
-    range_selected=False, layout=None, reference_frames=None, tolerance=2, exclusion=100,
-    vicinity=7, able_thresholds=100, radius=5.0, heading_limit=-1.0, min_frame_gap=None, axes="xyz",
-    normalize=True, label="python", score="distance", score_window=10,
-    accept_threshold=None, accept_consistency=0, sequence_length=1, partial="ahead",
-    direction="forward", protocol="openable", truth_file_soft="", truth_soft_matrix=None)
-    -> EvaluationResult
+    aligned=False, truth_file=None, truth_type=None, truth_file_2="", base=@base@,
+    first_frame=@first_frame@, range_selected=False, layout=None, reference_frames=None,
+    tolerance=@tolerance@, exclusion=@exclusion@, vicinity=@vicinity@,
+    able_thresholds=@able_thresholds@, radius=@radius@, heading_limit=@heading_limit@,
+    min_frame_gap=None, axes="@axes@", normalize=True, label="python", score="@score@",
+    score_window=@score_window@, accept_threshold=None,
+    accept_consistency=@accept_consistency@, sequence_length=@sequence_length@,
+    partial="@partial@", direction="@direction@", protocol="@protocol@",
+    truth_file_soft="@truth_file_soft@", truth_soft_matrix=None) -> EvaluationResult
 
 Evaluates a distance matrix against ground truth with the protocols of docs/evaluation.md,
 exactly as Test_OpenABLE (Ground_truth_type, Evaluation_protocol) and openable_evaluate do.
+The defaults of the keywords that are Config.txt keys (tolerance: Tolerance, exclusion:
+Exclusion, score: Match_score, ...) are those of the programs, from their option table.
 
 Args:
     matrix (numpy.ndarray): distances (small = similar), shape (N, N) or (Q, R); float32 is
@@ -310,7 +397,13 @@ Returns:
     average_precision, ...) and curves (curve, able_p_curve).
 
 Raises:
-    ValueError (openable.InputError for files and options): one line naming the argument.)doc";
+    ValueError (openable.InputError for files and options): one line naming the argument.
+
+Warns:
+    UserWarning: figures that say little about the matrix (also in the result's warnings): no
+    query with a true place among its candidates, none with a value among them, or a ranking
+    that looks reversed (a similarity given as distances; docs/evaluation.md, "Warnings").)doc";
+    text = Defaults().Fill(text);
     std::string formats;
     for (const GroundTruthFormat& f : GroundTruthFormats())
       formats += std::string(formats.empty() ? "" : ", ") + "\"" + f.name + "\"";
@@ -400,6 +493,12 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
       .def_property_readonly(
           "scores", [](const Result& r) { return ArrayOf(r.run.per_query.score); },
           "float32 array: the score of each query's best candidate (inf without candidates).")
+      .def_property_readonly(
+          "warnings", [](const Result& r) { return r.run.warnings; },
+          "list[str]: what makes the figures say little about the matrix, one line each (also "
+          "given as UserWarning by evaluate): no query with a candidate, with a true place or "
+          "with a value among its candidates, or a ranking that looks reversed (a similarity "
+          "read as a distance; docs/evaluation.md, \"Warnings\").")
       .def_property_readonly(
           "unanswered_queries", [](const Result& r) { return r.run.per_query.unanswered; },
           "Queries whose candidates all hold no value (skipped sequence cells): no answer.")
@@ -560,10 +659,23 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
 }
 
 void RegisterEvaluate(py::module_& m) {
-  // The keywords' defaults are those of the structs they fill, so that they cannot drift.
+  // The keywords' defaults are the programs' (the option table's), so that they cannot drift.
   const EvaluationOptions kOptions;
-  const GroundTruthOptions kTruth;
-  const MatchingOptions kMatching;
+  const KeyDefaults& d = Defaults();
+
+  // read_matrix_settings' checks (openable/__init__.py): the settings file beside a matrix
+  // holds together and fits the matrix, as openable_evaluate checks them.
+  m.def(
+      "_check_matrix_settings",
+      [](const std::string& matrix_path) {
+        py::gil_scoped_release release;
+        const std::optional<SavedMatrixSettings> saved = ReadMatrixSettings(matrix_path);
+        if (!saved) return false;
+        const cv::Size size = MatrixFileSize(matrix_path);
+        CheckMatrixFitsSettings(*saved, matrix_path, size.height, size.width);
+        return true;
+      },
+      py::arg("matrix_path"));
 
   m.def(
       "evaluate",
@@ -606,6 +718,8 @@ void RegisterEvaluate(py::module_& m) {
         const EvaluationLayout layout =
             LayoutOf(layout_name, reference_frames, full_rows, full_cols);
         const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
+        if (loop && (s.options.protocols.vpr_bench || s.options.protocols.vpr_tutorial))
+          NeedsTwoTraversals("protocol: \"" + protocol + "\"", full_rows, full_cols);
 
         const int given = (truth_matrix.is_none() ? 0 : 1) + (pairs.is_none() ? 0 : 1) +
                           (poses.is_none() ? 0 : 1) + (aligned ? 1 : 0) +
@@ -633,6 +747,9 @@ void RegisterEvaluate(py::module_& m) {
                 "truth_type: expected with truth_file (" + GroundTruthFormatList() + ")");
           gt = WithArgumentNames([&] {
             t.type = ParseGroundTruthType(truth_type.cast<std::string>());
+            if (loop && t.type.Format().two_traversals)
+              NeedsTwoTraversals("truth_type: \"" + GroundTruthTypeName(t.type) + "\"",
+                                 full_rows, full_cols);
             return LoadGroundTruth(t, layout, full_rows, full_cols);
           });
         } else if (aligned) {
@@ -734,6 +851,7 @@ void RegisterEvaluate(py::module_& m) {
           }
           run.per_query =
               WithArgumentNames([&] { return EvaluatePerQuery(m, layout, gt, s.options); });
+          run.warnings = EvaluationWarnings(m, layout, gt, s.options, run.per_query);
           run.able_p = EvaluateAbleP(m, layout, gt, s.options);
           WithArgumentNames([&] {
             if (s.options.protocols.vpr_bench) {
@@ -746,34 +864,32 @@ void RegisterEvaluate(py::module_& m) {
             }
           });
         }
+        for (const std::string& w : result.run.warnings) Warn(w);
         return result;
       },
       py::arg("matrix"), py::kw_only(), py::arg("truth_matrix") = py::none(),
       py::arg("pairs") = py::none(), py::arg("poses") = py::none(),
       py::arg("reference_poses") = py::none(), py::arg("aligned") = false,
       py::arg("truth_file") = py::none(), py::arg("truth_type") = py::none(),
-      py::arg("truth_file_2") = "", py::arg("base") = kTruth.base,
-      py::arg("first_frame") = kTruth.first_frame, py::arg("range_selected") = false,
+      py::arg("truth_file_2") = "", py::arg("base") = d.base,
+      py::arg("first_frame") = d.first_frame, py::arg("range_selected") = false,
       py::arg("layout") = py::none(), py::arg("reference_frames") = py::none(),
-      py::arg("tolerance") = kOptions.tolerance, py::arg("exclusion") = kOptions.exclusion,
-      py::arg("vicinity") = kOptions.vicinity, py::arg("able_thresholds") = kOptions.able_thresholds,
-      py::arg("radius") = kTruth.radius, py::arg("heading_limit") = kTruth.heading_limit,
-      py::arg("min_frame_gap") = py::none(), py::arg("axes") = kTruth.axes,
+      py::arg("tolerance") = d.tolerance, py::arg("exclusion") = d.exclusion,
+      py::arg("vicinity") = d.vicinity, py::arg("able_thresholds") = kOptions.able_thresholds,
+      py::arg("radius") = d.radius, py::arg("heading_limit") = d.heading_limit,
+      py::arg("min_frame_gap") = py::none(), py::arg("axes") = d.axes,
       py::arg("normalize") = true, py::arg("label") = "python",
-      py::arg("score") = EnumName(kOptions.score), py::arg("score_window") = kOptions.score_window,
+      py::arg("score") = d.score, py::arg("score_window") = d.score_window,
       py::arg("accept_threshold") = py::none(),
-      py::arg("accept_consistency") = kOptions.accept_consistency,
-      py::arg("sequence_length") = kMatching.sequence_length,
-      py::arg("partial") = EnumName(kMatching.partial),
-      py::arg("direction") = EnumName(kMatching.direction),
-      py::arg("protocol") = EvaluationProtocolsText(kOptions.protocols),
-      py::arg("truth_file_soft") = kTruth.soft_path, py::arg("truth_soft_matrix") = py::none(),
+      py::arg("accept_consistency") = d.accept_consistency,
+      py::arg("sequence_length") = d.sequence_length, py::arg("partial") = d.partial,
+      py::arg("direction") = d.direction, py::arg("protocol") = d.protocol,
+      py::arg("truth_file_soft") = d.truth_file_soft, py::arg("truth_soft_matrix") = py::none(),
       EvaluateDoc().c_str());
 }
 
 void RegisterUnsupervised(py::module_& m) {
-  const EvaluationOptions kOptions;
-  const MatchingOptions kMatching;
+  const KeyDefaults& d = Defaults();
 
   m.def(
       "unsupervised_criteria",
@@ -818,13 +934,12 @@ void RegisterUnsupervised(py::module_& m) {
       },
       py::arg("matrix"), py::kw_only(), py::arg("layout") = py::none(),
       py::arg("reference_frames") = py::none(),
-      py::arg("sequence_length") = kMatching.sequence_length,
-      py::arg("partial") = EnumName(kMatching.partial),
-      py::arg("direction") = EnumName(kMatching.direction),
-      py::arg("exclusion") = kOptions.exclusion, py::arg("score_window") = kOptions.score_window,
-      R"doc(unsupervised_criteria(matrix, *, layout=None, reference_frames=None,
-    sequence_length=1, partial="ahead", direction="forward", exclusion=100,
-    score_window=10) -> dict
+      py::arg("sequence_length") = d.sequence_length, py::arg("partial") = d.partial,
+      py::arg("direction") = d.direction, py::arg("exclusion") = d.exclusion,
+      py::arg("score_window") = d.score_window,
+      d.Fill(R"doc(unsupervised_criteria(matrix, *, layout=None, reference_frames=None,
+    sequence_length=@sequence_length@, partial="@partial@", direction="@direction@",
+    exclusion=@exclusion@, score_window=@score_window@) -> dict
 
 The criteria openable_sweep --rank-by and the auto mode (Auto 1) judge a matrix by, with no
 ground truth (docs/evaluation.md, "Without ground truth"): each query's best match (answer)
@@ -845,7 +960,7 @@ Returns:
     dict: consistency (share of the queries whose answer agrees), distinctiveness (mean of 1 -
     ratio, 0 for a query without answer), agreement ((10 consistency + distinctiveness) / 11),
     queries, answered, agreeing, gap and tolerance (frames), and per query row of the block
-    best (column, -1 none), ratio and agrees (bool).)doc");
+    best (column, -1 none), ratio and agrees (bool).)doc").c_str());
 }
 
 }  // namespace

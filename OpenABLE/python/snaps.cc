@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdint>
+#include <cstring>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -50,6 +51,60 @@ std::vector<Eigen::Isometry3d> IsometriesOf(const py::handle& object, const char
   }
   return poses;
 }
+
+// The keywords' defaults that are Snaps_* keys (or Initial_image), from the option table.
+struct KeyDefaults {
+  std::string format = TableDefault("Snaps_trajectory_format");
+  bool world_to_camera = TableDefault("Snaps_world_to_camera") == "1";
+  double time_tolerance = std::stod(TableDefault("Snaps_time_tolerance"));
+  int keyframe_tolerance = std::stoi(TableDefault("Snaps_keyframe_tolerance"));
+  bool drop_outside = TableDefault("Snaps_drop_outside") == "1";
+  bool middle_of_runs = TableDefault("Snaps_middle_of_runs") == "1";
+  double matrix_threshold = std::stod(TableDefault("Snaps_matrix_threshold"));
+  int frame_distance = std::stoi(TableDefault("Snaps_frame_distance"));
+  int initial = std::stoi(TableDefault("Initial_image"));
+  int discount_length = std::stoi(TableDefault("Snaps_discount_length"));
+  int pause = std::stoi(TableDefault("Snaps_pause"));
+  double odometry_translation_weight =
+      std::stod(TableDefault("Snaps_odometry_translation_weight"));
+  double odometry_rotation_weight = std::stod(TableDefault("Snaps_odometry_rotation_weight"));
+  double loop_weight = std::stod(TableDefault("Snaps_loop_weight"));
+  std::string robust_kernel = TableDefault("Snaps_robust_kernel");
+  double robust_scale = std::stod(TableDefault("Snaps_robust_scale"));
+
+  // `text` with each "@name@" replaced by the default of that keyword (Python's spelling).
+  std::string Fill(std::string text) const {
+    const auto flag = [](bool b) { return std::string(b ? "True" : "False"); };
+    const std::pair<const char*, std::string> values[] = {
+        {"@format@", format},
+        {"@world_to_camera@", flag(world_to_camera)},
+        {"@time_tolerance@", FormatNumber(time_tolerance)},
+        {"@keyframe_tolerance@", std::to_string(keyframe_tolerance)},
+        {"@drop_outside@", flag(drop_outside)},
+        {"@middle_of_runs@", flag(middle_of_runs)},
+        {"@matrix_threshold@", FormatNumber(matrix_threshold)},
+        {"@frame_distance@", std::to_string(frame_distance)},
+        {"@initial@", std::to_string(initial)},
+        {"@discount_length@", std::to_string(discount_length)},
+        {"@pause@", std::to_string(pause)},
+        {"@odometry_translation_weight@", FormatNumber(odometry_translation_weight)},
+        {"@odometry_rotation_weight@", FormatNumber(odometry_rotation_weight)},
+        {"@loop_weight@", FormatNumber(loop_weight)},
+        {"@robust_kernel@", robust_kernel},
+        {"@robust_scale@", FormatNumber(robust_scale)}};
+    return FillPlaceholders(std::move(text), values);
+  }
+};
+
+const KeyDefaults& Defaults() {
+  static const KeyDefaults defaults;
+  return defaults;
+}
+
+// The hint at the conventions (snaps::ConventionHint) in the words of this module.
+constexpr snaps::ConventionWords kPythonConventionWords = {
+    "the estimate", "world_to_camera", "True",
+    "the format of each file (read_trajectory's format)"};
 
 py::array_t<double> PosesArray(const Trajectory& t, int rows) {
   py::array_t<double> a({static_cast<py::ssize_t>(t.Size()), static_cast<py::ssize_t>(rows),
@@ -142,11 +197,12 @@ struct ChainRun {
 namespace {
 
 void RegisterTrajectory(py::module_& m) {
+  const KeyDefaults& d = Defaults();
 
   py::class_<Trajectory>(
       m, "Trajectory",
-      R"doc(Trajectory(poses, frame_ids=None, timestamps=None, format="kitti",
-    world_to_camera=False)
+      d.Fill(R"doc(Trajectory(poses, frame_ids=None, timestamps=None, format="@format@",
+    world_to_camera=@world_to_camera@)
 
 Camera-to-world poses of a camera over a run.
 
@@ -160,11 +216,13 @@ Args:
         frame i), "kitti-id" (a frame number then 12 numbers), "tum" (timestamp tx ty tz qx qy
         qz qw).
     world_to_camera (bool): save() writes the inverse matrices (as SO-DSO's files are).)doc")
+                 .c_str())
       .def(py::init(&MakeTrajectory), py::arg("poses"), py::arg("frame_ids") = py::none(),
-           py::arg("timestamps") = py::none(), py::arg("format") = "kitti",
-           py::arg("world_to_camera") = false,
-           "__init__(poses, frame_ids=None, timestamps=None, format=\"kitti\", "
-           "world_to_camera=False)\n\nSee help(openable.snaps.Trajectory).")
+           py::arg("timestamps") = py::none(), py::arg("format") = d.format,
+           py::arg("world_to_camera") = d.world_to_camera,
+           d.Fill("__init__(poses, frame_ids=None, timestamps=None, format=\"@format@\", "
+                  "world_to_camera=@world_to_camera@)\n\nSee help(openable.snaps.Trajectory).")
+               .c_str())
       .def_property_readonly(
           "poses", [](const Trajectory& t) { return PosesArray(t, 4); },
           "float64 (N, 4, 4) camera-to-world matrices (a copy).")
@@ -228,8 +286,9 @@ Args:
         py::gil_scoped_release release;
         return snaps::ReadTrajectory(path, f, world_to_camera);
       },
-      py::arg("path"), py::arg("format") = "kitti", py::arg("world_to_camera") = false,
-      R"doc(read_trajectory(path, format="kitti", world_to_camera=False) -> Trajectory
+      py::arg("path"), py::arg("format") = d.format, py::arg("world_to_camera") = d.world_to_camera,
+      d.Fill(R"doc(read_trajectory(path, format="@format@", world_to_camera=@world_to_camera@)
+    -> Trajectory
 
 Reads a trajectory file.
 
@@ -243,7 +302,9 @@ Args:
 
 Raises:
     openable.InputError: one line naming the file and line (wrong count of numbers, not a
-    number, a matrix that is not a rotation, frame ids not increasing, empty file).)doc");
+    number, a matrix that is not a rotation, frame ids not increasing, empty file; a line of
+    the other KITTI format names it: kitti-id for a frame number then 12 numbers).)doc")
+          .c_str());
 
   m.def(
       "associate",
@@ -254,8 +315,8 @@ Raises:
         std::copy(a.begin(), a.end(), out.mutable_data());
         return out;
       },
-      py::arg("estimate"), py::arg("truth"), py::arg("time_tolerance") = 0.02,
-      R"doc(associate(estimate, truth, time_tolerance=0.02) -> numpy.ndarray
+      py::arg("estimate"), py::arg("truth"), py::arg("time_tolerance") = d.time_tolerance,
+      d.Fill(R"doc(associate(estimate, truth, time_tolerance=@time_tolerance@) -> numpy.ndarray
 
 For each pose of `estimate`, the index of its pose in `truth`: by frame id (kitti and
 kitti-id), or by nearest timestamp within time_tolerance seconds (both tum).
@@ -264,10 +325,12 @@ Returns:
     numpy.ndarray: int32 (N,).
 
 Raises:
-    openable.InputError: a pose without counterpart (naming the first such frame).)doc");
+    openable.InputError: a pose without counterpart (naming the first such frame).)doc")
+          .c_str());
 }
 
 void RegisterTrajectoryErrors(py::module_& m) {
+  const KeyDefaults& d = Defaults();
 
   py::class_<snaps::TrajectoryError>(m, "TrajectoryError",
                                      "Absolute trajectory error of the positions (metres).")
@@ -307,13 +370,22 @@ void RegisterTrajectoryErrors(py::module_& m) {
               throw py::value_error("association: index " + std::to_string(i) +
                                     " is not a pose of the truth");
         }
-        py::gil_scoped_release release;
-        return snaps::AbsoluteTrajectoryError(estimate, truth, a, align);
+        snaps::TrajectoryError error, aligned;
+        {
+          py::gil_scoped_release release;
+          error = snaps::AbsoluteTrajectoryError(estimate, truth, a, align);
+          aligned = align ? error : snaps::AbsoluteTrajectoryError(estimate, truth, a, true);
+        }
+        if (const std::string hint =
+                snaps::ConventionHint(aligned, truth, kPythonConventionWords);
+            !hint.empty())
+          Warn(hint);
+        return error;
       },
       py::arg("estimate"), py::arg("truth"), py::arg("association") = py::none(),
-      py::arg("align") = false, py::arg("time_tolerance") = 0.02,
-      R"doc(trajectory_error(estimate, truth, association=None, align=False,
-    time_tolerance=0.02) -> TrajectoryError
+      py::arg("align") = false, py::arg("time_tolerance") = d.time_tolerance,
+      d.Fill(R"doc(trajectory_error(estimate, truth, association=None, align=False,
+    time_tolerance=@time_tolerance@) -> TrajectoryError
 
 Absolute trajectory error of the estimate's positions against their ground-truth
 counterparts, as openable_snaps reports it.
@@ -327,7 +399,13 @@ Args:
         the truth (Umeyama); False measures the trajectory as it is.
 
 Returns:
-    TrajectoryError: rmse, mean, median, max (metres), aligned, alignment.)doc");
+    TrajectoryError: rmse, mean, median, max (metres), aligned, alignment.
+
+Warns:
+    UserWarning: when the estimate is farther from the truth after alignment than a quarter of
+    the route's extent: a convention (world_to_camera, the format) rather than drift, as
+    openable_snaps hints (docs/snaps.md, "Conventions").)doc")
+          .c_str());
 
   m.def(
       "loops_from_csv",
@@ -347,13 +425,15 @@ Returns:
         c["outside"] = outside;
         return py::make_tuple(LoopsList(loops), c);
       },
-      py::arg("path"), py::arg("trajectory"), py::arg("tolerance") = 0,
-      py::arg("drop_outside") = false, py::arg("middle_of_runs") = false, py::arg("counts") = false,
-      R"doc(loops_from_csv(path, trajectory, tolerance=0, drop_outside=False, middle_of_runs=False,
-    counts=False) -> list
+      py::arg("path"), py::arg("trajectory"), py::arg("tolerance") = d.keyframe_tolerance,
+      py::arg("drop_outside") = d.drop_outside, py::arg("middle_of_runs") = d.middle_of_runs,
+      py::arg("counts") = false,
+      d.Fill(R"doc(loops_from_csv(path, trajectory, tolerance=@keyframe_tolerance@,
+    drop_outside=@drop_outside@, middle_of_runs=@middle_of_runs@, counts=False) -> list
 
 Loop pairs from a CSV of frame pairs ("row,col" a line, row the later frame; '#' comments),
-as openable_snaps reads Snaps_loops_file with Snaps_loops = pairs.
+as openable_snaps reads Snaps_loops_file with Snaps_loops = pairs, with its defaults (the
+option table's): by default the middle reference of each run is kept, as the program does.
 
 Args:
     path (str): the pairs file.
@@ -370,7 +450,8 @@ Args:
 
 Returns:
     list[tuple[int, int, float]]: (query, reference, similarity 1.0) pose indices
-    (or (list, dict) with counts=True).)doc");
+    (or (list, dict) with counts=True).)doc")
+          .c_str());
 
   m.def(
       "middle_of_runs",
@@ -391,6 +472,7 @@ reference.)doc");
 }
 
 void RegisterLoopsAndCorrections(py::module_& m) {
+  const KeyDefaults& d = Defaults();
 
   m.def(
       "loops_from_matrix",
@@ -417,10 +499,11 @@ void RegisterLoopsAndCorrections(py::module_& m) {
         }
         return LoopsList(loops);
       },
-      py::arg("matrix"), py::arg("trajectory"), py::arg("threshold") = 0.1,
-      py::arg("exclusion") = 100, py::arg("initial") = 0, py::arg("tolerance") = 0,
-      R"doc(loops_from_matrix(matrix, trajectory, threshold=0.1, exclusion=100, initial=0,
-    tolerance=0) -> list
+      py::arg("matrix"), py::arg("trajectory"), py::arg("threshold") = d.matrix_threshold,
+      py::arg("exclusion") = d.frame_distance, py::arg("initial") = d.initial,
+      py::arg("tolerance") = d.keyframe_tolerance,
+      d.Fill(R"doc(loops_from_matrix(matrix, trajectory, threshold=@matrix_threshold@,
+    exclusion=@frame_distance@, initial=@initial@, tolerance=@keyframe_tolerance@) -> list
 
 Loops from an OpenABLE matrix of one sequence (Snaps_loops = matrix): for each row q its best
 earlier match j (smallest M'(q, j) with j <= q - exclusion) with M'(q, j) < threshold gives
@@ -433,17 +516,19 @@ Args:
     threshold (float): Snaps_matrix_threshold.
     exclusion (int): Snaps_frame_distance.
     initial (int): frame id of row 0 (Initial_image).
-    tolerance (int): Snaps_keyframe_tolerance.)doc");
+    tolerance (int): Snaps_keyframe_tolerance.)doc")
+          .c_str());
 
   m.def("closed_loops",
         [](const py::object& loops, int pause) {
           return LoopsList(snaps::ClosedLoops(LoopsOf(loops, nullptr), pause));
         },
-        py::arg("loops"), py::arg("pause") = 20,
-        R"doc(closed_loops(loops, pause=20) -> list
+        py::arg("loops"), py::arg("pause") = d.pause,
+        d.Fill(R"doc(closed_loops(loops, pause=@pause@) -> list
 
 The loops correct_discounted() closes, in order: taken by query, a loop is skipped when its
-query is not more than `pause` poses after the last closed loop's query.)doc");
+query is not more than `pause` poses after the last closed loop's query (Snaps_pause).)doc")
+            .c_str());
 
   m.def("discount_gamma", &snaps::DiscountGamma, py::arg("s_prime"), py::arg("alpha"),
         R"doc(discount_gamma(s_prime, alpha) -> float
@@ -464,13 +549,14 @@ frames before the loop's frame N, alpha >= 1 the number of loops closed so far.)
         return py::make_tuple(out, DoubleArray({shift.x(), shift.y(), shift.z()}));
       },
       py::arg("trajectory"), py::arg("n"), py::arg("reference"), py::arg("similarity") = 1.0,
-      py::arg("alpha") = 1, py::arg("discount_length") = 300,
-      R"doc(apply_discounted_update(trajectory, n, reference, similarity=1.0, alpha=1,
-    discount_length=300) -> tuple[Trajectory, numpy.ndarray]
+      py::arg("alpha") = 1, py::arg("discount_length") = d.discount_length,
+      d.Fill(R"doc(apply_discounted_update(trajectory, n, reference, similarity=1.0, alpha=1,
+    discount_length=@discount_length@) -> tuple[Trajectory, numpy.ndarray]
 
 One loop of Eq. 6: pose n closes a loop with pose `reference`; positions of poses
 max(0, n-K)..n move by similarity * gamma(n - s) * (p_reference - p_n), later poses with pose
-n; rotations are kept. Returns the corrected copy and the shift of pose n.)doc");
+n; rotations are kept. Returns the corrected copy and the shift of pose n.)doc")
+          .c_str());
 
   m.def(
       "correct_discounted",
@@ -484,9 +570,10 @@ n; rotations are kept. Returns the corrected copy and the shift of pose n.)doc")
         py::gil_scoped_release release;
         return snaps::CorrectDiscounted(t, l, o);
       },
-      py::arg("trajectory"), py::arg("loops"), py::arg("discount_length") = 300,
-      py::arg("pause") = 20,
-      R"doc(correct_discounted(trajectory, loops, discount_length=300, pause=20) -> Trajectory
+      py::arg("trajectory"), py::arg("loops"), py::arg("discount_length") = d.discount_length,
+      py::arg("pause") = d.pause,
+      d.Fill(R"doc(correct_discounted(trajectory, loops, discount_length=@discount_length@,
+    pause=@pause@) -> Trajectory
 
 The paper's correction (Eq. 6) of a whole trajectory, offline, as openable_snaps does with
 Snaps_corrector = discounted: loops taken in the order of their query, a loop skipped while its
@@ -499,7 +586,8 @@ Args:
     loops (list): (query, reference[, similarity]) pose indices.
 
 Returns:
-    Trajectory: the corrected copy (frame ids, format and convention kept).)doc");
+    Trajectory: the corrected copy (frame ids, format and convention kept).)doc")
+          .c_str());
 
   py::class_<snaps::PoseGraphReport>(m, "PoseGraphReport", "What correct_pose_graph() did.")
       .def_readonly("iterations", &snaps::PoseGraphReport::iterations, "Steps tried.")
@@ -522,6 +610,8 @@ Returns:
 }
 
 void RegisterPoseGraph(py::module_& m) {
+  const KeyDefaults& d = Defaults();
+  const snaps::PoseGraphOptions kGraph;  // the solver's settings that are no key
 
   m.def(
       "correct_pose_graph",
@@ -550,15 +640,20 @@ void RegisterPoseGraph(py::module_& m) {
         if (report) return py::make_tuple(out, r);
         return py::cast(out);
       },
-      py::arg("trajectory"), py::arg("loops"), py::arg("odometry_translation_weight") = 2500.0,
-      py::arg("odometry_rotation_weight") = 1e6, py::arg("loop_weight") = 1.0,
-      py::arg("use_similarity") = false, py::arg("robust_kernel") = "huber",
-      py::arg("robust_scale") = 3.0, py::arg("relative_tolerance") = 1e-9,
-      py::arg("max_iterations") = 100, py::arg("initial_lambda") = 1e-6, py::arg("report") = false,
-      R"doc(correct_pose_graph(trajectory, loops, odometry_translation_weight=2500.0,
-    odometry_rotation_weight=1e6, loop_weight=1.0, use_similarity=False, robust_kernel="huber",
-    robust_scale=3.0, relative_tolerance=1e-9, max_iterations=100, initial_lambda=1e-6,
-    report=False) -> Trajectory
+      py::arg("trajectory"), py::arg("loops"),
+      py::arg("odometry_translation_weight") = d.odometry_translation_weight,
+      py::arg("odometry_rotation_weight") = d.odometry_rotation_weight,
+      py::arg("loop_weight") = d.loop_weight, py::arg("use_similarity") = kGraph.use_similarity,
+      py::arg("robust_kernel") = d.robust_kernel, py::arg("robust_scale") = d.robust_scale,
+      py::arg("relative_tolerance") = kGraph.relative_tolerance,
+      py::arg("max_iterations") = kGraph.max_iterations,
+      py::arg("initial_lambda") = kGraph.initial_lambda, py::arg("report") = false,
+      d.Fill(R"doc(correct_pose_graph(trajectory, loops,
+    odometry_translation_weight=@odometry_translation_weight@,
+    odometry_rotation_weight=@odometry_rotation_weight@, loop_weight=@loop_weight@,
+    use_similarity=False, robust_kernel="@robust_kernel@", robust_scale=@robust_scale@,
+    relative_tolerance=1e-9, max_iterations=100, initial_lambda=1e-6, report=False)
+    -> Trajectory
 
 Least-squares pose-graph correction (docs/snaps.md): odometry edges between consecutive poses
 (relative pose of the input; information diag(w_t I, w_R I)), loop edges pulling the two
@@ -580,7 +675,8 @@ Args:
     report (bool): also return a PoseGraphReport.
 
 Returns:
-    Trajectory (or (Trajectory, PoseGraphReport) with report=True).)doc");
+    Trajectory (or (Trajectory, PoseGraphReport) with report=True).)doc")
+          .c_str());
 
   py::class_<ChainRun>(m, "ChainResult", R"doc(What run() did: the trajectories, the loops, the
 corrections and their errors, as openable_snaps reports them.)doc")
@@ -652,6 +748,12 @@ void RegisterChain(py::module_& m) {
         ProgressReporter progress(std::cerr, !quiet, IsTerminal(2));
         c->result = snaps::RunChain(c->config, progress);
         if (write) c->written = snaps::WriteChainOutputs(c->config, c->result);
+        py::gil_scoped_acquire acquire;
+        if (!c->result.errors.empty())
+          if (const std::string hint =
+                  snaps::ConventionHint(c->result.errors.front().aligned, c->result.truth);
+              !hint.empty())
+            Warn(hint);
         return c;
       },
       py::arg("config") = py::none(), py::kw_only(), py::arg("settings") = py::none(),

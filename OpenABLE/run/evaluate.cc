@@ -59,6 +59,8 @@ void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
   run.truth_dropped = truth.dropped;
   run.truth_skipped_header = truth.skipped_header;
   run.per_query = EvaluatePerQuery(normalized, layout, truth, evaluation.settings.options);
+  run.warnings =
+      EvaluationWarnings(normalized, layout, truth, evaluation.settings.options, run.per_query);
   if (verified != nullptr) {
     run.verified = true;
     run.per_query_unverified = std::move(run.per_query);

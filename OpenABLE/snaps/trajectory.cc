@@ -88,7 +88,7 @@ Trajectory ReadTrajectory(const std::string& path, TrajectoryFormat format,
   Trajectory trajectory;
   trajectory.format = format;
   trajectory.world_to_camera = world_to_camera;
-  for (const PoseFileLine& line : ReadPoseFile(path, file_format, "trajectory")) {
+  for (const PoseFileLine& line : ReadPoseFile(path, file_format, "trajectory", /*both_kitti=*/true)) {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     pose.linear() = line.rotation;
     pose.translation() = line.translation;
@@ -217,5 +217,24 @@ TrajectoryError AbsoluteTrajectoryError(const Trajectory& estimate, const Trajec
   error.median = n % 2 == 1 ? d[n / 2] : 0.5 * (d[n / 2 - 1] + d[n / 2]);
   return error;
 }
+
+std::string ConventionHint(const TrajectoryError& aligned, const Trajectory& truth,
+                           const ConventionWords& words) {
+  if (truth.poses.empty()) return "";
+  Eigen::Vector3d lo = truth.poses.front().translation(), hi = lo;
+  for (const Eigen::Isometry3d& p : truth.poses) {
+    lo = lo.cwiseMin(p.translation());
+    hi = hi.cwiseMax(p.translation());
+  }
+  const double extent = (hi - lo).norm();
+  if (!(extent > 0 && aligned.mean > 0.25 * extent)) return "";
+  return std::string(words.estimate) + " is " + FormatFixed(aligned.mean, 1) +
+         " m from the ground truth on average even after alignment, on a route " +
+         FormatFixed(extent, 1) + " m across: more than drift. Check " + words.world_to_camera +
+         " (" + words.on +
+         " when the file holds world-to-camera matrices, as SO-DSO's poses_history_file.txt), " +
+         words.formats + ", and that both cover the same frames.";
+}
+
 
 }  // namespace openable::snaps

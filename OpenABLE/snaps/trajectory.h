@@ -97,6 +97,27 @@ struct TrajectoryError {
 TrajectoryError AbsoluteTrajectoryError(const Trajectory& estimate, const Trajectory& truth,
                                         const std::vector<int>& association, bool align);
 
+// The words of ConventionHint in the caller's terms: openable_snaps' keys, Python's arguments.
+struct ConventionWords {
+  const char* estimate;         // the trajectory evaluated: "the input"
+  const char* world_to_camera;  // the setting that inverts the file's matrices
+  const char* on;               // its value that does: "1", "True"
+  const char* formats;          // the settings of both files' formats
+};
+inline constexpr ConventionWords kChainConventionWords = {
+    "the input", "Snaps_world_to_camera", "1",
+    "Snaps_trajectory_format and Snaps_ground_truth_format"};
+
+// A hint at the conventions when the estimate cannot be a drifting estimate of the truth's
+// route: its mean error after rigid alignment (`aligned`, AbsoluteTrajectoryError with align)
+// exceeds a quarter of the route's extent, the diagonal of the bounding box of the truth's
+// positions. Such an error comes from a convention (world-to-camera matrices read as
+// camera-to-world, the wrong format) or files of different frames, not from drift. One line
+// naming the settings as `words` gives them; empty otherwise. openable_snaps prints it after
+// "Hint: "; Python's trajectory_error and snaps.run give it as a warning.
+std::string ConventionHint(const TrajectoryError& aligned, const Trajectory& truth,
+                           const ConventionWords& words = kChainConventionWords);
+
 // A loop: pose `query` (the later one) revisits the place of pose `reference` (indices into
 // the trajectory, reference < query). `similarity` in [0, 1] (Q of the paper; 1 when unknown).
 struct LoopPair {

@@ -169,14 +169,26 @@ TEST(TestOpenABLE, OverridesRangeAndSingleSequence) {
   const Outcome o =
       RunProgram(testing::TestOpenableExe(),
                  {SampleConfig(dir), "--set", "Images_path_2=", "--set", "Final_image=50", "--set",
-                  "Initial_image=10", "--set", "Image_sequences=1", "--quiet"},
+                  "Initial_image=10", "--set", "Image_sequences=1", "--set", "Exclusion=10",
+                  "--quiet"},
                  dir);
   ASSERT_EQ(o.status, 0) << o.err;
-  EXPECT_EQ(o.err, "");  // --quiet: no progress
+  EXPECT_EQ(o.err, "");  // --quiet: no progress, and no warning
   const cv::Mat1f m = ReadNpy(dir + "/out/matrix.npy");
   ASSERT_EQ(m.rows, 40);
   for (int i = 0; i < 40; ++i) EXPECT_EQ(m(i, i), 0.f);
   EXPECT_NE(o.out.find("40 frames"), std::string::npos) << o.out;
+  // The sample's Exclusion (100) leaves none of the 40 frames a candidate: said in one line.
+  const Outcome all_excluded =
+      RunProgram(testing::TestOpenableExe(),
+                 {SampleConfig(dir), "--set", "Images_path_2=", "--set", "Final_image=50", "--set",
+                  "Initial_image=10", "--set", "Image_sequences=1", "--quiet"},
+                 dir);
+  ASSERT_EQ(all_excluded.status, 0) << all_excluded.err;
+  EXPECT_TRUE(OneLine(all_excluded.err)) << all_excluded.err;
+  EXPECT_NE(all_excluded.err.find("warning: Exclusion: 100 leaves no frame a candidate"),
+            std::string::npos)
+      << all_excluded.err;
 }
 
 // Auto mode with a tiny Memory_limit: the run says it is bounded and why, writes the matches
@@ -555,8 +567,11 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadInput{"MissingFolder", {"Images_path=$DIR/nope"}, "Images_path: folder \""},
         BadInput{"EmptyFolder", {"Images_path=$DIR/empty"}, "Images_path: "},
-        BadInput{"CorruptImage", {"Images_path=$DIR/corrupt"}, "a2.png"},
-        BadInput{"DifferentSizes", {"Images_path=$DIR/sizes", "Images_path_2="}, "f2.png"},
+        // Two frames each: sequences of one frame, so that the frames are read at all.
+        BadInput{"CorruptImage", {"Images_path=$DIR/corrupt", "Image_sequences=1"}, "a2.png"},
+        BadInput{"DifferentSizes",
+                 {"Images_path=$DIR/sizes", "Images_path_2=", "Image_sequences=1"},
+                 "f2.png"},
         BadInput{"MatrixImageNotPng",
                  {"Png_name=out/m.jpg"},
                  "Png_name: \"out/m.jpg\" does not end in .png; expected a .png path"},
@@ -629,8 +644,70 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"SadPatchTooLarge",
                  {"Image_descriptor=SAD", "Patch_size=32", "Sad_patch=20"},
                  "Sad_patch: 20"},
-        BadInput{"UnknownPartial", {"Sequence_partial=drop"}, "Sequence_partial"}),
+        BadInput{"UnknownPartial", {"Sequence_partial=drop"}, "Sequence_partial"},
+        // Sequences longer than the traversals leave no cell with a value (Sequence_partial
+        // ahead or skip): refused before any frame is read.
+        BadInput{"SequencesLongerThanBothTraversals",
+                 {"Final_image=39", "Image_sequences=100"},
+                 "Image_sequences: 100 frames, but the traversals have 39 (Images_path) and 39 "
+                 "(Images_path_2) frames: with Sequence_partial ahead a cell has a value only on "
+                 "a diagonal of at least 100 frames"},
+        BadInput{"SequencesLongerThanTheShorterTraversal",
+                 {"Images_path=$DIR/twenty", "Images_path_2=$DIR/thirty", "Image_sequences=25",
+                  "Sequence_partial=skip"},
+                 "expected Image_sequences <= 20, or Sequence_partial scale"},
+        BadInput{"SequencesLongerThanTheOnlyTraversal",
+                 {"Images_path=$DIR/twenty", "Images_path_2=", "Image_sequences=21"},
+                 "the matrix would hold no value; expected Image_sequences <= 20"}),
     [](const ::testing::TestParamInfo<BadInput>& info) { return std::string(info.param.name); });
+
+// Sequences longer than the traversals: with Sequence_partial scale every cell still has a
+// value (the partial sums scaled up), so the run goes on.
+TEST(TestOpenABLE, LongSequencesWithScaledPartialSumsRun) {
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunProgram(testing::TestOpenableExe(),
+                               {SampleConfig(dir), "--quiet", "--set", "Final_image=39", "--set",
+                                "Image_sequences=100", "--set", "Sequence_partial=scale"},
+                               dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const cv::Mat1f m = ReadNpy(dir + "/out/matrix.npy");
+  ASSERT_EQ(m.rows, 78);
+  EXPECT_EQ(cv::countNonZero(m <= 1.0f), 78 * 78);  // every cell finite
+}
+
+// One traversal whose frames have no candidate with a value (candidates Exclusion frames back,
+// sequences longer than what remains): the matrix is written, and the run says in one line,
+// on stderr and in the report, why no loop can be found. Checked here on the matrix itself.
+TEST(TestOpenABLE, NoCandidateWithAValueIsSaidInOneLine) {
+  const std::string dir = testing::TempDir();
+  const Outcome o = RunProgram(testing::TestOpenableExe(),
+                               {SampleConfig(dir), "--quiet", "--set", "Images_path_2=", "--set",
+                                "Image_sequences=250", "--set", "Exclusion=100"},
+                               dir);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const std::string line =
+      "warning: Image_sequences: 250 leaves no candidate with a value (a frame's candidates are "
+      "at least Exclusion 100 frames back";
+  EXPECT_NE(o.err.find("Test_OpenABLE: " + line), std::string::npos) << o.err;
+  EXPECT_TRUE(OneLine(o.err)) << o.err;
+  EXPECT_NE(o.out.find("  " + line), std::string::npos) << o.out;
+  // Every candidate cell (q, j <= q - 100) of the 300 x 300 matrix is +inf, and some other
+  // cell has a value.
+  const cv::Mat1f m = ReadNpy(dir + "/out/matrix.npy");
+  ASSERT_EQ(m.rows, 300);
+  int finite_candidates = 0;
+  for (int q = 100; q < 300; ++q)
+    for (int j = 0; j <= q - 100; ++j) finite_candidates += std::isfinite(m(q, j)) ? 1 : 0;
+  EXPECT_EQ(finite_candidates, 0);
+  EXPECT_GT(cv::countNonZero(m <= 1.0f), 0);
+  // With sequences that fit, no such line.
+  const Outcome fit = RunProgram(testing::TestOpenableExe(),
+                                 {SampleConfig(dir), "--quiet", "--set", "Images_path_2=", "--set",
+                                  "Image_sequences=150", "--set", "Exclusion=100"},
+                                 dir);
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  EXPECT_EQ(fit.err.find("warning"), std::string::npos) << fit.err;
+}
 
 TEST(TestOpenABLE, MissingOrBrokenConfigFile) {
   const std::string dir = testing::TempDir();

@@ -429,5 +429,111 @@ TEST(PerQueryRatio, WindowAsLargeAsTheReferencesIsAnError) {
   EXPECT_THROW(o.Check(), InputError);
 }
 
+// Warnings of an evaluation whose figures say little about the matrix (EvaluationWarnings).
+// A 6 x 6 similarity of two aligned traversals: each query's own place is the most similar
+// (0.9), the others 0.1 .. 0.6. Read as a distance, every query's smallest value is a wrong
+// place: no answer is right, AUC 0. Reversed (max - S), every smallest value is the query's own
+// place: every answer right, AUC 1.
+cv::Mat1f AlignedSimilarity() {
+  cv::Mat1f s(6, 6);
+  for (int q = 0; q < 6; ++q)
+    for (int c = 0; c < 6; ++c) s(q, c) = q == c ? 0.9f : 0.1f * static_cast<float>(1 + (q + c) % 6);
+  return s;
+}
+
+GroundTruth AlignedTruth(int n) {
+  GroundTruth t;
+  t.references = n;
+  for (int q = 0; q < n; ++q) t.matches.push_back({q});
+  return t;
+}
+
+TEST(EvaluationWarnings, ASimilarityGivenAsDistancesLooksReversed) {
+  EvaluationOptions o;
+  o.tolerance = 0;
+  const cv::Mat1f s = AlignedSimilarity();
+  const EvaluationLayout layout = EvaluationLayout::QueryReference(6, 6);
+  const GroundTruth truth = AlignedTruth(6);
+  const PerQueryResult as_given = EvaluatePerQuery(s, layout, truth, o);
+  EXPECT_EQ(as_given.auc, 0.0);
+  // The reversed evaluation, computed independently: 1 - S ranks as max - S does.
+  const cv::Mat1f distances = 1.0f - s;
+  const double expected = EvaluatePerQuery(distances, layout, truth, o).auc;
+  EXPECT_EQ(expected, 1.0);
+  EXPECT_DOUBLE_EQ(ReversedAuc(s, layout, truth, o), expected);
+  const std::vector<std::string> w = EvaluationWarnings(s, layout, truth, o, as_given);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("looks reversed: per-query AUC 0.000"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("1.000 with the largest"), std::string::npos) << w[0];
+  EXPECT_NE(w[0].find("similarity"), std::string::npos) << w[0];
+  EXPECT_EQ(w[0].find('\n'), std::string::npos);
+  // The distances themselves: nothing to warn about.
+  EXPECT_TRUE(EvaluationWarnings(distances, layout, truth, o,
+                                 EvaluatePerQuery(distances, layout, truth, o))
+                  .empty());
+}
+
+TEST(EvaluationWarnings, APoorMatrixIsNotCalledReversed) {
+  // Random distances rank badly either way: a low AUC alone is no reason to warn.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  cv::Mat1f m(200, 200);
+  for (int q = 0; q < m.rows; ++q)
+    for (int c = 0; c < m.cols; ++c) m(q, c) = u(rng);
+  EvaluationOptions o;
+  const EvaluationLayout layout = EvaluationLayout::QueryReference(200, 200);
+  const GroundTruth truth = AlignedTruth(200);
+  const PerQueryResult r = EvaluatePerQuery(m, layout, truth, o);
+  ASSERT_LT(r.auc, kReversedAucBelow);
+  EXPECT_LT(ReversedAuc(m, layout, truth, o), kReversedAucAtLeast);
+  EXPECT_TRUE(EvaluationWarnings(m, layout, truth, o, r).empty());
+}
+
+TEST(EvaluationWarnings, NoTruePlaceNoValueNoQuery) {
+  EvaluationOptions o;
+  const cv::Mat1f s = 1.0f - AlignedSimilarity();
+  const EvaluationLayout layout = EvaluationLayout::QueryReference(6, 6);
+  // No query with a true place: the figures are 0 whatever the matrix.
+  GroundTruth none = AlignedTruth(6);
+  for (auto& m : none.matches) m.clear();
+  std::vector<std::string> w =
+      EvaluationWarnings(s, layout, none, o, EvaluatePerQuery(s, layout, none, o));
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("no query has a true place among its candidates (6 queries; 0 pairs"),
+            std::string::npos)
+      << w[0];
+  // Every candidate without a value.
+  const cv::Mat1f empty(6, 6, std::numeric_limits<float>::infinity());
+  w = EvaluationWarnings(empty, layout, AlignedTruth(6), o,
+                         EvaluatePerQuery(empty, layout, AlignedTruth(6), o));
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("no query has a candidate with a value"), std::string::npos) << w[0];
+  // One sequence of 6 frames with candidates 100 frames back: no query at all.
+  GroundTruth loop;
+  loop.references = 6;
+  loop.matches = {{}, {}, {}, {}, {}, {0}};
+  const EvaluationLayout one = EvaluationLayout::LoopClosure(6);
+  w = EvaluationWarnings(s, one, loop, o, EvaluatePerQuery(s, one, loop, o));
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NE(w[0].find("no query has a candidate: 6 frames of one sequence"), std::string::npos)
+      << w[0];
+}
+
+TEST(AnyCandidateHasValue, OnlyCandidateCellsCount) {
+  const float inf = std::numeric_limits<float>::infinity();
+  cv::Mat1f m(5, 5, inf);
+  // One sequence, exclusion 3: the candidates are (3, 0), (4, 0) and (4, 1).
+  m(4, 2) = 0.5f;  // within the exclusion window: not a candidate
+  EXPECT_FALSE(AnyCandidateHasValue(m, EvaluationLayout::LoopClosure(5), 3));
+  m(4, 1) = 0.5f;
+  EXPECT_TRUE(AnyCandidateHasValue(m, EvaluationLayout::LoopClosure(5), 3));
+  // Two traversals of 2 and 3 frames: only the lower-left 3 x 2 block holds candidates.
+  cv::Mat1f t(5, 5, inf);
+  t(0, 0) = t(4, 4) = 0.1f;
+  EXPECT_FALSE(AnyCandidateHasValue(t, EvaluationLayout::TwoTraversals(2, 3), 100));
+  t(3, 1) = 0.1f;
+  EXPECT_TRUE(AnyCandidateHasValue(t, EvaluationLayout::TwoTraversals(2, 3), 100));
+}
+
 }  // namespace
 }  // namespace openable

@@ -15,7 +15,8 @@
 namespace openable::snaps {
 namespace {
 
-using namespace openable::testing;  // NOLINT: TempDir, WriteBytes, Q, ExpectInputError
+using namespace openable::testing;  // NOLINT: TempDir, WriteBytes, Q, ExpectInputError,
+                                    // DatasetsDir
 
 std::string Write(const std::string& name, const std::string& text) {
   const std::string path = TempDir() + "/" + name;
@@ -166,7 +167,13 @@ TEST(ReadTrajectory, ErrorsNameFileLineValueAndExpectation) {
   ExpectInputError(read(p, TrajectoryFormat::kKitti), {Q(p) + ":3", "11 numbers", "expected 12"});
   p = Write("count_id.txt", ok);
   ExpectInputError(read(p, TrajectoryFormat::kKittiWithId),
-                   {Q(p) + ":1", "12 numbers", "expected 13"});
+                   {Q(p) + ":1", "12 numbers", "expected 13",
+                    "12 numbers without a frame number are the format kitti"});
+  // A file of keyframes (a frame number, then the 12 numbers) read as kitti names kitti-id.
+  p = Write("keyframes.txt", "0 " + ok + "5 " + ok);
+  ExpectInputError(read(p, TrajectoryFormat::kKitti),
+                   {Q(p) + ":1", "13 numbers", "expected 12",
+                    "a frame number then 12 numbers is the format kitti-id"});
   p = Write("nan_word.txt", ok + "1 0 0 x1 0 1 0 0 0 0 1 0\n");
   ExpectInputError(read(p, TrajectoryFormat::kKitti),
                    {Q(p) + ":2", "\"x1\"", "column 4", "not a number"});
@@ -299,6 +306,53 @@ TEST(AbsoluteTrajectoryError, StatisticsOfUnequalDistances) {
   const TrajectoryError odd = AbsoluteTrajectoryError(estimate, truth, {0, 1, 2, 0}, false);
   // Pose 3 (x = 3, y = 2) against truth 0 (origin): sqrt(13); sorted 1, 3, sqrt(13), 4.
   EXPECT_DOUBLE_EQ(odd.median, 0.5 * (3 + std::sqrt(13.0)));
+}
+
+// The hint of openable_snaps and Python at an estimate that cannot be a drifting estimate of
+// the truth's route: its aligned mean error beyond a quarter of the route's extent.
+TEST(ConventionHint, OnlyBeyondAQuarterOfTheRoutesExtent) {
+  // The truth: 0, 1, ..., 40 m along x; extent 40 m, a quarter 10 m.
+  std::vector<long> ids;
+  for (long i = 0; i <= 40; ++i) ids.push_back(i);
+  const Trajectory truth = Line(TrajectoryFormat::kKitti, ids);
+  TrajectoryError aligned;
+  aligned.aligned = true;
+  aligned.mean = 10.0;  // a quarter: drift, no hint
+  EXPECT_EQ(ConventionHint(aligned, truth), "");
+  aligned.mean = 10.5;
+  const std::string hint = ConventionHint(aligned, truth);
+  EXPECT_EQ(hint,
+            "the input is 10.5 m from the ground truth on average even after alignment, on a "
+            "route 40.0 m across: more than drift. Check Snaps_world_to_camera (1 when the file "
+            "holds world-to-camera matrices, as SO-DSO's poses_history_file.txt), "
+            "Snaps_trajectory_format and Snaps_ground_truth_format, and that both cover the same "
+            "frames.");
+  const ConventionWords python = {"the estimate", "world_to_camera", "True", "the formats"};
+  const std::string words = ConventionHint(aligned, truth, python);
+  EXPECT_EQ(words.rfind("the estimate is 10.5 m", 0), 0u) << words;
+  EXPECT_NE(words.find("Check world_to_camera (True when"), std::string::npos) << words;
+  EXPECT_EQ(ConventionHint(aligned, Trajectory()), "");  // no truth: nothing to compare
+}
+
+// SO-DSO's keyframes of KITTI 00 are world-to-camera: read as they are, the trajectory is
+// hundreds of metres off its route even after alignment, and the hint says why; read with
+// world_to_camera, it drifts by about 10 m and nothing is hinted.
+TEST(ConventionHint, SoDsoKeyframesReadWithoutWorldToCamera) {
+  const std::string root = DatasetsDir() + "/kitti_trajectories";
+  OPENABLE_REQUIRE_PATH(root);
+  const std::string vo = root + "/vo_so_dso/seq00/poses_history_file.txt";
+  const Trajectory truth = ReadTrajectory(root + "/poses/00.txt", TrajectoryFormat::kKitti);
+  for (const bool inverted : {false, true}) {
+    const Trajectory estimate = ReadTrajectory(vo, TrajectoryFormat::kKittiWithId, inverted);
+    const std::vector<int> a = AssociateWithTruth(estimate, truth, 0.02, "truth");
+    const TrajectoryError aligned = AbsoluteTrajectoryError(estimate, truth, a, true);
+    // The route's extent computed here, independently of the hint.
+    Eigen::AlignedBox3d box;
+    for (const Eigen::Isometry3d& p : truth.poses) box.extend(p.translation());
+    const double quarter = 0.25 * box.diagonal().norm();
+    EXPECT_EQ(ConventionHint(aligned, truth).empty(), aligned.mean <= quarter) << inverted;
+    EXPECT_EQ(ConventionHint(aligned, truth).empty(), inverted) << aligned.mean << " " << quarter;
+  }
 }
 
 }  // namespace
