@@ -90,6 +90,47 @@ class Interrupts(TempDirTestCase):
         self.assertIn("unchanged", outcomes)
 
 
+class MergeInterrupts(TempDirTestCase):
+    """SIGINT and SIGTERM at moments spread over a merge of two maps into a third."""
+
+    def test_no_output_or_the_whole_merge_and_one_line(self):
+        images = NORDLAND / "summer" if NORDLAND.exists() else SAMPLE / "summer"
+        a, b = self.tmp / "a.map", self.tmp / "b.map"
+        # HOG rows (a 13 MB map of Nordland): a merge long enough to be interrupted in its midst.
+        for path, name in ((a, "a"), (b, "b")):
+            run("openable_map", ["add", path, "--images", images, "--session", name, "--quiet",
+                                 "--set", "Image_descriptor=HOG"], self.tmp)
+        t0 = time.monotonic()
+        run("openable_map", ["merge", a, b, "-o", self.tmp / "timing.map", "--quiet"], self.tmp)
+        duration = time.monotonic() - t0
+        outcomes = set()
+        for k in range(36):  # twelve moments; again while no signal has met a running merge
+            if k >= 12 and outcomes & {"not written", "written"}:
+                break
+            out = self.tmp / ("c%d.map" % k)
+            p = start(["merge", a, b, "-o", out], self.tmp)
+            time.sleep(duration * (k % 12 + 0.5) / 12)
+            p.send_signal(signal.SIGTERM if k % 2 else signal.SIGINT)
+            _, err = p.communicate()
+            self.assertEqual(temporaries(self.tmp), [], err)
+            if out.exists():  # whole, with both sessions
+                self.assertEqual(sessions(out), ["a", "b"], err)
+            if p.returncode == 0:
+                self.assertTrue(out.exists())
+                outcomes.add("finished")
+                continue
+            if p.returncode < 0:  # the signal came before the program began: nothing done
+                self.assertFalse(out.exists())
+                continue
+            self.assertIn(p.returncode, (130, 143), err)
+            lines = [line for line in err.splitlines() if "interrupted" in line]
+            self.assertEqual(len(lines), 1, err)
+            outcomes.add("written" if out.exists() else "not written")
+            if out.exists():
+                self.assertIn("%s written" % out.name, lines[0])
+        self.assertTrue(outcomes & {"not written", "written"}, outcomes)
+
+
 class Times(TempDirTestCase):
     def test_time_is_iso_8601_utc(self):
         path = self.tmp / "t.map"
