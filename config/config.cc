@@ -179,7 +179,8 @@ void AddDescriptionKeys(OptionTable& t, Config& c) {
   t.Add("Image_descriptor", kDescription, c.descriptor, c.descriptor.name,
         "LDB, D-LDB (LDB of the grey and of the disparity image; needs Camera_type 1), ORB, "
         "BRISK, BRIEF, FREAK (binary, Hamming distance), SIFT, HOG (vector, L2 distance) or SAD "
-        "(SeqSLAM's patch-normalised thumbnail, sum of absolute differences; Sad_patch). Several "
+        "(SeqSLAM's patch-normalised thumbnail, sum of absolute differences; Sad_patch), or ONNX "
+        "(a network of the user's, Model_path; float rows, L2 distance). Several "
         "names joined by + or , (HOG+LDB) fuse their matrices (Fusion_weights). SURF is not "
         "available (non-free, absent from Debian's OpenCV).", false);
   t.Add("Image_sequences", kDescription, c.matching, c.matching.sequence_length, 1, 100000,
@@ -195,6 +196,29 @@ void AddDescriptionKeys(OptionTable& t, Config& c) {
   t.Add("Sad_patch", kDescription, c.descriptor, c.descriptor.sad_patch, 2, 64,
         "SAD: side in pixels of the squares of the Patch_size x Patch_size/2 thumbnail that are "
         "each normalised to zero mean and unit deviation (8 in SeqSLAM); at most Patch_size/2.");
+  t.Add("Model_path", kDescription, c.descriptor, c.descriptor.model_path,
+        "Image_descriptor ONNX: the .onnx file of a network whose output is one vector per "
+        "image (NetVLAD, CosPlace, MixVPR, EigenPlaces, ...), run by OpenCV's DNN module. Its "
+        "rows are floats matched by L2. See docs/descriptors.md, \"Bring your own "
+        "descriptor\".");
+  t.Add("Model_input_size", kDescription, c.descriptor, c.descriptor.model_input_size,
+        "Image_descriptor ONNX: the network's input as WxH pixels (e.g. 224x224); each frame "
+        "(each cell of a grid, each sub-panorama) is resized to it.");
+  t.Add("Model_channels", kDescription, c.descriptor, c.descriptor.model_channels,
+        "Image_descriptor ONNX: the channels the network takes, in order: rgb (torchvision's "
+        "models), bgr or grey.");
+  t.Add("Model_mean", kDescription, c.descriptor, c.descriptor.model_mean,
+        "Image_descriptor ONNX: per channel, subtracted from the pixels scaled to [0, 1] "
+        "(comma-separated, or one value for all); ImageNet's by default.");
+  t.Add("Model_std", kDescription, c.descriptor, c.descriptor.model_std,
+        "Image_descriptor ONNX: per channel, the scaled pixels minus Model_mean are divided by "
+        "it (positive; comma-separated, or one value for all); ImageNet's by default.");
+  t.Add("Model_normalize", kDescription, c.descriptor, c.descriptor.model_normalize,
+        "Image_descriptor ONNX: 1 divides each output row by its L2 norm (as NetVLAD and its "
+        "successors are compared); 0 keeps the network's output as it is.");
+  t.Add("Model_batch", kDescription, c.descriptor, c.descriptor.model_batch, 1, 1024,
+        "Image_descriptor ONNX: images per forward pass (a network exported without a dynamic "
+        "batch axis runs one at a time whatever this says).");
   t.Add("Threads", kDescription, c.matching, c.matching.threads, 0, 1024,
         "Worker threads for description and matching; 0 = all cores.");
   t.AddEnumNumber("Sequence_direction", kDescription, c.matching, c.matching.direction,

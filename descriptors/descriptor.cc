@@ -1,5 +1,6 @@
 #include "descriptors/descriptor.h"
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
@@ -24,6 +25,10 @@ void DescriptorOptions::Check() const {
     throw InputError("Ldb_bits: " + std::to_string(ldb_bits) +
                      " is out of range; expected an integer in [1, 1386]");
   }
+  if (model_batch < 1 || model_batch > 1024) {
+    throw InputError("Model_batch: " + std::to_string(model_batch) +
+                     " is out of range; expected an integer in [1, 1024]");
+  }
   if (sad_patch < 2 || sad_patch > 64) {
     throw InputError("Sad_patch: " + std::to_string(sad_patch) +
                      " is out of range; expected an integer in [2, 64]");
@@ -35,12 +40,21 @@ Descriptor::Descriptor(const DescriptorOptions& options) : patch_size_(options.p
 }
 
 void Descriptor::CheckPatch(const cv::Mat& patch) const {
-  if (patch.type() != CV_8UC(Channels()) || patch.rows != patch_size_ ||
-      patch.cols != patch_size_) {
-    throw std::logic_error(Name() + ": expected a " + std::to_string(patch_size_) + " x " +
-                           std::to_string(patch_size_) + " " +
+  const cv::Size size = InputSize();
+  if (patch.type() != CV_8UC(Channels()) || patch.rows != size.height ||
+      patch.cols != size.width) {
+    throw std::logic_error(Name() + ": expected a " + std::to_string(size.height) + " x " +
+                           std::to_string(size.width) + " " +
                            cv::typeToString(CV_8UC(Channels())) + " patch, got " + Shape(patch));
   }
+}
+
+void Descriptor::DescribeBatch(const std::vector<cv::Mat>& patches, cv::Mat rows) const {
+  if (rows.rows != static_cast<int>(patches.size()))
+    throw std::logic_error(Name() + ": " + std::to_string(patches.size()) + " patches for " +
+                           std::to_string(rows.rows) + " rows");
+  for (std::size_t i = 0; i < patches.size(); ++i)
+    Describe(patches[i], rows.row(static_cast<int>(i)));
 }
 
 void Descriptor::Describe(const cv::Mat& patch, cv::Mat row) const {

@@ -29,6 +29,14 @@ struct DescriptorOptions {
   int patch_size = 64;       // side of the square patch, pixels, 16..1024
   int ldb_bits = 256;        // LDB bits kept after selection, 1..1386 (32 bytes = 256 in ABLE-P)
   int sad_patch = 8;         // SAD: side of the normalised squares, pixels, 2..64 (SeqSLAM: 8)
+  // ONNX (descriptors/onnx.h): a network of the user's, run by OpenCV's DNN module.
+  std::string model_path;               // the .onnx file
+  std::string model_input_size;         // "WxH" of the network's input; "": the model's own
+  std::string model_channels = "rgb";   // rgb, bgr or grey: the channels the network takes
+  std::string model_mean = "0.485,0.456,0.406";  // per channel, after scaling pixels to [0, 1]
+  std::string model_std = "0.229,0.224,0.225";   // per channel (ImageNet's, as torchvision's)
+  bool model_normalize = true;          // L2-normalise each output row
+  int model_batch = 16;                 // frames per forward pass, 1..1024
 
   // Throws InputError naming the key (Patch_size, Ldb_bits, Sad_patch), the value and the
   // valid range.
@@ -56,9 +64,20 @@ class Descriptor {
   }
   // Side of the square patch this descriptor expects.
   int PatchSize() const { return patch_size_; }
+  // The size of the image Describe takes: the square patch, or a network's input (ONNX).
+  virtual cv::Size InputSize() const { return cv::Size(patch_size_, patch_size_); }
   // Channels of the patch: 1 (grey) for every descriptor but D-LDB, whose patch has 2
-  // (channel 0 grey, channel 1 disparity, both CV_8U; descriptors/dldb.h).
+  // (channel 0 grey, channel 1 disparity, both CV_8U; descriptors/dldb.h), and ONNX, whose
+  // patch has 3 (the frame's colours, BGR, as OpenCV holds them).
   virtual int Channels() const { return 1; }
+  // What else than the settings makes this descriptor's rows: a network's weights (a digest of
+  // the model file); empty for the hand-crafted descriptors. Part of the descriptor cache's key.
+  virtual std::string Fingerprint() const { return std::string(); }
+  // Describes several patches at once into the rows of `rows` (patches.size() x Width()), as
+  // Describe would one by one; a network runs them as one batch. Thread-safe.
+  virtual void DescribeBatch(const std::vector<cv::Mat>& patches, cv::Mat rows) const;
+  // The patches DescribeBatch is best given at once (1: no gain from batches).
+  virtual int PreferredBatch() const { return 1; }
   // Describes `patch` (CV_8UC(Channels()), PatchSize() x PatchSize()) into `row`, a 1 x Width()
   // matrix of CV_8U (binary) or CV_32F (float) that the caller allocated. Deterministic and
   // safe to call from several threads at once. Checks both once for every descriptor (after

@@ -2,6 +2,9 @@
 // of ABLE-P, over any descriptor of the registry.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/base/enum_names.h"
@@ -52,6 +55,25 @@ class FrameDescriber {
   // (1 x RowWidth(), RowType()). Every channel of a cell is resized alike. Thread-safe.
   // Throws std::logic_error on another type or a smaller image.
   void Describe(const cv::Mat& image, cv::Mat row) const;
+
+  // Whether frames are best described several at once (a network: Descriptor::PreferredBatch
+  // above 1): then the caller cuts each frame's patches (Patches, in parallel) and describes
+  // the patches of many frames in one call (DescribePatches).
+  bool Batched() const { return descriptor_.PreferredBatch() > 1; }
+  // The descriptor's Fingerprint (a network's weights): part of the descriptor cache's key.
+  std::string Fingerprint() const { return descriptor_.Fingerprint(); }
+  // Frames whose patches make about one batch.
+  int PreferredBatchOfFrames() const {
+    const int per_frame = grid_x_ * grid_y_ * panoramas_;
+    return descriptor_.PreferredBatch() > per_frame ? descriptor_.PreferredBatch() / per_frame
+                                                     : 1;
+  }
+  // The patches Describe would describe for `image`, in row order (sub-panorama, then cell),
+  // each resized to the descriptor's input. Thread-safe; throws as Describe.
+  std::vector<cv::Mat> Patches(const cv::Mat& image) const;
+  // Describes the patches of several frames (Patches of each, concatenated) into `rows`
+  // (frames x RowWidth()), Descriptor::PreferredBatch patches at a time.
+  void DescribePatches(const std::vector<cv::Mat>& patches, cv::Mat rows) const;
 
  private:
   const Descriptor& descriptor_;

@@ -12,6 +12,7 @@
 #include "descriptors/dldb.h"
 #include "descriptors/hog.h"
 #include "descriptors/ldb.h"
+#include "descriptors/onnx.h"
 #include "descriptors/opencv_descriptors.h"
 #include "descriptors/sad.h"
 
@@ -41,6 +42,7 @@ const Entry kDescriptors[] = {
     {"SIFT", &Make<SiftDescriptor>},    // descriptors/opencv_descriptors.h
     {"HOG", &Make<HogDescriptor>},      // descriptors/hog.h
     {"SAD", &Make<SadDescriptor>},      // descriptors/sad.h (SeqSLAM; byte values, L1 distance)
+    {"ONNX", &Make<OnnxDescriptor>},    // descriptors/onnx.h (a network of the user's; Model_path)
 };
 
 struct Unavailable {

@@ -8,6 +8,7 @@
 //                   PNG and JPEG are decoded and PNG written in the program itself)
 //   openable_mpi    Open MPI, for runs spread over processes (OpenABLE/cluster/cluster.h)
 //   openable_faiss  FAISS, approximate search (matching/search/approximate.h)
+//   openable_dnn    OpenCV dnn (ONNX networks of the ONNX descriptor, descriptors/onnx.h)
 //   openable_rosbag ROS 1 bags (rosbag_storage: Boost, lz4, bz2, the ROS plugin loader)
 //
 // Debian's OpenImageIO and videoio pull in about 250 shared libraries each (FFmpeg, GDAL,

@@ -44,7 +44,7 @@ foreach(folder OpenABLE descriptors matching config)
 endforeach()
 
 # Run-time modules (OpenABLE/base/module_loader.h), where module_loader.cc looks for them.
-install(TARGETS openable_oiio openable_video openable_gui openable_codecs
+install(TARGETS openable_oiio openable_video openable_gui openable_codecs openable_dnn
   LIBRARY DESTINATION "${OPENABLE_INSTALL_MODULEDIR}")
 if(TARGET openable_mpi)  # runs over several processes (docs/distributed.md)
   install(TARGETS openable_mpi LIBRARY DESTINATION "${OPENABLE_INSTALL_MODULEDIR}")

@@ -78,6 +78,13 @@ std::vector<DescribedSequence> DescribeSequences(
   // Describes frame i once it is in memory with the descriptors whose rows are not cached
   // (`needed`); records a size mismatch as a failure. The frame is converted once for all of
   // them: grey (or Eq. 6) for every descriptor, grey + disparity (a stereo frame) for D-LDB.
+  // Descriptors that run on batches (a network): each frame's patches wait in `pending` until
+  // `flush` describes those of many frames in one call.
+  bool any_batched = false;
+  for (const FrameDescriber* d : describers) any_batched = any_batched || d->Batched();
+  std::vector<std::vector<std::vector<cv::Mat>>> pending(
+      static_cast<size_t>(kinds), std::vector<std::vector<cv::Mat>>(any_batched ? n : 0));
+  std::vector<cv::Size> read_sizes(any_batched ? n : 0);
   auto describe = [&](int i, const cv::Mat& frame, const std::vector<char>& needed) {
     if (!check_size(i, frame.size())) return;
     // Noise (robustness studies) on the frame as read, before any conversion.
@@ -86,22 +93,25 @@ std::vector<DescribedSequence> DescribeSequences(
                                NoiseState(noise.seed, options.noise_stream,
                                           options.share_first + i))
                     : frame;
-    cv::Mat images[2];  // [0]: grey or Eq. 6, then side-window fusion; [1]: grey + disparity
+    // [0]: grey or Eq. 6, then side-window fusion; [1]: grey + disparity; [2]: colour (BGR)
+    cv::Mat images[3];
     for (int k = 0; k < kinds; ++k) {
       if (!needed[static_cast<size_t>(k)]) continue;
       const FrameDescriber& describer = *describers[static_cast<size_t>(k)];
-      const int kind = describer.Channels() == 2 ? 1 : 0;
+      const int kind = describer.Channels() == 2 ? 1 : describer.Channels() == 3 ? 2 : 0;
       cv::Mat& image = images[kind];
       if (image.empty()) {
         try {
           image = kind == 1                  ? ToGrayDisparity8(input)
+                  : kind == 2                ? ToColour8(input)
                   : illumination_invariance ? cv::Mat(IlluminationInvariant(input, alpha))
                                             : cv::Mat(ToGray8(input));
         } catch (const InputError& e) {
           fail(i, "image " + Quoted(source.FrameName(i)) + ": " + e.what());
           return;
         }
-        if (!side_window_radii.empty()) image = SideWindowFusion(image, side_window_radii);
+        if (kind == 0 && !side_window_radii.empty())
+          image = SideWindowFusion(image, side_window_radii);
       }
       const cv::Size need = describer.MinimumFrame();
       if (image.cols < need.width || image.rows < need.height) {
@@ -110,12 +120,44 @@ std::vector<DescribedSequence> DescribeSequences(
                     " (Grid_x x Panoramas by Grid_y pixels)");
         return;
       }
+      if (describer.Batched()) {
+        pending[static_cast<size_t>(k)][static_cast<size_t>(i)] = describer.Patches(image);
+        read_sizes[static_cast<size_t>(i)] = frame.size();
+        continue;
+      }
       describer.Describe(image, rows[static_cast<size_t>(k)].row(i));
       if (caches[static_cast<size_t>(k)] != nullptr && use_caches)
         caches[static_cast<size_t>(k)]->Store(source, i, rows[static_cast<size_t>(k)].row(i),
                                              frame.size());
     }
     ok[i] = 1;
+  };
+  // The waiting patches of frames [first, last) described, batch by batch, then cached.
+  auto flush = [&](int first, int last) {
+    for (int k = 0; k < kinds; ++k) {
+      const FrameDescriber& describer = *describers[static_cast<size_t>(k)];
+      if (!describer.Batched()) continue;
+      std::vector<int> frames;
+      std::vector<cv::Mat> patches;
+      for (int i = first; i < last; ++i) {
+        std::vector<cv::Mat>& p = pending[static_cast<size_t>(k)][static_cast<size_t>(i)];
+        if (p.empty()) continue;
+        frames.push_back(i);
+        for (cv::Mat& m : p) patches.push_back(std::move(m));
+        p.clear();
+      }
+      if (frames.empty()) continue;
+      cv::Mat described(static_cast<int>(frames.size()), describer.RowWidth(),
+                        describer.RowType());
+      describer.DescribePatches(patches, described);
+      for (size_t r = 0; r < frames.size(); ++r) {
+        const int i = frames[r];
+        described.row(static_cast<int>(r)).copyTo(rows[static_cast<size_t>(k)].row(i));
+        if (caches[static_cast<size_t>(k)] != nullptr && use_caches)
+          caches[static_cast<size_t>(k)]->Store(source, i, rows[static_cast<size_t>(k)].row(i),
+                                               read_sizes[static_cast<size_t>(i)]);
+      }
+    }
   };
   const std::vector<char> all_needed(static_cast<size_t>(kinds), 1);
   auto report = [&]() {
@@ -164,9 +206,21 @@ std::vector<DescribedSequence> DescribeSequences(
         describe(frames[k].first, frames[k].second, all_needed);
         report();
       });
+      if (any_batched && !stopped()) flush(start, std::min(n, start + batch));
     }
   } else {
-    ParallelFor(n, threads, [&](int i) {
+    // With a network, frames in chunks: each chunk's frames read and cut in parallel, then
+    // their patches described in batches (the network uses every core itself).
+    int chunk = n;
+    if (any_batched) {
+      chunk = std::max(1, threads * 8);
+      for (const FrameDescriber* d : describers)
+        if (d->Batched()) chunk = std::max(chunk, d->PreferredBatchOfFrames());
+    }
+    for (int start = 0; start < n && !stopped(); start += chunk) {
+    const int end = std::min(n, start + chunk);
+    ParallelFor(end - start, threads, [&](int j) {
+      const int i = start + j;
       if (stopped()) return;
       // Rows of the caches first; the frame is read only when a descriptor still needs it.
       std::vector<char> needed(static_cast<size_t>(kinds), 1);
@@ -193,6 +247,8 @@ std::vector<DescribedSequence> DescribeSequences(
       }
       report();
     });
+    if (any_batched && !stopped()) flush(start, end);
+    }
   }
 
   if (error_index < n) throw InputError(prefix + error_message);

@@ -43,6 +43,22 @@ cv::Mat1b ToGray8(const cv::Mat& frame) {
   return out;
 }
 
+cv::Mat ToColour8(const cv::Mat& frame) {
+  if (frame.depth() != CV_32F || frame.channels() > 3)
+    throw std::logic_error("ToColour8: expected a CV_32FC1, CV_32FC2 or CV_32FC3 frame");
+  cv::Mat colour;
+  if (frame.channels() == 3) {
+    colour = frame;
+  } else {
+    cv::Mat grey = frame;
+    if (frame.channels() == 2) cv::extractChannel(frame, grey, 0);
+    cv::cvtColor(grey, colour, cv::COLOR_GRAY2BGR);
+  }
+  cv::Mat out;
+  colour.convertTo(out, CV_8U, 255.0);  // saturating and rounding
+  return out;
+}
+
 cv::Mat1b IlluminationInvariant(const cv::Mat& frame, double alpha) {
   if (frame.depth() != CV_32F)
     throw std::logic_error("IlluminationInvariant: expected a CV_32F frame");

@@ -23,6 +23,12 @@ cv::Mat1b ToGray8(const cv::Mat& frame);
 // Test_OpenABLE applies. Throws InputError "<what> is empty / has OpenCV type ..." otherwise.
 cv::Mat1b GreyOfImage(const cv::Mat& image, const std::string& what);
 
+// Colour 8-bit version of a frame as given by a FrameSource (CV_8UC3, BGR; value x 255,
+// rounded): the image a network describes (descriptors/onnx.h). A grey frame gives its grey
+// value in all three channels; a stereo frame (CV_32FC2), its rectified left image so.
+// Throws std::logic_error on any other type.
+cv::Mat ToColour8(const cv::Mat& frame);
+
 // Both channels of a stereo frame (CV_32FC2 in [0, 1]) as CV_8UC2 (value x 255, rounded): the
 // patch D-LDB describes. Throws std::logic_error on any other type.
 cv::Mat ToGrayDisparity8(const cv::Mat& frame);

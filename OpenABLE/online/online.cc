@@ -147,6 +147,15 @@ void OnlineOptions::Check() const {
 
 Describer MakeDescriber(const OnlineOptions& options) {
   options.Check();
+  // A network (descriptors/onnx.h) describes the frames of a run (Test_OpenABLE, openable_sweep,
+  // runs over processes); the online detector, its maps and Python's describe functions give
+  // it no model settings yet, and are told so rather than asked for a Model_path they cannot
+  // take.
+  if (Upper(Trim(options.descriptor.name)) == "ONNX")
+    throw InputError("descriptor: \"ONNX\" (a network) describes the frames of Test_OpenABLE "
+                     "and openable_sweep runs, not yet those of the online detector, its maps or "
+                     "Python's describe functions; expected one of the built-in descriptors here "
+                     "(docs/descriptors.md, \"Bring your own descriptor\")");
   Describer out;
   out.descriptor = CreateDescriptor(options.descriptor);
   // A grey image per frame: descriptors of several channels (D-LDB: grey + disparity) need

@@ -103,8 +103,12 @@ std::string DescriptionSettingsText(const Config& config, const std::string& des
                   "\nOpenABLE " + kVersion + "\ndescriptor: " + descriptor_name +
                   "\nrow: " + std::to_string(row_width) + " x " + cv::typeToString(row_type) +
                   "\n";
+  // The keys of a network (Model_*) only for rows a network made ("ONNX", with its weights'
+  // digest), so that the caches of the other descriptors keep the keys they were written with.
+  const bool network = descriptor_name.rfind("ONNX", 0) == 0;
   for (const std::string& key : DescriptionKeys())
-    s += key + ": " + ConfigValueText(config, key) + "\n";
+    if (network || key.rfind("Model_", 0) != 0)
+      s += key + ": " + ConfigValueText(config, key) + "\n";
   return s;
 }
 

@@ -77,8 +77,11 @@ std::unique_ptr<DescriptorCache> OpenDescriptorCache(const ToDescribe& d, const 
                                   std::to_string(cluster.Rank()) + "-of-" +
                                   std::to_string(cluster.Size())
                             : scale.descriptor_cache,
-      DescriptionSettingsText(*d.config, d.name, d.describer->RowWidth(),
-                              d.describer->RowType()),
+      DescriptionSettingsText(*d.config,
+                              d.describer->Fingerprint().empty()
+                                  ? d.name
+                                  : d.name + " (weights " + d.describer->Fingerprint() + ")",
+                              d.describer->RowWidth(), d.describer->RowType()),
       d.describer->RowWidth(), d.describer->RowType(), out.warnings);
 }
 

@@ -19,6 +19,7 @@
 #include "tests/descriptors/descriptor_test_util.h"
 #include "descriptors/descriptor.h"
 #include "descriptors/registry.h"
+#include "tests/test_support.h"
 
 namespace openable {
 namespace {
@@ -43,6 +44,8 @@ const std::map<std::string, Expected>& ExpectedFor64() {
       {"BRIEF", {32, DescriptorKind::kBinary}},  // 256 tests
       {"FREAK", {64, DescriptorKind::kBinary}},  // 512 pairs
       {"SAD", {2048, DescriptorKind::kBytes}},   // 64 x 32 thumbnail
+      // the test network with GeM pooling (tests/data/onnx/gem.onnx): 32 channels pooled
+      {"ONNX", {32, DescriptorKind::kFloat}},
   };
   return table;
 }
@@ -73,12 +76,14 @@ double Distance(const Descriptor& d, const cv::Mat& a, const cv::Mat& b) {
 }
 
 // A patch of the descriptor's channel count: the textured grey patch, and for a 2-channel
-// descriptor (D-LDB: grey, disparity) a second, independent textured patch as channel 1.
+// descriptor (D-LDB: grey, disparity) or a 3-channel one (ONNX: colour) independent textured
+// patches as the other channels.
 cv::Mat PatchFor(const Descriptor& d, int size, std::uint64_t seed) {
   if (d.Channels() == 1) return TexturedPatch(size, seed);
-  const cv::Mat channels[2] = {TexturedPatch(size, seed), TexturedPatch(size, seed + 7919)};
+  std::vector<cv::Mat> channels;
+  for (int c = 0; c < d.Channels(); ++c) channels.push_back(TexturedPatch(size, seed + 7919 * c));
   cv::Mat out;
-  cv::merge(channels, 2, out);
+  cv::merge(channels, out);
   return out;
 }
 
@@ -92,6 +97,10 @@ class DescriptorConformance : public ::testing::TestWithParam<std::string> {
   std::unique_ptr<Descriptor> Make(int patch_size = 64) const {
     DescriptorOptions options;
     options.patch_size = patch_size;
+    // A network: the test network with GeM pooling, which takes any input size; its input is
+    // the square patch here.
+    options.model_path = testing::SourceDir() + "/tests/data/onnx/gem.onnx";
+    options.model_input_size = std::to_string(patch_size) + "x" + std::to_string(patch_size);
     return CreateDescriptor(GetParam(), options);
   }
 };
@@ -206,7 +215,7 @@ TEST_P(DescriptorConformance, RejectsPatchOfWrongSizeOrType) {
       cv::Mat(64, 65, CV_8UC(c), cv::Scalar::all(9)),
       cv::Mat(32, 32, CV_8UC(c), cv::Scalar::all(9)),
       cv::Mat(64, 64, CV_8UC(c == 1 ? 2 : 1), cv::Scalar::all(9)),  // the other channel count
-      cv::Mat(64, 64, CV_8UC3, cv::Scalar::all(9)),
+      cv::Mat(64, 64, CV_8UC(c == 3 ? 4 : 3), cv::Scalar::all(9)),
       cv::Mat(64, 64, CV_32FC1, cv::Scalar(9)),
       cv::Mat(64, 64, CV_16UC1, cv::Scalar(9)),
   };

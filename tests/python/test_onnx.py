@@ -1,0 +1,81 @@
+"""A whole Test_OpenABLE run on a network's rows (Image_descriptor ONNX) against NumPy: the 16
+frames PyTorch described in tests/data/onnx/make_models.py, the pairwise L2 distances of
+PyTorch's vectors divided by their largest (Eq. 5), as the run's matrix must hold them."""
+import unittest
+
+import numpy as np
+
+from support import SAMPLE, SOURCE_DIR, TempDirTestCase, run, settings
+
+ONNX = SOURCE_DIR / "tests" / "data" / "onnx"
+CONFIG = SOURCE_DIR / "config" / "Config.txt"
+
+
+def numpy_matrix(rows):
+    """M' of single frames: L2 distances of the rows, divided by the largest."""
+    rows = rows.astype(np.float64)
+    d = np.sqrt(np.maximum(((rows[:, None, :] - rows[None, :, :]) ** 2).sum(axis=2), 0.0))
+    return d / d.max()
+
+
+class OnnxRunTest(TempDirTestCase):
+    def test_the_run_matrix_is_numpys_on_pytorchs_vectors(self):
+        # The frames PyTorch described, in a folder of their own (their names sort as listed).
+        frames = self.tmp / "frames"
+        frames.mkdir()
+        for line in (ONNX / "frames.txt").read_text().split():
+            (frames / line).symlink_to(SAMPLE / "summer" / line)
+        for name in ("netvlad", "gem", "projection"):
+            expected = numpy_matrix(np.load(ONNX / ("%s_outputs.npy" % name)))
+            out = self.tmp / ("%s.npy" % name)
+            run("Test_OpenABLE",
+                [CONFIG, "--quiet"] + settings(
+                    "Images_path=%s" % frames, "Images_path_2=",
+                    "Image_descriptor=ONNX", "Model_path=%s" % (ONNX / ("%s.onnx" % name)),
+                    "Model_input_size=64x32", "Model_normalize=0", "Image_sequences=1",
+                    "Exclusion=1", "Ground_truth_type=none", "Npy_name=%s" % out, "Png_name=",
+                    "Txt_name=", "Evaluation_name=", "Report_name="), self.tmp)
+            m = np.load(out)
+            self.assertEqual(m.shape, (16, 16))
+            # The run takes L2 distances as sqrt(|a|^2 + |b|^2 - 2 a.b) in float32 (OpenBLAS),
+            # which loses about 1e-7 |a|^2 / d of a distance d: up to 2e-5 of the largest here
+            # (the projection's rows are not normalised, its distances small against its
+            # norms). A wrong row, order or normalisation is off by 1e-2 or more.
+            self.assertLess(np.abs(m - expected).max(), 1e-4, name)
+
+    def test_a_bad_model_is_one_line_and_nothing_written(self):
+        bad = self.tmp / "bad.onnx"
+        bad.write_bytes(b"not a network")
+        import subprocess
+        from support import program
+        done = subprocess.run(
+            [program("Test_OpenABLE"), str(CONFIG), "--quiet"] + settings(
+                "Images_path=%s" % (SAMPLE / "summer"), "Images_path_2=",
+                "Image_descriptor=ONNX", "Model_path=%s" % bad, "Model_input_size=64x32",
+                "Npy_name=%s" % (self.tmp / "none.npy")),
+            cwd=str(self.tmp), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.assertEqual(done.returncode, 1, done.stderr)
+        self.assertEqual(len(done.stderr.strip().splitlines()), 1, done.stderr)
+        self.assertIn("not an ONNX network", done.stderr)
+        self.assertFalse((self.tmp / "none.npy").exists())
+
+    def test_the_online_detector_says_it_runs_no_network_yet(self):
+        import openable
+        image = np.zeros((32, 64), np.uint8)
+        with self.assertRaises(openable.InputError) as caught:
+            openable.describe_images([image], descriptor="ONNX")
+        self.assertIn("not yet those of the online detector", str(caught.exception))
+        import subprocess
+        from support import program
+        done = subprocess.run(
+            [program("openable_map"), "add", str(self.tmp / "m.map"), "--images",
+             str(SAMPLE / "summer"), "--session", "s", "--set", "Image_descriptor=ONNX"],
+            cwd=str(self.tmp), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.assertEqual(done.returncode, 1, done.stderr)
+        self.assertEqual(len(done.stderr.strip().splitlines()), 1, done.stderr)
+        self.assertIn("not yet those of the online detector", done.stderr)
+        self.assertFalse((self.tmp / "m.map").exists())
+
+
+if __name__ == "__main__":
+    unittest.main()
