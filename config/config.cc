@@ -62,6 +62,15 @@ void AddInputKeys(OptionTable& t, Config& c) {
         "Folder of a second traversal of the route (Frame_mode 0). The matrix covers both "
         "sequences concatenated (Images_path first), so its lower-left block holds every frame of"
         " this folder (rows) against every frame of Images_path (columns). Empty: one sequence.");
+  t.Add("Descriptors_path", kDatasets, c.input, c.input.descriptors_path,
+        "A .npy of one descriptor row per frame of the first traversal, computed elsewhere (a "
+        "learned model's features, as VPR_Tutorial and hloc save them): float32 rows are matched "
+        "by L2, uint8 rows as bits by Hamming. The frames are not described (Image_descriptor "
+        "is not used) but still listed: one row per frame the run reads, in its order. See "
+        "docs/descriptors.md, \"Features computed elsewhere\".");
+  t.Add("Descriptors_path_2", kDatasets, c.input, c.input.descriptors_path_2,
+        "The rows of the second traversal's frames, as Descriptors_path (same width and type); "
+        "needed with a second traversal when Descriptors_path is given.");
   t.Add("Images_path_left", kDatasets, c.input, c.input.images_path_left,
         "Left image folder of a stereo camera (Camera_type 1; Images_path is then not used). Same"
         " Images_format and Initial_image/Final_image range as Images_path; the frame names of "

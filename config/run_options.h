@@ -46,6 +46,10 @@ struct InputOptions {
   int final_image = -1;           // one past the last position; -1: to the end
   bool skip_unreadable = false;   // skip unreadable frames with a warning instead of stopping
   CameraType camera_type = CameraType::kMonocular;
+  // Rows computed elsewhere (a .npy of one row per frame), in place of describing the frames
+  // of the first and of the second traversal (OpenABLE/run/given_rows.h).
+  std::string descriptors_path;
+  std::string descriptors_path_2;
 
   // Throws InputError naming the key: a range that selects nothing, the inputs the frame mode
   // and camera read not given, a stereo camera with videos or a second traversal.

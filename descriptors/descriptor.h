@@ -78,6 +78,9 @@ class Descriptor {
   virtual void DescribeBatch(const std::vector<cv::Mat>& patches, cv::Mat rows) const;
   // The patches DescribeBatch is best given at once (1: no gain from batches).
   virtual int PreferredBatch() const { return 1; }
+  // Rows given rather than described (features computed elsewhere, OpenABLE/run/given_rows.h):
+  // those of traversal `traversal`, one per frame; nullptr for a descriptor that describes.
+  virtual const cv::Mat* GivenRows(int /*traversal*/) const { return nullptr; }
   // Describes `patch` (CV_8UC(Channels()), PatchSize() x PatchSize()) into `row`, a 1 x Width()
   // matrix of CV_8U (binary) or CV_32F (float) that the caller allocated. Deterministic and
   // safe to call from several threads at once. Checks both once for every descriptor (after

@@ -60,6 +60,8 @@ class FrameDescriber {
   // above 1): then the caller cuts each frame's patches (Patches, in parallel) and describes
   // the patches of many frames in one call (DescribePatches).
   bool Batched() const { return descriptor_.PreferredBatch() > 1; }
+  // The rows of traversal `t` when they are given, not described (Descriptor::GivenRows).
+  const cv::Mat* GivenRows(int t) const { return descriptor_.GivenRows(t); }
   // The descriptor's Fingerprint (a network's weights): part of the descriptor cache's key.
   std::string Fingerprint() const { return descriptor_.Fingerprint(); }
   // Frames whose patches make about one batch.

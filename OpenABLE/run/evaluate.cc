@@ -39,7 +39,12 @@ EvaluationSettings EvaluationSettingsFrom(const Config& c) {
 
 std::string RunLabel(const Config& config) {
   if (!config.evaluation.label.empty()) return config.evaluation.label;
+  // Rows given by a file are named by it (its name without ".npy").
   std::string label = config.descriptor.name;
+  if (!config.input.descriptors_path.empty()) {
+    label = std::filesystem::path(config.input.descriptors_path).stem().string();
+    if (label.empty()) label = "NPY";
+  }
   if (config.description.type == DescriptionType::kGrid)
     label += " " + std::to_string(config.description.grid_x) + "x" +
              std::to_string(config.description.grid_y);

@@ -85,6 +85,39 @@ std::unique_ptr<DescriptorCache> OpenDescriptorCache(const ToDescribe& d, const 
       d.describer->RowWidth(), d.describer->RowType(), out.warnings);
 }
 
+// The rows given for every source (Descriptors_path, OpenABLE/run/given_rows.h): nothing is
+// described; the frames are listed (names, times) and the first one read for its size.
+Described GivenRowsDescribed(const FrameDescriber& describer,
+                             const std::vector<SourceSpec>& specs,
+                             const std::vector<std::unique_ptr<FrameSource>>& sources) {
+  Described out;
+  std::vector<cv::Mat> blocks;
+  int row = 0;
+  for (size_t s = 0; s < sources.size(); ++s) {
+    const cv::Mat& rows = *describer.GivenRows(static_cast<int>(s));
+    Traversal tr;
+    tr.key = specs[s].key;
+    tr.path = specs[s].path;
+    tr.first_row = row;
+    tr.frames = rows.rows;
+    tr.frame_size = sources[s]->Read(0).size();
+    for (int i = 0; i < sources[s]->Size(); ++i) {
+      tr.names.push_back(sources[s]->FrameName(i));
+      tr.times.push_back(sources[s]->Timestamp(i));
+    }
+    if (std::any_of(tr.times.begin(), tr.times.end(), [](double t) { return std::isnan(t); }))
+      tr.times.clear();  // a source without times
+    row += tr.frames;
+    out.frames += sources[s]->Size();
+    out.traversals.push_back(std::move(tr));
+    blocks.push_back(rows);
+  }
+  cv::vconcat(blocks, out.rows);
+  out.notes.push_back("Descriptors_path: the rows of " + std::to_string(out.frames) +
+                      " frames given, none described");
+  return out;
+}
+
 // Describes every source with each descriptor of `all`. In one process, each frame is read and
 // converted once for all of them (DescribeSequences: decoding a KITTI frame costs more than
 // describing it with LDB or HOG); spread over processes, one descriptor after the other
@@ -106,6 +139,8 @@ std::vector<Described> DescribeSources(const std::vector<ToDescribe>& all,
   const Config& config = *all.front().config;
   const InputOptions& input = config.input;
   const int count = static_cast<int>(all.size());
+  if (count == 1 && all.front().describer->GivenRows(0) != nullptr)
+    return {GivenRowsDescribed(*all.front().describer, specs, sources)};
   std::vector<Described> out(static_cast<size_t>(count));
   DescribeOptions options;
   options.threads = config.matching.threads;

@@ -1,5 +1,7 @@
 #include "OpenABLE/run/plan.h"
 
+#include "OpenABLE/run/given_rows.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -139,6 +141,49 @@ std::vector<std::unique_ptr<FrameSource>> FramesOfRows(
 
 namespace {
 
+// The descriptor of rows given by Descriptors_path (and Descriptors_path_2), each file read and
+// checked; what the run does not do with them refused, and Image_descriptor said unused.
+std::unique_ptr<Descriptor> GivenRowsOf(const Config& config, RunResult& result) {
+  const InputOptions& input = config.input;
+  const std::vector<SourceSpec> specs = SourcesOf(input);
+  if (config.automatic.enabled)
+    throw InputError("Descriptors_path: given with Auto 1, which chooses among descriptors of "
+                     "its own; expected one of them (Auto 0 to run on the given rows)");
+  if (Cluster::Get().Distributed())
+    throw InputError("Descriptors_path: given to a run over several processes; expected a run "
+                     "in one process (every process would read every row)");
+  if (config.description.type != DescriptionType::kGlobal ||
+      input.camera_type != CameraType::kMonocular)
+    throw InputError("Descriptors_path: given with " +
+                     std::string(config.description.type != DescriptionType::kGlobal
+                                     ? "Description_type grid"
+                                     : "Camera_type " +
+                                           std::to_string(static_cast<int>(input.camera_type))) +
+                     "; expected one row per frame of one camera (Description_type global, "
+                     "Camera_type 0)");
+  if (specs.size() == 2 && input.descriptors_path_2.empty())
+    throw InputError("Descriptors_path_2: empty, but the run has a second traversal (" +
+                     specs[1].key + "); expected the rows of its frames too");
+  if (specs.size() == 1 && !input.descriptors_path_2.empty())
+    throw InputError("Descriptors_path_2: " + Quoted(input.descriptors_path_2) +
+                     " given, but the run has one traversal; expected it with a second one");
+  std::vector<cv::Mat> rows = {ReadGivenRows(input.descriptors_path, "Descriptors_path")};
+  if (specs.size() == 2) {
+    rows.push_back(ReadGivenRows(input.descriptors_path_2, "Descriptors_path_2"));
+    const auto text = [](const cv::Mat& m) {
+      return std::to_string(m.cols) + (m.type() == CV_32F ? " float32" : " uint8") + " values";
+    };
+    if (rows[1].cols != rows[0].cols || rows[1].type() != rows[0].type())
+      throw InputError("Descriptors_path_2: rows of " + text(rows[1]) +
+                       ", Descriptors_path rows of " + text(rows[0]) +
+                       "; expected rows of one width and type for both traversals");
+  }
+  if (config.descriptor.name != DescriptorOptions().name)
+    result.notes.push_back("Image_descriptor: \"" + config.descriptor.name +
+                           "\" not used: the rows come from Descriptors_path");
+  return std::make_unique<GivenRowsDescriptor>(config.descriptor, std::move(rows));
+}
+
 // The descriptors of Image_descriptor, each created (and so checked), their fusion checked,
 // the row of a frame refused when it cannot be held, and the camera described.
 void PlanDescriptors(RunPlan& plan) {
@@ -146,13 +191,15 @@ void PlanDescriptors(RunPlan& plan) {
   const InputOptions& input = config.input;
   const MatchingOptions& matching = config.matching;
   RunResult& result = plan.head;
-  plan.names = DescriptorList(config.descriptor.name);
+  const bool given = !input.descriptors_path.empty();
+  plan.names = given ? std::vector<std::string>{"NPY"} : DescriptorList(config.descriptor.name);
   const std::vector<std::string>& names = plan.names;
   const bool fused = plan.Fused();
+  if (given) plan.descriptors.push_back(GivenRowsOf(config, result));
   for (const std::string& name : names) {
     DescriptorOptions o = config.descriptor;
     o.name = name;
-    plan.descriptors.push_back(CreateDescriptor(o));
+    if (!given) plan.descriptors.push_back(CreateDescriptor(o));
     if (fused && plan.descriptors.back()->Channels() != 1)
       throw InputError("Image_descriptor: \"" + config.descriptor.name + "\" fuses " + name +
                        ", whose stereo frames carry a disparity channel the others do not "
@@ -273,6 +320,19 @@ void OpenSources(RunPlan& plan) {
 void CheckAgainstSources(const RunPlan& plan) {
   const Config& config = plan.config;
   const MatchingOptions& matching = config.matching;
+  // Given rows: one per frame the run reads.
+  for (size_t s = 0; s < plan.sources.size(); ++s)
+    if (const cv::Mat* rows = plan.describers.front()->GivenRows(static_cast<int>(s)))
+      if (rows->rows != plan.sources[s]->Size()) {
+        const std::string key = s == 0 ? "Descriptors_path" : "Descriptors_path_2";
+        throw InputError(key + " " +
+                         Quoted(s == 0 ? config.input.descriptors_path
+                                       : config.input.descriptors_path_2) +
+                         ": " + std::to_string(rows->rows) + " rows, but " + plan.specs[s].key +
+                         " has " + std::to_string(plan.sources[s]->Size()) +
+                         " frames (Initial_image, Final_image applied); expected one row per "
+                         "frame, in the run's order");
+      }
   // The ratio score needs rivals: its window must leave references outside it.
   if (matching.score == MatchScore::kRatio) {
     const int references = plan.sources.front()->Size();  // the reference traversal, or the one

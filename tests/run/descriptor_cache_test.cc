@@ -54,7 +54,7 @@ const std::set<std::string> kNotDescription = {
     "Match_threshold", "Match_consistency", "Auto", "Auto_candidates", "Auto_min_consistency",
     "Contrast_enhancement", "Contrast_window", "Fusion_weights",
     "Loops_name", "Bag_path", "Bag_topic", "Bag_topic_right", "Bag_path_2", "Bag_topic_2",
-    "Timestamps_name"};
+    "Timestamps_name", "Descriptors_path", "Descriptors_path_2"};
 
 bool Perturb(Config& c, const std::string& key) {
   const std::string v = ConfigValueText(c, key);
