@@ -208,7 +208,8 @@ void AddDescriptionKeys(OptionTable& t, Config& c) {
   t.Add("Model_path", kDescription, c.descriptor, c.descriptor.model_path,
         "Image_descriptor ONNX: the .onnx file of a network whose output is one vector per "
         "image (NetVLAD, CosPlace, MixVPR, EigenPlaces, ...), run by OpenCV's DNN module. Its "
-        "rows are floats matched by L2. See docs/descriptors.md, \"Bring your own "
+        "rows are floats matched by L2; with Auto 1 it joins the candidates (Image_descriptor "
+        "ONNX, sequences of 10, 20 and 40). See docs/descriptors.md, \"Bring your own "
         "descriptor\".");
   t.Add("Model_input_size", kDescription, c.descriptor, c.descriptor.model_input_size,
         "Image_descriptor ONNX: the network's input as WxH pixels (e.g. 224x224); each frame "

@@ -200,7 +200,7 @@ void PlanDescriptors(RunPlan& plan) {
     DescriptorOptions o = config.descriptor;
     o.name = name;
     if (!given) plan.descriptors.push_back(CreateDescriptor(o));
-    if (fused && plan.descriptors.back()->Channels() != 1)
+    if (fused && plan.descriptors.back()->Channels() == 2)
       throw InputError("Image_descriptor: \"" + config.descriptor.name + "\" fuses " + name +
                        ", whose stereo frames carry a disparity channel the others do not "
                        "read; expected " + name + " alone");

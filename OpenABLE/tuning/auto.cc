@@ -237,7 +237,7 @@ void CheckAuto(const Config& config) {
     throw InputError(
         "Auto: 1 runs on one process; expected Test_OpenABLE without mpirun (the "
         "chosen settings can then be run over processes with Auto 0)");
-  for (const AutoSettings& candidate : ParseAutoCandidates(config.automatic.candidates)) {
+  for (const AutoSettings& candidate : ParseAutoCandidates(AutoCandidatesOf(config))) {
     try {
       CheckRun(AutoCandidateConfig(config, Completed(config, candidate)));
     } catch (const InputError& e) {
@@ -245,6 +245,14 @@ void CheckAuto(const Config& config) {
                        e.what());
     }
   }
+}
+
+std::string AutoCandidatesOf(const Config& config) {
+  const std::string& text = config.automatic.candidates;
+  if (config.descriptor.model_path.empty() || Upper(text).find("ONNX") != std::string::npos)
+    return text;
+  // A configured network joins the candidates, with the sequences of the default groups.
+  return text + " | Image_descriptor=ONNX Image_sequences=10,20,40";
 }
 
 AutoPlan PlanCandidates(const Config& config, const std::vector<AutoSettings>& candidates) {
@@ -318,7 +326,7 @@ AutoChoice ChooseSettings(const Config& config, ProgressReporter& progress, Sing
                           const std::function<void(const std::string&)>& log) {
   const auto start = std::chrono::steady_clock::now();
   CheckAuto(config);
-  const AutoPlan plan = PlanCandidates(config, ParseAutoCandidates(config.automatic.candidates));
+  const AutoPlan plan = PlanCandidates(config, ParseAutoCandidates(AutoCandidatesOf(config)));
 
   // Every descriptor of every candidate, described and compared once, each frame read once
   // for all the descriptors of candidates that share their description settings.

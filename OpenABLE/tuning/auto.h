@@ -37,6 +37,11 @@ using AutoSettings = std::vector<std::pair<std::string, std::string>>;
 // of one traversal; a key given twice in a group; a candidate given twice.
 std::vector<AutoSettings> ParseAutoCandidates(const std::string& text);
 
+// The candidates of a run's auto mode: Auto_candidates, and with Model_path set (a network of
+// the user's, descriptors/onnx.h) the group "Image_descriptor=ONNX Image_sequences=10,20,40"
+// when Auto_candidates names no ONNX candidate of its own.
+std::string AutoCandidatesOf(const Config& config);
+
 // "Key=value Key=value": how the report and the JSON name a candidate.
 std::string AutoSettingsText(const AutoSettings& settings);
 

@@ -59,6 +59,21 @@ class OnnxRunTest(TempDirTestCase):
         self.assertIn("not an ONNX network", done.stderr)
         self.assertFalse((self.tmp / "none.npy").exists())
 
+    def test_a_configured_model_joins_the_auto_modes_candidates(self):
+        done = run("Test_OpenABLE",
+                   [SOURCE_DIR / "config" / "presets" / "auto.txt", "--json"] + settings(
+                       "Images_path=%s" % (SAMPLE / "summer"),
+                       "Images_path_2=%s" % (SAMPLE / "winter"),
+                       "Model_path=%s" % (ONNX / "gem.onnx"), "Model_input_size=64x32",
+                       "Auto_candidates=Image_descriptor=HOG Image_sequences=10", "Npy_name=",
+                       "Png_name=", "Txt_name=", "Evaluation_name=", "Report_name="), self.tmp)
+        import json
+        auto = json.loads(done.stdout)["auto"]
+        settings_judged = [c["settings"] for c in auto["candidates"]]
+        for length in (10, 20, 40):
+            self.assertIn("Image_descriptor=ONNX Image_sequences=%d" % length, settings_judged)
+        self.assertIn("Image_descriptor=HOG Image_sequences=10", settings_judged)
+
     def test_the_online_detector_says_it_runs_no_network_yet(self):
         import openable
         image = np.zeros((32, 64), np.uint8)
