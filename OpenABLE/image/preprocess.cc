@@ -28,6 +28,19 @@ cv::Mat1b GreyOfImage(const cv::Mat& image, const std::string& what) {
   return ToGray8(scaled);
 }
 
+cv::Mat ColourOfImage(const cv::Mat& image, const std::string& what) {
+  if (image.empty()) throw InputError(what + " is empty (expected an image)");
+  const int depth = image.depth(), channels = image.channels();
+  if ((depth != CV_8U && depth != CV_32F) || (channels != 1 && channels != 3))
+    throw InputError(what + " has OpenCV type " + cv::typeToString(image.type()) +
+                     " (expected CV_8UC1, CV_8UC3 (BGR), CV_32FC1 or CV_32FC3 in [0, 1])");
+  if (depth == CV_32F) return ToColour8(image);
+  if (channels == 3) return image;
+  cv::Mat colour;
+  cv::cvtColor(image, colour, cv::COLOR_GRAY2BGR);
+  return colour;
+}
+
 cv::Mat1b ToGray8(const cv::Mat& frame) {
   if (frame.depth() != CV_32F || frame.channels() > 3)
     throw std::logic_error("ToGray8: expected a CV_32FC1, CV_32FC2 or CV_32FC3 frame");

@@ -29,6 +29,11 @@ cv::Mat1b GreyOfImage(const cv::Mat& image, const std::string& what);
 // Throws std::logic_error on any other type.
 cv::Mat ToColour8(const cv::Mat& frame);
 
+// The colour 8-bit image (CV_8UC3, BGR) of an image a program gives, for a network
+// (descriptors/onnx.h): the types GreyOfImage takes, 8-bit colour as it is, grey in all three
+// channels, floats as ToColour8 converts a frame. Throws InputError as GreyOfImage.
+cv::Mat ColourOfImage(const cv::Mat& image, const std::string& what);
+
 // Both channels of a stereo frame (CV_32FC2 in [0, 1]) as CV_8UC2 (value x 255, rounded): the
 // patch D-LDB describes. Throws std::logic_error on any other type.
 cv::Mat ToGrayDisparity8(const cv::Mat& frame);

@@ -409,6 +409,10 @@ int Add(const Arguments& a) {
   const auto lock = LockForWriting(path, a.quiet);
   OnlineOptions wanted = OptionsOfConfig(ConfigOf(a), SearchKeysGiven(a));
   SetThreshold(a, wanted);
+  // Refused before any frame is described (SaveMap would refuse it at the end).
+  if (Upper(wanted.descriptor.name + "+" + wanted.kept_descriptors).find("ONNX") !=
+      std::string::npos)
+    throw InputError(NetworkMapRefusal(path));
   std::unique_ptr<OnlineDetector> d;
   const bool exists = std::filesystem::exists(path);
   if (exists) {

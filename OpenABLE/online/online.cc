@@ -145,22 +145,19 @@ void OnlineOptions::Check() const {
   }
 }
 
+std::string NetworkMapRefusal(const std::string& path) {
+  return "map " + Quoted(path) + ": a map of a network (descriptor ONNX) is not saved yet: the "
+         "map would not keep its model's settings and weights; expected a built-in descriptor "
+         "for a map (the detector itself runs a network in memory)";
+}
+
 Describer MakeDescriber(const OnlineOptions& options) {
   options.Check();
-  // A network (descriptors/onnx.h) describes the frames of a run (Test_OpenABLE, openable_sweep,
-  // runs over processes); the online detector, its maps and Python's describe functions give
-  // it no model settings yet, and are told so rather than asked for a Model_path they cannot
-  // take.
-  if (Upper(Trim(options.descriptor.name)) == "ONNX")
-    throw InputError("descriptor: \"ONNX\" (a network) describes the frames of Test_OpenABLE "
-                     "and openable_sweep runs, not yet those of the online detector, its maps or "
-                     "Python's describe functions; expected one of the built-in descriptors here "
-                     "(docs/descriptors.md, \"Bring your own descriptor\")");
   Describer out;
   out.descriptor = CreateDescriptor(options.descriptor);
-  // A grey image per frame: descriptors of several channels (D-LDB: grey + disparity) need
+  // A grey image per frame (a colour one for a network): D-LDB's grey + disparity needs
   // stereo pairs.
-  Require(out.descriptor->Channels() == 1, "descriptor", options.descriptor.name,
+  Require(out.descriptor->Channels() != 2, "descriptor", options.descriptor.name,
           "a single-camera descriptor (" + out.descriptor->Name() +
               " needs stereo pairs: use Test_OpenABLE with Camera_type 1)");
   out.frame = std::make_unique<FrameDescriber>(*out.descriptor, options.description,
@@ -170,14 +167,34 @@ Describer MakeDescriber(const OnlineOptions& options) {
 
 namespace {
 
-// Describes the grey image of a frame (GreyOfImage) with `describer`, checking its size.
-void DescribeInto(const FrameDescriber& describer, const cv::Mat1b& grey, const std::string& what,
-                  cv::Mat row) {
+// The images of one frame a describer takes: grey (GreyOfImage), and colour for a network
+// (ColourOfImage), each made once when a describer needs it.
+struct FrameImages {
+  const cv::Mat& image;
+  const std::string& what;
+  cv::Mat grey, colour;
+  const cv::Mat& For(const FrameDescriber& describer) {
+    if (describer.Channels() == 3) {
+      if (colour.empty()) colour = ColourOfImage(image, what);
+      return colour;
+    }
+    return Grey();
+  }
+  const cv::Mat& Grey() {
+    if (grey.empty()) grey = GreyOfImage(image, what);
+    return grey;
+  }
+};
+
+// Describes the image of a frame `describer` takes with it, checking its size.
+void DescribeInto(const FrameDescriber& describer, FrameImages& images, cv::Mat row) {
+  const cv::Mat& image = images.For(describer);
   const cv::Size need = describer.MinimumFrame();
-  if (grey.cols < need.width || grey.rows < need.height)
-    throw InputError(what + " is " + SizeText(grey.size()) + "; the grid needs at least " +
-                     SizeText(need) + " pixels (grid_x by grid_y)");
-  describer.Describe(grey, row);
+  if (image.cols < need.width || image.rows < need.height)
+    throw InputError(images.what + " is " + SizeText(image.size()) +
+                     "; the grid needs at least " + SizeText(need) +
+                     " pixels (grid_x by grid_y)");
+  describer.Describe(image, row);
 }
 
 // The name of image i in messages: `names[i]` quoted as a file, or "image i".
@@ -201,9 +218,9 @@ std::vector<cv::Mat> DescribeNamed(const std::vector<const FrameDescriber*>& des
   ParallelFor(n, threads, [&](int i) {
     try {
       const std::string what = ImageName(names, i);
-      const cv::Mat1b grey = GreyOfImage(images[i], what);
+      FrameImages frame{images[i], what, {}, {}};
       for (size_t c = 0; c < describers.size(); ++c)
-        DescribeInto(*describers[c], grey, what, rows[c].row(i));
+        DescribeInto(*describers[c], frame, rows[c].row(i));
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex);
       if (i < error_index) error_index = i, error = e.what();
@@ -667,13 +684,14 @@ OnlineResult OnlineDetector::AddFrame(const cv::Mat& image) {
   s.ThrowIfDamaged(false);
   const auto start = Clock::now();
   const std::string what = "frame " + std::to_string(Size());
-  const cv::Mat1b grey = GreyOfImage(image, what);
-  const std::string size = SizeText(grey.size());
+  FrameImages frame{image, what, {}, {}};
+  // The image the first descriptor takes (made once; the others reuse it) gives the size.
+  const std::string size = SizeText(frame.For(*s.channels.front().describer.frame).size());
   CheckFrameSize(what, size, s.frame_size);
   RowsByChannel rows;
   for (const State::Channel& c : s.channels) {
     rows.emplace_back(1, c.width, c.type);
-    DescribeInto(*c.describer.frame, grey, what, rows.back());
+    DescribeInto(*c.describer.frame, frame, rows.back());
   }
   s.frame_size = size;
   const double describe = Seconds(start);
@@ -683,7 +701,7 @@ OnlineResult OnlineDetector::AddFrame(const cv::Mat& image) {
     return r;
   }
   const auto verify_start = Clock::now();
-  s.features.push_back(s.verifier->Extract(grey));
+  s.features.push_back(s.verifier->Extract(frame.Grey()));
   double verify = Seconds(verify_start);
   OnlineResult r = s.Search(rows);
   r.describe_seconds = describe;
@@ -1141,6 +1159,9 @@ void OnlineDetector::SaveMap(const std::string& path) {
   State& s = *state_;
   // A map loaded damaged is not written out again as if it were sound.
   s.ThrowIfDamaged(true);
+  for (const State::Channel& c : s.channels)
+    if (c.describer.descriptor->Name() == "ONNX")
+      throw InputError(NetworkMapRefusal(path));
   FinishMerges();
   const State::Channel& first = s.channels.front();
   MapFile map;

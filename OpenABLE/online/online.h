@@ -394,6 +394,10 @@ OnlineOptions MapOptions(const std::string& path, const OnlineOptions& base = On
 
 // ---- Batch helpers -------------------------------------------------------------------------
 
+// The one line that refuses to save a map of a network (descriptor ONNX, descriptors/onnx.h):
+// maps do not keep a model's settings and weights yet.
+std::string NetworkMapRefusal(const std::string& path);
+
 // The describer of `options` (descriptor, description, grid) and the descriptor it uses.
 struct Describer {
   std::unique_ptr<Descriptor> descriptor;

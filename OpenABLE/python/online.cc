@@ -21,10 +21,34 @@ namespace openable::python {
 namespace {
 
 // The description part of OnlineOptions.
+// The network's settings of describe and describe_images (Image_descriptor ONNX), as the
+// Model_* keys: their defaults are the option table's.
+struct ModelArgs {
+  std::string path, input_size, channels, mean, std;
+  bool normalize = true;
+  int batch = 16;
+};
+
+#define OPENABLE_MODEL_ARGS                                                                   \
+  py::arg("model_path") = TableDefault("Model_path"),                                         \
+      py::arg("model_input_size") = TableDefault("Model_input_size"),                         \
+      py::arg("model_channels") = TableDefault("Model_channels"),                             \
+      py::arg("model_mean") = TableDefault("Model_mean"),                                     \
+      py::arg("model_std") = TableDefault("Model_std"),                                       \
+      py::arg("model_normalize") = TableDefault("Model_normalize") == "1",                    \
+      py::arg("model_batch") = std::stoi(TableDefault("Model_batch"))
+
 OnlineOptions DescriptionOptions(const std::string& descriptor, const std::string& description,
                                  int patch_size, int ldb_bits, std::pair<int, int> grid,
-                                 int sad_patch) {
+                                 int sad_patch, const ModelArgs& model = {}) {
   OnlineOptions o;
+  o.descriptor.model_path = model.path;
+  o.descriptor.model_input_size = model.input_size;
+  if (!model.channels.empty()) o.descriptor.model_channels = model.channels;
+  if (!model.mean.empty()) o.descriptor.model_mean = model.mean;
+  if (!model.std.empty()) o.descriptor.model_std = model.std;
+  o.descriptor.model_normalize = model.normalize;
+  o.descriptor.model_batch = model.batch;
   o.descriptor.name = descriptor;
   o.description = ParseEnum<DescriptionType>(description, "description");
   o.descriptor.patch_size = patch_size;
@@ -252,6 +276,21 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
   search("kd_trees", &ApproximateOptions::kd_trees, "Randomised k-d trees.");
   search("threads", &ApproximateOptions::threads, "Threads of a search; 0 = all cores.");
   search("seed", &ApproximateOptions::seed, "Seed of the index build.");
+  // The network of descriptor "ONNX" (descriptors/onnx.h, the Model_* keys).
+  const auto model = [&nested](const char* name, auto member, const char* doc) {
+    nested(name, &O::descriptor, member, doc);
+  };
+  model("model_path", &DescriptorOptions::model_path, "descriptor ONNX: the .onnx file.");
+  model("model_input_size", &DescriptorOptions::model_input_size,
+        "descriptor ONNX: the network's input, \"WxH\".");
+  model("model_channels", &DescriptorOptions::model_channels,
+        "descriptor ONNX: \"rgb\", \"bgr\" or \"grey\".");
+  model("model_mean", &DescriptorOptions::model_mean,
+        "descriptor ONNX: per channel, after scaling to [0, 1].");
+  model("model_std", &DescriptorOptions::model_std, "descriptor ONNX: per channel.");
+  model("model_normalize", &DescriptorOptions::model_normalize,
+        "descriptor ONNX: L2-normalise each row.");
+  model("model_batch", &DescriptorOptions::model_batch, "descriptor ONNX: images per pass.");
   // Geometric verification (OpenABLE/verification/verification.h, the Verification_* keys).
   const auto verify = [&nested](const char* name, auto member, const char* doc) {
     nested(name, &O::verification, member, doc);
@@ -333,7 +372,11 @@ const char* const kDescriptionArgs =
     sad_patch (int): SAD: side of the normalised squares of its Patch_size x Patch_size/2
         thumbnail, pixels (2..64).
     color_order (str): channel order of colour images, "bgr" (OpenCV's, as read_image()
-        gives them by default) or "rgb" (as matplotlib, PIL and imageio give them).)doc";
+        gives them by default) or "rgb" (as matplotlib, PIL and imageio give them).
+    model_path, model_input_size, model_channels, model_mean, model_std, model_normalize,
+        model_batch: descriptor "ONNX", a network of the user's, as the Model_* keys of
+        Config.txt (docs/descriptors.md, "Bring your own descriptor"); the image is described
+        in colour.)doc";
 
 }  // namespace
 
@@ -352,18 +395,25 @@ the order shown to users: )doc") +
       "describe",
       [](const py::object& image, const std::string& descriptor, const std::string& description,
          int patch_size, int ldb_bits, std::pair<int, int> grid, int sad_patch,
-         const std::string& color_order) {
-        const OnlineOptions o =
-            DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid, sad_patch);
+         const std::string& color_order, const std::string& model_path,
+         const std::string& model_input_size, const std::string& model_channels,
+         const std::string& model_mean, const std::string& model_std, bool model_normalize,
+         int model_batch) {
+        const OnlineOptions o = DescriptionOptions(
+            descriptor, description, patch_size, ldb_bits, grid, sad_patch,
+            {model_path, model_input_size, model_channels, model_mean, model_std,
+             model_normalize, model_batch});
         const cv::Mat rows = Describe({Image(image, "image", IsRgbOrder(color_order))}, o, 1);
         return ToNumpy(rows.row(0).clone(), true);
       },
       py::arg("image"), py::arg("descriptor") = "LDB", py::arg("description") = "global",
       py::arg("patch_size") = 64, py::arg("ldb_bits") = 256, py::arg("grid") = std::make_pair(1, 1),
-      py::arg("sad_patch") = 8, py::arg("color_order") = "bgr",
+      py::arg("sad_patch") = 8, py::arg("color_order") = "bgr", OPENABLE_MODEL_ARGS,
       (std::string(
            R"doc(describe(image, descriptor="LDB", description="global", patch_size=64,
-    ldb_bits=256, grid=(1, 1), sad_patch=8, color_order="bgr") -> numpy.ndarray
+    ldb_bits=256, grid=(1, 1), sad_patch=8, color_order="bgr", model_path="",
+    model_input_size="", model_channels="rgb", model_mean="0.485,0.456,0.406",
+    model_std="0.229,0.224,0.225", model_normalize=True, model_batch=16) -> numpy.ndarray
 
 The descriptor row of one image, as Test_OpenABLE describes a frame (grey conversion, then
 global or grid description).
@@ -385,17 +435,25 @@ Raises:
       "describe_images",
       [](const py::object& images, const std::string& descriptor, const std::string& description,
          int patch_size, int ldb_bits, std::pair<int, int> grid, int sad_patch, int threads,
-         const std::string& color_order) {
-        const OnlineOptions o =
-            DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid, sad_patch);
+         const std::string& color_order, const std::string& model_path,
+         const std::string& model_input_size, const std::string& model_channels,
+         const std::string& model_mean, const std::string& model_std, bool model_normalize,
+         int model_batch) {
+        const OnlineOptions o = DescriptionOptions(
+            descriptor, description, patch_size, ldb_bits, grid, sad_patch,
+            {model_path, model_input_size, model_channels, model_mean, model_std,
+             model_normalize, model_batch});
         return ToNumpy(Describe(Images(images, "images", IsRgbOrder(color_order)), o, threads));
       },
       py::arg("images"), py::arg("descriptor") = "LDB", py::arg("description") = "global",
       py::arg("patch_size") = 64, py::arg("ldb_bits") = 256, py::arg("grid") = std::make_pair(1, 1),
       py::arg("sad_patch") = 8, py::arg("threads") = 0, py::arg("color_order") = "bgr",
+      OPENABLE_MODEL_ARGS,
       (std::string(
            R"doc(describe_images(images, descriptor="LDB", description="global", patch_size=64,
-    ldb_bits=256, grid=(1, 1), sad_patch=8, threads=0, color_order="bgr") -> numpy.ndarray
+    ldb_bits=256, grid=(1, 1), sad_patch=8, threads=0, color_order="bgr", model_path="",
+    model_input_size="", model_channels="rgb", model_mean="0.485,0.456,0.406",
+    model_std="0.229,0.224,0.225", model_normalize=True, model_batch=16) -> numpy.ndarray
 
 One descriptor row per image, described in parallel (the GIL is released).
 

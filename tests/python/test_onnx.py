@@ -74,23 +74,41 @@ class OnnxRunTest(TempDirTestCase):
             self.assertIn("Image_descriptor=ONNX Image_sequences=%d" % length, settings_judged)
         self.assertIn("Image_descriptor=HOG Image_sequences=10", settings_judged)
 
-    def test_the_online_detector_says_it_runs_no_network_yet(self):
+    def test_python_and_the_online_detector_run_a_network_but_save_no_map_of_it(self):
         import openable
-        image = np.zeros((32, 64), np.uint8)
+        names = (ONNX / "frames.txt").read_text().split()
+        images = [openable.read_image(str(SAMPLE / "summer" / n)) for n in names]
+        expected = np.load(ONNX / "gem_outputs.npy")
+        rows = openable.describe_images(images, descriptor="ONNX",
+                                        model_path=str(ONNX / "gem.onnx"),
+                                        model_input_size="64x32", model_batch=5)
+        self.assertEqual(rows.dtype, np.float32)
+        self.assertLess(np.abs(rows - expected).max(), 1e-5)
+        one = openable.describe(images[3], descriptor="ONNX", model_path=str(ONNX / "gem.onnx"),
+                                model_input_size="64x32")
+        self.assertLess(np.abs(one - expected[3]).max(), 1e-5)
+        # The online detector: frames added one by one, each its network row.
+        detector = openable.OnlineDetector(descriptor="ONNX", model_path=str(ONNX / "gem.onnx"),
+                                           model_input_size="64x32", sequence_length=1)
+        for image in images:
+            detector.add_frame(image)
+        self.assertEqual(detector.size, 16)
         with self.assertRaises(openable.InputError) as caught:
-            openable.describe_images([image], descriptor="ONNX")
-        self.assertIn("not yet those of the online detector", str(caught.exception))
+            detector.save_map(str(self.tmp / "net.map"))
+        self.assertIn("a map of a network (descriptor ONNX) is not saved yet",
+                      str(caught.exception))
+        self.assertFalse((self.tmp / "net.map").exists())
         import subprocess
         from support import program
         done = subprocess.run(
             [program("openable_map"), "add", str(self.tmp / "m.map"), "--images",
-             str(SAMPLE / "summer"), "--session", "s", "--set", "Image_descriptor=ONNX"],
+             str(SAMPLE / "summer"), "--session", "s", "--set", "Image_descriptor=ONNX",
+             "--set", "Model_path=%s" % (ONNX / "gem.onnx"), "--set", "Model_input_size=64x32"],
             cwd=str(self.tmp), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.assertEqual(done.returncode, 1, done.stderr)
         self.assertEqual(len(done.stderr.strip().splitlines()), 1, done.stderr)
-        self.assertIn("not yet those of the online detector", done.stderr)
+        self.assertIn("is not saved yet", done.stderr)
         self.assertFalse((self.tmp / "m.map").exists())
-
 
 if __name__ == "__main__":
     unittest.main()
