@@ -14,12 +14,22 @@
 
 namespace openable {
 
-cv::Mat1b GreyOfImage(const cv::Mat& image, const std::string& what) {
+namespace {
+
+// An image a program gives: not empty, of one of the types GreyOfImage and ColourOfImage take.
+void CheckProgramImage(const cv::Mat& image, const std::string& what) {
   if (image.empty()) throw InputError(what + " is empty (expected an image)");
   const int depth = image.depth(), channels = image.channels();
   if ((depth != CV_8U && depth != CV_32F) || (channels != 1 && channels != 3))
     throw InputError(what + " has OpenCV type " + cv::typeToString(image.type()) +
                      " (expected CV_8UC1, CV_8UC3 (BGR), CV_32FC1 or CV_32FC3 in [0, 1])");
+}
+
+}  // namespace
+
+cv::Mat1b GreyOfImage(const cv::Mat& image, const std::string& what) {
+  CheckProgramImage(image, what);
+  const int depth = image.depth(), channels = image.channels();
   if (depth == CV_32F) return ToGray8(image);
   // 8-bit grey is already what ToGray8 would give back (x / 255 x 255 rounds to x).
   if (channels == 1) return image;
@@ -29,13 +39,9 @@ cv::Mat1b GreyOfImage(const cv::Mat& image, const std::string& what) {
 }
 
 cv::Mat ColourOfImage(const cv::Mat& image, const std::string& what) {
-  if (image.empty()) throw InputError(what + " is empty (expected an image)");
-  const int depth = image.depth(), channels = image.channels();
-  if ((depth != CV_8U && depth != CV_32F) || (channels != 1 && channels != 3))
-    throw InputError(what + " has OpenCV type " + cv::typeToString(image.type()) +
-                     " (expected CV_8UC1, CV_8UC3 (BGR), CV_32FC1 or CV_32FC3 in [0, 1])");
-  if (depth == CV_32F) return ToColour8(image);
-  if (channels == 3) return image;
+  CheckProgramImage(image, what);
+  if (image.depth() == CV_32F) return ToColour8(image);
+  if (image.channels() == 3) return image;
   cv::Mat colour;
   cv::cvtColor(image, colour, cv::COLOR_GRAY2BGR);
   return colour;
