@@ -218,36 +218,36 @@ std::vector<DescribedSequence> DescribeSequences(
         if (d->Batched()) chunk = std::max(chunk, d->PreferredBatchOfFrames());
     }
     for (int start = 0; start < n && !stopped(); start += chunk) {
-    const int end = std::min(n, start + chunk);
-    ParallelFor(end - start, threads, [&](int j) {
-      const int i = start + j;
-      if (stopped()) return;
-      // Rows of the caches first; the frame is read only when a descriptor still needs it.
-      std::vector<char> needed(static_cast<size_t>(kinds), 1);
-      bool any_needed = false, sizes_agree = true;
-      for (int k = 0; k < kinds; ++k) {
-        RowCache* cache = caches[static_cast<size_t>(k)];
-        cv::Size cached_size;
-        if (cache != nullptr && use_caches &&
-            cache->Lookup(source, i, rows[static_cast<size_t>(k)].row(i), &cached_size)) {
-          needed[static_cast<size_t>(k)] = 0;
-          sizes_agree &= check_size(i, cached_size);
-        } else {
-          any_needed = true;
+      const int end = std::min(n, start + chunk);
+      ParallelFor(end - start, threads, [&](int j) {
+        const int i = start + j;
+        if (stopped()) return;
+        // Rows of the caches first; the frame is read only when a descriptor still needs it.
+        std::vector<char> needed(static_cast<size_t>(kinds), 1);
+        bool any_needed = false, sizes_agree = true;
+        for (int k = 0; k < kinds; ++k) {
+          RowCache* cache = caches[static_cast<size_t>(k)];
+          cv::Size cached_size;
+          if (cache != nullptr && use_caches &&
+              cache->Lookup(source, i, rows[static_cast<size_t>(k)].row(i), &cached_size)) {
+            needed[static_cast<size_t>(k)] = 0;
+            sizes_agree &= check_size(i, cached_size);
+          } else {
+            any_needed = true;
+          }
         }
-      }
-      if (!sizes_agree) {
+        if (!sizes_agree) {
+          report();
+          return;
+        }
+        if (!any_needed) {
+          ok[i] = 1;
+        } else if (auto f = read(i)) {
+          describe(i, *f, needed);
+        }
         report();
-        return;
-      }
-      if (!any_needed) {
-        ok[i] = 1;
-      } else if (auto f = read(i)) {
-        describe(i, *f, needed);
-      }
-      report();
-    });
-    if (any_batched && !stopped()) flush(start, end);
+      });
+      if (any_batched && !stopped()) flush(start, end);
     }
   }
 

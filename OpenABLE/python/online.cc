@@ -38,6 +38,20 @@ struct ModelArgs {
       py::arg("model_normalize") = TableDefault("Model_normalize") == "1",                    \
       py::arg("model_batch") = std::stoi(TableDefault("Model_batch"))
 
+// `text` with "@model_args@" replaced by the model_* keywords and their defaults, which are
+// the option table's (as OPENABLE_MODEL_ARGS gives them).
+std::string ModelDefaultsIn(const std::string& text) {
+  const auto quoted = [](const char* key) { return "\"" + TableDefault(key) + "\""; };
+  const std::pair<const char*, std::string> values[] = {
+      {"@model_args@",
+       "\n    model_path=" + quoted("Model_path") + ", model_input_size=" +
+           quoted("Model_input_size") + ",\n    model_channels=" + quoted("Model_channels") +
+           ", model_mean=" + quoted("Model_mean") + ",\n    model_std=" + quoted("Model_std") +
+           ", model_normalize=" + (TableDefault("Model_normalize") == "1" ? "True" : "False") +
+           ", model_batch=" + TableDefault("Model_batch")}};
+  return FillPlaceholders(text, values);
+}
+
 OnlineOptions DescriptionOptions(const std::string& descriptor, const std::string& description,
                                  int patch_size, int ldb_bits, std::pair<int, int> grid,
                                  int sad_patch, const ModelArgs& model = {}) {
@@ -409,11 +423,9 @@ the order shown to users: )doc") +
       py::arg("image"), py::arg("descriptor") = "LDB", py::arg("description") = "global",
       py::arg("patch_size") = 64, py::arg("ldb_bits") = 256, py::arg("grid") = std::make_pair(1, 1),
       py::arg("sad_patch") = 8, py::arg("color_order") = "bgr", OPENABLE_MODEL_ARGS,
-      (std::string(
+      ModelDefaultsIn(std::string(
            R"doc(describe(image, descriptor="LDB", description="global", patch_size=64,
-    ldb_bits=256, grid=(1, 1), sad_patch=8, color_order="bgr", model_path="",
-    model_input_size="", model_channels="rgb", model_mean="0.485,0.456,0.406",
-    model_std="0.229,0.224,0.225", model_normalize=True, model_batch=16) -> numpy.ndarray
+    ldb_bits=256, grid=(1, 1), sad_patch=8, color_order="bgr",@model_args@) -> numpy.ndarray
 
 The descriptor row of one image, as Test_OpenABLE describes a frame (grey conversion, then
 global or grid description).
@@ -449,11 +461,9 @@ Raises:
       py::arg("patch_size") = 64, py::arg("ldb_bits") = 256, py::arg("grid") = std::make_pair(1, 1),
       py::arg("sad_patch") = 8, py::arg("threads") = 0, py::arg("color_order") = "bgr",
       OPENABLE_MODEL_ARGS,
-      (std::string(
+      ModelDefaultsIn(std::string(
            R"doc(describe_images(images, descriptor="LDB", description="global", patch_size=64,
-    ldb_bits=256, grid=(1, 1), sad_patch=8, threads=0, color_order="bgr", model_path="",
-    model_input_size="", model_channels="rgb", model_mean="0.485,0.456,0.406",
-    model_std="0.229,0.224,0.225", model_normalize=True, model_batch=16) -> numpy.ndarray
+    ldb_bits=256, grid=(1, 1), sad_patch=8, threads=0, color_order="bgr",@model_args@) -> numpy.ndarray
 
 One descriptor row per image, described in parallel (the GIL is released).
 
