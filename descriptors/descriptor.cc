@@ -41,6 +41,12 @@ Descriptor::Descriptor(const DescriptorOptions& options) : patch_size_(options.p
 
 void Descriptor::CheckPatch(const cv::Mat& patch) const {
   const cv::Size size = InputSize();
+  if (size.empty()) {
+    if (patch.type() != CV_8UC(Channels()) || patch.rows < 16 || patch.cols < 16)
+      throw std::logic_error(Name() + ": expected a " + cv::typeToString(CV_8UC(Channels())) +
+                             " patch of at least 16 x 16, got " + Shape(patch));
+    return;
+  }
   if (patch.type() != CV_8UC(Channels()) || patch.rows != size.height ||
       patch.cols != size.width) {
     throw std::logic_error(Name() + ": expected a " + std::to_string(size.height) + " x " +

@@ -37,6 +37,11 @@ struct DescriptorOptions {
   std::string model_std = "0.229,0.224,0.225";   // per channel (ImageNet's, as torchvision's)
   bool model_normalize = true;          // L2-normalise each output row
   int model_batch = 16;                 // frames per forward pass, 1..1024
+  // "NPY": rows computed elsewhere and given, not described (a map made by openable_map add
+  // --descriptors): their width in elements and whether they are bytes of bits (Hamming) or
+  // floats (L2). Not keys of a run, whose given rows come from Descriptors_path.
+  int given_width = 0;
+  bool given_binary = false;
 
   // Throws InputError naming the key (Patch_size, Ldb_bits, Sad_patch), the value and the
   // valid range.
@@ -64,7 +69,9 @@ class Descriptor {
   }
   // Side of the square patch this descriptor expects.
   int PatchSize() const { return patch_size_; }
-  // The size of the image Describe takes: the square patch, or a network's input (ONNX).
+  // The size of the image Describe takes: the square patch, or a network's input (ONNX);
+  // empty for a descriptor that takes any size of at least 16 x 16 (DenseVLAD shrinks it
+  // itself).
   virtual cv::Size InputSize() const { return cv::Size(patch_size_, patch_size_); }
   // Channels of the patch: 1 (grey) for every descriptor but D-LDB, whose patch has 2
   // (channel 0 grey, channel 1 disparity, both CV_8U; descriptors/dldb.h), and ONNX, whose
@@ -78,6 +85,12 @@ class Descriptor {
   virtual void DescribeBatch(const std::vector<cv::Mat>& patches, cv::Mat rows) const;
   // The patches DescribeBatch is best given at once (1: no gain from batches).
   virtual int PreferredBatch() const { return 1; }
+  // Whether the descriptor learns from frames before it describes (DenseVLAD's vocabulary,
+  // learnt from the reference traversal): Learn must then be called first.
+  virtual bool Learns() const { return false; }
+  // Learns from `patches` (as Describe takes them, of frames spread over the reference
+  // traversal). Called once before any Describe, never while one runs. The default does nothing.
+  virtual void Learn(const std::vector<cv::Mat>& /*patches*/) const {}
   // Rows given rather than described (features computed elsewhere, OpenABLE/run/given_rows.h):
   // those of traversal `traversal`, one per frame; nullptr for a descriptor that describes.
   virtual const cv::Mat* GivenRows(int /*traversal*/) const { return nullptr; }

@@ -40,7 +40,15 @@ int FrameDescriber::RowWidth() const {
   return descriptor_.Width() * grid_x_ * grid_y_ * panoramas_;
 }
 cv::Size FrameDescriber::MinimumFrame() const {
-  return cv::Size(grid_x_ * panoramas_, grid_y_);
+  const int cell = descriptor_.InputSize().empty() ? 16 : 1;
+  return cv::Size(cell * grid_x_ * panoramas_, cell * grid_y_);
+}
+
+void FrameDescriber::Learn(const std::vector<cv::Mat>& images) const {
+  std::vector<cv::Mat> patches;
+  for (const cv::Mat& image : images)
+    for (cv::Mat& p : Patches(image)) patches.push_back(std::move(p));
+  descriptor_.Learn(patches);
 }
 
 int FrameDescriber::RowType() const { return openable::RowType(descriptor_); }
@@ -52,7 +60,8 @@ std::vector<cv::Mat> FrameDescriber::Patches(const cv::Mat& image) const {
     throw std::logic_error("FrameDescriber: expected a CV_8UC" +
                            std::to_string(descriptor_.Channels()) + " image for " +
                            descriptor_.Name() + ", got " + cv::typeToString(image.type()));
-  if (image.cols < grid_x_ * panoramas_ || image.rows < grid_y_)
+  const cv::Size minimum = MinimumFrame();
+  if (image.cols < minimum.width || image.rows < minimum.height)
     throw std::logic_error("FrameDescriber: frame smaller than the grid");
   const cv::Size input = descriptor_.InputSize();
   std::vector<cv::Mat> patches;
@@ -70,7 +79,7 @@ std::vector<cv::Mat> FrameDescriber::Patches(const cv::Mat& image) const {
         // Area interpolation when shrinking (it averages, avoiding aliasing); linear when a
         // cell is smaller than the patch; none when it has the patch's size.
         cv::Mat patch;
-        if (cell.size() == input) {
+        if (input.empty() || cell.size() == input) {
           patch = cell.clone();
         } else {
           const bool shrink = cell.cols >= input.width && cell.rows >= input.height;

@@ -46,7 +46,8 @@ class FrameDescriber {
   // CV_32F).
   int RowWidth() const;
   int RowType() const;
-  // Smallest frame Describe accepts: (grid_x * panoramas) x grid_y pixels.
+  // Smallest frame Describe accepts: (grid_x * panoramas) x grid_y pixels; 16 times as many
+  // for a descriptor that takes patches of any size (DenseVLAD's cells are at least 16 x 16).
   cv::Size MinimumFrame() const;
   // Channels of the image Describe takes: the descriptor's (1 grey; 2 grey + disparity for
   // D-LDB, whose cells are then 2-channel: LDB(grey cell) ++ LDB(disparity cell)).
@@ -60,6 +61,11 @@ class FrameDescriber {
   // above 1): then the caller cuts each frame's patches (Patches, in parallel) and describes
   // the patches of many frames in one call (DescribePatches).
   bool Batched() const { return descriptor_.PreferredBatch() > 1; }
+  // Whether the descriptor learns from frames before describing (Descriptor::Learns).
+  bool Learns() const { return descriptor_.Learns(); }
+  // Learns from the patches of `images` (as Describe takes them, frames spread over the
+  // reference traversal): Descriptor::Learn. Call before any Describe.
+  void Learn(const std::vector<cv::Mat>& images) const;
   // The rows of traversal `t` when they are given, not described (Descriptor::GivenRows).
   const cv::Mat* GivenRows(int t) const { return descriptor_.GivenRows(t); }
   // The descriptor's Fingerprint (a network's weights): part of the descriptor cache's key.

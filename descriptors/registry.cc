@@ -9,6 +9,7 @@
 #include "OpenABLE/base/strings.h"
 #include "descriptors/brief.h"
 #include "descriptors/freak.h"
+#include "descriptors/densevlad.h"
 #include "descriptors/dldb.h"
 #include "descriptors/hog.h"
 #include "descriptors/ldb.h"
@@ -42,6 +43,8 @@ const Entry kDescriptors[] = {
     {"SIFT", &Make<SiftDescriptor>},    // descriptors/opencv_descriptors.h
     {"HOG", &Make<HogDescriptor>},      // descriptors/hog.h
     {"SAD", &Make<SadDescriptor>},      // descriptors/sad.h (SeqSLAM; byte values, L1 distance)
+    // descriptors/densevlad.h (dense RootSIFT + VLAD, its vocabulary learnt from the reference)
+    {"DENSEVLAD", &Make<DenseVladDescriptor>},
     {"ONNX", &Make<OnnxDescriptor>},    // descriptors/onnx.h (a network of the user's; Model_path)
 };
 
@@ -54,6 +57,35 @@ const Unavailable kUnavailable[] = {
     {"SURF",
      "patented non-free code, absent from Debian's OpenCV build; use SIFT for a vector "
      "descriptor or LDB for a binary one"},
+};
+
+// "NPY": rows given by a file, not described (DescriptorOptions::given_width, given_binary).
+// Not in the table: a user does not choose it (a run's given rows come from Descriptors_path,
+// OpenABLE/run/given_rows.h), but a map of given rows names its channel so.
+class RowsGivenDescriptor : public Descriptor {
+ public:
+  explicit RowsGivenDescriptor(const DescriptorOptions& options)
+      : Descriptor(options), width_(options.given_width), binary_(options.given_binary) {
+    if (width_ < 1)
+      throw InputError("Image_descriptor: NPY names rows given by a file (Descriptors_path, "
+                       "openable_map add --descriptors), not a descriptor to choose; expected "
+                       "one of the registered descriptors");
+  }
+  std::string Name() const override { return "NPY"; }
+  int Width() const override { return width_; }
+  DescriptorKind Kind() const override {
+    return binary_ ? DescriptorKind::kBinary : DescriptorKind::kFloat;
+  }
+
+ protected:
+  void DescribePatch(const cv::Mat&, cv::Mat) const override {
+    throw InputError("descriptor NPY: the rows were computed elsewhere and given; expected "
+                     "rows for these frames too (openable_map --descriptors FILE.npy)");
+  }
+
+ private:
+  int width_;
+  bool binary_;
 };
 
 }  // namespace
@@ -77,6 +109,7 @@ std::vector<std::pair<std::string, std::string>> UnavailableDescriptors() {
 std::unique_ptr<Descriptor> CreateDescriptor(const std::string& name,
                                              const DescriptorOptions& options) {
   const std::string key = Upper(name);
+  if (key == "NPY") return std::make_unique<RowsGivenDescriptor>(options);
   for (const Entry& e : kDescriptors) {
     if (key == e.name) {
       return e.create(options);
@@ -115,7 +148,7 @@ std::vector<std::string> DescriptorList(const std::string& value) {
       if (seen == name)
         throw InputError("Image_descriptor: \"" + value + "\" names " + name +
                          " twice; expected each fused descriptor once");
-    bool known = false;
+    bool known = name == "NPY";  // rows given (RowsGivenDescriptor)
     for (const Entry& e : kDescriptors) known = known || name == e.name;
     if (!known) CreateDescriptor(name, DescriptorOptions());  // throws the unknown-name error
     names.push_back(name);

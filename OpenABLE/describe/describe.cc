@@ -21,7 +21,54 @@ std::string SizeText(const cv::Size& s) {
   return std::to_string(s.width) + "x" + std::to_string(s.height);
 }
 
+// Frame `i` of a traversal as a describer of `kind` takes it (0: grey, or Eq. 6, then side-window
+// fusion; 1: grey + disparity; 2: colour, BGR), after the noise of robustness studies.
+cv::Mat ConvertFrame(const cv::Mat& frame, int kind, int i, const DescribeOptions& options) {
+  const NoiseOptions& noise = options.preprocess.noise;
+  const cv::Mat input =
+      noise.Any() ? AddNoise(frame, noise,
+                             NoiseState(noise.seed, options.noise_stream, options.share_first + i))
+                  : frame;
+  if (kind == 1) return ToGrayDisparity8(input);
+  if (kind == 2) return ToColour8(input);
+  cv::Mat image = options.preprocess.illumination_invariance
+                      ? cv::Mat(IlluminationInvariant(input, options.preprocess.Alpha()))
+                      : cv::Mat(ToGray8(input));
+  const std::vector<int> radii = options.preprocess.SideWindowRadii();
+  if (!radii.empty()) image = SideWindowFusion(image, radii);
+  return image;
+}
+
+int KindOf(const FrameDescriber& describer) {
+  return describer.Channels() == 2 ? 1 : describer.Channels() == 3 ? 2 : 0;
+}
+
 }  // namespace
+
+int LearnFromSource(const FrameSource& source, const FrameDescriber& describer,
+                    const DescribeOptions& options, int frames) {
+  const int n = source.Size();
+  const int count = std::min(n, std::max(1, frames));
+  std::vector<cv::Mat> images(static_cast<size_t>(count));
+  // Frames evenly spread over the traversal, read and converted in parallel when the source
+  // allows it (not a video); an unreadable one is left out here (describing reports it).
+  const int threads = source.ParallelReads() ? EffectiveThreads(options.threads) : 1;
+  ParallelFor(count, threads, [&](int j) {
+    const int i = static_cast<int>((2LL * j + 1) * n / (2LL * count));
+    try {
+      const cv::Mat image = ConvertFrame(source.Read(i), KindOf(describer), i, options);
+      const cv::Size need = describer.MinimumFrame();
+      if (image.cols >= need.width && image.rows >= need.height)
+        images[static_cast<size_t>(j)] = image;
+    } catch (const InputError&) {
+    }
+  });
+  images.erase(std::remove_if(images.begin(), images.end(),
+                              [](const cv::Mat& m) { return m.empty(); }),
+               images.end());
+  describer.Learn(images);
+  return static_cast<int>(images.size());
+}
 
 DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescriber& describer,
                                    const DescribeOptions& options,
@@ -71,10 +118,6 @@ std::vector<DescribedSequence> DescribeSequences(
     }
     return true;
   };
-  const NoiseOptions& noise = options.preprocess.noise;
-  const bool illumination_invariance = options.preprocess.illumination_invariance;
-  const double alpha = options.preprocess.Alpha();
-  const std::vector<int> side_window_radii = options.preprocess.SideWindowRadii();
   // Describes frame i once it is in memory with the descriptors whose rows are not cached
   // (`needed`); records a size mismatch as a failure. The frame is converted once for all of
   // them: grey (or Eq. 6) for every descriptor, grey + disparity (a stereo frame) for D-LDB.
@@ -87,31 +130,20 @@ std::vector<DescribedSequence> DescribeSequences(
   std::vector<cv::Size> read_sizes(any_batched ? n : 0);
   auto describe = [&](int i, const cv::Mat& frame, const std::vector<char>& needed) {
     if (!check_size(i, frame.size())) return;
-    // Noise (robustness studies) on the frame as read, before any conversion.
-    const cv::Mat input =
-        noise.Any() ? AddNoise(frame, noise,
-                               NoiseState(noise.seed, options.noise_stream,
-                                          options.share_first + i))
-                    : frame;
     // [0]: grey or Eq. 6, then side-window fusion; [1]: grey + disparity; [2]: colour (BGR)
     cv::Mat images[3];
     for (int k = 0; k < kinds; ++k) {
       if (!needed[static_cast<size_t>(k)]) continue;
       const FrameDescriber& describer = *describers[static_cast<size_t>(k)];
-      const int kind = describer.Channels() == 2 ? 1 : describer.Channels() == 3 ? 2 : 0;
+      const int kind = KindOf(describer);
       cv::Mat& image = images[kind];
       if (image.empty()) {
         try {
-          image = kind == 1                  ? ToGrayDisparity8(input)
-                  : kind == 2                ? ToColour8(input)
-                  : illumination_invariance ? cv::Mat(IlluminationInvariant(input, alpha))
-                                            : cv::Mat(ToGray8(input));
+          image = ConvertFrame(frame, kind, i, options);
         } catch (const InputError& e) {
           fail(i, "image " + Quoted(source.FrameName(i)) + ": " + e.what());
           return;
         }
-        if (kind == 0 && !side_window_radii.empty())
-          image = SideWindowFusion(image, side_window_radii);
       }
       const cv::Size need = describer.MinimumFrame();
       if (image.cols < need.width || image.rows < need.height) {

@@ -66,6 +66,13 @@ struct DescribeOptions {
   int share_first = 0;
 };
 
+// For a descriptor that learns before it describes (FrameDescriber::Learns: DenseVLAD's
+// vocabulary): reads `frames` frames evenly spread over `source` (the reference traversal),
+// converts them as describing does, and learns from them. Unreadable frames are left out.
+// Returns the frames learnt from. Throws InputError when the descriptor cannot learn from them.
+int LearnFromSource(const FrameSource& source, const FrameDescriber& describer,
+                    const DescribeOptions& options, int frames);
+
 // Reads and describes every frame of `source` (in parallel when the source allows it).
 // `progress(done, total)` is called from one thread at a time. Throws InputError naming the
 // frame when a frame cannot be read (unless skipping), when frames differ in size, or when

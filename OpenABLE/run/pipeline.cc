@@ -148,6 +148,21 @@ std::vector<Described> DescribeSources(const std::vector<ToDescribe>& all,
   options.show_images = config.output.show_images && HasDisplay();
   options.preprocess = config.preprocess;
 
+  // A descriptor that learns before describing (DenseVLAD's vocabulary) learns from frames
+  // spread over the reference traversal, the same in every process, before its rows are
+  // described or looked up in the cache (whose key holds what was learnt: Fingerprint).
+  for (int k = 0; k < count; ++k) {
+    const ToDescribe& d = all[static_cast<size_t>(k)];
+    if (!d.describer->Learns() || !d.describer->Fingerprint().empty()) continue;
+    constexpr int kLearnFrames = 40;
+    progress.Begin("learning", 1, d.name + " from frames of " + specs.front().key);
+    const int used = LearnFromSource(*sources.front(), *d.describer, options, kLearnFrames);
+    progress.End();
+    out[static_cast<size_t>(k)].notes.push_back(
+        d.name + ": learnt from " + std::to_string(used) + " frames spread over " +
+        specs.front().key + " (no ground truth)");
+  }
+
   // Descriptor caches: image folders only (a video frame or a stereo pair has no one file).
   std::vector<std::unique_ptr<DescriptorCache>> caches;
   std::vector<const FrameDescriber*> describers;

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -46,6 +47,7 @@ const std::map<std::string, Expected>& ExpectedFor64() {
       {"SAD", {2048, DescriptorKind::kBytes}},   // 64 x 32 thumbnail
       // the test network with GeM pooling (tests/data/onnx/gem.onnx): 32 channels pooled
       {"ONNX", {32, DescriptorKind::kFloat}},
+      {"DENSEVLAD", {64 * 128, DescriptorKind::kFloat}},  // 64 words x 128 (RootSIFT)
   };
   return table;
 }
@@ -101,7 +103,16 @@ class DescriptorConformance : public ::testing::TestWithParam<std::string> {
     // the square patch here.
     options.model_path = testing::SourceDir() + "/tests/data/onnx/gem.onnx";
     options.model_input_size = std::to_string(patch_size) + "x" + std::to_string(patch_size);
-    return CreateDescriptor(GetParam(), options);
+    std::unique_ptr<Descriptor> d = CreateDescriptor(GetParam(), options);
+    // A descriptor that learns (DenseVLAD's vocabulary) learns from textured patches first
+    // (of at least 64 pixels: 16 x 16 patches hold too few of its local descriptors).
+    if (d->Learns()) {
+      std::vector<cv::Mat> patches;
+      for (std::uint64_t seed = 500; seed < 508; ++seed)
+        patches.push_back(TexturedPatch(std::max(patch_size, 64), seed));
+      d->Learn(patches);
+    }
+    return d;
   }
 };
 
@@ -209,11 +220,13 @@ TEST_P(DescriptorConformance, RejectsPatchOfWrongSizeOrType) {
   const auto d = Make();
   cv::Mat row(1, d->Width(), RowType(*d));
   const int c = d->Channels();
+  // A descriptor of any input size (empty InputSize: DenseVLAD) refuses patches below 16 x 16.
+  const bool any_size = d->InputSize().empty();
   const std::vector<cv::Mat> wrong = {
       cv::Mat(),
-      cv::Mat(63, 64, CV_8UC(c), cv::Scalar::all(9)),
-      cv::Mat(64, 65, CV_8UC(c), cv::Scalar::all(9)),
-      cv::Mat(32, 32, CV_8UC(c), cv::Scalar::all(9)),
+      cv::Mat(any_size ? 15 : 63, 64, CV_8UC(c), cv::Scalar::all(9)),
+      cv::Mat(64, any_size ? 15 : 65, CV_8UC(c), cv::Scalar::all(9)),
+      cv::Mat(any_size ? 8 : 32, any_size ? 8 : 32, CV_8UC(c), cv::Scalar::all(9)),
       cv::Mat(64, 64, CV_8UC(c == 1 ? 2 : 1), cv::Scalar::all(9)),  // the other channel count
       cv::Mat(64, 64, CV_8UC(c == 3 ? 4 : 3), cv::Scalar::all(9)),
       cv::Mat(64, 64, CV_32FC1, cv::Scalar(9)),

@@ -33,7 +33,7 @@ DescriptorOptions Options(int patch_size, int ldb_bits = 256) {
 TEST(Registry, ListsTheBuiltDescriptorsInOrder) {
   EXPECT_EQ(RegisteredDescriptorNames(),
             (std::vector<std::string>{"LDB", "D-LDB", "ORB", "BRISK", "BRIEF", "FREAK", "SIFT",
-                                      "HOG", "SAD", "ONNX"}));
+                                      "HOG", "SAD", "DENSEVLAD", "ONNX"}));
 }
 
 TEST(Registry, ListsUnavailableDescriptorsWithReasons) {
@@ -63,7 +63,7 @@ TEST(Registry, UnknownNameNamesTheValueAndListsValidNames) {
   const std::string message = InputErrorMessage([] { CreateDescriptor("XYZ", Options(64)); });
   EXPECT_EQ(message,
             "Image_descriptor: unknown descriptor \"XYZ\"; expected one of LDB, D-LDB, ORB, BRISK, "
-            "BRIEF, FREAK, SIFT, HOG, SAD, ONNX");
+            "BRIEF, FREAK, SIFT, HOG, SAD, DENSEVLAD, ONNX");
   EXPECT_TRUE(Contains(InputErrorMessage([] { CreateDescriptor("", Options(64)); }), "\"\""));
 }
 
