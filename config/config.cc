@@ -188,8 +188,11 @@ void AddDescriptionKeys(OptionTable& t, Config& c) {
   t.Add("Image_descriptor", kDescription, c.descriptor, c.descriptor.name,
         "LDB, D-LDB (LDB of the grey and of the disparity image; needs Camera_type 1), ORB, "
         "BRISK, BRIEF, FREAK (binary, Hamming distance), SIFT, HOG (vector, L2 distance) or SAD "
-        "(SeqSLAM's patch-normalised thumbnail, sum of absolute differences; Sad_patch), or ONNX "
-        "(a network of the user's, Model_path; float rows, L2 distance). Several "
+        "(SeqSLAM's patch-normalised thumbnail, sum of absolute differences; Sad_patch), "
+        "DenseVLAD (dense RootSIFT aggregated by VLAD over a vocabulary learnt from the frames "
+        "of Images_path, no ground truth; robust to a change of viewpoint and of light; float "
+        "rows, L2 distance; not in maps or the online detector), or ONNX (a network of the "
+        "user's, Model_path; float rows, L2 distance). Several "
         "names joined by + or , (HOG+LDB) fuse their matrices (Fusion_weights). SURF is not "
         "available (non-free, absent from Debian's OpenCV).", false);
   t.Add("Image_sequences", kDescription, c.matching, c.matching.sequence_length, 1, 100000,

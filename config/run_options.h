@@ -105,10 +105,11 @@ struct AutoOptions {
   double min_consistency = 0.5;
 
   // The candidates measured across the shared datasets (docs/benchmarks.md, "Settings chosen
-  // from the data").
+  // from the data"; DenseVLAD's group: "A descriptor for viewpoint and light together").
   static constexpr const char* kDefaultCandidates =
       "Image_descriptor=HOG,SIFT,LDB,HOG+LDB Image_sequences=10,20,40 | "
-      "Image_descriptor=SAD Contrast_enhancement=1 Image_sequences=10,20,40";
+      "Image_descriptor=SAD Contrast_enhancement=1 Image_sequences=10,20,40 | "
+      "Image_descriptor=DenseVLAD Image_sequences=10,20,40";
 
   // Throws InputError naming the key of a bad value (the candidates' own checks are the auto
   // mode's, OpenABLE/tuning/auto.h).

@@ -88,7 +88,7 @@ TEST(Auto, TheRunOfTheChoiceIsThePlainRunOfItsSettingsByteForByte) {
   // Every candidate of the default list is there, each with its criteria.
   const Json report = Json::parse(json);
   const Json& candidates = report.at("auto").at("candidates");
-  EXPECT_EQ(candidates.size(), 15u);
+  EXPECT_EQ(candidates.size(), 18u);
   for (const Json& c : candidates)
     for (const char* key : {"settings", "consistency", "distinctiveness", "agreement"})
       EXPECT_TRUE(c.contains(key)) << c.dump();
