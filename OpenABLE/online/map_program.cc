@@ -29,6 +29,7 @@
 #include "OpenABLE/run/evaluate.h"
 #include "OpenABLE/tuning/auto.h"
 #include "config/config.h"
+#include "OpenABLE/run/given_rows.h"
 #include "descriptors/registry.h"
 
 namespace openable {
@@ -36,14 +37,14 @@ namespace {
 
 const char* const kUsageText =
     "Usage: openable_map add MAP --images FOLDER --session NAME [--time T] [--config FILE]\n"
-    "                        [--set Key=Value ...] [--threshold X]\n"
+    "                        [--set Key=Value ...] [--threshold X] [--descriptors FILE.npy]\n"
     "       openable_map tune MAP [--session REFERENCE --session QUERY] [--frames N]\n"
     "                         [--threshold X] [--config FILE] [--set Key=Value ...] [--json]\n"
     "       openable_map info MAP [--json]\n"
     "       openable_map merge A B -o C\n"
     "       openable_map query MAP --images FOLDER [--session NAME ...] [--config FILE]\n"
     "                          [--set Key=Value ...] [--threshold X] [--json]\n"
-    "                          [--output PREFIX]\n"
+    "                          [--output PREFIX] [--descriptors FILE.npy]\n"
     "\n"
     "A map holds the places of one or more sessions (traversals of a route): each frame's\n"
     "descriptor rows and the index that finds them again (docs/library.md, \"Maps that grow\").\n"
@@ -57,7 +58,11 @@ const char* const kUsageText =
     "         tune can choose among them. An existing map keeps its own settings, and a\n"
     "         --config that describes otherwise is refused. The frames must be of the map's\n"
     "         size. MAP is replaced whole when the new one is written (an interrupted add leaves\n"
-    "         it as it was).\n"
+    "         it as it was). --descriptors FILE.npy adds rows computed elsewhere (one per\n"
+    "         frame, float32 matched by L2 or uint8 bits by Hamming, as a run's\n"
+    "         Descriptors_path) instead of describing images; --images then only names the\n"
+    "         frames (one image per row) and may be left out. A map made so takes only such\n"
+    "         rows, of the same width and type, in add and query.\n"
     "  tune   chooses the map's search settings from its data, with no ground truth, as\n"
     "         Test_OpenABLE's auto mode does (docs/evaluation.md, \"Without ground truth\"): the\n"
     "         frames of the second session (or the QUERY one) are matched against those of the\n"
@@ -111,7 +116,8 @@ using Arguments = MapCommandLine;
 std::string Parse(int argc, const char* const* argv, Arguments& a) {
   const std::vector<std::string> with_value = {"--images", "--session",   "--time",
                                                "--config", "--set",       "-o",
-                                               "--output", "--threshold", "--frames"};
+                                               "--output", "--threshold", "--frames",
+                                               "--descriptors"};
   for (int i = 1; i < argc; ++i) {
     std::string arg = argv[i], value;
     const std::size_t eq = arg.find('=');
@@ -132,6 +138,7 @@ std::string Parse(int argc, const char* const* argv, Arguments& a) {
       else if (arg == "--set") a.sets.push_back(value);
       else if (arg == "--threshold") a.threshold = value;
       else if (arg == "--frames") a.frames = value;
+      else if (arg == "--descriptors") a.descriptors = value;
       else a.output = value;
     } else if (arg == "--json") {
       a.json = true;
@@ -153,8 +160,9 @@ std::string Parse(int argc, const char* const* argv, Arguments& a) {
   if (a.positional.size() != maps)
     return a.command + " takes " + (maps == 1 ? "one map" : "two maps (A B)") + ", got " +
            std::to_string(a.positional.size()) + " paths";
-  if ((a.command == "add" || a.command == "query") && a.images.empty())
-    return a.command + " needs --images FOLDER";
+  if ((a.command == "add" || a.command == "query") && a.images.empty() &&
+      a.descriptors.empty())
+    return a.command + " needs --images FOLDER (or --descriptors FILE.npy)";
   if (a.command == "add" && a.sessions.size() != 1)
     return "add needs one --session NAME (the new session's name)";
   if (a.command == "merge" && a.output.empty()) return "merge needs -o C (the merged map)";
@@ -168,6 +176,7 @@ std::string Parse(int argc, const char* const* argv, Arguments& a) {
   };
   for (const std::string& problem :
        {only(!a.images.empty(), "--images", {"add", "query"}),
+        only(!a.descriptors.empty(), "--descriptors", {"add", "query"}),
         only(!a.time.empty(), "--time", {"add"}),
         only(!a.frames.empty(), "--frames", {"tune"}),
         only(!a.threshold.empty(), "--threshold", {"add", "tune", "query"}),
@@ -260,9 +269,18 @@ void SetThreshold(const Arguments& a, OnlineOptions& o) {
   o.threshold = t;
 }
 
+// Whether the registered descriptor `name` learns from a reference traversal (a network is
+// not created here: it learns nothing).
+bool LearnsFromReference(const std::string& name) {
+  if (Upper(name) == "ONNX") return false;
+  return CreateDescriptor(name, DescriptorOptions())->Learns();
+}
+
 // The options of a new map from a Config.txt and --set: description, index, and the search
 // keys `search` (those the command line gives; the others keep the detector's defaults). With
-// Auto 1 (the auto preset) the map keeps the rows of every descriptor of its candidates.
+// Auto 1 (the auto preset) the map keeps the rows of every descriptor of its candidates but
+// those that learn from a reference traversal (DenseVLAD: a map's sessions would each learn
+// another vocabulary), which tune then leaves out.
 OnlineOptions OptionsOfConfig(const Config& c, const std::vector<std::string>& search) {
   OnlineOptions o;
   o.descriptor = c.descriptor;
@@ -281,7 +299,8 @@ OnlineOptions OptionsOfConfig(const Config& c, const std::vector<std::string>& s
       for (const auto& [key, value] : candidate)
         if (key == "Image_descriptor")
           for (const std::string& name : DescriptorList(value))
-            if (std::find(kept.begin(), kept.end(), Upper(name)) == kept.end())
+            if (std::find(kept.begin(), kept.end(), Upper(name)) == kept.end() &&
+                !LearnsFromReference(name))
               kept.push_back(Upper(name));
     std::string text;
     for (const std::string& name : kept) text += (text.empty() ? "" : "+") + name;
@@ -368,9 +387,15 @@ std::string DescriptionOf(const OnlineOptions& o) {
   std::sort(names.begin(), names.end());
   std::string list;
   for (const std::string& n : names) list += (list.empty() ? "" : "+") + n;
+  std::string network;
+  if (std::find(names.begin(), names.end(), "ONNX") != names.end())
+    network = " (network input " + o.descriptor.model_input_size + " " +
+              o.descriptor.model_channels + ", mean " + o.descriptor.model_mean + ", std " +
+              o.descriptor.model_std + ", normalize " +
+              (o.descriptor.model_normalize ? "1" : "0") + ")";
   return list + " " + std::to_string(o.descriptor.patch_size) + " " +
          std::to_string(o.descriptor.ldb_bits) + " " + EnumName(o.description) + " " +
-         std::to_string(o.grid_x) + "x" + std::to_string(o.grid_y);
+         std::to_string(o.grid_x) + "x" + std::to_string(o.grid_y) + network;
 }
 
 // The search settings as a person reads them.
@@ -402,6 +427,48 @@ std::unique_ptr<MapWriteLock> LockForWriting(const std::string& path, bool quiet
   return lock;
 }
 
+// Rows computed elsewhere (--descriptors FILE.npy, read and checked as a run's
+// Descriptors_path) and the names of their frames: the images of --images when given (one per
+// row, in natural order of their names; only listed, not read), else none.
+struct GivenRowsOfCommand {
+  cv::Mat rows;
+  std::vector<std::string> names;
+};
+GivenRowsOfCommand GivenRowsOf(const Arguments& a) {
+  GivenRowsOfCommand out;
+  out.rows = ReadGivenRows(a.descriptors, "--descriptors");
+  if (!a.images.empty()) {
+    out.names = ListImages(a.images, "");
+    if (out.names.size() != static_cast<size_t>(out.rows.rows))
+      throw InputError("--descriptors: " + Quoted(a.descriptors) + " holds " +
+                       std::to_string(out.rows.rows) + " rows, but --images " +
+                       Quoted(a.images) + " holds " + std::to_string(out.names.size()) +
+                       " images; expected one row per image, in the natural order of their names");
+  }
+  return out;
+}
+
+// Whether the map at `path` holds rows given by a file (openable_map add --descriptors).
+bool MapOfGivenRows(const std::string& path) {
+  MapReadOptions read;
+  read.header_only = true;
+  return Upper(ReadMapFile(path, read).Setting("descriptor")) == "NPY";
+}
+
+// One line refusing --images without --descriptors for a map of given rows, or --descriptors
+// for a map that describes its frames itself.
+void CheckRowsFitMap(const Arguments& a, const std::string& path) {
+  const bool given = MapOfGivenRows(path);
+  if (given && a.descriptors.empty())
+    throw InputError(path + ": the map's rows were computed elsewhere (openable_map add "
+                     "--descriptors); expected --descriptors FILE.npy with the rows of these "
+                     "frames, computed the same way");
+  if (!given && !a.descriptors.empty())
+    throw InputError("--descriptors: " + Quoted(a.descriptors) + " given, but " + path +
+                     " describes its frames itself; expected --images FOLDER, or a map made "
+                     "with --descriptors");
+}
+
 int Add(const Arguments& a) {
   const std::string& path = a.positional[0];
   if (!a.time.empty()) CheckSessionTime(a.time, "--time");
@@ -409,14 +476,29 @@ int Add(const Arguments& a) {
   const auto lock = LockForWriting(path, a.quiet);
   OnlineOptions wanted = OptionsOfConfig(ConfigOf(a), SearchKeysGiven(a));
   SetThreshold(a, wanted);
-  // Refused before any frame is described (SaveMap would refuse it at the end).
-  if (Upper(wanted.descriptor.name + "+" + wanted.kept_descriptors).find("ONNX") !=
-      std::string::npos)
-    throw InputError(NetworkMapRefusal(path));
   std::unique_ptr<OnlineDetector> d;
   const bool exists = std::filesystem::exists(path);
+  GivenRowsOfCommand given;
+  if (!a.descriptors.empty()) {
+    given = GivenRowsOf(a);
+    if (!exists) {
+      // A new map of rows computed elsewhere: one channel, "NPY", of the rows' width and type.
+      if (configured && !a.quiet &&
+          (wanted.descriptor.name != OnlineOptions().descriptor.name ||
+           !wanted.kept_descriptors.empty()))
+        std::cerr << "note: Image_descriptor " << wanted.descriptor.name
+                  << (wanted.kept_descriptors.empty() ? "" : " and Auto's candidates")
+                  << " not used: the rows come from " << Quoted(a.descriptors) << "\n";
+      wanted.descriptor.name = "NPY";
+      wanted.kept_descriptors.clear();
+      wanted.fusion_weights.clear();
+      wanted.descriptor.given_width = given.rows.cols;
+      wanted.descriptor.given_binary = given.rows.type() == CV_8U;
+    }
+  }
   if (exists) {
     RequireNoFeatures(path);
+    CheckRowsFitMap(a, path);
     d = Open(path, wanted);
     const OnlineOptions& have = d->Options();
     if (configured && DescriptionOf(have) != DescriptionOf(wanted))
@@ -428,10 +510,17 @@ int Add(const Arguments& a) {
   }
   d->StartSession(a.sessions[0], a.time);
   const int before = d->Size();
-  ForImagesOf(a.images, a.quiet, "describing", [&](const std::vector<cv::Mat>& images,
-                                                   const std::vector<std::string>& names) {
-    d->AddImagesToMap(images, names);
-  });
+  if (!a.descriptors.empty()) {
+    if (given.names.empty())
+      d->AddToMap(given.rows);
+    else
+      d->AddToMap(given.rows, given.names);
+  } else {
+    ForImagesOf(a.images, a.quiet, "describing", [&](const std::vector<cv::Mat>& images,
+                                                     const std::vector<std::string>& names) {
+      d->AddImagesToMap(images, names);
+    });
+  }
   d->SaveMap(path);
   SetInterruptNote(path + " holds session " + Quoted(a.sessions[0]));
   if (!a.quiet) {
@@ -523,6 +612,12 @@ int Info(const Arguments& a) {
             << " (grid " << map.Setting("grid_x") << "x" << map.Setting("grid_y") << "); frames "
             << (map.Setting("frame_size").empty() ? "of unknown size" : map.Setting("frame_size"))
             << "\n";
+  if (!map.Setting("model_weights").empty())
+    std::cout << "Network: " << map.Setting("model_path") << " (weights "
+              << map.Setting("model_weights") << "), input " << map.Setting("model_input_size")
+              << " " << map.Setting("model_channels") << ", mean " << map.Setting("model_mean")
+              << ", std " << map.Setting("model_std") << ", normalize "
+              << map.Setting("model_normalize") << "\n";
   std::cout << "Search: " << SearchText(d->Options())
             << (tuning.tuned ? "" : " (not tuned: openable_map tune chooses it from the data)")
             << "\n";
@@ -722,10 +817,11 @@ std::vector<std::string> WriteQueryOutputs(const std::string& prefix, const Conf
   const std::string label = "map " + o.descriptor.name + " L=" + std::to_string(o.sequence_length);
   ReportInput report;
   report.program = "openable_map query";
-  report.title = "OpenABLE map query: " + FileName(a.images) + " against " +
+  const std::string queries = a.images.empty() ? a.descriptors : a.images;
+  report.title = "OpenABLE map query: " + FileName(queries) + " against " +
                  FileName(a.positional[0]);
   report.settings = {{"map", a.positional[0]},
-                     {"queries", a.images},
+                     {"queries", queries},
                      {"sessions searched", a.sessions.empty() ? "all" : json::Strings(a.sessions).dump()},
                      {"search", SearchText(o)},
                      {"tuned", d.Tuning().tuned ? (d.UsesTuning() ? "yes, used" : "yes, replaced")
@@ -844,6 +940,7 @@ int Query(const Arguments& a) {
   if (a.json && !a.output.empty())
     throw InputError("--json and --output: expected one of them (--output writes " + a.output +
                      ".json)");
+  CheckRowsFitMap(a, path);
   std::unique_ptr<OnlineDetector> d = std::make_unique<OnlineDetector>(options);
   d->LoadMap(path);
   const bool quiet = a.quiet || a.json;
@@ -863,11 +960,20 @@ int Query(const Arguments& a) {
   }
   std::vector<cv::Mat> rows;
   std::vector<std::string> names;
-  ForImagesOf(a.images, quiet, "describing queries",
-              [&](const std::vector<cv::Mat>& images, const std::vector<std::string>& chunk) {
-                rows.push_back(d->DescribeFrames(images, chunk));
-                names.insert(names.end(), chunk.begin(), chunk.end());
-              });
+  if (!a.descriptors.empty()) {
+    // Rows computed elsewhere: named by their images when --images lists them, else "row i".
+    GivenRowsOfCommand given = GivenRowsOf(a);
+    rows.push_back(given.rows);
+    names = given.names;
+    for (int i = static_cast<int>(names.size()); i < given.rows.rows; ++i)
+      names.push_back("row " + std::to_string(i));
+  } else {
+    ForImagesOf(a.images, quiet, "describing queries",
+                [&](const std::vector<cv::Mat>& images, const std::vector<std::string>& chunk) {
+                  rows.push_back(d->DescribeFrames(images, chunk));
+                  names.insert(names.end(), chunk.begin(), chunk.end());
+                });
+  }
   cv::Mat all;
   cv::vconcat(rows, all);
   ProgressReporter progress(std::cerr, !quiet, isatty(STDERR_FILENO) != 0);

@@ -145,10 +145,11 @@ void OnlineOptions::Check() const {
   }
 }
 
-std::string NetworkMapRefusal(const std::string& path) {
-  return "map " + Quoted(path) + ": a map of a network (descriptor ONNX) is not saved yet: the "
-         "map would not keep its model's settings and weights; expected a built-in descriptor "
-         "for a map (the detector itself runs a network in memory)";
+std::string AbsoluteModelPath(const std::string& path) {
+  if (path.empty()) return path;
+  std::error_code error;
+  const std::filesystem::path absolute = std::filesystem::absolute(path, error);
+  return error ? path : absolute.lexically_normal().string();
 }
 
 Describer MakeDescriber(const OnlineOptions& options) {
@@ -160,6 +161,13 @@ Describer MakeDescriber(const OnlineOptions& options) {
   Require(out.descriptor->Channels() != 2, "descriptor", options.descriptor.name,
           "a single-camera descriptor (" + out.descriptor->Name() +
               " needs stereo pairs: use Test_OpenABLE with Camera_type 1)");
+  // DenseVLAD's rows depend on the vocabulary learnt from a reference traversal: frames
+  // described one call at a time (or a map's later sessions) would each learn another.
+  if (out.descriptor->Learns())
+    throw InputError("descriptor: " + out.descriptor->Name() + " learns its vocabulary from a "
+                     "reference traversal, which the online detector, maps and describe() do "
+                     "not keep; expected a run of the whole traversals (Test_OpenABLE, "
+                     "openable.sweep or python3 -m openable run), or another descriptor here");
   out.frame = std::make_unique<FrameDescriber>(*out.descriptor, options.description,
                                                options.grid_x, options.grid_y, 1);
   return out;
@@ -780,6 +788,17 @@ void OnlineDetector::AddImagesToMap(const std::vector<cv::Mat>& images,
   }
 }
 
+void OnlineDetector::AddToMap(const cv::Mat& rows, const std::vector<std::string>& names) {
+  if (names.size() != static_cast<size_t>(rows.rows))
+    throw InputError("OnlineDetector::AddToMap: " + std::to_string(names.size()) +
+                     " names for " + std::to_string(rows.rows) + " rows; expected one each");
+  State& s = *state_;
+  const int before = Size();
+  AddToMap(rows);
+  s.files.resize(static_cast<size_t>(before));
+  s.files.insert(s.files.end(), names.begin(), names.end());
+}
+
 OnlineResult OnlineDetector::AddDescriptor(const cv::Mat& row) {
   State& s = *state_;
   const RowsByChannel split = s.Split(row, "descriptor row", "1");
@@ -1089,6 +1108,15 @@ std::string Exact(double v) {
   return out.str();
 }
 
+// Whether the descriptors of `o` (searched or kept) include a network (ONNX).
+bool UsesNetwork(const OnlineOptions& o) {
+  for (const std::string& list : {o.descriptor.name, o.kept_descriptors})
+    if (!list.empty())
+      for (const std::string& n : DescriptorList(list))
+        if (n == "ONNX") return true;
+  return false;
+}
+
 std::string Numbers(const std::vector<double>& values) {
   std::string out;
   for (const double v : values) out += (out.empty() ? "" : ",") + Exact(v);
@@ -1098,12 +1126,22 @@ std::string Numbers(const std::vector<double>& values) {
 // The settings that make the rows: a map made with others cannot be searched with this
 // detector's rows. (The descriptors themselves are the map's "channels".)
 std::vector<std::pair<std::string, std::string>> DescriptionSettings(const OnlineOptions& o) {
-  return {{"description", EnumName(o.description)},
-          {"patch_size", std::to_string(o.descriptor.patch_size)},
-          {"ldb_bits", std::to_string(o.descriptor.ldb_bits)},
-          {"sad_patch", std::to_string(o.descriptor.sad_patch)},
-          {"grid_x", std::to_string(o.grid_x)},
-          {"grid_y", std::to_string(o.grid_y)}};
+  std::vector<std::pair<std::string, std::string>> out = {
+      {"description", EnumName(o.description)},
+      {"patch_size", std::to_string(o.descriptor.patch_size)},
+      {"ldb_bits", std::to_string(o.descriptor.ldb_bits)},
+      {"sad_patch", std::to_string(o.descriptor.sad_patch)},
+      {"grid_x", std::to_string(o.grid_x)},
+      {"grid_y", std::to_string(o.grid_y)}};
+  // A network: how frames are prepared for it (its weights are checked by their digest,
+  // "model_weights", and its file may move: "model_path" is where it was).
+  if (UsesNetwork(o))
+    out.insert(out.end(), {{"model_input_size", o.descriptor.model_input_size},
+                           {"model_channels", o.descriptor.model_channels},
+                           {"model_mean", o.descriptor.model_mean},
+                           {"model_std", o.descriptor.model_std},
+                           {"model_normalize", o.descriptor.model_normalize ? "1" : "0"}});
+  return out;
 }
 
 // The settings that make the index blocks: with others, the saved blocks are rebuilt.
@@ -1159,9 +1197,6 @@ void OnlineDetector::SaveMap(const std::string& path) {
   State& s = *state_;
   // A map loaded damaged is not written out again as if it were sound.
   s.ThrowIfDamaged(true);
-  for (const State::Channel& c : s.channels)
-    if (c.describer.descriptor->Name() == "ONNX")
-      throw InputError(NetworkMapRefusal(path));
   FinishMerges();
   const State::Channel& first = s.channels.front();
   MapFile map;
@@ -1184,6 +1219,11 @@ void OnlineDetector::SaveMap(const std::string& path) {
   for (const auto& list : {DescriptionSettings(s.options), IndexSettings(s.options),
                            FeatureSettings(s.options)})
     map.settings.insert(map.settings.end(), list.begin(), list.end());
+  for (const State::Channel& c : s.channels)
+    if (c.describer.descriptor->Name() == "ONNX")
+      map.settings.insert(map.settings.end(),
+                          {{"model_path", AbsoluteModelPath(s.options.descriptor.model_path)},
+                           {"model_weights", c.describer.descriptor->Fingerprint()}});
   for (const auto& [key, value] : SearchSettings(s.options))
     map.settings.emplace_back("search_" + key, value);
   if (s.tuning.tuned) {
@@ -1426,6 +1466,21 @@ OnlineOptions ReadMapOptions(const std::string& path, const OnlineOptions& base)
   ParseWhole(map, "patch_size", path, o.descriptor.patch_size);
   ParseWhole(map, "ldb_bits", path, o.descriptor.ldb_bits);
   if (!map.Setting("sad_patch").empty()) ParseWhole(map, "sad_patch", path, o.descriptor.sad_patch);
+  if (Upper(o.descriptor.name) == "NPY") {
+    // Rows given by a file (openable_map add --descriptors): their width and type.
+    ParseWhole(map, "row_width", path, o.descriptor.given_width);
+    o.descriptor.given_binary = map.Setting("row_type") == "CV_8U";
+  }
+  if (!map.Setting("model_weights").empty()) {
+    // A network: its file as given (a copy moved elsewhere, checked by its weights' digest
+    // when the map loads), else where the map was saved from.
+    if (o.descriptor.model_path.empty()) o.descriptor.model_path = map.Setting("model_path");
+    o.descriptor.model_input_size = map.Setting("model_input_size");
+    o.descriptor.model_channels = map.Setting("model_channels");
+    o.descriptor.model_mean = map.Setting("model_mean");
+    o.descriptor.model_std = map.Setting("model_std");
+    o.descriptor.model_normalize = map.Setting("model_normalize") != "0";
+  }
   ParseWhole(map, "grid_x", path, o.grid_x);
   ParseWhole(map, "grid_y", path, o.grid_y);
   ParseWhole(map, "exclusion", path, o.exclusion);
@@ -1488,6 +1543,16 @@ OnlineDetector::LoadedMap OnlineDetector::LoadMapNamed(const std::string& path,
   }
   std::vector<int> widths, types;
   for (const State::Channel& c : s.channels) widths.push_back(c.width), types.push_back(c.type);
+  // A network's weights first: other weights are also what makes rows of another width.
+  for (const State::Channel& c : s.channels)
+    if (c.describer.descriptor->Name() == "ONNX" &&
+        c.describer.descriptor->Fingerprint() != map.Setting("model_weights"))
+      throw InputError(
+          path + ": the map was made with the network " + Quoted(map.Setting("model_path")) +
+          " of weights " + Quoted(map.Setting("model_weights")) + "; Model_path " +
+          Quoted(s.options.descriptor.model_path) + " holds weights " +
+          Quoted(c.describer.descriptor->Fingerprint()) +
+          " (expected the same model file: give Model_path of a copy of it)");
   const double unit = CheckMapFits(map, path, s.options, s.ChannelList(), widths, types,
                                    s.verifier.get(), s.unit);
   if (map.frame_files.size() != 0 && map.frame_files.size() != static_cast<size_t>(map.rows.rows))

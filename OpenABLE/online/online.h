@@ -218,6 +218,8 @@ class OnlineDetector {
   // searching for them: a map saved from an earlier run (see Descriptors()). Later frames find
   // them as candidates like any other frame.
   void AddToMap(const cv::Mat& rows);
+  // AddToMap, the frames named `names` (one per row; their image files, kept in saved maps).
+  void AddToMap(const cv::Mat& rows, const std::vector<std::string>& names);
   // Describes `images` (as AddFrame takes them, spread over the cores) and appends them as
   // AddToMap does: a traversal added to a map in bulk. Every image must be of the map's frame
   // size (FrameSize; the first sets it); `names` (one per image, or empty) name them in
@@ -394,9 +396,9 @@ OnlineOptions MapOptions(const std::string& path, const OnlineOptions& base = On
 
 // ---- Batch helpers -------------------------------------------------------------------------
 
-// The one line that refuses to save a map of a network (descriptor ONNX, descriptors/onnx.h):
-// maps do not keep a model's settings and weights yet.
-std::string NetworkMapRefusal(const std::string& path);
+// The absolute path of a network's file (Model_path) as a map keeps it, so that the map finds
+// it from another working folder; `path` itself when it cannot be made absolute.
+std::string AbsoluteModelPath(const std::string& path);
 
 // The describer of `options` (descriptor, description, grid) and the descriptor it uses.
 struct Describer {

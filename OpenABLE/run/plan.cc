@@ -146,12 +146,6 @@ namespace {
 std::unique_ptr<Descriptor> GivenRowsOf(const Config& config, RunResult& result) {
   const InputOptions& input = config.input;
   const std::vector<SourceSpec> specs = SourcesOf(input);
-  if (config.automatic.enabled)
-    throw InputError("Descriptors_path: given with Auto 1, which chooses among descriptors of "
-                     "its own; expected one of them (Auto 0 to run on the given rows)");
-  if (Cluster::Get().Distributed())
-    throw InputError("Descriptors_path: given to a run over several processes; expected a run "
-                     "in one process (every process would read every row)");
   if (config.description.type != DescriptionType::kGlobal ||
       input.camera_type != CameraType::kMonocular)
     throw InputError("Descriptors_path: given with " +
@@ -178,7 +172,7 @@ std::unique_ptr<Descriptor> GivenRowsOf(const Config& config, RunResult& result)
                        ", Descriptors_path rows of " + text(rows[0]) +
                        "; expected rows of one width and type for both traversals");
   }
-  if (config.descriptor.name != DescriptorOptions().name)
+  if (config.descriptor.name != DescriptorOptions().name && Upper(config.descriptor.name) != "NPY")
     result.notes.push_back("Image_descriptor: \"" + config.descriptor.name +
                            "\" not used: the rows come from Descriptors_path");
   return std::make_unique<GivenRowsDescriptor>(config.descriptor, std::move(rows));

@@ -216,6 +216,8 @@ Config AutoCandidateConfig(const Config& config, const AutoSettings& candidate) 
   Config c = config;
   for (const auto& [key, value] : candidate) ApplyOverride(c, key + "=" + value, kKey);
   c.automatic.enabled = false;
+  // Rows given by files: every candidate's single-frame matrix is theirs (the run's "NPY").
+  if (!c.input.descriptors_path.empty()) c.descriptor.name = "NPY";
   return c;
 }
 
@@ -238,6 +240,12 @@ void CheckAuto(const Config& config) {
         "Auto: 1 runs on one process; expected Test_OpenABLE without mpirun (the "
         "chosen settings can then be run over processes with Auto 0)");
   for (const AutoSettings& candidate : ParseAutoCandidates(AutoCandidatesOf(config))) {
+    if (!config.input.descriptors_path.empty())
+      for (const auto& [key, value] : candidate)
+        if (key == "Image_descriptor" || key == "Patch_size" || key == "Description_type")
+          throw InputError(std::string(kKey) + ": " + AutoSettingsText(candidate) + " sets " +
+                           key + ", but the rows come from Descriptors_path; expected "
+                           "candidates of matching settings only (e.g. Image_sequences=10,20,40)");
     try {
       CheckRun(AutoCandidateConfig(config, Completed(config, candidate)));
     } catch (const InputError& e) {
@@ -249,6 +257,12 @@ void CheckAuto(const Config& config) {
 
 std::string AutoCandidatesOf(const Config& config) {
   const std::string& text = config.automatic.candidates;
+  // Rows given by files (Descriptors_path): one descriptor, so the default candidates are the
+  // default's matching without a descriptor: sequences, and contrast enhancement with them.
+  if (!config.input.descriptors_path.empty())
+    return text == AutoOptions::kDefaultCandidates
+               ? "Image_sequences=10,20,40 | Contrast_enhancement=1 Image_sequences=10,20,40"
+               : text;
   if (config.descriptor.model_path.empty() || Upper(text).find("ONNX") != std::string::npos)
     return text;
   // A configured network joins the candidates, with the sequences of the default groups.

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "OpenABLE/io/npy.h"
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
 
@@ -205,6 +206,62 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"HogBoundedTwoL1", "HOG", true, true, 1},
                       Case{"HogBoundedTwoL10", "HOG", true, true, 10}),
     [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
+
+// Descriptors users bring, spread over processes: a network (the GeM test network), DenseVLAD
+// (each process learns the same vocabulary from the same frames) and rows computed elsewhere
+// (Descriptors_path: every process reads the file, none describes), dense and bounded: two
+// processes write the one-process outputs.
+TEST(SpreadBrought, ANetworkDenseVladAndGivenRowsGiveTheOneProcessOutputs) {
+  const std::string missing = MissingMpi();
+  if (!missing.empty()) GTEST_SKIP() << missing;
+  const std::string rows_dir = testing::TempDir();
+  cv::Mat1f rows(300, 48);
+  cv::RNG(11).fill(rows, cv::RNG::UNIFORM, 0.0, 1.0);
+  std::ofstream(rows_dir + "/rows.npy", std::ios::binary) << EncodeNpy(rows);
+  struct Brought {
+    const char* name;
+    const char* descriptor;
+    std::vector<std::string> keys;
+  };
+  const std::vector<Brought> cases = {
+      {"network", "ONNX",
+       {"Model_path: \"" + testing::SourceDir() + "/tests/data/onnx/gem.onnx\"",
+        "Model_input_size: \"64x32\""}},
+      {"DenseVLAD", "DenseVLAD", {}},
+      {"given rows", "HOG", {"Descriptors_path: \"" + rows_dir + "/rows.npy\""}},
+      {"given rows, bounded", "HOG", {"Descriptors_path: \"" + rows_dir + "/rows.npy\""}}};
+  for (const Brought& brought : cases) {
+    const std::string name = brought.name;
+    const std::vector<std::string>& keys = brought.keys;
+    SCOPED_TRACE(name);
+    const bool bounded = name.find("bounded") != std::string::npos;
+    std::string outputs[2];
+    for (const int processes : {0, 2}) {
+      const std::string dir = testing::TempDir();
+      const Case c{"", brought.descriptor, bounded, false, 5};
+      const std::string config = ConfigOf(dir, c);
+      {
+        std::ofstream f(config, std::ios::app);
+        for (const std::string& k : keys) f << k << "\n";
+      }
+      const Outcome o = RunSpread(processes, testing::TestOpenableExe(), {config, "--quiet"}, dir);
+      ASSERT_EQ(o.status, 0) << o.err << o.out;
+      outputs[processes == 0 ? 0 : 1] = dir;
+    }
+    ExpectSameMatches(outputs[0] + "/out/matches.csv", outputs[1] + "/out/matches.csv", false);
+    if (bounded) continue;
+    const cv::Mat1f a = ReadNpy(outputs[0] + "/out/matrix.npy");
+    const cv::Mat1f b = ReadNpy(outputs[1] + "/out/matrix.npy");
+    ASSERT_EQ(a.size(), b.size());
+    ASSERT_EQ(a.rows, 300);
+    double worst = 0;
+    for (int i = 0; i < a.rows; ++i)
+      for (int j = 0; j < a.cols; ++j)
+        if (std::isfinite(a(i, j)) || std::isfinite(b(i, j)))
+          worst = std::max(worst, static_cast<double>(std::abs(a(i, j) - b(i, j))));
+    EXPECT_LE(worst, 1e-6);
+  }
+}
 
 // A frame that only process 1 reads is damaged: the run ends on every process, process 0 says
 // so in one line naming the frame and the process, and nothing is written.

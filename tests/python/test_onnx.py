@@ -74,8 +74,12 @@ class OnnxRunTest(TempDirTestCase):
             self.assertIn("Image_descriptor=ONNX Image_sequences=%d" % length, settings_judged)
         self.assertIn("Image_descriptor=HOG Image_sequences=10", settings_judged)
 
-    def test_python_and_the_online_detector_run_a_network_but_save_no_map_of_it(self):
+    def test_python_the_online_detector_and_maps_run_a_network(self):
+        import json
+        import shutil
+        import subprocess
         import openable
+        from support import program
         names = (ONNX / "frames.txt").read_text().split()
         images = [openable.read_image(str(SAMPLE / "summer" / n)) for n in names]
         expected = np.load(ONNX / "gem_outputs.npy")
@@ -93,22 +97,48 @@ class OnnxRunTest(TempDirTestCase):
         for image in images:
             detector.add_frame(image)
         self.assertEqual(detector.size, 16)
-        with self.assertRaises(openable.InputError) as caught:
-            detector.save_map(str(self.tmp / "net.map"))
-        self.assertIn("a map of a network (descriptor ONNX) is not saved yet",
-                      str(caught.exception))
-        self.assertFalse((self.tmp / "net.map").exists())
-        import subprocess
-        from support import program
-        done = subprocess.run(
-            [program("openable_map"), "add", str(self.tmp / "m.map"), "--images",
-             str(SAMPLE / "summer"), "--session", "s", "--set", "Image_descriptor=ONNX",
-             "--set", "Model_path=%s" % (ONNX / "gem.onnx"), "--set", "Model_input_size=64x32"],
-            cwd=str(self.tmp), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        # Its map keeps the network's settings and the digest of its weights: opened with no
+        # option, it describes queries with the same network (its nearest frame is itself).
+        detector.save_map(str(self.tmp / "net.map"))
+        reopened = openable.OnlineDetector.open(str(self.tmp / "net.map"), sequence_length=1)
+        self.assertLess(np.abs(reopened.descriptors - expected).max(), 1e-5)
+        for i, result in enumerate(reopened.query_images(images)):
+            self.assertEqual(result[0]["frame"], i)
+        # openable_map add and query with a network, from another working folder.
+        work = self.tmp / "work"
+        work.mkdir()
+        frames = self.tmp / "map_frames"
+        frames.mkdir()
+        for n in names:
+            shutil.copy(SAMPLE / "summer" / n, frames / n)
+        model = self.tmp / "model.onnx"
+        shutil.copy(ONNX / "gem.onnx", model)
+
+        def map_tool(*args):
+            return subprocess.run([program("openable_map")] + [str(a) for a in args],
+                                  cwd=str(work), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                  text=True)
+        done = map_tool("add", "m.map", "--images", frames, "--session", "s",
+                        "--set", "Image_descriptor=ONNX", "--set", "Model_path=../model.onnx",
+                        "--set", "Model_input_size=64x32", "--set", "Image_sequences=1")
+        self.assertEqual(done.returncode, 0, done.stderr)
+        info = json.loads(map_tool("info", "m.map", "--json").stdout)
+        self.assertEqual(info["settings"]["model_path"], str(model))
+        self.assertEqual(info["settings"]["model_input_size"], "64x32")
+        done = map_tool("query", "m.map", "--images", frames, "--json")
+        self.assertEqual(done.returncode, 0, done.stderr)
+        self.assertEqual([q["frame"] for q in json.loads(done.stdout)["queries"]],
+                         list(range(16)))
+        # Other weights under the map's model path: refused in one line naming both digests.
+        shutil.copy(ONNX / "projection.onnx", model)
+        done = map_tool("query", "m.map", "--images", frames)
         self.assertEqual(done.returncode, 1, done.stderr)
         self.assertEqual(len(done.stderr.strip().splitlines()), 1, done.stderr)
-        self.assertIn("is not saved yet", done.stderr)
-        self.assertFalse((self.tmp / "m.map").exists())
+        self.assertIn("the map was made with the network", done.stderr)
+        # The map's network moved: Model_path names the copy, whose weights are checked.
+        done = map_tool("query", "m.map", "--images", frames, "--set",
+                        "Model_path=%s" % (ONNX / "gem.onnx"), "--json")
+        self.assertEqual(done.returncode, 0, done.stderr)
 
 if __name__ == "__main__":
     unittest.main()
