@@ -54,3 +54,18 @@ scale_data() {
       touch "$dir/.done"
   fi
 }
+
+# link_part DIR FOLDER FIRST COUNT: DIR holds links to the files FIRST.. FIRST + COUNT - 1
+# (1-based, natural order of their names) of FOLDER, a part of a traversal (made once).
+link_part() {
+  local dir="$1"
+  [ -d "$dir" ] && return
+  mkdir -p "$dir"
+  ls "$2" | sort -V | sed -n "$3,$(($3 + $4 - 1))p" | while read -r f; do ln -s "$2/$f" "$dir/$f"; done
+}
+
+# night_like FOLDER NAME SOURCE ARGS...: FOLDER/NAME made once by build/bench/make_night from
+# SOURCE (synthetic night-like frames; ARGS as make_night takes them).
+night_like() {
+  [ -d "$1/$2" ] || "$root/build/bench/make_night" "$3" "${@:4}" "$1/$2" > /dev/null
+}

@@ -3,30 +3,15 @@
 # Point day_right against day_left (the other side of the path) and night-like variants of
 # day_right (build/bench/make_night, as bench/auto.sh makes them) against day_left, at L = 1, 10
 # and 40, with the auto preset's matching (ratio score <= 0.9, confirmed by one independent
-# query) and Auto 0. Then the auto mode with and without DenseVLAD among its candidates on the
-# shared pairs. Prints Markdown rows (docs/benchmarks.md, "A descriptor for viewpoint and light
+# query) and Auto 0; the same on the other shared pairs (Nordland, KITTI 00, the RTAB-Map
+# sample, the Sussex panoramas). Then the auto mode with and without DenseVLAD among its
+# candidates on the pairs of bench/auto.sh. Prints Markdown rows (docs/benchmarks.md, "A descriptor for viewpoint and light
 # together"). Usage: bench/viewpoint_light.sh [work folder] (default: a temporary folder).
 source "$(dirname "$0")/common.sh"
-gp="$datasets/gardens_point"; nl="$datasets/nordland_trimmed"
-need_data "$gp"
-need_built "$exe" "$root/build/bench/make_night"
+need_data "$datasets/gardens_point"
+need_built "$exe" "$root/build/bench/make_night" "$root/build/bench/shift_panoramas"
 if [ $# -ge 1 ]; then work="$1"; mkdir -p "$work"; else temp_out; work="$out"; fi
-night="$work/night"; mkdir -p "$night"
-make() { [ -d "$night/$1" ] || "$root/build/bench/make_night" "${@:2}" "$night/$1" > /dev/null; }
-make gp_right_night "$gp/day_right" --seed 1
-make gp_right_night_strong "$gp/day_right" --strong --seed 2
-make gp_right_night_extreme "$gp/day_right" --strong --seed 6 --zoom 0.15 --shift 0.08 --rotation 5 --noise 1.5
-part() {  # part NAME FOLDER FIRST COUNT: files FIRST.. (1-based) of FOLDER in natural order
-  local dir="$work/parts/$1"; [ -d "$dir" ] && return; mkdir -p "$dir"
-  ls "$2" | sort -V | sed -n "$3,$(($3 + $4 - 1))p" | while read -r f; do ln -s "$2/$f" "$dir/$f"; done
-}
-part nord_s0 "$nl/summer" 1 300; part nord_w0 "$nl/winter" 1 300
-part nord_w600 "$nl/winter" 601 300; part nord_s600 "$nl/summer" 601 300
-part nord_summer_a "$nl/summer" 1 300; part nord_winter_b "$nl/winter" 1101 300
-part nord_winter_c "$nl/winter" 1101 200
-part rtab_lap1 "$datasets/rtabmap_samples/images" 1 40; part rtab_lap2 "$datasets/rtabmap_samples/images" 41 44
-awk '!/^#/ && $1 >= 41 && $2 <= 40 {print $1 - 41 "," $2 - 1}' \
-  "$datasets/rtabmap_samples/ground_truth_pairs.txt" > "$work/rtab_pairs.csv"
+source "$(dirname "$0")/shared_pairs.sh"
 
 # figures JSON: "R@1|AUC|R@100P|accepted|precision|reliable|chosen" of a run's --json
 figures() {
@@ -66,6 +51,27 @@ for p in "day_right vs day_left|$gp/day_right" "night-like day_right vs day_left
 done
 
 echo
+echo "| pair | descriptor | L | R@1 | AUC | R@100P | accepted | precision |"
+echo "|---|---|---|---|---|---|---|---|"
+for p in "Nordland winter vs summer|$nl/summer|$nl/winter|aligned" \
+         "KITTI 00 1500-1699 vs 40-260|$work/parts/kitti_ref|$work/parts/kitti_qry|kitti" \
+         "RTAB-Map sample, lap 2 vs lap 1|$work/parts/rtab_lap1|$work/parts/rtab_lap2|rtab" \
+         "Sussex panoramas, re-run vs training|$sx/training|$work/sussex_rerun|sussex"; do
+  IFS='|' read -r name ref query kind <<< "$p"
+  # shellcheck disable=SC2046
+  gt=($(truth "$kind"))
+  for d in HOG SIFT DenseVLAD; do
+    for L in 1 10 40; do
+      "$exe" "$root/config/presets/auto.txt" --set Auto=0 "${common[@]}" "${gt[@]}" \
+        --set Images_path="$ref" --set Images_path_2="$query" \
+        --set Image_descriptor=$d --set Image_sequences=$L > "$work/run.json"
+      IFS='|' read -r r1 auc r100 acc prec _ <<< "$(figures "$work/run.json")"
+      echo "| $name | $d | $L | $r1 | $auc | $r100 | $acc | $prec |"
+    done
+  done
+done
+
+echo
 echo "| pair | without DenseVLAD: R@1 / AUC / accepted (precision) / chosen | with DenseVLAD: R@1 / AUC / accepted (precision) / chosen |"
 echo "|---|---|---|"
 default="Image_descriptor=HOG,SIFT,LDB,HOG+LDB Image_sequences=10,20,40 | Image_descriptor=SAD Contrast_enhancement=1 Image_sequences=10,20,40"
@@ -79,16 +85,14 @@ pairs=(
   "Nordland 0-299, winter vs summer|$work/parts/nord_s0|$work/parts/nord_w0|aligned"
   "Nordland 600-899, summer vs winter|$work/parts/nord_w600|$work/parts/nord_s600|aligned"
   "RTAB-Map sample, lap 2 vs lap 1|$work/parts/rtab_lap1|$work/parts/rtab_lap2|rtab"
+  "KITTI 00 1500-1699 vs 40-260|$work/parts/kitti_ref|$work/parts/kitti_qry|kitti"
   "Unrelated: Nordland winter 1100-1299 vs Gardens Point|$gp/day_left|$work/parts/nord_winter_c|none"
-  "Unrelated: Nordland winter 1100-1399 vs summer 0-299|$work/parts/nord_summer_a|$work/parts/nord_winter_b|none"
+  "Unrelated: Nordland winter 1100-1699 vs summer 0-599|$work/parts/nord_summer_a|$work/parts/nord_winter_b|none"
 )
 for p in "${pairs[@]}"; do
   IFS='|' read -r name ref query kind <<< "$p"
-  case "$kind" in
-    aligned) gt=("${aligned[@]}") ;;
-    rtab) gt=(--set Ground_truth_type=pairs --set Ground_truth="$work/rtab_pairs.csv" --set Ground_truth_base=0 --set Tolerance=1) ;;
-    none) gt=() ;;
-  esac
+  # shellcheck disable=SC2046
+  gt=($(truth "$kind"))
   cells=()
   for candidates in "$default" "$default | Image_descriptor=DenseVLAD Image_sequences=10,20,40"; do
     "$exe" "$root/config/presets/auto.txt" "${common[@]}" "${gt[@]}" --set Images_path="$ref" \

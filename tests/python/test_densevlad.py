@@ -46,19 +46,17 @@ class DenseVladRunTest(TempDirTestCase):
         first, _ = self.run_against(SAMPLE / "winter", "first", "Descriptor_cache=cache")
         again, _ = self.run_against(SAMPLE / "winter", "again", "Descriptor_cache=cache")
         np.testing.assert_array_equal(first, again)
-        done = run("Test_OpenABLE", [CONFIG, "--quiet"] + settings(
-            "Images_path=%s" % (SAMPLE / "summer"), "Images_path_2=%s" % (SAMPLE / "winter"),
-            "Image_descriptor=DenseVLAD", "Png_name=", "Txt_name=", "Evaluation_name=",
-            "Report_name=", "Ground_truth_type=", "Npy_name=", "Descriptor_cache=cache"),
-            self.tmp)
-        self.assertIn("600 of 600 frames from the cache", done.stdout)
+
+        def cached(reference, query):
+            """What a run with `reference` as Images_path says of the cache."""
+            return run("Test_OpenABLE", [CONFIG, "--quiet"] + settings(
+                "Images_path=%s" % (SAMPLE / reference), "Images_path_2=%s" % (SAMPLE / query),
+                "Image_descriptor=DenseVLAD", "Png_name=", "Txt_name=", "Evaluation_name=",
+                "Report_name=", "Ground_truth_type=", "Npy_name=", "Descriptor_cache=cache"),
+                self.tmp).stdout
+        self.assertIn("600 of 600 frames from the cache", cached("summer", "winter"))
         # Another reference, another vocabulary: none of its rows come from this cache.
-        done = run("Test_OpenABLE", [CONFIG, "--quiet"] + settings(
-            "Images_path=%s" % (SAMPLE / "winter"), "Images_path_2=%s" % (SAMPLE / "summer"),
-            "Image_descriptor=DenseVLAD", "Png_name=", "Txt_name=", "Evaluation_name=",
-            "Report_name=", "Ground_truth_type=", "Npy_name=", "Descriptor_cache=cache"),
-            self.tmp)
-        self.assertIn("0 of 600 frames from the cache", done.stdout)
+        self.assertIn("0 of 600 frames from the cache", cached("winter", "summer"))
 
     def test_describe_images_and_the_detector_refuse_it_in_one_line(self):
         image = openable.read_image(str(sorted((SAMPLE / "summer").iterdir())[0]))

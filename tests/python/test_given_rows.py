@@ -88,6 +88,23 @@ class GivenRowsTest(TempDirTestCase):
             self.assertEqual(len(done.stderr.strip().splitlines()), 1, done.stderr)
             self.assertIn(expect, done.stderr)
 
+    def test_pythons_sweep_runs_on_given_rows(self):
+        """openable.sweep over sequence lengths of given HOG rows: each run's AUC is that of the
+        same run on HOG rows the run describes."""
+        def sweep(**given):
+            return {r["settings"]["Image_sequences"]: r["auc"] for r in openable.sweep(
+                str(CONFIG), settings={"Images_path": str(SAMPLE / "summer"),
+                                       "Images_path_2": str(SAMPLE / "winter"),
+                                       "Ground_truth_type": "aligned", "Tolerance": "2",
+                                       **given},
+                vary={"Image_sequences": [1, 10]}).runs}
+        given = sweep(Descriptors_path=str(self.tmp / "HOG_summer.npy"),
+                      Descriptors_path_2=str(self.tmp / "HOG_winter.npy"))
+        described = sweep(Image_descriptor="HOG")
+        self.assertEqual(sorted(given), sorted(described))
+        for length, auc in described.items():
+            self.assertAlmostEqual(given[length], auc, places=9)
+
     def test_the_auto_mode_chooses_the_matching_of_given_rows(self):
         """With Descriptors_path the auto mode's default candidates are the default's matchings
         (sequences, contrast enhancement); each candidate's criteria are those of the same
@@ -150,6 +167,11 @@ class GivenRowsTest(TempDirTestCase):
         d = np.sqrt(((winter[:, None, :].astype(np.float64) - summer[None, :, :]) ** 2).sum(2))
         self.assertEqual([q["frame"] for q in queries], list(np.argmin(d, axis=1)))
         self.assertEqual(queries[5]["query"], "row 5")
+        # From Python: the map opened with its own settings answers the rows alike.
+        detector = openable.OnlineDetector.open(str(self.tmp / "rows.map"))
+        self.assertEqual(detector.channels, ["NPY"])
+        results = detector.query(winter, sessions="summer")
+        self.assertEqual([r[0]["frame"] for r in results], [q["frame"] for q in queries])
         # What does not fit is one line, and the map is kept.
         np.save(self.tmp / "narrow.npy", summer[:, :100])
         five = self.tmp / "five"
