@@ -607,11 +607,20 @@ int Info(const Arguments& a) {
             << cv::format("%.1f", map.rows.rows > 0 ? static_cast<double>(bytes) / map.rows.rows
                                                      : 0.0)
             << " a frame); checksums match\n";
-  std::cout << "Descriptors: " << JoinedChannels(*d) << ", patch " << map.Setting("patch_size")
-            << ", " << map.Setting("ldb_bits") << " LDB bits, " << map.Setting("description")
-            << " (grid " << map.Setting("grid_x") << "x" << map.Setting("grid_y") << "); frames "
-            << (map.Setting("frame_size").empty() ? "of unknown size" : map.Setting("frame_size"))
-            << "\n";
+  if (Upper(map.Setting("descriptor")) == "NPY")
+    std::cout << "Descriptors: NPY, rows computed elsewhere (openable_map add --descriptors): "
+              << map.Setting("row_width")
+              << (map.Setting("row_type") == "CV_8U" ? " bytes of bits (Hamming)"
+                                                     : " float32 values (L2)")
+              << " a frame\n";
+  else
+    std::cout << "Descriptors: " << JoinedChannels(*d) << ", patch " << map.Setting("patch_size")
+              << ", " << map.Setting("ldb_bits") << " LDB bits, " << map.Setting("description")
+              << " (grid " << map.Setting("grid_x") << "x" << map.Setting("grid_y")
+              << "); frames "
+              << (map.Setting("frame_size").empty() ? "of unknown size"
+                                                    : map.Setting("frame_size"))
+              << "\n";
   if (!map.Setting("model_weights").empty())
     std::cout << "Network: " << map.Setting("model_path") << " (weights "
               << map.Setting("model_weights") << "), input " << map.Setting("model_input_size")
