@@ -70,6 +70,10 @@ class RowsGivenDescriptor : public Descriptor {
       throw InputError("Image_descriptor: NPY names rows given by a file (Descriptors_path, "
                        "openable_map add --descriptors), not a descriptor to choose; expected "
                        "one of the registered descriptors");
+    // A bound for rows a map names (4 MB of floats a frame), far above any descriptor's.
+    if (width_ > kMaxWidth)
+      throw InputError("rows given of " + std::to_string(width_) +
+                       " values a frame; expected at most " + std::to_string(kMaxWidth));
   }
   std::string Name() const override { return "NPY"; }
   int Width() const override { return width_; }
@@ -84,6 +88,7 @@ class RowsGivenDescriptor : public Descriptor {
   }
 
  private:
+  static constexpr int kMaxWidth = 1 << 20;
   int width_;
   bool binary_;
 };

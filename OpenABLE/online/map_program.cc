@@ -490,6 +490,8 @@ int Add(const Arguments& a) {
                   << (wanted.kept_descriptors.empty() ? "" : " and Auto's candidates")
                   << " not used: the rows come from " << Quoted(a.descriptors) << "\n";
       wanted.descriptor.name = "NPY";
+      wanted.description = DescriptionType::kGlobal;  // one row a frame
+      wanted.grid_x = wanted.grid_y = 1;
       wanted.kept_descriptors.clear();
       wanted.fusion_weights.clear();
       wanted.descriptor.given_width = given.rows.cols;

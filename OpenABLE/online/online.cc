@@ -1303,6 +1303,17 @@ void ParseWhole(const MapFile& map, const std::string& key, const std::string& p
                    ": expected a whole number");
 }
 
+// The channel whose index finds candidates ("indexed_channel"): -1 (none) or one of the
+// map's `channels`, else one line (an index beyond them would be read out of bounds).
+void ParseIndexedChannel(const MapFile& map, const std::string& path, int channels, int& indexed) {
+  ParseWhole(map, "indexed_channel", path, indexed);
+  if (indexed < -1 || indexed >= channels)
+    throw InputError(path + ": setting \"indexed_channel\" of the map is " +
+                     std::to_string(indexed) + "; expected -1 (none) to " +
+                     std::to_string(channels - 1) + " (its " + std::to_string(channels) +
+                     " descriptors)");
+}
+
 // The descriptors of a map: "channels" (format 3), else its one "descriptor".
 std::vector<std::string> MapChannels(const MapFile& map) {
   std::vector<std::string> out;
@@ -1470,6 +1481,11 @@ OnlineOptions ReadMapOptions(const std::string& path, const OnlineOptions& base)
     // Rows given by a file (openable_map add --descriptors): their width and type.
     ParseWhole(map, "row_width", path, o.descriptor.given_width);
     o.descriptor.given_binary = map.Setting("row_type") == "CV_8U";
+    if (o.description != DescriptionType::kGlobal)
+      throw InputError(path + ": the map's rows were given (descriptor NPY), one row a frame, "
+                       "but its settings name the description " + EnumName(o.description) +
+                       "; expected global");
+    CreateDescriptor(o.descriptor);  // the width's bound, named by NamingMap
   }
   if (!map.Setting("model_weights").empty()) {
     // A network: its file as given (a copy moved elsewhere, checked by its weights' digest
@@ -1530,12 +1546,12 @@ OnlineDetector::LoadedMap OnlineDetector::LoadMapNamed(const std::string& path,
   std::sort(b.begin(), b.end());
   if (a == b && mine != theirs) {
     int indexed = -1;
-    ParseWhole(map, "indexed_channel", path, indexed);
+    ParseIndexedChannel(map, path, static_cast<int>(theirs.size()), indexed);
     s.Build(s.options, theirs, indexed);
     s.SetSearch();
   } else if (a == b && !map.Setting("indexed_channel").empty()) {
     int indexed = -1;
-    ParseWhole(map, "indexed_channel", path, indexed);
+    ParseIndexedChannel(map, path, static_cast<int>(theirs.size()), indexed);
     if (indexed != s.indexed) {
       s.Build(s.options, theirs, indexed);
       s.SetSearch();

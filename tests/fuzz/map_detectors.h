@@ -10,14 +10,15 @@
 
 namespace openable::fuzz {
 
-enum class MapKind { kRows, kFloat, kVerifying, kSeveral };
+enum class MapKind { kRows, kFloat, kVerifying, kSeveral, kGiven };
 
 // kRows: LDB rows (CV_8U) with index blocks from 16 searchable frames on (exact_limit 0,
 // block_frames 16; FLANN's LSH, kept small, which a loaded map builds again). kFloat: HOG rows
 // of a 16-pixel patch (36 CV_32F), exact search. kVerifying: LDB rows and each frame's ORB
 // features (10 a frame), candidates verified with 5 inliers. kSeveral: LDB rows and SAD's
 // (a 16-pixel patch, 128 bytes) kept beside them, exact search, the contrast enhancement of the
-// search and a tuned search in its seed.
+// search and a tuned search in its seed. kGiven: rows computed elsewhere (descriptor NPY, 8
+// floats a frame), exact search.
 inline OnlineOptions MapDetectorOptions(MapKind kind) {
   OnlineOptions o;
   o.exclusion = 2;
@@ -32,6 +33,9 @@ inline OnlineOptions MapDetectorOptions(MapKind kind) {
   } else if (kind == MapKind::kFloat) {
     o.descriptor.name = "HOG";
     o.descriptor.patch_size = 16;
+  } else if (kind == MapKind::kGiven) {
+    o.descriptor.name = "NPY";
+    o.descriptor.given_width = 8;
   } else if (kind == MapKind::kSeveral) {
     o.descriptor.patch_size = 16;
     o.kept_descriptors = "SAD";

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -19,6 +20,7 @@
 #include <libdeflate.h>
 
 #include "OpenABLE/base/hash.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/online/map_file.h"
 #include "OpenABLE/online/online.h"
 #include "tests/fuzz/fuzz_support.h"
@@ -63,6 +65,7 @@ bool FixChecksums(std::string& b) {
 
 MapKind KindOf(const openable::MapFile& map) {
   if (!map.more_rows.empty()) return MapKind::kSeveral;
+  if (openable::Upper(map.Setting("descriptor")) == "NPY") return MapKind::kGiven;
   if (map.Setting("row_type") == "CV_32F") return MapKind::kFloat;
   return map.Setting("features") == "none" ? MapKind::kRows : MapKind::kVerifying;
 }
@@ -89,6 +92,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     Refuses([&] { detector.AddFrame(openable::fuzz::MapFrame(0)); });
   } else {
     detector.AddDescriptor(cv::Mat::zeros(1, detector.RowWidth(), detector.RowType()));
+  }
+  // A map of rows given by a file (descriptor NPY) is also opened with its own settings
+  // (MapOptions: the rows' width and type from the map), as openable_map opens it. Maps of
+  // other descriptors are not: a network's would name a model file to read.
+  if (openable::Upper(map.Setting("descriptor")) == "NPY") {
+    openable::OnlineOptions own;
+    if (Refuses([&] { own = openable::MapOptions(file.Path(), openable::OnlineOptions()); },
+                file.Path()))
+      return 0;
+    std::unique_ptr<openable::OnlineDetector> given;
+    if (Refuses([&] { given = std::make_unique<openable::OnlineDetector>(own); }) ||
+        Refuses([&] { given->LoadMap(file.Path()); }, file.Path()))
+      return 0;
+    given->AddDescriptor(cv::Mat::zeros(1, given->RowWidth(), given->RowType()));
   }
   return 0;
 }

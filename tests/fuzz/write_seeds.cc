@@ -68,6 +68,14 @@ void WriteMaps(const std::string& dir) {
     }
     d.SaveMap(dir + "/float.map");
   }
+  {  // 6 rows computed elsewhere (8 floats).
+    OnlineDetector d(MapDetectorOptions(MapKind::kGiven));
+    d.StartSession("given", "2026-11-29T00:00:00Z");
+    cv::Mat rows(6, d.RowWidth(), d.RowType());
+    rng.fill(rows, cv::RNG::UNIFORM, 0.0, 1.0);
+    d.AddToMap(rows);
+    d.SaveMap(dir + "/given.map");
+  }
   {  // 3 frames with their ORB features.
     OnlineDetector d(MapDetectorOptions(MapKind::kVerifying));
     for (int i = 0; i < 3; ++i) d.AddFrame(MapFrame(i));

@@ -12,6 +12,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -466,6 +467,67 @@ TEST(SavedMap, UnknownDescriptorsNameTheMap) {
     EXPECT_EQ(fresh.Size(), 0);
     OnlineDetector appender(options);
     ExpectInputError([&] { appender.AppendMap(path); }, {path, "QQX"});
+  }
+}
+
+// A map whose "indexed_channel" names no channel of it (map fuzzer finding: it was read out of
+// bounds): one line naming the map and the setting, for -2 and for one past the last channel.
+TEST(SavedMap, AnIndexedChannelBeyondTheMapsDescriptorsIsOneLine) {
+  OnlineOptions options;
+  options.kept_descriptors = "HOG";
+  options.descriptor.patch_size = 16;
+  OnlineDetector d(options);
+  cv::Mat frame(48, 48, CV_8UC1);
+  cv::RNG rng(5);
+  for (int i = 0; i < 4; ++i) {
+    rng.fill(frame, cv::RNG::UNIFORM, 0, 256);
+    d.AddFrame(frame);
+  }
+  const std::string good = testing::TempDir() + "/two.map";
+  d.SaveMap(good);
+  for (const std::string value : {"2", "-2", "7"}) {
+    MapFile map = ReadMapFile(good, {false, false});
+    for (auto& [k, v] : map.settings)
+      if (k == "indexed_channel") v = value;
+    const std::string path = testing::TempDir() + "/indexed_" + value + ".map";
+    WriteMapFile(path, map);
+    // A detector whose channels are in another order rebuilds them on the map's.
+    OnlineOptions reversed = options;
+    reversed.descriptor.name = "HOG";
+    reversed.kept_descriptors = "LDB";
+    OnlineDetector other(reversed);
+    ExpectInputError([&] { other.LoadMap(path); }, {path, "indexed_channel", value});
+    EXPECT_EQ(other.Size(), 0);
+  }
+}
+
+// A map of rows given by a file (descriptor NPY) whose settings name rows of absurd width, or a
+// grid: one line naming the map, before anything is built for them.
+TEST(SavedMap, MapsOfGivenRowsWithAbsurdSettingsAreOneLine) {
+  OnlineOptions options;
+  options.descriptor.name = "NPY";
+  options.descriptor.given_width = 8;
+  OnlineDetector d(options);
+  cv::Mat1f rows(5, 8);
+  cv::randu(rows, 0, 1);
+  d.AddToMap(rows);
+  const std::string good = testing::TempDir() + "/given.map";
+  d.SaveMap(good);
+  OnlineDetector reopened(MapOptions(good));
+  EXPECT_EQ(reopened.Size(), 0);
+  reopened.LoadMap(good);
+  EXPECT_EQ(reopened.Size(), 5);
+  EXPECT_EQ(reopened.RowWidth(), 8);
+  for (const auto& [key, value, expected] :
+       std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"row_width", "2000000000", "2000000000"},
+           {"description", "grid", "expected global"}}) {
+    MapFile map = ReadMapFile(good, {false, false});
+    for (auto& [k, v] : map.settings)
+      if (k == key) v = value;
+    const std::string path = testing::TempDir() + "/given_" + key + ".map";
+    WriteMapFile(path, map);
+    ExpectInputError([&] { OnlineDetector other(MapOptions(path)); }, {path, expected});
   }
 }
 
