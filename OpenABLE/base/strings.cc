@@ -47,6 +47,10 @@ std::vector<std::string> SplitTrimmed(std::string_view s, char separator) {
   }
 }
 
+std::string SizeText(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
 std::string FormatNumber(double value, int significant) {
   char buffer[64];  // %.17g of any double takes at most 24 characters
   std::snprintf(buffer, sizeof buffer, "%.*g", significant, value);

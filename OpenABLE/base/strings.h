@@ -33,6 +33,14 @@ std::string FormatNumber(double value, int significant = 6);
 // reports.
 std::string FormatFixed(double value, int decimals);
 
+// "WxH" (640x480) of a size in messages and saved maps; also rows x cols of a matrix.
+std::string SizeText(int width, int height);
+// The same of anything with `width` and `height` (cv::Size).
+template <typename Size>
+std::string SizeText(const Size& size) {
+  return SizeText(size.width, size.height);
+}
+
 // `s` as text that every output can show: `s` itself, byte for byte, when it is valid UTF-8;
 // otherwise each byte that is not part of a well-formed UTF-8 sequence (The Unicode Standard,
 // section 3.9, Table 3-7: no overlong forms, no surrogates D800-DFFF, nothing above U+10FFFF, no

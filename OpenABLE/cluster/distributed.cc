@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 #include "matching/distances.h"
 #include "matching/large_matrix.h"
 #include "matching/matrix.h"
@@ -50,10 +51,6 @@ std::string ReadString(const char*& p) {
   std::string s(p, static_cast<std::size_t>(n));
   p += n;
   return s;
-}
-
-std::string SizeText(const cv::Size& s) {
-  return std::to_string(s.width) + "x" + std::to_string(s.height);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/module_loader.h"
+#include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/threading.h"
 #include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/io/module_api.h"
@@ -16,10 +17,6 @@
 namespace openable {
 
 namespace {
-
-std::string SizeText(const cv::Size& s) {
-  return std::to_string(s.width) + "x" + std::to_string(s.height);
-}
 
 // Frame `i` of a traversal as a describer of `kind` takes it (0: grey, or Eq. 6, then side-window
 // fusion; 1: grey + disparity; 2: colour, BGR), after the noise of robustness studies.

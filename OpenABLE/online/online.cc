@@ -46,10 +46,6 @@ void Require(bool ok, const std::string& field, const std::string& value,
     throw InputError("OnlineOptions." + field + " = " + value + ": expected " + expected);
 }
 
-std::string SizeText(cv::Size s) {
-  return std::to_string(s.width) + "x" + std::to_string(s.height);
-}
-
 // A frame (`what`) of size `size` joining a map whose frames are `map_size` ("" = unknown).
 void CheckFrameSize(const std::string& what, const std::string& size,
                     const std::string& map_size) {

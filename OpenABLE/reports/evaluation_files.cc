@@ -81,16 +81,5 @@ void StageEvaluation(OutputBatch& batch, const std::string& key, const std::stri
   }
   batch.Stage(key, prefix + kEvaluationSetSuffixes[1], EncodePng(RenderEvaluationPr(evaluation)));
 }
-std::vector<std::string> WriteEvaluation(const std::string& key, const std::string& prefix,
-                                         const Evaluation& evaluation,
-                                         const std::vector<cv::Mat1f>& matrices) {
-  OutputBatch batch;
-  std::vector<const cv::Mat1f*> pointers;
-  for (const auto& m : matrices) pointers.push_back(&m);
-  StageEvaluation(batch, key, prefix, evaluation, pointers);
-  const std::vector<std::string> paths = batch.Paths();
-  batch.Commit();
-  return paths;
-}
 
 }  // namespace openable

@@ -37,10 +37,4 @@ cv::Mat3b RenderRunOverlay(const Evaluation& evaluation, std::size_t i, const cv
 void StageEvaluation(OutputBatch& batch, const std::string& key, const std::string& prefix,
                      const Evaluation& evaluation, const std::vector<const cv::Mat1f*>& matrices);
 
-// Writes the files of `evaluation` under `prefix` (StageEvaluation), all or nothing; returns
-// the paths written. `key` names the prefix in errors.
-std::vector<std::string> WriteEvaluation(const std::string& key, const std::string& prefix,
-                                         const Evaluation& evaluation,
-                                         const std::vector<cv::Mat1f>& matrices);
-
 }  // namespace openable

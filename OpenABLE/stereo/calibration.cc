@@ -13,10 +13,6 @@ std::string Num(double v) {
   return std::isnan(v) ? "nan" : FormatNumber(v);  // not "-nan": the sign of a NaN means nothing
 }
 
-std::string SizeText(int rows, int cols) {
-  return std::to_string(rows) + "x" + std::to_string(cols);
-}
-
 // The prefix of every message: calibration "<path>": <key>:
 class Reader {
  public:

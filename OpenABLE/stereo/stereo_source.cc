@@ -5,13 +5,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 
 namespace openable {
 namespace {
-
-std::string SizeText(const cv::Size& s) {
-  return std::to_string(s.width) + "x" + std::to_string(s.height);
-}
 
 // A frame of a FrameSource (CV_32FC1/3 in [0, 1]) as 8-bit grey, luma weights as ToGray8.
 cv::Mat Gray8(const cv::Mat& frame) {

@@ -186,3 +186,19 @@ TEST(Strings, QuotedShowsInvalidBytesAsEscapes) {
 
 }  // namespace
 }  // namespace openable
+
+namespace openable {
+namespace {
+
+struct FakeSize {
+  int width, height;
+};
+
+TEST(SizeText, IsWidthTimesHeight) {
+  EXPECT_EQ(SizeText(640, 480), "640x480");
+  EXPECT_EQ(SizeText(FakeSize{1241, 376}), "1241x376");
+  EXPECT_EQ(SizeText(0, 0), "0x0");
+}
+
+}  // namespace
+}  // namespace openable
