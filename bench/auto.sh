@@ -36,27 +36,6 @@ pairs=(
   "Unrelated: Nordland winter 1100-1699 vs summer 0-599|$work/parts/nord_summer_a|$work/parts/nord_winter_b|none"
   "Unrelated: Nordland winter 1100-1299 vs Gardens Point|$gp/day_left|$work/parts/nord_winter_c|none"
 )
-figures() {  # figures JSON: "R@1 AUC R@100P accepted precision reliable chosen consistency"
-  python3 - "$1" <<'PY'
-import json, sys
-j = json.load(open(sys.argv[1]))
-e = j["evaluation"]
-a = j.get("auto")
-acc = j["accepted"]
-if e:
-    q = e["runs"][0]["per_query"]
-    op = q.get("accepted", {})
-    print("%.3f|%.3f|%.3f|%d|%.3f" % (q["recall_at_1"], q["auc"], q["recall_at_100p"],
-                                      op.get("matches", 0), op.get("precision", 1)), end="")
-else:
-    print("-|-|-|%d|-" % (acc["queries"] if acc else 0), end="")
-if a:
-    c = [x for x in a["candidates"] if x["rank"] == 1][0]
-    print("|%s|%s|%.3f" % ("yes" if a["reliable"] else "**no**", a["chosen"], c["consistency"]))
-else:
-    print()
-PY
-}
 best_auc() {  # the best AUC over the candidates of Auto_candidates, by openable_sweep
   python3 - "$@" <<'PY'
 import json, sys

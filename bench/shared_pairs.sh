@@ -1,7 +1,7 @@
 # Sourced by bench/auto.sh and bench/viewpoint_light.sh (after common.sh, with `work` set to a
 # folder of their own): the night-like variants and the parts of the shared traversals that
 # their pairs use, the ground truth of the parts, and `truth KIND`, the ground-truth keys of a
-# pair (aligned, rtab, kitti, sussex or none).
+# pair (aligned, rtab, kitti, sussex or none), and `figures JSON`, the figures of a run's --json.
 data="$datasets"
 night="$work/night"; mkdir -p "$night"
 gp="$data/gardens_point"; nl="$data/nordland_trimmed"
@@ -42,4 +42,27 @@ truth() {  # the ground-truth keys of a pair
     sussex) echo "--set Ground_truth_type=positions --set Ground_truth=$work/sussex_train.csv --set Ground_truth_2=$work/sussex_rerun.csv --set Ground_truth_radius=30 --set Tolerance=0 --set Camera_type=2 --set Panoramas=4 --set Panorama_matching=0" ;;
     none) echo "" ;;
   esac
+}
+# figures JSON: "R@1|AUC|R@100P|accepted|precision" of a run's --json ("-" without ground truth),
+# then "|reliable|chosen|consistency" of its auto mode when it has one.
+figures() {
+  python3 - "$1" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+e = j["evaluation"]
+a = j.get("auto")
+acc = j["accepted"]
+if e:
+    q = e["runs"][0]["per_query"]
+    op = q.get("accepted", {})
+    print("%.3f|%.3f|%.3f|%d|%.3f" % (q["recall_at_1"], q["auc"], q["recall_at_100p"],
+                                      op.get("matches", 0), op.get("precision", 1)), end="")
+else:
+    print("-|-|-|%d|-" % (acc["queries"] if acc else 0), end="")
+if a:
+    c = [x for x in a["candidates"] if x["rank"] == 1][0]
+    print("|%s|%s|%.3f" % ("yes" if a["reliable"] else "**no**", a["chosen"], c["consistency"]))
+else:
+    print()
+PY
 }

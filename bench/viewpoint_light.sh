@@ -13,22 +13,6 @@ need_built "$exe" "$root/build/bench/make_night" "$root/build/bench/shift_panora
 if [ $# -ge 1 ]; then work="$1"; mkdir -p "$work"; else temp_out; work="$out"; fi
 source "$(dirname "$0")/shared_pairs.sh"
 
-# figures JSON: "R@1|AUC|R@100P|accepted|precision|reliable|chosen" of a run's --json
-figures() {
-  python3 - "$1" <<'PY'
-import json, sys
-j = json.load(open(sys.argv[1]))
-e, a = j["evaluation"], j.get("auto")
-if e:
-    q = e["runs"][0]["per_query"]
-    op = q.get("accepted", {})
-    print("%.3f|%.3f|%.3f|%d|%.3f" % (q["recall_at_1"], q["auc"], q["recall_at_100p"],
-                                      op.get("matches", 0), op.get("precision", 1)), end="")
-else:
-    print("-|-|-|%d|-" % (j["accepted"]["queries"] if j["accepted"] else 0), end="")
-print("|%s|%s" % (("yes" if a["reliable"] else "**no**"), a["chosen"]) if a else "||")
-PY
-}
 aligned=(--set Ground_truth_type=aligned --set Tolerance=2)
 common=(--quiet --json --set Npy_name= --set Png_name= --set Evaluation_name=)
 
@@ -104,7 +88,7 @@ for p in "${pairs[@]}"; do
   for candidates in "$default" "$default | Image_descriptor=DenseVLAD Image_sequences=10,20,40"; do
     "$exe" "$root/config/presets/auto.txt" "${common[@]}" "${gt[@]}" --set Images_path="$ref" \
       --set Images_path_2="$query" --set "Auto_candidates=$candidates" > "$work/auto.json"
-    IFS='|' read -r r1 auc _ acc prec rel chosen <<< "$(figures "$work/auto.json")"
+    IFS='|' read -r r1 auc _ acc prec rel chosen _ <<< "$(figures "$work/auto.json")"
     cells+=("$r1 / $auc / $acc ($prec) / $chosen${rel:+, reliable: $rel}")
   done
   echo "| $name | ${cells[0]} | ${cells[1]} |"
