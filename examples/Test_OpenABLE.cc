@@ -7,10 +7,11 @@
 #include "OpenABLE/app/command_line.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/ground_truth.h"
+#include "descriptors/registry.h"
 
 namespace {
 
-// A function, not a constant: the ground-truth formats come from their registry.
+// A function, not a constant: the descriptors and ground-truth formats come from their registries.
 openable::ProgramHelp Help() {
   return {
       "Usage: Test_OpenABLE [Config.txt] [--set Key=Value ...] [options]\n"
@@ -33,7 +34,7 @@ openable::ProgramHelp Help() {
        {"Images_path_2", "folder of a second traversal, matched against the first"},
        {"Frame_mode", "0 image folders, 1 a video (Video_path_1), 3 a ROS 1 bag"},
        {"Image_descriptor",
-        "LDB, D-LDB, ORB, BRISK, BRIEF, FREAK, SIFT, HOG, SAD, DenseVLAD, ONNX; A+B fuses"},
+        openable::JoinStrings(openable::RegisteredDescriptorNames(), ", ") + "; A+B fuses"},
        {"Image_sequences", "frames summed along the diagonal per place (1: single frames)"},
        {"Auto", "1: choose the settings from the data itself (two traversals)"},
        {"Match_score", "distance or ratio: how confident a best match is"},
