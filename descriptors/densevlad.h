@@ -45,6 +45,7 @@ class DenseVladDescriptor : public Descriptor {
   // Any size (the cell as it is): the descriptor shrinks it itself, keeping its aspect.
   cv::Size InputSize() const override { return cv::Size(); }
   bool Learns() const override { return true; }
+  int LearnFrames() const override { return kLearnFrames; }
   // Learns the vocabulary by k-means (seeded: the same patches give the same words) over the
   // RootSIFT descriptors of `patches` (kLearnPerFrame of each, evenly spread). Call before any
   // Describe and not while one runs. Throws InputError when the patches hold fewer descriptors

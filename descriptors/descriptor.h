@@ -91,6 +91,8 @@ class Descriptor {
   // Learns from `patches` (as Describe takes them, of frames spread over the reference
   // traversal). Called once before any Describe, never while one runs. The default does nothing.
   virtual void Learn(const std::vector<cv::Mat>& /*patches*/) const {}
+  // The frames, spread over the reference traversal, Learn is best given (0: it learns nothing).
+  virtual int LearnFrames() const { return 0; }
   // Rows given rather than described (features computed elsewhere, OpenABLE/run/given_rows.h):
   // those of traversal `traversal`, one per frame; nullptr for a descriptor that describes.
   virtual const cv::Mat* GivenRows(int /*traversal*/) const { return nullptr; }

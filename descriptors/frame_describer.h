@@ -63,6 +63,7 @@ class FrameDescriber {
   bool Batched() const { return descriptor_.PreferredBatch() > 1; }
   // Whether the descriptor learns from frames before describing (Descriptor::Learns).
   bool Learns() const { return descriptor_.Learns(); }
+  int LearnFrames() const { return descriptor_.LearnFrames(); }
   // Learns from the patches of `images` (as Describe takes them, frames spread over the
   // reference traversal): Descriptor::Learn. Call before any Describe.
   void Learn(const std::vector<cv::Mat>& images) const;

@@ -774,14 +774,12 @@ cv::Mat OnlineDetector::DescribeFrames(const std::vector<cv::Mat>& images,
 
 void OnlineDetector::AddImagesToMap(const std::vector<cv::Mat>& images,
                                     const std::vector<std::string>& names) {
-  State& s = *state_;
-  const int before = Size();
-  AddToMap(DescribeFrames(images, names));
-  if (!images.empty()) s.frame_size = SizeText(images.front().size());
-  if (!names.empty()) {
-    s.files.resize(static_cast<size_t>(before));
-    s.files.insert(s.files.end(), names.begin(), names.end());
-  }
+  const cv::Mat rows = DescribeFrames(images, names);
+  if (names.empty())
+    AddToMap(rows);
+  else
+    AddToMap(rows, names);
+  if (!images.empty()) state_->frame_size = SizeText(images.front().size());
 }
 
 void OnlineDetector::AddToMap(const cv::Mat& rows, const std::vector<std::string>& names) {

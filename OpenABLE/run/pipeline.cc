@@ -154,9 +154,9 @@ std::vector<Described> DescribeSources(const std::vector<ToDescribe>& all,
   for (int k = 0; k < count; ++k) {
     const ToDescribe& d = all[static_cast<size_t>(k)];
     if (!d.describer->Learns() || !d.describer->Fingerprint().empty()) continue;
-    constexpr int kLearnFrames = 40;
     progress.Begin("learning", 1, d.name + " from frames of " + specs.front().key);
-    const int used = LearnFromSource(*sources.front(), *d.describer, options, kLearnFrames);
+    const int used =
+        LearnFromSource(*sources.front(), *d.describer, options, d.describer->LearnFrames());
     progress.End();
     out[static_cast<size_t>(k)].notes.push_back(
         d.name + ": learnt from " + std::to_string(used) + " frames spread over " +

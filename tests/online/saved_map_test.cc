@@ -441,6 +441,15 @@ TEST(SavedMap, InconsistentFeaturesAreRefused) {
 }
 
 
+// A copy of the map at `good`, written to `path`, whose setting `key` is `value`.
+void WriteWithSetting(const std::string& good, const std::string& key, const std::string& value,
+                      const std::string& path) {
+  MapFile map = ReadMapFile(good, {false, false});
+  for (auto& [k, v] : map.settings)
+    if (k == key) v = value;
+  WriteMapFile(path, map);
+}
+
 // A map whose settings name a descriptor that does not exist (map fuzzer finding): one line
 // naming the map, from LoadMap, MapOptions and AppendMap alike.
 TEST(SavedMap, UnknownDescriptorsNameTheMap) {
@@ -455,11 +464,8 @@ TEST(SavedMap, UnknownDescriptorsNameTheMap) {
   const std::string good = testing::TempDir() + "/good.map";
   d.SaveMap(good);
   for (const std::string key : {"descriptor", "channels", "search_descriptor"}) {
-    MapFile map = ReadMapFile(good, {false, false});
-    for (auto& [k, v] : map.settings)
-      if (k == key) v = "QQX";
     const std::string path = testing::TempDir() + "/bad_" + key + ".map";
-    WriteMapFile(path, map);
+    WriteWithSetting(good, key, "QQX", path);
     ExpectInputError([&] { OnlineDetector other(MapOptions(path)); }, {path, "QQX"});
     if (key != "channels") continue;  // the rows are LDB's: a detector of LDB loads them
     OnlineDetector fresh(options);
@@ -486,11 +492,8 @@ TEST(SavedMap, AnIndexedChannelBeyondTheMapsDescriptorsIsOneLine) {
   const std::string good = testing::TempDir() + "/two.map";
   d.SaveMap(good);
   for (const std::string value : {"2", "-2", "7"}) {
-    MapFile map = ReadMapFile(good, {false, false});
-    for (auto& [k, v] : map.settings)
-      if (k == "indexed_channel") v = value;
     const std::string path = testing::TempDir() + "/indexed_" + value + ".map";
-    WriteMapFile(path, map);
+    WriteWithSetting(good, "indexed_channel", value, path);
     // A detector whose channels are in another order rebuilds them on the map's.
     OnlineOptions reversed = options;
     reversed.descriptor.name = "HOG";
@@ -522,11 +525,8 @@ TEST(SavedMap, MapsOfGivenRowsWithAbsurdSettingsAreOneLine) {
        std::vector<std::tuple<std::string, std::string, std::string>>{
            {"row_width", "2000000000", "2000000000"},
            {"description", "grid", "expected global"}}) {
-    MapFile map = ReadMapFile(good, {false, false});
-    for (auto& [k, v] : map.settings)
-      if (k == key) v = value;
     const std::string path = testing::TempDir() + "/given_" + key + ".map";
-    WriteMapFile(path, map);
+    WriteWithSetting(good, key, value, path);
     ExpectInputError([&] { OnlineDetector other(MapOptions(path)); }, {path, expected});
   }
 }
