@@ -397,7 +397,8 @@ std::vector<Setting> LshSettings() {
     o.lsh_key_bits = bits;
     o.lsh_probe_level = probe;
     const std::string name = "flann/tables:" + std::to_string(tables) +
-                             "/key_bits:" + std::to_string(bits) + "/probe:" + std::to_string(probe);
+                             "/key_bits:" + std::to_string(bits) +
+                             "/probe:" + std::to_string(probe);
     out.push_back({name, name, o});
   }
   return out;

@@ -3,15 +3,14 @@
 // matrix of a real run (its Npy_name) instead of the synthetic one, as the run's Txt_name and
 // Png_name see it (cells without a value, +inf, as the largest finite value).
 #include <benchmark/benchmark.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <limits>
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
 
 #include "OpenABLE/io/npy.h"
 #include "OpenABLE/outputs/matrix_files.h"

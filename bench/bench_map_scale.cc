@@ -30,11 +30,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <string>
 #include <vector>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/online/map_file.h"
@@ -82,13 +81,20 @@ int main(int argc, char** argv) {
   bool keep_file = false;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
-    if (a == "--rows") rows = std::atoi(v.c_str());
-    else if (a == "--engine") engine = v;
-    else if (a == "--nprobe") nprobe = std::atoi(v.c_str());
-    else if (a == "--flip") flip = std::atof(v.c_str());
-    else if (a == "--queries") queries = std::atoi(v.c_str());
-    else if (a == "--datasets") datasets = v;
-    else if (a == "--map-file") map_file = v, keep_file = true;
+    if (a == "--rows")
+      rows = std::atoi(v.c_str());
+    else if (a == "--engine")
+      engine = v;
+    else if (a == "--nprobe")
+      nprobe = std::atoi(v.c_str());
+    else if (a == "--flip")
+      flip = std::atof(v.c_str());
+    else if (a == "--queries")
+      queries = std::atoi(v.c_str());
+    else if (a == "--datasets")
+      datasets = v;
+    else if (a == "--map-file")
+      map_file = v, keep_file = true;
     else {
       std::fprintf(stderr, "bench_map_scale: unknown argument %s (see the top of the source)\n",
                    a.c_str());
@@ -142,8 +148,7 @@ int main(int argc, char** argv) {
     searching += Seconds(t);
     scored += candidates.size();
     float d = 1e30f;
-    for (const int j : candidates)
-      d = std::min(d, openable::RowDistance(stored, j, winter, q));
+    for (const int j : candidates) d = std::min(d, openable::RowDistance(stored, j, winter, q));
     best[static_cast<std::size_t>(q)] = d;
     times.push_back(Seconds(t));
   }
@@ -164,17 +169,20 @@ int main(int argc, char** argv) {
   const double p99 = sorted[std::min(sorted.size() - 1, sorted.size() * 99 / 100)];
   const double beyond = static_cast<double>(index.MemoryBytes()) / rows - map.cols;
   std::printf("CPU: %s\n", CpuModel().c_str());
-  std::printf("%d rows of %d bytes (Nordland summer LDB, bits flipped with p = %.3f), engine %s, "
-              "nprobe %d, %d blocks\n",
-              rows, map.cols, flip, engine.c_str(), nprobe, index.Blocks());
-  std::printf("  build %.1f s; query mean %.3f ms, p99 %.3f ms (%d winter frames); best "
-              "candidate = exact nearest for %.3f of them; memory %.1f bytes a place beyond "
-              "the %d-byte row\n",
-              build, 1e3 * mean, 1e3 * p99, queries, static_cast<double>(agree) / queries,
-              beyond, map.cols);
-  std::printf("  of a query: %.3f ms in the blocks' search, the rest scoring %.0f candidates "
-              "(the blocks' k best and the rows not in a block yet)\n",
-              1e3 * searching / queries, static_cast<double>(scored) / queries);
+  std::printf(
+      "%d rows of %d bytes (Nordland summer LDB, bits flipped with p = %.3f), engine %s, "
+      "nprobe %d, %d blocks\n",
+      rows, map.cols, flip, engine.c_str(), nprobe, index.Blocks());
+  std::printf(
+      "  build %.1f s; query mean %.3f ms, p99 %.3f ms (%d winter frames); best "
+      "candidate = exact nearest for %.3f of them; memory %.1f bytes a place beyond "
+      "the %d-byte row\n",
+      build, 1e3 * mean, 1e3 * p99, queries, static_cast<double>(agree) / queries, beyond,
+      map.cols);
+  std::printf(
+      "  of a query: %.3f ms in the blocks' search, the rest scoring %.0f candidates "
+      "(the blocks' k best and the rows not in a block yet)\n",
+      1e3 * searching / queries, static_cast<double>(scored) / queries);
 
   // Saved and loaded as a map file: opened in place (mapped, checksums verified in the
   // background), from a cold page cache and again warm, then read into memory.
@@ -196,8 +204,8 @@ int main(int argc, char** argv) {
     int same = 0;
     for (int q = 0; q < queries; ++q) {
       bool a = false, b = false;
-      same += index.Candidates(winter.row(q), rows, &a) ==
-              loaded.Candidates(winter.row(q), rows, &b);
+      same +=
+          index.Candidates(winter.row(q), rows, &a) == loaded.Candidates(winter.row(q), rows, &b);
     }
     return same;
   };
@@ -224,14 +232,17 @@ int main(int argc, char** argv) {
     if (!cold) loaded.Append(winter.row(0));
     const double append = Seconds(t);
     if (!cold)
-      std::printf("  the first row appended after opening in place: %.2f s (the rows copied "
-                  "out of the file)\n", append);
-    std::printf("  opened in place (%s page cache) in %.3f s; first query %.1f ms, then %.3f ms "
-                "a query; checksums verified by %.1f s after opening, while the queries ran (%s); the "
-                "same candidates "
-                "as the map built for %d of %d queries\n",
-                cold ? "cold" : "warm", open, 1e3 * first, 1e3 * rest, checked,
-                error.empty() ? "match" : error.c_str(), same_candidates(loaded), queries);
+      std::printf(
+          "  the first row appended after opening in place: %.2f s (the rows copied "
+          "out of the file)\n",
+          append);
+    std::printf(
+        "  opened in place (%s page cache) in %.3f s; first query %.1f ms, then %.3f ms "
+        "a query; checksums verified by %.1f s after opening, while the queries ran (%s); the "
+        "same candidates "
+        "as the map built for %d of %d queries\n",
+        cold ? "cold" : "warm", open, 1e3 * first, 1e3 * rest, checked,
+        error.empty() ? "match" : error.c_str(), same_candidates(loaded), queries);
   }
   t = std::chrono::steady_clock::now();
   openable::MapReadOptions copy;
@@ -243,8 +254,9 @@ int main(int argc, char** argv) {
   const double load = Seconds(t);
   const int same = same_candidates(loaded);
   if (!keep_file) std::remove(map_file.c_str());
-  std::printf("  saved in %.1f s (%.0f MB); read into memory in %.1f s (checksums first, rows "
-              "and blocks copied); the same candidates for %d of %d queries\n",
-              save, megabytes, load, same, queries);
+  std::printf(
+      "  saved in %.1f s (%.0f MB); read into memory in %.1f s (checksums first, rows "
+      "and blocks copied); the same candidates for %d of %d queries\n",
+      save, megabytes, load, same, queries);
   return 0;
 }

@@ -5,9 +5,8 @@
 #include <immintrin.h>
 
 #include <cstdint>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "matching/distances.h"
 #include "matching/matrix.h"
@@ -47,8 +46,12 @@ void BM_Hamming(benchmark::State& state) {
   TimeDistances(state, CV_8U, openable::HammingDistances);
 }
 BENCHMARK(BM_Hamming)
-    ->Args({3576, 32, 1})->Args({3576, 32, 2})->Args({3576, 174, 2})->Args({10000, 32, 2})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Args({3576, 32, 1})
+    ->Args({3576, 32, 2})
+    ->Args({3576, 174, 2})
+    ->Args({10000, 32, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // The popcount instruction's peak throughput on this CPU: blocks of sixteen POPCNT over four
 // registers with no dependency between them and no memory traffic, reported as bits counted
@@ -159,14 +162,22 @@ void BM_HammingKernel(benchmark::State& state) {
       static_cast<double>(state.iterations()) * n * bytes * 8, benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_HammingKernel)
-    ->Args({2048, 32, 1})->Args({2048, 32, 2})->Args({2048, 32, 3})->Args({2048, 32, 4})
-    ->Args({2048, 174, 1})->Args({2048, 174, 2})->Args({2048, 174, 3})->Args({2048, 174, 4});
+    ->Args({2048, 32, 1})
+    ->Args({2048, 32, 2})
+    ->Args({2048, 32, 3})
+    ->Args({2048, 32, 4})
+    ->Args({2048, 174, 1})
+    ->Args({2048, 174, 2})
+    ->Args({2048, 174, 3})
+    ->Args({2048, 174, 4});
 
 // Args: frames N, floats per descriptor, threads.
 void BM_L2(benchmark::State& state) { TimeDistances(state, CV_32F, openable::L2Distances); }
 BENCHMARK(BM_L2)
-    ->Args({3576, 128, 2})->Args({3576, 1764, 2})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Args({3576, 128, 2})
+    ->Args({3576, 1764, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // Args: frames N, sequence length L. Items: matrix cells.
 void BM_Sequence(benchmark::State& state) {
@@ -179,7 +190,10 @@ void BM_Sequence(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n) * n);
 }
-BENCHMARK(BM_Sequence)->Args({3576, 1})->Args({3576, 10})->Args({3576, 100})
+BENCHMARK(BM_Sequence)
+    ->Args({3576, 1})
+    ->Args({3576, 10})
+    ->Args({3576, 100})
     ->Unit(benchmark::kMillisecond);
 
 void BM_NormalizeByMax(benchmark::State& state) {

@@ -11,10 +11,9 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/odometry/calibration.h"
@@ -123,8 +122,8 @@ int main(int argc, char** argv) {
         kDegrees * direction_error / std::max(1, directions));
     std::printf("ATE unaligned: mean %.2f m, rmse %.2f m, max %.2f m\n", unaligned.mean,
                 unaligned.rmse, unaligned.max);
-    std::printf("ATE aligned:   mean %.2f m, rmse %.2f m, max %.2f m\n", aligned.mean,
-                aligned.rmse, aligned.max);
+    std::printf("ATE aligned:   mean %.2f m, rmse %.2f m, max %.2f m\n", aligned.mean, aligned.rmse,
+                aligned.max);
     std::printf("final drift: %.2f m (%.2f %% of the length)\n", drift, 100 * drift / length);
     std::printf("trajectory written to %s (KITTI format)\n", argv[1]);
   } catch (const InputError& e) {

@@ -27,13 +27,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/progress.h"  // SecondsSince
@@ -81,35 +80,54 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--datasets") datasets = next();
-    else if (a == "--descriptor") options.descriptor.name = next();
-    else if (a == "--sequence") options.sequence_length = std::stoi(next());
-    else if (a == "--exclusion") options.exclusion = std::stoi(next());
-    else if (a == "--threshold") options.threshold = std::stod(next());
-    else if (a == "--consistency") options.consistency = std::stoi(next());
+    if (a == "--datasets")
+      datasets = next();
+    else if (a == "--descriptor")
+      options.descriptor.name = next();
+    else if (a == "--sequence")
+      options.sequence_length = std::stoi(next());
+    else if (a == "--exclusion")
+      options.exclusion = std::stoi(next());
+    else if (a == "--threshold")
+      options.threshold = std::stod(next());
+    else if (a == "--consistency")
+      options.consistency = std::stoi(next());
     else if (a == "--score")
       options.score = openable::ParseEnum<openable::MatchScore>(next(), "--score");
-    else if (a == "--score-window") options.score_window = std::stoi(next());
-    else if (a == "--heading-limit") heading_limit = std::stod(next());
-    else if (a == "--prefill") prefill = std::stoi(next());
-    else if (a == "--exact-limit") options.exact_limit = std::stoi(next());
-    else if (a == "--block-frames") options.block_frames = std::stoi(next());
-    else if (a == "--foreground-merges") options.background_merges = false;
-    else if (a == "--csv") csv = next();
+    else if (a == "--score-window")
+      options.score_window = std::stoi(next());
+    else if (a == "--heading-limit")
+      heading_limit = std::stod(next());
+    else if (a == "--prefill")
+      prefill = std::stoi(next());
+    else if (a == "--exact-limit")
+      options.exact_limit = std::stoi(next());
+    else if (a == "--block-frames")
+      options.block_frames = std::stoi(next());
+    else if (a == "--foreground-merges")
+      options.background_merges = false;
+    else if (a == "--csv")
+      csv = next();
     else if (a == "--engine")
       options.approximate.engine = openable::ParseApproximateEngine(next(), "--engine");
-    else if (a == "--save-map") save_map = next();
-    else if (a == "--verify") options.verification.enabled = true;
-    else if (a == "--verify-candidates") options.verification.candidates = std::stoi(next());
-    else if (a == "--verify-consistency") options.verification.consistency = std::stoi(next());
+    else if (a == "--save-map")
+      save_map = next();
+    else if (a == "--verify")
+      options.verification.enabled = true;
+    else if (a == "--verify-candidates")
+      options.verification.candidates = std::stoi(next());
+    else if (a == "--verify-consistency")
+      options.verification.consistency = std::stoi(next());
     else if (a == "--verify-features")
       options.verification.features =
           openable::ParseEnum<openable::LocalFeatures>(next(), "--verify-features");
     else if (a == "--verify-max-features")
       options.verification.max_features = std::stoi(next());
     else {
-      std::fprintf(stderr, "bench_online: unknown argument %s (see the comment at the top of "
-                           "bench/bench_online.cc)\n", a.c_str());
+      std::fprintf(stderr,
+                   "bench_online: unknown argument %s (see the comment at the top of "
+                   "bench/bench_online.cc)\n",
+                   a.c_str());
       return 2;
     }
   }
@@ -143,8 +161,10 @@ int main(int argc, char** argv) {
     if (prefill > 0) {
       cv::RNG rng(1);
       cv::Mat rows(prefill, detector.RowWidth(), detector.RowType());
-      if (detector.RowType() == CV_8U) rng.fill(rows, cv::RNG::UNIFORM, 0, 256);
-      else rng.fill(rows, cv::RNG::UNIFORM, 0.0, 0.2);
+      if (detector.RowType() == CV_8U)
+        rng.fill(rows, cv::RNG::UNIFORM, 0, 256);
+      else
+        rng.fill(rows, cv::RNG::UNIFORM, 0.0, 0.2);
       const auto start = std::chrono::steady_clock::now();
       detector.AddToMap(rows);
       std::printf("map of %d random rows added in %.2f s\n", prefill,
@@ -192,16 +212,18 @@ int main(int argc, char** argv) {
             << 1e3 * r.search_seconds << '\n';
     }
     const int positives = std::count(positive.begin(), positive.end(), 1);
-    std::printf("OnlineDetector on KITTI 00 frames 0-1699: %s, L=%d, exclusion %d, score %s, "
-                "threshold %.3f, consistency %d, %d random rows before (map %d frames at the end), exact limit %d, %d "
-                "frames searched with %s index blocks (%d blocks at the end, merges %s), memory "
-                "%.1f MB\n",
-                options.descriptor.name.c_str(), options.sequence_length, options.exclusion,
-                openable::EnumName(options.score).c_str(), options.Threshold(), options.consistency, prefill, detector.Size(), options.exact_limit,
-                approximate_frames, options.approximate.engine.c_str(),
-                detector.Blocks(),
-                options.background_merges ? "in the background" : "in AddFrame",
-                detector.MemoryBytes() / 1e6);
+    std::printf(
+        "OnlineDetector on KITTI 00 frames 0-1699: %s, L=%d, exclusion %d, score %s, "
+        "threshold %.3f, consistency %d, %d random rows before (map %d frames at the end), exact "
+        "limit %d, %d "
+        "frames searched with %s index blocks (%d blocks at the end, merges %s), memory "
+        "%.1f MB\n",
+        options.descriptor.name.c_str(), options.sequence_length, options.exclusion,
+        openable::EnumName(options.score).c_str(), options.Threshold(), options.consistency,
+        prefill, detector.Size(), options.exact_limit, approximate_frames,
+        options.approximate.engine.c_str(), detector.Blocks(),
+        options.background_merges ? "in the background" : "in AddFrame",
+        detector.MemoryBytes() / 1e6);
     Print("describe", Summarise(describe));
     Print("search", Summarise(search));
     if (options.verification.enabled) {
@@ -232,8 +254,10 @@ int main(int argc, char** argv) {
       if (f1 > best_f1) best_f1 = f1, best_t = top[i].first;
       if (fp == 0) r100 = rc, t100 = top[i].first;
     }
-    std::printf("  sweep of the top-1 threshold: max F1 %.3f at %.4f; recall at precision 1: "
-                "%.3f up to %.4f\n", best_f1, best_t, r100, t100);
+    std::printf(
+        "  sweep of the top-1 threshold: max F1 %.3f at %.4f; recall at precision 1: "
+        "%.3f up to %.4f\n",
+        best_f1, best_t, r100, t100);
     if (!save_map.empty()) {
       using Clock = std::chrono::steady_clock;
       auto start = Clock::now();
@@ -247,10 +271,11 @@ int main(int argc, char** argv) {
       start = Clock::now();
       rebuilt.AddToMap(detector.Descriptors());
       const double build = openable::SecondsSince(start);
-      std::printf("  saved map: %d frames, %d blocks, %.1f MB; save %.2f s, load %.2f s "
-                  "(blocks %s), the same map built from its rows %.2f s\n",
-                  info.frames, info.blocks, std::filesystem::file_size(save_map) / 1e6, save,
-                  load, info.rebuilt ? "rebuilt" : "read", build);
+      std::printf(
+          "  saved map: %d frames, %d blocks, %.1f MB; save %.2f s, load %.2f s "
+          "(blocks %s), the same map built from its rows %.2f s\n",
+          info.frames, info.blocks, std::filesystem::file_size(save_map) / 1e6, save, load,
+          info.rebuilt ? "rebuilt" : "read", build);
     }
   } catch (const openable::InputError& e) {
     std::fprintf(stderr, "bench_online: %s\n", e.what());

@@ -6,14 +6,13 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <opencv2/core.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
-
-#include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/image/preprocess.h"
+#include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/snaps/loops.h"
 
 using namespace openable::snaps;
@@ -112,8 +111,7 @@ int main(int argc, char** argv) {
               thumbnails[0].rows);
   Print("read + grey + thumbnail", thumb_seconds);
   Report("ground-truth poses", truth, truth, thumbnails, options);
-  const std::string dso =
-      datasets + "/kitti_trajectories/vo_so_dso/seq00/poses_history_file.txt";
+  const std::string dso = datasets + "/kitti_trajectories/vo_so_dso/seq00/poses_history_file.txt";
   Trajectory keyframes = ReadPoses(dso, true, true);
   Trajectory kept;
   for (int i = 0; i < keyframes.Size(); ++i)

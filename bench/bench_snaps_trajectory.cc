@@ -2,13 +2,12 @@
 // pairs: prints the figures of docs/benchmarks.md ("SNAPS and odometry") and writes the top views.
 // Usage: bench_snaps_trajectory [output folder, default .]
 #include <cstdio>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
-
-#include "OpenABLE/snaps/plot.h"
 #include "OpenABLE/snaps/loops.h"
+#include "OpenABLE/snaps/plot.h"
 #include "OpenABLE/snaps/pose_graph.h"
 #include "OpenABLE/snaps/trajectory.h"
 
@@ -42,15 +41,15 @@ int main(int argc, char** argv) {
           const auto e = [&](const Trajectory& t, bool align) {
             return AbsoluteTrajectoryError(t, truth, association, align);
           };
-          std::printf("%s | %s | %s | %zu of %zu | %.2f -> %.2f (%+.0f %%) | %.2f -> %.2f | "
-                      "%.2f -> %.2f | %.2f -> %.2f | %d | %.3f s\n",
-                      s.c_str(), middle ? "middle of runs" : "all on keyframes",
-                      RobustKernelName(kernel).c_str(), loops.size(), pairs.size(),
-                      e(vo, false).mean, e(corrected, false).mean,
-                      -100 * (1 - e(corrected, false).mean / e(vo, false).mean),
-                      e(vo, false).rmse, e(corrected, false).rmse, e(vo, true).mean,
-                      e(corrected, true).mean, e(vo, true).rmse, e(corrected, true).rmse,
-                      report.iterations, report.seconds);
+          std::printf(
+              "%s | %s | %s | %zu of %zu | %.2f -> %.2f (%+.0f %%) | %.2f -> %.2f | "
+              "%.2f -> %.2f | %.2f -> %.2f | %d | %.3f s\n",
+              s.c_str(), middle ? "middle of runs" : "all on keyframes",
+              RobustKernelName(kernel).c_str(), loops.size(), pairs.size(), e(vo, false).mean,
+              e(corrected, false).mean, -100 * (1 - e(corrected, false).mean / e(vo, false).mean),
+              e(vo, false).rmse, e(corrected, false).rmse, e(vo, true).mean,
+              e(corrected, true).mean, e(vo, true).rmse, e(corrected, true).rmse, report.iterations,
+              report.seconds);
           if (middle && kernel == RobustKernel::kHuber) {
             // Upper bound of any loop-based correction here: the same loops with their exact
             // relative pose taken from the ground truth (what a perfect geometric verification
@@ -62,15 +61,15 @@ int main(int argc, char** argv) {
                                    truth.poses[association[l.query]]});
             PoseGraphReport oracle_report;
             const Trajectory oracle = CorrectPoseGraph(vo, {}, exact, options, &oracle_report);
-            std::printf("%s | exact relative poses from the ground truth (upper bound) | %s | %zu "
-                        "| %.2f -> %.2f (%+.0f %%) | %.2f -> %.2f | %.2f -> %.2f | %.2f -> %.2f "
-                        "| %d | %.3f s\n",
-                        s.c_str(), RobustKernelName(kernel).c_str(), exact.size(),
-                        e(vo, false).mean, e(oracle, false).mean,
-                        -100 * (1 - e(oracle, false).mean / e(vo, false).mean), e(vo, false).rmse,
-                        e(oracle, false).rmse, e(vo, true).mean, e(oracle, true).mean,
-                        e(vo, true).rmse, e(oracle, true).rmse, oracle_report.iterations,
-                        oracle_report.seconds);
+            std::printf(
+                "%s | exact relative poses from the ground truth (upper bound) | %s | %zu "
+                "| %.2f -> %.2f (%+.0f %%) | %.2f -> %.2f | %.2f -> %.2f | %.2f -> %.2f "
+                "| %d | %.3f s\n",
+                s.c_str(), RobustKernelName(kernel).c_str(), exact.size(), e(vo, false).mean,
+                e(oracle, false).mean, -100 * (1 - e(oracle, false).mean / e(vo, false).mean),
+                e(vo, false).rmse, e(oracle, false).rmse, e(vo, true).mean, e(oracle, true).mean,
+                e(vo, true).rmse, e(oracle, true).rmse, oracle_report.iterations,
+                oracle_report.seconds);
             TrajectoryPlot plot;
             plot.truth = &truth;
             plot.input = &vo;

@@ -8,9 +8,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <string>
-
 #include <opencv2/imgcodecs.hpp>
+#include <string>
 
 #include "OpenABLE/describe/describe.h"
 #include "OpenABLE/image/preprocess.h"
@@ -72,8 +71,8 @@ void PrintDistances() {
   if (d == nullptr) return;
   const auto source = OpenPairs(*d);
   std::printf("Hamming distances on the EuRoC pairs (0-1 revisit; 2-3 0.5 s apart):\n");
-  std::printf("%-28s %5s %5s %5s %5s %5s %5s %6s\n", "setting", "0-1", "0-2", "0-3", "1-2",
-              "1-3", "2-3", "bits");
+  std::printf("%-28s %5s %5s %5s %5s %5s %5s %6s\n", "setting", "0-1", "0-2", "0-3", "1-2", "1-3",
+              "2-3", "bits");
   for (const char* name : {"LDB", "D-LDB"}) {
     for (const int bits : {256, 1386}) {
       for (const int grid : {1, 2}) {

@@ -25,12 +25,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <string>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 #include "descriptors/freak.h"
 
@@ -64,9 +63,9 @@ int main(int argc, char** argv) {
       datasets = a;
     }
   }
-  const std::vector<std::string> folders = {
-      "kitti00_first1700/image_0", "nordland_trimmed/summer", "nordland_trimmed/winter",
-      "gardens_point/day_left", "gardens_point/day_right"};
+  const std::vector<std::string> folders = {"kitti00_first1700/image_0", "nordland_trimmed/summer",
+                                            "nordland_trimmed/winter", "gardens_point/day_left",
+                                            "gardens_point/day_right"};
 
   openable::DescriptorOptions options;
   options.patch_size = 64;
@@ -166,13 +165,12 @@ int main(int argc, char** argv) {
     const auto& table = openable::FreakPairs();
     for (int k = 0; k < kFreakBits; ++k) {
       if (table[k][0] != pair_of[kept[k]][0] || table[k][1] != pair_of[kept[k]][1]) {
-        std::cerr << "freak_pairs: the table of descriptors/freak.cc differs at bit " << k
-                  << "\n";
+        std::cerr << "freak_pairs: the table of descriptors/freak.cc differs at bit " << k << "\n";
         return 1;
       }
     }
-    std::cout << "freak_pairs: the table matches (" << frames << " frames, threshold "
-              << threshold << ")\n";
+    std::cout << "freak_pairs: the table matches (" << frames << " frames, threshold " << threshold
+              << ")\n";
     return 0;
   }
 
@@ -180,13 +178,12 @@ int main(int argc, char** argv) {
   for (std::size_t a = 0; a < kept.size(); ++a)
     for (std::size_t b = a + 1; b < kept.size(); ++b)
       worst = std::max(worst, corr[static_cast<std::size_t>(kept[a]) * kFreakAllPairs + kept[b]]);
-  std::printf("// %zu frames, %zu candidate tests, threshold %.3f, largest |correlation| kept "
-              "%.3f, means of the first and last kept bits %.3f, %.3f\n",
-              frames, order.size(), threshold, worst, ones[kept.front()] / n,
-              ones[kept.back()] / n);
+  std::printf(
+      "// %zu frames, %zu candidate tests, threshold %.3f, largest |correlation| kept "
+      "%.3f, means of the first and last kept bits %.3f, %.3f\n",
+      frames, order.size(), threshold, worst, ones[kept.front()] / n, ones[kept.back()] / n);
   for (int k = 0; k < kFreakBits; ++k) {
-    std::printf("%s{%d, %d},", k % 8 == 0 ? "    " : " ", pair_of[kept[k]][0],
-                pair_of[kept[k]][1]);
+    std::printf("%s{%d, %d},", k % 8 == 0 ? "    " : " ", pair_of[kept[k]][0], pair_of[kept[k]][1]);
     if (k % 8 == 7) std::printf("\n");
   }
   return 0;

@@ -5,13 +5,12 @@
 // number. Usage: make_scale_data <nordland_trimmed folder> <output folder> <N>
 #include <cstdio>
 #include <filesystem>
-#include <string>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -42,8 +41,8 @@ int main(int argc, char** argv) {
         cv::Mat frame = src;
         if (rep > 0) {
           cv::RNG rng(static_cast<std::uint64_t>(i) * 2654435761u + 17);
-          const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, rng.uniform(-2, 3), 0, 1,
-                                 rng.uniform(-2, 3));
+          const cv::Mat shift =
+              (cv::Mat_<double>(2, 3) << 1, 0, rng.uniform(-2, 3), 0, 1, rng.uniform(-2, 3));
           cv::warpAffine(src, frame, shift, src.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
           cv::Mat noise(frame.size(), CV_16S);
           rng.fill(noise, cv::RNG::NORMAL, 0, 4);

@@ -11,10 +11,9 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <string>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <string>
 
 #include "OpenABLE/io/frame_source.h"
 

@@ -28,10 +28,11 @@ const std::string& GroundTruthTypeHelp() {
   static const std::string help = [] {
     std::string text = "Empty: no evaluation. ";
     for (const GroundTruthFormat& f : GroundTruthFormats())
-      text += std::string(&f == &GroundTruthFormats().front() ? "" : "; ") + f.name + ": " +
-              f.summary;
-    return text + ". The run's matrix is evaluated against it with the protocols of "
-                  "Evaluation_protocol (docs/evaluation.md).";
+      text +=
+          std::string(&f == &GroundTruthFormats().front() ? "" : "; ") + f.name + ": " + f.summary;
+    return text +
+           ". The run's matrix is evaluated against it with the protocols of "
+           "Evaluation_protocol (docs/evaluation.md).";
   }();
   return help;
 }
@@ -49,15 +50,18 @@ std::string GroundTruthTypeText(GroundTruthType type) {
 // The inputs and the matrix outputs (Datasets, Representation).
 void AddInputKeys(OptionTable& t, Config& c) {
   // Datasets
-  t.AddEnumNumber("Frame_mode", kDatasets, c.input, c.input.frame_mode,
-        "Input: 0 image folder(s) (Images_path, optionally Images_path_2), 1 one video "
-        "(Video_path_1), 2 two videos matched as one concatenated sequence (Video_path_1, "
-        "Video_path_2), 3 a ROS 1 bag (Bag_path, Bag_topic; optionally Bag_topic_2 for a "
-        "second traversal).", false);
+  t.AddEnumNumber(
+      "Frame_mode", kDatasets, c.input, c.input.frame_mode,
+      "Input: 0 image folder(s) (Images_path, optionally Images_path_2), 1 one video "
+      "(Video_path_1), 2 two videos matched as one concatenated sequence (Video_path_1, "
+      "Video_path_2), 3 a ROS 1 bag (Bag_path, Bag_topic; optionally Bag_topic_2 for a "
+      "second traversal).",
+      false);
   t.Add("Images_path", kDatasets, c.input, c.input.images_path,
         "Folder of the image sequence (Frame_mode 0). Any file names: frames are taken in natural"
         " order (img2 before img10). PNG, JPEG, TIFF, PGM/PPM, BMP; 8 or 16 bit; grey or colour. "
-        "Relative paths are relative to the working directory.", false);
+        "Relative paths are relative to the working directory.",
+        false);
   t.Add("Images_path_2", kDatasets, c.input, c.input.images_path_2,
         "Folder of a second traversal of the route (Frame_mode 0). The matrix covers both "
         "sequences concatenated (Images_path first), so its lower-left block holds every frame of"
@@ -74,16 +78,20 @@ void AddInputKeys(OptionTable& t, Config& c) {
   t.Add("Images_path_left", kDatasets, c.input, c.input.images_path_left,
         "Left image folder of a stereo camera (Camera_type 1; Images_path is then not used). Same"
         " Images_format and Initial_image/Final_image range as Images_path; the frame names of "
-        "the run are the left file names.", false);
+        "the run are the left file names.",
+        false);
   t.Add("Images_path_right", kDatasets, c.input, c.input.images_path_right,
         "Right image folder of a stereo camera (Camera_type 1). Must hold as many images as "
-        "Images_path_left: pairs are matched by position in natural order.", false);
+        "Images_path_left: pairs are matched by position in natural order.",
+        false);
   t.Add("Calibration_path", kDatasets, c.input, c.input.calibration_path,
         "Stereo calibration file (Camera_type 1), OpenCV YAML as the original: ML, MR, DL, DR, R,"
-        " T, optional colormap and use_log (docs/cameras.md).", false);
+        " T, optional colormap and use_log (docs/cameras.md).",
+        false);
   t.Add("Images_format", kDatasets, c.input, c.input.images_format,
         "Extension of the images to take from the folders (e.g. png); empty takes every supported"
-        " image file. Unlike the original, names need not be %06d.<ext>.", false);
+        " image file. Unlike the original, names need not be %06d.<ext>.",
+        false);
   t.Add("Video_path_1", kDatasets, c.input, c.input.video_path_1,
         "Video file read with OpenCV (Frame_mode 1 and 2).", false);
   t.Add("Video_path_2", kDatasets, c.input, c.input.video_path_2,
@@ -106,10 +114,12 @@ void AddInputKeys(OptionTable& t, Config& c) {
         "matched against Bag_topic as Images_path_2 against Images_path. Empty: one traversal.");
   t.Add("Initial_image", kDatasets, c.input, c.input.initial_image, 0, kNoLimit,
         "First frame to process: a 0-based position in the natural order of the folder's images "
-        "(or the video's frames). Applies to every folder or video of the run.", false);
+        "(or the video's frames). Applies to every folder or video of the run.",
+        false);
   t.Add("Final_image", kDatasets, c.input, c.input.final_image, -1, kNoLimit,
         "One past the last frame to process (a position, as Initial_image); -1 processes to the "
-        "end.", false);
+        "end.",
+        false);
   t.Add("Skip_unreadable", kDatasets, c.input, c.input.skip_unreadable,
         "0 stops at the first frame that cannot be read, naming it; 1 skips such frames with a "
         "warning (the matrix then has fewer rows, and the skipped frames are listed).");
@@ -117,7 +127,8 @@ void AddInputKeys(OptionTable& t, Config& c) {
   t.Add("Txt_name", kRepresentation, c.output, c.output.txt_name,
         "Output: the normalised matrix M' (or M'' when Threshold is set, as the original) as "
         "space-separated text, one row per line, with <name>.json beside it (the settings that "
-        "shaped it). Empty: not written (text is slow and large for long runs).", false);
+        "shaped it). Empty: not written (text is slow and large for long runs).",
+        false);
   t.Add("Npy_name", kRepresentation, c.output, c.output.npy_name,
         "Output: the normalised matrix M' (before any threshold) as a float32 NumPy .npy file "
         "(numpy.load reads it), and beside it <name>.json, the settings that shaped it "
@@ -129,35 +140,43 @@ void AddInputKeys(OptionTable& t, Config& c) {
         "times.");
   t.Add("Png_name", kRepresentation, c.output, c.output.png_name,
         "Output: the normalised matrix M' as a colour PNG image (a .png path), one pixel per "
-        "pair of frames, coloured with Matrix_color. Empty: not written.", false);
+        "pair of frames, coloured with Matrix_color. Empty: not written.",
+        false);
   t.Add("Png_threshold_name", kRepresentation, c.output, c.output.png_threshold_name,
         "Output when Threshold is set: the thresholded matrix M'' as a PNG image, coloured with "
         "Matrix_color at 0 (loop candidate, M' < Threshold) and 1 (not): black and white with map"
         " 0. Empty: Png_name with _thresholded before the extension.");
   t.Add("Matrix_color", kRepresentation, c.output, c.output.matrix_color, 0, 11,
         "Colour map of Png_name, as the original's 12 maps (docs/output_formats.md): 0 grey, 1 "
-        "red, 2 green, 3 blue, 4-11 two-colour ramps.", false);
+        "red, 2 green, 3 blue, 4-11 two-colour ramps.",
+        false);
   t.Add("Show_images", kRepresentation, c.output, c.output.show_images,
         "1 shows each frame in a window while it is described (needs a display; ignored with a "
-        "warning when there is none).", false);
+        "warning when there is none).",
+        false);
 }
 
 // Description and matching.
 void AddDescriptionKeys(OptionTable& t, Config& c) {
   // Description and matching
-  t.AddEnumNumber("Camera_type", kDescription, c.input, c.input.camera_type,
-        "0 monocular (ABLE-M); 1 stereo (ABLE-S): pairs of Images_path_left and Images_path_right"
-        " are rectified with Calibration_path and matched (SGBM) for D-LDB; other descriptors "
-        "describe the rectified left image (docs/cameras.md). 2 panoramic (ABLE-P): each frame is"
-        " a 360-degree panorama cut into Panoramas sub-panoramas, compared as Panorama_matching "
-        "says.", false);
-  t.AddEnumNumber("Description_type", kDescription, c.description, c.description.type,
-        "0 global: the frame is resized to Patch_size x Patch_size and described at its centre; 1"
-        " grid: the frame is cut into Grid_x x Grid_y cells, each resized to Patch_size and "
-        "described at its centre, and the descriptors are concatenated.", false);
+  t.AddEnumNumber(
+      "Camera_type", kDescription, c.input, c.input.camera_type,
+      "0 monocular (ABLE-M); 1 stereo (ABLE-S): pairs of Images_path_left and Images_path_right"
+      " are rectified with Calibration_path and matched (SGBM) for D-LDB; other descriptors "
+      "describe the rectified left image (docs/cameras.md). 2 panoramic (ABLE-P): each frame is"
+      " a 360-degree panorama cut into Panoramas sub-panoramas, compared as Panorama_matching "
+      "says.",
+      false);
+  t.AddEnumNumber(
+      "Description_type", kDescription, c.description, c.description.type,
+      "0 global: the frame is resized to Patch_size x Patch_size and described at its centre; 1"
+      " grid: the frame is cut into Grid_x x Grid_y cells, each resized to Patch_size and "
+      "described at its centre, and the descriptors are concatenated.",
+      false);
   t.Add("Patch_size", kDescription, c.descriptor, c.descriptor.patch_size, 16, 1024,
         "Side of the square patch in pixels (64 in the ABLE papers). HOG needs a multiple of 8. "
-        "Used as given for every descriptor (the original forced 128 for ORB).", false);
+        "Used as given for every descriptor (the original forced 128 for ORB).",
+        false);
   t.Add("Grid_x", kDescription, c.description, c.description.grid_x, 1, 64,
         "Grid cells across the frame (Description_type 1).", false);
   t.Add("Grid_y", kDescription, c.description, c.description.grid_y, 1, 64,
@@ -165,19 +184,23 @@ void AddDescriptionKeys(OptionTable& t, Config& c) {
   t.Add("Panoramas", kDescription, c.description, c.description.panoramas, 1, 64,
         "Sub-panoramas (equal-width vertical strips) of a panoramic frame (Camera_type 2), each "
         "described on its own (global or grid) and concatenated. An even number makes a half-turn"
-        " (the route driven the other way) a whole number of strips.", false);
-  t.AddEnumNumber("Panorama_matching", kDescription, c.matching, c.matching.panorama_matching,
-        "Camera_type 2: how two panoramas are compared. 0 aligned (ABLE-P Eq. 2: strip k against "
-        "strip k; same-direction revisits only); 1 cross-correlation (Eq. 3, 4: the smallest "
-        "distance over every pair of strips; finds revisits in the opposite direction); 2 "
-        "circular (the whole panorama turned by the best whole number of strips).");
+        " (the route driven the other way) a whole number of strips.",
+        false);
+  t.AddEnumNumber(
+      "Panorama_matching", kDescription, c.matching, c.matching.panorama_matching,
+      "Camera_type 2: how two panoramas are compared. 0 aligned (ABLE-P Eq. 2: strip k against "
+      "strip k; same-direction revisits only); 1 cross-correlation (Eq. 3, 4: the smallest "
+      "distance over every pair of strips; finds revisits in the opposite direction); 2 "
+      "circular (the whole panorama turned by the best whole number of strips).");
   t.Add("Illumination_invariance", kDescription, c.preprocess, c.preprocess.illumination_invariance,
         "1 describes the illumination invariant image of Eq. 6, I = log G - Alpha log B - (1 - "
         "Alpha) log R, instead of the grey image. Needs colour frames (an error names the first "
-        "grey one).", false);
+        "grey one).",
+        false);
   t.Add("Alpha", kDescription, c.preprocess, c.preprocess.alpha, 0, 1,
         "Alpha of Eq. 6 (0.47 for KITTI's PointGrey Flea2). Replaced by Eq. 7 when Lambda_red, "
-        "Lambda_green and Lambda_blue are given.", false);
+        "Lambda_green and Lambda_blue are given.",
+        false);
   t.Add("Lambda_red", kDescription, c.preprocess, c.preprocess.lambda_red, 0, 2000,
         "Peak spectral response of the red channel, nm (camera data sheet); with Lambda_green and"
         " Lambda_blue it sets Alpha by Eq. 7. 0 = not given (all three or none).");
@@ -194,14 +217,17 @@ void AddDescriptionKeys(OptionTable& t, Config& c) {
         "rows, L2 distance; not in maps or the online detector), or ONNX (a network of the "
         "user's, Model_path; float rows, L2 distance). Several "
         "names joined by + or , (HOG+LDB) fuse their matrices (Fusion_weights). SURF is not "
-        "available (non-free, absent from Debian's OpenCV).", false);
+        "available (non-free, absent from Debian's OpenCV).",
+        false);
   t.Add("Image_sequences", kDescription, c.matching, c.matching.sequence_length, 1, 100000,
         "Sequence length L: the distance of two places sums L single-frame distances along the "
         "diagonal; 1 = single images. Frames with fewer than L predecessors in their traversal: "
-        "see Sequence_partial.", false);
+        "see Sequence_partial.",
+        false);
   t.Add("Threshold", kDescription, c.matching, c.matching.threshold, -1, 1,
         "Theta of Eq. 9: M'' = 0 where M' < Threshold, 1 elsewhere. -1 disables; otherwise in [0,"
-        " 1].", false);
+        " 1].",
+        false);
   t.Add("Ldb_bits", kDescription, c.descriptor, c.descriptor.ldb_bits, 1, 1386,
         "Bits of the LDB descriptor (256 = 32 bytes, as in ABLE-P; 1386 = every test of the 2x2 "
         "to 5x5 grids). See docs/descriptors.md for the selection.");
@@ -234,10 +260,11 @@ void AddDescriptionKeys(OptionTable& t, Config& c) {
         "batch axis runs one at a time whatever this says).");
   t.Add("Threads", kDescription, c.matching, c.matching.threads, 0, 1024,
         "Worker threads for description and matching; 0 = all cores.");
-  t.AddEnumNumber("Sequence_direction", kDescription, c.matching, c.matching.direction,
-        "0 sums along diagonals (both routes driven the same way, the original); 1 along anti-"
-        "diagonals (the reference route driven the opposite way); 2 the smaller of the two for "
-        "every cell (needs a second matrix in dense mode).");
+  t.AddEnumNumber(
+      "Sequence_direction", kDescription, c.matching, c.matching.direction,
+      "0 sums along diagonals (both routes driven the same way, the original); 1 along anti-"
+      "diagonals (the reference route driven the opposite way); 2 the smaller of the two for "
+      "every cell (needs a second matrix in dense mode).");
   t.AddEnumName(
       "Sequence_partial", kDescription, c.matching, c.matching.partial,
       "What a sequence cell holds when fewer than L frames precede it in its traversal (the "
@@ -249,12 +276,13 @@ void AddDescriptionKeys(OptionTable& t, Config& c) {
       "skip, no value, the rule of OpenSeqSLAM. A cell without a value is never a candidate "
       "nor a best match, and is written as the largest value of the matrix in Txt_name and "
       "the PNGs and as +inf in Npy_name (docs/matching.md compares the three).");
-  t.AddEnumName("Match_score", kDescription, c.matching, c.matching.score,
-        "How confident a query's best match is, for Match_threshold, the per-query evaluation "
-        "(PR curve, AUC, R@100P, F1), the score column of Matches_name: distance (its "
-        "normalised distance) or ratio (its distance over the smallest distance of the query's "
-        "other candidates more than Match_score_window frames away: Lowe's ratio test, as "
-        "SeqSLAM uses it; 1 without such a rival). docs/evaluation.md defines both.");
+  t.AddEnumName(
+      "Match_score", kDescription, c.matching, c.matching.score,
+      "How confident a query's best match is, for Match_threshold, the per-query evaluation "
+      "(PR curve, AUC, R@100P, F1), the score column of Matches_name: distance (its "
+      "normalised distance) or ratio (its distance over the smallest distance of the query's "
+      "other candidates more than Match_score_window frames away: Lowe's ratio test, as "
+      "SeqSLAM uses it; 1 without such a rival). docs/evaluation.md defines both.");
   t.Add("Match_score_window", kDescription, c.matching, c.matching.score_window, 0, 100000,
         "Frames on each side of a best match whose cells are not its rivals for the ratio "
         "score (they show the same place); smaller than the reference traversal.");
@@ -341,12 +369,14 @@ void AddRobustnessAndAutoKeys(OptionTable& t, Config& c) {
 // Scale: dense or bounded matrices, approximate search, the descriptor cache.
 void AddScaleKeys(OptionTable& t, Config& c) {
   // Scale
-  t.AddEnumNumber("Matrix_mode", kScale, c.scale, c.scale.matrix_mode,
-        "0 auto: dense when the N x N matrix fits in Memory_limit, bounded otherwise (the run "
-        "says which and why); 1 dense: the whole matrix, every output; 2 bounded: the matrix is "
-        "never held: rows are computed in ranges and only the matches of Best_matches and "
-        "Band_width are kept (Matches_name); with two traversals only queries (Images_path_2) against references "
-        "(Images_path) are computed.");
+  t.AddEnumNumber(
+      "Matrix_mode", kScale, c.scale, c.scale.matrix_mode,
+      "0 auto: dense when the N x N matrix fits in Memory_limit, bounded otherwise (the run "
+      "says which and why); 1 dense: the whole matrix, every output; 2 bounded: the matrix is "
+      "never held: rows are computed in ranges and only the matches of Best_matches and "
+      "Band_width are kept (Matches_name); with two traversals only queries (Images_path_2) "
+      "against references "
+      "(Images_path) are computed.");
   t.Add("Memory_limit", kScale, c.scale, c.scale.memory_limit, 0, kNoLimit,
         "GiB the dense matrices may take before auto mode switches to bounded; 0 = three quarters"
         " of the machine's memory.");
@@ -394,9 +424,8 @@ void AddScaleKeys(OptionTable& t, Config& c) {
 // Evaluation and verification.
 void AddEvaluationKeys(OptionTable& t, Config& c) {
   // Evaluation
-  t.AddEnumName(
-      "Ground_truth_type", kEvaluation, c.evaluation, c.evaluation.truth.type,
-      &ParseGroundTruthType, &GroundTruthTypeText, GroundTruthTypeHelp().c_str());
+  t.AddEnumName("Ground_truth_type", kEvaluation, c.evaluation, c.evaluation.truth.type,
+                &ParseGroundTruthType, &GroundTruthTypeText, GroundTruthTypeHelp().c_str());
   t.Add("Ground_truth", kEvaluation, c.evaluation, c.evaluation.truth.path,
         "Ground-truth file (not needed for aligned). Pairs and poses count frames from the start "
         "of the source, as Initial_image does; for poses of two traversals, the poses of the "
@@ -413,7 +442,8 @@ void AddEvaluationKeys(OptionTable& t, Config& c) {
         "\"0-based\" or \"1-based\", else 0.");
   t.Add("Ground_truth_radius", kEvaluation, c.evaluation, c.evaluation.truth.radius, 0, kNoLimit,
         "Poses: two frames are the same place when their positions are closer than this (the "
-        "poses' unit, metres for KITTI).", true, /*min_excluded=*/true);
+        "poses' unit, metres for KITTI).",
+        true, /*min_excluded=*/true);
   t.Add("Ground_truth_heading", kEvaluation, c.evaluation, c.evaluation.truth.heading_limit, -1,
         180,
         "Poses: and when their viewing directions differ by less than this many degrees (a "
@@ -421,8 +451,8 @@ void AddEvaluationKeys(OptionTable& t, Config& c) {
   t.Add("Ground_truth_min_gap", kEvaluation, c.evaluation, c.evaluation.min_frame_gap, -1, kNoLimit,
         "Poses, one sequence: only frames at least this many frames apart are loops; -1: "
         "Exclusion.");
-  t.Add("Ground_truth_time_tolerance", kEvaluation, c.evaluation,
-        c.evaluation.truth.time_tolerance, 0, kNoLimit,
+  t.Add("Ground_truth_time_tolerance", kEvaluation, c.evaluation, c.evaluation.truth.time_tolerance,
+        0, kNoLimit,
         "tum with frames that carry times (Frame_mode 3, ROS bags): each frame takes the pose "
         "of the file with the nearest timestamp, which must be within this many seconds (else "
         "the frame is named in an error). Frames without times take pose line i as frame i.");
@@ -438,9 +468,8 @@ void AddEvaluationKeys(OptionTable& t, Config& c) {
   t.Add("Vicinity", kEvaluation, c.evaluation, c.evaluation.protocol.vicinity, 0, kNoLimit,
         "ABLE-P protocol: a detected cell is a true positive when a ground-truth loop lies within"
         " this many frames of it in both directions (7 in the ABLE-P paper).");
-  t.AddEnumName("Evaluation_protocol", kEvaluation, c.evaluation,
-                c.evaluation.protocol.protocols, &ParseEvaluationProtocols,
-                &EvaluationProtocolsValue,
+  t.AddEnumName("Evaluation_protocol", kEvaluation, c.evaluation, c.evaluation.protocol.protocols,
+                &ParseEvaluationProtocols, &EvaluationProtocolsValue,
                 "Protocols reported: openable (the toolbox's own: per query and ABLE-P), "
                 "vpr_bench (VPR-Bench's AUC-PR, R@100P, extended precision and RecallRate@N), "
                 "vpr_tutorial (VPR_Tutorial's multi- and single-match AUC and R@100P, R@K), "
@@ -473,29 +502,25 @@ void AddEvaluationKeys(OptionTable& t, Config& c) {
         "by temporal consistency; the run's answer for a query is its best-ranked verified "
         "candidate, and a query without one has no answer (docs/verification.md). The frames "
         "of the candidates are read again: image folders and stereo pairs, not videos.");
-  t.AddEnumName("Verification_features", kVerification, c.verification,
-        c.verification.features,
-        "Local features of the verification: ORB (binary, fast) or SIFT (slower, more "
-        "matches across seasons and light); OpenCV's implementations.");
-  t.Add("Verification_max_features", kVerification, c.verification,
-        c.verification.max_features, 10, 100000,
-        "Features kept per frame (the strongest).");
+  t.AddEnumName("Verification_features", kVerification, c.verification, c.verification.features,
+                "Local features of the verification: ORB (binary, fast) or SIFT (slower, more "
+                "matches across seasons and light); OpenCV's implementations.");
+  t.Add("Verification_max_features", kVerification, c.verification, c.verification.max_features, 10,
+        100000, "Features kept per frame (the strongest).");
   t.Add("Verification_ratio", kVerification, c.verification, c.verification.ratio, 0.1, 1,
         "Lowe's ratio test: a feature match is kept when its distance is below this fraction of"
         " the second nearest's.");
-  t.Add("Verification_min_inliers", kVerification, c.verification, c.verification.min_inliers,
-        5, 100000,
-        "A candidate is verified when its geometric model has at least this many inliers.");
+  t.Add("Verification_min_inliers", kVerification, c.verification, c.verification.min_inliers, 5,
+        100000, "A candidate is verified when its geometric model has at least this many inliers.");
   t.Add("Verification_ransac_threshold", kVerification, c.verification,
         c.verification.ransac_threshold, 0.1, 100,
         "RANSAC: pixels between a point and its epipolar line (or its homography image) for "
         "the point to be an inlier.");
-  t.Add("Verification_candidates", kVerification, c.verification, c.verification.candidates,
-        1, 100,
+  t.Add("Verification_candidates", kVerification, c.verification, c.verification.candidates, 1, 100,
         "k: candidates checked per query, the k best at distinct places (each more than "
         "Match_score_window frames from the others), in order of distance.");
-  t.Add("Verification_consistency", kVerification, c.verification,
-        c.verification.consistency, 0, kNoLimit,
+  t.Add("Verification_consistency", kVerification, c.verification, c.verification.consistency, 0,
+        kNoLimit,
         "n: a verified candidate is accepted only when the n previous queries also had verified "
         "candidates at references within Tolerance frames of it (DLoopDetector's temporal "
         "consistency); 0: off.");
@@ -507,8 +532,7 @@ void AddEvaluationKeys(OptionTable& t, Config& c) {
         c.verification.calibration_scale, 0.01, 10,
         "Multiplies the calibration's focal lengths and principal point (0.5 for frames at half "
         "the calibrated size).");
-  t.Add("Verification_cache", kVerification, c.verification, c.verification.cache_mb, 1,
-        kNoLimit,
+  t.Add("Verification_cache", kVerification, c.verification, c.verification.cache_mb, 1, kNoLimit,
         "MB of frame features kept in memory; beyond, the least recently used are dropped and "
         "computed again when needed (the report counts it).");
   t.Add("Loops_name", kVerification, c.output, c.output.loops_name,
@@ -523,16 +547,18 @@ void AddSnapsKeys(OptionTable& t, Config& c) {
   t.Add("Snaps_trajectory", kSnaps, c.snaps, c.snaps.trajectory,
         "openable_snaps: the drifting trajectory to correct (visual odometry), in "
         "Snaps_trajectory_format.");
-  t.AddEnumName("Snaps_odometry", kSnaps, c.odometry, c.odometry.kind,
-        "Empty: read Snaps_trajectory. mono: compute it from the images (Snaps_images or "
-        "Images_path) with the monocular odometry (docs/odometry.md; the scale comes from "
-        "Odometry_scale); stereo: from Images_path_left and Images_path_right (rectified with "
-        "Calibration_path, or already rectified with Odometry_calibration). The computed "
-        "trajectory is written as <Snaps_output_name>_odometry.txt (KITTI format).");
-  t.AddEnumName("Snaps_trajectory_format", kSnaps, c.snaps, c.snaps.trajectory_format,
-        "kitti (12 numbers per line, pose i = frame i), kitti-id (frame number + 12 numbers: "
-        "keyframes) or tum (timestamp tx ty tz qx qy qz qw). The corrected trajectories are "
-        "written in the same format.");
+  t.AddEnumName(
+      "Snaps_odometry", kSnaps, c.odometry, c.odometry.kind,
+      "Empty: read Snaps_trajectory. mono: compute it from the images (Snaps_images or "
+      "Images_path) with the monocular odometry (docs/odometry.md; the scale comes from "
+      "Odometry_scale); stereo: from Images_path_left and Images_path_right (rectified with "
+      "Calibration_path, or already rectified with Odometry_calibration). The computed "
+      "trajectory is written as <Snaps_output_name>_odometry.txt (KITTI format).");
+  t.AddEnumName(
+      "Snaps_trajectory_format", kSnaps, c.snaps, c.snaps.trajectory_format,
+      "kitti (12 numbers per line, pose i = frame i), kitti-id (frame number + 12 numbers: "
+      "keyframes) or tum (timestamp tx ty tz qx qy qz qw). The corrected trajectories are "
+      "written in the same format.");
   t.Add("Snaps_world_to_camera", kSnaps, c.snaps, c.snaps.world_to_camera,
         "1: the trajectory file holds world-to-camera matrices (SO-DSO's poses_history_file.txt);"
         " they are inverted on reading and again on writing.");
@@ -540,20 +566,21 @@ void AddSnapsKeys(OptionTable& t, Config& c) {
         "Ground-truth trajectory (camera-to-world) for the error figures and the plot; empty: no "
         "evaluation. Associated by frame number (kitti, kitti-id) or timestamp (tum).");
   t.AddEnumName("Snaps_ground_truth_format", kSnaps, c.snaps, c.snaps.ground_truth_format,
-        "Format of Snaps_ground_truth: kitti, kitti-id or tum.");
+                "Format of Snaps_ground_truth: kitti, kitti-id or tum.");
   t.Add("Snaps_time_tolerance", kSnaps, c.snaps, c.snaps.time_tolerance, 0, kNoLimit,
         "tum: a pose and its ground truth are associated when their timestamps differ by at most "
         "this many seconds.");
-  t.AddEnumName("Snaps_loops", kSnaps, c.snaps, c.snaps.loops,
-        "Where the loops come from: search (SNAPS's own search on thumbnails of Snaps_images, run"
-        " online with the discounted update, as the paper), openable (an OpenABLE run on the same"
-        " images with the description keys of this file: each frame's best match at least "
-        "Snaps_frame_distance frames back, kept below Snaps_matrix_threshold; with Verification 1"
-        " its verified answers instead, docs/verification.md), pairs "
-        "(Snaps_loops_file: two frame numbers per line, read as Ground_truth_type pairs), matrix "
-        "(Snaps_loops_file: the normalised matrix of an OpenABLE run of one sequence, "
-        ".npy/.txt/image: each frame's best match at least Snaps_frame_distance frames back, kept"
-        " below Snaps_matrix_threshold).");
+  t.AddEnumName(
+      "Snaps_loops", kSnaps, c.snaps, c.snaps.loops,
+      "Where the loops come from: search (SNAPS's own search on thumbnails of Snaps_images, run"
+      " online with the discounted update, as the paper), openable (an OpenABLE run on the same"
+      " images with the description keys of this file: each frame's best match at least "
+      "Snaps_frame_distance frames back, kept below Snaps_matrix_threshold; with Verification 1"
+      " its verified answers instead, docs/verification.md), pairs "
+      "(Snaps_loops_file: two frame numbers per line, read as Ground_truth_type pairs), matrix "
+      "(Snaps_loops_file: the normalised matrix of an OpenABLE run of one sequence, "
+      ".npy/.txt/image: each frame's best match at least Snaps_frame_distance frames back, kept"
+      " below Snaps_matrix_threshold).");
   t.Add("Snaps_loops_file", kSnaps, c.snaps, c.snaps.loops_file,
         "Pairs file (Snaps_loops pairs) or saved matrix (Snaps_loops matrix).");
   t.Add("Snaps_frame_times", kSnaps, c.snaps, c.snaps.frame_times,
@@ -603,9 +630,10 @@ void AddSnapsKeys(OptionTable& t, Config& c) {
   t.Add("Snaps_pause", kSnaps, c.snaps, c.snaps.search.discount.pause, 0, kNoLimit,
         "Inter-frame pause: no loop is closed within this many poses after the last one (not "
         "given in the paper).");
-  t.AddEnumName("Snaps_corrector", kSnaps, c.snaps, c.snaps.corrector,
-        "discounted (the paper's Eq. 6), pose-graph (least squares over odometry and loop edges) "
-        "or both.");
+  t.AddEnumName(
+      "Snaps_corrector", kSnaps, c.snaps, c.snaps.corrector,
+      "discounted (the paper's Eq. 6), pose-graph (least squares over odometry and loop edges) "
+      "or both.");
   t.Add("Snaps_loop_weight", kSnaps, c.snaps, c.snaps.pose_graph.loop_weight, 0, kNoLimit,
         "Pose graph: information of a loop edge's position residual, 1/m^2 (1 = sigma 1 m).", true,
         /*min_excluded=*/true);
@@ -619,14 +647,15 @@ void AddSnapsKeys(OptionTable& t, Config& c) {
         "Pose graph: information of an odometry edge's rotation per pose step, 1/rad^2 (1e6 = "
         "sigma 0.001 rad).",
         true, /*min_excluded=*/true);
-  t.AddEnumName("Snaps_robust_kernel", kSnaps, c.snaps, c.snaps.pose_graph.robust_kernel,
-        "Pose graph: robust kernel on loop edges, none, huber or cauchy (a few wrong loops then "
-        "pull with a bounded force).");
+  t.AddEnumName(
+      "Snaps_robust_kernel", kSnaps, c.snaps, c.snaps.pose_graph.robust_kernel,
+      "Pose graph: robust kernel on loop edges, none, huber or cauchy (a few wrong loops then "
+      "pull with a bounded force).");
   t.Add("Snaps_robust_scale", kSnaps, c.snaps, c.snaps.pose_graph.robust_scale, 0, kNoLimit,
         "Pose graph: scale of the robust kernel in sigmas of a loop edge.", true,
         /*min_excluded=*/true);
   t.AddEnumName("Snaps_axes", kSnaps, c.snaps, c.snaps.axes,
-        "Ground plane of the plot and of the yaw: xz (KITTI: y points down) or xy (z up).");
+                "Ground plane of the plot and of the yaw: xz (KITTI: y points down) or xy (z up).");
   t.Add("Snaps_output_name", kSnaps, c.snaps, c.snaps.output_name,
         "Output prefix: <name>_discounted.txt and/or <name>_pose_graph.txt (the corrected "
         "trajectories), <name>_loops.csv, <name>.json (figures), <name>.png (plot). Empty: "
@@ -642,10 +671,11 @@ void AddOdometryKeys(OptionTable& t, Config& c) {
   t.Add("Odometry_calibration_scale", kOdometry, c.odometry, c.odometry.calibration_scale, 0.01, 10,
         "Multiplies the focal lengths and principal point of Odometry_calibration (0.5 for images"
         " at half the calibrated size, as the shared KITTI frames).");
-  t.AddEnumName("Odometry_scale", kOdometry, c.odometry, c.odometry.scale,
-        "mono: where the length of each step comes from, since one camera cannot measure it: "
-        "truth (the step lengths of Snaps_ground_truth), step (Odometry_step_length every frame) "
-        "or none (unit steps: the trajectory's scale is arbitrary).");
+  t.AddEnumName(
+      "Odometry_scale", kOdometry, c.odometry, c.odometry.scale,
+      "mono: where the length of each step comes from, since one camera cannot measure it: "
+      "truth (the step lengths of Snaps_ground_truth), step (Odometry_step_length every frame) "
+      "or none (unit steps: the trajectory's scale is arbitrary).");
   t.Add("Odometry_step_length", kOdometry, c.odometry, c.odometry.step_length, 0, kNoLimit,
         "mono with Odometry_scale step: metres travelled between two frames (speed / frame rate).");
   t.Add("Odometry_features", kOdometry, c.odometry, c.odometry.features,
@@ -727,8 +757,9 @@ void CheckConfig(const Config& c) {
                        std::to_string(static_cast<int>(camera)));
   c.input.Check();
   if (camera == CameraType::kStereo && c.preprocess.illumination_invariance)
-    throw InputError("Illumination_invariance: 1 with Camera_type 1 (stereo); expected 0: the "
-                     "stereo pipeline describes grey rectified images, and Eq. 6 needs colour");
+    throw InputError(
+        "Illumination_invariance: 1 with Camera_type 1 (stereo); expected 0: the "
+        "stereo pipeline describes grey rectified images, and Eq. 6 needs colour");
   c.output.Check();
   if (!c.output.timestamps_name.empty() && c.input.frame_mode != FrameMode::kBag)
     throw InputError("Timestamps_name: " + Quoted(c.output.timestamps_name) + " with Frame_mode " +
@@ -747,28 +778,34 @@ void CheckSnapsConfig(const Config& c) {
   c.snaps.Check();
   const OdometryKind kind = c.odometry.kind;
   if (kind == OdometryKind::kNone && c.snaps.trajectory.empty())
-    throw InputError("Snaps_trajectory: empty; expected the path of the trajectory to correct "
-                     "(or Snaps_odometry mono or stereo to compute it from the images)");
+    throw InputError(
+        "Snaps_trajectory: empty; expected the path of the trajectory to correct "
+        "(or Snaps_odometry mono or stereo to compute it from the images)");
   if (kind != OdometryKind::kNone) {
     c.odometry.Check();
     if (kind == OdometryKind::kMono && c.odometry.calibration.empty())
-      throw InputError("Odometry_calibration: empty; expected the camera's KITTI calib.txt "
-                       "for Snaps_odometry mono");
+      throw InputError(
+          "Odometry_calibration: empty; expected the camera's KITTI calib.txt "
+          "for Snaps_odometry mono");
     if (kind == OdometryKind::kMono && c.odometry.scale == odometry::StepScale::kTruth &&
         c.snaps.ground_truth.empty())
-      throw InputError("Odometry_scale: truth needs Snaps_ground_truth (its step lengths give "
-                       "the scale); expected a ground truth, or Odometry_scale step or none");
+      throw InputError(
+          "Odometry_scale: truth needs Snaps_ground_truth (its step lengths give "
+          "the scale); expected a ground truth, or Odometry_scale step or none");
     if (kind == OdometryKind::kMono && c.snaps.images.empty() && c.input.images_path.empty())
-      throw InputError("Snaps_images: empty and Images_path empty; expected the image folder "
-                       "of the monocular odometry");
+      throw InputError(
+          "Snaps_images: empty and Images_path empty; expected the image folder "
+          "of the monocular odometry");
     if (kind == OdometryKind::kStereo) {
       if (c.input.images_path_left.empty() || c.input.images_path_right.empty())
-        throw InputError("Images_path_left, Images_path_right: expected both folders for "
-                         "Snaps_odometry stereo");
+        throw InputError(
+            "Images_path_left, Images_path_right: expected both folders for "
+            "Snaps_odometry stereo");
       if (c.input.calibration_path.empty() && c.odometry.calibration.empty())
-        throw InputError("Calibration_path, Odometry_calibration: both empty; expected the "
-                         "stereo calibration (Calibration.txt for raw pairs, or KITTI calib.txt "
-                         "for rectified pairs)");
+        throw InputError(
+            "Calibration_path, Odometry_calibration: both empty; expected the "
+            "stereo calibration (Calibration.txt for raw pairs, or KITTI calib.txt "
+            "for rectified pairs)");
     }
   }
   const LoopSource loops = c.snaps.loops;
@@ -780,8 +817,10 @@ void CheckSnapsConfig(const Config& c) {
   if ((loops == LoopSource::kSearch || loops == LoopSource::kOpenable) && c.snaps.images.empty() &&
       c.input.images_path.empty() &&
       !(kind == OdometryKind::kStereo && !c.input.images_path_left.empty()))
-    throw InputError("Snaps_images: empty and Images_path empty; expected the image folder "
-                     "of the trajectory's frames for Snaps_loops " + source);
+    throw InputError(
+        "Snaps_images: empty and Images_path empty; expected the image folder "
+        "of the trajectory's frames for Snaps_loops " +
+        source);
 }
 
 std::string FormatConfig(const Config& config) {

@@ -23,18 +23,18 @@ namespace openable {
 
 // Every key's field, in the option struct of the module that uses it.
 struct Config {
-  InputOptions input;               // Datasets, Camera_type
-  OutputOptions output;             // Representation
-  DescriptorOptions descriptor;     // Image_descriptor, Patch_size, Ldb_bits
-  DescriptionOptions description;   // Description_type, Grid_x, Grid_y, Panoramas
-  PreprocessOptions preprocess;     // Illumination_invariance, Alpha, Lambda_*, Robustness
-  MatchingOptions matching;         // Image_sequences, Sequence_direction, Panorama_matching,
-                                    // Threshold, Threads
-  AutoOptions automatic;            // Auto
-  ScaleOptions scale;               // Scale
-  EvaluationConfig evaluation;      // Evaluation
-  VerificationOptions verification;  // Verification
-  snaps::SnapsOptions snaps;        // SNAPS (openable_snaps)
+  InputOptions input;                  // Datasets, Camera_type
+  OutputOptions output;                // Representation
+  DescriptorOptions descriptor;        // Image_descriptor, Patch_size, Ldb_bits
+  DescriptionOptions description;      // Description_type, Grid_x, Grid_y, Panoramas
+  PreprocessOptions preprocess;        // Illumination_invariance, Alpha, Lambda_*, Robustness
+  MatchingOptions matching;            // Image_sequences, Sequence_direction, Panorama_matching,
+                                       // Threshold, Threads
+  AutoOptions automatic;               // Auto
+  ScaleOptions scale;                  // Scale
+  EvaluationConfig evaluation;         // Evaluation
+  VerificationOptions verification;    // Verification
+  snaps::SnapsOptions snaps;           // SNAPS (openable_snaps)
   odometry::OdometryOptions odometry;  // Odometry and Snaps_odometry (openable_snaps)
 
   bool operator==(const Config& other) const;

@@ -104,7 +104,7 @@ void OptionTable::AddNumber(const char* key, const char* group, const char* mean
   const bool integral = kind != OptionBinding::Kind::kDouble;
   const std::string range = b.RangeText();
   b.assign = [set, integral, min, max, min_excluded, range, k = b.key](const std::string& value,
-                                                                         const std::string& where) {
+                                                                       const std::string& where) {
     auto fail = [&] {
       throw InputError(where + ": " + k + ": value " + Quoted(value) + " is not valid; expected " +
                        range);
@@ -128,8 +128,7 @@ void OptionTable::AddNumber(const char* key, const char* group, const char* mean
 }
 
 void OptionTable::AddText(const char* key, const char* group, const std::string& meaning,
-                          bool is_new,
-                          std::function<void(const std::string&)> set,
+                          bool is_new, std::function<void(const std::string&)> set,
                           std::function<std::string()> get, std::function<void()> check) {
   OptionBinding b;
   b.key = key;
@@ -145,8 +144,7 @@ void OptionTable::AddText(const char* key, const char* group, const std::string&
 }
 
 void OptionTable::AddEnum(const char* key, const char* group, const std::string& meaning,
-                          bool is_new,
-                          std::function<void(const std::string&)> set,
+                          bool is_new, std::function<void(const std::string&)> set,
                           std::function<std::string()> get, std::function<void()> check) {
   AddText(key, group, meaning, is_new, nullptr, std::move(get), std::move(check));
   OptionBinding& b = bindings_.back();
@@ -272,8 +270,8 @@ std::string OptionHelpText(const OptionTable& table, const std::string& group) {
       },
       [&](const OptionBinding& b) {
         if (!shown) return;
-        os << "  " << b.key << (b.is_new ? " (new)" : "") << "  [" << b.RangeText()
-           << ", default " << b.format() << "]\n";
+        os << "  " << b.key << (b.is_new ? " (new)" : "") << "  [" << b.RangeText() << ", default "
+           << b.format() << "]\n";
         // Wrap the meaning at about 90 columns, indented.
         std::istringstream words(b.meaning);
         std::string word, line = "      ";

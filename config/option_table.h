@@ -54,29 +54,33 @@ class OptionTable {
   template <typename Owner>
   void Add(const char* key, const char* group, Owner& owner, int& field, double min, double max,
            const char* meaning, bool is_new = true) {
-    AddNumber(key, group, meaning, is_new, OptionBinding::Kind::kInt, min, max, false,
-              [&field](double v) { field = static_cast<int>(v); },
-              [&field] { return static_cast<double>(field); }, CheckOf(owner));
+    AddNumber(
+        key, group, meaning, is_new, OptionBinding::Kind::kInt, min, max, false,
+        [&field](double v) { field = static_cast<int>(v); },
+        [&field] { return static_cast<double>(field); }, CheckOf(owner));
   }
   template <typename Owner>
-  void Add(const char* key, const char* group, Owner& owner, double& field, double min,
-           double max, const char* meaning, bool is_new = true, bool min_excluded = false) {
-    AddNumber(key, group, meaning, is_new, OptionBinding::Kind::kDouble, min, max, min_excluded,
-              [&field](double v) { field = v; }, [&field] { return field; }, CheckOf(owner));
+  void Add(const char* key, const char* group, Owner& owner, double& field, double min, double max,
+           const char* meaning, bool is_new = true, bool min_excluded = false) {
+    AddNumber(
+        key, group, meaning, is_new, OptionBinding::Kind::kDouble, min, max, min_excluded,
+        [&field](double v) { field = v; }, [&field] { return field; }, CheckOf(owner));
   }
   // A flag read as 0 or 1, as the original's keys are.
   template <typename Owner>
   void Add(const char* key, const char* group, Owner& owner, bool& field, const char* meaning,
            bool is_new = true) {
-    AddNumber(key, group, meaning, is_new, OptionBinding::Kind::kBool, 0, 1, false,
-              [&field](double v) { field = v != 0; }, [&field] { return field ? 1.0 : 0.0; },
-              CheckOf(owner));
+    AddNumber(
+        key, group, meaning, is_new, OptionBinding::Kind::kBool, 0, 1, false,
+        [&field](double v) { field = v != 0; }, [&field] { return field ? 1.0 : 0.0; },
+        CheckOf(owner));
   }
   template <typename Owner>
   void Add(const char* key, const char* group, Owner& owner, std::string& field,
            const char* meaning, bool is_new = true) {
-    AddText(key, group, meaning, is_new, [&field](const std::string& v) { field = v; },
-            [&field] { return field; }, CheckOf(owner));
+    AddText(
+        key, group, meaning, is_new, [&field](const std::string& v) { field = v; },
+        [&field] { return field; }, CheckOf(owner));
   }
   // An enum read as the number of its value (0, 1, ...), as the original's keys are.
   template <typename Owner, typename E>
@@ -84,26 +88,26 @@ class OptionTable {
                      const char* meaning, bool is_new = true) {
     static_assert(std::is_enum_v<E>);
     const double last = static_cast<double>(EnumNames<E>().size()) - 1;
-    AddNumber(key, group, meaning, is_new, OptionBinding::Kind::kEnumNumber, 0, last, false,
-              [&field](double v) { field = static_cast<E>(static_cast<int>(v)); },
-              [&field] { return static_cast<double>(field); }, CheckOf(owner));
+    AddNumber(
+        key, group, meaning, is_new, OptionBinding::Kind::kEnumNumber, 0, last, false,
+        [&field](double v) { field = static_cast<E>(static_cast<int>(v)); },
+        [&field] { return static_cast<double>(field); }, CheckOf(owner));
   }
   // An enum read by the name of its value (EnumNames, any case).
   template <typename Owner, typename E>
-  void AddEnumName(const char* key, const char* group, Owner& owner, E& field,
-                   const char* meaning, bool is_new = true) {
+  void AddEnumName(const char* key, const char* group, Owner& owner, E& field, const char* meaning,
+                   bool is_new = true) {
     static_assert(std::is_enum_v<E>);
-    AddEnum(key, group, meaning, is_new,
-            [&field, k = std::string(key)](const std::string& v) {
-              field = ParseEnum<E>(v, k);
-            },
-            [&field] { return EnumName(field); }, CheckOf(owner));
+    AddEnum(
+        key, group, meaning, is_new,
+        [&field, k = std::string(key)](const std::string& v) { field = ParseEnum<E>(v, k); },
+        [&field] { return EnumName(field); }, CheckOf(owner));
   }
   // An enum with its own reader and writer (a name for "none" that reads as empty text, say).
   template <typename Owner, typename E>
   void AddEnumName(const char* key, const char* group, Owner& owner, E& field,
-                   E (*parse)(const std::string&), std::string (*format)(E),
-                   const char* meaning, bool is_new = true) {
+                   E (*parse)(const std::string&), std::string (*format)(E), const char* meaning,
+                   bool is_new = true) {
     AddEnum(
         key, group, meaning, is_new, [&field, parse](const std::string& v) { field = parse(v); },
         [&field, format] { return format(field); }, CheckOf(owner));

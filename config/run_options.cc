@@ -42,8 +42,7 @@ void InputOptions::Check() const {
                "Camera_type 1 with Frame_mode 3 reads the right camera's image topic");
     } else {
       NeedPath(images_path_left, "Images_path_left", "Camera_type 1 reads a left image folder");
-      NeedPath(images_path_right, "Images_path_right",
-               "Camera_type 1 reads a right image folder");
+      NeedPath(images_path_right, "Images_path_right", "Camera_type 1 reads a right image folder");
     }
     NeedPath(calibration_path, "Calibration_path", "Camera_type 1 needs a stereo calibration");
   }
@@ -80,8 +79,7 @@ std::string OutputOptions::ThresholdPngPath(bool thresholded) const {
   if (!png_threshold_name.empty()) return png_threshold_name;
   if (png_name.empty()) return "";
   const std::filesystem::path p(png_name);
-  return (p.parent_path() / (p.stem().string() + "_thresholded" + p.extension().string()))
-      .string();
+  return (p.parent_path() / (p.stem().string() + "_thresholded" + p.extension().string())).string();
 }
 
 void OutputOptions::Check() const {
@@ -120,11 +118,13 @@ void ScaleOptions::Check() const {
   }
   if (approximate_search) CheckEngineAvailable(approximate.engine, "Approximate_engine");
   if (approximate_search && matrix_mode == MatrixMode::kDense)
-    throw InputError("Approximate_search: 1 needs Matrix_mode 2 (bounded) or 0 (auto); "
-                     "Matrix_mode is 1 (dense), which compares every pair");
+    throw InputError(
+        "Approximate_search: 1 needs Matrix_mode 2 (bounded) or 0 (auto); "
+        "Matrix_mode is 1 (dense), which compares every pair");
   if (matrix_mode == MatrixMode::kBounded && matches_name.empty())
-    throw InputError("Matches_name: empty, but Matrix_mode 2 (bounded) keeps only matches; "
-                     "expected a .npy or .csv path");
+    throw InputError(
+        "Matches_name: empty, but Matrix_mode 2 (bounded) keeps only matches; "
+        "expected a .npy or .csv path");
   if (!matches_name.empty()) {
     const auto dot = matches_name.find_last_of('.');
     const std::string ext = dot == std::string::npos ? "" : matches_name.substr(dot);

@@ -9,8 +9,8 @@
 #include "OpenABLE/base/enum_names.h"
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/metrics.h"
-#include "matching/search/approximate.h"
 #include "matching/bounded.h"
+#include "matching/search/approximate.h"
 
 namespace openable {
 
@@ -77,15 +77,15 @@ struct OutputOptions {
 // Dense or bounded matrices, and what the bounded mode keeps (the Scale keys).
 struct ScaleOptions {
   MatrixMode matrix_mode = MatrixMode::kAuto;
-  double memory_limit = 0.0;      // GiB the dense matrices may take, >= 0; 0: 3/4 of the RAM
-  KeepRules keep;                 // Best_matches and Band_width (its exclusion: Exclusion)
-  std::string matches_name;       // kept matches, .npy or .csv
+  double memory_limit = 0.0;        // GiB the dense matrices may take, >= 0; 0: 3/4 of the RAM
+  KeepRules keep;                   // Best_matches and Band_width (its exclusion: Exclusion)
+  std::string matches_name;         // kept matches, .npy or .csv
   bool approximate_search = false;  // approximate candidates instead of every pair (bounded)
   // The engine and search budget of those candidates (matching/search/approximate.h; the keys
   // Approximate_engine, Approximate_checks, Approximate_ef_search and Approximate_nprobe are
   // bound onto its fields). The run sets its k (from Best_matches) and threads.
   ApproximateOptions approximate;
-  std::string descriptor_cache;   // folder of the descriptor cache; empty: off
+  std::string descriptor_cache;  // folder of the descriptor cache; empty: off
 
   // Throws InputError naming the key: a value out of range, approximate search with the dense
   // mode, the bounded mode without Matches_name, a matches file that is not .npy or .csv.
@@ -118,11 +118,11 @@ struct AutoOptions {
 
 // The evaluation of a run (the Evaluation keys).
 struct EvaluationConfig {
-  GroundTruthOptions truth;  // the ground truth (its frame gap, first frame and range: below)
-  int min_frame_gap = -1;    // Ground_truth_min_gap: poses, one sequence; -1: Exclusion
+  GroundTruthOptions truth;    // the ground truth (its frame gap, first frame and range: below)
+  int min_frame_gap = -1;      // Ground_truth_min_gap: poses, one sequence; -1: Exclusion
   EvaluationOptions protocol;  // Tolerance, Exclusion, Vicinity
-  std::string name;          // output prefix (Evaluation_name); empty: the table only
-  std::string label;         // legend label (Evaluation_label); empty: descriptor and L
+  std::string name;            // output prefix (Evaluation_name); empty: the table only
+  std::string label;           // legend label (Evaluation_label); empty: descriptor and L
   // Self-contained HTML report (Report_name): of the evaluation with Ground_truth_type, else
   // of the run's answers; empty: none.
   std::string report_name;

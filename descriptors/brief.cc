@@ -13,7 +13,6 @@
 namespace openable {
 namespace {
 
-
 // Two standard normal deviates from two raw 32-bit outputs (Box-Muller, in double).
 void NormalPair(std::mt19937& generator, double* z0, double* z1) {
   constexpr double kTwoTo32 = 4294967296.0;
@@ -47,8 +46,7 @@ const std::array<BriefUnitTest, kBriefTests>& BriefUnitPattern() {
   return pattern;
 }
 
-BriefDescriptor::BriefDescriptor(const DescriptorOptions& options)
-    : Descriptor(options) {
+BriefDescriptor::BriefDescriptor(const DescriptorOptions& options) : Descriptor(options) {
   half_ = std::max(1, static_cast<int>(std::lround(4.0 * PatchSize() / 48.0)));
   tests_.reserve(kBriefTests);
   for (const BriefUnitTest& t : BriefUnitPattern()) {

@@ -3,11 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <string>
-#include <vector>
-
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/hash.h"
@@ -24,8 +23,7 @@ const std::vector<double>& DenseVladDescriptor::Scales() {
   return scales;
 }
 
-DenseVladDescriptor::DenseVladDescriptor(const DescriptorOptions& options)
-    : Descriptor(options) {}
+DenseVladDescriptor::DenseVladDescriptor(const DescriptorOptions& options) : Descriptor(options) {}
 
 cv::Mat DenseVladDescriptor::DenseRootSift(const cv::Mat& patch) {
   CV_Assert(patch.type() == CV_8UC1 && !patch.empty());
@@ -77,7 +75,8 @@ cv::Mat1f DenseVladDescriptor::Vlad(const cv::Mat1f& local, const cv::Mat1f& cen
   cv::Mat1f dots;
   cv::gemm(local, centres, 1.0, cv::noArray(), 0.0, dots, cv::GEMM_2_T);
   std::vector<float> norms(static_cast<size_t>(k));
-  for (int j = 0; j < k; ++j) norms[static_cast<size_t>(j)] = static_cast<float>(centres.row(j).dot(centres.row(j)));
+  for (int j = 0; j < k; ++j)
+    norms[static_cast<size_t>(j)] = static_cast<float>(centres.row(j).dot(centres.row(j)));
   float* v = out.ptr<float>(0);
   for (int i = 0; i < local.rows; ++i) {
     const float* s = dots.ptr<float>(i);
@@ -113,8 +112,7 @@ void DenseVladDescriptor::Learn(const std::vector<cv::Mat>& patches) const {
       const int kept = std::min(all.rows, kLearnPerFrame);
       cv::Mat1f some(kept, all.cols);
       for (int j = 0; j < kept; ++j)
-        all.row(static_cast<int>(static_cast<long long>(j) * all.rows / kept))
-            .copyTo(some.row(j));
+        all.row(static_cast<int>(static_cast<long long>(j) * all.rows / kept)).copyTo(some.row(j));
       per_patch[static_cast<size_t>(i)] = some;
     }
   });
@@ -140,16 +138,17 @@ void DenseVladDescriptor::Learn(const std::vector<cv::Mat>& patches) const {
   centres_ = centres;
   char digest[17];
   std::snprintf(digest, sizeof digest, "%016llx",
-                static_cast<unsigned long long>(Fnv1a64(
-                    centres_.data, centres_.total() * centres_.elemSize())));
+                static_cast<unsigned long long>(
+                    Fnv1a64(centres_.data, centres_.total() * centres_.elemSize())));
   fingerprint_ = "vocabulary " + std::string(digest);
 }
 
 void DenseVladDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
   if (centres_.empty())
-    throw InputError("Image_descriptor: DenseVLAD describes frames with a vocabulary learnt "
-                     "from a reference traversal first; expected Test_OpenABLE (which learns "
-                     "it from Images_path) or describe_images in Python (from the images given)");
+    throw InputError(
+        "Image_descriptor: DenseVLAD describes frames with a vocabulary learnt "
+        "from a reference traversal first; expected Test_OpenABLE (which learns "
+        "it from Images_path) or describe_images in Python (from the images given)");
   Vlad(DenseRootSift(patch), centres_).copyTo(row);
 }
 

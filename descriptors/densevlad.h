@@ -5,10 +5,10 @@
 //
 // A frame is shrunk to at most kWidth pixels wide (its aspect kept), described densely by
 // RootSIFT (SIFT on a grid of kStep pixels at the Scales() of the frame, each descriptor
-// L1-normalised and square-rooted: Arandjelovic and Zisserman, CVPR 2012), and the descriptors aggregated by
-// VLAD over a vocabulary of kCentres visual words: for each word, the sum of the residuals of the
-// descriptors nearest to it, L2-normalised per word, then as a whole. Rows are kCentres x 128
-// floats matched by L2.
+// L1-normalised and square-rooted: Arandjelovic and Zisserman, CVPR 2012), and the descriptors
+// aggregated by VLAD over a vocabulary of kCentres visual words: for each word, the sum of the
+// residuals of the descriptors nearest to it, L2-normalised per word, then as a whole. Rows are
+// kCentres x 128 floats matched by L2.
 //
 // The vocabulary is learnt from the run's own reference traversal (Learn), with no ground
 // truth: k-means over RootSIFT descriptors of frames spread over it. Torii et al. also whiten
@@ -17,10 +17,9 @@
 // (docs/descriptors.md).
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "descriptors/descriptor.h"
 
@@ -28,12 +27,12 @@ namespace openable {
 
 class DenseVladDescriptor : public Descriptor {
  public:
-  static constexpr int kWidth = 320;                 // frames shrunk to at most this width
-  static constexpr int kStep = 4;                    // grid step of the dense keypoints, pixels
-  static constexpr int kCentres = 64;                // visual words of the vocabulary
-  static constexpr int kLearnFrames = 40;            // frames Learn is best given
-  static constexpr int kLearnPerFrame = 600;         // descriptors kept of each for k-means
-  static constexpr float kSize = 2.0f;               // SIFT keypoint size (12-pixel windows)
+  static constexpr int kWidth = 320;          // frames shrunk to at most this width
+  static constexpr int kStep = 4;             // grid step of the dense keypoints, pixels
+  static constexpr int kCentres = 64;         // visual words of the vocabulary
+  static constexpr int kLearnFrames = 40;     // frames Learn is best given
+  static constexpr int kLearnPerFrame = 600;  // descriptors kept of each for k-means
+  static constexpr float kSize = 2.0f;        // SIFT keypoint size (12-pixel windows)
   // The scales the frame is described at (1: the shrunk frame; below: smaller copies of it).
   static const std::vector<double>& Scales();
 
@@ -66,7 +65,7 @@ class DenseVladDescriptor : public Descriptor {
   void DescribePatch(const cv::Mat& patch, cv::Mat row) const override;
 
  private:
-  mutable cv::Mat1f centres_;       // kCentres x 128, set by Learn
+  mutable cv::Mat1f centres_;  // kCentres x 128, set by Learn
   mutable std::string fingerprint_;
 };
 

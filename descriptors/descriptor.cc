@@ -10,8 +10,7 @@ namespace openable {
 namespace {
 
 std::string Shape(const cv::Mat& m) {
-  return std::to_string(m.rows) + " x " + std::to_string(m.cols) + " " +
-         cv::typeToString(m.type());
+  return std::to_string(m.rows) + " x " + std::to_string(m.cols) + " " + cv::typeToString(m.type());
 }
 
 }  // namespace
@@ -47,11 +46,10 @@ void Descriptor::CheckPatch(const cv::Mat& patch) const {
                              " patch of at least 16 x 16, got " + Shape(patch));
     return;
   }
-  if (patch.type() != CV_8UC(Channels()) || patch.rows != size.height ||
-      patch.cols != size.width) {
+  if (patch.type() != CV_8UC(Channels()) || patch.rows != size.height || patch.cols != size.width) {
     throw std::logic_error(Name() + ": expected a " + std::to_string(size.height) + " x " +
-                           std::to_string(size.width) + " " +
-                           cv::typeToString(CV_8UC(Channels())) + " patch, got " + Shape(patch));
+                           std::to_string(size.width) + " " + cv::typeToString(CV_8UC(Channels())) +
+                           " patch, got " + Shape(patch));
   }
 }
 

@@ -9,10 +9,9 @@
 #pragma once
 
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace openable {
 
@@ -30,13 +29,13 @@ struct DescriptorOptions {
   int ldb_bits = 256;        // LDB bits kept after selection, 1..1386 (32 bytes = 256 in ABLE-P)
   int sad_patch = 8;         // SAD: side of the normalised squares, pixels, 2..64 (SeqSLAM: 8)
   // ONNX (descriptors/onnx.h): a network of the user's, run by OpenCV's DNN module.
-  std::string model_path;               // the .onnx file
-  std::string model_input_size;         // "WxH" of the network's input; "": the model's own
-  std::string model_channels = "rgb";   // rgb, bgr or grey: the channels the network takes
+  std::string model_path;              // the .onnx file
+  std::string model_input_size;        // "WxH" of the network's input; "": the model's own
+  std::string model_channels = "rgb";  // rgb, bgr or grey: the channels the network takes
   std::string model_mean = "0.485,0.456,0.406";  // per channel, after scaling pixels to [0, 1]
   std::string model_std = "0.229,0.224,0.225";   // per channel (ImageNet's, as torchvision's)
-  bool model_normalize = true;          // L2-normalise each output row
-  int model_batch = 16;                 // frames per forward pass, 1..1024
+  bool model_normalize = true;                   // L2-normalise each output row
+  int model_batch = 16;                          // frames per forward pass, 1..1024
   // "NPY": rows computed elsewhere and given, not described (a map made by openable_map add
   // --descriptors): their width in elements and whether they are bytes of bits (Hamming) or
   // floats (L2). Not keys of a run, whose given rows come from Descriptors_path.
@@ -61,9 +60,12 @@ class Descriptor {
   virtual DescriptorKind Kind() const = 0;
   DistanceKind Distance() const {
     switch (Kind()) {
-      case DescriptorKind::kBinary: return DistanceKind::kHamming;
-      case DescriptorKind::kFloat: return DistanceKind::kL2;
-      case DescriptorKind::kBytes: break;
+      case DescriptorKind::kBinary:
+        return DistanceKind::kHamming;
+      case DescriptorKind::kFloat:
+        return DistanceKind::kL2;
+      case DescriptorKind::kBytes:
+        break;
     }
     return DistanceKind::kL1;
   }

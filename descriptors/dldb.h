@@ -31,8 +31,7 @@ namespace openable {
 class DldbDescriptor final : public Descriptor {
  public:
   // Same options and limits as LDB (Patch_size >= 16, Ldb_bits in [1, 1386]).
-  explicit DldbDescriptor(const DescriptorOptions& options)
-      : Descriptor(options), ldb_(options) {}
+  explicit DldbDescriptor(const DescriptorOptions& options) : Descriptor(options), ldb_(options) {}
 
   std::string Name() const override { return "D-LDB"; }
   int Width() const override { return 2 * ldb_.Width(); }

@@ -2,12 +2,11 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
-#include <string>
-
-#include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
 
@@ -99,16 +98,16 @@ void FrameDescriber::Describe(const cv::Mat& image, cv::Mat row) const {
   }
   const int width = descriptor_.Width();
   for (std::size_t c = 0; c < patches.size(); ++c)
-    descriptor_.Describe(patches[c], row.colRange(static_cast<int>(c) * width,
-                                                  (static_cast<int>(c) + 1) * width));
+    descriptor_.Describe(
+        patches[c], row.colRange(static_cast<int>(c) * width, (static_cast<int>(c) + 1) * width));
 }
 
 void FrameDescriber::DescribePatches(const std::vector<cv::Mat>& patches, cv::Mat rows) const {
   const int per_frame = grid_x_ * grid_y_ * panoramas_;
   if (rows.cols != RowWidth() || rows.type() != RowType() ||
       static_cast<std::size_t>(rows.rows) * static_cast<std::size_t>(per_frame) != patches.size())
-    throw std::logic_error("FrameDescriber: " + std::to_string(patches.size()) +
-                           " patches for " + std::to_string(rows.rows) + " rows");
+    throw std::logic_error("FrameDescriber: " + std::to_string(patches.size()) + " patches for " +
+                           std::to_string(rows.rows) + " rows");
   // Row r of `rows` holds the descriptor rows of its frame's patches side by side: viewed as
   // (frames x patches) rows of the descriptor's width, it is one row per patch, in order.
   CV_Assert(rows.isContinuous());
@@ -119,8 +118,8 @@ void FrameDescriber::DescribePatches(const std::vector<cv::Mat>& patches, cv::Ma
     const std::size_t end = std::min(patches.size(), at + static_cast<std::size_t>(batch));
     const std::vector<cv::Mat> some(patches.begin() + static_cast<std::ptrdiff_t>(at),
                                     patches.begin() + static_cast<std::ptrdiff_t>(end));
-    descriptor_.DescribeBatch(some, one_per_patch.rowRange(static_cast<int>(at),
-                                                           static_cast<int>(end)));
+    descriptor_.DescribeBatch(some,
+                              one_per_patch.rowRange(static_cast<int>(at), static_cast<int>(end)));
   }
 }
 

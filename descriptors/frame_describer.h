@@ -2,10 +2,9 @@
 // of ABLE-P, over any descriptor of the registry.
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/base/enum_names.h"
 #include "descriptors/descriptor.h"
@@ -19,9 +18,9 @@ OPENABLE_ENUM_NAMES(DescriptionType, "global", "grid")
 // Panoramas).
 struct DescriptionOptions {
   DescriptionType type = DescriptionType::kGlobal;  // global: the whole frame; grid: cells
-  int grid_x = 2;      // grid cells across (type kGrid), 1..64
-  int grid_y = 2;      // grid cells down (type kGrid), 1..64
-  int panoramas = 4;   // sub-panoramas of a panoramic frame, 1..64 (used for panoramic cameras)
+  int grid_x = 2;                                   // grid cells across (type kGrid), 1..64
+  int grid_y = 2;                                   // grid cells down (type kGrid), 1..64
+  int panoramas = 4;  // sub-panoramas of a panoramic frame, 1..64 (used for panoramic cameras)
 
   // Throws InputError naming the key (Grid_x, Grid_y, Panoramas), the value and the range.
   void Check() const;
@@ -40,8 +39,8 @@ struct DescriptionOptions {
 // is described as above (global or grid) and the n rows are concatenated in strip order.
 class FrameDescriber {
  public:
-  FrameDescriber(const Descriptor& descriptor, DescriptionType type, int grid_x = 1,
-                 int grid_y = 1, int panoramas = 1);
+  FrameDescriber(const Descriptor& descriptor, DescriptionType type, int grid_x = 1, int grid_y = 1,
+                 int panoramas = 1);
   // Elements per row (descriptor width x cells x sub-panoramas) and their CV type (CV_8U or
   // CV_32F).
   int RowWidth() const;
@@ -74,8 +73,7 @@ class FrameDescriber {
   // Frames whose patches make about one batch.
   int PreferredBatchOfFrames() const {
     const int per_frame = grid_x_ * grid_y_ * panoramas_;
-    return descriptor_.PreferredBatch() > per_frame ? descriptor_.PreferredBatch() / per_frame
-                                                     : 1;
+    return descriptor_.PreferredBatch() > per_frame ? descriptor_.PreferredBatch() / per_frame : 1;
   }
   // The patches Describe would describe for `image`, in row order (sub-panorama, then cell),
   // each resized to the descriptor's input. Thread-safe; throws as Describe.

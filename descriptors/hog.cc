@@ -25,8 +25,7 @@ cv::HOGDescriptor MakeHog(int patch_size) {
 
 }  // namespace
 
-HogDescriptor::HogDescriptor(const DescriptorOptions& options)
-    : Descriptor(options), width_(0) {
+HogDescriptor::HogDescriptor(const DescriptorOptions& options) : Descriptor(options), width_(0) {
   if (PatchSize() < kBlock || PatchSize() % kCell != 0) {
     throw InputError("Patch_size: " + std::to_string(PatchSize()) +
                      " does not suit HOG; expected a multiple of 8 that is at least 16");

@@ -46,7 +46,6 @@ std::vector<int> LdbSelectedTests(int bits, LdbSelection selection) {
 
 LdbDescriptor::LdbDescriptor(const DescriptorOptions& options, LdbSelection selection)
     : Descriptor(options), bits_(options.ldb_bits), selection_(selection) {
-
   const long long s = PatchSize();
   cells_.reserve(kCellCount);
   for (const int n : kLevels) {

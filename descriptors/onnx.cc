@@ -7,12 +7,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
 #include <system_error>
 #include <vector>
-
-#include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/hash.h"
@@ -47,8 +46,8 @@ cv::Size ParseInputSize(const std::string& text) {
     const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
     return ec == std::errc() && end == s.data() + s.size() && !s.empty();
   };
-  if (x == std::string::npos || !whole(t.substr(0, x), w) || !whole(t.substr(x + 1), h) ||
-      w < 1 || h < 1 || w > 4096 || h > 4096)
+  if (x == std::string::npos || !whole(t.substr(0, x), w) || !whole(t.substr(x + 1), h) || w < 1 ||
+      h < 1 || w > 4096 || h > 4096)
     throw InputError("Model_input_size: " + Quoted(text) +
                      (t.empty() ? " is empty" : " is not valid") +
                      "; expected the network's input as WxH in pixels, each in [1, 4096] (e.g. "
@@ -82,8 +81,9 @@ std::vector<float> ParseValues(const char* key, const std::string& text, int cha
 OnnxDescriptor::OnnxDescriptor(const DescriptorOptions& options)
     : Descriptor(options), path_(options.model_path), normalize_(options.model_normalize) {
   if (Trim(path_).empty())
-    throw InputError("Model_path: empty; expected the .onnx file of the network "
-                     "(Image_descriptor ONNX)");
+    throw InputError(
+        "Model_path: empty; expected the .onnx file of the network "
+        "(Image_descriptor ONNX)");
   const std::string channels = Lower(Trim(options.model_channels));
   if (channels == "rgb") {
     order_ = Order::kRgb;
@@ -138,8 +138,7 @@ OnnxDescriptor::OnnxDescriptor(const DescriptorOptions& options)
     }
     const std::size_t total = out.total();
     const bool one_vector_each =
-        out.dims >= 2 && out.size[0] == n && total % static_cast<std::size_t>(n) == 0 &&
-        [&] {
+        out.dims >= 2 && out.size[0] == n && total % static_cast<std::size_t>(n) == 0 && [&] {
           // N x D, or N x D x 1 x 1 (a pooled convolution): one axis beyond N of size > 1.
           int wide = 0;
           for (int d = 1; d < out.dims; ++d) wide += out.size[d] > 1 ? 1 : 0;
@@ -163,13 +162,13 @@ OnnxDescriptor::OnnxDescriptor(const DescriptorOptions& options)
     width = width_of(1, &why_one);
     batch_ = 1;
     if (width <= 0)
-      throw InputError(name + ": " +
-                       (width == 0 ? why_one
-                                   : "the network does not run on a " + std::to_string(input_.width) +
-                                         "x" + std::to_string(input_.height) + " " +
-                                         (c == 1 ? "grey" : "colour") +
-                                         " image (Model_input_size, Model_channels): " + why_one) +
-                       "; expected a network whose output is one vector per image");
+      throw InputError(
+          name + ": " +
+          (width == 0 ? why_one
+                      : "the network does not run on a " + std::to_string(input_.width) + "x" +
+                            std::to_string(input_.height) + " " + (c == 1 ? "grey" : "colour") +
+                            " image (Model_input_size, Model_channels): " + why_one) +
+          "; expected a network whose output is one vector per image");
   }
   width_ = width;
 }
@@ -188,8 +187,8 @@ cv::Mat OnnxDescriptor::Blob(const std::vector<cv::Mat>& patches) const {
     float* out = blob.ptr<float>() + n * static_cast<std::size_t>(c) * plane;
     if (order_ == Order::kGrey) cv::cvtColor(p, grey, cv::COLOR_BGR2GRAY);
     for (int y = 0; y < input_.height; ++y) {
-      const unsigned char* in = order_ == Order::kGrey ? grey.ptr<unsigned char>(y)
-                                                       : p.ptr<unsigned char>(y);
+      const unsigned char* in =
+          order_ == Order::kGrey ? grey.ptr<unsigned char>(y) : p.ptr<unsigned char>(y);
       for (int x = 0; x < input_.width; ++x) {
         const std::size_t at = static_cast<std::size_t>(y) * input_.width + x;
         for (int k = 0; k < c; ++k) {
@@ -234,8 +233,7 @@ void OnnxDescriptor::Run(const std::vector<cv::Mat>& patches, cv::Mat rows) cons
 }
 
 void OnnxDescriptor::DescribeBatch(const std::vector<cv::Mat>& patches, cv::Mat rows) const {
-  if (rows.rows != static_cast<int>(patches.size()) || rows.cols != width_ ||
-      rows.type() != CV_32F)
+  if (rows.rows != static_cast<int>(patches.size()) || rows.cols != width_ || rows.type() != CV_32F)
     throw std::logic_error("ONNX: rows of another shape than the patches");
   for (std::size_t at = 0; at < patches.size(); at += static_cast<std::size_t>(batch_)) {
     const std::size_t end = std::min(patches.size(), at + static_cast<std::size_t>(batch_));
@@ -245,8 +243,6 @@ void OnnxDescriptor::DescribeBatch(const std::vector<cv::Mat>& patches, cv::Mat 
   }
 }
 
-void OnnxDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
-  Run({patch}, row);
-}
+void OnnxDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const { Run({patch}, row); }
 
 }  // namespace openable

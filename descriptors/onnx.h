@@ -8,10 +8,9 @@
 
 #include <memory>
 #include <mutex>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "descriptors/descriptor.h"
 

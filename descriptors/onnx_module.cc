@@ -2,9 +2,8 @@
 // descriptor (descriptors/onnx.h). A module, loaded on first use (OpenABLE/base/module_loader.h),
 // so that runs without a model do not load OpenCV's DNN library and its protobuf.
 #include <memory>
-#include <string>
-
 #include <opencv2/dnn.hpp>
+#include <string>
 
 #include "descriptors/onnx.h"
 

@@ -89,8 +89,7 @@ cv::Ptr<cv::BRISK> MakeBrisk() {
 // ---------------------------------------------------------------------------------------------
 // ORB
 
-OrbDescriptor::OrbDescriptor(const DescriptorOptions& options) : Descriptor(options) {
-}
+OrbDescriptor::OrbDescriptor(const DescriptorOptions& options) : Descriptor(options) {}
 
 void OrbDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
   // cv::ORB is cheap to build (its pattern is made in compute()); one per call is thread-safe.
@@ -120,7 +119,6 @@ BriskDescriptor::BriskDescriptor(const DescriptorOptions& options)
 BriskDescriptor::~BriskDescriptor() = default;
 
 void BriskDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
-
   cv::Ptr<cv::BRISK> brisk;
   {
     std::lock_guard<std::mutex> lock(pool_->mutex);
@@ -160,8 +158,7 @@ void BriskDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
 // ---------------------------------------------------------------------------------------------
 // SIFT
 
-SiftDescriptor::SiftDescriptor(const DescriptorOptions& options) : Descriptor(options) {
-}
+SiftDescriptor::SiftDescriptor(const DescriptorOptions& options) : Descriptor(options) {}
 
 void SiftDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
   // cv::SIFT is cheap to build; one per call is thread-safe.

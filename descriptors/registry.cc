@@ -8,9 +8,9 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
 #include "descriptors/brief.h"
-#include "descriptors/freak.h"
 #include "descriptors/densevlad.h"
 #include "descriptors/dldb.h"
+#include "descriptors/freak.h"
 #include "descriptors/hog.h"
 #include "descriptors/ldb.h"
 #include "descriptors/onnx.h"
@@ -45,7 +45,7 @@ const Entry kDescriptors[] = {
     {"SAD", &Make<SadDescriptor>},      // descriptors/sad.h (SeqSLAM; byte values, L1 distance)
     // descriptors/densevlad.h (dense RootSIFT + VLAD, its vocabulary learnt from the reference)
     {"DENSEVLAD", &Make<DenseVladDescriptor>},
-    {"ONNX", &Make<OnnxDescriptor>},    // descriptors/onnx.h (a network of the user's; Model_path)
+    {"ONNX", &Make<OnnxDescriptor>},  // descriptors/onnx.h (a network of the user's; Model_path)
 };
 
 struct Unavailable {
@@ -67,9 +67,10 @@ class RowsGivenDescriptor : public Descriptor {
   explicit RowsGivenDescriptor(const DescriptorOptions& options)
       : Descriptor(options), width_(options.given_width), binary_(options.given_binary) {
     if (width_ < 1)
-      throw InputError("Image_descriptor: NPY names rows given by a file (Descriptors_path, "
-                       "openable_map add --descriptors), not a descriptor to choose; expected "
-                       "one of the registered descriptors");
+      throw InputError(
+          "Image_descriptor: NPY names rows given by a file (Descriptors_path, "
+          "openable_map add --descriptors), not a descriptor to choose; expected "
+          "one of the registered descriptors");
     // A bound for rows a map names (4 MB of floats a frame), far above any descriptor's.
     if (width_ > kMaxWidth)
       throw InputError("rows given of " + std::to_string(width_) +
@@ -83,8 +84,9 @@ class RowsGivenDescriptor : public Descriptor {
 
  protected:
   void DescribePatch(const cv::Mat&, cv::Mat) const override {
-    throw InputError("descriptor NPY: the rows were computed elsewhere and given; expected "
-                     "rows for these frames too (openable_map --descriptors FILE.npy)");
+    throw InputError(
+        "descriptor NPY: the rows were computed elsewhere and given; expected "
+        "rows for these frames too (openable_map --descriptors FILE.npy)");
   }
 
  private:
@@ -147,7 +149,8 @@ std::vector<std::string> DescriptorList(const std::string& value) {
     const std::string name = Upper(Trim(item));
     item.clear();
     if (name.empty())
-      throw InputError("Image_descriptor: \"" + value + "\" has an empty name; expected one "
+      throw InputError("Image_descriptor: \"" + value +
+                       "\" has an empty name; expected one "
                        "descriptor name, or several joined by + or , (e.g. HOG+LDB)");
     for (const std::string& seen : names)
       if (seen == name)

@@ -3,9 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <string>
-
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 #include "OpenABLE/base/error.h"
 
@@ -40,8 +39,8 @@ void SadDescriptor::DescribePatch(const cv::Mat& patch, cv::Mat row) const {
         for (int x = square.x; x < square.x + square.width; ++x) {
           // A uniform square (s = 0) has no contrast to normalise: it becomes z = 0.
           const double z = s > 0 ? (in[x] - m) / s : 0.0;
-          out[y * width_ + x] = static_cast<std::uint8_t>(
-              std::clamp(std::lround(128.0 + 32.0 * z), 0L, 255L));
+          out[y * width_ + x] =
+              static_cast<std::uint8_t>(std::clamp(std::lround(128.0 + 32.0 * z), 0L, 255L));
         }
       }
     }

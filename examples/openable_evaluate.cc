@@ -122,9 +122,8 @@ int main(int argc, char** argv) {
     if (command_line.json) {
       std::cout << openable::ProgramJson(
           "openable_evaluate",
-          {{"evaluation",
-            openable::EvaluationJson(evaluated.evaluation.settings, evaluated.evaluation.runs,
-                                     openable::kVersion)}},
+          {{"evaluation", openable::EvaluationJson(evaluated.evaluation.settings,
+                                                   evaluated.evaluation.runs, openable::kVersion)}},
           paths);
       return 0;
     }

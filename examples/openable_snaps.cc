@@ -64,7 +64,8 @@ int main(int argc, char** argv) {
         const auto say = [&](const std::string& line) {
           if (!cl.quiet) std::cerr << "  " << openable::ToValidUtf8(line) << "\n";
         };
-        const openable::snaps::ChainResult result = openable::snaps::RunChain(config, progress, say);
+        const openable::snaps::ChainResult result =
+            openable::snaps::RunChain(config, progress, say);
         if (cl.json) {
           const std::vector<std::string> paths = openable::snaps::WriteChainOutputs(config, result);
           std::cout << openable::ProgramJson(

@@ -101,8 +101,8 @@ int main(int argc, char** argv) {
         const std::vector<std::string> written = openable::WriteSweep(prefix, result);
         if (command_line.json) {
           std::cout << openable::ProgramJson(
-              "openable_sweep",
-              {{"sweep", openable::SweepJson(result, openable::kVersion)}}, written);
+              "openable_sweep", {{"sweep", openable::SweepJson(result, openable::kVersion)}},
+              written);
           return 0;
         }
         std::cout << openable::FormatSweepTable(result) << "Wrote:\n";

@@ -1,12 +1,11 @@
 #include "matching/blas.h"
 
+#include <cblas.h>  // OpenBLAS's (matching/CMakeLists.txt): the types of the calls looked up
+#include <dlfcn.h>
+
 #include <cstdlib>
 #include <mutex>
 #include <set>
-
-#include <dlfcn.h>
-
-#include <cblas.h>  // OpenBLAS's (matching/CMakeLists.txt): the types of the calls looked up
 
 #include "OpenABLE/base/error.h"
 
@@ -24,7 +23,7 @@ struct OpenBlas {
   decltype(&openblas_get_parallel) get_parallel = nullptr;
   decltype(&openblas_get_config) get_config = nullptr;
   decltype(&openblas_get_corename) get_corename = nullptr;
-  std::string chosen;  // the OPENBLAS_CORETYPE OpenABLE set, if it did
+  std::string chosen;    // the OPENBLAS_CORETYPE OpenABLE set, if it did
   bool overlap = false;  // calls from several threads may run at once (pthreads build)
 };
 
@@ -41,7 +40,8 @@ void Open(OpenBlas& b) {
   if (!b.handle) {
     const char* why = dlerror();
     throw InputError(std::string("cannot load OpenBLAS for the float distance matrices (") +
-                     (why ? why : kLibrary) + "); expected package libopenblas0 "
+                     (why ? why : kLibrary) +
+                     "); expected package libopenblas0 "
                      "(examples/setup.sh installs it)");
   }
   Look(b.handle, "cblas_sgemm", b.sgemm);
@@ -57,8 +57,8 @@ void Open(OpenBlas& b) {
 // AVX-512 subsets those kernels use, Haswell with AVX2 and FMA; empty otherwise (OpenBLAS's
 // choice stands, whatever it is on a CPU it knows).
 std::string BetterCore(const std::string& loaded) {
-  static const std::set<std::string> with_avx2 = {"Haswell", "Zen", "SkylakeX", "Cooperlake",
-                                                  "SapphireRapids", "Excavator"};
+  static const std::set<std::string> with_avx2 = {
+      "Haswell", "Zen", "SkylakeX", "Cooperlake", "SapphireRapids", "Excavator"};
   if (with_avx2.count(loaded)) return "";
   __builtin_cpu_init();
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
@@ -166,9 +166,13 @@ std::string BlasDescription() {
   const OpenBlas& blas = Library();
   const int parallel = blas.get_parallel();
   return std::string(blas.get_config()) + "; kernels " + blas.get_corename() +
-         (blas.chosen.empty() ? "" : " (OPENBLAS_CORETYPE set by OpenABLE: the library did not "
-                                     "recognise this CPU)") +
-         "; " + (parallel == 1 ? "pthreads" : parallel == 2 ? "OpenMP" : "single-threaded") +
+         (blas.chosen.empty() ? ""
+                              : " (OPENBLAS_CORETYPE set by OpenABLE: the library did not "
+                                "recognise this CPU)") +
+         "; " +
+         (parallel == 1   ? "pthreads"
+          : parallel == 2 ? "OpenMP"
+                          : "single-threaded") +
          " build";
 }
 

@@ -8,9 +8,8 @@
 #include <functional>
 #include <limits>
 #include <mutex>
-#include <stdexcept>
-
 #include <opencv2/core/hal/intrin.hpp>
+#include <stdexcept>
 
 #include "OpenABLE/base/option_checks.h"
 #include "OpenABLE/base/threading.h"
@@ -52,8 +51,7 @@ class SlicedKeep {
  public:
   SlicedKeep(int q, int references, const KeepRules& rules)
       : q_(q),
-        limit_(rules.one_traversal ? std::min(references, q - rules.exclusion + 1)
-                                   : references),
+        limit_(rules.one_traversal ? std::min(references, q - rules.exclusion + 1) : references),
         kept_(KeptCells(rules)),
         rules_(&rules) {}
 
@@ -117,8 +115,8 @@ class SlicedKeep {
                               rules_->score_window);
     };
     for (int r = 0; r < ranked; ++r)
-      out.push_back({q_, heap_[r].second, heap_[r].first, r + 1,
-                     score(heap_[r].first, heap_[r].second)});
+      out.push_back(
+          {q_, heap_[r].second, heap_[r].first, r + 1, score(heap_[r].first, heap_[r].second)});
     for (const std::pair<float, int>& cell : band_) {
       // (Not a structured binding: C++17 does not let a lambda capture one; clang refuses.)
       const int j = cell.second;
@@ -231,9 +229,8 @@ bool SumsAreExactInFloat(Metric metric, int width, int L) {
 // the traversal, and prev[-1] and old[-L .. -1] hold the cells of the columns before it (read
 // where a sum reaches back there), so that a slice gives the same floats as the whole row.
 template <typename Acc>
-float SequenceRow(const float* row, const float* old, const Acc* prev, Acc* cur, float* out,
-                  int m, int steps, int L, bool reverse, SequencePartial partial,
-                  int first = 0) {
+float SequenceRow(const float* row, const float* old, const Acc* prev, Acc* cur, float* out, int m,
+                  int steps, int L, bool reverse, SequencePartial partial, int first = 0) {
   float largest = 0.0f;
   // Columns whose sums reach back a full L - 1 steps along the columns too: [L, m) going
   // forward, [0, m - L) in reverse; the other L columns go through the general case.
@@ -307,8 +304,8 @@ RangePlan PlanRanges(const MatchBlock& block, const BoundedOptions& options) {
                                 : std::clamp(options.query_end, p.begin, block.query_count);
   const int queries = p.end - p.begin;
   p.threads = EffectiveThreads(options.threads);
-  p.range_rows = options.range_rows > 0 ? options.range_rows
-                                        : std::clamp(queries / (8 * p.threads), 64, 1024);
+  p.range_rows =
+      options.range_rows > 0 ? options.range_rows : std::clamp(queries / (8 * p.threads), 64, 1024);
   p.ranges = queries <= 0 ? 0 : (queries + p.range_rows - 1) / p.range_rows;
   return p;
 }
@@ -321,8 +318,7 @@ float SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
   const int m = block.reference_count;
   const RangePlan plan = PlanRanges(block, options);
   const int q_begin = plan.begin, q_end = plan.end, queries = q_end - q_begin;
-  const cv::Mat references = descriptors.rowRange(block.reference_first,
-                                                  block.reference_first + m);
+  const cv::Mat references = descriptors.rowRange(block.reference_first, block.reference_first + m);
   const Metric metric = options.metric.value_or(MetricOfType(descriptors.type()));
   std::unique_ptr<HammingReferences> packed;
   if (metric == Metric::kHamming) packed = std::make_unique<HammingReferences>(references);
@@ -348,7 +344,7 @@ float SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
   const bool exact = SumsAreExactInFloat(metric, descriptors.cols, L);
   ParallelFor(ranges, threads, [&](int c) {
     const int r0 = q_begin + c * range_rows, r1 = std::min(q_end, r0 + range_rows);
-    const int h0 = std::max(0, r0 - (L - 1));  // first row summed
+    const int h0 = std::max(0, r0 - (L - 1));                     // first row summed
     const int rows_end = std::min(block.query_count, r1 + look);  // one past the last summed
     // The ring of D: blocks of block_rows rows, enough to hold rows i - L .. i and the rest of
     // the block of row i; row i (counted from h0) is row (i - h0) % slots. A block's rows are
@@ -411,8 +407,7 @@ float SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
     };
     for (int b0 = h0; b0 < rows_end; b0 += block_rows) {
       const int b1 = std::min(rows_end, b0 + block_rows);
-      const cv::Mat queries =
-          descriptors.rowRange(block.query_first + b0, block.query_first + b1);
+      const cv::Mat queries = descriptors.rowRange(block.query_first + b0, block.query_first + b1);
       if (packed) {
         cv::Mat1f into(b1 - b0, m, ring_row(b0));  // blocks start on a block of the ring
         packed->DistancesInto(queries, into, 1);
@@ -429,23 +424,22 @@ float SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
           // One direction's row of sums into `into`, its running sums (float or double) moved
           // on by one row; returns the row's largest value.
           const auto step = [&](auto& prev, auto& cur, float* into, bool reverse) {
-            const float row_largest = SequenceRow(d, old, prev.data(), cur.data(), into, m,
-                                                  steps, L, reverse, options.partial);
+            const float row_largest = SequenceRow(d, old, prev.data(), cur.data(), into, m, steps,
+                                                  L, reverse, options.partial);
             std::swap(prev, cur);
             return row_largest;
           };
           // With Sequence_partial ahead, the sums go straight into the rows kept for it.
-          float* sums = ahead && forward ? &sums_f[static_cast<std::size_t>(i % L) * width]
-                                         : sum_f.data();
+          float* sums =
+              ahead && forward ? &sums_f[static_cast<std::size_t>(i % L) * width] : sum_f.data();
           if (forward) {
-            summed(i, exact ? step(prev_ef, cur_ef, sums, false)
-                            : step(prev_f, cur_f, sums, false));
+            summed(i,
+                   exact ? step(prev_ef, cur_ef, sums, false) : step(prev_f, cur_f, sums, false));
           }
           if (backward) {
             float* into = ahead ? &sums_r[static_cast<std::size_t>(i % L) * width]
                                 : (forward ? sum_r.data() : sum_f.data());
-            summed(i, exact ? step(prev_er, cur_er, into, true)
-                            : step(prev_r, cur_r, into, true));
+            summed(i, exact ? step(prev_er, cur_er, into, true) : step(prev_r, cur_r, into, true));
             if (forward && !ahead)  // both directions: the smaller of the two sums
               for (int j = 0; j < m; ++j) sum_f[j] = std::min(sum_f[j], sum_r[j]);
           }
@@ -473,7 +467,6 @@ float SequenceRows(const cv::Mat& descriptors, const MatchBlock& block,
   for (const float v : range_max) largest = std::max(largest, v);
   return largest;
 }
-
 
 // The kept matches of every range, in the order of the ranges.
 std::vector<Match> Concatenated(const std::vector<std::vector<Match>>& kept) {
@@ -507,15 +500,14 @@ int TileColumns(const BoundedOptions& options, Metric metric, const KeepRules& r
 // last L distances, which the sums of the next tile's first columns read: every sum is the
 // same float as SequenceRows gives.
 std::vector<Match> TiledMatches(const cv::Mat& descriptors, const MatchBlock& block,
-                                const KeepRules& rules, const BoundedOptions& options,
-                                int tile, float& max_distance,
+                                const KeepRules& rules, const BoundedOptions& options, int tile,
+                                float& max_distance,
                                 const std::function<void(int, int)>& progress) {
   const int L = options.sequence_length;
   if (L < 1) throw std::logic_error("BoundedMatches: sequence length < 1");
   const int m = block.reference_count;
   const RangePlan plan = PlanRanges(block, options);
-  const cv::Mat references = descriptors.rowRange(block.reference_first,
-                                                  block.reference_first + m);
+  const cv::Mat references = descriptors.rowRange(block.reference_first, block.reference_first + m);
   const Metric metric = options.metric.value_or(MetricOfType(descriptors.type()));
   std::unique_ptr<HammingReferences> packed;
   if (metric == Metric::kHamming) packed = std::make_unique<HammingReferences>(references);
@@ -604,9 +596,8 @@ std::vector<Match> TiledMatches(const cv::Mat& descriptors, const MatchBlock& bl
             // read as prev[-1] by the next row.
             const auto step = [&](auto& prev, auto& cur, auto& edge_sum) {
               cur[0] = edge_sum[static_cast<std::size_t>(i - h0)];
-              const float row_largest =
-                  SequenceRow(d, old, prev.data() + 1, cur.data() + 1, into, ce - c0, steps, L,
-                              false, options.partial, c0);
+              const float row_largest = SequenceRow(d, old, prev.data() + 1, cur.data() + 1, into,
+                                                    ce - c0, steps, L, false, options.partial, c0);
               if (more) edge_sum[static_cast<std::size_t>(i - h0)] = cur[c1 - c0];
               std::swap(prev, cur);
               return row_largest;
@@ -682,8 +673,7 @@ float SequenceMatrix(const cv::Mat& descriptors, const MatchBlock& block,
 }
 
 std::vector<std::uint8_t> AcceptedMatches(const std::vector<Match>& matches, int queries,
-                                          double threshold,
-                                          const AgreementOptions* consistency) {
+                                          double threshold, const AgreementOptions* consistency) {
   std::vector<int> best(static_cast<std::size_t>(std::max(queries, 0)), -1);
   std::vector<float> score(best.size(), 0.0f);
   for (const Match& m : matches)

@@ -17,33 +17,32 @@
 
 #include <cstdint>
 #include <functional>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
-
 #include "matching/agreement.h"
-#include "matching/search/approximate.h"
 #include "matching/distances.h"
 #include "matching/score.h"
+#include "matching/search/approximate.h"
 #include "matching/sequence.h"
 
 namespace openable {
 
 struct Match {
-  int query = 0;      // frame number in the query traversal
-  int reference = 0;  // frame number in the reference traversal
-  float distance = 0; // normalised (M')
-  int rank = 0;       // 1 = best of its query, ..., k; 0 = kept by the band only
-  float score = 0;    // KeepRules::score of this match (matching/score.h): the normalised
-                      // distance, or its ratio to the best rival outside the window
+  int query = 0;       // frame number in the query traversal
+  int reference = 0;   // frame number in the reference traversal
+  float distance = 0;  // normalised (M')
+  int rank = 0;        // 1 = best of its query, ..., k; 0 = kept by the band only
+  float score = 0;     // KeepRules::score of this match (matching/score.h): the normalised
+                       // distance, or its ratio to the best rival outside the window
 };
 
 struct KeepRules {
-  int best = 10;          // k (Best_matches), 0..100000
-  int band = -1;          // |i - j| <= band (Band_width); -1 none
-  int exclusion = 100;    // one traversal: candidates at least this many frames earlier, >= 1
+  int best = 10;        // k (Best_matches), 0..100000
+  int band = -1;        // |i - j| <= band (Band_width); -1 none
+  int exclusion = 100;  // one traversal: candidates at least this many frames earlier, >= 1
   bool one_traversal = true;
   MatchScore score = MatchScore::kDistance;  // the score of each kept match (Match_score)
   int score_window = 10;                     // its rivals' window, frames (Match_score_window)
@@ -128,10 +127,10 @@ float SequenceMatrix(const cv::Mat& descriptors, const MatchBlock& block,
                      const std::function<void(int, int)>& progress = {});
 
 // Approximate_search: the index of `approximate` (its engine and search budget; its k and
-// threads are set here: matching/search/approximate.h) gives Best_matches candidates per query (with
-// one traversal, Best_matches + 2 x Exclusion, of which those Exclusion frames back are kept),
-// each scored by its exact sequence sum; the k best by that score are kept. Normalised by the
-// largest score computed.
+// threads are set here: matching/search/approximate.h) gives Best_matches candidates per query
+// (with one traversal, Best_matches + 2 x Exclusion, of which those Exclusion frames back are
+// kept), each scored by its exact sequence sum; the k best by that score are kept. Normalised by
+// the largest score computed.
 std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlock& block,
                                       const KeepRules& rules, const BoundedOptions& options,
                                       const ApproximateOptions& approximate, float& max_distance);

@@ -47,9 +47,8 @@ float EnhanceContrastUnshifted(cv::Mat1f& d, int window, const std::vector<int>&
       const double var = std::max(0.0, (s2[b] - s2[a]) / c - mean * mean);
       const double sd = std::sqrt(var);
       // Rounding leaves a tiny variance where every value is equal: treat as equal.
-      const float v = sd > 1e-9 * (std::fabs(mean) + 1.0)
-                          ? static_cast<float>((row[j] - mean) / sd)
-                          : 0.0f;
+      const float v =
+          sd > 1e-9 * (std::fabs(mean) + 1.0) ? static_cast<float>((row[j] - mean) / sd) : 0.0f;
       row[j] = v;
       local = std::min(local, v);
     }
@@ -59,8 +58,7 @@ float EnhanceContrastUnshifted(cv::Mat1f& d, int window, const std::vector<int>&
   return smallest;
 }
 
-void EnhanceContrast(cv::Mat1f& d, int window, const std::vector<int>& col_starts,
-                     int threads) {
+void EnhanceContrast(cv::Mat1f& d, int window, const std::vector<int>& col_starts, int threads) {
   const float smallest = EnhanceContrastUnshifted(d, window, col_starts, threads);
   const int n = d.rows, m = d.cols;
   if (!std::isfinite(smallest) || smallest == 0.0f) return;

@@ -12,9 +12,8 @@
 // Eq. 5 expect distances >= 0; a constant shift does not change which cell of a row is best).
 #pragma once
 
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 namespace openable {
 
@@ -30,7 +29,7 @@ void EnhanceContrast(cv::Mat1f& d, int window, const std::vector<int>& col_start
 // rows at a time and shift them by a value fixed beforehand (a map's tuned settings, online.h).
 // A z-score among the 2R + 1 values of a window is at least -sqrt(2R) (Samuelson's
 // inequality), so a shift of sqrt(2 window) never leaves a cell below 0.
-float EnhanceContrastUnshifted(cv::Mat1f& d, int window,
-                               const std::vector<int>& col_starts = {}, int threads = 0);
+float EnhanceContrastUnshifted(cv::Mat1f& d, int window, const std::vector<int>& col_starts = {},
+                               int threads = 0);
 
 }  // namespace openable

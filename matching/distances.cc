@@ -1,9 +1,6 @@
 #include "matching/distances.h"
 
-#include "matching/blas.h"
-#include "matching/large_matrix.h"
-
-#include "OpenABLE/base/threading.h"
+#include <immintrin.h>
 
 #include <algorithm>
 #include <atomic>
@@ -13,7 +10,9 @@
 #include <stdexcept>
 #include <vector>
 
-#include <immintrin.h>
+#include "OpenABLE/base/threading.h"
+#include "matching/blas.h"
+#include "matching/large_matrix.h"
 
 namespace openable {
 namespace {
@@ -29,9 +28,7 @@ struct PackedRows {
   int blocks = 0;
   std::vector<std::uint64_t> data;
   const std::uint64_t* base = nullptr;
-  const std::uint64_t* Block(int b) const {
-    return base + static_cast<size_t>(b) * words * 4;
-  }
+  const std::uint64_t* Block(int b) const { return base + static_cast<size_t>(b) * words * 4; }
 };
 
 PackedRows Pack(const cv::Mat& m) {
@@ -79,9 +76,8 @@ void PortableKernel(const std::uint64_t* q, const PackedRows& refs, int b0, int 
   ScalarBlocks(q, refs, b0, b1, out);
 }
 
-__attribute__((target("popcnt"))) void PopcntKernel(const std::uint64_t* q,
-                                                    const PackedRows& refs, int b0, int b1,
-                                                    float* out) {
+__attribute__((target("popcnt"))) void PopcntKernel(const std::uint64_t* q, const PackedRows& refs,
+                                                    int b0, int b1, float* out) {
   ScalarBlocks(q, refs, b0, b1, out);
 }
 
@@ -133,8 +129,8 @@ __attribute__((target("avx2"), always_inline)) inline void StoreCounts(const Avx
 // word loop unrolls. Two blocks per step for instruction-level parallelism.
 template <int W>
 __attribute__((target("avx2,popcnt"))) void Avx2FixedKernel(const std::uint64_t* q,
-                                                     const PackedRows& refs, int b0, int b1,
-                                                     float* out) {
+                                                            const PackedRows& refs, int b0, int b1,
+                                                            float* out) {
   static_assert(W >= 1 && W <= 31, "byte counters hold 31 words");
   const Avx2Consts c = MakeAvx2Consts();
   __m256i qk[W];
@@ -163,8 +159,8 @@ __attribute__((target("avx2,popcnt"))) void Avx2FixedKernel(const std::uint64_t*
     StoreCounts(c, _mm256_sad_epu8(bytes2, c.zero), _mm256_sad_epu8(bytes3, c.zero), 8,
                 out + 4 * (b - b0) + 8);
     const int valid = std::min(4, refs.rows - 4 * (b + 4));
-    const float counts[4] = {static_cast<float>(s0), static_cast<float>(s1),
-                             static_cast<float>(s2), static_cast<float>(s3)};
+    const float counts[4] = {static_cast<float>(s0), static_cast<float>(s1), static_cast<float>(s2),
+                             static_cast<float>(s3)};
     std::copy(counts, counts + valid, out + 4 * (b + 4 - b0));
   }
   for (; b + 1 < b1; b += 2) {
@@ -185,10 +181,14 @@ __attribute__((target("avx2,popcnt"))) void Avx2Kernel(const std::uint64_t* q,
                                                        const PackedRows& refs, int b0, int b1,
                                                        float* out) {
   switch (refs.words) {
-    case 4: return Avx2FixedKernel<4>(q, refs, b0, b1, out);    // 256 bits (LDB, ORB)
-    case 8: return Avx2FixedKernel<8>(q, refs, b0, b1, out);    // 512 bits (BRISK)
-    case 22: return Avx2FixedKernel<22>(q, refs, b0, b1, out);  // 1386 bits (all LDB tests)
-    default: break;
+    case 4:
+      return Avx2FixedKernel<4>(q, refs, b0, b1, out);  // 256 bits (LDB, ORB)
+    case 8:
+      return Avx2FixedKernel<8>(q, refs, b0, b1, out);  // 512 bits (BRISK)
+    case 22:
+      return Avx2FixedKernel<22>(q, refs, b0, b1, out);  // 1386 bits (all LDB tests)
+    default:
+      break;
   }
   const Avx2Consts c = MakeAvx2Consts();
   const int words = refs.words;
@@ -220,18 +220,17 @@ __attribute__((target("avx2,popcnt"))) void Avx2Kernel(const std::uint64_t* q,
 // by hand because OpenCV's Hamming norm (cv::batchDistance) works on one pair of rows at a
 // time in this layout's stead and does not use VPOPCNTQ. Four blocks per step keep four
 // independent accumulator chains in flight.
-#define OPENABLE_AVX512 \
-  __attribute__((target("avx512f,avx512dq,avx512vl,avx512vpopcntdq,popcnt")))
+#define OPENABLE_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,avx512vpopcntdq,popcnt")))
 
-OPENABLE_AVX512 __attribute__((always_inline)) inline __m512i QueryPair(
-    const std::uint64_t* q, int k, int words) {
+OPENABLE_AVX512 __attribute__((always_inline)) inline __m512i QueryPair(const std::uint64_t* q,
+                                                                        int k, int words) {
   const long long hi = k + 1 < words ? static_cast<long long>(q[k + 1]) : 0;
   return _mm512_mask_set1_epi64(_mm512_set1_epi64(static_cast<long long>(q[k])), 0xF0, hi);
 }
 
 // Words k, k + 1 of a block (only word k, upper half zero, when k is the last word).
-OPENABLE_AVX512 __attribute__((always_inline)) inline __m512i BlockPair(
-    const std::uint64_t* block, int k, int words) {
+OPENABLE_AVX512 __attribute__((always_inline)) inline __m512i BlockPair(const std::uint64_t* block,
+                                                                        int k, int words) {
   return k + 1 < words ? _mm512_loadu_si512(block + 4 * k)
                        : _mm512_maskz_loadu_epi64(0x0F, block + 4 * k);
 }
@@ -277,8 +276,7 @@ OPENABLE_AVX512 void Avx512Blocks(const std::uint64_t* q, const PackedRows& refs
       a3 = AddPairCount(a3, qv, block + 3 * stride, k, words);
     }
     StorePair(a0, a1, std::min(8, refs.rows - 4 * b), out + 4 * (b - b0));
-    StorePair(a2, a3, std::max(0, std::min(8, refs.rows - 4 * (b + 2))),
-              out + 4 * (b - b0) + 8);
+    StorePair(a2, a3, std::max(0, std::min(8, refs.rows - 4 * (b + 2))), out + 4 * (b - b0) + 8);
   }
   for (; b < b1; b += 2) {  // the last one to three blocks, two at a time
     const std::uint64_t* block = refs.Block(b);
@@ -297,10 +295,14 @@ OPENABLE_AVX512 void Avx512Blocks(const std::uint64_t* q, const PackedRows& refs
 OPENABLE_AVX512 void Avx512Kernel(const std::uint64_t* q, const PackedRows& refs, int b0, int b1,
                                   float* out) {
   switch (refs.words) {
-    case 4: return Avx512Blocks<2>(q, refs, b0, b1, out);    // 256 bits (LDB, ORB)
-    case 8: return Avx512Blocks<4>(q, refs, b0, b1, out);    // 512 bits (BRISK)
-    case 22: return Avx512Blocks<11>(q, refs, b0, b1, out);  // 1386 bits (LDB's largest)
-    default: return Avx512Blocks<0>(q, refs, b0, b1, out);
+    case 4:
+      return Avx512Blocks<2>(q, refs, b0, b1, out);  // 256 bits (LDB, ORB)
+    case 8:
+      return Avx512Blocks<4>(q, refs, b0, b1, out);  // 512 bits (BRISK)
+    case 22:
+      return Avx512Blocks<11>(q, refs, b0, b1, out);  // 1386 bits (LDB's largest)
+    default:
+      return Avx512Blocks<0>(q, refs, b0, b1, out);
   }
 }
 
@@ -330,11 +332,16 @@ std::atomic<int> g_forced{static_cast<int>(HammingKernel::kAuto)};
 KernelChoice Current() {
   static const KernelChoice best = Best();
   switch (static_cast<HammingKernel>(g_forced.load())) {
-    case HammingKernel::kPortable: return {PortableKernel, "portable"};
-    case HammingKernel::kPopcnt: return {PopcntKernel, "popcnt"};
-    case HammingKernel::kAvx2: return {Avx2Kernel, "avx2"};
-    case HammingKernel::kAvx512: return {Avx512Kernel, "avx512"};
-    default: return best;
+    case HammingKernel::kPortable:
+      return {PortableKernel, "portable"};
+    case HammingKernel::kPopcnt:
+      return {PopcntKernel, "popcnt"};
+    case HammingKernel::kAvx2:
+      return {Avx2Kernel, "avx2"};
+    case HammingKernel::kAvx512:
+      return {Avx512Kernel, "avx512"};
+    default:
+      return best;
   }
 }
 
@@ -435,8 +442,8 @@ int PairBitsPortable(const std::uint8_t* a, const std::uint8_t* b, int bytes) {
   return PairBits<0>(a, b, bytes);
 }
 
-__attribute__((target("popcnt"))) int PairBitsPopcnt(const std::uint8_t* a,
-                                                     const std::uint8_t* b, int bytes) {
+__attribute__((target("popcnt"))) int PairBitsPopcnt(const std::uint8_t* a, const std::uint8_t* b,
+                                                     int bytes) {
   return PairBits<1>(a, b, bytes);
 }
 
@@ -493,8 +500,7 @@ cv::Mat1f Distances(const cv::Mat& a, const cv::Mat& b, Metric metric, int threa
 
 namespace {
 
-std::int64_t AbsoluteDifferencesPortable(const std::uint8_t* a, const std::uint8_t* b,
-                                         int bytes) {
+std::int64_t AbsoluteDifferencesPortable(const std::uint8_t* a, const std::uint8_t* b, int bytes) {
   std::int64_t sum = 0;
   for (int k = 0; k < bytes; ++k) sum += a[k] > b[k] ? a[k] - b[k] : b[k] - a[k];
   return sum;
@@ -610,8 +616,7 @@ void HammingReferences::Distances(const std::uint8_t* query, float* out) const {
   Current().kernel(words, packed_->rows, 0, packed_->rows.blocks, out);
 }
 
-void HammingReferences::DistancesInto(const cv::Mat& queries, cv::Mat1f& out,
-                                      int threads) const {
+void HammingReferences::DistancesInto(const cv::Mat& queries, cv::Mat1f& out, int threads) const {
   if (queries.depth() != CV_8U || queries.cols != bytes_)
     throw std::logic_error("HammingReferences::DistancesInto: queries of another width/type");
   const int n = queries.rows, m = Size();
@@ -667,7 +672,7 @@ constexpr int kTile = kL2Tile;
 constexpr float kCancellation = 1e-3f;
 
 struct L2Operands {
-  cv::Mat a, b;  // continuous rows
+  cv::Mat a, b;               // continuous rows
   std::vector<float> na, nb;  // squared norms
   int Tiles(const cv::Mat& m) const { return (m.rows + kTile - 1) / kTile; }
 };
@@ -749,11 +754,10 @@ cv::Mat1f L2Distances(const cv::Mat& a, const cv::Mat& b, int threads,
   for (int t = 0; t < static_cast<int>(tiles.size()); ++t) total += cells(t);
   // Progress in cells of the whole matrix, of which a symmetric one computes about half.
   const std::int64_t whole = static_cast<std::int64_t>(n) * m;
-  const PairProgress in_cells =
-      progress ? PairProgress([&](std::int64_t done, std::int64_t) {
-        progress(static_cast<std::int64_t>(static_cast<double>(done) / total * whole), whole);
-      })
-               : PairProgress();
+  const PairProgress in_cells = progress ? PairProgress([&](std::int64_t done, std::int64_t) {
+    progress(static_cast<std::int64_t>(static_cast<double>(done) / total * whole), whole);
+  })
+                                         : PairProgress();
   ParallelRows(static_cast<int>(tiles.size()), threads, in_cells, cells, total, [&](int t) {
     const auto [I, J] = tiles[static_cast<size_t>(t)];
     L2Tile(o, I, J, out.ptr<float>(I * kTile) + J * kTile, out.step1());

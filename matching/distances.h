@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
-
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/base/enum_names.h"

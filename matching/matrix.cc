@@ -61,8 +61,8 @@ std::vector<double> MatchingOptions::FusionWeights(int descriptors) const {
   return weights;
 }
 
-cv::Mat1f PairwiseDistances(const cv::Mat& rows, Metric metric, int strips,
-                            PanoramaMatching mode, int threads, const PairProgress& progress) {
+cv::Mat1f PairwiseDistances(const cv::Mat& rows, Metric metric, int strips, PanoramaMatching mode,
+                            int threads, const PairProgress& progress) {
   if (strips > 1) return PanoramaDistances(rows, strips, mode, threads, progress, metric);
   return Distances(rows, cv::Mat(), metric, threads, progress);
 }
@@ -74,8 +74,8 @@ cv::Mat1f PairwiseDistances(const cv::Mat& rows, int strips, PanoramaMatching mo
 
 cv::Mat1f FusedSequenceMatrix(const cv::Mat& rows, Metric metric, int sequence_length,
                               SequenceDirection direction, SequencePartial partial,
-                              const std::vector<int>& traversal_starts, int threads,
-                              float& largest, const std::function<void(int, int)>& progress) {
+                              const std::vector<int>& traversal_starts, int threads, float& largest,
+                              const std::function<void(int, int)>& progress) {
   if (metric == Metric::kL2)
     throw std::logic_error("FusedSequenceMatrix: L2 rows take PairwiseDistances");
   const int n = rows.rows;
@@ -130,8 +130,8 @@ cv::Mat1f NormalizedDistanceMatrix(const cv::Mat& rows, int sequence_length,
   } else {
     d = PairwiseDistances(rows, kind, 1, PanoramaMatching::kAligned, threads);
     if (sequence_length > 1 || direction != SequenceDirection::kForward)
-      SequenceDistancesInPlace(d, sequence_length, traversal_starts, traversal_starts,
-                               direction, threads, partial);
+      SequenceDistancesInPlace(d, sequence_length, traversal_starts, traversal_starts, direction,
+                               threads, partial);
     m = NormalizeByMax(d);
   }
   if (max_distance != nullptr) *max_distance = m;

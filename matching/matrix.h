@@ -3,11 +3,10 @@
 #pragma once
 
 #include <functional>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "matching/agreement.h"
 #include "matching/distances.h"
@@ -22,7 +21,7 @@ namespace openable {
 struct MatchingOptions {
   int sequence_length = 1;  // L: single-frame distances summed along a diagonal, 1..100000
   SequenceDirection direction = SequenceDirection::kForward;  // diagonals, anti-diagonals, both
-  SequencePartial partial = SequencePartial::kAhead;  // cells with fewer than L terms
+  SequencePartial partial = SequencePartial::kAhead;          // cells with fewer than L terms
   PanoramaMatching panorama_matching = PanoramaMatching::kCrossCorrelation;  // panoramic frames
   double threshold = -1.0;  // theta of Eq. 9: -1 (no thresholded matrix) or a number in [0, 1]
   int threads = 0;          // worker threads for description and matching, 0..1024, 0 = all
@@ -73,8 +72,8 @@ cv::Mat1f PairwiseDistances(const cv::Mat& rows, int strips = 1,
 // same way (matching/distances.h). `largest` receives the largest finite sum.
 cv::Mat1f FusedSequenceMatrix(const cv::Mat& rows, Metric metric, int sequence_length,
                               SequenceDirection direction, SequencePartial partial,
-                              const std::vector<int>& traversal_starts, int threads,
-                              float& largest, const std::function<void(int, int)>& progress = {});
+                              const std::vector<int>& traversal_starts, int threads, float& largest,
+                              const std::function<void(int, int)>& progress = {});
 
 // M' of Eq. 5 of a single-camera run: PairwiseDistances (with `metric`, or the rows' type's),
 // the sequence sums of sequence.h over
@@ -83,8 +82,7 @@ cv::Mat1f FusedSequenceMatrix(const cv::Mat& rows, Metric metric, int sequence_l
 cv::Mat1f NormalizedDistanceMatrix(const cv::Mat& rows, int sequence_length,
                                    SequenceDirection direction,
                                    const std::vector<int>& traversal_starts, int threads,
-                                   float* max_distance = nullptr,
-                                   std::optional<Metric> metric = {},
+                                   float* max_distance = nullptr, std::optional<Metric> metric = {},
                                    SequencePartial partial = SequencePartial::kAhead);
 
 }  // namespace openable

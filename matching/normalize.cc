@@ -2,10 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <mutex>
-
-#include <opencv2/core/utility.hpp>
 #include <limits>
+#include <mutex>
+#include <opencv2/core/utility.hpp>
 #include <stdexcept>
 
 namespace openable {

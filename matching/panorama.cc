@@ -29,8 +29,7 @@ cv::Mat1f PanoramaDistances(const cv::Mat& rows, const cv::Mat& references, int 
   if (strips < 1)
     throw std::invalid_argument("PanoramaDistances: " + std::to_string(strips) +
                                 " strips; expected >= 1");
-  if (!references.empty() &&
-      (references.cols != rows.cols || references.type() != rows.type()))
+  if (!references.empty() && (references.cols != rows.cols || references.type() != rows.type()))
     throw std::invalid_argument("PanoramaDistances: references of another width or type");
   if (rows.cols % strips != 0)
     throw std::invalid_argument("PanoramaDistances: row width " + std::to_string(rows.cols) +
@@ -49,9 +48,9 @@ cv::Mat1f PanoramaDistances(const cv::Mat& rows, const cv::Mat& references, int 
   std::vector<cv::Mat> strip(static_cast<size_t>(strips)), ref_strip(strip.size());
   for (int k = 0; k < strips; ++k) {
     strip[static_cast<size_t>(k)] = rows.colRange(k * w, (k + 1) * w).clone();
-    ref_strip[static_cast<size_t>(k)] =
-        references.empty() ? strip[static_cast<size_t>(k)]
-                           : refs.colRange(k * w, (k + 1) * w).clone();
+    ref_strip[static_cast<size_t>(k)] = references.empty()
+                                            ? strip[static_cast<size_t>(k)]
+                                            : refs.colRange(k * w, (k + 1) * w).clone();
   }
 
   // Progress over the strips^2 single-strip matrices.

@@ -22,12 +22,10 @@
 // single-strip distance matrices; the aligned variant costs one.
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <optional>
 
-#include <opencv2/core.hpp>
-
 #include "OpenABLE/base/enum_names.h"
-
 #include "matching/distances.h"
 
 namespace openable {
@@ -40,8 +38,8 @@ OPENABLE_ENUM_NAMES(PanoramaMatching, "aligned", "cross-correlation", "circular"
 // w elements. `threads` as in
 // distances.h (0 = all cores); `progress` counts single-strip matrices (cells). Throws
 // std::invalid_argument when strips < 1 or the row width is not a multiple of strips.
-cv::Mat1f PanoramaDistances(const cv::Mat& rows, int strips, PanoramaMatching mode,
-                            int threads = 0, const PairProgress& progress = {},
+cv::Mat1f PanoramaDistances(const cv::Mat& rows, int strips, PanoramaMatching mode, int threads = 0,
+                            const PairProgress& progress = {},
                             std::optional<Metric> metric = std::nullopt);
 
 // The rows of `rows` (N of them) against those of `references` (M, same width and type; empty:

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <cstdlib>
+#include <numeric>
 
 namespace openable {
 namespace {
@@ -23,8 +23,7 @@ int BestCandidate(const float* distances, int count) {
   return best;
 }
 
-float ScoreOfCandidate(const float* distances, int count, int best, MatchScore score,
-                       int window) {
+float ScoreOfCandidate(const float* distances, int count, int best, MatchScore score, int window) {
   if (score == MatchScore::kDistance) return distances[best];
   float rival = std::numeric_limits<float>::infinity();
   for (int c = 0; c < count; ++c)
@@ -42,8 +41,8 @@ float ScoreOfCandidate(const std::vector<std::pair<float, int>>& candidates, std
   return Ratio(distance, rival);
 }
 
-std::vector<std::size_t> DistinctBest(const std::vector<std::pair<float, int>>& candidates,
-                                      int k, int window) {
+std::vector<std::size_t> DistinctBest(const std::vector<std::pair<float, int>>& candidates, int k,
+                                      int window) {
   std::vector<std::size_t> order;
   order.reserve(candidates.size());
   for (std::size_t i = 0; i < candidates.size(); ++i)

@@ -27,8 +27,7 @@ OPENABLE_ENUM_NAMES(MatchScore, "distance", "ratio")
 
 // The score of candidate `best` of a row of `count` candidate distances (columns 0 .. count-1
 // are the candidates, column = frame of the reference traversal).
-float ScoreOfCandidate(const float* distances, int count, int best, MatchScore score,
-                       int window);
+float ScoreOfCandidate(const float* distances, int count, int best, MatchScore score, int window);
 
 // The same over sparse candidates: (distance, frame) pairs of one query (any order; an
 // approximate search's candidates), candidate `best` an index into `candidates`. Rivals are the
@@ -46,7 +45,7 @@ int BestCandidate(const float* distances, int count);
 // frames next to a candidate show the same place). Returns indices into `candidates`, best
 // first; non-finite distances are never taken. The first is the query's best match
 // (BestCandidate on a dense row).
-std::vector<std::size_t> DistinctBest(const std::vector<std::pair<float, int>>& candidates,
-                                      int k, int window);
+std::vector<std::size_t> DistinctBest(const std::vector<std::pair<float, int>>& candidates, int k,
+                                      int window);
 
 }  // namespace openable

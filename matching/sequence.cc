@@ -19,7 +19,8 @@ void CheckTraversalStarts(const std::vector<int>& starts, int n, const char* wha
     if (v <= prev || v < 0 || (prev < 0 && v != 0) || (n > 0 && v >= n))
       throw std::logic_error(std::string(what) + ": " + std::to_string(v) +
                              " is not valid; expected first frames increasing from 0 and below "
-                             "the " + std::to_string(n) + " frames");
+                             "the " +
+                             std::to_string(n) + " frames");
     prev = v;
   }
 }
@@ -122,11 +123,10 @@ void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, 
       float* keep = &ring[static_cast<size_t>(i % R) * m];
       const float* old = &ring[static_cast<size_t>((i + 1) % R) * m];  // row i - L
       const int ti = i - rows.first[static_cast<size_t>(i)];  // steps back within i's traversal
-      SumRow(row, keep, old, prev.data(), cur.data(), c0, c1, ti, L, reverse, partial,
-             [&](int j) {
-               return reverse ? cols.last[static_cast<size_t>(j)] - j
-                              : j - cols.first[static_cast<size_t>(j)];
-             });
+      SumRow(row, keep, old, prev.data(), cur.data(), c0, c1, ti, L, reverse, partial, [&](int j) {
+        return reverse ? cols.last[static_cast<size_t>(j)] - j
+                       : j - cols.first[static_cast<size_t>(j)];
+      });
       if (c0 == 0) {
         const auto now = std::chrono::steady_clock::now();
         if (now - last_check >= std::chrono::milliseconds(50)) {
@@ -155,16 +155,15 @@ void Sweep(cv::Mat1f& d, int L, const Traversals& rows, const Traversals& cols, 
 }
 
 // FillAheadCells on known traversals.
-void FillAhead(cv::Mat1f& s, int L, const Traversals& rows, const Traversals& cols,
-               bool reverse) {
+void FillAhead(cv::Mat1f& s, int L, const Traversals& rows, const Traversals& cols, bool reverse) {
   if (L <= 1) return;
   const int n = s.rows, m = s.cols;
   // Columns that can go fewer than L - 1 steps back: the first L - 1 of each traversal along
   // diagonals, the last L - 1 along anti-diagonals.
   std::vector<int> edge;
   for (int j = 0; j < m; ++j) {
-    const int tj = reverse ? cols.last[static_cast<size_t>(j)] - j
-                           : j - cols.first[static_cast<size_t>(j)];
+    const int tj =
+        reverse ? cols.last[static_cast<size_t>(j)] - j : j - cols.first[static_cast<size_t>(j)];
     if (tj < L - 1) edge.push_back(j);
   }
   const float inf = std::numeric_limits<float>::infinity();
@@ -197,8 +196,7 @@ void FillAheadCells(cv::Mat1f& s, int sequence_length, const std::vector<int>& r
             Bounds(col_starts, s.cols, "column"), reverse);
 }
 
-void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length,
-                              const std::vector<int>& row_starts,
+void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length, const std::vector<int>& row_starts,
                               const std::vector<int>& col_starts, SequenceDirection direction,
                               int threads, SequencePartial partial) {
   if (sequence_length < 1) throw std::logic_error("SequenceDistances: sequence length < 1");
@@ -225,9 +223,8 @@ void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length,
 }
 
 cv::Mat1f SequenceDistances(const cv::Mat1f& d, int sequence_length,
-                            const std::vector<int>& row_starts,
-                            const std::vector<int>& col_starts, SequenceDirection direction,
-                            int threads, SequencePartial partial) {
+                            const std::vector<int>& row_starts, const std::vector<int>& col_starts,
+                            SequenceDirection direction, int threads, SequencePartial partial) {
   cv::Mat1f out = LargeMatrix(d.rows, d.cols);
   d.copyTo(out);
   SequenceDistancesInPlace(out, sequence_length, row_starts, col_starts, direction, threads,
@@ -240,8 +237,7 @@ float SequenceCellDistance(const cv::Mat& queries, int q, const cv::Mat& referen
                            SequencePartial partial) {
   int steps_back = std::min(q, reverse ? references.rows - 1 - j : j);
   if (partial == SequencePartial::kAhead && steps_back < sequence_length - 1) {
-    const int steps_forward =
-        std::min(queries.rows - 1 - q, reverse ? j : references.rows - 1 - j);
+    const int steps_forward = std::min(queries.rows - 1 - q, reverse ? j : references.rows - 1 - j);
     const int shift = AheadShift(sequence_length, steps_back, steps_forward);
     if (shift < 0) return std::numeric_limits<float>::infinity();
     q += shift;
@@ -257,7 +253,6 @@ float SequenceCellDistance(const cv::Mat& queries, int q, const cv::Mat& referen
   }
   return ScaleSequenceSum(sum, terms, sequence_length, partial);
 }
-
 
 SequenceRowSums::SequenceRowSums(int sequence_length, SequencePartial partial)
     : length_(sequence_length), partial_(partial) {
@@ -278,7 +273,8 @@ void SequenceRowSums::Push(float* d, int columns, const std::vector<int>& col_st
     extends = col_starts[k] >= columns_;
   if (rows_ > 0 && (!grows || !extends))
     throw std::logic_error("SequenceRowSums::Push: " + std::to_string(columns) + " columns after " +
-                           std::to_string(columns_) + ", or other traversals; expected as many "
+                           std::to_string(columns_) +
+                           ", or other traversals; expected as many "
                            "columns or one more, and the same traversals (Restart first)");
   CheckTraversalStarts(col_starts, columns + 1, "SequenceRowSums: column starts");
   if (rows_ == 0) columns_ = 0;
@@ -300,8 +296,8 @@ void SequenceRowSums::Push(float* d, int columns, const std::vector<int>& col_st
   const std::vector<float>& old = ring_[static_cast<size_t>((i + 1) % R)];
   keep.resize(static_cast<size_t>(columns));
   cur_.resize(static_cast<size_t>(columns));
-  SumRow(d, keep.data(), old.data(), prev_.data(), cur_.data(), 0, columns, i, L, false,
-         partial_, [&](int j) { return j - first_[static_cast<size_t>(j)]; });
+  SumRow(d, keep.data(), old.data(), prev_.data(), cur_.data(), 0, columns, i, L, false, partial_,
+         [&](int j) { return j - first_[static_cast<size_t>(j)]; });
   std::swap(prev_, cur_);
   columns_ = columns;
   ++rows_;

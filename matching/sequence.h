@@ -33,9 +33,8 @@
 #pragma once
 
 #include <limits>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "OpenABLE/base/enum_names.h"
 
@@ -64,8 +63,7 @@ inline int SequenceTerms(int sequence_length, int steps_back) {
 // rounded to float, or +inf for a partial sum with kSkip and kAhead (kAhead then replaces the
 // cell by AheadShift's): how every sequence distance is finished, in the matrix sweep below
 // and in SequenceCellDistance.
-inline float ScaleSequenceSum(double sum, int terms, int sequence_length,
-                              SequencePartial partial) {
+inline float ScaleSequenceSum(double sum, int terms, int sequence_length, SequencePartial partial) {
   if (terms == sequence_length) return static_cast<float>(sum);
   if (partial != SequencePartial::kScale) return std::numeric_limits<float>::infinity();
   return static_cast<float>(sum * sequence_length / terms);
@@ -105,8 +103,7 @@ float SequenceCellDistance(const cv::Mat& queries, int q, const cv::Mat& referen
 class SequenceRowSums {
  public:
   // Throws std::logic_error when L < 1 or `partial` is kAhead.
-  explicit SequenceRowSums(int sequence_length,
-                        SequencePartial partial = SequencePartial::kScale);
+  explicit SequenceRowSums(int sequence_length, SequencePartial partial = SequencePartial::kScale);
   // The next row pushed is the first of a new query traversal.
   void Restart();
   // Row Rows() of the query traversal: `d` holds D(q, j) for the columns 0 .. columns - 1 and
@@ -143,15 +140,13 @@ void SequenceDistancesInPlace(cv::Mat1f& d, int sequence_length,
                               const std::vector<int>& row_starts = {},
                               const std::vector<int>& col_starts = {},
                               SequenceDirection direction = SequenceDirection::kForward,
-                              int threads = 0,
-                              SequencePartial partial = SequencePartial::kAhead);
+                              int threads = 0, SequencePartial partial = SequencePartial::kAhead);
 
 // The same, returning S in a new matrix and leaving D as it is.
 cv::Mat1f SequenceDistances(const cv::Mat1f& d, int sequence_length,
                             const std::vector<int>& row_starts = {},
                             const std::vector<int>& col_starts = {},
                             SequenceDirection direction = SequenceDirection::kForward,
-                            int threads = 0,
-                            SequencePartial partial = SequencePartial::kAhead);
+                            int threads = 0, SequencePartial partial = SequencePartial::kAhead);
 
 }  // namespace openable

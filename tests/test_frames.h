@@ -1,13 +1,13 @@
 // Frames of ../shared/datasets that several tests read.
 #pragma once
 
-#include <cstdio>
-#include <string>
-#include <vector>
-
 #include <gtest/gtest.h>
+
+#include <cstdio>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
 
 #include "tests/test_support.h"
 

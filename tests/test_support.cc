@@ -1,17 +1,16 @@
 #include "tests/test_support.h"
 
-#include <fstream>
-
-#include "OpenABLE/base/error.h"
+#include <unistd.h>
 
 #include <atomic>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <vector>
 
-#include <unistd.h>
+#include "OpenABLE/base/error.h"
 
 namespace fs = std::filesystem;
 

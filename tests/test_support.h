@@ -2,12 +2,12 @@
 // shared datasets are absent.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <functional>
 #include <initializer_list>
 #include <string>
-
-#include <gtest/gtest.h>
 
 namespace openable::testing {
 
@@ -68,7 +68,7 @@ std::string OpenableMapExe();
 }  // namespace openable::testing
 
 // Skips the current test with a message when `path` does not exist.
-#define OPENABLE_REQUIRE_PATH(path)                                                        \
-  do {                                                                                     \
-    if (!std::filesystem::exists(path)) GTEST_SKIP() << "dataset absent: " << (path);      \
+#define OPENABLE_REQUIRE_PATH(path)                                                   \
+  do {                                                                                \
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "dataset absent: " << (path); \
   } while (0)

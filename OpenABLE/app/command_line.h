@@ -58,8 +58,7 @@ std::string ParseCommandLine(int argc, const char* const* argv, const std::strin
                              CommandLine& out, const ProgramOptions& options);
 // The same with the program's own value options alone.
 std::string ParseCommandLine(int argc, const char* const* argv, const std::string& program,
-                             CommandLine& out,
-                             const std::vector<std::string>& value_options = {});
+                             CommandLine& out, const std::vector<std::string>& value_options = {});
 
 // Prints every key (or those of `group`, ConfigHelpText) on stdout and returns 0, or prints
 // the one-line error for an unknown group on stderr and returns 2 (a usage error).

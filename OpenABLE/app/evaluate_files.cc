@@ -158,8 +158,8 @@ std::string ParseEvaluateCommandLine(int argc, const char* const* argv, Evaluate
                       "references) or auto (the default: by its shape and --reference-frames)");
       }
     } else if (!out.config_path.empty()) {  // --config, after a file or another --config
-      return refuse("more than one configuration file (\"" + out.config_path + "\" and \"" +
-                    value + "\"); expected one");
+      return refuse("more than one configuration file (\"" + out.config_path + "\" and \"" + value +
+                    "\"); expected one");
     } else {
       out.config_path = value;
     }
@@ -183,7 +183,7 @@ bool SameFile(const std::string& a, const std::string& b) {
 EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line) {
   // The settings the matrices remember (matrix_settings.h) come first, then the configuration
   // file's keys and the command line's, which override them (and are said to).
-  Remembered remembered;  // key: its value, the settings file it came from
+  Remembered remembered;        // key: its value, the settings file it came from
   std::set<std::string> given;  // keys the command line sets
   for (const auto& o : command_line.overrides) given.insert(Trim(o.substr(0, o.find('='))));
   int reference_frames = command_line.reference_frames;
@@ -198,7 +198,8 @@ EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line) {
     if (saved->thresholded)
       throw InputError("--matrix " + Quoted(m.path) +
                        ": holds the thresholded matrix M'' of Eq. 9, not distances (" +
-                       saved->path + "); expected a distance matrix (Npy_name, or Txt_name "
+                       saved->path +
+                       "); expected a distance matrix (Npy_name, or Txt_name "
                        "without Threshold)");
     for (const auto& [key, value] : saved->keys) {
       const auto known = remembered.find(key);
@@ -226,8 +227,7 @@ EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line) {
   if (!command_line.config_path.empty()) config = LoadConfig(command_line.config_path, config);
   for (const auto& o : command_line.overrides) ApplyOverride(config, o);
   if (!EvaluationRequested(config))
-    throw InputError("Ground_truth_type: not set; expected --gt-type " +
-                     GroundTruthFormatList());
+    throw InputError("Ground_truth_type: not set; expected --gt-type " + GroundTruthFormatList());
   CheckEvaluationConfig(config);
   CheckOutputPrefix("Evaluation_name", config.evaluation.name);
   EvaluatedFiles out;
@@ -249,15 +249,17 @@ EvaluatedFiles EvaluateFiles(const EvaluateCommandLine& command_line) {
       applied += (applied.empty() ? "" : ", ") + key + " " + plain;
   }
   if (!remembered.empty())
-    out.notes.insert(out.notes.begin(),
-                     "evaluated with the settings the matrix's run had (" +
-                         remembered.begin()->second.second + ")" +
-                         (applied.empty() ? "" : ": " + applied));
+    out.notes.insert(out.notes.begin(), "evaluated with the settings the matrix's run had (" +
+                                            remembered.begin()->second.second + ")" +
+                                            (applied.empty() ? "" : ": " + applied));
   if (command_line.query_reference && reference_frames > 0)
-    throw InputError("--layout query_reference: the matrix is queries x references as a whole, "
-                     "but --reference-frames (or its run's settings) says it holds two traversals "
-                     "of " + std::to_string(reference_frames) + " reference frames; expected one "
-                     "of them");
+    throw InputError(
+        "--layout query_reference: the matrix is queries x references as a whole, "
+        "but --reference-frames (or its run's settings) says it holds two traversals "
+        "of " +
+        std::to_string(reference_frames) +
+        " reference frames; expected one "
+        "of them");
   out.matrices = EvaluateMatrixFiles(out.evaluation, command_line.matrices, reference_frames,
                                      command_line.query_reference);
   return out;

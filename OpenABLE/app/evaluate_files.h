@@ -26,8 +26,8 @@ struct EvaluateCommandLine {
 
 // Parses argv. Returns an empty string, or one line ("openable_evaluate: ... (see --help)")
 // naming the bad argument: an unknown option, a missing value, --label before any --matrix, a
-// bad --reference-frames or --layout, or no --matrix. --help, --help-keys and --version end the parsing
-// (answered whatever follows, as before any other argument is read).
+// bad --reference-frames or --layout, or no --matrix. --help, --help-keys and --version end the
+// parsing (answered whatever follows, as before any other argument is read).
 std::string ParseEvaluateCommandLine(int argc, const char* const* argv, EvaluateCommandLine& out);
 
 // The configuration of the command line, checked, and each matrix evaluated

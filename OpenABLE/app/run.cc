@@ -1,20 +1,20 @@
 #include "OpenABLE/app/run.h"
-#include "OpenABLE/base/output_batch.h"
-#include "OpenABLE/outputs/run_outputs.h"
 
 #include <algorithm>
 #include <chrono>
-#include <optional>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
+#include "OpenABLE/base/output_batch.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/version.h"
 #include "OpenABLE/cluster/cluster.h"
 #include "OpenABLE/evaluation/metrics.h"
 #include "OpenABLE/evaluation/report.h"
+#include "OpenABLE/outputs/run_outputs.h"
 
 namespace openable {
 namespace {
@@ -126,8 +126,7 @@ RunOutcome Run(const Config& base, ProgressReporter& progress,
     chosen = &out.automatic->config;
     if (!out.automatic->reliable)
       log("warning: Auto: no candidate is consistent enough to be trusted (the best confirms " +
-          FormatFixed(100.0 * out.automatic->candidates[out.automatic->chosen].figures
-                                  .consistency,
+          FormatFixed(100.0 * out.automatic->candidates[out.automatic->chosen].figures.consistency,
                       1) +
           " % of its best matches, Auto_min_consistency " +
           FormatNumber(100.0 * base.automatic.min_consistency) +
@@ -146,8 +145,7 @@ RunOutcome Run(const Config& base, ProgressReporter& progress,
   // Process 0 evaluates, verifies and writes; the others have given it their shares.
   if (cluster.Distributed() && cluster.Rank() != 0) return out;
   RunResult& result = out.result;
-  for (const std::string& note : UnwrittenOutputNotes(config, result))
-    result.notes.push_back(note);
+  for (const std::string& note : UnwrittenOutputNotes(config, result)) result.notes.push_back(note);
   if (const std::string w = NoCandidateWarning(config, result); !w.empty())
     result.warnings.push_back(w);
   if (out.automatic && !out.automatic->reliable && result.accepted_queries > 0)
@@ -155,8 +153,7 @@ RunOutcome Run(const Config& base, ProgressReporter& progress,
   for (const std::string& w : result.warnings) log("warning: " + w);
   for (const std::string& note : result.notes) log("note: " + note);
   if (config.verification.enabled) {
-    out.verification =
-        std::make_unique<RunVerification>(VerifyRun(config, result, progress));
+    out.verification = std::make_unique<RunVerification>(VerifyRun(config, result, progress));
     result.timings.total_seconds += out.verification->seconds;
   }
   if (out.evaluation && result.bounded) {

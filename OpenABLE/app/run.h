@@ -4,11 +4,10 @@
 
 #include <functional>
 #include <memory>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <nlohmann/json_fwd.hpp>
 
 #include "OpenABLE/base/progress.h"
 #include "OpenABLE/run/evaluate.h"
@@ -25,8 +24,8 @@ struct RunOutcome {
   // the run went on with.
   std::unique_ptr<AutoChoice> automatic;
   std::unique_ptr<RunVerification> verification;  // when Verification is 1
-  std::unique_ptr<Evaluation> evaluation;  // when Ground_truth_type is set (not bounded)
-  std::vector<std::string> written;        // the paths of the outputs
+  std::unique_ptr<Evaluation> evaluation;         // when Ground_truth_type is set (not bounded)
+  std::vector<std::string> written;               // the paths of the outputs
 };
 
 // Checks the evaluation settings, chooses the settings from the data when Auto is 1
@@ -40,7 +39,6 @@ struct RunOutcome {
 // the key, file or value.
 RunOutcome Run(const Config& config, ProgressReporter& progress,
                const std::function<void(const std::string&)>& log);
-
 
 // The report Test_OpenABLE prints at the end: descriptor and camera, traversals, mode and
 // matrix, the auto mode's candidates and choice, timings, the evaluation table, the files

@@ -184,8 +184,7 @@ std::string EncodeRunJson(const Config& config, const RunOutcome& outcome) {
   o["threshold_cells_below"] =
       r.thresholded.empty()
           ? Json()
-          : Json(r.thresholded.total() -
-                 static_cast<std::size_t>(cv::countNonZero(r.thresholded)));
+          : Json(r.thresholded.total() - static_cast<std::size_t>(cv::countNonZero(r.thresholded)));
   o["accepted"] = Json();
   if (r.accepted_queries >= 0)
     o["accepted"] = {{"queries", r.accepted_queries},

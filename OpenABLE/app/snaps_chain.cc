@@ -1,7 +1,5 @@
 #include "OpenABLE/app/snaps_chain.h"
 
-#include "OpenABLE/run/verify.h"
-
 #include <chrono>
 #include <map>
 #include <memory>
@@ -15,6 +13,7 @@
 #include "OpenABLE/odometry/mono_odometry.h"
 #include "OpenABLE/odometry/stereo_odometry.h"
 #include "OpenABLE/run/pipeline.h"
+#include "OpenABLE/run/verify.h"
 #include "OpenABLE/snaps/discounted.h"
 #include "OpenABLE/stereo/calibration.h"
 #include "OpenABLE/stereo/rectification.h"
@@ -121,8 +120,8 @@ Trajectory ComputeOdometry(const Config& c, const Trajectory* truth, ProgressRep
   double baseline = 0;
   std::unique_ptr<StereoRectifier> rectifier;
   if (!in.calibration_path.empty()) {
-    const StereoCalibration calibration = WithKey(
-        "Calibration_path", [&] { return LoadStereoCalibration(in.calibration_path); });
+    const StereoCalibration calibration =
+        WithKey("Calibration_path", [&] { return LoadStereoCalibration(in.calibration_path); });
     const cv::Size size = GrayOf(left.front()).size();
     CheckCalibrationFits(calibration, size, in.calibration_path);
     rectifier = std::make_unique<StereoRectifier>(calibration, size);
@@ -184,7 +183,7 @@ Config OpenableRunOf(const Config& c) {
     run.input.bag_path_2.clear();
   } else {
     run.input.frame_mode = FrameMode::kImageFolders;
-    run.input.images_path = !c.snaps.images.empty()       ? c.snaps.images
+    run.input.images_path = !c.snaps.images.empty()        ? c.snaps.images
                             : !c.input.images_path.empty() ? c.input.images_path
                                                            : c.input.images_path_left;
   }
@@ -272,8 +271,8 @@ ChainResult RunChain(const Config& c, ProgressReporter& progress,
         std::vector<FrameMatch> answers;
         for (const QueryVerification& q : verification.queries)
           if (q.answer >= 0)
-            answers.push_back({q.query, q.candidates[q.answer].reference,
-                               q.candidates[q.answer].distance});
+            answers.push_back(
+                {q.query, q.candidates[q.answer].reference, q.candidates[q.answer].distance});
         MatrixLoopOptions by = MatrixLoops(c);
         by.frame_times = run.traversals.front().times;
         r.loops_by_time = !by.frame_times.empty() && !r.input.timestamps.empty();
@@ -308,14 +307,13 @@ ChainResult RunChain(const Config& c, ProgressReporter& progress,
   r.loop_seconds = Seconds(t);
   say(std::to_string(r.loops.size()) + " loop pairs (" + EnumName(s.loops) + ")" +
       (r.pairs.associated == 0 ? std::string()
-       : r.loops_by_time
-           ? ", " + std::to_string(r.pairs.associated) +
-                 " pairs associated by time to the nearest pose within " +
-                 FormatNumber(s.time_tolerance) + " s"
-           : ", " + std::to_string(r.pairs.associated) +
-                 " pairs associated to the nearest pose within +-" +
-                 std::to_string(s.keyframe_tolerance) +
-                 (s.keyframe_tolerance == 1 ? " frame" : " frames")) +
+       : r.loops_by_time       ? ", " + std::to_string(r.pairs.associated) +
+                               " pairs associated by time to the nearest pose within " +
+                               FormatNumber(s.time_tolerance) + " s"
+                         : ", " + std::to_string(r.pairs.associated) +
+                               " pairs associated to the nearest pose within +-" +
+                               std::to_string(s.keyframe_tolerance) +
+                               (s.keyframe_tolerance == 1 ? " frame" : " frames")) +
       (r.pairs.dropped > 0 ? ", " + std::to_string(r.pairs.dropped) +
                                  " pairs with a frame that is not a pose dropped"
                            : std::string()) +

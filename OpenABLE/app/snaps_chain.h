@@ -7,10 +7,9 @@
 #pragma once
 
 #include <functional>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json_fwd.hpp>
 
 #include "OpenABLE/base/progress.h"
 #include "OpenABLE/snaps/loop_search.h"
@@ -38,11 +37,11 @@ struct ChainErrors {
 
 // Everything one run of the chain produced.
 struct ChainResult {
-  Trajectory input;              // the trajectory corrected (read, or computed by odometry)
-  std::string trajectory_name;   // its file, or "mono odometry" / "stereo odometry"
-  bool computed = false;         // the trajectory came from the odometry front-end
+  Trajectory input;             // the trajectory corrected (read, or computed by odometry)
+  std::string trajectory_name;  // its file, or "mono odometry" / "stereo odometry"
+  bool computed = false;        // the trajectory came from the odometry front-end
   OdometryReport odometry;
-  bool evaluated = false;        // a ground truth was given
+  bool evaluated = false;  // a ground truth was given
   Trajectory truth;
   std::vector<int> association;  // index in `truth` of each pose of `input`
   std::vector<LoopPair> loops;   // indices of `input`
@@ -54,13 +53,13 @@ struct ChainResult {
   // or (pairs file) outside the trajectory; `loops` is what remains after MiddleOfRuns (pairs)
   // or one loop per query pose (matrix).
   PairCounts pairs;
-  double loop_seconds = 0;       // finding or reading the loops
-  ImageSearchResult searched;    // Snaps_loops search: the online search and its latencies
-  bool discounted_ran = false;   // Snaps_corrector discounted or both
+  double loop_seconds = 0;      // finding or reading the loops
+  ImageSearchResult searched;   // Snaps_loops search: the online search and its latencies
+  bool discounted_ran = false;  // Snaps_corrector discounted or both
   Trajectory discounted;
   std::vector<LoopPair> closed;  // the loops the discounted update closed
   double discounted_seconds = 0;
-  bool graph_ran = false;        // Snaps_corrector pose-graph or both
+  bool graph_ran = false;  // Snaps_corrector pose-graph or both
   Trajectory graph;
   PoseGraphReport graph_report;
   std::vector<ChainErrors> errors;  // with a ground truth: input, then each correction

@@ -20,13 +20,10 @@ std::string Number(double v) { return FormatNumber(v); }
 Json JsonNumber(double v) { return json::Number(v, 6); }
 
 Json StatsJson(const LatencyStats& s) {
-  return {{"count", s.count},
-          {"mean_s", JsonNumber(s.mean)},
-          {"min_s", JsonNumber(s.min)},
-          {"q1_s", JsonNumber(s.q1)},
-          {"median_s", JsonNumber(s.median)},
-          {"q3_s", JsonNumber(s.q3)},
-          {"max_s", JsonNumber(s.max)}};
+  return {
+      {"count", s.count},          {"mean_s", JsonNumber(s.mean)},     {"min_s", JsonNumber(s.min)},
+      {"q1_s", JsonNumber(s.q1)},  {"median_s", JsonNumber(s.median)}, {"q3_s", JsonNumber(s.q3)},
+      {"max_s", JsonNumber(s.max)}};
 }
 
 Json ErrorJson(const TrajectoryError& e) {
@@ -38,10 +35,9 @@ Json ErrorJson(const TrajectoryError& e) {
 
 std::string StatsLine(const LatencyStats& s) {
   char b[200];
-  std::snprintf(b, sizeof b,
-                "%6d  mean %9.3f ms  [min %.3f, q1 %.3f, median %.3f, q3 %.3f, max %.3f] ms",
-                s.count, s.mean * 1e3, s.min * 1e3, s.q1 * 1e3, s.median * 1e3, s.q3 * 1e3,
-                s.max * 1e3);
+  std::snprintf(
+      b, sizeof b, "%6d  mean %9.3f ms  [min %.3f, q1 %.3f, median %.3f, q3 %.3f, max %.3f] ms",
+      s.count, s.mean * 1e3, s.min * 1e3, s.q1 * 1e3, s.median * 1e3, s.q3 * 1e3, s.max * 1e3);
   return b;
 }
 
@@ -66,8 +62,8 @@ SearchLatencies LatenciesOf(const ImageSearchResult& searched) {
     all.push_back(s.seconds);
     (s.loop ? found : none).push_back(s.seconds);
   }
-  return {Summarize(none), Summarize(found), Summarize(all),
-          Summarize(searched.correction_seconds), Summarize(searched.thumbnail_seconds)};
+  return {Summarize(none), Summarize(found), Summarize(all), Summarize(searched.correction_seconds),
+          Summarize(searched.thumbnail_seconds)};
 }
 
 // Snaps_loops pairs, matrix and openable: what became of the pairs of the file, or of the
@@ -86,8 +82,7 @@ std::string PairCountsLine(const Config& c, const ChainResult& r) {
   else if (r.verified_loops)
     o << "verified loops: " << n.Total() << " queries answered by geometric verification: ";
   else
-    o << "matrix: " << n.Total() << " matches below " << Number(c.snaps.matrix_threshold)
-      << ": ";
+    o << "matrix: " << n.Total() << " matches below " << Number(c.snaps.matrix_threshold) << ": ";
   o << n.on_poses << " on keyframes, " << n.associated;
   if (r.loops_by_time)
     o << " associated by time (frames of a bag, Snaps_time_tolerance "
@@ -170,19 +165,18 @@ std::string FormatChainReport(const Config& c, const ChainResult& r) {
         << (r.odometry.failed ? ", first " + r.odometry.first_failure : std::string())
         << "\n  odometry per frame " << StatsLine(Summarize(r.odometry.seconds))
         << " (paper: 0.295 s per frame with loop closure)\n";
-  out << "  loops: " << r.loops.size() << " pairs from " << source << " ("
-      << Number(r.loop_seconds) << " s)";
+  out << "  loops: " << r.loops.size() << " pairs from " << source << " (" << Number(r.loop_seconds)
+      << " s)";
   if (r.discounted_ran)
-    out << "; discounted update closes " << r.closed.size() << " (pause "
-        << s.search.discount.pause << ", K " << s.search.discount.discount_length << ")";
+    out << "; discounted update closes " << r.closed.size() << " (pause " << s.search.discount.pause
+        << ", K " << s.search.discount.discount_length << ")";
   out << "\n";
   if (HasPairCounts(c)) out << "  " << PairCountsLine(c, r) << "\n";
   if (r.graph_ran)
     out << "  pose graph: " << r.graph_report.loop_edges << " loop edges, "
-        << r.graph_report.iterations << " iterations, cost "
-        << Number(r.graph_report.initial_cost) << " -> " << Number(r.graph_report.final_cost)
-        << ", " << Number(r.graph_report.seconds) << " s"
-        << (r.graph_report.converged ? "" : " (not converged: max iterations)") << "\n";
+        << r.graph_report.iterations << " iterations, cost " << Number(r.graph_report.initial_cost)
+        << " -> " << Number(r.graph_report.final_cost) << ", " << Number(r.graph_report.seconds)
+        << " s" << (r.graph_report.converged ? "" : " (not converged: max iterations)") << "\n";
   if (r.evaluated) {
     out << "Absolute trajectory error against \"" << s.ground_truth << "\" (metres):\n"
         << "  trajectory      mean dev.      RMSE       max   | aligned: mean dev.   RMSE\n";
@@ -288,8 +282,8 @@ std::vector<std::string> WriteChainOutputs(const Config& c, const ChainResult& r
     plot.corrected_label = label;
     plot.loops = r.loops;
     plot.axes = EnumName(c.snaps.axes);
-    plot.title = "SNAPS, " + std::to_string(r.loops.size()) + " loops (" +
-                 EnumName(c.snaps.loops) + "): " +
+    plot.title = "SNAPS, " + std::to_string(r.loops.size()) + " loops (" + EnumName(c.snaps.loops) +
+                 "): " +
                  (r.computed ? r.trajectory_name
                              : std::filesystem::path(c.snaps.trajectory).filename().string());
     return EncodePng(RenderTrajectories(plot));

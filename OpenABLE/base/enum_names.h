@@ -19,10 +19,10 @@
 
 // Declares the names of the values of `Enum`, in order, in Enum's namespace (found by
 // argument-dependent lookup).
-#define OPENABLE_ENUM_NAMES(Enum, ...)                                          \
-  inline const std::vector<std::string_view>& OpenableEnumNames(Enum) {         \
-    static const std::vector<std::string_view> names{__VA_ARGS__};              \
-    return names;                                                               \
+#define OPENABLE_ENUM_NAMES(Enum, ...)                                  \
+  inline const std::vector<std::string_view>& OpenableEnumNames(Enum) { \
+    static const std::vector<std::string_view> names{__VA_ARGS__};      \
+    return names;                                                       \
   }
 
 namespace openable {

@@ -121,7 +121,8 @@ void* Load(const std::string& name) {
     reasons += std::string("; ") + (why != nullptr ? why : "unknown dlopen error");
   }
   throw InputError("OpenABLE module " + Quoted(file) + " cannot be loaded (searched " + searched +
-                   reasons + "; expected it beside the build or installation of OpenABLE, or in "
+                   reasons +
+                   "; expected it beside the build or installation of OpenABLE, or in "
                    "a folder of OPENABLE_MODULE_PATH)");
 }
 

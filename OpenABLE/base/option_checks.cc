@@ -7,8 +7,7 @@
 
 namespace openable {
 
-void RefuseOption(const std::string& name, const std::string& value,
-                  const std::string& expected) {
+void RefuseOption(const std::string& name, const std::string& value, const std::string& expected) {
   throw InputError(name + ": " + value + " is not valid; expected " + expected);
 }
 

@@ -20,7 +20,6 @@ void CheckIntAtLeast(const std::string& name, long long value, long long lo);
 void CheckNumberRange(const std::string& name, double value, double lo, double hi);
 // Refuses `value` unless finite and value >= lo, or value > lo when `lo_excluded`
 // ("a number >= lo", "a number > lo").
-void CheckNumberAtLeast(const std::string& name, double value, double lo,
-                        bool lo_excluded = false);
+void CheckNumberAtLeast(const std::string& name, double value, double lo, bool lo_excluded = false);
 
 }  // namespace openable

@@ -1,9 +1,9 @@
 #include "OpenABLE/base/program.h"
 
+#include <malloc.h>
+
 #include <exception>
 #include <iostream>
-
-#include <malloc.h>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"

@@ -8,8 +8,8 @@
 namespace openable {
 
 inline constexpr int kExitSuccess = 0;
-inline constexpr int kExitInputError = 1;  // bad configuration, input data or output path
-inline constexpr int kExitUsageError = 2;  // bad command line
+inline constexpr int kExitInputError = 1;     // bad configuration, input data or output path
+inline constexpr int kExitUsageError = 2;     // bad command line
 inline constexpr int kExitInternalError = 3;  // a bug: a broken internal precondition
 
 // Runs `body` and returns its status; an InputError becomes one line

@@ -1,10 +1,10 @@
 #include "OpenABLE/base/progress.h"
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <ostream>
 #include <utility>
-
-#include <unistd.h>
 
 namespace openable {
 
@@ -22,8 +22,7 @@ ProgressReporter::~ProgressReporter() {
   if (pending_) out_ << "\r\x1b[K" << std::flush;
 }
 
-void ProgressReporter::Begin(const std::string& what, std::int64_t total,
-                             const std::string& unit) {
+void ProgressReporter::Begin(const std::string& what, std::int64_t total, const std::string& unit) {
   what_ = what;
   unit_ = unit;
   total_ = total;
@@ -52,9 +51,9 @@ void ProgressReporter::Print(std::int64_t done, bool final) {
   const double elapsed = std::chrono::duration<double>(clock_() - start_).count();
   char line[256];
   const double percent = total_ > 0 ? 100.0 * static_cast<double>(done) / total_ : 100.0;
-  int n = std::snprintf(line, sizeof line, "  %-11s %lld/%lld %s (%3.0f%%)  %.1f s",
-                        what_.c_str(), static_cast<long long>(done),
-                        static_cast<long long>(total_), unit_.c_str(), percent, elapsed);
+  int n = std::snprintf(line, sizeof line, "  %-11s %lld/%lld %s (%3.0f%%)  %.1f s", what_.c_str(),
+                        static_cast<long long>(done), static_cast<long long>(total_), unit_.c_str(),
+                        percent, elapsed);
   if (!final && done > 0 && done < total_) {
     const double left = elapsed * static_cast<double>(total_ - done) / static_cast<double>(done);
     n += std::snprintf(line + n, sizeof line - n, ", about %.0f s left", left);

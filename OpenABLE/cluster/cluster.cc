@@ -103,9 +103,9 @@ void Cluster::Agree(const std::function<void()>& step) {
   for (int r = 0; r < size_; ++r) {
     const std::int64_t n = sizes[static_cast<size_t>(r)];
     if (n > 0 && all[static_cast<size_t>(off)] != 0)
-      throw ClusterFailure(std::string(all.begin() + off + 1, all.begin() + off + n) + " (" +
-                               Name(r) + ")",
-                           all[static_cast<size_t>(off)] == 1);
+      throw ClusterFailure(
+          std::string(all.begin() + off + 1, all.begin() + off + n) + " (" + Name(r) + ")",
+          all[static_cast<size_t>(off)] == 1);
     off += n;
   }
 }
@@ -140,8 +140,7 @@ std::vector<char> Cluster::GatherToFirst(const std::vector<char>& mine,
   return Gather(mine, 0, sizes);
 }
 
-void Cluster::GatherInto(const char* mine, std::int64_t bytes, char* into,
-                         std::int64_t capacity) {
+void Cluster::GatherInto(const char* mine, std::int64_t bytes, char* into, std::int64_t capacity) {
   bool ok = true;
   if (!Distributed()) {
     ok = bytes == capacity;

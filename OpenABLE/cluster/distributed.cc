@@ -104,7 +104,8 @@ DescribedSequence DescribeShared(Cluster& cluster, const FrameSource& source,
     if (row_bytes > 0) std::memcpy(block.data, p, row_bytes);
     p += row_bytes;
     if (s.rows > 0) blocks.push_back(block);
-    const std::vector<int> kept = FromBytes<int>(p, s.kept * static_cast<std::int64_t>(sizeof(int)));
+    const std::vector<int> kept =
+        FromBytes<int>(p, s.kept * static_cast<std::int64_t>(sizeof(int)));
     p += s.kept * static_cast<std::int64_t>(sizeof(int));
     out.kept.insert(out.kept.end(), kept.begin(), kept.end());
     const std::string first_name = ReadString(p);
@@ -117,8 +118,8 @@ DescribedSequence DescribeShared(Cluster& cluster, const FrameSource& source,
       size_frame = first_name;
     } else if (frame != out.frame_size) {
       throw InputError(std::string(options.key.empty() ? "" : options.key + ": ") + "image \"" +
-                       first_name + "\" is " + SizeText(frame) + " but \"" + size_frame +
-                       "\" is " + SizeText(out.frame_size) +
+                       first_name + "\" is " + SizeText(frame) + " but \"" + size_frame + "\" is " +
+                       SizeText(out.frame_size) +
                        " (expected the frames of one sequence to have one size)");
     }
   }
@@ -133,9 +134,8 @@ DescribedSequence DescribeShared(Cluster& cluster, const FrameSource& source,
   return out;
 }
 
-cv::Mat1f DistanceRows(const cv::Mat& rows, int row_first, int row_last, Metric metric,
-                       int strips, PanoramaMatching mode, int threads,
-                       const PairProgress& progress) {
+cv::Mat1f DistanceRows(const cv::Mat& rows, int row_first, int row_last, Metric metric, int strips,
+                       PanoramaMatching mode, int threads, const PairProgress& progress) {
   if (row_first == 0 && row_last == rows.rows)
     return PairwiseDistances(rows, metric, strips, mode, threads, progress);
   if (row_last <= row_first) return cv::Mat1f(0, rows.rows);  // a process with no rows
@@ -183,8 +183,7 @@ cv::Mat1f GatherRows(Cluster& cluster, const cv::Mat1f& mine, int n, int cols) {
   if (cluster.Rank() == 0 && !out.isContinuous())
     throw std::logic_error("GatherRows: the matrix is not one block");
   cluster.GatherInto(reinterpret_cast<const char*>(rows.data), bytes,
-                     cluster.Rank() == 0 ? reinterpret_cast<char*>(out.data) : nullptr,
-                     capacity);
+                     cluster.Rank() == 0 ? reinterpret_cast<char*>(out.data) : nullptr, capacity);
   return out;
 }
 
@@ -197,9 +196,7 @@ std::vector<Match> SharedBoundedMatches(Cluster& cluster, const MatchBlock& bloc
   }
   std::vector<Match> mine;
   float largest = 0.0f;
-  cluster.Agree([&] {
-    mine = match_share(options, largest);
-  });
+  cluster.Agree([&] { mine = match_share(options, largest); });
   if (!cluster.Distributed()) {
     max_distance = largest;
     return mine;

@@ -4,9 +4,8 @@
 #pragma once
 
 #include <functional>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "OpenABLE/cluster/cluster.h"
 #include "OpenABLE/describe/describe.h"
@@ -28,9 +27,8 @@ DescribedSequence DescribeShared(Cluster& cluster, const FrameSource& source,
 
 // The single-frame distance matrix, what PairwiseDistances gives, for rows
 // [row_first, row_last) only: those rows against every row.
-cv::Mat1f DistanceRows(const cv::Mat& rows, int row_first, int row_last, Metric metric,
-                       int strips, PanoramaMatching mode, int threads,
-                       const PairProgress& progress);
+cv::Mat1f DistanceRows(const cv::Mat& rows, int row_first, int row_last, Metric metric, int strips,
+                       PanoramaMatching mode, int threads, const PairProgress& progress);
 
 // The rows of this process in a dense run of `n` frames: [first, last), and the rows of the
 // single-frame matrix it computes, [history, last), history = first - (L - 1) (the sequences

@@ -2,10 +2,9 @@
 
 #include <algorithm>
 #include <mutex>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <stdexcept>
-
-#include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/module_loader.h"
@@ -60,9 +59,9 @@ int LearnFromSource(const FrameSource& source, const FrameDescriber& describer,
     } catch (const InputError&) {
     }
   });
-  images.erase(std::remove_if(images.begin(), images.end(),
-                              [](const cv::Mat& m) { return m.empty(); }),
-               images.end());
+  images.erase(
+      std::remove_if(images.begin(), images.end(), [](const cv::Mat& m) { return m.empty(); }),
+      images.end());
   describer.Learn(images);
   return static_cast<int>(images.size());
 }
@@ -70,8 +69,8 @@ int LearnFromSource(const FrameSource& source, const FrameDescriber& describer,
 DescribedSequence DescribeSequence(const FrameSource& source, const FrameDescriber& describer,
                                    const DescribeOptions& options,
                                    const std::function<void(int, int)>& progress) {
-  return std::move(DescribeSequences(source, {&describer}, {options.cache}, options, progress)
-                       .front());
+  return std::move(
+      DescribeSequences(source, {&describer}, {options.cache}, options, progress).front());
 }
 
 std::vector<DescribedSequence> DescribeSequences(
@@ -106,9 +105,8 @@ std::vector<DescribedSequence> DescribeSequences(
     std::lock_guard<std::mutex> lock(mutex);
     if (!first_size) first_size = size, first_size_frame = source.FrameName(i);
     if (size != *first_size) {
-      const std::string message = "image \"" + source.FrameName(i) + "\" is " +
-                                  SizeText(size) + " but \"" + first_size_frame +
-                                  "\" is " + SizeText(*first_size) +
+      const std::string message = "image \"" + source.FrameName(i) + "\" is " + SizeText(size) +
+                                  " but \"" + first_size_frame + "\" is " + SizeText(*first_size) +
                                   " (expected the frames of one sequence to have one size)";
       if (i < error_index) error_index = i, error_message = message;
       return false;
@@ -157,7 +155,7 @@ std::vector<DescribedSequence> DescribeSequences(
       describer.Describe(image, rows[static_cast<size_t>(k)].row(i));
       if (caches[static_cast<size_t>(k)] != nullptr && use_caches)
         caches[static_cast<size_t>(k)]->Store(source, i, rows[static_cast<size_t>(k)].row(i),
-                                             frame.size());
+                                              frame.size());
     }
     ok[i] = 1;
   };
@@ -176,15 +174,14 @@ std::vector<DescribedSequence> DescribeSequences(
         p.clear();
       }
       if (frames.empty()) continue;
-      cv::Mat described(static_cast<int>(frames.size()), describer.RowWidth(),
-                        describer.RowType());
+      cv::Mat described(static_cast<int>(frames.size()), describer.RowWidth(), describer.RowType());
       describer.DescribePatches(patches, described);
       for (size_t r = 0; r < frames.size(); ++r) {
         const int i = frames[r];
         described.row(static_cast<int>(r)).copyTo(rows[static_cast<size_t>(k)].row(i));
         if (caches[static_cast<size_t>(k)] != nullptr && use_caches)
           caches[static_cast<size_t>(k)]->Store(source, i, rows[static_cast<size_t>(k)].row(i),
-                                               read_sizes[static_cast<size_t>(i)]);
+                                                read_sizes[static_cast<size_t>(i)]);
       }
     }
   };

@@ -3,10 +3,9 @@
 #pragma once
 
 #include <functional>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/image/preprocess.h"
 #include "OpenABLE/io/frame_source.h"
@@ -19,19 +18,22 @@ namespace openable {
 // The distance the rows of `d` are compared with (its DistanceKind as a matching Metric).
 inline Metric MetricOf(const Descriptor& d) {
   switch (d.Distance()) {
-    case DistanceKind::kHamming: return Metric::kHamming;
-    case DistanceKind::kL2: return Metric::kL2;
-    case DistanceKind::kL1: break;
+    case DistanceKind::kHamming:
+      return Metric::kHamming;
+    case DistanceKind::kL2:
+      return Metric::kL2;
+    case DistanceKind::kL1:
+      break;
   }
   return Metric::kL1;
 }
 
 // Descriptors of every frame of a source, and what was skipped.
 struct DescribedSequence {
-  cv::Mat rows;                          // one row per kept frame
-  std::vector<int> kept;                 // source index of each row
-  std::vector<std::string> skipped;      // names of frames that could not be read (skip mode)
-  cv::Size frame_size;                   // size of the frames of this source
+  cv::Mat rows;                      // one row per kept frame
+  std::vector<int> kept;             // source index of each row
+  std::vector<std::string> skipped;  // names of frames that could not be read (skip mode)
+  cv::Size frame_size;               // size of the frames of this source
 };
 
 // Rows kept from earlier runs (descriptor_cache.h). Both calls are made from several threads.
@@ -42,8 +44,7 @@ class RowCache {
   // `source` is cached; false otherwise (also when the frame's file cannot be read).
   virtual bool Lookup(const FrameSource& source, int i, cv::Mat row, cv::Size* frame_size) = 0;
   // Keeps the row of frame i, described from a frame of `frame_size`.
-  virtual void Store(const FrameSource& source, int i, const cv::Mat& row,
-                     cv::Size frame_size) = 0;
+  virtual void Store(const FrameSource& source, int i, const cv::Mat& row, cv::Size frame_size) = 0;
 };
 
 struct DescribeOptions {
@@ -57,7 +58,7 @@ struct DescribeOptions {
   // conversion (seeded from noise.seed, noise_stream and the frame's index), the grey image or
   // Eq. 6's, side-window fusion of it.
   PreprocessOptions preprocess;
-  int noise_stream = 0;          // traversal index: 0 Images_path, 1 Images_path_2
+  int noise_stream = 0;  // traversal index: 0 Images_path, 1 Images_path_2
   // `source` is a share of a traversal (a run spread over processes, OpenABLE/cluster/cluster.h):
   // its frame 0 is frame `share_first` of the traversal (the noise of a frame is seeded from
   // that index), and a share whose frames are all skipped is not an error here (the run checks

@@ -2,11 +2,10 @@
 #include "OpenABLE/evaluation/drawing.h"
 
 #include <algorithm>
-#include <string>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 namespace openable::drawing {
 
@@ -62,11 +61,10 @@ void PutVerticalText(cv::Mat3b& img, const std::string& text, cv::Point centre, 
   const cv::Rect clipped = where & cv::Rect(0, 0, img.cols, img.rows);
   if (clipped.empty()) return;
   cv::Mat target = img(clipped);
-  const cv::Mat source = rotated(cv::Rect(clipped.x - where.x, clipped.y - where.y,
-                                            clipped.width, clipped.height));
+  const cv::Mat source =
+      rotated(cv::Rect(clipped.x - where.x, clipped.y - where.y, clipped.width, clipped.height));
   cv::min(target, source, target);  // dark text over whatever is there (white)
 }
-
 
 void DrawLegend(cv::Mat3b& img, const cv::Rect& plot, const std::vector<LegendEntry>& entries,
                 LegendCorner corner) {

@@ -3,11 +3,10 @@
 // Okabe-Ito palette, a framed legend box).
 #pragma once
 
-#include <string>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 namespace openable::drawing {
 
@@ -20,8 +19,8 @@ inline const cv::Scalar kFrameGrey(160, 160, 160);
 // Okabe-Ito, BGR: blue, orange, bluish green, vermillion, reddish purple, sky blue, black,
 // yellow (yellow last: it is the weakest on white).
 inline const cv::Scalar kPalette[] = {
-    {178, 114, 0}, {0, 159, 230}, {115, 158, 0},  {0, 94, 213},
-    {167, 121, 204}, {233, 180, 86}, {0, 0, 0}, {66, 228, 240},
+    {178, 114, 0},   {0, 159, 230},  {115, 158, 0}, {0, 94, 213},
+    {167, 121, 204}, {233, 180, 86}, {0, 0, 0},     {66, 228, 240},
 };
 inline constexpr int kPaletteSize = static_cast<int>(sizeof(kPalette) / sizeof(kPalette[0]));
 
@@ -54,7 +53,7 @@ struct LegendEntry {
   std::string label;   // shortened with "..." when the box would not fit in the plot area
   std::string suffix;  // " (AUC 0.612)", kept whole
   cv::Scalar colour;
-  int thickness = 2;   // of the line sample
+  int thickness = 2;  // of the line sample
 };
 
 enum class LegendCorner { kLowerLeft, kUpperLeft, kUpperRight, kLowerRight };

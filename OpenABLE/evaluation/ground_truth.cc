@@ -6,13 +6,13 @@
 #include <charconv>
 #include <cmath>
 #include <cstddef>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -23,10 +23,10 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
-#include "OpenABLE/evaluation/text_parsing.h"
 #include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/evaluation/pairs_file.h"
 #include "OpenABLE/evaluation/pose_file.h"
+#include "OpenABLE/evaluation/text_parsing.h"
 #include "OpenABLE/io/npy.h"
 #include "OpenABLE/io/npy_objects.h"
 
@@ -127,9 +127,9 @@ std::vector<FramePose> PosesByTime(const std::string& path, GroundTruthType type
   poses.reserve(times.size());
   for (std::size_t i = 0; i < times.size(); ++i) {
     // Timestamps increase (ReadPoseFile checks it): the nearest is beside the first >= t.
-    const auto after = std::lower_bound(
-        lines.begin(), lines.end(), times[i],
-        [](const FramePose& line, double t) { return line.time < t; });
+    const auto after =
+        std::lower_bound(lines.begin(), lines.end(), times[i],
+                         [](const FramePose& line, double t) { return line.time < t; });
     auto nearest = after == lines.end() ? after - 1 : after;
     if (after != lines.begin() && after != lines.end() &&
         times[i] - (after - 1)->time < after->time - times[i])
@@ -344,9 +344,8 @@ std::vector<FramePose> ReadPositions(const std::string& path, const char* label)
       position_count = v.size();
       position_line = line.number;
     } else if (v.size() != position_count) {
-      throw InputError(at + ": line has " + count + "; expected " +
-                       std::to_string(position_count) + " like the first position (line " +
-                       std::to_string(position_line) + ")");
+      throw InputError(at + ": line has " + count + "; expected " + std::to_string(position_count) +
+                       " like the first position (line " + std::to_string(position_line) + ")");
     }
     pose.position = Eigen::Vector3d(v[0], v[1], v.size() == 3 ? v[2] : 0.0);
     pose.line = line.number;
@@ -390,7 +389,6 @@ void LoadAligned(const GroundTruthOptions&, const EvaluationLayout& layout, int,
   }
 }
 
-
 // VPR-Bench's ground_truth_new.npy: an object array, row q = [query index, the indices of
 // its true references] (a list, tuple, range or integer array). The row's position is the
 // query, as performance_comparison.py reads it (ground_truth_info[query][1]); indices count
@@ -398,8 +396,7 @@ void LoadAligned(const GroundTruthOptions&, const EvaluationLayout& layout, int,
 std::int64_t IntegerOf(const PyValue& v, bool* ok) {
   *ok = true;
   if (v.kind == PyValue::Kind::kInt || v.kind == PyValue::Kind::kBool) return v.integer;
-  if (v.kind == PyValue::Kind::kFloat && std::floor(v.real) == v.real &&
-      std::fabs(v.real) < 9.0e15)
+  if (v.kind == PyValue::Kind::kFloat && std::floor(v.real) == v.real && std::fabs(v.real) < 9.0e15)
     return static_cast<std::int64_t>(v.real);
   *ok = false;
   return 0;
@@ -430,9 +427,8 @@ void LoadVprBench(const GroundTruthOptions& o, const EvaluationLayout& layout, i
   if (queries >= 0 && queries < (limits.values - 1) / (2 + listed))
     limits.values = 1 + queries * (2 + listed);
   limits.range = std::min(limits.range, listed);
-  limits.expected = std::to_string(queries) + " queries listing at most " +
-                    std::to_string(listed) + " reference indices each: the " +
-                    std::to_string(first + layout.references) +
+  limits.expected = std::to_string(queries) + " queries listing at most " + std::to_string(listed) +
+                    " reference indices each: the " + std::to_string(first + layout.references) +
                     " reference frames up to the run's last, and 64 more";
   const NpyObjects gt_file = DecodeNpyObjects(bytes, where, limits);
   const bool pairs = gt_file.shape.size() == 2 && gt_file.shape[1] == 2;
@@ -499,9 +495,8 @@ void CheckTutorialSize(std::int64_t rows, std::int64_t cols, const std::string& 
                        const EvaluationLayout& layout, const GroundTruthOptions& o) {
   if (rows != layout.references || cols != layout.queries)
     throw InputError(what + ": " + std::to_string(rows) + "x" + std::to_string(cols) +
-                     " (database x queries); expected " + std::to_string(layout.references) +
-                     "x" + std::to_string(layout.queries) + ": the " +
-                     std::to_string(layout.references) +
+                     " (database x queries); expected " + std::to_string(layout.references) + "x" +
+                     std::to_string(layout.queries) + ": the " + std::to_string(layout.references) +
                      " reference frames (rows, VPR_Tutorial's database) by the " +
                      std::to_string(layout.queries) + " queries" +
                      (o.first_frame > 0 || o.range_selected
@@ -527,8 +522,8 @@ std::optional<cv::Mat1f> TutorialMatrix(const TutorialFile& f, const std::string
       if (std::find(names.begin(), names.end(), wanted) == names.end()) return std::nullopt;
     }
     NpzLimit limit;
-    const auto cells = static_cast<std::uint64_t>(layout.references) *
-                       static_cast<std::uint64_t>(layout.queries);
+    const auto cells =
+        static_cast<std::uint64_t>(layout.references) * static_cast<std::uint64_t>(layout.queries);
     limit.bytes = 65536 + 8 * cells;
     limit.expected = "a " + std::to_string(layout.references) + "x" +
                      std::to_string(layout.queries) +
@@ -564,13 +559,13 @@ void LoadVprTutorial(const GroundTruthOptions& o, const EvaluationLayout& layout
         "Ground_truth_type: vpr_tutorial needs two traversals (Images_path_2 or Frame_mode 2): "
         "its matrices are the database (reference traversal) by the queries");
   const TutorialFile file = ReadTutorialFile(o.path, "VPR_Tutorial ground truth");
-  TutorialCells(*TutorialMatrix(file, "GThard", true, file.where, layout, o), file.where, layout,
-                o, &gt->matches);
+  TutorialCells(*TutorialMatrix(file, "GThard", true, file.where, layout, o), file.where, layout, o,
+                &gt->matches);
   // GTsoft: Ground_truth_soft, else the archive's own when it has one.
   std::optional<cv::Mat1f> soft_matrix;
   const std::string& soft_path = o.soft_path;
-  const std::string soft_what = "VPR_Tutorial soft ground truth " +
-                                Quoted(soft_path.empty() ? o.path : soft_path);
+  const std::string soft_what =
+      "VPR_Tutorial soft ground truth " + Quoted(soft_path.empty() ? o.path : soft_path);
   if (!soft_path.empty()) {
     soft_matrix = TutorialMatrix(ReadTutorialFile(soft_path, "VPR_Tutorial soft ground truth"),
                                  "GTsoft", true, soft_what, layout, o);
@@ -618,21 +613,19 @@ const std::vector<GroundTruthFormat>& GroundTruthFormats() {
   static const std::vector<GroundTruthFormat> formats = {
       {"matrix", "a binary matrix: 0/1 text, an image (non-zero = same place) or .npy",
        "ground truth matrix file", true, false, nullptr, false, false, &LoadMatrix},
-      {"pairs", "a list of pairs row,col (CSV or whitespace)", "ground truth pairs", true,
-       false, nullptr, false, false, &LoadPairs},
+      {"pairs", "a list of pairs row,col (CSV or whitespace)", "ground truth pairs", true, false,
+       nullptr, false, false, &LoadPairs},
       {"aligned", "two traversals frame by frame: query i is reference i (no file)",
        "aligned traversals", false, true, nullptr, false, false, &LoadAligned},
-      {"kitti", "KITTI poses: 12 numbers per line, a 3x4 camera-to-world matrix",
-       "KITTI poses", true, false, &ReadKittiPoses, true, false, nullptr},
-      {"tum", "a TUM trajectory: timestamp tx ty tz qx qy qz qw per line", "TUM trajectory",
-       true, false, &ReadTumPoses, true, true, nullptr},
-      {"positions", "positions x,y[,z] per line (no orientation)", "positions", true,
-       false, &ReadPositions, false, false, nullptr},
-      {"vpr_bench",
-       "VPR-Bench's ground_truth_new.npy: per query, the list of its true references",
+      {"kitti", "KITTI poses: 12 numbers per line, a 3x4 camera-to-world matrix", "KITTI poses",
+       true, false, &ReadKittiPoses, true, false, nullptr},
+      {"tum", "a TUM trajectory: timestamp tx ty tz qx qy qz qw per line", "TUM trajectory", true,
+       false, &ReadTumPoses, true, true, nullptr},
+      {"positions", "positions x,y[,z] per line (no orientation)", "positions", true, false,
+       &ReadPositions, false, false, nullptr},
+      {"vpr_bench", "VPR-Bench's ground_truth_new.npy: per query, the list of its true references",
        "VPR-Bench ground truth", true, true, nullptr, false, false, &LoadVprBench},
-      {"vpr_tutorial",
-       "VPR_Tutorial's GThard (database x queries, .npy, or GT.npz with GTsoft)",
+      {"vpr_tutorial", "VPR_Tutorial's GThard (database x queries, .npy, or GT.npz with GTsoft)",
        "VPR_Tutorial ground truth", true, true, nullptr, false, false, &LoadVprTutorial},
   };
   return formats;
@@ -658,7 +651,8 @@ void GroundTruthOptions::Check() const {
   if (!soft_path.empty() && type != GroundTruthType::kVprTutorial)
     throw InputError("Ground_truth_soft: " + Quoted(soft_path) +
                      " is VPR_Tutorial's soft ground truth; expected Ground_truth_type "
-                     "vpr_tutorial (it is " + GroundTruthTypeName(type) + "), or an empty value");
+                     "vpr_tutorial (it is " +
+                     GroundTruthTypeName(type) + "), or an empty value");
   if (base < -1 || base > 1) {
     throw InputError("Ground_truth_base: " + std::to_string(base) +
                      " is not valid; expected -1 (from a comment of the file), 0 or 1");
@@ -676,10 +670,13 @@ void GroundTruthOptions::Check() const {
       heading_limit >= 0) {
     std::string oriented;
     for (const GroundTruthFormat& f : GroundTruthFormats())
-      if (f.read_poses && f.orientations) oriented += std::string(oriented.empty() ? "" : " or ") + f.name;
-    throw InputError("Ground_truth_heading: " + FormatNumber(heading_limit) + " needs orientations, but " +
-                     type.Format().label + " have no orientation; expected -1 (no limit), or "
-                     "Ground_truth_type " + oriented);
+      if (f.read_poses && f.orientations)
+        oriented += std::string(oriented.empty() ? "" : " or ") + f.name;
+    throw InputError("Ground_truth_heading: " + FormatNumber(heading_limit) +
+                     " needs orientations, but " + type.Format().label +
+                     " have no orientation; expected -1 (no limit), or "
+                     "Ground_truth_type " +
+                     oriented);
   }
 }
 

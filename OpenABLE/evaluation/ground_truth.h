@@ -3,13 +3,12 @@
 // traversals, or poses / positions per frame (evaluation.md, "Ground truth inputs").
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "OpenABLE/evaluation/layout.h"
 
@@ -75,22 +74,22 @@ std::string GroundTruthTypeName(GroundTruthType type);
 
 struct GroundTruthOptions {
   GroundTruthType type = GroundTruthType::kNone;
-  std::string path;        // the file (matrix, pairs; poses of the reference or only sequence)
-  std::string path_2;      // poses of the query traversal (pose types, two traversals)
-  std::string soft_path;   // vpr_tutorial: GTsoft (.npy); "" = the GTsoft of a .npz, or none
-  int base = -1;           // pairs: 0- or 1-based indices; -1 = from a header comment that says
-                           // "0-based" or "1-based", else 0
-  int first_frame = 0;     // frame number of row 0 (Initial_image): pair indices and pose lines
-                           // count from the start of the source, rows from first_frame
+  std::string path;       // the file (matrix, pairs; poses of the reference or only sequence)
+  std::string path_2;     // poses of the query traversal (pose types, two traversals)
+  std::string soft_path;  // vpr_tutorial: GTsoft (.npy); "" = the GTsoft of a .npz, or none
+  int base = -1;          // pairs: 0- or 1-based indices; -1 = from a header comment that says
+                          // "0-based" or "1-based", else 0
+  int first_frame = 0;    // frame number of row 0 (Initial_image): pair indices and pose lines
+                          // count from the start of the source, rows from first_frame
   bool range_selected = false;  // the run processes part of its source (Initial_image > 0 or
                                 // Final_image != -1): pairs outside it are dropped, not errors
-  double radius = 5.0;     // poses: a pair is a loop when the positions are closer than this
-                           // (same unit as the file, metres for KITTI), > 0
+  double radius = 5.0;          // poses: a pair is a loop when the positions are closer than this
+                                // (same unit as the file, metres for KITTI), > 0
   double heading_limit = -1.0;  // poses: and when the viewing directions differ by less than
                                 // this many degrees (-1 = no limit); needs orientations
-  int min_frame_gap = 100;  // poses, loop closure: only pairs with q - j >= min_frame_gap
-  std::string axes = "xyz";  // poses: axes of the distance and heading: "xyz" (3D), "xz" (the
-                             // ground plane of KITTI's camera frame), "xy"
+  int min_frame_gap = 100;      // poses, loop closure: only pairs with q - j >= min_frame_gap
+  std::string axes = "xyz";     // poses: axes of the distance and heading: "xyz" (3D), "xz" (the
+                                // ground plane of KITTI's camera frame), "xy"
   // tum with frames that carry times (ROS bags): the time of each frame of the reference (or
   // only) traversal and of the query traversal, in seconds; a frame takes the pose with the
   // nearest timestamp, within time_tolerance seconds. Empty: pose line i is frame i.
@@ -120,7 +119,7 @@ struct FramePose {
   Eigen::Vector3d forward = Eigen::Vector3d::Zero();
   bool has_forward = false;
   double time = std::numeric_limits<double>::quiet_NaN();  // formats with timestamps
-  int line = 0;  // the line of the file
+  int line = 0;                                            // the line of the file
 };
 
 // Reads a file of a pose format (kitti, tum, positions: Format().read_poses). Throws

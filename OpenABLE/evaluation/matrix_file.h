@@ -1,9 +1,8 @@
 // Reading matrices saved by OpenABLE or given as ground truth.
 #pragma once
 
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace openable {
 

@@ -5,11 +5,10 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <stdexcept>
-#include <string>
-
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <string>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
@@ -27,9 +26,8 @@ void CheckShapes(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                            " x " + std::to_string(matrix.cols) + " matrix");
   }
   if (static_cast<int>(truth.matches.size()) != layout.queries) {
-    throw std::logic_error("evaluation: ground truth has " +
-                           std::to_string(truth.matches.size()) + " queries, layout " +
-                           std::to_string(layout.queries));
+    throw std::logic_error("evaluation: ground truth has " + std::to_string(truth.matches.size()) +
+                           " queries, layout " + std::to_string(layout.queries));
   }
   if (layout.kind == EvaluationLayout::Kind::kLoopClosure && layout.queries != layout.references)
     throw std::logic_error("evaluation: a loop-closure layout must be square");
@@ -37,8 +35,7 @@ void CheckShapes(const cv::Mat1f& matrix, const EvaluationLayout& layout,
 
 // True matches of q among its candidates (matches are sorted, so this is a prefix).
 std::vector<int> CandidateTruth(const std::vector<int>& matches, int end) {
-  return std::vector<int>(matches.begin(),
-                          std::lower_bound(matches.begin(), matches.end(), end));
+  return std::vector<int>(matches.begin(), std::lower_bound(matches.begin(), matches.end(), end));
 }
 
 // Whether column c lies within `tolerance` of a sorted list of true columns.
@@ -164,8 +161,8 @@ void Summarize(PerQueryResult& r, const std::vector<std::uint8_t>& has_candidate
       else
         ++p.fp;
     }
-    p.precision = p.tp + p.fp > 0 ? static_cast<double>(p.tp) / static_cast<double>(p.tp + p.fp)
-                                  : 1.0;
+    p.precision =
+        p.tp + p.fp > 0 ? static_cast<double>(p.tp) / static_cast<double>(p.tp + p.fp) : 1.0;
     p.recall = positives > 0 ? static_cast<double>(p.tp) / positives : 0.0;
     p.f1 = F1(p.precision, p.recall);
   }
@@ -252,8 +249,7 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
       if (t.empty()) continue;
       r.correct[q] = NearTruth(t, r.best[q], options.tolerance) ? 1 : 0;
       correct_at_n[q] = HitsAtN(
-          t, static_cast<int>(top.size()), [&](int n) { return top[n].second; },
-          options.tolerance);
+          t, static_cast<int>(top.size()), [&](int n) { return top[n].second; }, options.tolerance);
     }
   });
 
@@ -374,8 +370,7 @@ AblePResult EvaluateAbleP(const cv::Mat1f& matrix, const EvaluationLayout& layou
   return result;
 }
 
-bool AnyCandidateHasValue(const cv::Mat1f& matrix, const EvaluationLayout& layout,
-                          int exclusion) {
+bool AnyCandidateHasValue(const cv::Mat1f& matrix, const EvaluationLayout& layout, int exclusion) {
   for (int q = 0; q < layout.queries; ++q) {
     const float* row = matrix.ptr<float>(layout.row_offset + q) + layout.col_offset;
     const int end = layout.CandidateEnd(q, exclusion);
@@ -407,8 +402,7 @@ double ReversedAuc(const cv::Mat1f& matrix, const EvaluationLayout& layout,
   return EvaluatePerQuery(block, own, truth, plain).auc;
 }
 
-std::vector<std::string> EvaluationWarnings(const cv::Mat1f& matrix,
-                                            const EvaluationLayout& layout,
+std::vector<std::string> EvaluationWarnings(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                                             const GroundTruth& truth,
                                             const EvaluationOptions& options,
                                             const PerQueryResult& result) {

@@ -4,10 +4,9 @@
 #pragma once
 
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/layout.h"
@@ -54,8 +53,8 @@ struct CurvePoint {
 };
 
 struct PerQueryResult {
-  int queries = 0;            // queries with at least one candidate
-  int positive_queries = 0;   // of those, queries with a true match among their candidates
+  int queries = 0;           // queries with at least one candidate
+  int positive_queries = 0;  // of those, queries with a true match among their candidates
   // Of the queries, those whose candidates are all non-finite (sequence cells skipped at the
   // start of a traversal): they give no answer, and a positive one lowers recall.
   int unanswered = 0;
@@ -151,8 +150,7 @@ double ReversedAuc(const cv::Mat1f& matrix, const EvaluationLayout& layout,
 // among its candidates (the figures are 0 whatever the matrix), no query has a candidate with a
 // value (every candidate cell +inf), and a ranking that looks reversed (above). `result` is
 // EvaluatePerQuery's on the same matrix, layout, truth and options.
-std::vector<std::string> EvaluationWarnings(const cv::Mat1f& matrix,
-                                            const EvaluationLayout& layout,
+std::vector<std::string> EvaluationWarnings(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                                             const GroundTruth& truth,
                                             const EvaluationOptions& options,
                                             const PerQueryResult& result);

@@ -62,7 +62,8 @@ PairsFile ReadPairsFile(const std::string& path, int base, const std::string& wh
     out.pairs.push_back({raw[0] - base, raw[1] - base, line.number});
   });
   if (out.pairs.empty())
-    throw InputError(out.where + ": holds no pair; expected one pair of frame indices \"a,b\" "
+    throw InputError(out.where +
+                     ": holds no pair; expected one pair of frame indices \"a,b\" "
                      "per line (an empty ground truth would give figures of 0)");
   return out;
 }

@@ -19,14 +19,14 @@ struct PairsFile {
     // The two frame numbers, 0-based (the base subtracted): negative for a number below the
     // base, which the caller refuses with the range it expects.
     std::int64_t a = 0, b = 0;
-    int line = 0;               // line of the file, from 1
+    int line = 0;  // line of the file, from 1
   };
   std::vector<Pair> pairs;  // in file order
   int base = 0;             // the base the file was read with
   // How the base was chosen, for messages: " (1-based, as a comment says)", " (0-based,
   // Ground_truth_base)", " (0-based; set Ground_truth_base to 1 if the file counts from 1)".
   std::string base_note;
-  std::string where;        // `what` and the path, as messages name the file
+  std::string where;  // `what` and the path, as messages name the file
   // The first line, when it was read as a header and skipped (text_parsing.h's rule), and its
   // number; 0 and "" when the file has none. Reports say so: no line is dropped unsaid.
   int header_line = 0;

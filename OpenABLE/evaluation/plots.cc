@@ -14,21 +14,19 @@
 // The figure is max(k cols, 600) wide; a white legend strip (one or more 30 px lines) is below.
 #include "OpenABLE/evaluation/plots.h"
 
-#include "OpenABLE/evaluation/drawing.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include "OpenABLE/base/strings.h"
+#include "OpenABLE/evaluation/drawing.h"
 
 namespace openable {
 namespace {
@@ -37,9 +35,9 @@ using drawing::DrawLegend;
 using drawing::Ellipsize;
 using drawing::FitBold;
 using drawing::kBlack;
+using drawing::kGridGrey;
 using drawing::kPalette;
 using drawing::kPaletteSize;
-using drawing::kGridGrey;
 using drawing::LegendEntry;
 using drawing::PutText;
 using drawing::PutVerticalText;
@@ -109,8 +107,8 @@ void DrawAxes(cv::Mat3b& img, const Axes& axes, const std::string& panel_title) 
   // Axis labels.
   const double label_scale = 0.6;
   const cv::Size recall_size = TextSize("Recall", label_scale, 1);
-  PutText(img, "Recall", {left + r.width / 2 - recall_size.width / 2, bottom + 48}, label_scale,
-          1, kBlack);
+  PutText(img, "Recall", {left + r.width / 2 - recall_size.width / 2, bottom + 48}, label_scale, 1,
+          kBlack);
   PutVerticalText(img, "Precision", {left - 58, top + r.height / 2}, label_scale, 1);
   // Panel title, centred over the plot area.
   double title_scale = 0;
@@ -247,8 +245,7 @@ cv::Mat3b OverlayLegend(int width, bool truth, bool verification) {
   std::vector<std::pair<int, int>> where;
   int line = 0, x = margin;
   for (const Item& item : all) {
-    const int w =
-        (item.swatch ? swatch + swatch_gap : 0) + TextSize(item.text, scale, 1).width;
+    const int w = (item.swatch ? swatch + swatch_gap : 0) + TextSize(item.text, scale, 1).width;
     if (x > margin && x + w > width - margin) {
       ++line;
       x = margin;
@@ -303,8 +300,8 @@ void DrawOverlayAxes(cv::Mat3b& img, int rows, int cols, int k) {
     PutText(img, label, {left - 8 - w, y + text_h / 2}, scale, 1, kBlack);
   }
   const int title_w = TextSize("reference frame", scale, 1).width;
-  PutText(img, "reference frame", {left + (std::min(cols * k, 600) - title_w) / 2, 13}, scale,
-          1, kBlack);
+  PutText(img, "reference frame", {left + (std::min(cols * k, 600) - title_w) / 2, 13}, scale, 1,
+          kBlack);
   PutVerticalText(img, "query frame", {9, top + std::min(rows * k, 600) / 2}, scale, 1);
 }
 
@@ -324,11 +321,10 @@ cv::Mat3b DrawOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
   if (rows <= 0 || cols <= 0 || layout.row_offset < 0 || layout.col_offset < 0 ||
       layout.row_offset + rows > matrix.rows || layout.col_offset + cols > matrix.cols) {
     throw std::logic_error("RenderOverlay: the layout's block (" + std::to_string(rows) + " x " +
-                           std::to_string(cols) + " at row " +
-                           std::to_string(layout.row_offset) + ", column " +
-                           std::to_string(layout.col_offset) + ") is not inside the " +
-                           std::to_string(matrix.rows) + " x " + std::to_string(matrix.cols) +
-                           " matrix");
+                           std::to_string(cols) + " at row " + std::to_string(layout.row_offset) +
+                           ", column " + std::to_string(layout.col_offset) +
+                           ") is not inside the " + std::to_string(matrix.rows) + " x " +
+                           std::to_string(matrix.cols) + " matrix");
   }
   const cv::Mat1f block = matrix(cv::Rect(layout.col_offset, layout.row_offset, cols, rows));
 
@@ -358,8 +354,8 @@ cv::Mat3b DrawOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
   const int k = std::max(1, (kOverlayTarget + std::max(rows, cols) - 1) / std::max(rows, cols));
   const int image_w = cols * k, image_h = rows * k;
   const int left = kOverlayAxisLeft, top = kOverlayAxisTop;
-  const cv::Mat3b legend = OverlayLegend(left + std::max(image_w, kOverlayTarget),
-                                         truth != nullptr, rejected != nullptr);
+  const cv::Mat3b legend = OverlayLegend(left + std::max(image_w, kOverlayTarget), truth != nullptr,
+                                         rejected != nullptr);
   cv::Mat3b whole(top + image_h + legend.rows, legend.cols, cv::Vec3b(255, 255, 255));
   DrawOverlayAxes(whole, rows, cols, k);
   // The block's pixels: `img` is a view of them, so that marks are placed in cell units.
@@ -383,8 +379,7 @@ cv::Mat3b DrawOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
   if (rejected != nullptr)  // first, so that an answer at the same cell stays visible
     for (const cv::Point& cell : *rejected) {
       if (cell.x < 0 || cell.x >= cols || cell.y < 0 || cell.y >= rows) continue;
-      img(cv::Rect(cell.x * k - grow, cell.y * k - grow, k + 2 * grow, k + 2 * grow) &
-          image_area)
+      img(cv::Rect(cell.x * k - grow, cell.y * k - grow, k + 2 * grow, k + 2 * grow) & image_area)
           .setTo(kRejected);
     }
   marks(img, k, grow);
@@ -418,8 +413,7 @@ cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
         // below its threshold); else those with a score within the threshold given.
         const bool at_operating_point =
             result.has_operating_point && q < static_cast<int>(result.accepted.size());
-        const bool accepted =
-            at_operating_point ? result.accepted[q] != 0 : d <= accept_threshold;
+        const bool accepted = at_operating_point ? result.accepted[q] != 0 : d <= accept_threshold;
         if (c < 0 || c >= cols || !accepted) continue;
         const bool correct = result.correct[q] != 0;
         if (correct != (pass == 0)) continue;
@@ -435,8 +429,7 @@ cv::Mat3b RenderAnswersOverlay(const cv::Mat1f& matrix, const EvaluationLayout& 
                                const std::vector<cv::Point>* rejected) {
   const int rows = layout.queries, cols = layout.references;
   return DrawOverlay(matrix, layout, nullptr, rejected, [&](cv::Mat3b& img, int k, int grow) {
-    const int marked =
-        std::min(rows, static_cast<int>(std::min(best.size(), accepted.size())));
+    const int marked = std::min(rows, static_cast<int>(std::min(best.size(), accepted.size())));
     for (int q = 0; q < marked; ++q)
       if (best[q] >= 0 && best[q] < cols && accepted[q]) Mark(img, k, grow, q, best[q], kAccepted);
   });

@@ -4,10 +4,9 @@
 #pragma once
 
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/layout.h"
@@ -25,10 +24,10 @@ struct PrSeries {
 // A white figure, two panels side by side: "Per-query best match" (precision against recall of
 // each series' per_query curve) and "ABLE-P cells (vicinity V)" (the able_p curves of the
 // series that have one; the panel is left out when every able_p is empty). Axes from 0 to 1
-// labelled "Recall" and "Precision" with ticks every 0.1 and a light grid, one distinct colour per series, a legend with the labels
-// and each series' AUC / AP, and `title` above. About 1400 x 640 pixels with two panels.
-cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& title,
-                       int vicinity);
+// labelled "Recall" and "Precision" with ticks every 0.1 and a light grid, one distinct colour per
+// series, a legend with the labels and each series' AUC / AP, and `title` above. About 1400 x 640
+// pixels with two panels.
+cv::Mat3b RenderPrPlot(const std::vector<PrSeries>& series, const std::string& title, int vicinity);
 
 // The evaluated block of `matrix` (normalised) in grey (dark = small distance), with the ground
 // truth tinted blue, and each query's best match marked where it is accepted (at the operating
@@ -48,8 +47,7 @@ inline constexpr int kOverlayAxisLeft = 48;
 inline constexpr int kOverlayAxisTop = 40;
 cv::Mat3b RenderOverlay(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                         const GroundTruth& truth, const PerQueryResult& result,
-                        double accept_threshold,
-                        const std::vector<cv::Point>* rejected = nullptr);
+                        double accept_threshold, const std::vector<cv::Point>* rejected = nullptr);
 
 // The same figure without ground truth: the block in grey, no tint, and each query's answer
 // best[q] (a column of the block, -1 none) marked orange where accepted[q] is 1, not judged

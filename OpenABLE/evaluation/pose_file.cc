@@ -1,12 +1,11 @@
 #include "OpenABLE/evaluation/pose_file.h"
 
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
-
-#include <Eigen/Geometry>
-#include <Eigen/SVD>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
@@ -84,8 +83,7 @@ std::vector<PoseFileLine> ReadPoseFile(const std::string& path, PoseFileFormat f
   const std::size_t expected = format == PoseFileFormat::kKitti         ? 12
                                : format == PoseFileFormat::kKittiWithId ? 13
                                                                         : 8;
-  const char* layout = format == PoseFileFormat::kKitti
-                           ? "12 numbers (row-major 3x4 [R | t])"
+  const char* layout = format == PoseFileFormat::kKitti ? "12 numbers (row-major 3x4 [R | t])"
                        : format == PoseFileFormat::kKittiWithId
                            ? "13 numbers (frame number, row-major 3x4 [R | t])"
                            : "8 numbers (timestamp tx ty tz qx qy qz qw)";
@@ -122,8 +120,8 @@ std::vector<PoseFileLine> ReadPoseFile(const std::string& path, PoseFileFormat f
       const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);  // w, x, y, z
       const double norm = q.norm();
       if (!(std::abs(norm - 1) <= kPoseRotationTolerance))
-        throw InputError(where + ": quaternion (" + tokens[4] + " " + tokens[5] + " " +
-                         tokens[6] + " " + tokens[7] + ") has norm " + ShortestNumber(norm) +
+        throw InputError(where + ": quaternion (" + tokens[4] + " " + tokens[5] + " " + tokens[6] +
+                         " " + tokens[7] + ") has norm " + ShortestNumber(norm) +
                          "; expected a unit quaternion within " +
                          ShortestNumber(kPoseRotationTolerance));
       pose.rotation = CheckedRotationMatrix(q.normalized().toRotationMatrix(), where);

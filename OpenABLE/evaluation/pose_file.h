@@ -11,10 +11,9 @@
 // orthonormal (the nearest rotation) when it is not already within 1e-12.
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace openable {
 
@@ -25,9 +24,9 @@ enum class PoseFileFormat { kKitti, kKittiWithId, kTum };
 inline constexpr double kPoseRotationTolerance = 1e-3;
 
 struct PoseFileLine {
-  int line = 0;             // line of the file, from 1
-  long frame_id = 0;        // kitti-id: the first column; otherwise the pose's index (0, 1, ...)
-  double timestamp = 0;     // tum: seconds
+  int line = 0;          // line of the file, from 1
+  long frame_id = 0;     // kitti-id: the first column; otherwise the pose's index (0, 1, ...)
+  double timestamp = 0;  // tum: seconds
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // as written (camera-to-world)
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
 };

@@ -49,8 +49,8 @@ void TrueRow(const std::vector<int>& matches, int references, int tolerance,
   row.assign(static_cast<std::size_t>(references), 0);
   for (int m : matches) {
     const int from = std::max(0, m - tolerance);  // m >= 0: no overflow
-    const int to = static_cast<int>(std::min<std::int64_t>(references - 1,
-                                                           std::int64_t{m} + tolerance));
+    const int to =
+        static_cast<int>(std::min<std::int64_t>(references - 1, std::int64_t{m} + tolerance));
     for (int c = from; c <= to; ++c) row[static_cast<std::size_t>(c)] = 1;
   }
 }
@@ -195,8 +195,8 @@ VprBenchResult EvaluateVprBench(const cv::Mat1f& normalized, const EvaluationLay
   // tps / tps[-1]; the points from the first that reaches full recall back to the first,
   // then (recall 0, precision 1).
   const double total = tps.back();
-  const std::size_t last = static_cast<std::size_t>(
-      std::lower_bound(tps.begin(), tps.end(), total) - tps.begin());
+  const std::size_t last =
+      static_cast<std::size_t>(std::lower_bound(tps.begin(), tps.end(), total) - tps.begin());
   for (std::size_t k = last + 1; k-- > 0;) {
     r.precision.push_back(tps[k] / (tps[k] + fps[k]));
     r.recall.push_back(total > 0 ? tps[k] / total : kNaN);
@@ -219,9 +219,8 @@ VprBenchResult EvaluateVprBench(const cv::Mat1f& normalized, const EvaluationLay
   return r;
 }
 
-VprTutorialResult EvaluateVprTutorial(const cv::Mat1f& normalized,
-                                      const EvaluationLayout& layout, const GroundTruth& truth,
-                                      int tolerance) {
+VprTutorialResult EvaluateVprTutorial(const cv::Mat1f& normalized, const EvaluationLayout& layout,
+                                      const GroundTruth& truth, int tolerance) {
   const cv::Mat1f block = FiniteBlock(normalized, layout, truth, "vpr_tutorial");
   VprTutorialResult r;
   const int nq = layout.queries, nr = layout.references;

@@ -10,10 +10,9 @@
 // finite distance, the least similar. Both need a query-reference layout (two traversals).
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/layout.h"
@@ -72,9 +71,8 @@ struct VprTutorialResult {
 // truth as given). Throws InputError when the layout is one sequence.
 VprBenchResult EvaluateVprBench(const cv::Mat1f& normalized, const EvaluationLayout& layout,
                                 const GroundTruth& truth, int tolerance);
-VprTutorialResult EvaluateVprTutorial(const cv::Mat1f& normalized,
-                                      const EvaluationLayout& layout, const GroundTruth& truth,
-                                      int tolerance);
+VprTutorialResult EvaluateVprTutorial(const cv::Mat1f& normalized, const EvaluationLayout& layout,
+                                      const GroundTruth& truth, int tolerance);
 
 // The protocols an evaluation reports (Evaluation_protocol): the toolbox's own (per query and
 // ABLE-P), VPR-Bench's, VPR_Tutorial's, any of them.

@@ -122,8 +122,8 @@ std::vector<ProtocolRow> ProtocolRows(const EvaluationSettings& s,
       char more[96];
       std::snprintf(more, sizeof more, "max F1 %.3f, ABLE-P AP %.1f%%", q.max_f1,
                     r.able_p.average_precision);
-      rows.push_back({r.label, "openable", q.auc, q.recall_at_100p, q.recall_at_1,
-                      q.recall_at_5, q.recall_at_10, more});
+      rows.push_back({r.label, "openable", q.auc, q.recall_at_100p, q.recall_at_1, q.recall_at_5,
+                      q.recall_at_10, more});
     }
     if (r.has_vpr_bench) {
       const VprBenchResult& b = r.vpr_bench;
@@ -135,10 +135,9 @@ std::vector<ProtocolRow> ProtocolRows(const EvaluationSettings& s,
     }
     if (r.has_vpr_tutorial) {
       const VprTutorialResult& t = r.vpr_tutorial;
-      const std::string single =
-          t.single ? "single-match AUC " + Figure(t.auc_single) + ", R@100P " +
-                         Figure(t.recall_at_100p_single)
-                   : std::string("single-match: not with GTsoft");
+      const std::string single = t.single ? "single-match AUC " + Figure(t.auc_single) +
+                                                ", R@100P " + Figure(t.recall_at_100p_single)
+                                          : std::string("single-match: not with GTsoft");
       // recall_at_k holds K = 1, 5, 10 in its positions 1, 2, 3.
       rows.push_back({r.label, "vpr_tutorial", t.auc_multi, t.recall_at_100p_multi,
                       AtN(t.recall_at_k, 1), AtN(t.recall_at_k, 2), AtN(t.recall_at_k, 3),
@@ -149,8 +148,8 @@ std::vector<ProtocolRow> ProtocolRows(const EvaluationSettings& s,
 }
 
 std::string ProtocolToleranceNote(const EvaluationSettings& s) {
-  if (s.options.tolerance > 0 && (s.truth.type == GroundTruthType::kVprBench ||
-                                  s.truth.type == GroundTruthType::kVprTutorial))
+  if (s.options.tolerance > 0 &&
+      (s.truth.type == GroundTruthType::kVprBench || s.truth.type == GroundTruthType::kVprTutorial))
     return "Tolerance " + std::to_string(s.options.tolerance) +
            " widens the file's true references by +-" + std::to_string(s.options.tolerance) +
            " frames; Tolerance 0 takes them as the reference code does";
@@ -169,8 +168,8 @@ std::string EncodeVprTutorialCsv(const VprTutorialResult& r) {
   for (std::size_t k = 0; k < r.precision_multi.size(); ++k)
     out += "multi," + CsvNumber(r.precision_multi[k]) + "," + CsvNumber(r.recall_multi[k]) + "\n";
   for (std::size_t k = 0; k < r.precision_single.size(); ++k)
-    out += "single," + CsvNumber(r.precision_single[k]) + "," + CsvNumber(r.recall_single[k]) +
-           "\n";
+    out +=
+        "single," + CsvNumber(r.precision_single[k]) + "," + CsvNumber(r.recall_single[k]) + "\n";
   return out;
 }
 
@@ -179,8 +178,8 @@ std::string CsvNumber(double v) { return std::isfinite(v) ? FormatNumber(v, 9) :
 std::string EncodeCurveCsv(const std::vector<CurvePoint>& curve) {
   std::string out = "threshold,precision,recall,f1,tp,fp\n";
   for (const CurvePoint& p : curve) {
-    out += CsvNumber(p.threshold) + "," + CsvNumber(p.precision) + "," + CsvNumber(p.recall) +
-           "," + CsvNumber(p.f1) + "," + std::to_string(p.tp) + "," + std::to_string(p.fp) + "\n";
+    out += CsvNumber(p.threshold) + "," + CsvNumber(p.precision) + "," + CsvNumber(p.recall) + "," +
+           CsvNumber(p.f1) + "," + std::to_string(p.tp) + "," + std::to_string(p.fp) + "\n";
   }
   return out;
 }
@@ -287,14 +286,14 @@ std::string FormatEvaluationTable(const EvaluationSettings& s,
     const bool both = r.verified;
     for (int pass = both ? 0 : 1; pass < 2; ++pass) {
       const PerQueryResult& q = pass == 0 ? r.per_query_unverified : r.per_query;
-      const std::string label = pass == 0 || !both ? r.label.substr(0, 18)
-                                                   : std::string("  + verification");
+      const std::string label =
+          pass == 0 || !both ? r.label.substr(0, 18) : std::string("  + verification");
       char f1[32];
       std::snprintf(f1, sizeof f1, "%.3f (%.3f)", q.max_f1, q.max_f1_threshold);
       std::snprintf(line, sizeof line,
-                    "  %-18s %7d %7d %7.3f %7.3f %16s %6.3f %6.3f %6.3f %7.1f%%\n",
-                    label.c_str(), q.queries, q.positive_queries, q.auc, q.recall_at_100p, f1,
-                    q.recall_at_1, q.recall_at_5, q.recall_at_10, r.able_p.average_precision);
+                    "  %-18s %7d %7d %7.3f %7.3f %16s %6.3f %6.3f %6.3f %7.1f%%\n", label.c_str(),
+                    q.queries, q.positive_queries, q.auc, q.recall_at_100p, f1, q.recall_at_1,
+                    q.recall_at_5, q.recall_at_10, r.able_p.average_precision);
       o << line;
       if (pass == 0 || !both) {
         if (q.truth_pairs_outside_candidates > 0)

@@ -3,10 +3,9 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json_fwd.hpp>
 
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/layout.h"
@@ -19,8 +18,8 @@ struct EvaluatedRun {
   std::string label;   // legend label ("LDB L=10")
   std::string source;  // where the matrix came from (a file, or "Test_OpenABLE run")
   EvaluationLayout layout;
-  std::int64_t truth_pairs = 0;    // ground-truth pairs loaded over the block
-  std::int64_t truth_dropped = 0;  // GroundTruth::dropped
+  std::int64_t truth_pairs = 0;      // ground-truth pairs loaded over the block
+  std::int64_t truth_dropped = 0;    // GroundTruth::dropped
   std::string truth_skipped_header;  // GroundTruth::skipped_header
   // The run's final answers: with verification (`verified`), each query's best-ranked verified
   // candidate (a query without one has no answer), and per_query_unverified the matrix's best

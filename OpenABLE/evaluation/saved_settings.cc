@@ -16,13 +16,28 @@ namespace openable {
 namespace fs = std::filesystem;
 
 const std::vector<std::string>& MatrixEvaluationKeys() {
-  static const std::vector<std::string> keys = {
-      "Ground_truth_type", "Ground_truth",       "Ground_truth_2",     "Ground_truth_base",
-      "Ground_truth_radius", "Ground_truth_heading", "Ground_truth_min_gap",
-      "Ground_truth_time_tolerance", "Ground_truth_axes", "Tolerance", "Exclusion", "Vicinity",
-      "Initial_image", "Final_image", "Match_score", "Match_score_window", "Match_threshold",
-      "Match_consistency", "Image_sequences", "Sequence_partial", "Sequence_direction",
-      "Ground_truth_soft"};
+  static const std::vector<std::string> keys = {"Ground_truth_type",
+                                                "Ground_truth",
+                                                "Ground_truth_2",
+                                                "Ground_truth_base",
+                                                "Ground_truth_radius",
+                                                "Ground_truth_heading",
+                                                "Ground_truth_min_gap",
+                                                "Ground_truth_time_tolerance",
+                                                "Ground_truth_axes",
+                                                "Tolerance",
+                                                "Exclusion",
+                                                "Vicinity",
+                                                "Initial_image",
+                                                "Final_image",
+                                                "Match_score",
+                                                "Match_score_window",
+                                                "Match_threshold",
+                                                "Match_consistency",
+                                                "Image_sequences",
+                                                "Sequence_partial",
+                                                "Sequence_direction",
+                                                "Ground_truth_soft"};
   return keys;
 }
 
@@ -76,8 +91,7 @@ SavedMatrixSettings DecodeMatrixSettings(std::string_view text, const std::strin
     throw refuse("\"traversals\" is not a list of one or two traversals");
   std::int64_t frames = 0;
   for (const Json& t : o["traversals"]) {
-    if (!t.is_object() || !t.contains("frames"))
-      throw refuse("a traversal without \"frames\"");
+    if (!t.is_object() || !t.contains("frames")) throw refuse("a traversal without \"frames\"");
     s.traversal_frames.push_back(count(t["frames"], "a traversal's \"frames\"", 1));
     frames += s.traversal_frames.back();
   }
@@ -128,12 +142,12 @@ void CheckMatrixFitsSettings(const SavedMatrixSettings& saved, const std::string
   std::string traversals;
   for (std::size_t i = 0; i < saved.traversal_frames.size(); ++i)
     traversals += (i ? " and " : "") + std::to_string(saved.traversal_frames[i]);
-  throw InputError(
-      "matrix " + Quoted(matrix_path) + ": " + std::to_string(rows) + "x" + std::to_string(cols) +
-      ", but its settings file " + Quoted(saved.path) + " was written with a " +
-      std::to_string(saved.rows) + "x" + std::to_string(saved.cols) + " matrix (traversals of " +
-      traversals + " frames); expected the settings file of this matrix (delete or rename it " +
-      "to evaluate the matrix without it)");
+  throw InputError("matrix " + Quoted(matrix_path) + ": " + std::to_string(rows) + "x" +
+                   std::to_string(cols) + ", but its settings file " + Quoted(saved.path) +
+                   " was written with a " + std::to_string(saved.rows) + "x" +
+                   std::to_string(saved.cols) + " matrix (traversals of " + traversals +
+                   " frames); expected the settings file of this matrix (delete or rename it " +
+                   "to evaluate the matrix without it)");
 }
 
 std::optional<SavedMatrixSettings> ReadMatrixSettings(const std::string& matrix_path) {

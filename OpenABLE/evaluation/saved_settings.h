@@ -21,7 +21,7 @@ std::string MatrixSettingsPath(const std::string& matrix_path);
 
 // What a reader takes from a settings file.
 struct SavedMatrixSettings {
-  std::string path;  // the settings file
+  std::string path;                                       // the settings file
   std::vector<std::pair<std::string, std::string>> keys;  // MatrixEvaluationKeys, "Key", value
   int reference_frames = 0;  // two traversals in one square matrix: the first traversal's frames
   bool thresholded = false;  // M'' of Eq. 9: not distances

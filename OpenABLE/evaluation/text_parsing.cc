@@ -24,7 +24,6 @@ bool ParseNumber(std::string_view token, double* value) {
   return r.ec == std::errc() && r.ptr == end;
 }
 
-
 bool ParseIndex(std::string_view field, std::int64_t* value) {
   std::string_view f = field;
   if (!f.empty() && f.front() == '+') f.remove_prefix(1);

@@ -1,5 +1,5 @@
-// Internal helpers of the evaluation readers (matrix_file.cc, ground_truth.cc, pairs_file.cc): whole-file
-// reading with one-line errors, and number parsing without locale surprises.
+// Internal helpers of the evaluation readers (matrix_file.cc, ground_truth.cc, pairs_file.cc):
+// whole-file reading with one-line errors, and number parsing without locale surprises.
 #pragma once
 
 #include <cstddef>
@@ -18,9 +18,7 @@ void RequireFile(const std::string& path, const std::string& where);
 std::string ReadWholeFile(const std::string& path, const std::string& where);
 
 // Blank characters that separate fields (not '\n').
-inline bool IsBlank(char c) {
-  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
-}
+inline bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
 // A whole token as a number ("1", "-2.5e3", "+4", "nan", "inf"); false on anything else.
 bool ParseNumber(std::string_view token, double* value);

@@ -3,10 +3,9 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
-
-#include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/option_checks.h"
@@ -103,16 +102,17 @@ cv::Mat1b IlluminationInvariant(const cv::Mat& frame, double alpha) {
     }
   }
   if (grey)
-    throw InputError("the frame is grey (R = G = B in every pixel); Illumination_invariance 1 "
-                     "(Eq. 6) gives a constant image for it: expected colour frames");
+    throw InputError(
+        "the frame is grey (R = G = B in every pixel); Illumination_invariance 1 "
+        "(Eq. 6) gives a constant image for it: expected colour frames");
   return out;
 }
 
 double AlphaFromPeakResponses(double red_nm, double green_nm, double blue_nm) {
   if (!(blue_nm > 0 && blue_nm < green_nm && green_nm < red_nm) || !std::isfinite(red_nm)) {
     std::ostringstream s;
-    s << "Lambda_red, Lambda_green, Lambda_blue: " << red_nm << ", " << green_nm << ", "
-      << blue_nm << " nm are not valid peak spectral responses; expected 0 < blue < green < red "
+    s << "Lambda_red, Lambda_green, Lambda_blue: " << red_nm << ", " << green_nm << ", " << blue_nm
+      << " nm are not valid peak spectral responses; expected 0 < blue < green < red "
       << "(e.g. 610, 535, 470 for KITTI's PointGrey Flea2)";
     throw InputError(s.str());
   }
@@ -168,8 +168,8 @@ void PreprocessOptions::Check() const {
   CheckNumberRange("Lambda_blue", lambda_blue, 0, 2000);
   const int given = (lambda_red > 0) + (lambda_green > 0) + (lambda_blue > 0);
   if (given != 0 && given != 3)
-    throw InputError("Lambda_red, Lambda_green, Lambda_blue: " + FormatNumber(lambda_red) +
-                     ", " + FormatNumber(lambda_green) + ", " + FormatNumber(lambda_blue) +
+    throw InputError("Lambda_red, Lambda_green, Lambda_blue: " + FormatNumber(lambda_red) + ", " +
+                     FormatNumber(lambda_green) + ", " + FormatNumber(lambda_blue) +
                      "; expected all three peak responses (nm) or none (0)");
   CheckNumberRange("Noise_gaussian", noise.gaussian, 0, 1);
   CheckNumberRange("Noise_salt_pepper", noise.salt_pepper, 0, 1);

@@ -1,10 +1,9 @@
 // Preprocessing of a frame before description.
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/image/robustness.h"
 
@@ -72,9 +71,9 @@ struct PreprocessOptions {
   // Peak spectral responses of the red, green and blue channels, nm, [0, 2000]: all three
   // (then Eq. 7 gives alpha) or none (0).
   double lambda_red = 0, lambda_green = 0, lambda_blue = 0;
-  bool side_window = false;               // side-window multilayer fusion (robustness.h)
+  bool side_window = false;                 // side-window multilayer fusion (robustness.h)
   std::string side_window_radii = "1,2,3";  // its layer radii, ParseSideWindowRadii
-  NoiseOptions noise;                     // noise for robustness studies (robustness.h)
+  NoiseOptions noise;                       // noise for robustness studies (robustness.h)
 
   // Alpha of Eq. 6: by Eq. 7 from the peak responses when they are given, else `alpha`.
   double Alpha() const;

@@ -2,9 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
-
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 namespace openable {
 
@@ -31,15 +30,14 @@ void InteriorRow(const double* __restrict in, double* __restrict out,
   for (int x = x0; x < x1; ++x) {
     const int a = x - r, b = x, c = x + 1, d = x + r + 1;  // integral columns
     const double p = in[x];
-    const double q[8] = {
-        (below[d] - top[d] - below[a] + top[a]) / half,              // U
-        (bottom[d] - centre[d] - bottom[a] + centre[a]) / half,      // D
-        (bottom[c] - top[c] - bottom[a] + top[a]) / half,            // L
-        (bottom[d] - top[d] - bottom[b] + top[b]) / half,            // R
-        (below[c] - top[c] - below[a] + top[a]) / quarter,           // NW
-        (below[d] - top[d] - below[b] + top[b]) / quarter,           // NE
-        (bottom[c] - centre[c] - bottom[a] + centre[a]) / quarter,   // SW
-        (bottom[d] - centre[d] - bottom[b] + centre[b]) / quarter};  // SE
+    const double q[8] = {(below[d] - top[d] - below[a] + top[a]) / half,              // U
+                         (bottom[d] - centre[d] - bottom[a] + centre[a]) / half,      // D
+                         (bottom[c] - top[c] - bottom[a] + top[a]) / half,            // L
+                         (bottom[d] - top[d] - bottom[b] + top[b]) / half,            // R
+                         (below[c] - top[c] - below[a] + top[a]) / quarter,           // NW
+                         (below[d] - top[d] - below[b] + top[b]) / quarter,           // NE
+                         (bottom[c] - centre[c] - bottom[a] + centre[a]) / quarter,   // SW
+                         (bottom[d] - centre[d] - bottom[b] + centre[b]) / quarter};  // SE
     double best = std::abs(q[0] - p), chosen = q[0];
     for (int n = 1; n < 8; ++n) {
       const double dist = std::abs(q[n] - p);
@@ -90,8 +88,7 @@ cv::Mat1d SideWindowLayer(const cv::Mat1d& image, int r) {
     }
     for (int x = 0; x < x0; ++x) general(y, x);
     InteriorRow(image.ptr<double>(y), out.ptr<double>(y), sum.ptr<double>(y - r),
-                sum.ptr<double>(y), sum.ptr<double>(y + 1), sum.ptr<double>(y + r + 1), r, x0,
-                x1);
+                sum.ptr<double>(y), sum.ptr<double>(y + 1), sum.ptr<double>(y + r + 1), r, x0, x1);
     for (int x = x1; x < w; ++x) general(y, x);
   }
   return out;
@@ -137,8 +134,7 @@ uint64_t NoiseState(int seed, int stream, int frame) {
 cv::Mat AddNoise(const cv::Mat& frame, const NoiseOptions& o, uint64_t state) {
   const int type = frame.type();
   if (type != CV_32FC1 && type != CV_32FC2 && type != CV_32FC3)
-    throw std::logic_error("AddNoise: expected CV_32FC1, C2 or C3, got " +
-                           cv::typeToString(type));
+    throw std::logic_error("AddNoise: expected CV_32FC1, C2 or C3, got " + cv::typeToString(type));
   cv::Mat out = frame.clone();
   // Channels that are intensities: all but a stereo frame's disparity (channel 1).
   const int cn = frame.channels(), noisy = cn == 2 ? 1 : cn;

@@ -28,9 +28,8 @@
 #pragma once
 
 #include <cstdint>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 namespace openable {
 
@@ -93,12 +92,12 @@ cv::Mat AddNoise(const cv::Mat& frame, const NoiseOptions& options, uint64_t sta
 // The defaults give a frame clearly darker in its upper part, lit from the right, noisy and of
 // low contrast; `Strong()` a harder night. The result depends only on the frame and `state`.
 struct NightOptions {
-  double zoom = 0.04, shift = 0.02, rotation = 1.5;   // viewpoint
-  double ambient = 0.25, side = 0.7;                   // light field
+  double zoom = 0.04, shift = 0.02, rotation = 1.5;  // viewpoint
+  double ambient = 0.25, side = 0.7;                 // light field
   bool from_left = false;
   double sky_floor = 0.1, sky_height = 0.5;
   double gamma = 1.6;
-  double gain_b = 0.55, gain_g = 0.8, gain_r = 1.0;    // sodium-like cast
+  double gain_b = 0.55, gain_g = 0.8, gain_r = 1.0;  // sodium-like cast
   double target_mean = 0.3, shot = 0.04, read = 0.02, glare = 0.25;
   static NightOptions Strong() {
     NightOptions o;

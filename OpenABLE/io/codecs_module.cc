@@ -2,10 +2,9 @@
 // the program does not decode itself (PNG and JPEG are decoded in the program: image_codec.h).
 // imgcodecs loads GDAL, GDCM, OpenEXR and about 120 other libraries, which a run on PNG or JPEG
 // frames no longer pays for at start-up.
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/io/module_api.h"
 

@@ -26,8 +26,6 @@ using namespace io_internal;
 
 bool IsDigit(char c) { return c >= '0' && c <= '9'; }
 
-
-
 std::string JoinSupported() {
   std::string out;
   for (const std::string& e : SupportedImageExtensions()) out += (out.empty() ? "" : ", ") + e;
@@ -142,8 +140,8 @@ std::vector<std::string> ListImages(const std::string& folder, const std::string
   std::error_code ec;
   const fs::file_status status = fs::status(folder, ec);
   if (!fs::exists(status)) {
-    throw InputError("folder " + Quoted(folder) + " does not exist" +
-                     WorkingDirectoryNote(folder) + " (" + kExpectedFolder + ")");
+    throw InputError("folder " + Quoted(folder) + " does not exist" + WorkingDirectoryNote(folder) +
+                     " (" + kExpectedFolder + ")");
   }
   if (!fs::is_directory(status)) {
     throw InputError("folder " + Quoted(folder) + " is not a folder but a file (" +
@@ -174,8 +172,8 @@ std::vector<std::string> ListImages(const std::string& folder, const std::string
     const bool broken_link = it->is_symlink(file_ec) && !fs::exists(it->path(), file_ec);
     std::error_code type_ec;
     const bool regular = it->is_regular_file(type_ec) && !type_ec;  // follows links
-    const bool special = !broken_link && !regular && !type_ec &&
-                         !it->is_directory(type_ec) && !type_ec;
+    const bool special =
+        !broken_link && !regular && !type_ec && !it->is_directory(type_ec) && !type_ec;
     if (!broken_link && !regular && !special) continue;
     if ((broken_link || special) && !accepted(ext)) continue;
     ++file_count;
@@ -236,8 +234,8 @@ cv::Mat DecodeImageBytes(const std::string& bytes, const std::string& name) {
   const std::vector<unsigned char> data(bytes.begin(), bytes.end());
   return DecodeBytes(data, name, [&] {
     cv::Mat frame;
-    reinterpret_cast<OpenableOiioReadMemory>(
-        ModuleSymbol("oiio", "openable_oiio_read_memory"))(bytes, name, frame);
+    reinterpret_cast<OpenableOiioReadMemory>(ModuleSymbol("oiio", "openable_oiio_read_memory"))(
+        bytes, name, frame);
     return frame;
   });
 }
@@ -260,8 +258,8 @@ std::unique_ptr<FrameSource> OpenVideo(const std::string& path, int first, int l
     CheckInputFile(path, "video " + Quoted(path), kExpectedVideo);
   // FFmpeg's "tty" demuxer renders any text file as ANSI-art frames, so a configuration or
   // ground-truth file given as a video by mistake would "work". Refuse the usual text types.
-  static const std::set<std::string> kTextExtensions = {"txt", "csv", "yaml", "yml", "json",
-                                                        "md", "xml"};
+  static const std::set<std::string> kTextExtensions = {"txt",  "csv", "yaml", "yml",
+                                                        "json", "md",  "xml"};
   if (kTextExtensions.count(ExtensionOf(path)) != 0) {
     throw InputError("video " + Quoted(path) + " is a text file (." + ExtensionOf(path) + "); " +
                      kExpectedVideo);
@@ -272,8 +270,8 @@ std::unique_ptr<FrameSource> OpenVideo(const std::string& path, int first, int l
   return source;
 }
 
-std::unique_ptr<FrameSource> OpenBag(const std::string& path, const std::string& topic,
-                                     int first, int last, const std::string& key,
+std::unique_ptr<FrameSource> OpenBag(const std::string& path, const std::string& topic, int first,
+                                     int last, const std::string& key,
                                      const std::string& topic_key) {
   if (path.empty())
     throw InputError(key + ": empty; expected the path of a ROS 1 bag (Frame_mode 3)");

@@ -8,10 +8,9 @@
 
 #include <limits>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace openable {
 
@@ -92,8 +91,8 @@ std::unique_ptr<FrameSource> OpenVideo(const std::string& path, int first, int l
 // truncated (no index), a topic that is absent (the bag's image topics are listed) or of
 // another type, an empty range; Read(i) when a message cannot be decoded. Reads are
 // thread-safe: the bag is read under a lock, messages are decoded outside it.
-std::unique_ptr<FrameSource> OpenBag(const std::string& path, const std::string& topic,
-                                     int first, int last, const std::string& key,
+std::unique_ptr<FrameSource> OpenBag(const std::string& path, const std::string& topic, int first,
+                                     int last, const std::string& key,
                                      const std::string& topic_key);
 
 }  // namespace openable

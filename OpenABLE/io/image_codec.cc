@@ -1,5 +1,6 @@
 #include "OpenABLE/io/image_codec.h"
 
+#include <jpeglib.h>  // after <cstdio>: it uses FILE and size_t without including them
 #include <libdeflate.h>
 #include <png.h>
 
@@ -14,8 +15,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <jpeglib.h>  // after <cstdio>: it uses FILE and size_t without including them
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/module_loader.h"
@@ -58,8 +57,8 @@ bool IsLittleEndian() {
 }
 
 // Reads the header and sets the transformations; false on a libpng error.
-bool ReadHeader(png_structp png, png_infop info, int& width, int& height, int& channels,
-                int& depth, std::size_t& row_bytes) {
+bool ReadHeader(png_structp png, png_infop info, int& width, int& height, int& channels, int& depth,
+                std::size_t& row_bytes) {
   if (setjmp(png_jmpbuf(png))) return false;
   png_read_info(png, info);
   const int color = png_get_color_type(png, info);
@@ -107,8 +106,7 @@ void PutChunk(std::string& out, const char type[4], const char* data, std::size_
 }
 
 // One row in PNG sample order: RGB(A) from BGR(A), 16-bit values big-endian.
-void SwapToPng(const unsigned char* src, unsigned char* raw, int cols, int channels,
-               int sample) {
+void SwapToPng(const unsigned char* src, unsigned char* raw, int cols, int channels, int sample) {
   for (int x = 0; x < cols; ++x) {
     for (int c = 0; c < channels; ++c) {
       const int from = channels >= 3 && c < 3 ? 2 - c : c;
@@ -248,8 +246,11 @@ constexpr std::uint64_t kMaxPixels = 100'000'000;
 void CheckPixelCount(std::uint64_t width, std::uint64_t height) {
   if (width * height > kMaxPixels)
     throw InputError("is " + std::to_string(width) + "x" + std::to_string(height) + " (" +
-                     std::to_string(width * height / 1'000'000) + " megapixels); expected at "
-                     "most " + std::to_string(kMaxPixels / 1'000'000) + " megapixels (frames are "
+                     std::to_string(width * height / 1'000'000) +
+                     " megapixels); expected at "
+                     "most " +
+                     std::to_string(kMaxPixels / 1'000'000) +
+                     " megapixels (frames are "
                      "resized to Patch_size: scale the images down first)");
 }
 
@@ -260,8 +261,8 @@ bool JpegSize(const std::vector<unsigned char>& bytes, std::uint32_t& width,
   while (pos + 9 <= bytes.size() && bytes[pos] == 0xFF) {
     const unsigned char marker = bytes[pos + 1];
     const std::size_t length = (std::size_t{bytes[pos + 2]} << 8) | bytes[pos + 3];
-    const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
-                     marker != 0xCC;
+    const bool sof =
+        marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
     if (sof) {
       height = (std::uint32_t{bytes[pos + 5]} << 8) | bytes[pos + 6];
       width = (std::uint32_t{bytes[pos + 7]} << 8) | bytes[pos + 8];
@@ -370,8 +371,7 @@ bool Unfilter(unsigned char* data, int rows, std::size_t row_bytes, int bpp) {
           x[i] = static_cast<unsigned char>(x[i] + x[i - step]);
         break;
       case 2:  // Up
-        for (std::size_t i = 0; i < row_bytes; ++i)
-          x[i] = static_cast<unsigned char>(x[i] + up[i]);
+        for (std::size_t i = 0; i < row_bytes; ++i) x[i] = static_cast<unsigned char>(x[i] + up[i]);
         break;
       case 3:  // Average
         for (std::size_t i = 0; i < row_bytes; ++i)
@@ -401,13 +401,12 @@ bool Unfilter(unsigned char* data, int rows, std::size_t row_bytes, int bpp) {
 // its fast loop, and inflate took a fifth of a bounded run over 200,000 such frames
 // (docs/benchmarks.md, "PNG frames decoded whole"). The pixels are libpng's: alpha dropped,
 // BGR order. The five filters are undone here because libpng offers no call that unfilters a
-// buffer it did not inflate itself. Returns false, leaving the file to libpng, for any other layout, a chunk whose CRC does not
-// match, an unknown critical chunk, or image data that is not exactly the image's: libpng then
-// decodes the file or gives its own reason.
+// buffer it did not inflate itself. Returns false, leaving the file to libpng, for any other
+// layout, a chunk whose CRC does not match, an unknown critical chunk, or image data that is not
+// exactly the image's: libpng then decodes the file or gives its own reason.
 bool DecodeWholeStream(const std::vector<unsigned char>& bytes, cv::Mat& image) {
   static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (bytes.size() < 8 + 25 || !std::equal(kSignature, kSignature + 8, bytes.begin()))
-    return false;
+  if (bytes.size() < 8 + 25 || !std::equal(kSignature, kSignature + 8, bytes.begin())) return false;
   std::uint32_t width = 0, height = 0;
   int channels = 0;
   std::vector<unsigned char> stream;
@@ -467,8 +466,7 @@ bool DecodeWholeStream(const std::vector<unsigned char>& bytes, cv::Mat& image) 
       written != size)
     return false;
   if (!Unfilter(raw.get(), static_cast<int>(height), row_bytes, channels)) return false;
-  cv::Mat out(static_cast<int>(height), static_cast<int>(width),
-              channels >= 3 ? CV_8UC3 : CV_8UC1);
+  cv::Mat out(static_cast<int>(height), static_cast<int>(width), channels >= 3 ? CV_8UC3 : CV_8UC1);
   for (int y = 0; y < out.rows; ++y) {
     const unsigned char* in = raw.get() + static_cast<std::size_t>(y) * (row_bytes + 1) + 1;
     unsigned char* o = out.ptr(y);
@@ -532,8 +530,10 @@ std::string EncodePngFile(const cv::Mat& image, int threads) {
   const int depth = image.depth(), channels = image.channels();
   if ((depth != CV_8U && depth != CV_16U) || (channels != 1 && channels != 3 && channels != 4) ||
       image.empty()) {
-    throw std::logic_error("EncodePngFile: expected a non-empty 8- or 16-bit image of 1, 3 or 4 "
-                           "channels, got " + cv::typeToString(image.type()));
+    throw std::logic_error(
+        "EncodePngFile: expected a non-empty 8- or 16-bit image of 1, 3 or 4 "
+        "channels, got " +
+        cv::typeToString(image.type()));
   }
   // The filtered rows: bands of 64 rows in parallel, into one buffer (every byte is written).
   const int bpp = channels * (depth == CV_16U ? 2 : 1);
@@ -587,16 +587,15 @@ cv::Mat DecodeCommonFormat(const std::vector<unsigned char>& bytes, bool& grey_a
   if (!why.empty()) throw InputError(why);
   if (bytes.size() < 16) return cv::Mat();
   const bool jpeg = bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
-  const bool pnm = bytes[0] == 'P' && (bytes[1] == '2' || bytes[1] == '3' || bytes[1] == '5' ||
-                                       bytes[1] == '6');
+  const bool pnm =
+      bytes[0] == 'P' && (bytes[1] == '2' || bytes[1] == '3' || bytes[1] == '5' || bytes[1] == '6');
   const bool bmp = bytes[0] == 'B' && bytes[1] == 'M';
   if (!why.empty()) throw InputError(why);
   if (png == PngCheck::kSound) {
     // IHDR colour type 4: grey + alpha. A sound chunk walk does not mean that IHDR comes first
     // (or at all: a signature and IEND are 20 bytes), and the decoders refuse such a file.
     static const unsigned char kIhdr[4] = {'I', 'H', 'D', 'R'};
-    const bool ihdr_first =
-        bytes.size() > 25 && std::equal(kIhdr, kIhdr + 4, bytes.begin() + 12);
+    const bool ihdr_first = bytes.size() > 25 && std::equal(kIhdr, kIhdr + 4, bytes.begin() + 12);
     if (ihdr_first) CheckPixelCount(BigEndian32(&bytes[16]), BigEndian32(&bytes[20]));
     grey_alpha = ihdr_first && bytes[25] == 4;
   } else if (png == PngCheck::kDamaged || (jpeg && !JpegHasEnd(bytes))) {
@@ -620,8 +619,8 @@ cv::Mat DecodeCommonFormat(const std::vector<unsigned char>& bytes, bool& grey_a
   }
   // PGM/PPM and BMP: OpenCV's imgcodecs, loaded on first use.
   cv::Mat image;
-  reinterpret_cast<OpenableCodecsDecode>(ModuleSymbol("codecs", "openable_codecs_decode"))(
-      bytes, image);
+  reinterpret_cast<OpenableCodecsDecode>(ModuleSymbol("codecs", "openable_codecs_decode"))(bytes,
+                                                                                           image);
   return image;
 }
 
@@ -651,8 +650,8 @@ std::string EncodeJpegFile(const cv::Mat& image, int quality) {
   cinfo.optimize_coding = TRUE;  // Huffman tables of the image itself: smaller files
   jpeg_start_compress(&cinfo, TRUE);
   while (cinfo.next_scanline < cinfo.image_height) {
-    JSAMPROW row = const_cast<unsigned char*>(image.ptr<unsigned char>(
-        static_cast<int>(cinfo.next_scanline)));
+    JSAMPROW row =
+        const_cast<unsigned char*>(image.ptr<unsigned char>(static_cast<int>(cinfo.next_scanline)));
     jpeg_write_scanlines(&cinfo, &row, 1);
   }
   jpeg_finish_compress(&cinfo);

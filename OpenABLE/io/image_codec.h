@@ -7,10 +7,9 @@
 // (module_loader.h). Frame sources (frame_source.h) read files and hand their bytes here.
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace openable {
 

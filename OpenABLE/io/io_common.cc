@@ -1,12 +1,11 @@
 #include "OpenABLE/io/io_common.h"
 
-#include "OpenABLE/base/strings.h"
-
 #include <cctype>
 #include <filesystem>
 #include <stdexcept>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/strings.h"
 
 namespace openable::io_internal {
 

@@ -5,10 +5,9 @@
 // json::Dump (docs/output_formats.md, "Reports as JSON").
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace openable {
 

@@ -4,10 +4,9 @@
 
 #include <cstdint>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/io/frame_source.h"
 
@@ -38,9 +37,8 @@ using OpenableVideoOpen = void (*)(const std::string&, int, int,
 
 // libopenable_rosbag.so: the messages [first, last) of an image topic of a ROS 1 bag (see
 // OpenBag); `key` and `topic_key` name the Config.txt keys in messages.
-extern "C" void openable_rosbag_open(const std::string& path, const std::string& topic,
-                                     int first, int last, const std::string& key,
-                                     const std::string& topic_key,
+extern "C" void openable_rosbag_open(const std::string& path, const std::string& topic, int first,
+                                     int last, const std::string& key, const std::string& topic_key,
                                      std::unique_ptr<openable::FrameSource>& source);
 using OpenableRosbagOpen = void (*)(const std::string&, const std::string&, int, int,
                                     const std::string&, const std::string&,
@@ -64,8 +62,8 @@ extern "C" void openable_mpi_abort(int code);
 using OpenableMpiAbort = void (*)(int);
 // The bytes of every process in rank order, on rank `root` only (root -1: on every process);
 // `sizes` receives each process's byte count there. Any size (sent in pieces below 2^31).
-extern "C" void openable_mpi_gather(const std::vector<char>& mine, int root,
-                                    std::vector<char>& all, std::vector<std::int64_t>& sizes);
+extern "C" void openable_mpi_gather(const std::vector<char>& mine, int root, std::vector<char>& all,
+                                    std::vector<std::int64_t>& sizes);
 using OpenableMpiGather = void (*)(const std::vector<char>&, int, std::vector<char>&,
                                    std::vector<std::int64_t>&);
 // The `bytes` at `mine` of every process, in rank order, into `into` on process 0, which holds

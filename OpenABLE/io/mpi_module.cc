@@ -46,8 +46,8 @@ extern "C" void openable_mpi_finalize() {
 
 extern "C" void openable_mpi_abort(int code) { MPI_Abort(MPI_COMM_WORLD, code); }
 
-extern "C" void openable_mpi_gather(const std::vector<char>& mine, int root,
-                                    std::vector<char>& all, std::vector<std::int64_t>& sizes) {
+extern "C" void openable_mpi_gather(const std::vector<char>& mine, int root, std::vector<char>& all,
+                                    std::vector<std::int64_t>& sizes) {
   int rank = 0, size = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);

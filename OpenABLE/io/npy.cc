@@ -147,7 +147,6 @@ class NpyHeaderParser {
   std::size_t i_ = 0;
 };
 
-
 enum class NpyKind { kBool, kU1, kI1, kU2, kI2, kU4, kI4, kU8, kI8, kF4, kF8 };
 
 float ElementAsFloat(NpyKind kind, const unsigned char* p) {

@@ -5,9 +5,9 @@
 // (pickled) and .npz archives are read by npy_objects.h.
 #pragma once
 
-#include <opencv2/core.hpp>
 #include <cstddef>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <string>
 #include <string_view>
 #include <vector>

@@ -1049,8 +1049,8 @@ Value PickleMachine::Range(const std::vector<Value>& args) {
   CountItems(count, true);
   if (count > static_cast<std::uint64_t>(std::max<std::int64_t>(0, limits_.range))) {
     Fail(Here() + ": range(" + std::to_string(start) + ", " + std::to_string(stop) + ", " +
-         std::to_string(step) + ") makes " + std::to_string(count) +
-         " numbers; expected at most " + std::to_string(limits_.range) + " in one list" + Why());
+         std::to_string(step) + ") makes " + std::to_string(count) + " numbers; expected at most " +
+         std::to_string(limits_.range) + " in one list" + Why());
   }
   std::vector<Value> items;
   items.reserve(count);
@@ -1382,8 +1382,7 @@ NpyObjects DecodeNpyObjects(std::string_view data, const std::string& where,
       std::max<std::int64_t>(0, std::min(kNpyMaxObjectItems, limits.values)));
   if (count > most) {
     throw InputError(where + ": shape " + NpyShapeText(header.shape) + " holds " +
-                     std::to_string(count) + " elements; expected at most " +
-                     std::to_string(most) +
+                     std::to_string(count) + " elements; expected at most " + std::to_string(most) +
                      (limits.expected.empty() ? std::string() : " (" + limits.expected + ")"));
   }
   NpyObjects out;

@@ -2,23 +2,21 @@
 // TIFF and for the files OpenCV's decoders refuse (so that the error names the real problem).
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/typedesc.h>
-
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <filesystem>
 #include <memory>
-#include <string>
-
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/io/io_common.h"
@@ -150,9 +148,9 @@ void ReadUnguarded(const std::string& path, const std::string& oiio_name, cv::Ma
     max_pixels = std::max<std::int64_t>(1, std::atoll(env));
   }
   if (std::int64_t{spec.width} * spec.height > max_pixels) {
-    throw fail("is too large to read: its header announces " + std::to_string(spec.width) +
-               " x " + std::to_string(spec.height) + " pixels, more than " +
-               std::to_string(max_pixels) + " (OPENCV_IO_MAX_IMAGE_PIXELS)");
+    throw fail("is too large to read: its header announces " + std::to_string(spec.width) + " x " +
+               std::to_string(spec.height) + " pixels, more than " + std::to_string(max_pixels) +
+               " (OPENCV_IO_MAX_IMAGE_PIXELS)");
   }
   cv::Mat image;
   try {

@@ -2,6 +2,9 @@
 
 #include <bzlib.h>
 #include <lz4.h>
+#include <ros/message_traits.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <sensor_msgs/Image.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -12,10 +15,6 @@
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <ros/message_traits.h>
-#include <sensor_msgs/CompressedImage.h>
-#include <sensor_msgs/Image.h>
 
 #include "OpenABLE/base/error.h"
 
@@ -32,8 +31,8 @@ constexpr std::uint64_t kMaxHeader = std::uint64_t{16} << 20;
 constexpr std::uint64_t kMaxChunk = std::uint64_t{1} << 30;
 
 // The record ops of format 2.0.
-constexpr std::uint8_t kMessageData = 0x02, kFileHeader = 0x03, kIndexData = 0x04,
-                       kChunk = 0x05, kChunkInfo = 0x06, kConnection = 0x07;
+constexpr std::uint8_t kMessageData = 0x02, kFileHeader = 0x03, kIndexData = 0x04, kChunk = 0x05,
+                       kChunkInfo = 0x06, kConnection = 0x07;
 
 // A defect found: thrown inside this file, returned by BagDefect as its text.
 struct Defect {
@@ -43,8 +42,7 @@ struct Defect {
 
 std::uint64_t Little(std::string_view bytes) {  // little-endian, up to 8 bytes
   std::uint64_t v = 0;
-  for (std::size_t i = bytes.size(); i-- > 0;)
-    v = (v << 8) | static_cast<unsigned char>(bytes[i]);
+  for (std::size_t i = bytes.size(); i-- > 0;) v = (v << 8) | static_cast<unsigned char>(bytes[i]);
   return v;
 }
 
@@ -329,8 +327,7 @@ void Check(BagFile& bag) {
   if (encryptor != header.fields.end() && !encryptor->second.empty())
     Fail("it is encrypted (" + Quoted(encryptor->second) + "), which OpenABLE does not read");
   const std::uint64_t index_pos = Number(header.fields, "index_pos", 8, file_header);
-  if (index_pos == 0)
-    Fail("it has no index: a recording cut short (rosbag reindex repairs it)");
+  if (index_pos == 0) Fail("it has no index: a recording cut short (rosbag reindex repairs it)");
   const std::uint64_t connection_count = Number(header.fields, "conn_count", 4, file_header);
   const std::uint64_t chunk_count = Number(header.fields, "chunk_count", 4, file_header);
 
@@ -344,10 +341,9 @@ void Check(BagFile& bag) {
     const auto id = static_cast<std::uint32_t>(Number(r.fields, "conn", 4, what));
     const std::string& topic = Field(r.fields, "topic", 0, what);
     if (r.data_length > kMaxHeader)  // read as a header too
-      Fail(what + " announces a connection header of " + std::to_string(r.data_length) +
-           " bytes");
-    const Fields c = ParseFields(bag.Read(r.data_pos, r.data_length, what),
-                                 what + "'s connection header");
+      Fail(what + " announces a connection header of " + std::to_string(r.data_length) + " bytes");
+    const Fields c =
+        ParseFields(bag.Read(r.data_pos, r.data_length, what), what + "'s connection header");
     const auto md5sum = c.find("md5sum");
     connections.emplace(id, Connection{topic, md5sum == c.end() ? "" : md5sum->second});
     pos = r.End();
@@ -413,8 +409,8 @@ void Check(BagFile& bag) {
         // ros::Time normalises the nanoseconds, and throws std::runtime_error when the
         // seconds then overflow.
         if (nsec >= 1000000000)
-          Fail(record + " has a time of " + std::to_string(sec) + " s and " +
-               std::to_string(nsec) + " ns; expected fewer than 10^9 ns");
+          Fail(record + " has a time of " + std::to_string(sec) + " s and " + std::to_string(nsec) +
+               " ns; expected fewer than 10^9 ns");
         if (sec == 0 && nsec == 0) continue;  // before ros::TIME_MIN: left out by the reader
         entries.push_back({static_cast<std::uint32_t>(Little(entry.substr(8, 4))), connection});
       }
@@ -423,7 +419,7 @@ void Check(BagFile& bag) {
     if (entries.empty()) continue;
     const std::string stored = bag.Read(chunk.data_pos, chunk.data_length, what);
     // Stored as is, the chunk is its data whatever "size" says (rosbag_storage reads it so).
-    const std::string content = compression == "none" ? stored
+    const std::string content = compression == "none"  ? stored
                                 : compression == "bz2" ? Bz2(stored, size, what)
                                                        : Lz4(stored, size, what);
     CheckChunk(content, entries, connections, what);

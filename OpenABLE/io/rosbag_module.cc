@@ -2,22 +2,22 @@
 // frame_source.h), read with Debian's rosbag_storage (librosbag-storage-dev) and the message
 // types of libsensor-msgs-dev. A module: rosbag_storage pulls in Boost, console_bridge, lz4,
 // bz2 and the ROS plugin loader, which a run without bags does not load.
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <sensor_msgs/Image.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
 #include <map>
 #include <mutex>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
-#include <sensor_msgs/CompressedImage.h>
-#include <sensor_msgs/Image.h>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/io/module_api.h"
@@ -36,13 +36,18 @@ cv::Mat DecodeImage(const sensor_msgs::Image& m, const std::string& what) {
     int convert;  // cv::cvtColor code to BGR or grey, -1: none
   };
   static const std::map<std::string, Layout> kEncodings = {
-      {"mono8", {CV_8UC1, -1}},        {"8UC1", {CV_8UC1, -1}},
-      {"mono16", {CV_16UC1, -1}},      {"16UC1", {CV_16UC1, -1}},
-      {"bgr8", {CV_8UC3, -1}},         {"8UC3", {CV_8UC3, -1}},
+      {"mono8", {CV_8UC1, -1}},
+      {"8UC1", {CV_8UC1, -1}},
+      {"mono16", {CV_16UC1, -1}},
+      {"16UC1", {CV_16UC1, -1}},
+      {"bgr8", {CV_8UC3, -1}},
+      {"8UC3", {CV_8UC3, -1}},
       {"rgb8", {CV_8UC3, cv::COLOR_RGB2BGR}},
-      {"bgra8", {CV_8UC4, cv::COLOR_BGRA2BGR}}, {"8UC4", {CV_8UC4, cv::COLOR_BGRA2BGR}},
+      {"bgra8", {CV_8UC4, cv::COLOR_BGRA2BGR}},
+      {"8UC4", {CV_8UC4, cv::COLOR_BGRA2BGR}},
       {"rgba8", {CV_8UC4, cv::COLOR_RGBA2BGR}},
-      {"bgr16", {CV_16UC3, -1}},       {"rgb16", {CV_16UC3, cv::COLOR_RGB2BGR}},
+      {"bgr16", {CV_16UC3, -1}},
+      {"rgb16", {CV_16UC3, cv::COLOR_RGB2BGR}},
   };
   const auto found = kEncodings.find(m.encoding);
   if (found == kEncodings.end()) {
@@ -130,10 +135,10 @@ class BagSource final : public FrameSource {
         std::string& list = datatype == kImage || datatype == kCompressed ? images : others;
         list += (list.empty() ? "" : ", ") + Escaped(t) + " (" + Escaped(datatype) + ")";
       }
-      throw InputError(topic_key + ": topic " + Quoted(topic) + " is not in " + bag_text +
-                       "; expected an image topic of the bag: " +
-                       (images.empty() ? "it has none" : images) +
-                       (others.empty() ? "" : "; other topics: " + others));
+      throw InputError(
+          topic_key + ": topic " + Quoted(topic) + " is not in " + bag_text +
+          "; expected an image topic of the bag: " + (images.empty() ? "it has none" : images) +
+          (others.empty() ? "" : "; other topics: " + others));
     }
     if (const std::set<std::string>& types = types_of_topic[topic]; types.size() > 1) {
       std::string list;
@@ -164,8 +169,8 @@ class BagSource final : public FrameSource {
                        std::to_string(count) + " messages; the range Initial_image " +
                        std::to_string(first) + " to Final_image " + std::to_string(last) +
                        " keeps none (expected at least one image message in the range)");
-    messages_ = std::vector<rosbag::MessageInstance>(messages_.begin() + first,
-                                                     messages_.begin() + end);
+    messages_ =
+        std::vector<rosbag::MessageInstance>(messages_.begin() + first, messages_.begin() + end);
     first_ = first;
     stamps_.assign(messages_.size(), std::numeric_limits<double>::quiet_NaN());
   }
@@ -180,8 +185,8 @@ class BagSource final : public FrameSource {
   }
 
   cv::Mat Read(int i) const override {
-    const std::string what = "bag " + Quoted(path_) + ", topic " + Quoted(topic_) +
-                             ", message " + std::to_string(first_ + i);
+    const std::string what = "bag " + Quoted(path_) + ", topic " + Quoted(topic_) + ", message " +
+                             std::to_string(first_ + i);
     Message message = Load(i, what);
     try {
       if (compressed_) {
@@ -259,9 +264,8 @@ class BagSource final : public FrameSource {
 }  // namespace
 }  // namespace openable
 
-extern "C" void openable_rosbag_open(const std::string& path, const std::string& topic,
-                                     int first, int last, const std::string& key,
-                                     const std::string& topic_key,
+extern "C" void openable_rosbag_open(const std::string& path, const std::string& topic, int first,
+                                     int last, const std::string& key, const std::string& topic_key,
                                      std::unique_ptr<openable::FrameSource>& source) {
   openable::CheckBag(path, key);
   source = std::make_unique<openable::BagSource>(path, topic, first, last, key, topic_key);

@@ -3,7 +3,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <mutex>
-
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 #include <opencv2/videoio/registry.hpp>
@@ -179,4 +178,3 @@ extern "C" void openable_video_open(const std::string& path, int first, int last
   const int end = ResolveRangeEnd(first, last, count, "frames", "frame", "video " + Quoted(path));
   source = std::make_unique<VideoSource>(path, api, first, end - first, count);
 }
-

@@ -70,8 +70,7 @@ KittiCalibration ReadKittiCalibration(const std::string& path, double scale) {
   c.left.cx = p0(0, 2) * scale;
   c.left.cy = p0(1, 2) * scale;
   if (c.left.fx <= 0 || c.left.fy <= 0)
-    throw InputError(Quoted(path) + ":" + std::to_string(line0) +
-                     ": P0 focal lengths must be > 0");
+    throw InputError(Quoted(path) + ":" + std::to_string(line0) + ": P0 focal lengths must be > 0");
   if (p1(0, 0) <= 0)
     throw InputError(Quoted(path) + ":" + std::to_string(line1) + ": P1(0,0) must be > 0");
   c.baseline = -p1(0, 3) / p1(0, 0);

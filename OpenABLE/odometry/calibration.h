@@ -1,9 +1,8 @@
 // Camera intrinsics for the odometry front-end of SNAPS and the reader of KITTI's calib.txt.
 #pragma once
 
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace openable::odometry {
 

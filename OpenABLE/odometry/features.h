@@ -1,12 +1,10 @@
 // Keypoints and their matching between consecutive frames, shared by both odometries.
 #pragma once
 
-#include <string>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
-
+#include <string>
+#include <vector>
 
 namespace openable::odometry {
 

@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
-
-#include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
@@ -16,9 +15,7 @@
 
 namespace openable::odometry {
 
-double RotationAngle(const Eigen::Matrix3d& r) {
-  return Eigen::AngleAxisd(r).angle();
-}
+double RotationAngle(const Eigen::Matrix3d& r) { return Eigen::AngleAxisd(r).angle(); }
 
 MonoOdometry::MonoOdometry(const Intrinsics& intrinsics, const MonoOdometryOptions& options)
     : intrinsics_(intrinsics),
@@ -59,9 +56,9 @@ Eigen::Isometry3d MonoOdometry::Step(const cv::Mat& gray, double step_length) {
       const cv::Mat K(intrinsics_.K());
       cv::theRNG().state = 0x12345678;  // deterministic RANSAC
       cv::Mat mask;
-      const cv::Mat E = cv::findEssentialMat(p_prev, p_curr, K, cv::RANSAC,
-                                             options_.ransac_confidence,
-                                             options_.ransac_threshold_px, mask);
+      const cv::Mat E =
+          cv::findEssentialMat(p_prev, p_curr, K, cv::RANSAC, options_.ransac_confidence,
+                               options_.ransac_threshold_px, mask);
       if (E.rows == 3 && E.cols == 3) {
         cv::Mat R, t;
         // recoverPose: x_curr = R x_prev + t, |t| = 1; mask keeps the points in front of
@@ -98,8 +95,7 @@ Eigen::Isometry3d MonoOdometry::Step(const cv::Mat& gray, double step_length) {
   }
   previous_ = std::move(current);
   ++frames_;
-  last_.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  last_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return pose_;
 }
 

@@ -11,11 +11,10 @@
 // front-end for monocular sequences such as ../shared/datasets/kitti00_first1700 (left frames).
 #pragma once
 
-#include <optional>
-#include <string>
-
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
+#include <optional>
+#include <string>
 
 #include "OpenABLE/odometry/calibration.h"
 #include "OpenABLE/odometry/features.h"

@@ -2,13 +2,12 @@
 
 #include <chrono>
 #include <cmath>
-#include <sstream>
-#include <stdexcept>
-#include <vector>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/ximgproc/disparity_filter.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
@@ -31,9 +30,8 @@ cv::Ptr<cv::StereoMatcher> LeftMatcher(const StereoOdometryOptions& o) {
   const DisparityOptions d = SgbmOptions(o);
   const int area = d.block_size * d.block_size;
   return cv::StereoSGBM::create(0, d.num_disparities, d.block_size, 8 * area, 32 * area,
-                                d.disp12_max_diff, 63, d.uniqueness_ratio,
-                                d.speckle_window_size, d.speckle_range,
-                                cv::StereoSGBM::MODE_SGBM);
+                                d.disp12_max_diff, 63, d.uniqueness_ratio, d.speckle_window_size,
+                                d.speckle_range, cv::StereoSGBM::MODE_SGBM);
 }
 
 }  // namespace
@@ -78,8 +76,7 @@ StereoOdometry::StereoOdometry(const Intrinsics& rectified_left, double baseline
       extractor_(options.features, options.max_features, "StereoOdometryOptions.features") {
   intrinsics_.Check("StereoOdometry");
   if (!(baseline > 0) || !std::isfinite(baseline))
-    throw InputError("StereoOdometry: baseline " + std::to_string(baseline) +
-                     " m, expected > 0");
+    throw InputError("StereoOdometry: baseline " + std::to_string(baseline) + " m, expected > 0");
 }
 
 Eigen::Isometry3d StereoOdometry::Step(const cv::Mat& left_gray, const cv::Mat& right_gray) {
@@ -151,8 +148,7 @@ Eigen::Isometry3d StereoOdometry::Step(const cv::Mat& left_gray, const cv::Mat& 
   previous_ = std::move(current);
   previous_disparity_ = disparity;
   ++frames_;
-  last_.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  last_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return pose_;
 }
 

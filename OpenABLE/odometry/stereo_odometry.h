@@ -14,10 +14,9 @@
 // right image gives no depth; a constant-velocity fallback when PnP fails.
 #pragma once
 
-#include <string>
-
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "OpenABLE/odometry/calibration.h"
 #include "OpenABLE/odometry/features.h"

@@ -1,12 +1,11 @@
 #include "OpenABLE/online/map_file.h"
 
 #include <fcntl.h>
+#include <libdeflate.h>
 #include <sys/file.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
-#include <libdeflate.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -31,7 +30,7 @@ namespace {
 constexpr char kSignature[] = "OpenABLE-map\r\n\x1a\n";
 constexpr size_t kSignatureBytes = 16;
 static_assert(sizeof(kSignature) == kSignatureBytes + 1, "16 bytes and the terminating zero");
-constexpr size_t kAlign = 64;      // sections start at multiples of this
+constexpr size_t kAlign = 64;       // sections start at multiples of this
 constexpr size_t kEntryBytes = 32;  // one entry of the table of sections
 constexpr std::uint32_t kMaxSections = 1u << 20;
 
@@ -163,8 +162,8 @@ RowShape RowShapeOf(const MapFile& map, const std::string& path) {
     throw InputError(path + ": setting \"row_type\" of the map is \"" + type_name +
                      "\": expected CV_8U or CV_32F");
   shape.type = type_name == "CV_8U" ? CV_8U : CV_32F;
-  shape.bytes = static_cast<std::uint64_t>(shape.frames) *
-                static_cast<std::uint64_t>(shape.width) * CV_ELEM_SIZE(shape.type);
+  shape.bytes = static_cast<std::uint64_t>(shape.frames) * static_cast<std::uint64_t>(shape.width) *
+                CV_ELEM_SIZE(shape.type);
   return shape;
 }
 
@@ -210,10 +209,10 @@ std::vector<RowShape> MoreRowShapes(const MapFile& map, const RowShape& first,
 void CheckRowBytes(std::uint64_t bytes, const RowShape& shape, const MapFile& map,
                    const std::string& path) {
   if (bytes != shape.bytes)
-    throw InputError(path + ": the map's rows take " + std::to_string(bytes) +
-                     " bytes; expected " + std::to_string(shape.bytes) + " (" +
-                     std::to_string(shape.frames) + " frames of " + std::to_string(shape.width) +
-                     " " + map.Setting("row_type") + ")");
+    throw InputError(path + ": the map's rows take " + std::to_string(bytes) + " bytes; expected " +
+                     std::to_string(shape.bytes) + " (" + std::to_string(shape.frames) +
+                     " frames of " + std::to_string(shape.width) + " " + map.Setting("row_type") +
+                     ")");
 }
 
 // The local features of `frames` frames (the encoding both versions share).
@@ -236,9 +235,9 @@ void ParseFeatures(Reader& r, int frames, const std::string& path, MapFile& map)
     // extracted them.
     if (drows < 0 || dcols < 0 || (dtype != CV_8UC1 && dtype != CV_32FC1) ||
         static_cast<std::uint32_t>(drows) != points || (drows > 0 && dcols == 0))
-      throw InputError(path + ": a frame's feature descriptors are " + std::to_string(drows) +
-                       "x" + std::to_string(dcols) + " of type " + std::to_string(dtype) +
-                       " for " + std::to_string(points) + " feature points: expected one " +
+      throw InputError(path + ": a frame's feature descriptors are " + std::to_string(drows) + "x" +
+                       std::to_string(dcols) + " of type " + std::to_string(dtype) + " for " +
+                       std::to_string(points) + " feature points: expected one " +
                        "CV_8UC1 (ORB) or CV_32FC1 (SIFT) row per point");
     if (drows > 0) {
       const size_t bytes =
@@ -265,7 +264,8 @@ MapFile ReadFirstVersion(const std::string& path, std::string_view data) {
                      " bytes): expected its contents and an 8-byte checksum");
   r.end = data.size() - 8;
   if (GetAt<std::uint64_t>(data.data() + r.end) != Fnv1a64(data.data(), r.end))
-    throw InputError(path + ": the map is damaged or truncated: its checksum does not match "
+    throw InputError(path +
+                     ": the map is damaged or truncated: its checksum does not match "
                      "its contents (expected the file exactly as SaveMap wrote it)");
   MapFile map;
   map.version = 1;
@@ -315,7 +315,8 @@ struct Mapped {
 std::shared_ptr<Mapped> MapWholeFile(const std::string& path, const std::string& expected) {
   std::error_code error;
   if (std::filesystem::symlink_status(path, error).type() == std::filesystem::file_type::not_found)
-    throw InputError("no map at " + Quoted(path) + " (create one with openable_map add, or "
+    throw InputError("no map at " + Quoted(path) +
+                     " (create one with openable_map add, or "
                      "OnlineDetector::SaveMap)");
   CheckInputFile(path, "map " + Quoted(path), expected);
   const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
@@ -359,11 +360,13 @@ std::string SectionName(const Section& s) {
   switch (s.kind) {
     case kRows:
       return s.a == 0 ? "its descriptor rows" : "the rows of its descriptor " + std::to_string(s.a);
-    case kFrameFiles: return "its frames' file names";
+    case kFrameFiles:
+      return "its frames' file names";
     case kBlock:
       return "the index block of rows " + std::to_string(s.a) + " to " +
              std::to_string(static_cast<std::uint64_t>(s.a) + s.b - 1);
-    default: return "section " + std::to_string(s.kind);
+    default:
+      return "section " + std::to_string(s.kind);
   }
 }
 
@@ -380,8 +383,8 @@ MapWriteLock::MapWriteLock(const std::string& path,
     if (errno != EWOULDBLOCK) {
       const int error = errno;
       ::close(fd_);
-      throw InputError("map lock " + Quoted(lock) + " cannot be taken (" +
-                       std::strerror(error) + ")");
+      throw InputError("map lock " + Quoted(lock) + " cannot be taken (" + std::strerror(error) +
+                       ")");
     }
     if (waiting) {
       // The holder wrote its process id there.
@@ -395,8 +398,8 @@ MapWriteLock::MapWriteLock(const std::string& path,
       if (errno == EINTR) continue;
       const int error = errno;
       ::close(fd_);
-      throw InputError("map lock " + Quoted(lock) + " cannot be taken (" +
-                       std::strerror(error) + ")");
+      throw InputError("map lock " + Quoted(lock) + " cannot be taken (" + std::strerror(error) +
+                       ")");
     }
   }
   const std::string pid = std::to_string(::getpid());
@@ -434,8 +437,8 @@ void CheckSessionTime(const std::string& time, const std::string& what) {
   int year = 0, month = 0, day = 0, hour = 0, minute = 0, second = 0;
   bool ok = time.size() >= 20 && time.size() <= 40 && digits(0, 4, year) && time[4] == '-' &&
             digits(5, 2, month) && time[7] == '-' && digits(8, 2, day) && time[10] == 'T' &&
-            digits(11, 2, hour) && time[13] == ':' && digits(14, 2, minute) &&
-            time[16] == ':' && digits(17, 2, second) && time.back() == 'Z';
+            digits(11, 2, hour) && time[13] == ':' && digits(14, 2, minute) && time[16] == ':' &&
+            digits(17, 2, second) && time.back() == 'Z';
   if (ok && time.size() > 20) {  // decimals of the second: ".d..."
     ok = time[19] == '.' && time.size() > 21;
     for (size_t i = 20; ok && i + 1 < time.size(); ++i) ok = time[i] >= '0' && time[i] <= '9';
@@ -446,7 +449,8 @@ void CheckSessionTime(const std::string& time, const std::string& what) {
        day <= kDays[month - 1] + (month == 2 && leap ? 1 : 0) && hour <= 23 && minute <= 59 &&
        second <= 60;  // 60: a leap second
   if (!ok)
-    throw InputError(what + " " + Quoted(time) + ": expected a UTC time in ISO 8601, "
+    throw InputError(what + " " + Quoted(time) +
+                     ": expected a UTC time in ISO 8601, "
                      "YYYY-MM-DDTHH:MM:SSZ (e.g. 2026-11-27T09:30:00Z)");
 }
 
@@ -454,7 +458,8 @@ void CheckSessionName(const std::string& name, const std::string& what) {
   bool ok = !name.empty() && name.size() <= 200 && name.front() != ' ' && name.back() != ' ';
   for (const char c : name) ok = ok && !IsControl(c);
   if (!ok)
-    throw InputError(what + " " + Quoted(name) + ": expected a session name of 1 to 200 "
+    throw InputError(what + " " + Quoted(name) +
+                     ": expected a session name of 1 to 200 "
                      "printable characters (no tab or line break, no space at either end)");
 }
 
@@ -487,13 +492,15 @@ void WriteMapFile(const std::string& path, const MapFile& map) {
   for (size_t k = 0; k < map.more_rows.size(); ++k) {
     const cv::Mat* m = &map.more_rows[k];
     if (!m->isContinuous()) m = &continuous.emplace_back(m->clone());
-    pieces.push_back({kRows, static_cast<std::uint32_t>(k + 1), 0,
-                      {View(m->data, m->total() * m->elemSize())}});
+    pieces.push_back(
+        {kRows, static_cast<std::uint32_t>(k + 1), 0, {View(m->data, m->total() * m->elemSize())}});
   }
   for (const auto& b : map.blocks) {
     const SavedIndex bytes = b.Bytes();
-    pieces.push_back({kBlock, static_cast<std::uint32_t>(b.first),
-                      static_cast<std::uint32_t>(b.count), {View(bytes.data, bytes.size)}});
+    pieces.push_back({kBlock,
+                      static_cast<std::uint32_t>(b.first),
+                      static_cast<std::uint32_t>(b.count),
+                      {View(bytes.data, bytes.size)}});
   }
   if (!map.frame_files.empty()) {
     std::string files;
@@ -575,10 +582,10 @@ MapFile ReadMapFile(const std::string& path, const MapReadOptions& options) {
   const auto version = r.Get<std::uint32_t>("the format version");
   if (version == 1) return ReadFirstVersion(path, std::string_view(data, size));
   if (version != 2 && version != kMapFormatVersion)
-    throw InputError(path + ": map format version " + std::to_string(version) + "; this " +
-                     "OpenABLE reads versions 1 to " + std::to_string(kMapFormatVersion) +
-                     (version > kMapFormatVersion ? " (the map was written by a newer OpenABLE)"
-                                                  : ""));
+    throw InputError(
+        path + ": map format version " + std::to_string(version) + "; this " +
+        "OpenABLE reads versions 1 to " + std::to_string(kMapFormatVersion) +
+        (version > kMapFormatVersion ? " (the map was written by a newer OpenABLE)" : ""));
   const auto count = r.Get<std::uint32_t>("the section count");
   if (count > kMaxSections)
     throw InputError(path + ": the map is damaged: its table names " + std::to_string(count) +
@@ -587,7 +594,8 @@ MapFile ReadMapFile(const std::string& path, const MapReadOptions& options) {
   r.Take(static_cast<size_t>(count) * kEntryBytes, "the table of sections");
   const auto stored = r.Get<std::uint32_t>("the table's checksum");
   if (stored != Crc32(data, r.pos - 4))
-    throw InputError(path + ": the map is damaged: the checksum of its table of sections does "
+    throw InputError(path +
+                     ": the map is damaged: the checksum of its table of sections does "
                      "not match (expected the file exactly as it was saved)");
   const std::uint32_t last_kind = version == 2 ? kFeatures : kFrameFiles;
   for (std::uint32_t i = 0; i < count; ++i) {
@@ -603,7 +611,8 @@ MapFile ReadMapFile(const std::string& path, const MapReadOptions& options) {
       throw InputError(path + ": the map is truncated: section " + std::to_string(i) +
                        " takes bytes " + std::to_string(s.offset) + " to " +
                        std::to_string(s.offset + s.bytes) + " of a file of " +
-                       std::to_string(size) + " bytes (expected the file exactly as it was "
+                       std::to_string(size) +
+                       " bytes (expected the file exactly as it was "
                        "saved)");
     if (s.kind < kSettings || s.kind > last_kind)
       throw InputError(path + ": the map's section " + std::to_string(i) + " is of kind " +
@@ -628,7 +637,8 @@ MapFile ReadMapFile(const std::string& path, const MapReadOptions& options) {
                     (k == kFeatures && i + 1 == count);
     if (!ok)
       throw InputError(path + ": the map's section " + std::to_string(i) + " is of kind " +
-                       std::to_string(k) + "; expected the rows of each descriptor, index "
+                       std::to_string(k) +
+                       "; expected the rows of each descriptor, index "
                        "blocks, the frames' files, then the features last");
     if (k == kFrameFiles) i_files = i;
   }
@@ -636,8 +646,8 @@ MapFile ReadMapFile(const std::string& path, const MapReadOptions& options) {
   MapFile map;
   map.version = version;
   for (int i = 0; i < 2; ++i) {
-    const std::string error = CheckSection(data, sections[i], path,
-                                           i == 0 ? "its settings" : "its sessions");
+    const std::string error =
+        CheckSection(data, sections[i], path, i == 0 ? "its settings" : "its sessions");
     if (!error.empty()) throw InputError(error);
   }
   ParseSettings(View(data + sections[0].offset, sections[0].bytes), path, map);
@@ -712,8 +722,8 @@ MapFile ReadMapFile(const std::string& path, const MapReadOptions& options) {
     map.has_features = true;
     ParseFeatures(fr, shape.frames, path, map);
     if (fr.pos != fr.end)
-      throw InputError(path + ": the map's local features have " +
-                       std::to_string(fr.end - fr.pos) + " bytes after the last frame's");
+      throw InputError(path + ": the map's local features have " + std::to_string(fr.end - fr.pos) +
+                       " bytes after the last frame's");
   }
 
   // The frames' files: small, checked and parsed here.

@@ -29,19 +29,18 @@
 //     kind 6  (optional) the image file of each frame, a line each ("" when not known)
 //     kind 5  local features, each frame: u32 points, 2 f32 a point, i32 rows, i32 cols,
 //             i32 OpenCV type, the descriptor bytes
-// Version 2 (one descriptor, no files) and version 1 (one session, no table, one FNV-1a 64 checksum at the end) is still read: its
-// frames become one session named "default".
+// Version 2 (one descriptor, no files) and version 1 (one session, no table, one FNV-1a 64 checksum
+// at the end) is still read: its frames become one session named "default".
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <future>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/verification/verification.h"
 #include "matching/search/incremental_index.h"
@@ -71,7 +70,7 @@ void CheckSessionTime(const std::string& time, const std::string& what);
 void CheckSessionName(const std::string& name, const std::string& what);
 
 struct MapFile {
-  std::uint32_t version = kMapFormatVersion;  // of the file read
+  std::uint32_t version = kMapFormatVersion;                  // of the file read
   std::vector<std::pair<std::string, std::string>> settings;  // in the file's order
   std::vector<MapSession> sessions;  // tiling frames 0 .. rows.rows - 1 in order
   cv::Mat rows;  // frames x width, CV_8U or CV_32F, continuous: the first descriptor's

@@ -15,21 +15,21 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/interrupt.h"
+#include "OpenABLE/base/output_batch.h"
 #include "OpenABLE/base/progress.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/base/threading.h"
+#include "OpenABLE/evaluation/report.h"
 #include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/io/json.h"
 #include "OpenABLE/online/map_file.h"
-#include "OpenABLE/base/output_batch.h"
-#include "OpenABLE/evaluation/report.h"
 #include "OpenABLE/online/online.h"
 #include "OpenABLE/reports/evaluation_files.h"
 #include "OpenABLE/reports/html_report.h"
 #include "OpenABLE/run/evaluate.h"
+#include "OpenABLE/run/given_rows.h"
 #include "OpenABLE/tuning/auto.h"
 #include "config/config.h"
-#include "OpenABLE/run/given_rows.h"
 #include "descriptors/registry.h"
 
 namespace openable {
@@ -53,7 +53,8 @@ const char* const kUsageText =
     "         name), creating MAP when it does not exist. A new map takes its description and\n"
     "         index settings from --config FILE (a Config.txt) and --set, else the defaults\n"
     "         (LDB 256 bits, global), and keeps the search they give (L, score, threshold,\n"
-    "         confirmation) for its queries. With the auto preset (--config config/presets/auto.txt,\n"
+    "         confirmation) for its queries. With the auto preset (--config "
+    "config/presets/auto.txt,\n"
     "         Auto 1) the map keeps the rows of every descriptor of its candidates, so that\n"
     "         tune can choose among them. An existing map keeps its own settings, and a\n"
     "         --config that describes otherwise is refused. The frames must be of the map's\n"
@@ -114,10 +115,9 @@ using Arguments = MapCommandLine;
 
 // One line naming the bad argument, or "".
 std::string Parse(int argc, const char* const* argv, Arguments& a) {
-  const std::vector<std::string> with_value = {"--images", "--session",   "--time",
-                                               "--config", "--set",       "-o",
-                                               "--output", "--threshold", "--frames",
-                                               "--descriptors"};
+  const std::vector<std::string> with_value = {
+      "--images", "--session", "--time",      "--config", "--set",
+      "-o",       "--output",  "--threshold", "--frames", "--descriptors"};
   for (int i = 1; i < argc; ++i) {
     std::string arg = argv[i], value;
     const std::size_t eq = arg.find('=');
@@ -131,15 +131,24 @@ std::string Parse(int argc, const char* const* argv, Arguments& a) {
         if (i + 1 >= argc) return arg + " needs a value";
         value = argv[++i];
       }
-      if (arg == "--images") a.images = value;
-      else if (arg == "--session") a.sessions.push_back(value);
-      else if (arg == "--time") a.time = value;
-      else if (arg == "--config") a.config = value;
-      else if (arg == "--set") a.sets.push_back(value);
-      else if (arg == "--threshold") a.threshold = value;
-      else if (arg == "--frames") a.frames = value;
-      else if (arg == "--descriptors") a.descriptors = value;
-      else a.output = value;
+      if (arg == "--images")
+        a.images = value;
+      else if (arg == "--session")
+        a.sessions.push_back(value);
+      else if (arg == "--time")
+        a.time = value;
+      else if (arg == "--config")
+        a.config = value;
+      else if (arg == "--set")
+        a.sets.push_back(value);
+      else if (arg == "--threshold")
+        a.threshold = value;
+      else if (arg == "--frames")
+        a.frames = value;
+      else if (arg == "--descriptors")
+        a.descriptors = value;
+      else
+        a.output = value;
     } else if (arg == "--json") {
       a.json = true;
     } else if (arg == "--quiet" || arg == "-q") {
@@ -160,8 +169,7 @@ std::string Parse(int argc, const char* const* argv, Arguments& a) {
   if (a.positional.size() != maps)
     return a.command + " takes " + (maps == 1 ? "one map" : "two maps (A B)") + ", got " +
            std::to_string(a.positional.size()) + " paths";
-  if ((a.command == "add" || a.command == "query") && a.images.empty() &&
-      a.descriptors.empty())
+  if ((a.command == "add" || a.command == "query") && a.images.empty() && a.descriptors.empty())
     return a.command + " needs --images FOLDER (or --descriptors FILE.npy)";
   if (a.command == "add" && a.sessions.size() != 1)
     return "add needs one --session NAME (the new session's name)";
@@ -177,8 +185,7 @@ std::string Parse(int argc, const char* const* argv, Arguments& a) {
   for (const std::string& problem :
        {only(!a.images.empty(), "--images", {"add", "query"}),
         only(!a.descriptors.empty(), "--descriptors", {"add", "query"}),
-        only(!a.time.empty(), "--time", {"add"}),
-        only(!a.frames.empty(), "--frames", {"tune"}),
+        only(!a.time.empty(), "--time", {"add"}), only(!a.frames.empty(), "--frames", {"tune"}),
         only(!a.threshold.empty(), "--threshold", {"add", "tune", "query"}),
         only(!a.config.empty() || !a.sets.empty(), "--config/--set", {"add", "tune", "query"}),
         only(!a.output.empty() && a.command != "merge", "--output", {"query"}),
@@ -197,9 +204,9 @@ Config ConfigOf(const Arguments& a) {
 // The keys of the search (the settings Tune chooses and a query may set otherwise).
 const std::vector<std::string>& SearchKeys() {
   static const std::vector<std::string> keys = {
-      "Image_descriptor", "Fusion_weights", "Image_sequences", "Contrast_enhancement",
-      "Contrast_window", "Match_score", "Match_score_window", "Match_threshold",
-      "Match_consistency"};
+      "Image_descriptor",     "Fusion_weights",  "Image_sequences",
+      "Contrast_enhancement", "Contrast_window", "Match_score",
+      "Match_score_window",   "Match_threshold", "Match_consistency"};
   return keys;
 }
 
@@ -235,8 +242,8 @@ void SetSearchKey(const Config& c, const std::string& key, OnlineOptions& o) {
     if (o.fusion_weights.size() != searched.size()) o.fusion_weights.clear();
   } else if (key == "Fusion_weights") {
     const int names = static_cast<int>(DescriptorList(o.descriptor.name).size());
-    o.fusion_weights = m.fusion_weights.empty() || names < 2 ? std::vector<double>{}
-                                                            : m.FusionWeights(names);
+    o.fusion_weights =
+        m.fusion_weights.empty() || names < 2 ? std::vector<double>{} : m.FusionWeights(names);
   } else if (key == "Image_sequences") {
     o.sequence_length = m.sequence_length;
   } else if (key == "Contrast_enhancement") {
@@ -322,7 +329,8 @@ void ForImagesOf(const std::string& folder, bool quiet, const char* what, Body b
   for (std::size_t first = 0; first < files.size(); first += chunk) {
     if (first == 0 && !files.empty()) {
       const cv::Mat probe = ReadImageFile(files.front());
-      const double bytes = std::max<double>(1.0, static_cast<double>(probe.total() * probe.elemSize()));
+      const double bytes =
+          std::max<double>(1.0, static_cast<double>(probe.total() * probe.elemSize()));
       const std::size_t threads = static_cast<std::size_t>(EffectiveThreads(0));
       chunk = std::clamp<std::size_t>(static_cast<std::size_t>(256e6 / bytes), threads, 512);
     }
@@ -338,7 +346,8 @@ void ForImagesOf(const std::string& folder, bool quiet, const char* what, Body b
         images[static_cast<std::size_t>(i)] = ReadImageFile(names[static_cast<std::size_t>(i)]);
       } catch (const std::exception& e) {
         std::lock_guard<std::mutex> lock(mutex);
-        if (static_cast<std::size_t>(i) < error_at) error_at = static_cast<std::size_t>(i), error = e.what();
+        if (static_cast<std::size_t>(i) < error_at)
+          error_at = static_cast<std::size_t>(i), error = e.what();
       }
     });
     if (error_at < n) throw InputError(error);
@@ -362,7 +371,8 @@ void RequireNoFeatures(const std::string& path) {
   read.header_only = true;
   const std::string features = ReadMapFile(path, read).Setting("features");
   if (!features.empty() && features != "none")
-    throw InputError(path + ": the map holds " + features + " features for verified loops, "
+    throw InputError(path + ": the map holds " + features +
+                     " features for verified loops, "
                      "which openable_map does not keep; expected a map saved without "
                      "verification (add to this one with OnlineDetector::AddFrame and "
                      "verification on)");
@@ -382,8 +392,7 @@ std::string DescriptionOf(const OnlineOptions& o) {
   for (const std::string& n : DescriptorList(o.descriptor.name)) names.push_back(Upper(n));
   if (!o.kept_descriptors.empty())
     for (const std::string& n : DescriptorList(o.kept_descriptors))
-      if (std::find(names.begin(), names.end(), Upper(n)) == names.end())
-        names.push_back(Upper(n));
+      if (std::find(names.begin(), names.end(), Upper(n)) == names.end()) names.push_back(Upper(n));
   std::sort(names.begin(), names.end());
   std::string list;
   for (const std::string& n : names) list += (list.empty() ? "" : "+") + n;
@@ -391,8 +400,8 @@ std::string DescriptionOf(const OnlineOptions& o) {
   if (std::find(names.begin(), names.end(), "ONNX") != names.end())
     network = " (network input " + o.descriptor.model_input_size + " " +
               o.descriptor.model_channels + ", mean " + o.descriptor.model_mean + ", std " +
-              o.descriptor.model_std + ", normalize " +
-              (o.descriptor.model_normalize ? "1" : "0") + ")";
+              o.descriptor.model_std + ", normalize " + (o.descriptor.model_normalize ? "1" : "0") +
+              ")";
   return list + " " + std::to_string(o.descriptor.patch_size) + " " +
          std::to_string(o.descriptor.ldb_bits) + " " + EnumName(o.description) + " " +
          std::to_string(o.grid_x) + "x" + std::to_string(o.grid_y) + network;
@@ -441,8 +450,8 @@ GivenRowsOfCommand GivenRowsOf(const Arguments& a) {
     out.names = ListImages(a.images, "");
     if (out.names.size() != static_cast<size_t>(out.rows.rows))
       throw InputError("--descriptors: " + Quoted(a.descriptors) + " holds " +
-                       std::to_string(out.rows.rows) + " rows, but --images " +
-                       Quoted(a.images) + " holds " + std::to_string(out.names.size()) +
+                       std::to_string(out.rows.rows) + " rows, but --images " + Quoted(a.images) +
+                       " holds " + std::to_string(out.names.size()) +
                        " images; expected one row per image, in the natural order of their names");
   }
   return out;
@@ -460,7 +469,8 @@ bool MapOfGivenRows(const std::string& path) {
 void CheckRowsFitMap(const Arguments& a, const std::string& path) {
   const bool given = MapOfGivenRows(path);
   if (given && a.descriptors.empty())
-    throw InputError(path + ": the map's rows were computed elsewhere (openable_map add "
+    throw InputError(path +
+                     ": the map's rows were computed elsewhere (openable_map add "
                      "--descriptors); expected --descriptors FILE.npy with the rows of these "
                      "frames, computed the same way");
   if (!given && !a.descriptors.empty())
@@ -506,7 +516,8 @@ int Add(const Arguments& a) {
     if (configured && DescriptionOf(have) != DescriptionOf(wanted))
       throw InputError(path + ": the map describes frames with " + DescriptionOf(have) +
                        " (descriptors, patch, LDB bits, description, grid); --config/--set ask "
-                       "for " + DescriptionOf(wanted) + " (expected the map's own settings)");
+                       "for " +
+                       DescriptionOf(wanted) + " (expected the map's own settings)");
   } else {
     d = std::make_unique<OnlineDetector>(wanted);
   }
@@ -518,19 +529,19 @@ int Add(const Arguments& a) {
     else
       d->AddToMap(given.rows, given.names);
   } else {
-    ForImagesOf(a.images, a.quiet, "describing", [&](const std::vector<cv::Mat>& images,
-                                                     const std::vector<std::string>& names) {
-      d->AddImagesToMap(images, names);
-    });
+    ForImagesOf(a.images, a.quiet, "describing",
+                [&](const std::vector<cv::Mat>& images, const std::vector<std::string>& names) {
+                  d->AddImagesToMap(images, names);
+                });
   }
   d->SaveMap(path);
   SetInterruptNote(path + " holds session " + Quoted(a.sessions[0]));
   if (!a.quiet) {
-    std::cout << (exists ? "Appended" : "Created") << " session " << Quoted(a.sessions[0])
-              << ": " << d->Size() - before << " frames; " << path << " holds "
-              << d->Size() << " frames in " << d->Sessions().size() << " session"
-              << (d->Sessions().size() == 1 ? "" : "s") << " (descriptors "
-              << JoinedChannels(*d) << ").\n";
+    std::cout << (exists ? "Appended" : "Created") << " session " << Quoted(a.sessions[0]) << ": "
+              << d->Size() - before << " frames; " << path << " holds " << d->Size()
+              << " frames in " << d->Sessions().size() << " session"
+              << (d->Sessions().size() == 1 ? "" : "s") << " (descriptors " << JoinedChannels(*d)
+              << ").\n";
     if (d->Sessions().size() >= 2 && !d->Tuning().tuned)
       std::cout << "Next: openable_map tune " << path
                 << " chooses the search settings from its first two sessions.\n";
@@ -586,12 +597,11 @@ int Info(const Arguments& a) {
       if (k != "tuned_candidates") settings[k] = v;
     Json sessions = Json::array();
     for (const MapSession& s : map.sessions)
-      sessions.push_back({{"name", s.name}, {"time", s.time}, {"first", s.first},
-                          {"frames", s.count}});
+      sessions.push_back(
+          {{"name", s.name}, {"time", s.time}, {"first", s.first}, {"frames", s.count}});
     Json blocks = Json::array();
     for (const auto& b : map.blocks)
-      blocks.push_back({{"first", b.first}, {"frames", b.count},
-                        {"bytes", b.Bytes().size}});
+      blocks.push_back({{"first", b.first}, {"frames", b.count}, {"bytes", b.Bytes().size}});
     std::cout << json::Dump({{"map", path},
                              {"format_version", map.version},
                              {"frames", map.rows.rows},
@@ -606,8 +616,8 @@ int Info(const Arguments& a) {
   }
   std::cout << path << ": OpenABLE map, format version " << map.version << ", " << map.rows.rows
             << " frames, " << bytes << " bytes ("
-            << cv::format("%.1f", map.rows.rows > 0 ? static_cast<double>(bytes) / map.rows.rows
-                                                     : 0.0)
+            << cv::format("%.1f",
+                          map.rows.rows > 0 ? static_cast<double>(bytes) / map.rows.rows : 0.0)
             << " a frame); checksums match\n";
   if (Upper(map.Setting("descriptor")) == "NPY")
     std::cout << "Descriptors: NPY, rows computed elsewhere (openable_map add --descriptors): "
@@ -618,10 +628,8 @@ int Info(const Arguments& a) {
   else
     std::cout << "Descriptors: " << JoinedChannels(*d) << ", patch " << map.Setting("patch_size")
               << ", " << map.Setting("ldb_bits") << " LDB bits, " << map.Setting("description")
-              << " (grid " << map.Setting("grid_x") << "x" << map.Setting("grid_y")
-              << "); frames "
-              << (map.Setting("frame_size").empty() ? "of unknown size"
-                                                    : map.Setting("frame_size"))
+              << " (grid " << map.Setting("grid_x") << "x" << map.Setting("grid_y") << "); frames "
+              << (map.Setting("frame_size").empty() ? "of unknown size" : map.Setting("frame_size"))
               << "\n";
   if (!map.Setting("model_weights").empty())
     std::cout << "Network: " << map.Setting("model_path") << " (weights "
@@ -633,16 +641,14 @@ int Info(const Arguments& a) {
             << (tuning.tuned ? "" : " (not tuned: openable_map tune chooses it from the data)")
             << "\n";
   std::cout << TuningText(tuning);
-  std::cout << "Index: " << map.Setting("engine") << ", exact up to "
-            << map.Setting("exact_limit") << " frames, blocks of " << map.Setting("block_frames")
-            << " x 2^m frames (" << map.blocks.size() << " block"
-            << (map.blocks.size() == 1 ? "" : "s") << "), exclusion "
-            << map.Setting("exclusion") << "\n";
+  std::cout << "Index: " << map.Setting("engine") << ", exact up to " << map.Setting("exact_limit")
+            << " frames, blocks of " << map.Setting("block_frames") << " x 2^m frames ("
+            << map.blocks.size() << " block" << (map.blocks.size() == 1 ? "" : "s")
+            << "), exclusion " << map.Setting("exclusion") << "\n";
   std::cout << "Sessions:\n";
   for (const MapSession& s : map.sessions)
     std::cout << "  " << ToValidUtf8(s.name) << "  " << (s.time.empty() ? "-" : s.time)
-              << "  frames " << s.first << "-" << s.first + s.count - 1 << " (" << s.count
-              << ")\n";
+              << "  frames " << s.first << "-" << s.first + s.count - 1 << " (" << s.count << ")\n";
   return 0;
 }
 
@@ -654,8 +660,8 @@ int Merge(const Arguments& a) {
   d->SaveMap(a.output);
   SetInterruptNote(a.output + " written");
   if (!a.quiet)
-    std::cout << "Wrote " << a.output << ": " << d->Size() << " frames in "
-              << d->Sessions().size() << " sessions.\n";
+    std::cout << "Wrote " << a.output << ": " << d->Size() << " frames in " << d->Sessions().size()
+              << " sessions.\n";
   return 0;
 }
 
@@ -686,7 +692,8 @@ int Tune(const Arguments& a) {
       used = 0;
     }
     if (used != a.frames.size() || n < 1 || n > 100000000)
-      throw InputError("--frames " + Quoted(a.frames) + ": expected a whole number >= 1 (the "
+      throw InputError("--frames " + Quoted(a.frames) +
+                       ": expected a whole number >= 1 (the "
                        "first frames of each session to judge on)");
     t.max_frames = static_cast<int>(n);
   }
@@ -771,8 +778,9 @@ ReportFrames QueryFrames(const std::vector<std::string>& names, const OnlineDete
   ReportFrames frames;
   const std::vector<std::string>& files = d.FrameFiles();
   if (files.empty()) {
-    frames.missing = "the map keeps no image file of its frames (a map saved before format 3, "
-                     "or frames added without names)";
+    frames.missing =
+        "the map keeps no image file of its frames (a map saved before format 3, "
+        "or frames added without names)";
     return frames;
   }
   const auto file = [&names, &files, columns](bool row, int index) {
@@ -829,29 +837,32 @@ std::vector<std::string> WriteQueryOutputs(const std::string& prefix, const Conf
   ReportInput report;
   report.program = "openable_map query";
   const std::string queries = a.images.empty() ? a.descriptors : a.images;
-  report.title = "OpenABLE map query: " + FileName(queries) + " against " +
-                 FileName(a.positional[0]);
-  report.settings = {{"map", a.positional[0]},
-                     {"queries", queries},
-                     {"sessions searched", a.sessions.empty() ? "all" : json::Strings(a.sessions).dump()},
-                     {"search", SearchText(o)},
-                     {"tuned", d.Tuning().tuned ? (d.UsesTuning() ? "yes, used" : "yes, replaced")
-                                                : "no"}};
-  report.settings_note = "The map, the query's frames and the search it used (openable_map "
-                         "info gives the map's settings).";
+  report.title =
+      "OpenABLE map query: " + FileName(queries) + " against " + FileName(a.positional[0]);
+  report.settings = {
+      {"map", a.positional[0]},
+      {"queries", queries},
+      {"sessions searched", a.sessions.empty() ? "all" : json::Strings(a.sessions).dump()},
+      {"search", SearchText(o)},
+      {"tuned", d.Tuning().tuned ? (d.UsesTuning() ? "yes, used" : "yes, replaced") : "no"}};
+  report.settings_note =
+      "The map, the query's frames and the search it used (openable_map "
+      "info gives the map's settings).";
   report.examples = config.evaluation.report_examples;
   Evaluation evaluation;
   if (EvaluationRequested(config)) {
     if (a.sessions.size() != 1)
-      throw InputError("Ground_truth_type " + Quoted(GroundTruthTypeName(config.evaluation.truth.type)) +
-                       " with " + (a.sessions.empty() ? "every session" : "several sessions") +
+      throw InputError("Ground_truth_type " +
+                       Quoted(GroundTruthTypeName(config.evaluation.truth.type)) + " with " +
+                       (a.sessions.empty() ? "every session" : "several sessions") +
                        " searched: expected one --session NAME, the reference traversal the "
                        "ground truth is of");
     if (block.empty())
-      throw InputError("Ground_truth_type: the query used the map's index (the session holds "
-                       "more than exact_limit frames), so there is no matrix to evaluate; "
-                       "expected a session of at most " + std::to_string(o.exact_limit) +
-                       " frames");
+      throw InputError(
+          "Ground_truth_type: the query used the map's index (the session holds "
+          "more than exact_limit frames), so there is no matrix to evaluate; "
+          "expected a session of at most " +
+          std::to_string(o.exact_limit) + " frames");
     Config c = config;
     c.matching.score = o.score;
     c.matching.score_window = o.score_window;
@@ -966,8 +977,8 @@ int Query(const Arguments& a) {
                 << tuning.chosen << "); its verdict does not apply to them\n";
     else if (!tuning.reliable)
       std::cerr << "UNRELIABLE: the map's tuned settings could not be trusted (consistency "
-                << FormatFixed(tuning.consistency, 3) << " below " << FormatNumber(tuning.min_consistency)
-                << "): no match is accepted\n";
+                << FormatFixed(tuning.consistency, 3) << " below "
+                << FormatNumber(tuning.min_consistency) << "): no match is accepted\n";
   }
   std::vector<cv::Mat> rows;
   std::vector<std::string> names;
@@ -990,17 +1001,17 @@ int Query(const Arguments& a) {
   ProgressReporter progress(std::cerr, !quiet, isatty(STDERR_FILENO) != 0);
   progress.Begin("matching queries", all.rows, "frames");
   OnlineDetector::QueryMatrix out;
-  const std::vector<OnlineResult> results =
-      d->Query(all, a.sessions, [&](int done, int) { progress.Update(done); },
-               a.output.empty() ? nullptr : &out);
+  const std::vector<OnlineResult> results = d->Query(
+      all, a.sessions, [&](int done, int) { progress.Update(done); },
+      a.output.empty() ? nullptr : &out);
   progress.End();
   // Nothing is printed from a map whose checksums do not match.
   d->CheckMap();
   const auto& sessions = d->Sessions();
   std::vector<QueryRow> table;
   for (std::size_t i = 0; i < results.size(); ++i)
-    table.push_back({FileName(names[i]),
-                     results[i].candidates.empty() ? nullptr : &results[i].candidates[0]});
+    table.push_back(
+        {FileName(names[i]), results[i].candidates.empty() ? nullptr : &results[i].candidates[0]});
   Json queries = Json::array();
   for (const QueryRow& row : table) queries.push_back(QueryJson(row, sessions));
   const Json document = {{"map", path},

@@ -13,7 +13,7 @@ struct MapCommandLine {
   std::string command;                  // add, tune, info, merge, query
   std::vector<std::string> positional;  // the map(s)
   std::string images, config, time, output, threshold, frames;
-  std::string descriptors;              // --descriptors: rows computed elsewhere (.npy)
+  std::string descriptors;  // --descriptors: rows computed elsewhere (.npy)
   std::vector<std::string> sessions, sets;
   bool json = false, quiet = false;
 };

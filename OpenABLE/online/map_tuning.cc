@@ -32,7 +32,6 @@ Metric MetricOfDescriptor(const std::string& name, const OnlineOptions& options)
   return MetricOf(*CreateDescriptor(d));
 }
 
-
 // The keys a map's tuning may vary: the rows are described already, so only what is computed
 // from them.
 const std::set<std::string>& TunableKeys() {
@@ -59,20 +58,21 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
   CheckMap();
   const OnlineOptions& options = Options();
   if (options.verification.enabled)
-    throw InputError("tune: verification is on (OnlineOptions::verification.enabled), which "
-                     "decides the accepted loops itself; expected a detector without it");
+    throw InputError(
+        "tune: verification is on (OnlineOptions::verification.enabled), which "
+        "decides the accepted loops itself; expected a detector without it");
   const std::vector<MapSession>& sessions = Sessions();
   std::vector<MapSession> nonempty;
   for (const MapSession& m : sessions)
     if (m.count > 0) nonempty.push_back(m);
   if ((t.reference.empty() || t.query.empty()) && nonempty.size() < 2)
     throw InputError("tune: the map holds " + std::to_string(nonempty.size()) + " session" +
-                     (nonempty.size() == 1 ? "" : "s") + " with frames; expected two "
+                     (nonempty.size() == 1 ? "" : "s") +
+                     " with frames; expected two "
                      "traversals of the route (add a second session first)");
   const MapSession& ref =
       t.reference.empty() ? nonempty[0] : SessionNamed(sessions, t.reference, "reference");
-  const MapSession& qry =
-      t.query.empty() ? nonempty[1] : SessionNamed(sessions, t.query, "query");
+  const MapSession& qry = t.query.empty() ? nonempty[1] : SessionNamed(sessions, t.query, "query");
   if (ref.name == qry.name)
     throw InputError("tune: reference and query are both session " + Quoted(ref.name) +
                      "; expected two sessions (two traversals of the route)");
@@ -103,8 +103,7 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
   base.matching.score_window = options.score_window;
   const auto held = [&](const Config& c) {
     for (const std::string& name : DescriptorList(c.descriptor.name))
-      if (std::find(channels.begin(), channels.end(), Upper(name)) == channels.end())
-        return false;
+      if (std::find(channels.begin(), channels.end(), Upper(name)) == channels.end()) return false;
     return true;
   };
   const bool given = !t.candidates.empty();
@@ -113,9 +112,12 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
        ParseAutoCandidates(given ? t.candidates : AutoOptions::kDefaultCandidates)) {
     for (const auto& [key, value] : candidate)
       if (TunableKeys().count(key) == 0)
-        throw InputError("tune: Auto_candidates: " + key + " changes how frames are described, "
+        throw InputError("tune: Auto_candidates: " + key +
+                         " changes how frames are described, "
                          "and the map's rows are described already; expected candidates of "
-                         "Image_descriptor (among " + JoinStrings(channels, ", ") + "), "
+                         "Image_descriptor (among " +
+                         JoinStrings(channels, ", ") +
+                         "), "
                          "Fusion_weights, Image_sequences, Contrast_enhancement and "
                          "Contrast_window");
     Config c = AutoCandidateConfig(base, candidate);
@@ -124,17 +126,20 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
     } else if (given) {
       throw InputError("tune: Auto_candidates: " + Quoted(AutoSettingsText(candidate)) +
                        " needs rows the map does not hold (it holds " +
-                       JoinStrings(channels, ", ") + "); expected descriptors among them, or a "
+                       JoinStrings(channels, ", ") +
+                       "); expected descriptors among them, or a "
                        "map made with their rows (openable_map add --config "
                        "config/presets/auto.txt keeps those of the auto preset)");
     } else if (log) {
-      log("tune: skipped " + AutoSettingsText(candidate) + " (the map holds no rows of its "
+      log("tune: skipped " + AutoSettingsText(candidate) +
+          " (the map holds no rows of its "
           "descriptor; a map made with config/presets/auto.txt keeps them)");
     }
   }
   if (candidates.empty())
     throw InputError("tune: none of the default candidates uses the map's descriptors (" +
-                     JoinStrings(channels, ", ") + "); expected candidates given with "
+                     JoinStrings(channels, ", ") +
+                     "); expected candidates given with "
                      "--candidates (Auto_candidates' syntax)");
   const AutoPlan plan = PlanCandidates(base, candidates);
 
@@ -147,15 +152,15 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
   const double bytes = cells * 4.0 * (static_cast<double>(names.size()) + 2);
   if (bytes > 16e9)
     throw InputError("tune: sessions of " + std::to_string(references) + " and " +
-                     std::to_string(queries) + " frames need " +
-                     FormatFixed(bytes / 1e9, 1) + " GB to compare every pair with " +
-                     std::to_string(names.size()) + " descriptors; expected at most 16 GB (judge "
+                     std::to_string(queries) + " frames need " + FormatFixed(bytes / 1e9, 1) +
+                     " GB to compare every pair with " + std::to_string(names.size()) +
+                     " descriptors; expected at most 16 GB (judge "
                      "on the first frames of each: max_frames, openable_map tune --frames N)");
   SingleFrameStore store;
   std::map<std::string, cv::Mat1f> matrices;
   for (const std::string& name : names) {
-    const size_t c = static_cast<size_t>(
-        std::find(channels.begin(), channels.end(), name) - channels.begin());
+    const size_t c =
+        static_cast<size_t>(std::find(channels.begin(), channels.end(), name) - channels.begin());
     const cv::Mat all = ChannelRows(static_cast<int>(c));
     cv::Mat rows;
     cv::vconcat(all.rowRange(ref.first, ref.first + references),
@@ -186,7 +191,8 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
   search.contrast_window = m.contrast_window;
   search.sequence_length = m.sequence_length;
   search.score = MatchScore::kRatio;
-  search.threshold = t.threshold >= 0 ? t.threshold : OnlineOptions::DefaultThreshold(MatchScore::kRatio);
+  search.threshold =
+      t.threshold >= 0 ? t.threshold : OnlineOptions::DefaultThreshold(MatchScore::kRatio);
   search.consistency = 1;
   search.Check();
   MapTuning tuning;
@@ -221,8 +227,7 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
   if (chosen.size() == 1) tuning.units.clear();
   tuning.shift = 0;
   if (search.contrast_enhancement) {
-    const float smallest = EnhanceContrastUnshifted(fused, search.contrast_window,
-                                                    {0, references});
+    const float smallest = EnhanceContrastUnshifted(fused, search.contrast_window, {0, references});
     tuning.shift = std::isfinite(smallest) ? -smallest : 0.0;
   }
 

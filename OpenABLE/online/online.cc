@@ -10,14 +10,13 @@
 #include <ctime>
 #include <filesystem>
 #include <iostream>
-#include <map>
 #include <limits>
+#include <map>
 #include <mutex>
+#include <opencv2/core/utility.hpp>
 #include <set>
 #include <sstream>
 #include <utility>
-
-#include <opencv2/core/utility.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
@@ -42,13 +41,11 @@ double Seconds(Clock::time_point since) {
 
 void Require(bool ok, const std::string& field, const std::string& value,
              const std::string& expected) {
-  if (!ok)
-    throw InputError("OnlineOptions." + field + " = " + value + ": expected " + expected);
+  if (!ok) throw InputError("OnlineOptions." + field + " = " + value + ": expected " + expected);
 }
 
 // A frame (`what`) of size `size` joining a map whose frames are `map_size` ("" = unknown).
-void CheckFrameSize(const std::string& what, const std::string& size,
-                    const std::string& map_size) {
+void CheckFrameSize(const std::string& what, const std::string& size, const std::string& map_size) {
   if (!map_size.empty() && size != map_size)
     throw InputError(what + " is " + size + "; the map's frames are " + map_size +
                      " (expected frames of one camera at one size)");
@@ -160,12 +157,13 @@ Describer MakeDescriber(const OnlineOptions& options) {
   // DenseVLAD's rows depend on the vocabulary learnt from a reference traversal: frames
   // described one call at a time (or a map's later sessions) would each learn another.
   if (out.descriptor->Learns())
-    throw InputError("descriptor: " + out.descriptor->Name() + " learns its vocabulary from a "
+    throw InputError("descriptor: " + out.descriptor->Name() +
+                     " learns its vocabulary from a "
                      "reference traversal, which the online detector, maps and describe() do "
                      "not keep; expected a run of the whole traversals (Test_OpenABLE, "
                      "openable.sweep or python3 -m openable run), or another descriptor here");
-  out.frame = std::make_unique<FrameDescriber>(*out.descriptor, options.description,
-                                               options.grid_x, options.grid_y, 1);
+  out.frame = std::make_unique<FrameDescriber>(*out.descriptor, options.description, options.grid_x,
+                                               options.grid_y, 1);
   return out;
 }
 
@@ -195,9 +193,8 @@ void DescribeInto(const FrameDescriber& describer, FrameImages& images, cv::Mat 
   const cv::Mat& image = images.For(describer);
   const cv::Size need = describer.MinimumFrame();
   if (image.cols < need.width || image.rows < need.height)
-    throw InputError(images.what + " is " + SizeText(image.size()) +
-                     "; the grid needs at least " + SizeText(need) +
-                     " pixels (grid_x by grid_y)");
+    throw InputError(images.what + " is " + SizeText(image.size()) + "; the grid needs at least " +
+                     SizeText(need) + " pixels (grid_x by grid_y)");
   describer.Describe(image, row);
 }
 
@@ -243,19 +240,20 @@ cv::Mat DescribeImages(const std::vector<cv::Mat>& images, const OnlineOptions& 
 }
 
 cv::Mat1f DistanceMatrix(const cv::Mat& rows, int sequence_length, SequenceDirection direction,
-                         const std::vector<int>& traversal_starts, int threads,
-                         float* max_distance, std::optional<Metric> metric,
-                         SequencePartial partial) {
+                         const std::vector<int>& traversal_starts, int threads, float* max_distance,
+                         std::optional<Metric> metric, SequencePartial partial) {
   if (rows.empty() || (rows.type() != CV_8UC1 && rows.type() != CV_32FC1))
     throw InputError("descriptor rows of OpenCV type " + cv::typeToString(rows.type()) + " and " +
-                     std::to_string(rows.rows) + " rows: expected at least one row of CV_8UC1 "
+                     std::to_string(rows.rows) +
+                     " rows: expected at least one row of CV_8UC1 "
                      "(Hamming) or CV_32FC1 (L2)");
   if (sequence_length < 1)
     throw InputError("sequence_length = " + std::to_string(sequence_length) + ": expected >= 1");
   const Metric m = metric.value_or(MetricOfType(rows.type()));
   if ((m == Metric::kL2) != (rows.type() == CV_32FC1))
     throw InputError("descriptor rows of OpenCV type " + cv::typeToString(rows.type()) +
-                     " with the " + EnumName(m) + " distance: expected CV_32FC1 rows for l2, "
+                     " with the " + EnumName(m) +
+                     " distance: expected CV_32FC1 rows for l2, "
                      "CV_8UC1 rows for hamming and l1");
   return NormalizedDistanceMatrix(rows, sequence_length, direction, traversal_starts, threads,
                                   max_distance, m, partial);
@@ -299,10 +297,10 @@ struct OnlineDetector::State {
   };
 
   OnlineOptions options;
-  std::vector<Channel> channels;   // the map's descriptors (Channels())
-  int indexed = -1;                // the channel whose index finds candidates; -1: none
-  std::vector<int> search;         // the channels of options.descriptor, in its order
-  std::vector<double> weights;     // their fusion weights
+  std::vector<Channel> channels;  // the map's descriptors (Channels())
+  int indexed = -1;               // the channel whose index finds candidates; -1: none
+  std::vector<int> search;        // the channels of options.descriptor, in its order
+  std::vector<double> weights;    // their fusion weights
   // Fusion: each search channel's distances are divided by its unit (the largest
   // single-frame distance of a matrix, as a run divides, Tune's; or of the map's first frames
   // when first needed). Empty until known; unused for one channel.
@@ -313,7 +311,7 @@ struct OnlineDetector::State {
   // `normalized` = distance / (L x unit): binary: bits per row; else the largest single-frame
   // distance computed so far; fused: the sum of the weights.
   double unit = 0;
-  int packed_width = 0;            // bytes of a frame's rows side by side (several channels)
+  int packed_width = 0;  // bytes of a frame's rows side by side (several channels)
   MapTuning tuning;
   bool uses_tuning = false;
   // Verification: the checker, every frame's features, the previous frame's candidates.
@@ -372,7 +370,7 @@ struct OnlineDetector::State {
   // Rows given by the caller (packed for several channels) as one matrix per channel.
   // `rows_text`: the rows expected, as messages name them ("n", or "1" for one row).
   RowsByChannel Split(const cv::Mat& rows, const std::string& what,
-                    const std::string& rows_text = "n") const;
+                      const std::string& rows_text = "n") const;
   cv::Mat Pack(const RowsByChannel& rows) const;
   void Append(const RowsByChannel& rows);
   // The fusion's units from the map's first frames when not known yet (several channels).
@@ -393,8 +391,7 @@ struct OnlineDetector::State {
   // The search of the frame just appended (AddDescriptor, AddFrame).
   OnlineResult Search(const RowsByChannel& row);
   // The candidates kept of `scored` (distance, frame) and their scores, into r.candidates.
-  void Choose(std::vector<std::pair<double, int>>& scored, double unit_now,
-              OnlineResult& r) const;
+  void Choose(std::vector<std::pair<double, int>>& scored, double unit_now, OnlineResult& r) const;
   // The consistency of query `qi` of a traversal whose best candidates so far are `answers`
   // (answers[qi] set here from r), and the acceptance.
   void Confirm(OnlineResult& r, int qi, std::vector<int>& answers) const;
@@ -411,8 +408,7 @@ struct OnlineDetector::State {
   // check; else only a check already finished counts.
   void ThrowIfDamaged(bool wait) const {
     if (!map_check.valid()) return;
-    if (!wait && map_check.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
-      return;
+    if (!wait && map_check.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
     const std::string& error = map_check.get();
     if (!error.empty()) throw InputError(error);
   }
@@ -471,17 +467,15 @@ void OnlineDetector::State::SetSearch() {
                        "expected descriptors among them");
     search.push_back(static_cast<int>(c));
   }
-  weights = options.fusion_weights.empty()
-                ? std::vector<double>(search.size(), 1.0)
-                : options.fusion_weights;
+  weights = options.fusion_weights.empty() ? std::vector<double>(search.size(), 1.0)
+                                           : options.fusion_weights;
   if (Fused()) {
     unit = 0;
     for (const double w : weights) unit += w;
   } else if (channels[static_cast<size_t>(search.front())].metric == Metric::kHamming) {
     unit = 8.0 * channels[static_cast<size_t>(search.front())].width;
   }
-  if (options.contrast_enhancement && shift < 0)
-    shift = std::sqrt(2.0 * options.contrast_window);
+  if (options.contrast_enhancement && shift < 0) shift = std::sqrt(2.0 * options.contrast_window);
   // Another search than the one the units or shift were chosen for needs its own.
   if (units.size() != search.size()) units.clear();
   // The running sums and the answers of the current traversal were of the search before.
@@ -491,15 +485,15 @@ void OnlineDetector::State::SetSearch() {
 }
 
 RowsByChannel OnlineDetector::State::Split(const cv::Mat& rows, const std::string& what,
-                                         const std::string& rows_text) const {
+                                           const std::string& rows_text) const {
   const bool rows_ok = rows_text != "1" || rows.rows == 1;
   if (!Several()) {
     const State::Channel& c = channels.front();
     if (!rows_ok || rows.cols != c.width || rows.type() != c.type)
-      throw InputError(what + " of " + std::to_string(rows.rows) + "x" +
-                       std::to_string(rows.cols) + " " + cv::typeToString(rows.type()) +
-                       ": expected " + rows_text + "x" + std::to_string(c.width) + " " +
-                       cv::typeToString(c.type) + " (" + c.describer.descriptor->Name() + ")");
+      throw InputError(what + " of " + std::to_string(rows.rows) + "x" + std::to_string(rows.cols) +
+                       " " + cv::typeToString(rows.type()) + ": expected " + rows_text + "x" +
+                       std::to_string(c.width) + " " + cv::typeToString(c.type) + " (" +
+                       c.describer.descriptor->Name() + ")");
     if (c.type == CV_32F && !rows.empty() && !cv::checkRange(rows))
       throw InputError(what + " hold a value that is not finite");
     return {rows.isContinuous() ? rows : rows.clone()};
@@ -555,9 +549,9 @@ std::vector<double> OnlineDetector::State::UnitsNow() const {
   std::vector<double> out;
   for (const int c : search) {
     const cv::Mat rows = channels[static_cast<size_t>(c)].rows->Rows().rowRange(0, n);
-    out.push_back(n > 1 ? LargestFinite(Distances(rows, rows,
-                                                  channels[static_cast<size_t>(c)].metric))
-                        : 0.0);
+    out.push_back(
+        n > 1 ? LargestFinite(Distances(rows, rows, channels[static_cast<size_t>(c)].metric))
+              : 0.0);
   }
   return out;
 }
@@ -583,9 +577,8 @@ double OnlineDetector::State::PairDistance(const RowsByChannel& queries, int q, 
   return sum;
 }
 
-double OnlineDetector::State::CellDistance(const RowsByChannel& queries, int q, int q_first,
-                                           int j, const std::vector<double>& u,
-                                           double* largest) const {
+double OnlineDetector::State::CellDistance(const RowsByChannel& queries, int q, int q_first, int j,
+                                           const std::vector<double>& u, double* largest) const {
   const MapSession& sj = sessions[static_cast<size_t>(SessionOf(j))];
   const int L = options.sequence_length;
   const int terms = SequenceTerms(L, std::min(q - q_first, j - sj.first));
@@ -741,9 +734,10 @@ OnlineResult OnlineDetector::AddFrame(const cv::Mat& image) {
 void OnlineDetector::AddToMap(const cv::Mat& rows) {
   State& s = *state_;
   if (s.verifier)
-    throw InputError("OnlineDetector::AddToMap: verification is on (OnlineOptions::"
-                     "verification.enabled) and needs each frame's image: add the frames with "
-                     "AddFrame");
+    throw InputError(
+        "OnlineDetector::AddToMap: verification is on (OnlineOptions::"
+        "verification.enabled) and needs each frame's image: add the frames with "
+        "AddFrame");
   if (rows.empty()) return;
   const RowsByChannel split = s.Split(rows, "map rows");
   s.ThrowIfDamaged(false);
@@ -758,9 +752,8 @@ cv::Mat OnlineDetector::DescribeFrames(const std::vector<cv::Mat>& images,
                                        const std::vector<std::string>& names) const {
   const State& s = *state_;
   if (!names.empty() && names.size() != images.size())
-    throw std::invalid_argument("OnlineDetector::DescribeFrames: " +
-                                std::to_string(names.size()) + " names for " +
-                                std::to_string(images.size()) + " images");
+    throw std::invalid_argument("OnlineDetector::DescribeFrames: " + std::to_string(names.size()) +
+                                " names for " + std::to_string(images.size()) + " images");
   std::string size = s.frame_size;
   for (std::size_t i = 0; i < images.size(); ++i) {
     const std::string mine = SizeText(images[i].size());
@@ -784,8 +777,8 @@ void OnlineDetector::AddImagesToMap(const std::vector<cv::Mat>& images,
 
 void OnlineDetector::AddToMap(const cv::Mat& rows, const std::vector<std::string>& names) {
   if (names.size() != static_cast<size_t>(rows.rows))
-    throw InputError("OnlineDetector::AddToMap: " + std::to_string(names.size()) +
-                     " names for " + std::to_string(rows.rows) + " rows; expected one each");
+    throw InputError("OnlineDetector::AddToMap: " + std::to_string(names.size()) + " names for " +
+                     std::to_string(rows.rows) + " rows; expected one each");
   State& s = *state_;
   const int before = Size();
   AddToMap(rows);
@@ -797,8 +790,9 @@ OnlineResult OnlineDetector::AddDescriptor(const cv::Mat& row) {
   State& s = *state_;
   const RowsByChannel split = s.Split(row, "descriptor row", "1");
   if (s.verifier)
-    throw InputError("OnlineDetector::AddDescriptor: verification is on (OnlineOptions::"
-                     "verification.enabled) and needs each frame's image: use AddFrame");
+    throw InputError(
+        "OnlineDetector::AddDescriptor: verification is on (OnlineOptions::"
+        "verification.enabled) and needs each frame's image: use AddFrame");
   s.ThrowIfDamaged(false);
   return s.Search(split);
 }
@@ -849,10 +843,9 @@ OnlineResult OnlineDetector::State::Search(const RowsByChannel& row) {
       // fewer; else they start again from the L - 1 frames before (fewer at its start).
       const Columns columns = ColumnsUpTo(s.sessions, searchable);
       const int L = s.options.sequence_length;
-      const bool continues = s.running_last == q - 1 && s.running.Rows() > 0 &&
-                             q - 1 >= first &&
-                             (columns.count == s.running_columns ||
-                              columns.count == s.running_columns + 1);
+      const bool continues =
+          s.running_last == q - 1 && s.running.Rows() > 0 && q - 1 >= first &&
+          (columns.count == s.running_columns || columns.count == s.running_columns + 1);
       int from = q;
       if (!continues) {
         s.running.Restart();
@@ -932,8 +925,8 @@ void OnlineDetector::State::Confirm(OnlineResult& r, int qi, std::vector<int>& a
     // The chain of partners back from qi (matching/agreement.h), each agreeing with the one
     // after it, within one session of the map.
     int found = 0, from = qi, from_answer = c.frame;
-    for (int p = AgreementPartner(qi, qi + 1, agreement);
-         p >= 0 && found < agreement.partners; p = AgreementPartner(p, p + 1, agreement)) {
+    for (int p = AgreementPartner(qi, qi + 1, agreement); p >= 0 && found < agreement.partners;
+         p = AgreementPartner(p, p + 1, agreement)) {
       const int a = answers[static_cast<size_t>(p)];
       if (a < 0 || s.SessionOf(a) != s.SessionOf(from_answer) ||
           !AnswersAgree(p, a, from, from_answer, agreement))
@@ -968,8 +961,10 @@ const std::vector<MapSession>& OnlineDetector::Sessions() const { return state_-
 
 int OnlineDetector::SessionOf(int frame) const {
   if (frame < 0 || frame >= Size())
-    throw InputError("OnlineDetector::SessionOf(" + std::to_string(frame) + "): expected a frame "
-                     "of the map, 0 to " + std::to_string(Size() - 1));
+    throw InputError("OnlineDetector::SessionOf(" + std::to_string(frame) +
+                     "): expected a frame "
+                     "of the map, 0 to " +
+                     std::to_string(Size() - 1));
   return state_->SessionOf(frame);
 }
 
@@ -983,9 +978,10 @@ std::vector<OnlineResult> OnlineDetector::Query(const cv::Mat& rows,
                                                 QueryMatrix* matrix) const {
   const State& s = *state_;
   if (s.verifier)
-    throw InputError("OnlineDetector::Query: verification is on (OnlineOptions::verification."
-                     "enabled) and needs each query's image and features: add the frames with "
-                     "AddFrame, or query with a detector without verification");
+    throw InputError(
+        "OnlineDetector::Query: verification is on (OnlineOptions::verification."
+        "enabled) and needs each query's image and features: add the frames with "
+        "AddFrame, or query with a detector without verification");
   const RowsByChannel queries = s.Split(rows, "query rows");
   s.ThrowIfDamaged(false);
   // The sessions searched, and whether their frames are few enough to scan exactly.
@@ -997,8 +993,8 @@ std::vector<OnlineResult> OnlineDetector::Query(const cv::Mat& rows,
     if (i == s.sessions.size()) {
       std::string names;
       for (const MapSession& m : s.sessions) names += (names.empty() ? "" : ", ") + m.name;
-      throw InputError("session " + Quoted(name) + " is not in the map; its sessions: " +
-                       (names.empty() ? "none" : names));
+      throw InputError("session " + Quoted(name) +
+                       " is not in the map; its sessions: " + (names.empty() ? "none" : names));
     }
     if (!allowed[i]) allowed_frames += s.sessions[i].count;
     allowed[i] = 1;
@@ -1029,8 +1025,8 @@ std::vector<OnlineResult> OnlineDetector::Query(const cv::Mat& rows,
         matrix->sums.create(n, columns.count);
     }
     SequenceRowSums sums(s.options.sequence_length, SequencePartial::kScale);
-    const int block = std::max(
-        1, static_cast<int>(std::min<std::int64_t>(n, (64 << 20) / (4 * std::max(1, columns.count)))));
+    const int block = std::max(1, static_cast<int>(std::min<std::int64_t>(
+                                      n, (64 << 20) / (4 * std::max(1, columns.count)))));
     const bool track = !s.UnitFixed();
     for (int a = 0; a < n; a += block) {
       CheckForInterrupt();
@@ -1210,8 +1206,8 @@ void OnlineDetector::SaveMap(const std::string& path) {
                                            {"channel_widths", widths},
                                            {"channel_types", types},
                                            {"indexed_channel", std::to_string(s.indexed)}});
-  for (const auto& list : {DescriptionSettings(s.options), IndexSettings(s.options),
-                           FeatureSettings(s.options)})
+  for (const auto& list :
+       {DescriptionSettings(s.options), IndexSettings(s.options), FeatureSettings(s.options)})
     map.settings.insert(map.settings.end(), list.begin(), list.end());
   for (const State::Channel& c : s.channels)
     if (c.describer.descriptor->Name() == "ONNX")
@@ -1222,20 +1218,18 @@ void OnlineDetector::SaveMap(const std::string& path) {
     map.settings.emplace_back("search_" + key, value);
   if (s.tuning.tuned) {
     const MapTuning& t = s.tuning;
-    map.settings.insert(
-        map.settings.end(),
-        {{"tuned", t.reliable ? "reliable" : "unreliable"},
-         {"tuned_reference", t.reference},
-         {"tuned_query", t.query},
-         {"tuned_time", t.time},
-         {"tuned_chosen", t.chosen},
-         {"tuned_consistency_figure", Exact(t.consistency)},
-         {"tuned_distinctiveness", Exact(t.distinctiveness)},
-         {"tuned_agreement", Exact(t.agreement)},
-         {"tuned_min_consistency", Exact(t.min_consistency)},
-         {"tuned_fusion_units", Numbers(t.units)},
-         {"tuned_contrast_shift", Exact(t.shift)},
-         {"tuned_candidates", t.candidates_json}});
+    map.settings.insert(map.settings.end(), {{"tuned", t.reliable ? "reliable" : "unreliable"},
+                                             {"tuned_reference", t.reference},
+                                             {"tuned_query", t.query},
+                                             {"tuned_time", t.time},
+                                             {"tuned_chosen", t.chosen},
+                                             {"tuned_consistency_figure", Exact(t.consistency)},
+                                             {"tuned_distinctiveness", Exact(t.distinctiveness)},
+                                             {"tuned_agreement", Exact(t.agreement)},
+                                             {"tuned_min_consistency", Exact(t.min_consistency)},
+                                             {"tuned_fusion_units", Numbers(t.units)},
+                                             {"tuned_contrast_shift", Exact(t.shift)},
+                                             {"tuned_candidates", t.candidates_json}});
     for (const auto& [key, value] : SearchSettings(t.search))
       map.settings.emplace_back("tuned_" + key, value);
   }
@@ -1243,7 +1237,8 @@ void OnlineDetector::SaveMap(const std::string& path) {
   IncrementalIndex* index = s.Index();
   if (index != nullptr) map.blocks = index->SaveBlocks();
   map.rows = first.rows->Rows();
-  for (size_t c = 1; c < s.channels.size(); ++c) map.more_rows.push_back(s.channels[c].rows->Rows());
+  for (size_t c = 1; c < s.channels.size(); ++c)
+    map.more_rows.push_back(s.channels[c].rows->Rows());
   map.frame_files = s.files;
   if (!map.frame_files.empty()) map.frame_files.resize(static_cast<size_t>(Size()));
   map.has_features = s.verifier != nullptr;
@@ -1400,7 +1395,8 @@ double CheckMapFits(const MapFile& map, const std::string& path, const OnlineOpt
     require_same(FeatureSettings(options), "verifies with",
                  "expected a map saved by a detector with the same verification features");
     if (!map.has_features || map.features.size() != static_cast<size_t>(map.rows.rows))
-      throw InputError(path + ": the map holds no local features; expected a map saved by a "
+      throw InputError(path +
+                       ": the map holds no local features; expected a map saved by a "
                        "detector with verification enabled");
     // The matcher compares them with the descriptors of later frames.
     const int fwidth = verifier->DescriptorWidth(), ftype = verifier->DescriptorType();
@@ -1409,8 +1405,8 @@ double CheckMapFits(const MapFile& map, const std::string& path, const OnlineOpt
       if (!d.empty() && (d.cols != fwidth || d.type() != ftype))
         throw InputError(path + ": the local features of frame " + std::to_string(i) +
                          " have descriptors of " + std::to_string(d.cols) + " " +
-                         cv::typeToString(d.type()) + "; expected " + std::to_string(fwidth) +
-                         " " + cv::typeToString(ftype) + " (" + map.Setting("features") + ")");
+                         cv::typeToString(d.type()) + "; expected " + std::to_string(fwidth) + " " +
+                         cv::typeToString(ftype) + " (" + map.Setting("features") + ")");
     }
   }
   if (map.Setting("unit") != "") {
@@ -1466,8 +1462,8 @@ OnlineOptions ReadMapOptions(const std::string& path, const OnlineOptions& base)
   o.kept_descriptors = JoinStrings(kept, "+");
   if (!o.fusion_weights.empty() && o.fusion_weights.size() != searched.size())
     o.fusion_weights.clear();
-  o.description = ParseEnum<DescriptionType>(map.Setting("description"),
-                                             path + ": setting \"description\"");
+  o.description =
+      ParseEnum<DescriptionType>(map.Setting("description"), path + ": setting \"description\"");
   ParseWhole(map, "patch_size", path, o.descriptor.patch_size);
   ParseWhole(map, "ldb_bits", path, o.descriptor.ldb_bits);
   if (!map.Setting("sad_patch").empty()) ParseWhole(map, "sad_patch", path, o.descriptor.sad_patch);
@@ -1476,9 +1472,10 @@ OnlineOptions ReadMapOptions(const std::string& path, const OnlineOptions& base)
     ParseWhole(map, "row_width", path, o.descriptor.given_width);
     o.descriptor.given_binary = map.Setting("row_type") == "CV_8U";
     if (o.description != DescriptionType::kGlobal)
-      throw InputError(path + ": the map's rows were given (descriptor NPY), one row a frame, "
-                       "but its settings name the description " + EnumName(o.description) +
-                       "; expected global");
+      throw InputError(path +
+                       ": the map's rows were given (descriptor NPY), one row a frame, "
+                       "but its settings name the description " +
+                       EnumName(o.description) + "; expected global");
     CreateDescriptor(o.descriptor);  // the width's bound, named by NamingMap
   }
   if (!map.Setting("model_weights").empty()) {
@@ -1530,7 +1527,8 @@ OnlineDetector::LoadedMap OnlineDetector::LoadMapNamed(const std::string& path,
   State& s = *state_;
   if (Size() != 0)
     throw InputError("OnlineDetector::LoadMap(\"" + path + "\"): the detector holds " +
-                     std::to_string(Size()) + " frames; expected an empty detector (load the "
+                     std::to_string(Size()) +
+                     " frames; expected an empty detector (load the "
                      "map before adding frames)");
   MapFile map = ReadMapFile(path, read);
   // The detector's descriptors in the map's order (the same set), its index on the map's.
@@ -1557,14 +1555,14 @@ OnlineDetector::LoadedMap OnlineDetector::LoadMapNamed(const std::string& path,
   for (const State::Channel& c : s.channels)
     if (c.describer.descriptor->Name() == "ONNX" &&
         c.describer.descriptor->Fingerprint() != map.Setting("model_weights"))
-      throw InputError(
-          path + ": the map was made with the network " + Quoted(map.Setting("model_path")) +
-          " of weights " + Quoted(map.Setting("model_weights")) + "; Model_path " +
-          Quoted(s.options.descriptor.model_path) + " holds weights " +
-          Quoted(c.describer.descriptor->Fingerprint()) +
-          " (expected the same model file: give Model_path of a copy of it)");
-  const double unit = CheckMapFits(map, path, s.options, s.ChannelList(), widths, types,
-                                   s.verifier.get(), s.unit);
+      throw InputError(path + ": the map was made with the network " +
+                       Quoted(map.Setting("model_path")) + " of weights " +
+                       Quoted(map.Setting("model_weights")) + "; Model_path " +
+                       Quoted(s.options.descriptor.model_path) + " holds weights " +
+                       Quoted(c.describer.descriptor->Fingerprint()) +
+                       " (expected the same model file: give Model_path of a copy of it)");
+  const double unit =
+      CheckMapFits(map, path, s.options, s.ChannelList(), widths, types, s.verifier.get(), s.unit);
   if (map.frame_files.size() != 0 && map.frame_files.size() != static_cast<size_t>(map.rows.rows))
     throw InputError(path + ": the map names the files of " +
                      std::to_string(map.frame_files.size()) + " frames; expected its " +
@@ -1585,7 +1583,8 @@ OnlineDetector::LoadedMap OnlineDetector::LoadMapNamed(const std::string& path,
     IncrementalIndex& index = *s.channels[c].rows;
     const bool with_blocks = static_cast<int>(c) == s.indexed && !out.rebuilt;
     try {
-      index.Restore(*rows[c], with_blocks ? map.blocks : std::vector<IncrementalIndex::SavedBlock>{},
+      index.Restore(*rows[c],
+                    with_blocks ? map.blocks : std::vector<IncrementalIndex::SavedBlock>{},
                     map.mapping);
     } catch (const std::invalid_argument& e) {
       throw InputError(path + ": " + e.what());
@@ -1622,12 +1621,12 @@ void OnlineDetector::AppendMapNamed(const std::string& path) {
   MapFile map = ReadMapFile(path, {/*in_place=*/true, /*check_in_background=*/false});
   std::vector<int> widths, types;
   for (const State::Channel& c : s.channels) widths.push_back(c.width), types.push_back(c.type);
-  const double unit = CheckMapFits(map, path, s.options, s.ChannelList(), widths, types,
-                                   s.verifier.get(), s.unit);
+  const double unit =
+      CheckMapFits(map, path, s.options, s.ChannelList(), widths, types, s.verifier.get(), s.unit);
   const std::string size = map.Setting("frame_size");
   if (!size.empty() && !s.frame_size.empty() && size != s.frame_size)
-    throw InputError(path + ": the map's frames are " + size + "; this map's are " +
-                     s.frame_size + " (expected frames of one camera at one size)");
+    throw InputError(path + ": the map's frames are " + size + "; this map's are " + s.frame_size +
+                     " (expected frames of one camera at one size)");
   for (const MapSession& m : map.sessions)
     for (const MapSession& mine : s.sessions)
       if (m.name == mine.name && mine.count > 0)

@@ -19,19 +19,18 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
-
 #include "OpenABLE/describe/describe.h"
 #include "OpenABLE/online/map_file.h"
-#include "descriptors/descriptor.h"
 #include "OpenABLE/verification/verification.h"
-#include "matching/search/approximate.h"
+#include "descriptors/descriptor.h"
 #include "matching/distances.h"
 #include "matching/score.h"
+#include "matching/search/approximate.h"
 #include "matching/sequence.h"
 
 namespace openable {
@@ -63,8 +62,8 @@ struct OnlineOptions {
   // it is scanned exactly at any size (the index is not used).
   bool contrast_enhancement = false;
   int contrast_window = 10;  // >= 1
-  int exclusion = 100;      // frame q's candidates are frames j <= q - exclusion (>= 1)
-  int candidates = 5;       // candidates returned per frame (the k best), >= 1
+  int exclusion = 100;       // frame q's candidates are frames j <= q - exclusion (>= 1)
+  int candidates = 5;        // candidates returned per frame (the k best), >= 1
   // The confidence of a candidate (matching/score.h, the key Match_score): its normalised
   // distance, or the ratio of its distance to the best candidate more than score_window
   // frames away from it (the rivals are the candidates the search scored: every searchable
@@ -128,25 +127,25 @@ struct OnlineOptions {
 // description, sequence, score and acceptance the search then uses, and the verdict.
 struct MapTuning {
   bool tuned = false;
-  bool reliable = false;           // the choice's consistency >= min_consistency
-  std::string reference, query;    // the sessions it was judged on (reference: the columns)
-  std::string time;                // when (ISO 8601 UTC)
-  std::string chosen;              // the chosen candidate, "Key=value ..."
+  bool reliable = false;         // the choice's consistency >= min_consistency
+  std::string reference, query;  // the sessions it was judged on (reference: the columns)
+  std::string time;              // when (ISO 8601 UTC)
+  std::string chosen;            // the chosen candidate, "Key=value ..."
   double consistency = 0, distinctiveness = 0, agreement = 0;
   double min_consistency = 0.5;
-  std::string candidates_json;     // every candidate with its criteria (AutoJson's list)
-  OnlineOptions search;            // the options whose search settings were chosen
-  std::vector<double> units;       // the fusion's unit of each descriptor of the choice
-  double shift = 0;                // the contrast enhancement's shift of the choice
+  std::string candidates_json;  // every candidate with its criteria (AutoJson's list)
+  OnlineOptions search;         // the options whose search settings were chosen
+  std::vector<double> units;    // the fusion's unit of each descriptor of the choice
+  double shift = 0;             // the contrast enhancement's shift of the choice
 };
 
 // One loop candidate of a frame.
 struct LoopCandidate {
-  int frame = -1;         // the earlier frame (its number in the whole map)
-  int session = -1;       // its session (an index of OnlineDetector::Sessions())
-  int session_frame = -1; // its frame within that session (frame - the session's first)
-  double distance = 0;    // raw sequence distance S(q, j) (Hamming bits or L2, summed over L
-                          // frames; early frames scaled as in matching/sequence.h)
+  int frame = -1;          // the earlier frame (its number in the whole map)
+  int session = -1;        // its session (an index of OnlineDetector::Sessions())
+  int session_frame = -1;  // its frame within that session (frame - the session's first)
+  double distance = 0;     // raw sequence distance S(q, j) (Hamming bits or L2, summed over L
+                           // frames; early frames scaled as in matching/sequence.h)
   // distance / (L x unit): unit = the descriptor's bit count for binary descriptors (so it is
   // the mean fraction of differing bits, in [0, 1]), and for float descriptors the largest
   // single-frame distance the detector has computed so far. Not the scale of Config.txt's
@@ -173,15 +172,15 @@ struct LoopCandidate {
 };
 
 struct OnlineResult {
-  int frame = -1;                            // index of the frame just added (0, 1, ...);
-                                             // Query: the query's row
-  int session = -1;                          // the session it was added to (Query: -1)
-  std::vector<LoopCandidate> candidates;     // best first (ties: earlier frame first); empty
-                                             // while no frame is old enough
-  bool approximate = false;                  // the search used the index blocks
-  double describe_seconds = 0;               // AddFrame: describing the image
-  double search_seconds = 0;                 // searching and bookkeeping (index builds too)
-  double verify_seconds = 0;                 // verification: features of the frame and checks
+  int frame = -1;                         // index of the frame just added (0, 1, ...);
+                                          // Query: the query's row
+  int session = -1;                       // the session it was added to (Query: -1)
+  std::vector<LoopCandidate> candidates;  // best first (ties: earlier frame first); empty
+                                          // while no frame is old enough
+  bool approximate = false;               // the search used the index blocks
+  double describe_seconds = 0;            // AddFrame: describing the image
+  double search_seconds = 0;              // searching and bookkeeping (index builds too)
+  double verify_seconds = 0;              // verification: features of the frame and checks
 };
 
 // Loop candidates frame by frame. Memory: the descriptor rows of every frame (row bytes x
@@ -243,7 +242,7 @@ class OnlineDetector {
   // that is empty, not printable text (CheckSessionName) or already in the map.
   void StartSession(const std::string& name, const std::string& time = "");
   const std::vector<MapSession>& Sessions() const;
-  int SessionOf(int frame) const;   // the session holding `frame` (0 .. Size() - 1)
+  int SessionOf(int frame) const;  // the session holding `frame` (0 .. Size() - 1)
 
   // Searches the map for each row of `rows` (n x RowWidth(), RowType(): a query traversal, row
   // i its frame i, whose sequences use its own earlier rows) without adding them: every frame
@@ -280,9 +279,9 @@ class OnlineDetector {
   const std::string& FrameSize() const;
 
   const OnlineOptions& Options() const;
-  int Size() const;                 // frames added
-  int RowWidth() const;             // elements per row (bytes for a map of several descriptors)
-  int RowType() const;              // CV_8U (Hamming, L1, several descriptors) or CV_32F (L2)
+  int Size() const;      // frames added
+  int RowWidth() const;  // elements per row (bytes for a map of several descriptors)
+  int RowType() const;   // CV_8U (Hamming, L1, several descriptors) or CV_32F (L2)
   // Size() x RowWidth(): the stored rows (a view for one descriptor, a copy for several).
   cv::Mat Descriptors() const;
   // The descriptors the map describes every frame with (OnlineOptions::descriptor's, then
@@ -323,8 +322,8 @@ class OnlineDetector {
   cv::Mat ChannelRows(int channel) const;
   // Whether the search uses the tuned settings (then an unreliable map accepts nothing).
   bool UsesTuning() const;
-  std::int64_t MemoryBytes() const; // rows + indices held now
-  int Blocks() const;               // index blocks in use (0 while exact)
+  std::int64_t MemoryBytes() const;  // rows + indices held now
+  int Blocks() const;                // index blocks in use (0 while exact)
   // Waits for a background merge (background_merges) to finish and installs its index.
   void FinishMerges();
 

@@ -4,9 +4,8 @@
 #include <charconv>
 #include <cstdint>
 #include <cstring>
-#include <stdexcept>
-
 #include <opencv2/core/utility.hpp>
+#include <stdexcept>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/io/npy.h"

@@ -68,8 +68,8 @@ Planned One(const char* key, const std::string& path) {
 // encoder is single-threaded and the images dominate the time of the outputs.
 Stager EncodedInBackground(const std::string& key, const std::string& path,
                            std::function<std::string()> encode) {
-  auto bytes = std::make_shared<std::future<std::string>>(
-      std::async(std::launch::async, std::move(encode)));
+  auto bytes =
+      std::make_shared<std::future<std::string>>(std::async(std::launch::async, std::move(encode)));
   return [key, path, bytes](OutputBatch& batch) { batch.Stage(key, path, bytes->get()); };
 }
 
@@ -128,12 +128,11 @@ const std::vector<RunOutput>& RunOutputs() {
       // (matrix_settings.h), so that openable_evaluate and Python evaluate it as the run did.
       {true, true,
        [](const Config& c) {
-         Planned p = One("Npy_name (settings)", c.output.npy_name.empty()
-                                                    ? ""
-                                                    : MatrixSettingsPath(c.output.npy_name));
-         const Planned t = One("Txt_name (settings)", c.output.txt_name.empty()
-                                                          ? ""
-                                                          : MatrixSettingsPath(c.output.txt_name));
+         Planned p = One("Npy_name (settings)",
+                         c.output.npy_name.empty() ? "" : MatrixSettingsPath(c.output.npy_name));
+         const Planned t =
+             One("Txt_name (settings)",
+                 c.output.txt_name.empty() ? "" : MatrixSettingsPath(c.output.txt_name));
          p.insert(p.end(), t.begin(), t.end());
          return p;
        },
@@ -171,8 +170,8 @@ const std::vector<RunOutput>& RunOutputs() {
          const std::string path = ThresholdPngPath(in.config);
          if (path.empty()) return {};
          return EncodedInBackground(
-             in.config.output.png_threshold_name.empty() ? "Png_name" : "Png_threshold_name",
-             path, [&in] {
+             in.config.output.png_threshold_name.empty() ? "Png_name" : "Png_threshold_name", path,
+             [&in] {
                cv::Mat1f binary;
                in.result.thresholded.convertTo(binary, CV_32F);
                return EncodePng(ColorizeMatrix(binary, in.config.output.matrix_color));
@@ -189,8 +188,7 @@ const std::vector<RunOutput>& RunOutputs() {
            const MatchingOptions& m = in.config.matching;
            const AgreementOptions agreement = AgreementOf(m);
            const MatchVerdicts verdicts = VerdictsOf(
-               in.result.matches, m.match_threshold,
-               m.match_consistency > 0 ? &agreement : nullptr,
+               in.result.matches, m.match_threshold, m.match_consistency > 0 ? &agreement : nullptr,
                in.automatic != nullptr && !in.automatic->reliable);
            batch.Stage("Matches_name", path, EncodeMatches(in.result.matches, csv, verdicts));
          };
@@ -315,7 +313,8 @@ std::vector<std::string> UnwrittenOutputNotes(const Config& config, const RunRes
   for (const RunOutput& output : RunOutputs())
     if (output.dense_only && !output.companion)
       for (const auto& [key, path] : output.planned(config))
-        notes.push_back(key + ": not written: the run is bounded and keeps no dense matrix "
+        notes.push_back(key +
+                        ": not written: the run is bounded and keeps no dense matrix "
                         "(see Matches_name)");
   return notes;
 }

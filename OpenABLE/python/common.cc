@@ -1,9 +1,8 @@
 #include "OpenABLE/python/common.h"
 
 #include <cstdint>
-#include <string>
-
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 #include "config/config.h"
 
@@ -58,7 +57,7 @@ void CheckFloatImage(const cv::Mat& image, const char* what) {
 bool Viewable(const py::array& a, py::ssize_t item) {
   if (reinterpret_cast<std::uintptr_t>(a.data()) % static_cast<std::uintptr_t>(item) != 0)
     return false;
-  py::ssize_t packed = item;  // bytes of one row's packed inner part
+  py::ssize_t packed = item;                              // bytes of one row's packed inner part
   const py::ssize_t first_inner = a.ndim() == 1 ? 0 : 1;  // a 1-D array is one row
   for (py::ssize_t d = a.ndim() - 1; d >= first_inner; --d) {
     if (a.shape(d) > 1 && a.strides(d) != packed) return false;
@@ -128,8 +127,8 @@ MatView Matrix2D(const py::handle& object, Elements elements, const char* what) 
                           "; expected uint8 (the bytes of binary descriptor rows)");
   } else if (IsFloat32(a)) {
     depth = CV_32F;
-  } else if (kind == 'f' || (elements == Elements::kFloat32 &&
-                             (kind == 'i' || kind == 'u' || kind == 'b'))) {
+  } else if (kind == 'f' ||
+             (elements == Elements::kFloat32 && (kind == 'i' || kind == 'u' || kind == 'b'))) {
     return Wrap(ContiguousCopy<float>(a), CV_32F, 1, true);
   } else {
     throw py::value_error(std::string(what) + ": dtype " + DtypeName(a) +
@@ -166,8 +165,7 @@ MatView ToBgr(MatView v, bool rgb) {
 MatView ImageAsGiven(const py::handle& object, const char* what) {
   py::array a = py::array::ensure(object);
   if (!a) throw py::value_error(std::string(what) + ": expected an image as a NumPy array");
-  const bool shape_ok =
-      a.ndim() == 2 || (a.ndim() == 3 && (a.shape(2) == 1 || a.shape(2) == 3));
+  const bool shape_ok = a.ndim() == 2 || (a.ndim() == 3 && (a.shape(2) == 1 || a.shape(2) == 3));
   if (!shape_ok) {
     throw py::value_error(std::string(what) + ": array of shape " + ShapeText(a) +
                           "; expected (H, W) grey or (H, W, 3) colour");
@@ -225,11 +223,20 @@ py::array ToNumpy(const cv::Mat& input, bool one_dimensional) {
   if (!m.empty() && m.u == nullptr) m = m.clone();
   py::dtype dtype;
   switch (m.depth()) {
-    case CV_8U: dtype = py::dtype::of<std::uint8_t>(); break;
-    case CV_32F: dtype = py::dtype::of<float>(); break;
-    case CV_64F: dtype = py::dtype::of<double>(); break;
-    case CV_32S: dtype = py::dtype::of<std::int32_t>(); break;
-    default: throw std::logic_error("ToNumpy: unsupported depth " + std::to_string(m.depth()));
+    case CV_8U:
+      dtype = py::dtype::of<std::uint8_t>();
+      break;
+    case CV_32F:
+      dtype = py::dtype::of<float>();
+      break;
+    case CV_64F:
+      dtype = py::dtype::of<double>();
+      break;
+    case CV_32S:
+      dtype = py::dtype::of<std::int32_t>();
+      break;
+    default:
+      throw std::logic_error("ToNumpy: unsupported depth " + std::to_string(m.depth()));
   }
   const py::ssize_t item = static_cast<py::ssize_t>(m.elemSize1());
   const py::ssize_t channels = m.channels();
@@ -276,8 +283,7 @@ py::dict PropertiesAsDict(const py::handle& object, bool arrays) {
     } else if (value.is_none() || py::isinstance<py::bool_>(value) ||
                py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value) ||
                py::isinstance<py::str>(value) || py::isinstance<py::tuple>(value) ||
-               py::isinstance<py::dict>(value) ||
-               (arrays && py::isinstance<py::array>(value))) {
+               py::isinstance<py::dict>(value) || (arrays && py::isinstance<py::array>(value))) {
       out[name.c_str()] = value;
     }
   }

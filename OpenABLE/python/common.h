@@ -3,14 +3,14 @@
 // string options that the bindings take instead of C++ enums.
 #pragma once
 
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
 #include <cstddef>
+#include <opencv2/core.hpp>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <opencv2/core.hpp>
-#include <pybind11/numpy.h>
-#include <pybind11/pybind11.h>
 
 #include "OpenABLE/base/enum_names.h"
 #include "OpenABLE/base/strings.h"

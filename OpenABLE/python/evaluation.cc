@@ -1,14 +1,14 @@
 // Evaluation against ground truth (docs/evaluation.md): evaluate() and its result.
+#include <pybind11/stl.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <optional>
 #include <utility>
-
-#include <pybind11/stl.h>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/version.h"
@@ -17,8 +17,8 @@
 #include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/evaluation/metrics.h"
 #include "OpenABLE/evaluation/report.h"
-#include "OpenABLE/evaluation/unsupervised.h"
 #include "OpenABLE/evaluation/saved_settings.h"
+#include "OpenABLE/evaluation/unsupervised.h"
 #include "OpenABLE/python/common.h"
 #include "OpenABLE/run/evaluate.h"
 #include "matching/matrix.h"
@@ -45,13 +45,20 @@ struct Result {
 template <typename F>
 auto WithArgumentNames(F f) {
   static const std::pair<const char*, const char*> kNames[] = {
-      {"Ground_truth_radius:", "radius:"},   {"Ground_truth_heading:", "heading_limit:"},
-      {"Ground_truth_min_gap:", "min_frame_gap:"}, {"Ground_truth_axes:", "axes:"},
-      {"Ground_truth_base:", "base:"},        {"Initial_image:", "first_frame:"},
-      {"Tolerance:", "tolerance:"},          {"Exclusion:", "exclusion:"},
-      {"Vicinity:", "vicinity:"},            {"Ground_truth_2:", "truth_file_2:"},
-      {"Ground_truth:", "truth_file:"},      {"Ground_truth_type:", "truth_type:"},
-      {"Match_score_window:", "score_window:"}, {"Evaluation_protocol:", "protocol:"},
+      {"Ground_truth_radius:", "radius:"},
+      {"Ground_truth_heading:", "heading_limit:"},
+      {"Ground_truth_min_gap:", "min_frame_gap:"},
+      {"Ground_truth_axes:", "axes:"},
+      {"Ground_truth_base:", "base:"},
+      {"Initial_image:", "first_frame:"},
+      {"Tolerance:", "tolerance:"},
+      {"Exclusion:", "exclusion:"},
+      {"Vicinity:", "vicinity:"},
+      {"Ground_truth_2:", "truth_file_2:"},
+      {"Ground_truth:", "truth_file:"},
+      {"Ground_truth_type:", "truth_type:"},
+      {"Match_score_window:", "score_window:"},
+      {"Evaluation_protocol:", "protocol:"},
       {"Ground_truth_soft:", "truth_file_soft:"}};
   const auto word = [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_';
@@ -459,7 +466,6 @@ point.)doc")
 }
 
 void RegisterEvaluationResult(py::module_& m) {
-
   py::class_<Result>(m, "EvaluationResult", R"doc(The figures and curves of evaluate(): the
 per-query best-match protocol (auc, recall_at_100p, max_f1, recall_at_1/5/10, curve) and the
 ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md defines each.)doc")
@@ -633,8 +639,7 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
           "recall_at_100p_multi, their curve, the same for single-match (not with a GTsoft), "
           "recall_at_k {1, 5, 10}; None when not asked for.")
       .def(
-          "table",
-          [](const Result& r) { return FormatEvaluationTable(r.settings, {r.run}); },
+          "table", [](const Result& r) { return FormatEvaluationTable(r.settings, {r.run}); },
           "table() -> str\n\nThe table openable_evaluate prints: the figures of each protocol "
           "asked for, one row each.")
       .def(
@@ -652,8 +657,7 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
                       "<openable.EvaluationResult %s: AUC %.4f, R@100P %.4f, max F1 %.4f, "
                       "R@1/5/10 %.4f/%.4f/%.4f, ABLE-P AP %.2f %%>",
                       LayoutName(r.run.layout).c_str(), p.auc, p.recall_at_100p, p.max_f1,
-                      p.recall_at_1, p.recall_at_5, p.recall_at_10,
-                      r.run.able_p.average_precision);
+                      p.recall_at_1, p.recall_at_5, p.recall_at_10, r.run.able_p.average_precision);
         return std::string(b);
       });
 }
@@ -727,7 +731,8 @@ void RegisterEvaluate(py::module_& m) {
         if (given != 1) {
           throw py::value_error(
               "evaluate: give exactly one ground truth: truth_matrix, pairs, poses, aligned=True "
-              "or truth_file (got " + std::to_string(given) + ")");
+              "or truth_file (got " +
+              std::to_string(given) + ")");
         }
         GroundTruthOptions& t = s.truth;
         t.radius = radius;
@@ -743,13 +748,13 @@ void RegisterEvaluate(py::module_& m) {
           t.path_2 = truth_file_2;
           t.soft_path = truth_file_soft;
           if (truth_type.is_none())
-            throw py::value_error(
-                "truth_type: expected with truth_file (" + GroundTruthFormatList() + ")");
+            throw py::value_error("truth_type: expected with truth_file (" +
+                                  GroundTruthFormatList() + ")");
           gt = WithArgumentNames([&] {
             t.type = ParseGroundTruthType(truth_type.cast<std::string>());
             if (loop && t.type.Format().two_traversals)
-              NeedsTwoTraversals("truth_type: \"" + GroundTruthTypeName(t.type) + "\"",
-                                 full_rows, full_cols);
+              NeedsTwoTraversals("truth_type: \"" + GroundTruthTypeName(t.type) + "\"", full_rows,
+                                 full_cols);
             return LoadGroundTruth(t, layout, full_rows, full_cols);
           });
         } else if (aligned) {
@@ -877,10 +882,9 @@ void RegisterEvaluate(py::module_& m) {
       py::arg("tolerance") = d.tolerance, py::arg("exclusion") = d.exclusion,
       py::arg("vicinity") = d.vicinity, py::arg("able_thresholds") = kOptions.able_thresholds,
       py::arg("radius") = d.radius, py::arg("heading_limit") = d.heading_limit,
-      py::arg("min_frame_gap") = py::none(), py::arg("axes") = d.axes,
-      py::arg("normalize") = true, py::arg("label") = "python",
-      py::arg("score") = d.score, py::arg("score_window") = d.score_window,
-      py::arg("accept_threshold") = py::none(),
+      py::arg("min_frame_gap") = py::none(), py::arg("axes") = d.axes, py::arg("normalize") = true,
+      py::arg("label") = "python", py::arg("score") = d.score,
+      py::arg("score_window") = d.score_window, py::arg("accept_threshold") = py::none(),
       py::arg("accept_consistency") = d.accept_consistency,
       py::arg("sequence_length") = d.sequence_length, py::arg("partial") = d.partial,
       py::arg("direction") = d.direction, py::arg("protocol") = d.protocol,
@@ -933,10 +937,9 @@ void RegisterUnsupervised(py::module_& m) {
         return d;
       },
       py::arg("matrix"), py::kw_only(), py::arg("layout") = py::none(),
-      py::arg("reference_frames") = py::none(),
-      py::arg("sequence_length") = d.sequence_length, py::arg("partial") = d.partial,
-      py::arg("direction") = d.direction, py::arg("exclusion") = d.exclusion,
-      py::arg("score_window") = d.score_window,
+      py::arg("reference_frames") = py::none(), py::arg("sequence_length") = d.sequence_length,
+      py::arg("partial") = d.partial, py::arg("direction") = d.direction,
+      py::arg("exclusion") = d.exclusion, py::arg("score_window") = d.score_window,
       d.Fill(R"doc(unsupervised_criteria(matrix, *, layout=None, reference_frames=None,
     sequence_length=@sequence_length@, partial="@partial@", direction="@direction@",
     exclusion=@exclusion@, score_window=@score_window@) -> dict
@@ -960,7 +963,8 @@ Returns:
     dict: consistency (share of the queries whose answer agrees), distinctiveness (mean of 1 -
     ratio, 0 for a query without answer), agreement ((10 consistency + distinctiveness) / 11),
     queries, answered, agreeing, gap and tolerance (frames), and per query row of the block
-    best (column, -1 none), ratio and agrees (bool).)doc").c_str());
+    best (column, -1 none), ratio and agrees (bool).)doc")
+          .c_str());
 }
 
 }  // namespace

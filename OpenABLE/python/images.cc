@@ -1,9 +1,10 @@
 // Images and descriptor names: read_image, list_images, to_gray8, descriptor_names.
 #include <pybind11/stl.h>
+
 #include <opencv2/imgproc.hpp>
 
-#include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/image/preprocess.h"
+#include "OpenABLE/io/frame_source.h"
 #include "OpenABLE/python/common.h"
 #include "descriptors/registry.h"
 

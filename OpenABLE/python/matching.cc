@@ -1,10 +1,10 @@
 // Distance matrices: hamming_distances, l2_distances, l1_distances, sequence_distances,
 // contrast_enhancement, normalize_by_max, threshold_matrix, best_matches, read_matrix.
-#include <cmath>
-#include <limits>
-
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
+
+#include <cmath>
+#include <limits>
 
 #include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/python/common.h"
@@ -147,8 +147,8 @@ Raises:
   m.def(
       "sequence_distances",
       [](const py::object& d, int sequence_length, const std::string& direction,
-         const py::object& row_starts, const py::object& col_starts, int threads,
-         bool in_place, const std::string& partial) -> py::object {
+         const py::object& row_starts, const py::object& col_starts, int threads, bool in_place,
+         const std::string& partial) -> py::object {
         const auto dir = ParseEnum<SequenceDirection>(direction, "direction");
         const auto part = ParseEnum<SequencePartial>(partial, "partial");
         const std::vector<int> rows = Starts(row_starts, "row_starts");
@@ -209,14 +209,14 @@ Raises:
 }
 
 void RegisterSequencesAndScores(py::module_& m) {
-
   m.def(
       "contrast_enhancement",
       [](const py::object& d, int window, const py::object& col_starts, int threads) {
         const MatView view = Matrix2D(d, Elements::kFloat32, "d");
         const std::vector<int> cols = Starts(col_starts, "col_starts");
-        if (window < 1) throw py::value_error("window: " + std::to_string(window) +
-                                              "; expected >= 1 (references on each side)");
+        if (window < 1)
+          throw py::value_error("window: " + std::to_string(window) +
+                                "; expected >= 1 (references on each side)");
         cv::Mat1f out;
         {
           py::gil_scoped_release release;
@@ -278,7 +278,8 @@ Raises:
         // Eq. 9 compares M' (in [0, 1]) with theta in [0, 1]; NaN would compare as "not a
         // candidate" without a word.
         if (!(theta >= 0.0f && theta <= 1.0f))
-          throw py::value_error("theta: " + FormatNumber(theta) + " is not valid; expected a "
+          throw py::value_error("theta: " + FormatNumber(theta) +
+                                " is not valid; expected a "
                                 "threshold in [0, 1] (Eq. 9 on the normalised matrix)");
         const MatView view = Matrix2D(normalized, Elements::kFloat32, "normalized");
         for (int i = 0; i < view.mat.rows; ++i) {
@@ -286,7 +287,8 @@ Raises:
           for (int j = 0; j < view.mat.cols; ++j)
             if (std::isnan(row[j]))
               throw py::value_error("normalized: NaN at row " + std::to_string(i) + ", column " +
-                                    std::to_string(j) + "; expected M' in [0, 1] (inf for a "
+                                    std::to_string(j) +
+                                    "; expected M' in [0, 1] (inf for a "
                                     "cell without a value)");
         }
         cv::Mat1b out;
@@ -310,7 +312,6 @@ Returns:
 }
 
 void RegisterMatrices(py::module_& m) {
-
   m.def(
       "best_matches",
       [](const py::object& matrix, const std::string& score, int score_window) {

@@ -1,9 +1,9 @@
 // The extension openable._openable (docs/python.md), whose contents the package openable
 // (OpenABLE/python/openable/__init__.py) re-exports.
-#include <stdexcept>
-
 #include <pybind11/eval.h>
+
 #include <opencv2/core.hpp>
+#include <stdexcept>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/threading.h"
@@ -75,7 +75,8 @@ the command-line programs; other invalid arguments raise ValueError.)doc";
       if (e.code == cv::Error::StsNoMem) {
         PyErr_SetString(PyExc_MemoryError,
                         ("not enough memory for this request (OpenCV could not allocate: " +
-                         openable::Trim(e.err) + ")").c_str());
+                         openable::Trim(e.err) + ")")
+                            .c_str());
       } else {
         PyErr_SetString(PyExc_RuntimeError,
                         ("OpenCV error in " + e.func + ": " + openable::Trim(e.err)).c_str());
@@ -134,7 +135,8 @@ def _wrap_module(module):
                     setattr(obj, member, property(attribute.fget,
                                                   _one_line(attribute.fset, where),
                                                   attribute.fdel, attribute.__doc__))
-)py", m.attr("__dict__"));
+)py",
+           m.attr("__dict__"));
   m.attr("_wrap_module")(m);
   m.attr("_wrap_module")(m.attr("snaps"));
 

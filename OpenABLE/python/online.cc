@@ -1,5 +1,9 @@
 // The batch helpers and the online detector of OpenABLE/online/online.h: describe, describe_images,
 // distance_matrix, OnlineDetector.
+#include "OpenABLE/online/online.h"
+
+#include <pybind11/stl.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <memory>
@@ -10,9 +14,6 @@
 #include <type_traits>
 #include <utility>
 
-#include <pybind11/stl.h>
-
-#include "OpenABLE/online/online.h"
 #include "OpenABLE/python/common.h"
 #include "matching/search/engine_registry.h"
 #include "matching/sequence.h"
@@ -29,14 +30,14 @@ struct ModelArgs {
   int batch = 16;
 };
 
-#define OPENABLE_MODEL_ARGS                                                                   \
-  py::arg("model_path") = TableDefault("Model_path"),                                         \
-      py::arg("model_input_size") = TableDefault("Model_input_size"),                         \
-      py::arg("model_channels") = TableDefault("Model_channels"),                             \
-      py::arg("model_mean") = TableDefault("Model_mean"),                                     \
-      py::arg("model_std") = TableDefault("Model_std"),                                       \
-      py::arg("model_normalize") = TableDefault("Model_normalize") == "1",                    \
-      py::arg("model_batch") = std::stoi(TableDefault("Model_batch"))
+#define OPENABLE_MODEL_ARGS                                            \
+  py::arg("model_path") = TableDefault("Model_path"),                  \
+  py::arg("model_input_size") = TableDefault("Model_input_size"),      \
+  py::arg("model_channels") = TableDefault("Model_channels"),          \
+  py::arg("model_mean") = TableDefault("Model_mean"),                  \
+  py::arg("model_std") = TableDefault("Model_std"),                    \
+  py::arg("model_normalize") = TableDefault("Model_normalize") == "1", \
+  py::arg("model_batch") = std::stoi(TableDefault("Model_batch"))
 
 // `text` with "@model_args@" replaced by the model_* keywords and their defaults, which are
 // the option table's (as OPENABLE_MODEL_ARGS gives them).
@@ -102,8 +103,7 @@ py::tuple ResultTuple(const OnlineResult& r, bool verification) {
     v["geometric"] = c.geometric;
     v["streak"] = c.streak;
     v["verified"] = c.verified;
-    candidates.append(
-        py::make_tuple(c.frame, c.distance, c.normalized, c.accepted, c.score, v));
+    candidates.append(py::make_tuple(c.frame, c.distance, c.normalized, c.accepted, c.score, v));
   }
   py::dict timings;
   timings["describe_seconds"] = r.describe_seconds;
@@ -271,7 +271,8 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
   const auto search = [&nested](const char* name, auto member, const char* doc) {
     nested(name, &O::approximate, member, doc);
   };
-  // The engine's names and their meanings come from its registry (matching/search/engine_registry.h).
+  // The engine's names and their meanings come from its registry
+  // (matching/search/engine_registry.h).
   static const std::string engine_doc =
       "Index of the blocks beyond exact_limit: " + ApproximateEngineHelp();
   c.def_property(
@@ -314,8 +315,7 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
          "then carry a sixth element, a dict (matches, inliers, model, geometric, streak, "
          "verified), and accepted means verified. Needs add_frame (images).");
   c.def_property(
-      "verification_features",
-      [](const O& o) { return EnumName(o.verification.features); },
+      "verification_features", [](const O& o) { return EnumName(o.verification.features); },
       [](O& o, const std::string& v) {
         o.verification.features = ParseEnum<LocalFeatures>(v, "verification_features");
       },
@@ -343,8 +343,7 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
        "__getitem__",
        [](const py::object& self, const std::string& name) -> py::object {
          const auto names = PropertyNames(py::type::of(self));
-         if (std::find(names.begin(), names.end(), name) == names.end())
-           throw py::key_error(name);
+         if (std::find(names.begin(), names.end(), name) == names.end()) throw py::key_error(name);
          return self.attr(name.c_str());
        },
        "options[\"name\"]: the option `name`.")
@@ -413,18 +412,19 @@ the order shown to users: )doc") +
          const std::string& model_input_size, const std::string& model_channels,
          const std::string& model_mean, const std::string& model_std, bool model_normalize,
          int model_batch) {
-        const OnlineOptions o = DescriptionOptions(
-            descriptor, description, patch_size, ldb_bits, grid, sad_patch,
-            {model_path, model_input_size, model_channels, model_mean, model_std,
-             model_normalize, model_batch});
+        const OnlineOptions o =
+            DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid, sad_patch,
+                               {model_path, model_input_size, model_channels, model_mean, model_std,
+                                model_normalize, model_batch});
         const cv::Mat rows = Describe({Image(image, "image", IsRgbOrder(color_order))}, o, 1);
         return ToNumpy(rows.row(0).clone(), true);
       },
       py::arg("image"), py::arg("descriptor") = "LDB", py::arg("description") = "global",
       py::arg("patch_size") = 64, py::arg("ldb_bits") = 256, py::arg("grid") = std::make_pair(1, 1),
       py::arg("sad_patch") = 8, py::arg("color_order") = "bgr", OPENABLE_MODEL_ARGS,
-      ModelDefaultsIn(std::string(
-           R"doc(describe(image, descriptor="LDB", description="global", patch_size=64,
+      ModelDefaultsIn(
+          std::string(
+              R"doc(describe(image, descriptor="LDB", description="global", patch_size=64,
     ldb_bits=256, grid=(1, 1), sad_patch=8, color_order="bgr",@model_args@) -> numpy.ndarray
 
 The descriptor row of one image, as Test_OpenABLE describes a frame (grey conversion, then
@@ -433,8 +433,8 @@ global or grid description).
 Args:
     image (numpy.ndarray): (H, W) grey or (H, W, 3) colour; uint8 (0-255) or float32 (0-1,
         as read_image() gives it). Read in place when contiguous (and BGR).
-)doc") +
-       kDescriptionArgs + R"doc(
+)doc") + kDescriptionArgs +
+          R"doc(
 
 Returns:
     numpy.ndarray: 1-D; uint8 bytes for binary descriptors and SAD, float32 for SIFT and HOG.
@@ -451,18 +451,19 @@ Raises:
          const std::string& model_input_size, const std::string& model_channels,
          const std::string& model_mean, const std::string& model_std, bool model_normalize,
          int model_batch) {
-        const OnlineOptions o = DescriptionOptions(
-            descriptor, description, patch_size, ldb_bits, grid, sad_patch,
-            {model_path, model_input_size, model_channels, model_mean, model_std,
-             model_normalize, model_batch});
+        const OnlineOptions o =
+            DescriptionOptions(descriptor, description, patch_size, ldb_bits, grid, sad_patch,
+                               {model_path, model_input_size, model_channels, model_mean, model_std,
+                                model_normalize, model_batch});
         return ToNumpy(Describe(Images(images, "images", IsRgbOrder(color_order)), o, threads));
       },
       py::arg("images"), py::arg("descriptor") = "LDB", py::arg("description") = "global",
       py::arg("patch_size") = 64, py::arg("ldb_bits") = 256, py::arg("grid") = std::make_pair(1, 1),
       py::arg("sad_patch") = 8, py::arg("threads") = 0, py::arg("color_order") = "bgr",
       OPENABLE_MODEL_ARGS,
-      ModelDefaultsIn(std::string(
-           R"doc(describe_images(images, descriptor="LDB", description="global", patch_size=64,
+      ModelDefaultsIn(
+          std::string(
+              R"doc(describe_images(images, descriptor="LDB", description="global", patch_size=64,
     ldb_bits=256, grid=(1, 1), sad_patch=8, threads=0, color_order="bgr",@model_args@) -> numpy.ndarray
 
 One descriptor row per image, described in parallel (the GIL is released).
@@ -470,8 +471,8 @@ One descriptor row per image, described in parallel (the GIL is released).
 Args:
     images (list[numpy.ndarray] | numpy.ndarray): images as describe() takes them, or a stack
         (N, H, W) / (N, H, W, 3).
-)doc") +
-       kDescriptionArgs + R"doc(
+)doc") + kDescriptionArgs +
+          R"doc(
     threads (int): threads; 0 = all cores.
 
 Returns:
@@ -485,8 +486,8 @@ Raises:
   m.def(
       "distance_matrix",
       [](const py::object& rows, int sequence_length, const std::string& direction,
-         const py::object& traversal_starts, int threads, bool return_max,
-         const py::object& metric, const std::string& partial) -> py::object {
+         const py::object& traversal_starts, int threads, bool return_max, const py::object& metric,
+         const std::string& partial) -> py::object {
         const MatView v = Matrix2D(rows, Elements::kUint8OrFloat32, "rows");
         const auto dir = ParseEnum<SequenceDirection>(direction, "direction");
         const auto part = ParseEnum<SequencePartial>(partial, "partial");
@@ -507,8 +508,7 @@ Raises:
       },
       py::arg("rows"), py::arg("sequence_length") = 1, py::arg("direction") = "forward",
       py::arg("traversal_starts") = py::none(), py::arg("threads") = 0,
-      py::arg("return_max") = false, py::arg("metric") = py::none(),
-      py::arg("partial") = "ahead",
+      py::arg("return_max") = false, py::arg("metric") = py::none(), py::arg("partial") = "ahead",
       R"doc(distance_matrix(rows, sequence_length=1, direction="forward", traversal_starts=None,
     threads=0, return_max=False, metric=None, partial="ahead") -> numpy.ndarray
 
@@ -534,7 +534,6 @@ Args:
 Returns:
     numpy.ndarray: float32 (N, N) in [0, 1] (+inf for cells without a value), owning the C++ result
     (no copy); or (matrix, max) with return_max=True.)doc");
-
 }
 
 void BindDetectorMapAndState(py::class_<Detector>& c);
@@ -564,11 +563,11 @@ Raises:
 Calls from several threads are serialised by a lock.)doc";
   py::class_<Detector> c(m, "OnlineDetector", class_doc.c_str());
   c.def(py::init([](const py::kwargs& kwargs) {
-             auto d = std::make_unique<Detector>();
-             d->detector = std::make_unique<OnlineDetector>(OnlineOptionsOf(kwargs));
-             return d;
-           }),
-           "__init__(**options)\n\nSee help(openable.OnlineDetector) for the options.")
+          auto d = std::make_unique<Detector>();
+          d->detector = std::make_unique<OnlineDetector>(OnlineOptionsOf(kwargs));
+          return d;
+        }),
+        "__init__(**options)\n\nSee help(openable.OnlineDetector) for the options.")
       .def(
           "add_to_map",
           [](Detector& det, const py::object& rows) {
@@ -701,7 +700,8 @@ candidate, or with `sessions` (a name or a list of names) only the frames of tho
 Args:
     rows (numpy.ndarray): (n, row_width) of row_dtype, e.g. describe_images()'s rows.
     sessions (str | list[str] | None): the sessions searched; None: all.
-)doc") + kQueryDoc).c_str())
+)doc") + kQueryDoc)
+              .c_str())
       .def(
           "query_images",
           [](Detector& det, const py::object& images, const py::object& sessions,
@@ -719,11 +719,13 @@ Args:
             return QueryResults(results, det.detector->Sessions());
           },
           py::arg("images"), py::arg("sessions") = py::none(), py::arg("color_order") = "bgr",
-          (std::string(R"doc(query_images(images, sessions=None, color_order="bgr") -> list[list[dict]]
+          (std::string(
+               R"doc(query_images(images, sessions=None, color_order="bgr") -> list[list[dict]]
 
 Describes `images` (a query traversal, of the map's frame size) and queries them as query()
 does.
-)doc") + kQueryDoc).c_str())
+)doc") + kQueryDoc)
+              .c_str())
       .def(
           "append_map",
           [](Detector& det, const py::object& path_object) {
@@ -831,28 +833,27 @@ the background (check_map()).)doc");
 // The detector's loading of a saved map, finish_merges, and its state (the properties).
 void BindDetectorMapAndState(py::class_<Detector>& c) {
   c.def(
-          "load_map",
-          [](Detector& det, const py::object& path_object, bool in_place,
-             bool check_in_background) {
-            const std::string path = FileSystemPath(path_object, "load_map: path");
-            OnlineDetector::LoadedMap info;
-            MapReadOptions read;
-            read.in_place = in_place;
-            read.check_in_background = check_in_background;
-            {
-              py::gil_scoped_release release;
-              std::lock_guard<std::mutex> lock(det.mutex);
-              info = det.detector->LoadMap(path, read);
-            }
-            py::dict out;
-            out["frames"] = info.frames;
-            out["blocks"] = info.blocks;
-            out["rebuilt"] = info.rebuilt;
-            out["reason"] = info.reason;
-            return out;
-          },
-          py::arg("path"), py::arg("in_place") = true, py::arg("check_in_background") = true,
-          R"doc(load_map(path, in_place=True, check_in_background=True) -> dict
+       "load_map",
+       [](Detector& det, const py::object& path_object, bool in_place, bool check_in_background) {
+         const std::string path = FileSystemPath(path_object, "load_map: path");
+         OnlineDetector::LoadedMap info;
+         MapReadOptions read;
+         read.in_place = in_place;
+         read.check_in_background = check_in_background;
+         {
+           py::gil_scoped_release release;
+           std::lock_guard<std::mutex> lock(det.mutex);
+           info = det.detector->LoadMap(path, read);
+         }
+         py::dict out;
+         out["frames"] = info.frames;
+         out["blocks"] = info.blocks;
+         out["rebuilt"] = info.rebuilt;
+         out["reason"] = info.reason;
+         return out;
+       },
+       py::arg("path"), py::arg("in_place") = true, py::arg("check_in_background") = true,
+       R"doc(load_map(path, in_place=True, check_in_background=True) -> dict
 
 Loads a map written by save_map() into this detector, which must be empty: its frames become
 frames 0 .. frames - 1, and later frames find them as candidates; with the options of the
@@ -894,13 +895,15 @@ installs its index.)doc")
             return d.detector->Size();
           },
           "Frames added so far.")
-      .def("__len__", [](Detector& d) {
-        std::lock_guard<std::mutex> lock(d.mutex);
-        return d.detector->Size();
-      }, "Frames added so far.")
+      .def(
+          "__len__",
+          [](Detector& d) {
+            std::lock_guard<std::mutex> lock(d.mutex);
+            return d.detector->Size();
+          },
+          "Frames added so far.")
       .def_property_readonly(
-          "row_width",
-          [](Detector& d) { return d.detector->RowWidth(); },
+          "row_width", [](Detector& d) { return d.detector->RowWidth(); },
           "Elements per descriptor row.")
       .def_property_readonly(
           "row_dtype",
@@ -965,8 +968,9 @@ installs its index.)doc")
             if (!reference.is_none()) t.reference = reference.cast<std::string>();
             if (!query.is_none()) t.query = query.cast<std::string>();
             if (reference.is_none() != query.is_none())
-              throw InputError("tune: reference and query: expected both session names, or "
-                               "neither (the map's first two sessions)");
+              throw InputError(
+                  "tune: reference and query: expected both session names, or "
+                  "neither (the map's first two sessions)");
             t.candidates = candidates;
             t.min_consistency = min_consistency;
             t.threshold = threshold;
@@ -980,8 +984,8 @@ installs its index.)doc")
             return TuningDict(tuning);
           },
           py::arg("reference") = py::none(), py::arg("query") = py::none(),
-          py::arg("candidates") = "", py::arg("min_consistency") = 0.5,
-          py::arg("threshold") = -1.0, py::arg("max_frames") = 0,
+          py::arg("candidates") = "", py::arg("min_consistency") = 0.5, py::arg("threshold") = -1.0,
+          py::arg("max_frames") = 0,
           R"doc(tune(reference=None, query=None, candidates="", min_consistency=0.5, threshold=-1, max_frames=0) -> dict
 
 Chooses the search settings from the map's own frames, with no ground truth, as

@@ -1,14 +1,14 @@
 // The SNAPS add-on (docs/snaps.md) as openable.snaps: trajectories, loops, the discounted
 // update (Eq. 6), the pose graph, the absolute trajectory error.
+#include <pybind11/stl.h>
+
 #include <cmath>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <iostream>
 #include <string>
 #include <vector>
-
-#include <pybind11/stl.h>
 
 #include "OpenABLE/app/snaps_chain.h"
 #include "OpenABLE/base/error.h"
@@ -65,8 +65,7 @@ struct KeyDefaults {
   int initial = std::stoi(TableDefault("Initial_image"));
   int discount_length = std::stoi(TableDefault("Snaps_discount_length"));
   int pause = std::stoi(TableDefault("Snaps_pause"));
-  double odometry_translation_weight =
-      std::stod(TableDefault("Snaps_odometry_translation_weight"));
+  double odometry_translation_weight = std::stod(TableDefault("Snaps_odometry_translation_weight"));
   double odometry_rotation_weight = std::stod(TableDefault("Snaps_odometry_rotation_weight"));
   double loop_weight = std::stod(TableDefault("Snaps_loop_weight"));
   std::string robust_kernel = TableDefault("Snaps_robust_kernel");
@@ -107,8 +106,8 @@ constexpr snaps::ConventionWords kPythonConventionWords = {
     "the format of each file (read_trajectory's format)"};
 
 py::array_t<double> PosesArray(const Trajectory& t, int rows) {
-  py::array_t<double> a({static_cast<py::ssize_t>(t.Size()), static_cast<py::ssize_t>(rows),
-                         py::ssize_t{4}});
+  py::array_t<double> a(
+      {static_cast<py::ssize_t>(t.Size()), static_cast<py::ssize_t>(rows), py::ssize_t{4}});
   double* out = a.mutable_data();
   for (const Eigen::Isometry3d& pose : t.poses) {
     const Eigen::Matrix4d& m = pose.matrix();
@@ -216,7 +215,7 @@ Args:
         frame i), "kitti-id" (a frame number then 12 numbers), "tum" (timestamp tx ty tz qx qy
         qz qw).
     world_to_camera (bool): save() writes the inverse matrices (as SO-DSO's files are).)doc")
-                 .c_str())
+          .c_str())
       .def(py::init(&MakeTrajectory), py::arg("poses"), py::arg("frame_ids") = py::none(),
            py::arg("timestamps") = py::none(), py::arg("format") = d.format,
            py::arg("world_to_camera") = d.world_to_camera,
@@ -376,8 +375,7 @@ void RegisterTrajectoryErrors(py::module_& m) {
           error = snaps::AbsoluteTrajectoryError(estimate, truth, a, align);
           aligned = align ? error : snaps::AbsoluteTrajectoryError(estimate, truth, a, true);
         }
-        if (const std::string hint =
-                snaps::ConventionHint(aligned, truth, kPythonConventionWords);
+        if (const std::string hint = snaps::ConventionHint(aligned, truth, kPythonConventionWords);
             !hint.empty())
           Warn(hint);
         return error;
@@ -519,16 +517,17 @@ Args:
     tolerance (int): Snaps_keyframe_tolerance.)doc")
           .c_str());
 
-  m.def("closed_loops",
-        [](const py::object& loops, int pause) {
-          return LoopsList(snaps::ClosedLoops(LoopsOf(loops, nullptr), pause));
-        },
-        py::arg("loops"), py::arg("pause") = d.pause,
-        d.Fill(R"doc(closed_loops(loops, pause=@pause@) -> list
+  m.def(
+      "closed_loops",
+      [](const py::object& loops, int pause) {
+        return LoopsList(snaps::ClosedLoops(LoopsOf(loops, nullptr), pause));
+      },
+      py::arg("loops"), py::arg("pause") = d.pause,
+      d.Fill(R"doc(closed_loops(loops, pause=@pause@) -> list
 
 The loops correct_discounted() closes, in order: taken by query, a loop is skipped when its
 query is not more than `pause` poses after the last closed loop's query (Snaps_pause).)doc")
-            .c_str());
+          .c_str());
 
   m.def("discount_gamma", &snaps::DiscountGamma, py::arg("s_prime"), py::arg("alpha"),
         R"doc(discount_gamma(s_prime, alpha) -> float
@@ -723,25 +722,22 @@ corrections and their errors, as openable_snaps reports them.)doc")
           "to_json", [](const ChainRun& c) { return snaps::EncodeChainJson(c.config, c.result); },
           "to_json() -> str\n\nThe figures, as <Snaps_output_name>.json.")
       .def("__repr__", [](const ChainRun& c) {
-        return "<openable.snaps.ChainResult " + std::to_string(c.result.input.Size()) +
-               " poses, " + std::to_string(c.result.loops.size()) + " loops>";
+        return "<openable.snaps.ChainResult " + std::to_string(c.result.input.Size()) + " poses, " +
+               std::to_string(c.result.loops.size()) + " loops>";
       });
 }
 
 void RegisterChain(py::module_& m) {
-
   m.def(
       "run",
       [](const py::object& config, const py::object& settings, bool write, bool quiet) {
         auto c = std::make_unique<ChainRun>();
-        if (!config.is_none())
-          c->config = LoadConfig(py::str(config).cast<std::string>());
+        if (!config.is_none()) c->config = LoadConfig(py::str(config).cast<std::string>());
         if (!settings.is_none())
           for (const auto item : settings.cast<py::dict>()) {
             const py::handle v = item.second;
-            const std::string text = py::isinstance<py::bool_>(v)
-                                         ? (v.cast<bool>() ? "1" : "0")
-                                         : py::str(v).cast<std::string>();
+            const std::string text = py::isinstance<py::bool_>(v) ? (v.cast<bool>() ? "1" : "0")
+                                                                  : py::str(v).cast<std::string>();
             ApplyOverride(c->config, item.first.cast<std::string>() + "=" + text);
           }
         py::gil_scoped_release release;

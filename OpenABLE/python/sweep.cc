@@ -1,13 +1,14 @@
 // openable.sweep: the sweep of openable_sweep (OpenABLE/tuning/sweep.h) from Python.
+#include "OpenABLE/tuning/sweep.h"
+
+#include <pybind11/stl.h>
+
 #include <iostream>
 #include <memory>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/version.h"
-#include <pybind11/stl.h>
-
 #include "OpenABLE/python/common.h"
-#include "OpenABLE/tuning/sweep.h"
 
 namespace openable::python {
 namespace {
@@ -77,14 +78,15 @@ Attributes:
     written (list[str]): paths written (output given).
 
 Methods: table() (the ranked table openable_sweep prints), to_csv(), to_json().)doc")
-      .def_property_readonly("runs",
-                             [](const Sweep& s) {
-                               py::list runs;
-                               for (std::size_t i = 0; i < s.result.runs.size(); ++i)
-                                 runs.append(RunDict(s.result, i));
-                               return runs;
-                             },
-                             "list[dict]: one dict per combination, best first (see the class).")
+      .def_property_readonly(
+          "runs",
+          [](const Sweep& s) {
+            py::list runs;
+            for (std::size_t i = 0; i < s.result.runs.size(); ++i)
+              runs.append(RunDict(s.result, i));
+            return runs;
+          },
+          "list[dict]: one dict per combination, best first (see the class).")
       .def_property_readonly(
           "rank_by", [](const Sweep& s) { return EnumName(s.result.rank_by); },
           "str: the figure the runs are ranked by.")
@@ -100,12 +102,15 @@ Methods: table() (the ranked table openable_sweep prints), to_csv(), to_json().)
       .def_property_readonly(
           "written", [](const Sweep& s) { return s.written; },
           "list[str]: the paths written (output given), else empty.")
-      .def("table", [](const Sweep& s) { return FormatSweepTable(s.result); },
-           "table() -> str\n\nThe ranked table, as openable_sweep prints it.")
-      .def("to_csv", [](const Sweep& s) { return EncodeSweepCsv(s.result); },
-           "to_csv() -> str\n\nThe ranked rows as CSV (the file openable_sweep writes).")
-      .def("to_json", [](const Sweep& s) { return EncodeSweepJson(s.result, kVersion); },
-           "to_json() -> str\n\nThe whole sweep as JSON (the file openable_sweep writes).")
+      .def(
+          "table", [](const Sweep& s) { return FormatSweepTable(s.result); },
+          "table() -> str\n\nThe ranked table, as openable_sweep prints it.")
+      .def(
+          "to_csv", [](const Sweep& s) { return EncodeSweepCsv(s.result); },
+          "to_csv() -> str\n\nThe ranked rows as CSV (the file openable_sweep writes).")
+      .def(
+          "to_json", [](const Sweep& s) { return EncodeSweepJson(s.result, kVersion); },
+          "to_json() -> str\n\nThe whole sweep as JSON (the file openable_sweep writes).")
       .def("__repr__", [](const Sweep& s) {
         return "<openable.SweepResult " + std::to_string(s.result.runs.size()) +
                " runs ranked by " + EnumName(s.result.rank_by) + ">";

@@ -1,9 +1,8 @@
 #include "OpenABLE/reports/figures.h"
 
 #include <cmath>
-#include <stdexcept>
-
 #include <opencv2/core/utility.hpp>
+#include <stdexcept>
 
 #include "OpenABLE/io/image_codec.h"
 

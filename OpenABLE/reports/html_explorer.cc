@@ -4,10 +4,9 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <opencv2/imgproc.hpp>
 #include <tuple>
 #include <vector>
-
-#include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/io/image_codec.h"
@@ -60,14 +59,15 @@ std::string FrameName(const ReportFrames& frames, bool row, int index) {
 // `max_pixels` pixels; `read_one` is called after each frame read.
 void MakeSheets(const ReportFrames& frames, double max_pixels, FrameSet& set,
                 const std::function<void()>& read_one) {
-  for (int i = 0; i < set.count; ++i) set.names.push_back(FrameName(frames, set.row, set.first + i));
+  for (int i = 0; i < set.count; ++i)
+    set.names.push_back(FrameName(frames, set.row, set.first + i));
   if (!frames.read || set.count == 0) return;
   // The cell: the first frame's shape, at most kExploreThumbHeight high and kExploreThumbWidth
   // across, smaller when the report's budget asks.
   const cv::Mat first = EightBit(frames.read(set.row, set.first));
   read_one();
-  double scale = std::min({1.0, double(kExploreThumbHeight) / first.rows,
-                           double(kExploreThumbWidth) / first.cols});
+  double scale = std::min(
+      {1.0, double(kExploreThumbHeight) / first.rows, double(kExploreThumbWidth) / first.cols});
   if (first.rows * first.cols * scale * scale > max_pixels)
     scale = std::sqrt(max_pixels / (double(first.rows) * first.cols));
   set.cell_width = std::max(4, static_cast<int>(std::lround(first.cols * scale)));
@@ -89,10 +89,12 @@ void MakeSheets(const ReportFrames& frames, double max_pixels, FrameSet& set,
       if (image.channels() == 3 && !colour) cv::cvtColor(image, image, cv::COLOR_BGR2GRAY);
       if (image.channels() == 1 && colour) cv::cvtColor(image, image, cv::COLOR_GRAY2BGR);
       // Fitted into the cell, centred (frames of another shape are letterboxed).
-      const double s = std::min(double(set.cell_width) / image.cols,
-                                double(set.cell_height) / image.rows);
-      const int w = std::max(1, std::min(set.cell_width, static_cast<int>(std::lround(image.cols * s))));
-      const int h = std::max(1, std::min(set.cell_height, static_cast<int>(std::lround(image.rows * s))));
+      const double s =
+          std::min(double(set.cell_width) / image.cols, double(set.cell_height) / image.rows);
+      const int w =
+          std::max(1, std::min(set.cell_width, static_cast<int>(std::lround(image.cols * s))));
+      const int h =
+          std::max(1, std::min(set.cell_height, static_cast<int>(std::lround(image.rows * s))));
       cv::Mat fitted;
       cv::resize(image, fitted, cv::Size(w, h), 0, 0, s < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
       const int x = (k % kSheetColumns) * set.cell_width + (set.cell_width - w) / 2;
@@ -574,9 +576,10 @@ std::string ExplorerSection(const ReportInput& input, const std::vector<ReportRu
   for (FrameSet& set : sets) MakeSheets(frames, max_pixels, set, step);
 
   const bool truth = input.evaluation != nullptr;
-  std::string h = "<section id=\"explore\">\n<h2>Explore</h2>\n"
-                  "<noscript><p class=\"note\">The explorer needs JavaScript; the sections "
-                  "above and below show the same run without it.</p></noscript>\n";
+  std::string h =
+      "<section id=\"explore\">\n<h2>Explore</h2>\n"
+      "<noscript><p class=\"note\">The explorer needs JavaScript; the sections "
+      "above and below show the same run without it.</p></noscript>\n";
   h += truth ? "<p class=\"note\">Hover over the matrix to see a cell's two frames, click to keep "
                "it (the arrow keys then move it one cell at a time, ten with Shift). The slider "
                "sets the threshold on the score: the best matches with a score at or below it "
@@ -607,8 +610,8 @@ std::string ExplorerSection(const ReportInput& input, const std::vector<ReportRu
       const std::string id = "explore-sheet-" + std::to_string(s) + "-" + std::to_string(k);
       ids.push_back(id);
       sheets_html += "<img id=\"" + id + "\" class=\"sheet\" alt=\"thumbnails of " +
-                     std::string(set.row ? "rows " : "columns ") + std::to_string(set.first) +
-                     "-" + std::to_string(set.first + set.count - 1) + ", sheet " +
+                     std::string(set.row ? "rows " : "columns ") + std::to_string(set.first) + "-" +
+                     std::to_string(set.first + set.count - 1) + ", sheet " +
                      std::to_string(k + 1) + "\" src=\"data:image/jpeg;base64," +
                      Base64(set.sheets[k]) + "\">\n";
     }
@@ -634,8 +637,8 @@ std::string ExplorerSection(const ReportInput& input, const std::vector<ReportRu
 
     Json j;
     j["label"] = run.label;
-    j["kind"] = layout.kind == EvaluationLayout::Kind::kLoopClosure ? "loop-closure"
-                                                                     : "query-reference";
+    j["kind"] =
+        layout.kind == EvaluationLayout::Kind::kLoopClosure ? "loop-closure" : "query-reference";
     j["exclusion"] = run.exclusion;
     j["queries"] = layout.queries;
     j["references"] = layout.references;
@@ -677,15 +680,19 @@ std::string ExplorerSection(const ReportInput& input, const std::vector<ReportRu
     j["curve"] = curve;
     int cell_rows = 1, cell_cols = 1;
     const cv::Mat1b values = ExploreValues(matrix, layout, cell_rows, cell_cols);
-    j["values"] = {{"rows", values.rows}, {"cols", values.cols}, {"cell_rows", cell_rows},
+    j["values"] = {{"rows", values.rows},
+                   {"cols", values.cols},
+                   {"cell_rows", cell_rows},
                    {"cell_cols", cell_cols}};
 
     const cv::Mat3b image = MatrixImage(matrix, layout, run.truth);
     const std::string image_png = Base64(EncodePng(image));
     step();
     const double longer = std::max(layout.queries, layout.references);
-    const int display_w = std::max(1, static_cast<int>(std::lround(kMatrixDisplay * layout.references / longer)));
-    const int display_h = std::max(1, static_cast<int>(std::lround(kMatrixDisplay * layout.queries / longer)));
+    const int display_w =
+        std::max(1, static_cast<int>(std::lround(kMatrixDisplay * layout.references / longer)));
+    const int display_h =
+        std::max(1, static_cast<int>(std::lround(kMatrixDisplay * layout.queries / longer)));
 
     std::string note;
     if (run.consistency > 0)
@@ -693,15 +700,17 @@ std::string ExplorerSection(const ReportInput& input, const std::vector<ReportRu
               std::to_string(run.consistency) +
               " to confirm each answer; the slider applies the score alone.";
     if (run.untrusted)
-      note += " The run accepted no answer (the auto mode could not trust its choice); the "
-              "slider shows what a threshold would accept.";
+      note +=
+          " The run accepted no answer (the auto mode could not trust its choice); the "
+          "slider shows what a threshold would accept.";
     if (cell_rows > 1 || cell_cols > 1)
       note += " The block is larger than " + std::to_string(kExploreValuesSide) +
               " cells a side: a cell other than a best match shows the mean of its group of " +
               std::to_string(cell_rows) + " x " + std::to_string(cell_cols) + " cells.";
     if (image.cols != layout.references || image.rows != layout.queries)
       note += " The image is downsampled to " + std::to_string(image.cols) + " x " +
-              std::to_string(image.rows) + " pixels; clicks and arrow keys still select single cells.";
+              std::to_string(image.rows) +
+              " pixels; clicks and arrow keys still select single cells.";
 
     h += "<h3>" + HtmlEscape(run.label) + "</h3>\n";
     h += "<script type=\"application/json\" id=\"explore-run-" + n + "\">" +
@@ -711,18 +720,17 @@ std::string ExplorerSection(const ReportInput& input, const std::vector<ReportRu
          "</script>\n";
     h += "<div class=\"explorer\" id=\"explorer-" + n + "\" data-data=\"explore-run-" + n +
          "\" data-values=\"explore-values-" + n + "\" hidden>\n";
-    const std::string reset =
-        run.threshold >= 0
-            ? "run's operating point (" + FormatNumber(run.threshold, 4) + ")"
-            : std::string("every answer (no Match_threshold)");
+    const std::string reset = run.threshold >= 0
+                                  ? "run's operating point (" + FormatNumber(run.threshold, 4) + ")"
+                                  : std::string("every answer (no Match_threshold)");
     h += "<div class=\"ex-controls\"><label>threshold (" + score_kind +
          " score) <input type=\"range\" class=\"ex-threshold\"></label> "
          "<output class=\"ex-threshold-value\"></output> "
-         "<button type=\"button\" class=\"ex-reset\">" + reset + "</button><br>";
+         "<button type=\"button\" class=\"ex-reset\">" +
+         reset + "</button><br>";
     if (run.evaluated != nullptr) {
       const PerQueryResult& p = run.evaluated->per_query;
-      h += "accepted <b class=\"ex-accepted\"></b> of " +
-           std::to_string(p.queries - p.unanswered) +
+      h += "accepted <b class=\"ex-accepted\"></b> of " + std::to_string(p.queries - p.unanswered) +
            " answers, right <b class=\"ex-correct\"></b>; precision <b "
            "class=\"ex-precision\"></b>, recall <b class=\"ex-recall\"></b> (of " +
            std::to_string(p.positive_queries) + " queries with a true place)</div>\n";
@@ -751,8 +759,7 @@ std::string ExplorerSection(const ReportInput& input, const std::vector<ReportRu
     if (run.evaluated != nullptr)
       h += "<option value=\"right\">right</option><option value=\"wrong\">wrong</option>";
     h += "<option value=\"accepted\">accepted at the threshold</option>";
-    if (run.evaluated == nullptr)
-      h += "<option value=\"run\">accepted by the run</option>";
+    if (run.evaluated == nullptr) h += "<option value=\"run\">accepted by the run</option>";
     h += "<option value=\"unanswered\">no answer</option></select></label> "
          "<span class=\"ex-listed note\"></span>\n"
          "<table class=\"ex-queries\"><thead><tr><th>#</th><th>query</th><th>best match</th>"

@@ -10,10 +10,9 @@
 
 #include <cstdint>
 #include <functional>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/reports/html_report.h"
 
@@ -73,7 +72,8 @@ std::int64_t ExplorerSteps(const ReportInput& input, const std::vector<ReportRun
 
 // The section: its HTML, the embedded data and the script; `step` is called after each of
 // its ExplorerSteps.
-std::string ExplorerSection(const ReportInput& input, const std::vector<ReportRun>& runs,
-                            const std::function<void()>& step = [] {});
+std::string ExplorerSection(
+    const ReportInput& input, const std::vector<ReportRun>& runs,
+    const std::function<void()>& step = [] {});
 
 }  // namespace openable

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
-
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
@@ -46,8 +45,8 @@ cv::Mat Thumbnail(const cv::Mat& frame) {
   }
   if (image.depth() != CV_8U) image.convertTo(image, CV_8U, 255.0);
   if (image.cols > kThumbnailWidth) {
-    const int height =
-        std::max(1, static_cast<int>(std::lround(image.rows * double(kThumbnailWidth) / image.cols)));
+    const int height = std::max(
+        1, static_cast<int>(std::lround(image.rows * double(kThumbnailWidth) / image.cols)));
     cv::resize(image, image, cv::Size(kThumbnailWidth, height), 0, 0, cv::INTER_AREA);
   }
   return image;
@@ -207,8 +206,8 @@ std::vector<ReportRun> ReportRuns(const ReportInput& input) {
         accept.accept_threshold = std::numeric_limits<double>::infinity();
       std::vector<std::uint8_t> confirmed;
       AcceptAnswers(p.best, p.score, accept, r.answers.accepted, confirmed);
-      r.answers.confirmed = p.has_operating_point ? p.accepted
-                                                  : std::vector<std::uint8_t>(p.best.size(), 0);
+      r.answers.confirmed =
+          p.has_operating_point ? p.accepted : std::vector<std::uint8_t>(p.best.size(), 0);
       r.has_operating_point = p.has_operating_point;
       r.threshold = OperatingThreshold(e);
       r.consistency = options.accept_consistency;
@@ -285,8 +284,8 @@ std::string FrameCell(const ReportFrames& frames, const EvaluationLayout& layout
 // A note that the frames are named, not shown, and why; empty when they are shown.
 std::string NoImagesNote(const ReportFrames& frames) {
   return frames.read ? ""
-                     : "<p class=\"note\">Frames are named, not shown: " +
-                           Escape(frames.missing) + "</p>\n";
+                     : "<p class=\"note\">Frames are named, not shown: " + Escape(frames.missing) +
+                           "</p>\n";
 }
 
 // The two sections of worst cases (most confident wrong matches, misses), one table per run,
@@ -307,16 +306,16 @@ std::string WorstCaseSections(const ReportInput& input) {
       const auto distance = [&](int column) {
         return Number(matrix(run.layout.row_offset + c.query, run.layout.col_offset + column), 4);
       };
-      std::string score = c.answer >= 0 ? "score " + Number(c.score, 4) + "<br>match: " +
-                                              distance(c.answer)
-                                        : std::string("no answer");
+      std::string score = c.answer >= 0
+                              ? "score " + Number(c.score, 4) + "<br>match: " + distance(c.answer)
+                              : std::string("no answer");
       if (c.true_place >= 0) score += "<br>true place: " + distance(c.true_place);
       t += "<tr data-query=\"" + std::to_string(c.query) + "\"><td>" + std::to_string(k + 1) +
            "<br>" + score + "</td>" + FrameCell(frames, run.layout, true, c.query, "", "") +
            FrameCell(frames, run.layout, false, c.answer, "no answer",
                      c.correct ? "right" : "wrong") +
-           FrameCell(frames, run.layout, false, c.true_place,
-                     "no true place among the candidates", "right") +
+           FrameCell(frames, run.layout, false, c.true_place, "no true place among the candidates",
+                     "right") +
            "</tr>\n";
     }
     return t + "</table>\n";
@@ -329,9 +328,9 @@ std::string WorstCaseSections(const ReportInput& input) {
     std::string section = "<section id=\"" + id + "\">\n<h2>" + title +
                           "</h2>\n<p class=\"note\">" + note + "</p>\n" + no_images;
     for (std::size_t i = 0; i < evaluation.runs.size(); ++i)
-      section += cases_table(evaluation.runs[i], *input.matrices[i],
-                             select(evaluation.runs[i], evaluation.truths[i], *input.matrices[i]),
-                             kind);
+      section +=
+          cases_table(evaluation.runs[i], *input.matrices[i],
+                      select(evaluation.runs[i], evaluation.truths[i], *input.matrices[i]), kind);
     return section + "</section>\n";
   };
   h += cases_section(
@@ -374,8 +373,7 @@ std::string NoneAcceptedReason(const ReportRun& run) {
            "(UNRELIABLE)";
   if (!run.has_operating_point) return "Match_threshold is not set (-1), so the run accepts none";
   if (run.answers.Accepted() == 0)
-    return "no best match has a score at or below Match_threshold " +
-           FormatNumber(run.threshold);
+    return "no best match has a score at or below Match_threshold " + FormatNumber(run.threshold);
   return "Match_consistency confirmed none of the " + std::to_string(run.answers.Accepted()) +
          " best matches within Match_threshold";
 }
@@ -383,19 +381,20 @@ std::string NoneAcceptedReason(const ReportRun& run) {
 // The operating point of each run: queries, answered, accepted by the threshold, confirmed by
 // Match_consistency and, with ground truth, right, precision and recall of the run's matches.
 std::string OperatingPointTable(const std::vector<ReportRun>& runs, bool truth) {
-  std::string h = "<table id=\"operating-point-table\">\n<tr><th>run</th><th>queries</th>"
-                  "<th>answered</th><th>score</th><th>Match_threshold</th>"
-                  "<th>accepted</th><th>Match_consistency</th><th>confirmed</th>";
+  std::string h =
+      "<table id=\"operating-point-table\">\n<tr><th>run</th><th>queries</th>"
+      "<th>answered</th><th>score</th><th>Match_threshold</th>"
+      "<th>accepted</th><th>Match_consistency</th><th>confirmed</th>";
   if (truth) h += "<th>right</th><th>precision</th><th>recall</th>";
   h += "</tr>\n";
   for (const ReportRun& run : runs) {
     const QueryAnswers& a = run.answers;
     const std::string dash = "&ndash;";
     const bool point = run.has_operating_point;
-    const std::string threshold =
-        !point ? std::string("none")
-               : std::isfinite(run.threshold) ? FormatNumber(run.threshold)
-                                              : std::string("every verified answer");
+    const std::string threshold = !point ? std::string("none")
+                                  : std::isfinite(run.threshold)
+                                      ? FormatNumber(run.threshold)
+                                      : std::string("every verified answer");
     h += "<tr" + std::string(run.untrusted ? " class=\"unreliable\"" : "") + "><td>" +
          Escape(run.label + (run.verified ? " (verified)" : "")) + "</td><td class=\"n\">" +
          std::to_string(a.queries) + "</td><td class=\"n\">" + std::to_string(a.answered) +
@@ -428,18 +427,21 @@ std::string OperatingPointSentence(const ReportRun& run) {
                   (run.verified ? " (a candidate that passed geometric verification)"
                                 : " (a best match with a value)");
   if (run.untrusted)
-    return s + "; UNRELIABLE: the auto mode could not trust any candidate's settings, so the "
-               "run accepts no match. The explorer's slider shows what a threshold would "
-               "accept; the frames below are the best matches, not accepted.";
+    return s +
+           "; UNRELIABLE: the auto mode could not trust any candidate's settings, so the "
+           "run accepts no match. The explorer's slider shows what a threshold would "
+           "accept; the frames below are the best matches, not accepted.";
   if (!run.has_operating_point)
-    return s + "; Match_threshold is not set (-1), so the run accepts none. Set it to accept "
-               "the best matches whose " + ScoreName(run.score) +
-               " score is at or below it; the explorer's slider shows how many a threshold "
-               "accepts.";
+    return s +
+           "; Match_threshold is not set (-1), so the run accepts none. Set it to accept "
+           "the best matches whose " +
+           ScoreName(run.score) +
+           " score is at or below it; the explorer's slider shows how many a threshold "
+           "accepts.";
   s += "; " + std::to_string(a.Accepted()) +
        (std::isfinite(run.threshold)
-            ? " accepted with " + ScoreName(run.score) + " score <= " +
-                  FormatNumber(run.threshold) + " (Match_threshold)"
+            ? " accepted with " + ScoreName(run.score) +
+                  " score <= " + FormatNumber(run.threshold) + " (Match_threshold)"
             : std::string(" accepted (every verified answer: Match_threshold is -1)"));
   if (run.consistency > 0)
     s += ", " + std::to_string(a.Confirmed()) + " of them confirmed " +
@@ -533,8 +535,7 @@ std::vector<std::pair<std::string, std::string>> ProtocolSettings(
             {"match score", ScoreName(s.options.score)},
             {"ABLE-P vicinity", std::to_string(s.options.vicinity) + " frames"}};
     if (one_sequence)
-      rows.insert(rows.begin() + 2,
-                  {"exclusion", std::to_string(s.options.exclusion) + " frames"});
+      rows.insert(rows.begin() + 2, {"exclusion", std::to_string(s.options.exclusion) + " frames"});
     return rows;
   }
   rows.push_back({"ground truth", "none (no answer is judged)"});
@@ -542,11 +543,11 @@ std::vector<std::pair<std::string, std::string>> ProtocolSettings(
   const ReportRun& r = runs[0];
   if (one_sequence) rows.push_back({"exclusion", std::to_string(r.exclusion) + " frames"});
   const ReportAnswers& a = input.answers[0];
-  rows.push_back({"match score", ScoreName(r.score) +
-                                     (r.score == MatchScore::kRatio
-                                          ? " (rivals beyond &plusmn;" +
-                                                std::to_string(a.score_window) + " frames)"
-                                          : std::string())});
+  rows.push_back(
+      {"match score", ScoreName(r.score) + (r.score == MatchScore::kRatio
+                                                ? " (rivals beyond &plusmn;" +
+                                                      std::to_string(a.score_window) + " frames)"
+                                                : std::string())});
   return rows;
 }
 
@@ -557,8 +558,8 @@ std::string EncodeHtmlReport(const ReportInput& input) {
   const bool truth = input.evaluation != nullptr;
   // Progress: the precision-recall figure, each run's matrix figure, the explorer's steps and
   // the frames of the last sections.
-  const std::int64_t total = (truth ? 1 : 0) + static_cast<std::int64_t>(runs.size()) +
-                             ExplorerSteps(input, runs) + 1;
+  const std::int64_t total =
+      (truth ? 1 : 0) + static_cast<std::int64_t>(runs.size()) + ExplorerSteps(input, runs) + 1;
   std::int64_t done = 0;
   const auto step = [&] {
     if (input.on_progress) input.on_progress(++done, total);
@@ -568,8 +569,12 @@ std::string EncodeHtmlReport(const ReportInput& input) {
   std::string h;
   h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
        "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-       "<meta name=\"generator\" content=\"OpenABLE " + std::string(kVersion) + "\">\n"
-       "<title>" + Escape(input.title) + "</title>\n<style>\n"
+       "<meta name=\"generator\" content=\"OpenABLE " +
+       std::string(kVersion) +
+       "\">\n"
+       "<title>" +
+       Escape(input.title) +
+       "</title>\n<style>\n"
        "body{font-family:system-ui,sans-serif;margin:1.5em auto;max-width:1460px;padding:0 1em;"
        "color:#222}\n"
        "h1{font-size:1.6em}h2{margin-top:1.6em;border-bottom:1px solid #ddd}\n"
@@ -587,7 +592,8 @@ std::string EncodeHtmlReport(const ReportInput& input) {
        ".cases-row table.cases img{width:200px}\n"
        "pre{background:#f7f7f7;padding:.5em;overflow:auto;font-size:.85em}\n"
        // The explorer (html_explorer.h).
-       ".ex-controls{margin:.5em 0;line-height:1.8}.ex-threshold{width:360px;vertical-align:middle}\n"
+       ".ex-controls{margin:.5em "
+       "0;line-height:1.8}.ex-threshold{width:360px;vertical-align:middle}\n"
        ".ex-row{display:flex;flex-wrap:wrap;gap:1.2em;align-items:flex-start}\n"
        ".ex-matrix{position:relative;flex:none;cursor:crosshair;outline:1px solid #ccc}\n"
        ".ex-matrix:focus{outline:2px solid #ffb000}\n"
@@ -614,7 +620,8 @@ std::string EncodeHtmlReport(const ReportInput& input) {
     h += "<p class=\"no-truth\" id=\"no-truth\"><b>No ground truth.</b> This page shows what "
          "the run answered and accepted, not whether the answers are right: without a ground "
          "truth there is no precision, recall or wrong match to count. " +
-         Escape(advice) + " Until then, check the accepted matches by eye (section "
+         Escape(advice) +
+         " Until then, check the accepted matches by eye (section "
          "<a href=\"#accepted\">Accepted matches</a>).</p>\n";
   }
   std::string extra_links;
@@ -677,9 +684,9 @@ std::string EncodeHtmlReport(const ReportInput& input) {
            Escape(run.source) + "</td><td class=\"n\">" + std::to_string(p.queries) +
            "</td><td class=\"n\">" + std::to_string(p.positive_queries) + "</td><td class=\"n\">" +
            std::to_string(p.unanswered) + "</td>";
-      for (const double v : {p.auc, p.recall_at_100p, p.max_f1, p.max_f1_threshold,
-                             p.max_f1_precision, p.max_f1_recall, p.recall_at_1, p.recall_at_5,
-                             p.recall_at_10})
+      for (const double v :
+           {p.auc, p.recall_at_100p, p.max_f1, p.max_f1_threshold, p.max_f1_precision,
+            p.max_f1_recall, p.recall_at_1, p.recall_at_5, p.recall_at_10})
         h += "<td class=\"n\">" + Number(v, 4) + "</td>";
       h += "<td class=\"n\">" + Number(run.able_p.average_precision, 2) + "</td></tr>\n";
     }
@@ -711,8 +718,8 @@ std::string EncodeHtmlReport(const ReportInput& input) {
       for (const ProtocolRow& r : protocol_rows) {
         h += "<tr data-protocol=\"" + r.protocol + "\"><td>" + Escape(r.label) + "</td><td>" +
              r.protocol + "</td>";
-        for (const double v : {r.auc, r.recall_at_100p, r.recall_at_1, r.recall_at_5,
-                               r.recall_at_10})
+        for (const double v :
+             {r.auc, r.recall_at_100p, r.recall_at_1, r.recall_at_5, r.recall_at_10})
           h += "<td class=\"n\">" + Number(v, 4) + "</td>";
         h += "<td>" + Escape(r.more) + "</td></tr>\n";
       }
@@ -752,10 +759,9 @@ std::string EncodeHtmlReport(const ReportInput& input) {
        "</p>\n";
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const ReportRun& run = runs[i];
-    const cv::Mat3b image =
-        truth ? RenderRunOverlay(*input.evaluation, i, *run.matrix)
-              : RenderAnswersOverlay(*run.matrix, run.layout, run.answers.best,
-                                     run.answers.confirmed);
+    const cv::Mat3b image = truth ? RenderRunOverlay(*input.evaluation, i, *run.matrix)
+                                  : RenderAnswersOverlay(*run.matrix, run.layout, run.answers.best,
+                                                         run.answers.confirmed);
     h += "<figure>" +
          PngImage(image, "figure overlay",
                   "matrix of " + run.label + (truth ? " with the ground truth" : "")) +

@@ -32,11 +32,10 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/evaluation/answers.h"
 #include "OpenABLE/io/frame_source.h"
@@ -145,9 +144,9 @@ struct ReportInput {
   // The normalised matrix of each run (evaluation->runs[i], or answers[i]); the block of the
   // run's layout is shown.
   std::vector<const cv::Mat1f*> matrices;
-  int examples = 6;                        // Report_examples
+  int examples = 6;  // Report_examples
   ReportFrames frames;
-  std::vector<ReportTable> tables;         // shown after the settings
+  std::vector<ReportTable> tables;  // shown after the settings
   // Called as the page is made (done, total steps; first with done 0): a step per frame the
   // explorer reads for its thumbnails, the long part of a page of many frames, and one per
   // figure and section. For a progress line; unset: not called.

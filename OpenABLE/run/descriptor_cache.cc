@@ -1,14 +1,14 @@
 #include "OpenABLE/run/descriptor_cache.h"
 
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-#include <filesystem>
-
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/input_file.h"
@@ -101,8 +101,7 @@ std::string DescriptionSettingsText(const Config& config, const std::string& des
                                     int row_width, int row_type) {
   std::string s = "OpenABLE descriptor cache " + std::to_string(kDescriptorCacheVersion) +
                   "\nOpenABLE " + kVersion + "\ndescriptor: " + descriptor_name +
-                  "\nrow: " + std::to_string(row_width) + " x " + cv::typeToString(row_type) +
-                  "\n";
+                  "\nrow: " + std::to_string(row_width) + " x " + cv::typeToString(row_type) + "\n";
   // The keys of a network (Model_*) only for rows a network made ("ONNX", with its weights'
   // digest), so that the caches of the other descriptors keep the keys they were written with.
   const bool network = descriptor_name.rfind("ONNX", 0) == 0;
@@ -127,9 +126,9 @@ std::unique_ptr<DescriptorCache> DescriptorCache::Open(const std::string& folder
   c->row_width_ = row_width;
   c->row_type_ = row_type;
   c->row_bytes_ = static_cast<size_t>(row_width) * CV_ELEM_SIZE(row_type);
-  c->path_ = (fs::path(folder) /
-              (Hex(Fnv1a64(settings_text.data(), settings_text.size())) + ".rows"))
-                 .string();
+  c->path_ =
+      (fs::path(folder) / (Hex(Fnv1a64(settings_text.data(), settings_text.size())) + ".rows"))
+          .string();
   const std::string where = "Descriptor_cache: \"" + c->path_ + "\": ";
   const std::string header = Header(settings_text, c->row_bytes_, row_width, row_type);
 
@@ -153,8 +152,7 @@ std::unique_ptr<DescriptorCache> DescriptorCache::Open(const std::string& folder
   ::fcntl(c->fd_, F_SETFL, ::fcntl(c->fd_, F_GETFL) & ~O_NONBLOCK);
   // One run at a time writes a cache file; another run reads what is there.
   const bool locked = ::flock(c->fd_, LOCK_EX | LOCK_NB) == 0;
-  if (!locked)
-    warnings.push_back(where + "in use by another run; this run only reads it");
+  if (!locked) warnings.push_back(where + "in use by another run; this run only reads it");
   std::string bytes;
   if (!ReadFile(c->path_, &bytes)) {
     warnings.push_back(where + "cannot be read (" + std::strerror(errno) +
@@ -236,8 +234,7 @@ bool DescriptorCache::KeyOf(const FrameSource& source, int i, Key* key) {
   return true;
 }
 
-bool DescriptorCache::Lookup(const FrameSource& source, int i, cv::Mat row,
-                             cv::Size* frame_size) {
+bool DescriptorCache::Lookup(const FrameSource& source, int i, cv::Mat row, cv::Size* frame_size) {
   Key key;
   if (!KeyOf(source, i, &key)) return false;
   std::lock_guard<std::mutex> lock(mutex_);
@@ -270,8 +267,8 @@ void DescriptorCache::Store(const FrameSource& source, int i, const cv::Mat& row
   rec.append(reinterpret_cast<const char*>(row.data), row_bytes_);
   Put<std::uint64_t>(rec, Fnv1a64(rec.data(), rec.size()));
   if (!WriteAll(fd_, rec.data(), rec.size())) {
-    write_problem_ = "Descriptor_cache: \"" + path_ + "\": cannot append (" +
-                     std::strerror(errno) + "); the run goes on without caching";
+    write_problem_ = "Descriptor_cache: \"" + path_ + "\": cannot append (" + std::strerror(errno) +
+                     "); the run goes on without caching";
     return;
   }
   entries_[key] = Entry{rows_.size(), frame_size.width, frame_size.height};

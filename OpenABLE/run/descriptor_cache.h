@@ -6,11 +6,10 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <opencv2/core.hpp>
 #include <string>
 #include <unordered_map>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/base/hash.h"
 #include "OpenABLE/describe/describe.h"

@@ -3,8 +3,8 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <limits>
 #include <iterator>
+#include <limits>
 #include <set>
 #include <stdexcept>
 
@@ -99,7 +99,8 @@ double OperatingThreshold(const EvaluatedRun& run) {
 cv::Mat1f DistancesForEvaluation(const cv::Mat1f& matrix, const std::string& what) {
   if (matrix.empty())
     throw InputError(what + " is empty (" + std::to_string(matrix.rows) + " x " +
-                     std::to_string(matrix.cols) + "); expected a distance matrix with at least "
+                     std::to_string(matrix.cols) +
+                     "); expected a distance matrix with at least "
                      "one query and one reference");
   // A plain loop: OpenCV's vectorised comparisons do not single out NaN. +inf is a cell without
   // a value (Sequence_partial: skip, or a diagonal too short for a sequence); NaN is damage,

@@ -1,12 +1,11 @@
 // Evaluation of a run (Test_OpenABLE with Ground_truth_type set) or of saved matrices
-// (openable_evaluate); its files are written by OpenABLE/reports/evaluation_files.h. The protocols themselves are in
-// OpenABLE/evaluation/ (docs/evaluation.md).
+// (openable_evaluate); its files are written by OpenABLE/reports/evaluation_files.h. The protocols
+// themselves are in OpenABLE/evaluation/ (docs/evaluation.md).
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/layout.h"

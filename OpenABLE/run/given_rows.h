@@ -5,10 +5,9 @@
 #pragma once
 
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "descriptors/descriptor.h"
 
@@ -34,7 +33,7 @@ class GivenRowsDescriptor : public Descriptor {
   }
   const cv::Mat* GivenRows(int traversal) const override {
     return traversal >= 0 && traversal < static_cast<int>(rows_.size()) ? &rows_[traversal]
-                                                                         : nullptr;
+                                                                        : nullptr;
   }
 
  protected:

@@ -28,10 +28,9 @@ bool HasDisplay() {
   return std::getenv("DISPLAY") != nullptr || std::getenv("WAYLAND_DISPLAY") != nullptr;
 }
 
-
 // The frames of every source described with one descriptor.
 struct Described {
-  cv::Mat rows;                      // the traversals' rows, concatenated
+  cv::Mat rows;  // the traversals' rows, concatenated
   std::vector<Traversal> traversals;
   std::string cache;
   std::vector<std::string> warnings, notes;
@@ -54,9 +53,10 @@ std::unique_ptr<DescriptorCache> OpenDescriptorCache(const ToDescribe& d, const 
   const ScaleOptions& scale = d.config->scale;
   if (scale.descriptor_cache.empty()) return nullptr;
   if (first.kind != SourceKind::kFolder) {
-    out.notes.push_back("Descriptor_cache: not used: the cache keeps rows of image "
-                        "files (Frame_mode 0, Camera_type 0 or 2), not of videos, bags "
-                        "or stereo pairs");
+    out.notes.push_back(
+        "Descriptor_cache: not used: the cache keeps rows of image "
+        "files (Frame_mode 0, Camera_type 0 or 2), not of videos, bags "
+        "or stereo pairs");
     return nullptr;
   }
   if (options.show_images) {
@@ -65,18 +65,19 @@ std::unique_ptr<DescriptorCache> OpenDescriptorCache(const ToDescribe& d, const 
   }
   if (options.preprocess.noise.Any()) {
     // The noise of a frame depends on its position in the run, not only on its bytes.
-    out.notes.push_back("Descriptor_cache: not used with Noise_* (a frame's noise depends "
-                        "on its position in the run, not only on the image)");
+    out.notes.push_back(
+        "Descriptor_cache: not used with Noise_* (a frame's noise depends "
+        "on its position in the run, not only on the image)");
     return nullptr;
   }
   // Spread over processes, each process keeps its own cache (its share of the frames) in a
   // folder of the cache named after it.
   const Cluster& cluster = Cluster::Get();
   return DescriptorCache::Open(
-      cluster.Distributed() ? scale.descriptor_cache + "/process-" +
-                                  std::to_string(cluster.Rank()) + "-of-" +
-                                  std::to_string(cluster.Size())
-                            : scale.descriptor_cache,
+      cluster.Distributed()
+          ? scale.descriptor_cache + "/process-" + std::to_string(cluster.Rank()) + "-of-" +
+                std::to_string(cluster.Size())
+          : scale.descriptor_cache,
       DescriptionSettingsText(*d.config,
                               d.describer->Fingerprint().empty()
                                   ? d.name
@@ -87,8 +88,7 @@ std::unique_ptr<DescriptorCache> OpenDescriptorCache(const ToDescribe& d, const 
 
 // The rows given for every source (Descriptors_path, OpenABLE/run/given_rows.h): nothing is
 // described; the frames are listed (names, times) and the first one read for its size.
-Described GivenRowsDescribed(const FrameDescriber& describer,
-                             const std::vector<SourceSpec>& specs,
+Described GivenRowsDescribed(const FrameDescriber& describer, const std::vector<SourceSpec>& specs,
                              const std::vector<std::unique_ptr<FrameSource>>& sources) {
   Described out;
   std::vector<cv::Mat> blocks;
@@ -158,9 +158,9 @@ std::vector<Described> DescribeSources(const std::vector<ToDescribe>& all,
     const int used =
         LearnFromSource(*sources.front(), *d.describer, options, d.describer->LearnFrames());
     progress.End();
-    out[static_cast<size_t>(k)].notes.push_back(
-        d.name + ": learnt from " + std::to_string(used) + " frames spread over " +
-        specs.front().key + " (no ground truth)");
+    out[static_cast<size_t>(k)].notes.push_back(d.name + ": learnt from " + std::to_string(used) +
+                                                " frames spread over " + specs.front().key +
+                                                " (no ground truth)");
   }
 
   // Descriptor caches: image folders only (a video frame or a stereo pair has no one file).
@@ -183,7 +183,7 @@ std::vector<Described> DescribeSources(const std::vector<ToDescribe>& all,
   for (size_t s = 0; s < sources.size(); ++s) {
     const bool stereo =
         specs[s].kind == SourceKind::kStereo || specs[s].kind == SourceKind::kStereoBag;
-    options.key = stereo ? "" : specs[s].key;  // stereo read errors name their own key
+    options.key = stereo ? "" : specs[s].key;    // stereo read errors name their own key
     options.noise_stream = static_cast<int>(s);  // each traversal its own noise
     // Spread over processes: process 0's progress counts its share.
     const auto [share_first, share_last] = cluster.Share(sources[s]->Size());
@@ -195,8 +195,7 @@ std::vector<Described> DescribeSources(const std::vector<ToDescribe>& all,
     const auto on_frames = [&](int done, int) { progress.Update(done); };
     std::vector<DescribedSequence> seqs;
     if (count == 1) {
-      seqs.push_back(
-          DescribeShared(cluster, *sources[s], *describers.front(), options, on_frames));
+      seqs.push_back(DescribeShared(cluster, *sources[s], *describers.front(), options, on_frames));
     } else {
       seqs = DescribeSequences(*sources[s], describers, row_caches, options, on_frames);
     }
@@ -311,7 +310,8 @@ void SetTraversals(RunResult& result, std::vector<int>& starts,
   // misalign the fused matrices.
   for (size_t s = 0; s < traversals.size(); ++s)
     if (traversals[s].names != result.traversals[s].names)
-      throw InputError(traversals[s].key + ": the frames read differ between the fused "
+      throw InputError(traversals[s].key +
+                       ": the frames read differ between the fused "
                        "descriptors (a file changed during the run?); expected the same "
                        "frames for each");
 }
@@ -320,8 +320,8 @@ void SetTraversals(RunResult& result, std::vector<int>& starts,
 // traversals (their first rows into `starts`), cache, warnings, notes and timings.
 Described DescribeOne(const RunPlan& plan, ProgressReporter& progress, RunResult& result,
                       std::vector<int>& starts) {
-  Described described = DescribeSources(plan.config, *plan.describers.front(),
-                                        plan.names.front(), plan.specs, plan.sources, progress);
+  Described described = DescribeSources(plan.config, *plan.describers.front(), plan.names.front(),
+                                        plan.specs, plan.sources, progress);
   SetTraversals(result, starts, described.traversals);
   result.cache = described.cache;
   AddLines(result.warnings, described.warnings);
@@ -370,8 +370,7 @@ void ComputeBounded(const RunPlan& plan, ProgressReporter& progress, RunResult& 
   // as `share` says.
   const auto match_share = [&](const BoundedOptions& share, float& largest) {
     if (scale.approximate_search)
-      return ApproximateMatches(described.rows, block, rules, share, scale.approximate,
-                                largest);
+      return ApproximateMatches(described.rows, block, rules, share, scale.approximate, largest);
     return BoundedMatches(described.rows, block, rules, share, largest,
                           [&](int done, int) { progress.Update(done); });
   };
@@ -432,20 +431,17 @@ std::vector<const SingleFrame*> DenseSingleFrames(const RunPlan& plan, ProgressR
     frame.pairs = n * (n - 1) / 2;
     const auto t = Clock::now();
     // Spread over processes: this process's rows, with the L - 1 rows its sequences read.
-    const DenseShare share =
-        DenseShareOf(cluster, static_cast<int>(n), matching.sequence_length);
+    const DenseShare share = DenseShareOf(cluster, static_cast<int>(n), matching.sequence_length);
     const std::int64_t share_rows = share.last - share.history;
     const int strips = plan.strips;
     progress.Begin("matching", share_rows * n * (plan.cross ? strips * strips : 1),
                    std::string(plan.cross ? "cells of sub-panorama pairs" : "cells") +
                        (plan.Fused() ? " (" + names[k] + ")" : ""));
-    const PairProgress on_pairs = [&](std::int64_t done, std::int64_t) {
-      progress.Update(done);
-    };
+    const PairProgress on_pairs = [&](std::int64_t done, std::int64_t) { progress.Update(done); };
     cluster.Agree([&] {
-      frame.distances = DistanceRows(described.rows, share.history, share.last,
-                                     frame.descriptor.metric, strips, matching.panorama_matching,
-                                     matching.threads, on_pairs);
+      frame.distances =
+          DistanceRows(described.rows, share.history, share.last, frame.descriptor.metric, strips,
+                       matching.panorama_matching, matching.threads, on_pairs);
     });
     progress.End();
     frame.match_seconds = SecondsSince(t);
@@ -461,8 +457,8 @@ std::vector<const SingleFrame*> DenseSingleFrames(const RunPlan& plan, ProgressR
 
 // The single-frame matrices' traversals, cache lines, warnings, notes and timings, in the
 // run's result.
-void TakeSingleFrames(const std::vector<const SingleFrame*>& singles, bool fused,
-                      RunResult& result, std::vector<int>& starts) {
+void TakeSingleFrames(const std::vector<const SingleFrame*>& singles, bool fused, RunResult& result,
+                      std::vector<int>& starts) {
   for (const SingleFrame* f : singles) {
     SetTraversals(result, starts, f->traversals);
     if (!f->cache.empty())
@@ -507,9 +503,8 @@ bool FinishDense(const Config& config, cv::Mat1f distances, const std::vector<in
     // value, which ahead only copies) and process 0 fills them in the gathered matrix.
     const bool ahead = matching.partial == SequencePartial::kAhead;
     cluster.Agree([&] {
-      SequenceDistancesInPlace(distances, matching.sequence_length,
-                               ShareRowStarts(starts, share), starts, direction,
-                               matching.threads,
+      SequenceDistancesInPlace(distances, matching.sequence_length, ShareRowStarts(starts, share),
+                               starts, direction, matching.threads,
                                ahead ? SequencePartial::kSkip : matching.partial);
       rows = distances.rowRange(share.first - share.history, share.last - share.history);
       largest = LargestFiniteEntry(rows);
@@ -537,8 +532,7 @@ void FinishNormalized(const Config& config, const std::vector<int>& starts, RunR
     result.empty_cells = static_cast<std::int64_t>(result.normalized.total()) -
                          cv::countNonZero(result.normalized <= 1.0f);
   if (matching.threshold >= 0.0)
-    result.thresholded =
-        ThresholdMatrix(result.normalized, static_cast<float>(matching.threshold));
+    result.thresholded = ThresholdMatrix(result.normalized, static_cast<float>(matching.threshold));
   const MatchBlock block = BlockOf(starts, result.normalized.rows);
   const KeepRules rules = KeepRulesOf(config, block);
   if (!config.scale.matches_name.empty())
@@ -576,10 +570,10 @@ RunResult ComputeOnePass(const RunPlan& plan, ProgressReporter& progress,
   const auto t = Clock::now();
   progress.Begin("matching", n, "rows (distances and sequences in one pass)");
   float largest = 0.0f;
-  result.normalized = FusedSequenceMatrix(
-      described.rows, result.descriptors.front().metric, matching.sequence_length,
-      matching.direction, matching.partial, starts, matching.threads, largest,
-      [&](int done, int) { progress.Update(done); });
+  result.normalized =
+      FusedSequenceMatrix(described.rows, result.descriptors.front().metric,
+                          matching.sequence_length, matching.direction, matching.partial, starts,
+                          matching.threads, largest, [&](int done, int) { progress.Update(done); });
   progress.End();
   result.timings.match_seconds = SecondsSince(t);
   const auto t2 = Clock::now();

@@ -4,10 +4,9 @@
 
 #include <cstdint>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/base/progress.h"
 #include "OpenABLE/evaluation/layout.h"
@@ -21,7 +20,7 @@ namespace openable {
 // contrast enhancement and sequences, with what the run reports of its description.
 struct SingleFrame {
   RunDescriptor descriptor;
-  cv::Mat1f distances;                // N x N, every frame against every frame
+  cv::Mat1f distances;  // N x N, every frame against every frame
   std::vector<Traversal> traversals;
   std::string camera, cache;
   std::vector<std::string> warnings, notes;

@@ -1,7 +1,5 @@
 #include "OpenABLE/run/plan.h"
 
-#include "OpenABLE/run/given_rows.h"
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -11,6 +9,7 @@
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/cluster/cluster.h"
 #include "OpenABLE/describe/describe.h"
+#include "OpenABLE/run/given_rows.h"
 #include "OpenABLE/run/verify.h"
 #include "OpenABLE/stereo/calibration.h"
 #include "OpenABLE/stereo/stereo_source.h"
@@ -68,8 +67,7 @@ std::unique_ptr<FrameSource> OpenStoredFrames(const SourceSpec& spec, const Inpu
       break;
   }
   return WithKey(spec.key, [&] {
-    return OpenImageFolder(spec.path, input.images_format, input.initial_image,
-                           input.final_image);
+    return OpenImageFolder(spec.path, input.images_format, input.initial_image, input.final_image);
   });
 }
 
@@ -80,9 +78,12 @@ double PhysicalMemoryBytes() {
 
 const char* DistanceText(Metric m) {
   switch (m) {
-    case Metric::kHamming: return "Hamming";
-    case Metric::kL2: return "L2";
-    case Metric::kL1: break;
+    case Metric::kHamming:
+      return "Hamming";
+    case Metric::kL2:
+      return "L2";
+    case Metric::kL1:
+      break;
   }
   return "L1";
 }
@@ -148,13 +149,13 @@ std::unique_ptr<Descriptor> GivenRowsOf(const Config& config, RunResult& result)
   const std::vector<SourceSpec> specs = SourcesOf(input);
   if (config.description.type != DescriptionType::kGlobal ||
       input.camera_type != CameraType::kMonocular)
-    throw InputError("Descriptors_path: given with " +
-                     std::string(config.description.type != DescriptionType::kGlobal
-                                     ? "Description_type grid"
-                                     : "Camera_type " +
-                                           std::to_string(static_cast<int>(input.camera_type))) +
-                     "; expected one row per frame of one camera (Description_type global, "
-                     "Camera_type 0)");
+    throw InputError(
+        "Descriptors_path: given with " +
+        std::string(config.description.type != DescriptionType::kGlobal
+                        ? "Description_type grid"
+                        : "Camera_type " + std::to_string(static_cast<int>(input.camera_type))) +
+        "; expected one row per frame of one camera (Description_type global, "
+        "Camera_type 0)");
   if (specs.size() == 2 && input.descriptors_path_2.empty())
     throw InputError("Descriptors_path_2: empty, but the run has a second traversal (" +
                      specs[1].key + "); expected the rows of its frames too");
@@ -197,7 +198,8 @@ void PlanDescriptors(RunPlan& plan) {
     if (fused && plan.descriptors.back()->Channels() == 2)
       throw InputError("Image_descriptor: \"" + config.descriptor.name + "\" fuses " + name +
                        ", whose stereo frames carry a disparity channel the others do not "
-                       "read; expected " + name + " alone");
+                       "read; expected " +
+                       name + " alone");
     result.descriptors.push_back({name, 0, MetricOf(*plan.descriptors.back())});
   }
   result.descriptor = names.front();
@@ -212,15 +214,16 @@ void PlanDescriptors(RunPlan& plan) {
           kinds += (kinds.empty() ? "" : ", ") + e.name + ": " + DistanceText(e.metric);
         std::string example = "1";
         for (size_t k = 1; k < names.size(); ++k) example += ",1";
-        throw InputError("Fusion_weights: empty, but Image_descriptor \"" +
-                         config.descriptor.name + "\" fuses distances of different kinds (" +
-                         kinds + "); expected one weight per descriptor, e.g. Fusion_weights: " +
-                         example);
+        throw InputError("Fusion_weights: empty, but Image_descriptor \"" + config.descriptor.name +
+                         "\" fuses distances of different kinds (" + kinds +
+                         "); expected one weight per descriptor, e.g. Fusion_weights: " + example);
       }
     }
   } else if (!matching.fusion_weights.empty()) {
-    result.notes.push_back("Fusion_weights: \"" + matching.fusion_weights + "\" not used: "
-                           "Image_descriptor " + names.front() + " is one descriptor");
+    result.notes.push_back("Fusion_weights: \"" + matching.fusion_weights +
+                           "\" not used: "
+                           "Image_descriptor " +
+                           names.front() + " is one descriptor");
   }
 
   const bool panoramic = input.camera_type == CameraType::kPanoramic;
@@ -249,7 +252,8 @@ void PlanDescriptors(RunPlan& plan) {
                           : std::string("the global description")) +
                      (strips > 1 ? " and " + std::to_string(strips) + " sub-panoramas" : "") +
                      " makes a descriptor row of " + text + " per frame (" +
-                     config.descriptor.name + "); expected at most 1 GiB: a smaller Patch_size "
+                     config.descriptor.name +
+                     "); expected at most 1 GiB: a smaller Patch_size "
                      "or grid");
   }
   for (size_t k = 0; k < plan.descriptors.size(); ++k) {
@@ -263,12 +267,12 @@ void PlanDescriptors(RunPlan& plan) {
   const bool lambdas = config.preprocess.lambda_red > 0;
   const double alpha = config.preprocess.Alpha();
   char text[200];
-  result.camera = panoramic ? "panoramic, " + std::to_string(strips) + " sub-panoramas, " +
-                                  EnumName(panorama_matching) + " matching"
-                : input.camera_type == CameraType::kStereo
-                    ? std::string("stereo, rectified") +
-                          (disparity ? ", SGBM disparity" : ", left image")
-                    : "monocular";
+  result.camera =
+      panoramic ? "panoramic, " + std::to_string(strips) + " sub-panoramas, " +
+                      EnumName(panorama_matching) + " matching"
+      : input.camera_type == CameraType::kStereo
+          ? std::string("stereo, rectified") + (disparity ? ", SGBM disparity" : ", left image")
+          : "monocular";
   if (config.preprocess.illumination_invariance) {
     std::snprintf(text, sizeof text, ", illumination invariant (Eq. 6, alpha %.4f%s)", alpha,
                   lambdas ? " from Eq. 7" : "");
@@ -292,8 +296,8 @@ void OpenSources(RunPlan& plan) {
     // keys (Images_path_left, Images_path_right, Bag_topic_right, Calibration_path) themselves.
     StereoSourceOptions stereo_options;
     stereo_options.compute_disparity = disparity;  // only D-LDB reads it
-    const StereoCalibration calibration = WithKey(
-        "Calibration_path", [&] { return LoadStereoCalibration(input.calibration_path); });
+    const StereoCalibration calibration =
+        WithKey("Calibration_path", [&] { return LoadStereoCalibration(input.calibration_path); });
     if (spec.kind == SourceKind::kStereo) {
       plan.sources.push_back(OpenStereoFolders(input.images_path_left, input.images_path_right,
                                                input.images_format, input.initial_image,
@@ -319,13 +323,13 @@ void CheckAgainstSources(const RunPlan& plan) {
     if (const cv::Mat* rows = plan.describers.front()->GivenRows(static_cast<int>(s)))
       if (rows->rows != plan.sources[s]->Size()) {
         const std::string key = s == 0 ? "Descriptors_path" : "Descriptors_path_2";
-        throw InputError(key + " " +
-                         Quoted(s == 0 ? config.input.descriptors_path
-                                       : config.input.descriptors_path_2) +
-                         ": " + std::to_string(rows->rows) + " rows, but " + plan.specs[s].key +
-                         " has " + std::to_string(plan.sources[s]->Size()) +
-                         " frames (Initial_image, Final_image applied); expected one row per "
-                         "frame, in the run's order");
+        throw InputError(
+            key + " " +
+            Quoted(s == 0 ? config.input.descriptors_path : config.input.descriptors_path_2) +
+            ": " + std::to_string(rows->rows) + " rows, but " + plan.specs[s].key + " has " +
+            std::to_string(plan.sources[s]->Size()) +
+            " frames (Initial_image, Final_image applied); expected one row per "
+            "frame, in the run's order");
       }
   // The ratio score needs rivals: its window must leave references outside it.
   if (matching.score == MatchScore::kRatio) {
@@ -371,8 +375,8 @@ void DecideMode(RunPlan& plan, PlanScope scope) {
   const double gib = 1024.0 * 1024.0 * 1024.0;
   const double dense_bytes = static_cast<double>(planned) * planned * 4.0 *
                              (direction == SequenceDirection::kBoth ? 2.0 : 1.0);
-  const double limit_bytes = scale.memory_limit > 0 ? scale.memory_limit * gib
-                                                     : 0.75 * PhysicalMemoryBytes();
+  const double limit_bytes =
+      scale.memory_limit > 0 ? scale.memory_limit * gib : 0.75 * PhysicalMemoryBytes();
   char sizes[160];
   std::snprintf(sizes, sizeof sizes, "the %lldx%lld matrix needs %.2f GiB, Memory_limit %.2f GiB%s",
                 static_cast<long long>(planned), static_cast<long long>(planned), dense_bytes / gib,
@@ -387,8 +391,8 @@ void DecideMode(RunPlan& plan, PlanScope scope) {
     result.mode_reason = std::string("dense (Matrix_mode 1; ") + sizes + ")";
   } else {
     result.bounded = dense_bytes > limit_bytes;
-    result.mode_reason = std::string(result.bounded ? "bounded" : "dense") + " (Matrix_mode 0: " +
-                         sizes + ")";
+    result.mode_reason =
+        std::string(result.bounded ? "bounded" : "dense") + " (Matrix_mode 0: " + sizes + ")";
   }
   const double row_bytes = static_cast<double>(plan.row_bytes);
   if (row_bytes * static_cast<double>(planned) > limit_bytes) {
@@ -404,12 +408,13 @@ void DecideMode(RunPlan& plan, PlanScope scope) {
   // one direction; with both directions each direction's sums would be needed apart.
   if (!result.bounded && Cluster::Get().Distributed() && matching.sequence_length > 1 &&
       direction == SequenceDirection::kBoth && matching.partial == SequencePartial::kAhead)
-    throw InputError("Sequence_partial: ahead with Sequence_direction 2 is not computed over "
-                     "several processes (mpirun) in dense mode; expected Sequence_partial scale "
-                     "or skip, Sequence_direction 0 or 1, or one process");
+    throw InputError(
+        "Sequence_partial: ahead with Sequence_direction 2 is not computed over "
+        "several processes (mpirun) in dense mode; expected Sequence_partial scale "
+        "or skip, Sequence_direction 0 or 1, or one process");
   if (result.bounded && scope == PlanScope::kSingleFrames)
-    throw InputError("Auto: 1 compares dense matrices, but the run would be " +
-                     result.mode_reason + "; expected a larger Memory_limit, or fewer frames "
+    throw InputError("Auto: 1 compares dense matrices, but the run would be " + result.mode_reason +
+                     "; expected a larger Memory_limit, or fewer frames "
                      "(the auto mode keeps one single-frame matrix per candidate descriptor)");
   if (result.bounded && scale.matches_name.empty())
     throw InputError("Matches_name: empty, but the run is " + result.mode_reason +
@@ -419,21 +424,26 @@ void DecideMode(RunPlan& plan, PlanScope scope) {
   if (result.bounded && config.input.camera_type == CameraType::kPanoramic &&
       panorama_matching != PanoramaMatching::kAligned)
     throw InputError(std::string("Panorama_matching: ") +
-                     std::to_string(static_cast<int>(panorama_matching)) +
-                     " (" + EnumName(panorama_matching) + ") needs the dense "
-                     "matrix, but the run is " + result.mode_reason +
+                     std::to_string(static_cast<int>(panorama_matching)) + " (" +
+                     EnumName(panorama_matching) +
+                     ") needs the dense "
+                     "matrix, but the run is " +
+                     result.mode_reason +
                      "; expected Matrix_mode 1 (or 0 with a larger Memory_limit) or "
                      "Panorama_matching 0");
   // Fusion normalises each whole matrix and contrast enhancement reads a window of every row:
   // both need the dense matrix.
   if (result.bounded && plan.Fused())
-    throw InputError("Image_descriptor: \"" + config.descriptor.name + "\" fuses descriptors, "
-                     "which needs the dense matrix, but the run is " + result.mode_reason +
+    throw InputError("Image_descriptor: \"" + config.descriptor.name +
+                     "\" fuses descriptors, "
+                     "which needs the dense matrix, but the run is " +
+                     result.mode_reason +
                      "; expected one descriptor, or Matrix_mode 1 (or 0 with a larger "
                      "Memory_limit)");
   if (result.bounded && matching.contrast_enhancement)
     throw InputError("Contrast_enhancement: 1 needs the dense matrix, but the run is " +
-                     result.mode_reason + "; expected 0, or Matrix_mode 1 (or 0 with a larger "
+                     result.mode_reason +
+                     "; expected 0, or Matrix_mode 1 (or 0 with a larger "
                      "Memory_limit)");
   if (scale.approximate_search && result.descriptors.front().metric == Metric::kL1)
     throw InputError("Approximate_search: 1 with Image_descriptor " + plan.names.front() +

@@ -34,12 +34,12 @@ enum class PlanScope { kWholeRun, kSingleFrames };
 struct RunPlan {
   Config config;                   // the run's configuration, checked
   std::vector<std::string> names;  // the descriptors of Image_descriptor (fused when several)
-  std::vector<std::unique_ptr<Descriptor>> descriptors;      // one per name
-  std::vector<std::unique_ptr<FrameDescriber>> describers;   // one per name
-  std::vector<SourceSpec> specs;                             // one per traversal
-  std::vector<std::unique_ptr<FrameSource>> sources;         // one per traversal, opened
-  int strips = 1;          // sub-panoramas of a panoramic camera (1 otherwise)
-  bool cross = false;      // sub-panoramas compared every one against every one
+  std::vector<std::unique_ptr<Descriptor>> descriptors;     // one per name
+  std::vector<std::unique_ptr<FrameDescriber>> describers;  // one per name
+  std::vector<SourceSpec> specs;                            // one per traversal
+  std::vector<std::unique_ptr<FrameSource>> sources;        // one per traversal, opened
+  int strips = 1;              // sub-panoramas of a panoramic camera (1 otherwise)
+  bool cross = false;          // sub-panoramas compared every one against every one
   std::int64_t row_bytes = 0;  // every descriptor's row of one frame
   // What the run's result starts with: descriptors (name, row width, metric), the descriptor
   // text, fusion weights, camera, notes, and the mode (bounded, mode_reason).

@@ -95,14 +95,15 @@ void CheckVerification(const Config& config, bool from_video, int queries,
   if (!v.enabled) return;
   v.Check();
   if (from_video)
-    throw InputError("Verification: 1 reads the frames of the candidates again, by file, but "
-                     "the run reads a video or a bag (Frame_mode " +
-                     std::to_string(static_cast<int>(config.input.frame_mode)) +
-                     "), whose frames cannot be read again by name; expected Verification 0, "
-                     "or the frames extracted to a folder (Frame_mode 0)");
+    throw InputError(
+        "Verification: 1 reads the frames of the candidates again, by file, but "
+        "the run reads a video or a bag (Frame_mode " +
+        std::to_string(static_cast<int>(config.input.frame_mode)) +
+        "), whose frames cannot be read again by name; expected Verification 0, "
+        "or the frames extracted to a folder (Frame_mode 0)");
   if (!v.calibration.empty()) {
-    const CameraIntrinsics camera = ReadVerificationCalibration(
-        v.calibration, v.calibration_scale, "Verification_calibration");
+    const CameraIntrinsics camera =
+        ReadVerificationCalibration(v.calibration, v.calibration_scale, "Verification_calibration");
     CheckIntrinsicsFit(camera, v.calibration, size, first_frame, "Verification_calibration");
   }
   if (v.consistency > 0 && v.consistency >= queries)

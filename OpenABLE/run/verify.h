@@ -18,17 +18,17 @@
 namespace openable {
 
 struct RunVerification {
-  VerificationOptions options;   // as used (tolerance = Tolerance)
-  std::string geometry;          // "fundamental matrix (uncalibrated)" or "essential matrix (...)"
+  VerificationOptions options;  // as used (tolerance = Tolerance)
+  std::string geometry;         // "fundamental matrix (uncalibrated)" or "essential matrix (...)"
   // Queries of the block that have candidates, in frame order; query and reference numbers
   // count from the start of their traversal, as in Matches_name.
   std::vector<QueryVerification> queries;
-  int frames = 0;                // distinct frames whose features were computed
-  int extractions = 0;           // feature computations (more than frames when the cache was full)
-  int pairs = 0;                 // candidates checked
-  int geometric = 0;             // of those, geometrically verified
-  int answered = 0;              // queries with an accepted candidate (their answer)
-  double seconds = 0;            // wall time of the whole step
+  int frames = 0;                 // distinct frames whose features were computed
+  int extractions = 0;            // feature computations (more than frames when the cache was full)
+  int pairs = 0;                  // candidates checked
+  int geometric = 0;              // of those, geometrically verified
+  int answered = 0;               // queries with an accepted candidate (their answer)
+  double seconds = 0;             // wall time of the whole step
   std::vector<float> extract_ms;  // per feature computation (reading the frame included)
   std::vector<float> pair_ms;     // per candidate: matching and RANSAC
 };

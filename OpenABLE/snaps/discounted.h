@@ -16,9 +16,8 @@
 // faster gamma decays (Fig. 2).
 #pragma once
 
-#include <vector>
-
 #include <Eigen/Geometry>
+#include <vector>
 
 #include "OpenABLE/snaps/trajectory.h"
 

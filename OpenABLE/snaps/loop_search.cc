@@ -34,8 +34,8 @@ std::optional<LoopPair> LoopSearch::Step(int index, const Eigen::Isometry3d& pos
                                          const cv::Mat& thumbnail) {
   const auto start = std::chrono::steady_clock::now();
   if (index != static_cast<int>(poses_.size()))
-    throw std::invalid_argument("LoopSearch::Step: index " + std::to_string(index) +
-                                ", expected " + std::to_string(poses_.size()));
+    throw std::invalid_argument("LoopSearch::Step: index " + std::to_string(index) + ", expected " +
+                                std::to_string(poses_.size()));
   if (thumbnail.empty() || thumbnail.channels() != 1 ||
       (!thumbnails_.empty() &&
        (thumbnail.size() != thumbnails_[0].size() || thumbnail.type() != thumbnails_[0].type())))
@@ -80,8 +80,7 @@ std::optional<LoopPair> LoopSearch::Step(int index, const Eigen::Isometry3d& pos
       record.loop = true;
     }
   }
-  record.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   records_.push_back(record);
   return found;
 }
@@ -96,9 +95,9 @@ std::optional<LoopPair> OnlineSnaps::Step(const Eigen::Isometry3d& odometry_pose
     const auto start = std::chrono::steady_clock::now();
     std::vector<Eigen::Isometry3d>& poses = search_.poses();
     const Eigen::Vector3d reference = poses[loop->reference].translation();
-    offset_ += ApplyDiscountedUpdate(poses, loop->query, reference,
-                                     loop->similarity, search_.loops_closed(),
-                                     search_.options().discount.discount_length);
+    offset_ +=
+        ApplyDiscountedUpdate(poses, loop->query, reference, loop->similarity,
+                              search_.loops_closed(), search_.options().discount.discount_length);
     correction_seconds_.push_back(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     loops_.push_back(*loop);

@@ -2,11 +2,10 @@
 // it (Sec. III-C): fed frame by frame, as a SLAM system would call it.
 #pragma once
 
-#include <optional>
-#include <vector>
-
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
 
 #include "OpenABLE/snaps/discounted.h"
 #include "OpenABLE/snaps/quality_index.h"
@@ -55,10 +54,10 @@ double YawDifferenceDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b,
 
 // What one Step did.
 struct StepRecord {
-  double seconds = 0;      // wall time of the search (steady_clock)
-  int candidates = 0;      // candidates compared (Q computed), <= attempts
-  bool paused = false;     // within the inter-frame pause: no search
-  bool loop = false;       // a loop was returned
+  double seconds = 0;   // wall time of the search (steady_clock)
+  int candidates = 0;   // candidates compared (Q computed), <= attempts
+  bool paused = false;  // within the inter-frame pause: no search
+  bool loop = false;    // a loop was returned
 };
 
 class LoopSearch {

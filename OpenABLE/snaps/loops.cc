@@ -36,8 +36,7 @@ int IndexOfFrame(const Trajectory& trajectory, long frame_id, long tolerance) {
 namespace {
 
 // Whether both frames of a pair mapped (by IndexOfFrame, to valid indices) onto their own poses.
-bool OnPoses(const Trajectory& trajectory, int qi, long query_frame, int ri,
-             long reference_frame) {
+bool OnPoses(const Trajectory& trajectory, int qi, long query_frame, int ri, long reference_frame) {
   return trajectory.frame_ids[static_cast<std::size_t>(qi)] == query_frame &&
          trajectory.frame_ids[static_cast<std::size_t>(ri)] == reference_frame;
 }
@@ -93,8 +92,8 @@ struct Mapped {
 }  // namespace
 
 std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
-                                       const Trajectory& trajectory, long initial,
-                                       long tolerance, PairCounts* counts) {
+                                       const Trajectory& trajectory, long initial, long tolerance,
+                                       PairCounts* counts) {
   return CollectLoops(
       matches,
       [&](const FrameMatch& match) {
@@ -131,8 +130,7 @@ std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
         const double tr = options.frame_times.at(static_cast<std::size_t>(match.reference));
         const int qi = IndexOfTime(trajectory, tq, options.time_tolerance);
         const int ri = IndexOfTime(trajectory, tr, options.time_tolerance);
-        const bool exact = qi >= 0 && ri >= 0 &&
-                           std::abs(trajectory.timestamps[qi] - tq) < 1e-6 &&
+        const bool exact = qi >= 0 && ri >= 0 && std::abs(trajectory.timestamps[qi] - tq) < 1e-6 &&
                            std::abs(trajectory.timestamps[ri] - tr) < 1e-6;
         return Mapped{qi, ri, exact};
       },
@@ -155,8 +153,8 @@ std::vector<double> ReadFrameTimes(const std::string& path, const std::string& k
     std::string rest;
     if (!(fields >> row >> t) || (fields >> rest) || !std::isfinite(t) ||
         row != static_cast<long>(times.size()))
-      throw InputError(key + ": frame times " + Quoted(path) + ":" + std::to_string(number) +
-                       ": " + Quoted(line) + "; expected \"" + std::to_string(times.size()) +
+      throw InputError(key + ": frame times " + Quoted(path) + ":" + std::to_string(number) + ": " +
+                       Quoted(line) + "; expected \"" + std::to_string(times.size()) +
                        " <seconds>\" (rows in order, as Timestamps_name writes them)");
     times.push_back(t);
   }
@@ -193,13 +191,11 @@ std::vector<LoopPair> LoopsFromMatrix(cv::Mat1f m, const Trajectory& trajectory,
 }
 
 std::vector<LoopPair> LoopsFromCsv(const std::string& path, const Trajectory& trajectory,
-                                   long tolerance, int* dropped, int* outside,
-                                   PairCounts* counts) {
+                                   long tolerance, int* dropped, int* outside, PairCounts* counts) {
   // The same reader and checks as the evaluation's ground-truth pairs (pairs_file.h): commas
   // or blanks, a header line, comments, 0-based unless a comment says "1-based".
   const PairsFile file = ReadPairsFile(path, -1, "loop pairs file");
-  if (trajectory.frame_ids.empty())
-    throw InputError(file.where + ": the trajectory is empty");
+  if (trajectory.frame_ids.empty()) throw InputError(file.where + ": the trajectory is empty");
   const long first = trajectory.frame_ids.front(), last = trajectory.frame_ids.back();
   std::vector<LoopPair> out;
   PairCounts n;

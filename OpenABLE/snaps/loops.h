@@ -78,8 +78,8 @@ struct FrameMatch {
 // trajectory indices as LoopsFromMatrix maps them, with the same drops, merges and counts;
 // similarity 1 - distance.
 std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
-                                       const Trajectory& trajectory, long initial,
-                                       long tolerance, PairCounts* counts = nullptr);
+                                       const Trajectory& trajectory, long initial, long tolerance,
+                                       PairCounts* counts = nullptr);
 // The same with rows mapped by time when `times` holds one time per row and the trajectory has
 // timestamps (MatrixLoopOptions::frame_times); otherwise by frame id as above.
 std::vector<LoopPair> LoopsFromMatches(const std::vector<FrameMatch>& matches,
@@ -125,9 +125,9 @@ std::vector<LoopPair> MiddleOfRuns(std::vector<LoopPair> loops, const Trajectory
 // ToGray8), reduced to its thumbnail (options.thumbnail_scale) and fed to OnlineSnaps with the
 // trajectory's pose as the odometry. Throws InputError when a frame id has no image.
 struct ImageSearchResult {
-  std::vector<LoopPair> loops;       // indices of the trajectory
-  Trajectory corrected;              // the trajectory as corrected online
-  std::vector<StepRecord> steps;     // one per pose (search latency and what happened)
+  std::vector<LoopPair> loops;             // indices of the trajectory
+  Trajectory corrected;                    // the trajectory as corrected online
+  std::vector<StepRecord> steps;           // one per pose (search latency and what happened)
   std::vector<double> correction_seconds;  // one per loop
   std::vector<double> thumbnail_seconds;   // one per pose: read + grey + thumbnail
 };

@@ -33,18 +33,18 @@ struct SnapsOptions {
   TrajectoryFormat ground_truth_format = TrajectoryFormat::kKitti;
   double time_tolerance = 0.02;  // seconds, >= 0: TUM poses associated by timestamp
   LoopSource loops = LoopSource::kSearch;
-  std::string loops_file;        // the pairs file or saved matrix of kPairs and kMatrix
-  std::string frame_times;       // kMatrix: the matrix rows' times (Timestamps_name); empty: none
-  int keyframe_tolerance = 0;    // frames, >= 0: a frame that is not a pose takes the nearest
-  bool middle_of_runs = true;    // pairs: keep the middle reference of each run of references
-  bool drop_outside = false;     // pairs: drop pairs outside the trajectory instead of failing
+  std::string loops_file;          // the pairs file or saved matrix of kPairs and kMatrix
+  std::string frame_times;         // kMatrix: the matrix rows' times (Timestamps_name); empty: none
+  int keyframe_tolerance = 0;      // frames, >= 0: a frame that is not a pose takes the nearest
+  bool middle_of_runs = true;      // pairs: keep the middle reference of each run of references
+  bool drop_outside = false;       // pairs: drop pairs outside the trajectory instead of failing
   double matrix_threshold = 0.15;  // matrix, openable: loops below this M', [0, 1]
-  std::string images;            // image folder of the trajectory's frames; empty: Images_path
-  SearchOptions search;          // SNAPS's search and its discounted update (Table I)
+  std::string images;              // image folder of the trajectory's frames; empty: Images_path
+  SearchOptions search;            // SNAPS's search and its discounted update (Table I)
   Corrector corrector = Corrector::kBoth;
   PoseGraphOptions pose_graph;
   GroundPlane axes = GroundPlane::kXz;
-  std::string output_name;       // output prefix; empty: figures printed only
+  std::string output_name;  // output prefix; empty: figures printed only
 
   // Throws InputError naming the key of a value out of range (its own and those of search and
   // pose_graph). Which inputs a chain needs depends on other keys: CheckSnapsConfig

@@ -5,12 +5,11 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/drawing.h"
@@ -123,8 +122,7 @@ cv::Mat3b RenderTrajectories(const TrajectoryPlot& plot) {
   const double y1 = frame.y0 + area.height / frame.pixels_per_metre;
 
   // Grid, frame, ticks (the same step on both axes).
-  const double step =
-      NiceStep(std::max(area.width, area.height) / frame.pixels_per_metre, 10);
+  const double step = NiceStep(std::max(area.width, area.height) / frame.pixels_per_metre, 10);
   const double tick_scale = 0.45;
   for (double v = std::ceil(frame.x0 / step) * step; v <= x1; v += step) {
     const int x = static_cast<int>(std::lround(frame.Pixel(v, 0).x));
@@ -145,8 +143,8 @@ cv::Mat3b RenderTrajectories(const TrajectoryPlot& plot) {
   }
   const std::string vertical_name = plot.axes == "xz" ? "z [m]" : "y [m]";
   const cv::Size xs = TextSize("x [m]", 0.6, 1);
-  PutText(img, "x [m]", {area.x + area.width / 2 - xs.width / 2, area.y + area.height + 50}, 0.6,
-          1, kBlack);
+  PutText(img, "x [m]", {area.x + area.width / 2 - xs.width / 2, area.y + area.height + 50}, 0.6, 1,
+          kBlack);
   PutVerticalText(img, vertical_name, {area.x - 68, area.y + area.height / 2}, 0.6, 1);
 
   // Content, clipped to the plot area.

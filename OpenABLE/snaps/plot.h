@@ -3,10 +3,9 @@
 // evaluation/plots.cc (shared helpers in evaluation/drawing.h).
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/snaps/trajectory.h"
 

@@ -1,22 +1,21 @@
 // Pose-graph correction: see the model in pose_graph.h.
 #include "OpenABLE/snaps/pose_graph.h"
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <array>
 #include <cctype>
 #include <chrono>
 #include <cmath>
-#include <stdexcept>
-#include <string>
 #include <fstream>
 #include <map>
+#include <stdexcept>
+#include <string>
 #include <unordered_map>
 #include <vector>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>
-#include <Eigen/Sparse>
-#include <Eigen/SparseCholesky>
 
 #include "OpenABLE/base/error.h"
 
@@ -187,8 +186,8 @@ class NormalEquations {
         const int col = 6 * b + c;
         const int* rows = h_.innerIndexPtr();
         const int begin = h_.outerIndexPtr()[col], end = h_.outerIndexPtr()[col + 1];
-        block_start_[k][c] = static_cast<int>(std::lower_bound(rows + begin, rows + end, 6 * a) -
-                                              rows);
+        block_start_[k][c] =
+            static_cast<int>(std::lower_bound(rows + begin, rows + end, 6 * a) - rows);
       }
     }
     diagonal_.resize(n_);

@@ -39,10 +39,9 @@
 // sqrt(w_R / w_t) = 20 m).
 #pragma once
 
+#include <Eigen/Geometry>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "OpenABLE/snaps/trajectory.h"
 
@@ -91,12 +90,12 @@ struct RelativeLoop {
 };
 
 struct PoseGraphReport {
-  int iterations = 0;         // steps tried (accepted or rejected)
-  int loop_edges = 0;         // loop edges in the graph (LoopPair + RelativeLoop)
-  double initial_cost = 0;    // robustified cost of the input (0.5 x sum of weighted squares)
-  double final_cost = 0;      // of the output
-  double seconds = 0;         // wall time of the whole correction
-  bool converged = false;     // stopped by relative_tolerance (not max_iterations)
+  int iterations = 0;       // steps tried (accepted or rejected)
+  int loop_edges = 0;       // loop edges in the graph (LoopPair + RelativeLoop)
+  double initial_cost = 0;  // robustified cost of the input (0.5 x sum of weighted squares)
+  double final_cost = 0;    // of the output
+  double seconds = 0;       // wall time of the whole correction
+  bool converged = false;   // stopped by relative_tolerance (not max_iterations)
 };
 
 // The corrected trajectory: `input` with its poses replaced by the minimiser of the model above

@@ -2,6 +2,8 @@
 // error. See trajectory.h and docs/snaps.md ("Trajectories", "Trajectory error").
 #include "OpenABLE/snaps/trajectory.h"
 
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -11,9 +13,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
-#include <Eigen/SVD>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
@@ -78,8 +77,7 @@ void CheckTrajectory(const Trajectory& t, const std::string& what) {
   }
 }
 
-Trajectory ReadTrajectory(const std::string& path, TrajectoryFormat format,
-                          bool world_to_camera) {
+Trajectory ReadTrajectory(const std::string& path, TrajectoryFormat format, bool world_to_camera) {
   // The reader and checks the evaluation's ground truth uses too (pose_file.h).
   const PoseFileFormat file_format = format == TrajectoryFormat::kKitti ? PoseFileFormat::kKitti
                                      : format == TrajectoryFormat::kKittiWithId
@@ -88,7 +86,8 @@ Trajectory ReadTrajectory(const std::string& path, TrajectoryFormat format,
   Trajectory trajectory;
   trajectory.format = format;
   trajectory.world_to_camera = world_to_camera;
-  for (const PoseFileLine& line : ReadPoseFile(path, file_format, "trajectory", /*both_kitti=*/true)) {
+  for (const PoseFileLine& line :
+       ReadPoseFile(path, file_format, "trajectory", /*both_kitti=*/true)) {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     pose.linear() = line.rotation;
     pose.translation() = line.translation;
@@ -138,8 +137,8 @@ std::vector<int> AssociateWithTruth(const Trajectory& estimate, const Trajectory
                                     double time_tolerance, const std::string& key) {
   std::vector<int> association(estimate.poses.size(), -1);
   if (truth.poses.empty()) throw InputError(key + ": the ground truth has no pose");
-  const bool by_time = estimate.format == TrajectoryFormat::kTum &&
-                       truth.format == TrajectoryFormat::kTum;
+  const bool by_time =
+      estimate.format == TrajectoryFormat::kTum && truth.format == TrajectoryFormat::kTum;
   if (by_time) {
     const std::vector<double>& t = truth.timestamps;
     for (int i = 0; i < estimate.Size(); ++i) {
@@ -235,6 +234,5 @@ std::string ConventionHint(const TrajectoryError& aligned, const Trajectory& tru
          " when the file holds world-to-camera matrices, as SO-DSO's poses_history_file.txt), " +
          words.formats + ", and that both cover the same frames.";
 }
-
 
 }  // namespace openable::snaps

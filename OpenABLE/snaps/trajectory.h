@@ -5,10 +5,9 @@
 // Environments", Sec. II-III.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "OpenABLE/base/enum_names.h"
 
@@ -85,11 +84,11 @@ std::vector<int> AssociateWithTruth(const Trajectory& estimate, const Trajectory
 // Absolute trajectory error of the positions of `estimate` against their counterparts in
 // `truth` (`association` as AssociateWithTruth gives it).
 struct TrajectoryError {
-  double rmse = 0;     // sqrt(mean of squared distances), metres
-  double mean = 0;     // mean distance: the paper's "mean deviation from the ground truth"
+  double rmse = 0;  // sqrt(mean of squared distances), metres
+  double mean = 0;  // mean distance: the paper's "mean deviation from the ground truth"
   double median = 0;
   double max = 0;
-  bool aligned = false;                      // a rigid alignment was applied first
+  bool aligned = false;  // a rigid alignment was applied first
   Eigen::Isometry3d alignment = Eigen::Isometry3d::Identity();  // applied to the estimate
 };
 // `align` = true: first the rigid motion (rotation + translation, no scale) that best maps the

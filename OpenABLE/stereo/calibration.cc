@@ -141,19 +141,17 @@ StereoCalibration LoadStereoCalibration(const std::string& path) {
   return c;
 }
 
-void CheckPrincipalPointFits(const std::string& calibration, const std::string& camera,
-                             double cx, double cy, const cv::Size& size,
-                             const std::string& first_image) {
+void CheckPrincipalPointFits(const std::string& calibration, const std::string& camera, double cx,
+                             double cy, const cv::Size& size, const std::string& first_image) {
   const double w = size.width, h = size.height;
   if (cx < w / 4 || cx > 3 * w / 4 || cy < h / 4 || cy > 3 * h / 4)
-    throw InputError("calibration \"" + calibration + "\" does not fit the images: " + camera +
-                     " principal point (" + Num(cx) + ", " + Num(cy) +
-                     ") lies outside the middle half of the " + std::to_string(size.width) +
-                     "x" + std::to_string(size.height) + " image \"" + first_image +
-                     "\" (it suits images of about " +
-                     std::to_string(static_cast<int>(std::lround(2 * cx))) + "x" +
-                     std::to_string(static_cast<int>(std::lround(2 * cy))) +
-                     "); expected width/4 <= cx <= 3 width/4 and height/4 <= cy <= 3 height/4");
+    throw InputError(
+        "calibration \"" + calibration + "\" does not fit the images: " + camera +
+        " principal point (" + Num(cx) + ", " + Num(cy) + ") lies outside the middle half of the " +
+        std::to_string(size.width) + "x" + std::to_string(size.height) + " image \"" + first_image +
+        "\" (it suits images of about " + std::to_string(static_cast<int>(std::lround(2 * cx))) +
+        "x" + std::to_string(static_cast<int>(std::lround(2 * cy))) +
+        "); expected width/4 <= cx <= 3 width/4 and height/4 <= cy <= 3 height/4");
 }
 
 void CheckCalibrationFits(const StereoCalibration& c, const cv::Size& size,

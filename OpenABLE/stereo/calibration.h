@@ -14,22 +14,21 @@
 //           the pipeline writes no disparity image (docs/cameras.md).
 #pragma once
 
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace openable {
 
 struct StereoCalibration {
-  std::string path;                   // file it was read from (for messages)
-  cv::Matx33d left_camera;            // ML
-  cv::Matx33d right_camera;           // MR
+  std::string path;                     // file it was read from (for messages)
+  cv::Matx33d left_camera;              // ML
+  cv::Matx33d right_camera;             // MR
   cv::Vec<double, 5> left_distortion;   // DL: k1 k2 p1 p2 k3
   cv::Vec<double, 5> right_distortion;  // DR
-  cv::Matx33d rotation;               // R: right_from_left rotation
-  cv::Vec3d translation;              // T: right_from_left translation
-  int colormap = -1;                  // -1 grey, else a cv::ColormapTypes number 0-21
-  int use_log = 0;                    // 1: render log(1 + disparity)
+  cv::Matx33d rotation;                 // R: right_from_left rotation
+  cv::Vec3d translation;                // T: right_from_left translation
+  int colormap = -1;                    // -1 grey, else a cv::ColormapTypes number 0-21
+  int use_log = 0;                      // 1: render log(1 + disparity)
 };
 
 // Reads and checks a calibration file. Throws InputError with one line naming the file, the
@@ -40,9 +39,8 @@ struct StereoCalibration {
 StereoCalibration LoadStereoCalibration(const std::string& path);
 
 // The rule of CheckCalibrationFits for one camera (`camera` names it in the message: "ML").
-void CheckPrincipalPointFits(const std::string& calibration, const std::string& camera,
-                             double cx, double cy, const cv::Size& size,
-                             const std::string& first_image);
+void CheckPrincipalPointFits(const std::string& calibration, const std::string& camera, double cx,
+                             double cy, const cv::Size& size, const std::string& first_image);
 
 // Checks that the calibration fits images of `image_size` (the size of the first left image,
 // named `first_image` in the message). Rule: the principal point (cx, cy) of each camera lies

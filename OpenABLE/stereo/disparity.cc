@@ -1,10 +1,9 @@
 #include "OpenABLE/stereo/disparity.h"
 
 #include <algorithm>
+#include <opencv2/calib3d.hpp>
 #include <stdexcept>
 #include <string>
-
-#include <opencv2/calib3d.hpp>
 
 namespace openable {
 
@@ -26,8 +25,7 @@ void DisparityOptions::Check() const {
     throw std::logic_error("DisparityOptions: expected 0 <= P1 < P2");
 }
 
-cv::Mat1f ComputeDisparity(const cv::Mat& left, const cv::Mat& right,
-                           const DisparityOptions& o) {
+cv::Mat1f ComputeDisparity(const cv::Mat& left, const cv::Mat& right, const DisparityOptions& o) {
   o.Check();
   if (left.type() != CV_8UC1 || right.type() != CV_8UC1 || left.size() != right.size())
     throw std::logic_error("ComputeDisparity: expected two CV_8UC1 images of one size");

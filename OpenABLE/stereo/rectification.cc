@@ -1,7 +1,6 @@
 #include "OpenABLE/stereo/rectification.h"
 
 #include <cmath>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -14,8 +13,8 @@ StereoRectifier::StereoRectifier(const StereoCalibration& c, const cv::Size& ima
   const cv::Mat dl(c.left_distortion), dr(c.right_distortion);
   const cv::Mat r(c.rotation), t(c.translation);
   cv::Mat r1, r2, p1, p2, q;
-  cv::stereoRectify(ml, dl, mr, dr, size_, r, t, r1, r2, p1, p2, q, cv::CALIB_ZERO_DISPARITY,
-                    alpha, size_);
+  cv::stereoRectify(ml, dl, mr, dr, size_, r, t, r1, r2, p1, p2, q, cv::CALIB_ZERO_DISPARITY, alpha,
+                    size_);
   rotation_left_ = cv::Matx33d(r1);
   rotation_right_ = cv::Matx33d(r2);
   projection_left_ = cv::Matx34d(p1);
@@ -31,8 +30,7 @@ double StereoRectifier::Baseline() const {
 
 void StereoRectifier::Rectify(const cv::Mat& left, const cv::Mat& right, cv::Mat& left_rectified,
                               cv::Mat& right_rectified) const {
-  cv::remap(left, left_rectified, map_left_x_, map_left_y_, cv::INTER_LINEAR,
-            cv::BORDER_CONSTANT);
+  cv::remap(left, left_rectified, map_left_x_, map_left_y_, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
   if (right.empty()) {
     right_rectified.release();
     return;

@@ -1,8 +1,7 @@
 #include "OpenABLE/stereo/stereo_source.h"
 
-#include <utility>
-
 #include <opencv2/imgproc.hpp>
+#include <utility>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
@@ -35,9 +34,7 @@ class StereoFolderSource final : public FrameSource {
 
   int Size() const override { return left_->Size(); }
   std::string FrameName(int i) const override { return left_->FrameName(i); }
-  bool ParallelReads() const override {
-    return left_->ParallelReads() && right_->ParallelReads();
-  }
+  bool ParallelReads() const override { return left_->ParallelReads() && right_->ParallelReads(); }
   double Timestamp(int i) const override { return left_->Timestamp(i); }
 
   cv::Mat Read(int i) const override {
@@ -46,8 +43,8 @@ class StereoFolderSource final : public FrameSource {
     if (left.size() != right.size())
       throw InputError(left_key_ + "/" + right_key_ + ": stereo pair " + std::to_string(i) +
                        ": left image " + Quoted(left_->FrameName(i)) + " is " +
-                       SizeText(left.size()) + " but right image " +
-                       Quoted(right_->FrameName(i)) + " is " + SizeText(right.size()) +
+                       SizeText(left.size()) + " but right image " + Quoted(right_->FrameName(i)) +
+                       " is " + SizeText(right.size()) +
                        " (expected both images of a pair to have one size)");
     if (left.size() != size_)
       throw InputError(left_key_ + ": image " + Quoted(left_->FrameName(i)) + " is " +
@@ -103,10 +100,10 @@ std::unique_ptr<FrameSource> OpenStereoFolders(const std::string& left, const st
                      " holds " + std::to_string(right_paths.size()) +
                      " (expected one right image per left image: pairs are matched by position "
                      "in natural order)");
-  auto left_source = WithKey("Images_path_left",
-                             [&] { return OpenImageFolder(left, extension, first, last); });
-  auto right_source = WithKey("Images_path_right",
-                              [&] { return OpenImageFolder(right, extension, first, last); });
+  auto left_source =
+      WithKey("Images_path_left", [&] { return OpenImageFolder(left, extension, first, last); });
+  auto right_source =
+      WithKey("Images_path_right", [&] { return OpenImageFolder(right, extension, first, last); });
   return OpenStereoSources(std::move(left_source), std::move(right_source), calibration, options,
                            "Images_path_left", "Images_path_right");
 }

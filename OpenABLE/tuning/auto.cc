@@ -243,8 +243,8 @@ void CheckAuto(const Config& config) {
     if (!config.input.descriptors_path.empty())
       for (const auto& [key, value] : candidate)
         if (key == "Image_descriptor" || key == "Patch_size" || key == "Description_type")
-          throw InputError(std::string(kKey) + ": " + AutoSettingsText(candidate) + " sets " +
-                           key + ", but the rows come from Descriptors_path; expected "
+          throw InputError(std::string(kKey) + ": " + AutoSettingsText(candidate) + " sets " + key +
+                           ", but the rows come from Descriptors_path; expected "
                            "candidates of matching settings only (e.g. Image_sequences=10,20,40)");
     try {
       CheckRun(AutoCandidateConfig(config, Completed(config, candidate)));
@@ -324,8 +324,8 @@ AutoChoice JudgeCandidates(const AutoPlan& plan, double min_consistency,
     if (log)
       log("auto: " + std::to_string(i + 1) + " of " + std::to_string(configs.size()) + ": " +
           AutoSettingsText(choice.candidates[i].settings) + ": consistency " +
-          FormatFixed(f.consistency, 3) + ", distinctiveness " +
-          FormatFixed(f.distinctiveness, 3) + ", agreement " + FormatFixed(f.agreement, 3));
+          FormatFixed(f.consistency, 3) + ", distinctiveness " + FormatFixed(f.distinctiveness, 3) +
+          ", agreement " + FormatFixed(f.agreement, 3));
   }
   progress.End();
 

@@ -10,11 +10,10 @@
 #pragma once
 
 #include <functional>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <nlohmann/json_fwd.hpp>
 
 #include "OpenABLE/base/progress.h"
 #include "OpenABLE/evaluation/unsupervised.h"

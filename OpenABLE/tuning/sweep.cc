@@ -44,28 +44,44 @@ std::vector<std::string> SplitValues(const std::string& text) {
 double RankFigure(const SweepRun& run, SweepRank rank) {
   const PerQueryResult& q = run.evaluation.per_query;
   switch (rank) {
-    case SweepRank::kAuc: return q.auc;
-    case SweepRank::kRecallAt100p: return q.recall_at_100p;
-    case SweepRank::kRecallAt1: return q.recall_at_1;
-    case SweepRank::kMaxF1: return q.max_f1;
-    case SweepRank::kAveragePrecision: return run.evaluation.able_p.average_precision;
-    case SweepRank::kDistinctiveness: return run.unsupervised.distinctiveness;
-    case SweepRank::kConsistency: return run.unsupervised.consistency;
-    case SweepRank::kAgreement: return run.unsupervised.agreement;
+    case SweepRank::kAuc:
+      return q.auc;
+    case SweepRank::kRecallAt100p:
+      return q.recall_at_100p;
+    case SweepRank::kRecallAt1:
+      return q.recall_at_1;
+    case SweepRank::kMaxF1:
+      return q.max_f1;
+    case SweepRank::kAveragePrecision:
+      return run.evaluation.able_p.average_precision;
+    case SweepRank::kDistinctiveness:
+      return run.unsupervised.distinctiveness;
+    case SweepRank::kConsistency:
+      return run.unsupervised.consistency;
+    case SweepRank::kAgreement:
+      return run.unsupervised.agreement;
   }
   return 0;
 }
 
 const char* RankTitle(SweepRank rank) {
   switch (rank) {
-    case SweepRank::kAuc: return "AUC";
-    case SweepRank::kRecallAt100p: return "recall at 100% precision";
-    case SweepRank::kRecallAt1: return "recall at 1";
-    case SweepRank::kMaxF1: return "max F1";
-    case SweepRank::kAveragePrecision: return "ABLE-P average precision";
-    case SweepRank::kDistinctiveness: return "distinctiveness (no ground truth)";
-    case SweepRank::kConsistency: return "consistency (no ground truth)";
-    case SweepRank::kAgreement: return "agreement (no ground truth)";
+    case SweepRank::kAuc:
+      return "AUC";
+    case SweepRank::kRecallAt100p:
+      return "recall at 100% precision";
+    case SweepRank::kRecallAt1:
+      return "recall at 1";
+    case SweepRank::kMaxF1:
+      return "max F1";
+    case SweepRank::kAveragePrecision:
+      return "ABLE-P average precision";
+    case SweepRank::kDistinctiveness:
+      return "distinctiveness (no ground truth)";
+    case SweepRank::kConsistency:
+      return "consistency (no ground truth)";
+    case SweepRank::kAgreement:
+      return "agreement (no ground truth)";
   }
   return "";
 }
@@ -184,23 +200,28 @@ SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressRe
   std::set<std::string> keys;
   for (const SweepAxis& axis : options.axes)
     if (!keys.insert(axis.key).second)
-      throw InputError("--vary: " + axis.key + " is given twice; expected each key once, with "
+      throw InputError("--vary: " + axis.key +
+                       " is given twice; expected each key once, with "
                        "all its values in one --vary");
   if (options.best < 1)
     throw InputError("--best: " + std::to_string(options.best) +
                      " is not valid; expected the number of runs to draw, >= 1");
   if (!EvaluationRequested(base) && !Unsupervised(options.rank_by))
-    throw InputError("Ground_truth_type: empty; expected the ground truth the sweep ranks its "
-                     "runs by (--rank-by " + EnumName(options.rank_by) + ", docs/evaluation.md), "
-                     "or --rank-by agreement, consistency or distinctiveness, which need none");
+    throw InputError(
+        "Ground_truth_type: empty; expected the ground truth the sweep ranks its "
+        "runs by (--rank-by " +
+        EnumName(options.rank_by) +
+        ", docs/evaluation.md), "
+        "or --rank-by agreement, consistency or distinctiveness, which need none");
   if (base.automatic.enabled)
-    throw InputError("Auto: 1: a sweep runs each combination as given; expected Auto 0 "
-                     "(--rank-by agreement ranks settings without ground truth as Auto does)");
+    throw InputError(
+        "Auto: 1: a sweep runs each combination as given; expected Auto 0 "
+        "(--rank-by agreement ranks settings without ground truth as Auto does)");
   if (base.scale.matrix_mode == MatrixMode::kBounded || base.scale.approximate_search)
-    throw InputError(std::string(base.scale.approximate_search ? "Approximate_search: 1"
-                                                                : "Matrix_mode: 2") +
-                     " keeps no dense matrix, which a sweep evaluates; expected Matrix_mode 0 "
-                     "or 1 and Approximate_search 0");
+    throw InputError(
+        std::string(base.scale.approximate_search ? "Approximate_search: 1" : "Matrix_mode: 2") +
+        " keeps no dense matrix, which a sweep evaluates; expected Matrix_mode 0 "
+        "or 1 and Approximate_search 0");
 
   // Every combination is checked before the first frame is read: a bad value in the last
   // combination must not cost the time of the others.
@@ -231,8 +252,7 @@ SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressRe
   // decoded once for all the descriptors of combinations that share their description
   // settings; the runs then take their single-frame matrices from the store. A run is marked
   // as having described the frames for the descriptors no earlier run used.
-  out.frame_reads =
-      static_cast<int>(ComputeSingleFramesTogether(configs, progress, store).size());
+  out.frame_reads = static_cast<int>(ComputeSingleFramesTogether(configs, progress, store).size());
   std::set<std::string> credited;  // single-frame keys an earlier run used
   std::set<std::string> said;
   const int n = static_cast<int>(configs.size());
@@ -299,13 +319,12 @@ std::string FormatSweepTable(const SweepResult& r) {
   std::ostringstream o;
   std::string keys;
   for (const SweepAxis& a : r.axes) keys += (keys.empty() ? "" : " x ") + a.key;
-  o << "Sweep: " << r.runs.size() << " runs (" << keys << "), ranked by "
-    << RankTitle(r.rank_by) << "; frames described " << r.descriptions
-    << (r.descriptions == 1 ? " time" : " times") << " (once per descriptor), read "
-    << r.frame_reads << (r.frame_reads == 1 ? " time" : " times")
+  o << "Sweep: " << r.runs.size() << " runs (" << keys << "), ranked by " << RankTitle(r.rank_by)
+    << "; frames described " << r.descriptions << (r.descriptions == 1 ? " time" : " times")
+    << " (once per descriptor), read " << r.frame_reads << (r.frame_reads == 1 ? " time" : " times")
     << " (once per description setting), " << FormatFixed(r.seconds, 1) << " s\n";
-  const bool loop = !r.runs.empty() && r.runs[0].evaluation.layout.kind ==
-                                           EvaluationLayout::Kind::kLoopClosure;
+  const bool loop =
+      !r.runs.empty() && r.runs[0].evaluation.layout.kind == EvaluationLayout::Kind::kLoopClosure;
   if (r.evaluated) {
     const EvaluationSettings& s = r.settings;
     o << "Evaluation against " << GroundTruthTypeName(s.truth.type) << " ground truth"
@@ -379,9 +398,8 @@ std::string FormatSweepTable(const SweepResult& r) {
     double best_auc = 0;
     for (const SweepRun& run : r.runs) best_auc = std::max(best_auc, run.evaluation.per_query.auc);
     o << "  The first by " << EnumName(r.rank_by) << ", chosen without ground truth, has AUC "
-      << FormatFixed(r.runs[0].evaluation.per_query.auc, 3) << ": rank " << other_rank[0]
-      << " of " << r.runs.size() << " by AUC (the best AUC is " << FormatFixed(best_auc, 3)
-      << ")\n";
+      << FormatFixed(r.runs[0].evaluation.per_query.auc, 3) << ": rank " << other_rank[0] << " of "
+      << r.runs.size() << " by AUC (the best AUC is " << FormatFixed(best_auc, 3) << ")\n";
   }
   return ToValidUtf8(o.str());
 }
@@ -389,9 +407,10 @@ std::string FormatSweepTable(const SweepResult& r) {
 std::string EncodeSweepCsv(const SweepResult& r) {
   std::string out = "rank";
   for (const SweepAxis& a : r.axes) out += "," + CsvField(a.key);
-  out += ",label,auc,recall_at_100p,max_f1,max_f1_threshold,recall_at_1,recall_at_5,"
-         "recall_at_10,average_precision_percent,queries,unanswered_queries,consistency,"
-         "distinctiveness,agreement,seconds,described\n";
+  out +=
+      ",label,auc,recall_at_100p,max_f1,max_f1_threshold,recall_at_1,recall_at_5,"
+      "recall_at_10,average_precision_percent,queries,unanswered_queries,consistency,"
+      "distinctiveness,agreement,seconds,described\n";
   for (size_t i = 0; i < r.runs.size(); ++i) {
     const SweepRun& run = r.runs[i];
     const PerQueryResult& q = run.evaluation.per_query;
@@ -403,12 +422,10 @@ std::string EncodeSweepCsv(const SweepResult& r) {
       out += "," + CsvNumber(q.auc) + "," + CsvNumber(q.recall_at_100p) + "," +
              CsvNumber(q.max_f1) + "," + CsvNumber(q.max_f1_threshold) + "," +
              CsvNumber(q.recall_at_1) + "," + CsvNumber(q.recall_at_5) + "," +
-             CsvNumber(q.recall_at_10) + "," +
-             CsvNumber(run.evaluation.able_p.average_precision) + "," +
-             std::to_string(q.queries) + "," + std::to_string(q.unanswered);
+             CsvNumber(q.recall_at_10) + "," + CsvNumber(run.evaluation.able_p.average_precision) +
+             "," + std::to_string(q.queries) + "," + std::to_string(q.unanswered);
     } else {  // no ground truth: the figures are empty; queries from the criteria
-      out += ",,,,,,,,," + std::to_string(u.queries) + "," +
-             std::to_string(u.queries - u.answered);
+      out += ",,,,,,,,," + std::to_string(u.queries) + "," + std::to_string(u.queries - u.answered);
     }
     out += "," + CsvNumber(u.consistency) + "," + CsvNumber(u.distinctiveness) + "," +
            CsvNumber(u.agreement) + "," + CsvNumber(run.seconds) + "," +
@@ -477,8 +494,8 @@ std::vector<std::string> WriteSweep(const std::string& prefix, const SweepResult
   std::vector<PrSeries> series;
   const size_t shown = std::min(r.runs.size(), static_cast<size_t>(r.best));
   for (size_t i = 0; i < shown; ++i)
-    series.push_back({r.runs[i].label, r.runs[i].evaluation.per_query.curve,
-                      r.runs[i].evaluation.able_p.curve});
+    series.push_back(
+        {r.runs[i].label, r.runs[i].evaluation.per_query.curve, r.runs[i].evaluation.able_p.curve});
   const EvaluationSettings& s = r.settings;
   std::string title = "Best " + std::to_string(shown) + " of " + std::to_string(r.runs.size()) +
                       " runs by " + RankTitle(r.rank_by) + ", " +

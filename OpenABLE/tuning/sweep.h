@@ -8,10 +8,9 @@
 #pragma once
 
 #include <functional>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json_fwd.hpp>
 
 #include "OpenABLE/base/enum_names.h"
 #include "OpenABLE/base/progress.h"
@@ -58,17 +57,17 @@ inline bool Unsupervised(SweepRank rank) {
 struct SweepOptions {
   std::vector<SweepAxis> axes;  // at least one; keys distinct
   SweepRank rank_by = SweepRank::kAuc;
-  int best = 5;                 // runs drawn in the precision-recall figure, >= 1
+  int best = 5;  // runs drawn in the precision-recall figure, >= 1
 };
 
 // One combination, as run and evaluated.
 struct SweepRun {
-  std::vector<std::string> values;  // one per axis, in the order of SweepOptions::axes
-  std::string label;                // "HOG L=30 Match_score=ratio"
-  EvaluatedRun evaluation;          // with ground truth (SweepResult::evaluated)
+  std::vector<std::string> values;   // one per axis, in the order of SweepOptions::axes
+  std::string label;                 // "HOG L=30 Match_score=ratio"
+  EvaluatedRun evaluation;           // with ground truth (SweepResult::evaluated)
   UnsupervisedFigures unsupervised;  // always (without the per-query vectors)
-  double seconds = 0;               // wall time of the run and its evaluation
-  bool described = false;           // described frames (false: took kept single-frame matrices)
+  double seconds = 0;                // wall time of the run and its evaluation
+  bool described = false;            // described frames (false: took kept single-frame matrices)
 };
 
 struct SweepResult {

@@ -33,14 +33,12 @@ void VerificationOptions::Check() const {
   Require(min_inliers >= 5 && min_inliers <= 100000, "Verification_min_inliers",
           std::to_string(min_inliers), "5 to 100000 (the essential matrix needs 5 points)");
   Require(std::isfinite(ransac_threshold) && ransac_threshold >= 0.1 && ransac_threshold <= 100,
-          "Verification_ransac_threshold", FormatNumber(ransac_threshold),
-          "0.1 to 100 pixels");
+          "Verification_ransac_threshold", FormatNumber(ransac_threshold), "0.1 to 100 pixels");
   Require(candidates >= 1 && candidates <= 100, "Verification_candidates",
           std::to_string(candidates), "1 to 100 candidates per query");
   Require(consistency >= 0, "Verification_consistency", std::to_string(consistency),
           "a number of queries >= 0 (0: off)");
-  Require(std::isfinite(calibration_scale) && calibration_scale >= 0.01 &&
-              calibration_scale <= 10,
+  Require(std::isfinite(calibration_scale) && calibration_scale >= 0.01 && calibration_scale <= 10,
           "Verification_calibration_scale", FormatNumber(calibration_scale), "0.01 to 10");
   Require(std::isfinite(cache_mb) && cache_mb >= 1, "Verification_cache", FormatNumber(cache_mb),
           "at least 1 MB");
@@ -96,8 +94,8 @@ PairVerifier::PairVerifier(const VerificationOptions& options,
 FrameFeatures PairVerifier::Extract(const cv::Mat& image) const {
   const cv::Mat1b grey = GreyOfImage(image, "verification: the frame");
   // One detector per call: OpenCV's Feature2D objects are not documented as thread-safe.
-  const odometry::FeatureExtractor extractor(EnumName(options_.features),
-                                             options_.max_features, "Verification_features");
+  const odometry::FeatureExtractor extractor(EnumName(options_.features), options_.max_features,
+                                             "Verification_features");
   odometry::Features f = extractor.Extract(grey);
   FrameFeatures out;
   out.points.reserve(f.keypoints.size());
@@ -111,8 +109,7 @@ PairCheck PairVerifier::Verify(const FrameFeatures& query, const FrameFeatures& 
   odometry::Features a, b;  // MatchWithRatioTest reads only the descriptors
   a.descriptors = query.descriptors;
   b.descriptors = reference.descriptors;
-  const std::vector<cv::DMatch> matches =
-      odometry::MatchWithRatioTest(a, b, norm_, options_.ratio);
+  const std::vector<cv::DMatch> matches = odometry::MatchWithRatioTest(a, b, norm_, options_.ratio);
   check.matches = static_cast<int>(matches.size());
   if (check.matches < options_.min_inliers) return check;  // cannot reach the bar
   std::vector<cv::Point2f> p, q;
@@ -157,8 +154,8 @@ PairCheck PairVerifier::Verify(const FrameFeatures& query, const FrameFeatures& 
   cv::Mat h_mask;
   const cv::Mat h = cv::findHomography(p, q, cv::USAC_ACCURATE, threshold, h_mask, 2000, 0.999);
   const int h_inliers = h.empty() ? 0 : CountMask(h_mask);
-  if (h_inliers > 0 && (check.model == GeometricModel::kNone ||
-                        h_inliers >= kHomographyShare * check.inliers)) {
+  if (h_inliers > 0 &&
+      (check.model == GeometricModel::kNone || h_inliers >= kHomographyShare * check.inliers)) {
     check.model = GeometricModel::kHomography;
     check.inliers = h_inliers;
   }
@@ -166,8 +163,8 @@ PairCheck PairVerifier::Verify(const FrameFeatures& query, const FrameFeatures& 
   return check;
 }
 
-void ContinueStreaks(const QueryVerification* previous, QueryVerification& current,
-                     int consistency, int tolerance) {
+void ContinueStreaks(const QueryVerification* previous, QueryVerification& current, int consistency,
+                     int tolerance) {
   const bool consecutive = previous != nullptr && previous->query == current.query - 1;
   current.answer = -1;
   for (std::size_t i = 0; i < current.candidates.size(); ++i) {

@@ -26,11 +26,10 @@
 #pragma once
 
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/base/enum_names.h"
 
@@ -41,17 +40,17 @@ OPENABLE_ENUM_NAMES(LocalFeatures, "ORB", "SIFT")
 
 // The Verification_* keys.
 struct VerificationOptions {
-  bool enabled = false;                        // Verification
+  bool enabled = false;                          // Verification
   LocalFeatures features = LocalFeatures::kOrb;  // Verification_features
-  int max_features = 500;                      // Verification_max_features, 10..100000
-  double ratio = 0.8;                          // Verification_ratio, [0.1, 1]
-  int min_inliers = 40;                        // Verification_min_inliers, 5..100000
-  double ransac_threshold = 2.0;               // Verification_ransac_threshold, pixels
-  int candidates = 5;                          // Verification_candidates: k, 1..100
-  int consistency = 1;                         // Verification_consistency: n, >= 0
-  std::string calibration;                     // Verification_calibration; empty: none
-  double calibration_scale = 1.0;              // Verification_calibration_scale
-  double cache_mb = 1024;                      // Verification_cache: MB of features kept
+  int max_features = 500;                        // Verification_max_features, 10..100000
+  double ratio = 0.8;                            // Verification_ratio, [0.1, 1]
+  int min_inliers = 40;                          // Verification_min_inliers, 5..100000
+  double ransac_threshold = 2.0;                 // Verification_ransac_threshold, pixels
+  int candidates = 5;                            // Verification_candidates: k, 1..100
+  int consistency = 1;                           // Verification_consistency: n, >= 0
+  std::string calibration;                       // Verification_calibration; empty: none
+  double calibration_scale = 1.0;                // Verification_calibration_scale
+  double cache_mb = 1024;                        // Verification_cache: MB of features kept
   // Not a key: the frames within which references count as neighbours for the consistency
   // (the run takes Tolerance).
   int tolerance = 2;
@@ -91,8 +90,8 @@ enum class GeometricModel { kNone, kFundamental, kEssential, kHomography };
 OPENABLE_ENUM_NAMES(GeometricModel, "none", "fundamental", "essential", "homography")
 
 struct PairCheck {
-  int matches = 0;   // matches passing the ratio test
-  int inliers = 0;   // inliers of `model` (0 with kNone)
+  int matches = 0;  // matches passing the ratio test
+  int inliers = 0;  // inliers of `model` (0 with kNone)
   GeometricModel model = GeometricModel::kNone;
   bool verified = false;  // inliers >= min_inliers
 };
@@ -122,17 +121,17 @@ class PairVerifier {
 
 // One candidate of a query and what verification found.
 struct VerifiedCandidate {
-  int reference = -1;   // frame of the reference traversal
-  int rank = 0;         // 1 = the best distinct place of the query, 2, ...
-  float distance = 0;   // normalised distance M'
-  float score = 0;      // Match_score of the candidate
+  int reference = -1;  // frame of the reference traversal
+  int rank = 0;        // 1 = the best distinct place of the query, 2, ...
+  float distance = 0;  // normalised distance M'
+  float score = 0;     // Match_score of the candidate
   PairCheck check;
-  int streak = 0;       // consecutive queries with a verified loop near this one (this included)
+  int streak = 0;         // consecutive queries with a verified loop near this one (this included)
   bool accepted = false;  // check.verified and streak > consistency
 };
 
 struct QueryVerification {
-  int query = -1;  // frame of the query traversal
+  int query = -1;                             // frame of the query traversal
   std::vector<VerifiedCandidate> candidates;  // rank order
   // Index in `candidates` of the query's answer: the best-ranked accepted candidate; -1: none.
   int answer = -1;
@@ -140,8 +139,8 @@ struct QueryVerification {
 
 // Sets the streaks, `accepted` and `answer` of `current` from `previous` (the query before it,
 // or nullptr), as the top of this file explains.
-void ContinueStreaks(const QueryVerification* previous, QueryVerification& current,
-                     int consistency, int tolerance);
+void ContinueStreaks(const QueryVerification* previous, QueryVerification& current, int consistency,
+                     int tolerance);
 
 // The same over queries in frame order.
 void ApplyTemporalConsistency(std::vector<QueryVerification>& queries, int consistency,

@@ -4,6 +4,8 @@
 // find_package(OpenABLE) (CMakeLists.txt beside this file, docs/install.md), includes only
 // <OpenABLE/OpenABLE.h> and feeds the images of a folder, in natural order, to
 // openable::OnlineDetector one at a time.
+#include <OpenABLE/OpenABLE.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -13,8 +15,6 @@
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <OpenABLE/OpenABLE.h>
 
 namespace {
 

@@ -8,8 +8,8 @@
 #include <string>
 
 #include "OpenABLE/base/error.h"
-#include "matching/search/approximate_engine.h"
 #include "matching/distances.h"
+#include "matching/search/approximate_engine.h"
 
 namespace openable {
 namespace {
@@ -118,9 +118,7 @@ void ApproximateIndex::SetSearchBudget(const ApproximateOptions& options) {
   impl_->index->SetSearchBudget(impl_->options);
 }
 
-std::vector<std::uint8_t> ApproximateIndex::Serialize() const {
-  return impl_->index->Serialize();
-}
+std::vector<std::uint8_t> ApproximateIndex::Serialize() const { return impl_->index->Serialize(); }
 
 CandidateLists ApproximateIndex::Search(const cv::Mat& queries) const {
   CheckQueries(queries, impl_->type, impl_->width, "ApproximateIndex::Search");

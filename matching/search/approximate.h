@@ -4,8 +4,8 @@
 // are measured against.
 //
 // FAISS (libfaiss-dev, with OpenMP and BLAS) is compiled into the run-time module
-// libopenable_faiss.so (matching/search/faiss_module.cc, OpenABLE/base/module_loader.h), loaded when
-// the first FAISS index is built: a run that uses FLANN or exact search does not load libgomp,
+// libopenable_faiss.so (matching/search/faiss_module.cc, OpenABLE/base/module_loader.h), loaded
+// when the first FAISS index is built: a run that uses FLANN or exact search does not load libgomp,
 // BLAS or LAPACK. A build configured without FAISS refuses the engines that need it
 // (CheckEngineAvailable).
 //

@@ -1,6 +1,6 @@
-// What an approximate-search engine provides to ApproximateIndex (matching/search/approximate.h): an
-// entry of the table of matching/search/engine_registry.cc (name, help, whether it needs FAISS, its
-// build and its memory per row) and the index it builds (EngineIndex). The helpers below are
+// What an approximate-search engine provides to ApproximateIndex (matching/search/approximate.h):
+// an entry of the table of matching/search/engine_registry.cc (name, help, whether it needs FAISS,
+// its build and its memory per row) and the index it builds (EngineIndex). The helpers below are
 // shared by the engines and by the exact search of approximate.cc.
 #pragma once
 
@@ -58,8 +58,7 @@ struct ApproximateEngineEntry {
   // they hold another index), in place when saved.owner is set and its form allows.
   // Deterministic for given references and options.
   std::unique_ptr<EngineIndex> (*build)(const cv::Mat& references,
-                                        const ApproximateOptions& options,
-                                        const SavedIndex& saved);
+                                        const ApproximateOptions& options, const SavedIndex& saved);
   // Bytes the index holds per reference row besides ApproximateIndex's own copy of the rows
   // (an estimate, for IncrementalIndex::MemoryBytes); `row_bytes` is one row's size.
   std::int64_t (*bytes_per_row)(const ApproximateOptions& options, int depth,

@@ -1,13 +1,13 @@
 // The bounded mode with approximate candidates (Approximate_search 1): the index of
-// Approximate_engine (matching/search/approximate.h, an engine of matching/search/engine_registry.h) finds the
-// candidates of each query; each candidate is then scored by its exact sequence sum
-// (SequenceCellDistance). Declared in matching/bounded.h.
+// Approximate_engine (matching/search/approximate.h, an engine of
+// matching/search/engine_registry.h) finds the candidates of each query; each candidate is then
+// scored by its exact sequence sum (SequenceCellDistance). Declared in matching/bounded.h.
 #include <algorithm>
 #include <cmath>
 
 #include "OpenABLE/base/threading.h"
-#include "matching/search/approximate.h"
 #include "matching/bounded.h"
+#include "matching/search/approximate.h"
 #include "matching/sequence.h"
 
 namespace openable {
@@ -62,8 +62,7 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
     for (const int j : cand[static_cast<size_t>(share_row)]) {
       if (j < 0 || j >= m) continue;
       if (block.one_traversal && j > q - rules.exclusion) continue;
-      const float s =
-          both ? std::min(score(q, j, false), score(q, j, true)) : score(q, j, reverse);
+      const float s = both ? std::min(score(q, j, false), score(q, j, true)) : score(q, j, reverse);
       if (std::isfinite(s)) scored.emplace_back(s, j);
     }
     std::sort(scored.begin(), scored.end());
@@ -74,8 +73,7 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
     if (static_cast<int>(scored.size()) > k) scored.resize(static_cast<size_t>(k));
     auto& out = per_query[static_cast<size_t>(share_row)];
     for (size_t r = 0; r < scored.size(); ++r)
-      out.push_back(
-          {q, scored[r].second, scored[r].first, static_cast<int>(r + 1), scores[r]});
+      out.push_back({q, scored[r].second, scored[r].first, static_cast<int>(r + 1), scores[r]});
   });
   std::vector<Match> kept;
   float max_seen = 0.0f;

@@ -15,10 +15,10 @@
 namespace openable {
 namespace {
 
-constexpr int kRounds = 8;            // k-majority rounds
-constexpr int kSamplePerCell = 32;    // sample rows per cell
-constexpr int kMinSample = 65536;     // sample rows at least (all rows when fewer)
-constexpr int kRowsPerTask = 1024;    // rows assigned per task
+constexpr int kRounds = 8;          // k-majority rounds
+constexpr int kSamplePerCell = 32;  // sample rows per cell
+constexpr int kMinSample = 65536;   // sample rows at least (all rows when fewer)
+constexpr int kRowsPerTask = 1024;  // rows assigned per task
 const char kMagic[8] = {'O', 'A', 'B', 'I', 'V', 'F', '1', '\0'};   // first saved form
 const char kMagic2[8] = {'O', 'A', 'B', 'I', 'V', 'F', '2', '\0'};  // the form written now
 
@@ -71,8 +71,7 @@ cv::Mat TrainCentres(const cv::Mat& references, int cells, std::uint64_t seed, i
   } else {
     // Drawn with replacement: a repeated row weighs twice, which does not matter here.
     for (int i = 0; i < sample_rows; ++i)
-      references.row(static_cast<int>(rng() % static_cast<std::uint64_t>(n)))
-          .copyTo(sample.row(i));
+      references.row(static_cast<int>(rng() % static_cast<std::uint64_t>(n))).copyTo(sample.row(i));
   }
   // First centres: `cells` sample rows in an order drawn with the seed.
   std::vector<int> pick(static_cast<std::size_t>(sample_rows));
@@ -232,8 +231,8 @@ class BinaryIvfIndex final : public EngineIndex {
         at.cells > at.rows)
       Fail("has " + std::to_string(at.cells) + " cells over " + std::to_string(at.rows) +
            " rows of " + std::to_string(at.width) + " bytes; expected its " +
-           std::to_string(references.rows) + " references of " +
-           std::to_string(references.cols) + " bytes");
+           std::to_string(references.rows) + " references of " + std::to_string(references.cols) +
+           " bytes");
     // The offsets first: the packed section's size follows from them.
     if (saved.size < at.packed)
       Fail("holds " + std::to_string(saved.size) + " bytes, fewer than its cells' " +
@@ -254,8 +253,7 @@ class BinaryIvfIndex final : public EngineIndex {
            std::to_string(at.rows));
     const std::size_t expected = at.packed + 8 * words;
     if (saved.size != expected)
-      Fail("holds " + std::to_string(saved.size) + " bytes, expected " +
-           std::to_string(expected));
+      Fail("holds " + std::to_string(saved.size) + " bytes, expected " + std::to_string(expected));
     if (!LittleEndianHost()) Fail("holds little-endian words; this host is big-endian");
     // Read in place, or from an aligned copy when the bytes are not kept or not aligned.
     const std::uint8_t* base = saved.data;
@@ -279,9 +277,8 @@ class BinaryIvfIndex final : public EngineIndex {
       const std::int32_t id = cells->ids[i];
       if (id < 0 || static_cast<std::uint32_t>(id) >= at.rows || seen[id])
         Fail("names row " + std::to_string(id) +
-             (id < 0 || static_cast<std::uint32_t>(id) >= at.rows
-                  ? " of " + std::to_string(at.rows)
-                  : " twice"));
+             (id < 0 || static_cast<std::uint32_t>(id) >= at.rows ? " of " + std::to_string(at.rows)
+                                                                  : " twice"));
       seen[id] = 1;
     }
     const std::uint64_t* packed = reinterpret_cast<const std::uint64_t*>(base + at.packed);
@@ -298,22 +295,19 @@ class BinaryIvfIndex final : public EngineIndex {
 
   void ReadFirstVersion(const SavedIndex& saved, const cv::Mat& references,
                         std::vector<int>& cell) {
-    if (saved.size < sizeof kMagic + 12 ||
-        std::memcmp(saved.data, kMagic, sizeof kMagic) != 0)
+    if (saved.size < sizeof kMagic + 12 || std::memcmp(saved.data, kMagic, sizeof kMagic) != 0)
       Fail("is not a binary_ivf index");
     const std::uint8_t* p = saved.data + sizeof kMagic;
     const std::uint32_t cells = Get32(p), width = Get32(p + 4), rows = Get32(p + 8);
     if (width != static_cast<std::uint32_t>(references.cols) ||
         rows != static_cast<std::uint32_t>(references.rows) || cells == 0 || cells > rows)
-      Fail("has " + std::to_string(cells) + " cells over " + std::to_string(rows) +
-           " rows of " + std::to_string(width) + " bytes; expected its " +
-           std::to_string(references.rows) + " references of " +
-           std::to_string(references.cols) + " bytes");
-    const std::size_t expected = sizeof kMagic + 12 + std::size_t{cells} * width +
-                                 std::size_t{rows} * 4;
+      Fail("has " + std::to_string(cells) + " cells over " + std::to_string(rows) + " rows of " +
+           std::to_string(width) + " bytes; expected its " + std::to_string(references.rows) +
+           " references of " + std::to_string(references.cols) + " bytes");
+    const std::size_t expected =
+        sizeof kMagic + 12 + std::size_t{cells} * width + std::size_t{rows} * 4;
     if (saved.size != expected)
-      Fail("holds " + std::to_string(saved.size) + " bytes, expected " +
-           std::to_string(expected));
+      Fail("holds " + std::to_string(saved.size) + " bytes, expected " + std::to_string(expected));
     p += 12;
     centres_ = cv::Mat(static_cast<int>(cells), static_cast<int>(width), CV_8U);
     std::memcpy(centres_.data, p, std::size_t{cells} * width);

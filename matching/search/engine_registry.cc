@@ -17,9 +17,9 @@ namespace {
 
 // The one table of engines, in the order shown to users (auto comes after them).
 const ApproximateEngineEntry* const kEngines[] = {
-    &kFlannEngine,  // matching/search/flann_engine.h
-    &kHnswEngine,   // matching/search/faiss_engines.h
-    &kIvfEngine,    // matching/search/faiss_engines.h
+    &kFlannEngine,      // matching/search/flann_engine.h
+    &kHnswEngine,       // matching/search/faiss_engines.h
+    &kIvfEngine,        // matching/search/faiss_engines.h
     &kBinaryIvfEngine,  // matching/search/binary_ivf.h
 };
 

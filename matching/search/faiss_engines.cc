@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "OpenABLE/base/module_loader.h"
-#include "matching/distances.h"
 #include "matching/blas.h"
+#include "matching/distances.h"
 #include "matching/search/faiss_index.h"
 #include "matching/search/ivf_cells.h"
 
@@ -75,7 +75,7 @@ std::unique_ptr<FaissIndex> ReadFaiss(const ApproximateOptions& o, const cv::Mat
   }
   if (index->Size() != refs.rows)
     FailFaiss("ApproximateIndex: the saved index holds " + std::to_string(index->Size()) +
-         " rows, expected " + std::to_string(refs.rows) + " (its references)");
+              " rows, expected " + std::to_string(refs.rows) + " (its references)");
   return index;
 }
 
@@ -88,7 +88,7 @@ std::unique_ptr<IvfCells> CellsOf(const FaissIndex& index, const cv::Mat& refs) 
   const std::size_t width = static_cast<std::size_t>(refs.cols);
   if (centres.size() != cells.size() * width)
     FailFaiss("ApproximateIndex: the IVF index has " + std::to_string(centres.size()) +
-         " bytes of cell centres, expected " + std::to_string(cells.size() * width));
+              " bytes of cell centres, expected " + std::to_string(cells.size() * width));
   std::vector<std::vector<int>> ids(cells.size());
   for (std::size_t l = 0; l < cells.size(); ++l)
     for (const std::int64_t id : cells[l]) {

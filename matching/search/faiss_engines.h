@@ -1,5 +1,5 @@
-// The engines hnsw and ivf (matching/search/engine_registry.h), FAISS's indexes built in the run-time
-// module libopenable_faiss.so (matching/search/faiss_index.h, faiss_module.cc):
+// The engines hnsw and ivf (matching/search/engine_registry.h), FAISS's indexes built in the
+// run-time module libopenable_faiss.so (matching/search/faiss_index.h, faiss_module.cc):
 //
 //  - hnsw: hierarchical navigable small-world graphs, IndexBinaryHNSW (Hamming) and
 //    IndexHNSWFlat (L2). Y. A. Malkov and D. A. Yashunin, "Efficient and robust approximate

@@ -1,6 +1,6 @@
-// The entry points of the run-time module libopenable_faiss.so (matching/search/faiss_module.cc), the
-// FAISS indexes of the engines hnsw and ivf (matching/search/faiss_engines.h). The module links FAISS,
-// OpenMP and BLAS and nothing of OpenABLE but this header, so that openable_matching reaches
+// The entry points of the run-time module libopenable_faiss.so (matching/search/faiss_module.cc),
+// the FAISS indexes of the engines hnsw and ivf (matching/search/faiss_engines.h). The module links
+// FAISS, OpenMP and BLAS and nothing of OpenABLE but this header, so that openable_matching reaches
 // it through ModuleSymbol (OpenABLE/base/module_loader.h) alone. Module and program come from the
 // same build, so C++ types and exceptions cross the boundary.
 #pragma once

@@ -1,14 +1,6 @@
-// Module libopenable_faiss.so (matching/search/faiss_index.h): the HNSW and IVF indexes of FAISS for
-// ApproximateIndex. FAISS brings libgomp, BLAS and LAPACK, which a run that does not use it no
+// Module libopenable_faiss.so (matching/search/faiss_index.h): the HNSW and IVF indexes of FAISS
+// for ApproximateIndex. FAISS brings libgomp, BLAS and LAPACK, which a run that does not use it no
 // longer loads at start-up.
-#include <omp.h>
-
-#include <algorithm>
-#include <cmath>
-#include <memory>
-#include <stdexcept>
-#include <string>
-
 #include <faiss/IndexBinaryFlat.h>
 #include <faiss/IndexBinaryHNSW.h>
 #include <faiss/IndexBinaryIVF.h>
@@ -18,6 +10,13 @@
 #include <faiss/impl/FaissException.h>
 #include <faiss/impl/io.h>
 #include <faiss/index_io.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <string>
 
 #include "matching/search/faiss_index.h"
 #include "matching/search/ivf_cells.h"
@@ -65,8 +64,7 @@ bool SetSearchAs(Base* index, bool hnsw, int ef_search, int nprobe) {
   return false;
 }
 bool SetSearch(faiss::IndexBinary* index, bool hnsw, int ef_search, int nprobe) {
-  return SetSearchAs<faiss::IndexBinaryHNSW, faiss::IndexBinaryIVF>(index, hnsw, ef_search,
-                                                                    nprobe);
+  return SetSearchAs<faiss::IndexBinaryHNSW, faiss::IndexBinaryIVF>(index, hnsw, ef_search, nprobe);
 }
 bool SetSearch(faiss::Index* index, bool hnsw, int ef_search, int nprobe) {
   return SetSearchAs<faiss::IndexHNSWFlat, faiss::IndexIVFFlat>(index, hnsw, ef_search, nprobe);
@@ -85,7 +83,9 @@ bool IsHnsw(const faiss::Index* index) {
 void Write(const faiss::IndexBinary* index, faiss::IOWriter* writer) {
   faiss::write_index_binary(index, writer);
 }
-void Write(const faiss::Index* index, faiss::IOWriter* writer) { faiss::write_index(index, writer); }
+void Write(const faiss::Index* index, faiss::IOWriter* writer) {
+  faiss::write_index(index, writer);
+}
 
 bool CellsOf(const faiss::IndexBinary* index, std::vector<std::uint8_t>* centres,
              std::vector<std::vector<std::int64_t>>* cells) {
@@ -113,7 +113,8 @@ template <typename BaseIndex, typename Element, typename Distance>
 class Wrapped final : public FaissIndex {
  public:
   using Base = BaseIndex;
-  Wrapped(std::unique_ptr<BaseIndex> index, int threads) : index_(std::move(index)), threads_(threads) {}
+  Wrapped(std::unique_ptr<BaseIndex> index, int threads)
+      : index_(std::move(index)), threads_(threads) {}
   void Search(const void* queries, int n, int k, std::int64_t* labels) const override {
     std::vector<Distance> distances(static_cast<size_t>(n) * static_cast<size_t>(k));
     const OmpThreads omp(std::min(std::max(1, n), threads_ > 0 ? threads_ : omp_get_num_procs()));
@@ -154,7 +155,8 @@ FaissIndex* BuildAs(const FaissSettings& s, int d, const Element* x, int n) {
     h->add(n, x);
     index = std::move(h);
   } else {
-    auto v = std::make_unique<Ivf>(new Flat(d), d, static_cast<size_t>(IvfCellCount(s.ivf_lists, n)));
+    auto v =
+        std::make_unique<Ivf>(new Flat(d), d, static_cast<size_t>(IvfCellCount(s.ivf_lists, n)));
     v->own_fields = true;
     SetClustering(v->cp, s.seed);
     const OmpThreads omp(s.threads);

@@ -1,5 +1,5 @@
-// The engine flann (matching/search/engine_registry.h): OpenCV's FLANN, LSH for binary rows (Hamming)
-// and randomised k-d trees for float rows (L2).
+// The engine flann (matching/search/engine_registry.h): OpenCV's FLANN, LSH for binary rows
+// (Hamming) and randomised k-d trees for float rows (L2).
 //
 // Papers: M. Muja and D. G. Lowe, "Scalable Nearest Neighbor Algorithms for High Dimensional
 // Data", IEEE T-PAMI 36(11), 2014 (randomised k-d trees, best-bin-first with a budget of

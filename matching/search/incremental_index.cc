@@ -49,8 +49,8 @@ struct IncrementalIndex::State {
 
   // Installs a finished merge (waiting for it when `wait`), then starts the next one.
   void FinishMerge(bool wait, bool background = true) {
-    if (merge && (wait || merge->index.wait_for(std::chrono::seconds(0)) ==
-                              std::future_status::ready)) {
+    if (merge &&
+        (wait || merge->index.wait_for(std::chrono::seconds(0)) == std::future_status::ready)) {
       Block merged{merge->first, merge->count, merge->index.get()};
       // The two old indices are freed on another thread: freeing the tables of a large LSH
       // index takes a good part of a second.
@@ -204,10 +204,12 @@ void IncrementalIndex::Restore(const cv::Mat& rows, const std::vector<SavedBlock
     const bool power = b.count > 0 && b.count % s.options.block_frames == 0 && (m & (m - 1)) == 0;
     if (b.first != next || !power || (i > 0 && b.count >= blocks[i - 1].count) ||
         b.count > rows.rows - next)
-      throw std::invalid_argument(
-          "IncrementalIndex::Restore: block " + std::to_string(i) + " (rows " +
-          std::to_string(b.first) + ", " + std::to_string(b.count) + " of them) does not follow "
-          "the layout of blocks of " + std::to_string(s.options.block_frames) + " x 2^m rows");
+      throw std::invalid_argument("IncrementalIndex::Restore: block " + std::to_string(i) +
+                                  " (rows " + std::to_string(b.first) + ", " +
+                                  std::to_string(b.count) +
+                                  " of them) does not follow "
+                                  "the layout of blocks of " +
+                                  std::to_string(s.options.block_frames) + " x 2^m rows");
     next += b.count;
   }
   if (rows.rows > 0 && rows_owner && rows.isContinuous()) {
@@ -219,10 +221,10 @@ void IncrementalIndex::Restore(const cv::Mat& rows, const std::vector<SavedBlock
   }
   s.size = rows.rows;
   for (const SavedBlock& b : blocks)
-    s.blocks.push_back({b.first, b.count,
-                        std::make_unique<ApproximateIndex>(
-                            s.buffer.rowRange(b.first, b.first + b.count), s.options.approximate,
-                            b.Bytes())});
+    s.blocks.push_back(
+        {b.first, b.count,
+         std::make_unique<ApproximateIndex>(s.buffer.rowRange(b.first, b.first + b.count),
+                                            s.options.approximate, b.Bytes())});
   s.indexed = next;
 }
 

@@ -3,8 +3,8 @@
 //
 // Rows are appended one by one. While the searchable rows number at most exact_limit, every
 // one is a candidate (an exact scan); beyond, rows are indexed by the engine of
-// options.approximate (matching/search/approximate.h, matching/search/engine_registry.h) in blocks of
-// block_frames rows merged as they grow (sizes block_frames x 2^m, at most one of each, like a
+// options.approximate (matching/search/approximate.h, matching/search/engine_registry.h) in blocks
+// of block_frames rows merged as they grow (sizes block_frames x 2^m, at most one of each, like a
 // binary counter), and only the newest unindexed rows (fewer than block_frames) are scanned
 // exactly. Merges of two blocks are built on a background thread while the two old blocks go
 // on being searched, so that no row waits for a large index build.
@@ -12,9 +12,8 @@
 
 #include <cstdint>
 #include <memory>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "matching/search/approximate.h"
 

@@ -37,11 +37,11 @@ std::unique_ptr<IvfCells> MakeIvfCells(const cv::Mat& references, const cv::Mat&
     for (std::size_t i = 0; i < ids.size(); ++i) {
       const int id = ids[i];
       if (id < 0 || id >= references.rows || seen[static_cast<std::size_t>(id)])
-        throw std::invalid_argument("IVF cells: row " + std::to_string(id) +
-                                    (id < 0 || id >= references.rows
-                                         ? " is not one of the " +
-                                               std::to_string(references.rows) + " references"
-                                         : " is in two cells"));
+        throw std::invalid_argument(
+            "IVF cells: row " + std::to_string(id) +
+            (id < 0 || id >= references.rows
+                 ? " is not one of the " + std::to_string(references.rows) + " references"
+                 : " is in two cells"));
       seen[static_cast<std::size_t>(id)] = 1;
       references.row(id).copyTo(rows.row(static_cast<int>(i)));
     }

@@ -10,9 +10,8 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "matching/distances.h"
 #include "matching/search/approximate.h"

@@ -58,8 +58,7 @@ TEST(EvaluateCommandLine, TheSharedCommandLineFormsWork) {
   EvaluateCommandLine c;
   ASSERT_EQ(Parse({"--matrix=a.npy", "--radius=7", "base.txt", "--set=Tolerance=3"}, c), "");
   EXPECT_EQ(c.config_path, "base.txt");
-  EXPECT_EQ(c.overrides,
-            (std::vector<std::string>{"Ground_truth_radius=7", "Tolerance=3"}));
+  EXPECT_EQ(c.overrides, (std::vector<std::string>{"Ground_truth_radius=7", "Tolerance=3"}));
   EvaluateCommandLine twice;
   EXPECT_NE(Parse({"--matrix", "a", "base.txt", "--config", "other.txt"}, twice)
                 .find("more than one configuration file (\"base.txt\" and \"other.txt\")"),

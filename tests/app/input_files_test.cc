@@ -115,8 +115,8 @@ TEST(InputFiles, EveryReaderRefusesAFifoByNameAtOnce) {
   // The settings beside a matrix (<matrix>.json), read when the matrix is evaluated.
   const std::string matrix = dir + "/m.npy";
   ASSERT_EQ(::mkfifo((matrix + ".json").c_str(), 0600), 0);
-  const std::string message = MessageOf(
-      {"settings", [](const std::string& p) { ReadMatrixSettings(p); }}, matrix, false);
+  const std::string message =
+      MessageOf({"settings", [](const std::string& p) { ReadMatrixSettings(p); }}, matrix, false);
   EXPECT_NE(message.find(Q(matrix + ".json") + " is a FIFO (named pipe), not a regular file"),
             std::string::npos)
       << message;

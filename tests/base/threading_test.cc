@@ -2,12 +2,12 @@
 // for Ctrl-C. Item counts are asserted, not times.
 #include "OpenABLE/base/threading.h"
 
+#include <gtest/gtest.h>
+
 #include <atomic>
 #include <chrono>
 #include <stdexcept>
 #include <thread>
-
-#include <gtest/gtest.h>
 
 namespace openable {
 namespace {

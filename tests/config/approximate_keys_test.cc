@@ -1,7 +1,7 @@
 // The keys of approximate search agree with the library they are bound onto: the defaults,
 // ranges and engine names that Test_OpenABLE --help, docs/configuration.md and Config.txt show
-// are those of ApproximateOptions and of the engine registry (matching/search/engine_registry.h), and
-// every engine of the registry reads back through the key.
+// are those of ApproximateOptions and of the engine registry (matching/search/engine_registry.h),
+// and every engine of the registry reads back through the key.
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>

@@ -1,10 +1,10 @@
 #include "config/config.h"
 
+#include <gtest/gtest.h>
+
 #include <fstream>
 #include <functional>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "OpenABLE/base/error.h"
 #include "tests/test_support.h"
@@ -130,8 +130,9 @@ TEST(Config, WrongTypeAndOutOfRangeNameKeyValueAndRange) {
 TEST(Config, MalformedLinesDuplicatesAndEmptyFiles) {
   EXPECT_NE(ErrorOf([&] { LoadConfig(WriteFile("Frame_mode 0\n")); }).find("Key: value"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { LoadConfig(WriteFile("Frame_mode: 0\nFrame_mode: 1\n")); })
-                .find("given twice (first at line 1)"),
+  EXPECT_NE(ErrorOf([&] {
+              LoadConfig(WriteFile("Frame_mode: 0\nFrame_mode: 1\n"));
+            }).find("given twice (first at line 1)"),
             std::string::npos);
   EXPECT_NE(ErrorOf([&] { LoadConfig(WriteFile("%YAML:1.0\n# nothing\n")); }).find("no key"),
             std::string::npos);
@@ -204,8 +205,9 @@ TEST(Config, ApproximateEngineValues) {
   EXPECT_EQ(bad.find('\n'), std::string::npos) << bad;
   EXPECT_EQ(c.scale.approximate.engine, "hnsw");  // unchanged
   // Read from a file as well.
-  const Config f = LoadConfig(WriteFile("%YAML:1.0\nApproximate_engine: ivf\n"
-                                        "Approximate_nprobe: 32\nApproximate_ef_search: 128\n"));
+  const Config f =
+      LoadConfig(WriteFile("%YAML:1.0\nApproximate_engine: ivf\n"
+                           "Approximate_nprobe: 32\nApproximate_ef_search: 128\n"));
   EXPECT_EQ(f.scale.approximate.engine, "ivf");
   EXPECT_EQ(f.scale.approximate.nprobe, 32);
   EXPECT_EQ(f.scale.approximate.ef_search, 128);

@@ -2,12 +2,12 @@
 // binds: the range a key shows users is exactly what the owning struct's Check() accepts.
 #include "config/option_table.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/evaluation/ground_truth.h"
@@ -81,13 +81,13 @@ TEST(ConfigTable, OdometryKeysShowTheOdometrysLimits) {
   Config c;
   const OptionTable table = ConfigTable(c);
   EXPECT_EQ(table.Find("Odometry_num_disparities")->RangeText(), "integer in [16, 256]");
-  testing::ExpectInputError([&] { ApplyOverride(c, "Odometry_num_disparities=512"); },
-                            {"--set: Odometry_num_disparities: value \"512\"",
-                             "integer in [16, 256]"});
+  testing::ExpectInputError(
+      [&] { ApplyOverride(c, "Odometry_num_disparities=512"); },
+      {"--set: Odometry_num_disparities: value \"512\"", "integer in [16, 256]"});
   c.odometry.num_disparities = 40;  // in range, not a multiple of 16
-  testing::ExpectInputError([&] { c.odometry.Check(); },
-                            {"Odometry_num_disparities (StereoOdometryOptions.num_disparities)",
-                             "a multiple of 16"});
+  testing::ExpectInputError(
+      [&] { c.odometry.Check(); },
+      {"Odometry_num_disparities (StereoOdometryOptions.num_disparities)", "a multiple of 16"});
 }
 
 // Ground_truth_type's help describes every format of the registry (ground_truth.h).

@@ -1,10 +1,10 @@
 #include "OpenABLE/describe/describe.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
-
-#include <gtest/gtest.h>
 
 #include "OpenABLE/base/error.h"
 

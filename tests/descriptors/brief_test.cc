@@ -1,4 +1,3 @@
-#include "tests/descriptors/descriptor_test_util.h"
 #include "descriptors/brief.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +9,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include "tests/descriptors/descriptor_test_util.h"
 
 namespace openable {
 namespace {
@@ -86,7 +87,7 @@ TEST(BriefTest, UnitPatternIsStandardNormal) {
   // About 5% of |z| above 1.96, 0.3% above 3.
   const auto beyond = [&z](double limit) {
     return static_cast<double>(std::count_if(z.begin(), z.end(),
-                                              [limit](double v) { return std::abs(v) > limit; })) /
+                                             [limit](double v) { return std::abs(v) > limit; })) /
            z.size();
   };
   EXPECT_NEAR(beyond(1.96), 0.05, 0.02);
@@ -111,8 +112,8 @@ TEST(BriefTest, PixelPatternAt64HasSigmaSOver5AndStaysInThePatch) {
   const double mean = sum / coords.size();
   for (const int v : coords) sq += (v - mean) * (v - mean);
   const double sd = std::sqrt(sq / (coords.size() - 1));
-  EXPECT_NEAR(mean, 31.5, 1.5);        // pixel centre of the patch
-  EXPECT_NEAR(sd, 64.0 / 5.0, 1.2);    // sigma = S / 5 (clipping lowers it slightly)
+  EXPECT_NEAR(mean, 31.5, 1.5);                // pixel centre of the patch
+  EXPECT_NEAR(sd, 64.0 / 5.0, 1.2);            // sigma = S / 5 (clipping lowers it slightly)
   EXPECT_LT(on_border, 0.04 * coords.size());  // P(|z| > 2.5) = 1.2% per coordinate
 }
 

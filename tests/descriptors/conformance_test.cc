@@ -17,9 +17,9 @@
 #include <thread>
 #include <vector>
 
-#include "tests/descriptors/descriptor_test_util.h"
 #include "descriptors/descriptor.h"
 #include "descriptors/registry.h"
+#include "tests/descriptors/descriptor_test_util.h"
 #include "tests/test_support.h"
 
 namespace openable {
@@ -124,7 +124,7 @@ TEST_P(DescriptorConformance, DeclaresWidthAndRowType) {
   EXPECT_EQ(d->PatchSize(), 64);
   EXPECT_EQ(d->Width(), it->second.width);
   EXPECT_EQ(d->Kind(), it->second.kind);
-  EXPECT_EQ(d->Distance(), it->second.kind == DescriptorKind::kBinary ? DistanceKind::kHamming
+  EXPECT_EQ(d->Distance(), it->second.kind == DescriptorKind::kBinary  ? DistanceKind::kHamming
                            : it->second.kind == DescriptorKind::kFloat ? DistanceKind::kL2
                                                                        : DistanceKind::kL1);
   EXPECT_EQ(RowType(*d), it->second.kind == DescriptorKind::kFloat ? CV_32F : CV_8U);

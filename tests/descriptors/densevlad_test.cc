@@ -4,16 +4,16 @@
 // the same way from the same frames.
 #include "descriptors/densevlad.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <string>
-#include <vector>
-
-#include <gtest/gtest.h>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 #include "OpenABLE/base/error.h"
 #include "descriptors/frame_describer.h"
@@ -169,8 +169,7 @@ TEST(DenseVlad, RefusesToLearnFromTooFewDescriptors) {
     d->Learn(tiny);
     FAIL() << "learnt 64 words from 29 descriptors";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("expected at least 256"), std::string::npos)
-        << e.what();
+    EXPECT_NE(std::string(e.what()).find("expected at least 256"), std::string::npos) << e.what();
   }
 }
 

@@ -1,4 +1,3 @@
-#include "tests/descriptors/descriptor_test_util.h"
 #include "descriptors/freak.h"
 
 #include <gtest/gtest.h>
@@ -11,6 +10,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "tests/descriptors/descriptor_test_util.h"
 
 namespace openable {
 namespace {
@@ -171,7 +172,7 @@ TEST(FreakTest, BrightLeftDarkRightGivesTheBitsTheGeometryPredicts) {
   EXPECT_GT(count.ones, 10);
   // Field 3 (left, 180 degrees) against field 0 (right) on the outer ring, by hand.
   const std::vector<std::uint8_t> all = d.AllPairBits(patch);
-  EXPECT_EQ(all[0 * 42 + (3 - 1)], 0);  // pair (0, 3): mean(right) > mean(left) is false
+  EXPECT_EQ(all[0 * 42 + (3 - 1)], 0);   // pair (0, 3): mean(right) > mean(left) is false
   EXPECT_EQ(all[0 * 42 + (42 - 1)], 0);  // pair (0, 42): right against the centre (straddles)
 }
 

@@ -1,4 +1,3 @@
-#include "tests/descriptors/descriptor_test_util.h"
 #include "descriptors/hog.h"
 
 #include <gtest/gtest.h>
@@ -8,6 +7,7 @@
 #include <string>
 
 #include "OpenABLE/base/error.h"
+#include "tests/descriptors/descriptor_test_util.h"
 
 namespace openable {
 namespace {

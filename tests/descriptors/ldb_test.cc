@@ -1,4 +1,3 @@
-#include "tests/descriptors/descriptor_test_util.h"
 #include "descriptors/ldb.h"
 
 #include <gtest/gtest.h>
@@ -16,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/descriptors/descriptor_test_util.h"
 #include "tests/test_support.h"
 
 namespace openable {

@@ -5,14 +5,14 @@
 // prepared by the descriptor (RGB, scaled to [0, 1], ImageNet's mean and deviation).
 #include "descriptors/onnx.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/io/npy.h"
@@ -167,8 +167,9 @@ TEST(OnnxDescriptor, BadModelsAndSettingsAreOneLine) {
   o.model_input_size = "8x8";
   EXPECT_EQ(ErrorOf(o), "");
   // An output that is a map per image, not a vector.
-  expect(ErrorOf(Model("feature_map")), "its output is 1 x 4 x 32 x 64 for 1 image, not one "
-                                        "vector per image");
+  expect(ErrorOf(Model("feature_map")),
+         "its output is 1 x 4 x 32 x 64 for 1 image, not one "
+         "vector per image");
   // Channels the network does not take.
   o = Model("gem");
   o.model_channels = "grey";

@@ -1,4 +1,3 @@
-#include "tests/descriptors/descriptor_test_util.h"
 #include "descriptors/opencv_descriptors.h"
 
 #include <gtest/gtest.h>
@@ -12,6 +11,8 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
+
+#include "tests/descriptors/descriptor_test_util.h"
 
 namespace openable {
 namespace {

@@ -49,9 +49,9 @@ TEST(Registry, ListsUnavailableDescriptorsWithReasons) {
 
 TEST(Registry, LookupIsCaseInsensitive) {
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {"ldb", "LDB"},     {"d-Ldb", "D-LDB"}, {"Orb", "ORB"},   {"bRiSk", "BRISK"},
-      {"brief", "BRIEF"}, {"Freak", "FREAK"}, {"sift", "SIFT"}, {"Hog", "HOG"},
-      {"Sad", "SAD"}};
+      {"ldb", "LDB"},     {"d-Ldb", "D-LDB"}, {"Orb", "ORB"},
+      {"bRiSk", "BRISK"}, {"brief", "BRIEF"}, {"Freak", "FREAK"},
+      {"sift", "SIFT"},   {"Hog", "HOG"},     {"Sad", "SAD"}};
   for (const auto& [given, name] : cases) {
     const auto d = CreateDescriptor(given, Options(64));
     ASSERT_NE(d, nullptr) << given;

@@ -1,16 +1,16 @@
 // SAD (descriptors/sad.h): the thumbnail, the patch normalisation and the bytes, against a
 // direct computation written out here; the settings and their errors.
+#include "descriptors/sad.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdint>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "OpenABLE/base/error.h"
 #include "descriptors/registry.h"
-#include "descriptors/sad.h"
 #include "tests/descriptors/descriptor_test_util.h"
 #include "tests/test_support.h"
 
@@ -25,8 +25,9 @@ cv::Mat PairedRows(int size, std::uint64_t seed) {
   cv::RNG rng(seed);
   cv::Mat p(size, size, CV_8U);
   for (int y = 0; y < size; y += 2)
-    for (int x = 0; x < size; ++x) p.at<std::uint8_t>(y, x) = p.at<std::uint8_t>(y + 1, x) =
-                                        static_cast<std::uint8_t>(rng.uniform(0, 256));
+    for (int x = 0; x < size; ++x)
+      p.at<std::uint8_t>(y, x) = p.at<std::uint8_t>(y + 1, x) =
+          static_cast<std::uint8_t>(rng.uniform(0, 256));
   return p;
 }
 

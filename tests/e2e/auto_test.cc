@@ -141,8 +141,7 @@ TEST(Auto, UnrelatedTraversalsAreUnreliableAndAcceptNothing) {
       RunProgram(testing::TestOpenableExe(),
                  {AutoPreset(), "--quiet", "--set", "Images_path=a", "--set", "Images_path_2=b",
                   "--set", "Npy_name=out/m.npy", "--set", "Png_name=", "--set",
-                  "Report_name=out/report.html", "--set", "Matches_name=out/matches.csv",
-                  "--json"},
+                  "Report_name=out/report.html", "--set", "Matches_name=out/matches.csv", "--json"},
                  dir);
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_NE(o.out.find("\"reliable\": false"), std::string::npos) << o.out;

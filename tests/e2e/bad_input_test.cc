@@ -3,26 +3,25 @@
 // write exactly one line on stderr naming the file or key, leave no output behind, not crash
 // (a signal) and not hang (every run goes through `timeout`). docs/robustness.md lists the
 // cases and the decided behaviours (1x1 and huge images, odd names, symbolic links).
-#include <atomic>
-#include <thread>
-#include <filesystem>
-#include <functional>
-#include <fstream>
-#include <iomanip>
-#include <random>
-#include <sstream>
-#include <string>
-#include <vector>
-
+#include <gtest/gtest.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
-#include <gtest/gtest.h>
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iomanip>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include "OpenABLE/io/frame_source.h"
 #include "config/config.h"
@@ -95,8 +94,8 @@ std::string SoundFolder(const std::string& dir, const std::string& name = "imgs"
 
 struct BadImage {
   const char* name;
-  const char* file;                            // the bad file's name in the folder
-  std::string (*bytes)();                      // its content
+  const char* file;        // the bad file's name in the folder
+  std::string (*bytes)();  // its content
 };
 
 void PrintTo(const BadImage& c, std::ostream* os) { *os << c.name; }
@@ -163,9 +162,10 @@ TEST_P(BadImageFiles, OneLineNamingTheFileExit1) {
   ExpectRefused(o, dir, c.file);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Corpus, BadImageFiles, ::testing::ValuesIn(kBadImages),
-    [](const ::testing::TestParamInfo<BadImage>& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(Corpus, BadImageFiles, ::testing::ValuesIn(kBadImages),
+                         [](const ::testing::TestParamInfo<BadImage>& info) {
+                           return std::string(info.param.name);
+                         });
 
 // Skip_unreadable 1 skips the same files with a warning and runs on the sound ones.
 TEST(BadInputCorpus, SkipUnreadableRunsOnTheSoundImages) {
@@ -276,7 +276,7 @@ TEST(BadInputCorpus, ThousandsOfOddNames) {
   const std::string folder = dir + "/odd";
   fs::create_directories(folder);
   const std::string png = Encoded(".png", 16, 12, 5);
-  const char* const kStyles[] = {"frame %04d.png", "-%04d.png", "caf\xc3\xa9 %04d.png",
+  const char* const kStyles[] = {"frame %04d.png",    "-%04d.png",          "caf\xc3\xa9 %04d.png",
                                  "it's \"%04d\".png", "new\nline %04d.png", "--set=%04d.png"};
   char name[64];
   for (int i = 0; i < 2000; ++i) {
@@ -326,8 +326,7 @@ TEST(BadInputCorpus, SpecialFilesUnderImageNamesAreNamed) {
     std::function<void(const std::string&)> make;
     const char* what;
   } cases[] = {
-      {"a15.png", [](const std::string& p) { ASSERT_EQ(::mkfifo(p.c_str(), 0644), 0); },
-       "FIFO"},
+      {"a15.png", [](const std::string& p) { ASSERT_EQ(::mkfifo(p.c_str(), 0644), 0); }, "FIFO"},
       {"a16.png", [](const std::string& p) { fs::create_symlink("/dev/zero", p); },
        "character device"},
       {"a17.png",
@@ -441,8 +440,7 @@ TEST(BadInputCorpus, EveryNumericKeyWrongInTurn) {
     const Case& c = cases[i];
     SCOPED_TRACE(c.key + ": " + c.value);
     ExpectRefused(c.outcome, dir + "/run" + std::to_string(i),
-                  c.key + ": value \"" + c.value + "\" is not valid; expected " +
-                      c.values);
+                  c.key + ": value \"" + c.value + "\" is not valid; expected " + c.values);
   }
   for (const Case& c : cases)
     EXPECT_NE(c.outcome.err.find("Config.txt:"), std::string::npos) << c.outcome.err;
@@ -454,8 +452,9 @@ TEST(BadInputCorpus, TextKeysWithAnUnknownChoice) {
   const std::string dir = testing::TempDir();
   const std::string folder = SoundFolder(dir);
   for (const char* key : {"Image_descriptor", "Ground_truth_type", "Ground_truth_axes"}) {
-    const Outcome o = RunBounded(dir, {WriteConfig(dir, folder, std::string(key) + ": bogus\n" +
-                                                             "Ground_truth: \"gt.txt\"\n")});
+    const Outcome o = RunBounded(
+        dir,
+        {WriteConfig(dir, folder, std::string(key) + ": bogus\n" + "Ground_truth: \"gt.txt\"\n")});
     SCOPED_TRACE(key);
     ExpectRefused(o, dir, key);
   }
@@ -522,9 +521,10 @@ TEST(BadInputCorpus, SingularCalibrations) {
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
     testing::WriteBytes(dir + "/calibration.yaml", c.yaml);
-    const std::string config = WriteConfig(
-        dir, "", "Camera_type: 1\nImages_path_left: \"left\"\nImages_path_right: \"right\"\n"
-                 "Calibration_path: \"calibration.yaml\"\n");
+    const std::string config =
+        WriteConfig(dir, "",
+                    "Camera_type: 1\nImages_path_left: \"left\"\nImages_path_right: \"right\"\n"
+                    "Calibration_path: \"calibration.yaml\"\n");
     const Outcome o = RunBounded(dir, {config, "--set", "Images_path="});
     if (c.expect.empty()) {
       EXPECT_EQ(o.status, 0) << o.err;  // the template itself is sound
@@ -567,14 +567,14 @@ TEST(BadInputCorpus, StereoFoldersOfDifferentLengths) {
   SoundFolder(dir, "left");
   SoundFolder(dir, "right");
   fs::remove(dir + "/right/a2.png");
-  testing::WriteBytes(dir + "/calibration.yaml",
-                      Calibration("40, 0, 16, 0, 40, 12, 0, 0, 1", "1, 0, 0, 0, 1, 0, 0, 0, 1",
-                                  "-0.1, 0, 0"));
-  const Outcome o = RunBounded(
-      dir, {WriteConfig(dir, "",
-                        "Camera_type: 1\nImages_path_left: \"left\"\nImages_path_right: "
-                        "\"right\"\nCalibration_path: \"calibration.yaml\"\n"),
-            "--set", "Images_path="});
+  testing::WriteBytes(
+      dir + "/calibration.yaml",
+      Calibration("40, 0, 16, 0, 40, 12, 0, 0, 1", "1, 0, 0, 0, 1, 0, 0, 0, 1", "-0.1, 0, 0"));
+  const Outcome o =
+      RunBounded(dir, {WriteConfig(dir, "",
+                                   "Camera_type: 1\nImages_path_left: \"left\"\nImages_path_right: "
+                                   "\"right\"\nCalibration_path: \"calibration.yaml\"\n"),
+                       "--set", "Images_path="});
   ExpectRefused(o, dir, "Images_path_right");
 }
 

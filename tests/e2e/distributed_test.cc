@@ -33,9 +33,8 @@ namespace fs = std::filesystem;
 std::string MissingMpi() {
   if (std::system("command -v mpirun > /dev/null 2>&1") != 0)
     return "mpirun is not installed (Debian: openmpi-bin)";
-  const fs::path module =
-      fs::path(testing::TestOpenableExe()).parent_path().parent_path() / "modules" /
-      "libopenable_mpi.so";
+  const fs::path module = fs::path(testing::TestOpenableExe()).parent_path().parent_path() /
+                          "modules" / "libopenable_mpi.so";
   if (!fs::exists(module))
     return "this build has no MPI module (" + module.string() +
            "; configure with libopenmpi-dev installed)";
@@ -43,14 +42,19 @@ std::string MissingMpi() {
 }
 
 // `program` run by mpirun with `processes` processes (0: run directly, one process).
-Outcome RunSpread(int processes, const std::string& program,
-                  const std::vector<std::string>& args, const std::string& dir) {
+Outcome RunSpread(int processes, const std::string& program, const std::vector<std::string>& args,
+                  const std::string& dir) {
   if (processes == 0) return RunProgram(program, args, dir);
   // Root may run mpirun in containers and CI; --quiet keeps mpirun's own summary of a failed
   // run out of the output, so that what is left is the program's.
-  std::vector<std::string> all = {"OMPI_ALLOW_RUN_AS_ROOT=1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1",
-                                  "OMPI_MCA_rmaps_base_oversubscribe=1", "mpirun", "--quiet",
-                                  "-np", std::to_string(processes), program};
+  std::vector<std::string> all = {"OMPI_ALLOW_RUN_AS_ROOT=1",
+                                  "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1",
+                                  "OMPI_MCA_rmaps_base_oversubscribe=1",
+                                  "mpirun",
+                                  "--quiet",
+                                  "-np",
+                                  std::to_string(processes),
+                                  program};
   all.insert(all.end(), args.begin(), args.end());
   return RunProgram("/usr/bin/env", all, dir);
 }
@@ -71,10 +75,8 @@ std::string ConfigOf(const std::string& dir, const Case& c, const std::string& i
   const std::string path = dir + "/Config.txt";
   std::ofstream f(path);
   f << "%YAML:1.0\n"
-    << "Images_path: \"" << (images.empty() ? testing::SampleDir() + "/summer" : images)
-    << "\"\n"
-    << "Images_path_2: \"" << (c.two_traversals ? testing::SampleDir() + "/winter" : "")
-    << "\"\n"
+    << "Images_path: \"" << (images.empty() ? testing::SampleDir() + "/summer" : images) << "\"\n"
+    << "Images_path_2: \"" << (c.two_traversals ? testing::SampleDir() + "/winter" : "") << "\"\n"
     << "Image_descriptor: " << c.descriptor << "\n"
     << "Image_sequences: " << c.sequence_length << "\n"
     << "Matrix_mode: " << (c.bounded ? 2 : 1) << "\n"
@@ -151,8 +153,8 @@ TEST_P(Spread, OneTwoAndThreeProcessesWriteTheSingleProcessOutputs) {
   const Case& c = GetParam();
   const bool hamming = std::string(c.descriptor) == "LDB";
   const std::string single = testing::TempDir();
-  const Outcome one = RunProgram(testing::TestOpenableExe(), {ConfigOf(single, c), "--quiet"},
-                                 single);
+  const Outcome one =
+      RunProgram(testing::TestOpenableExe(), {ConfigOf(single, c), "--quiet"}, single);
   ASSERT_EQ(one.status, 0) << one.err;
   for (const int processes : {1, 2, 3}) {
     SCOPED_TRACE(std::to_string(processes) + " processes");
@@ -161,8 +163,7 @@ TEST_P(Spread, OneTwoAndThreeProcessesWriteTheSingleProcessOutputs) {
         RunSpread(processes, testing::TestOpenableExe(), {ConfigOf(dir, c), "--quiet"}, dir);
     ASSERT_EQ(o.status, 0) << o.err << o.out;
     if (processes > 1) {
-      EXPECT_NE(o.out.find("processes: " + std::to_string(processes)), std::string::npos)
-          << o.out;
+      EXPECT_NE(o.out.find("processes: " + std::to_string(processes)), std::string::npos) << o.out;
     }
     ExpectSameMatches(single + "/out/matches.csv", dir + "/out/matches.csv", hamming);
     if (c.bounded) {
@@ -187,25 +188,26 @@ TEST_P(Spread, OneTwoAndThreeProcessesWriteTheSingleProcessOutputs) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Mpi, Spread,
-    ::testing::Values(Case{"LdbDenseOneL1", "LDB", false, false, 1},
-                      Case{"LdbDenseOneL10", "LDB", false, false, 10},
-                      Case{"LdbDenseTwoL1", "LDB", false, true, 1},
-                      Case{"LdbDenseTwoL10", "LDB", false, true, 10},
-                      Case{"LdbBoundedOneL1", "LDB", true, false, 1},
-                      Case{"LdbBoundedOneL10", "LDB", true, false, 10},
-                      Case{"LdbBoundedTwoL1", "LDB", true, true, 1},
-                      Case{"LdbBoundedTwoL10", "LDB", true, true, 10},
-                      Case{"HogDenseOneL1", "HOG", false, false, 1},
-                      Case{"HogDenseOneL10", "HOG", false, false, 10},
-                      Case{"HogDenseTwoL1", "HOG", false, true, 1},
-                      Case{"HogDenseTwoL10", "HOG", false, true, 10},
-                      Case{"HogBoundedOneL1", "HOG", true, false, 1},
-                      Case{"HogBoundedOneL10", "HOG", true, false, 10},
-                      Case{"HogBoundedTwoL1", "HOG", true, true, 1},
-                      Case{"HogBoundedTwoL10", "HOG", true, true, 10}),
-    [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(Mpi, Spread,
+                         ::testing::Values(Case{"LdbDenseOneL1", "LDB", false, false, 1},
+                                           Case{"LdbDenseOneL10", "LDB", false, false, 10},
+                                           Case{"LdbDenseTwoL1", "LDB", false, true, 1},
+                                           Case{"LdbDenseTwoL10", "LDB", false, true, 10},
+                                           Case{"LdbBoundedOneL1", "LDB", true, false, 1},
+                                           Case{"LdbBoundedOneL10", "LDB", true, false, 10},
+                                           Case{"LdbBoundedTwoL1", "LDB", true, true, 1},
+                                           Case{"LdbBoundedTwoL10", "LDB", true, true, 10},
+                                           Case{"HogDenseOneL1", "HOG", false, false, 1},
+                                           Case{"HogDenseOneL10", "HOG", false, false, 10},
+                                           Case{"HogDenseTwoL1", "HOG", false, true, 1},
+                                           Case{"HogDenseTwoL10", "HOG", false, true, 10},
+                                           Case{"HogBoundedOneL1", "HOG", true, false, 1},
+                                           Case{"HogBoundedOneL10", "HOG", true, false, 10},
+                                           Case{"HogBoundedTwoL1", "HOG", true, true, 1},
+                                           Case{"HogBoundedTwoL10", "HOG", true, true, 10}),
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                           return std::string(info.param.name);
+                         });
 
 // Descriptors users bring, spread over processes: a network (the GeM test network), DenseVLAD
 // (each process learns the same vocabulary from the same frames) and rows computed elsewhere
@@ -224,7 +226,8 @@ TEST(SpreadBrought, ANetworkDenseVladAndGivenRowsGiveTheOneProcessOutputs) {
     std::vector<std::string> keys;
   };
   const std::vector<Brought> cases = {
-      {"network", "ONNX",
+      {"network",
+       "ONNX",
        {"Model_path: \"" + testing::SourceDir() + "/tests/data/onnx/gem.onnx\"",
         "Model_input_size: \"64x32\""}},
       {"DenseVLAD", "DenseVLAD", {}},

@@ -49,7 +49,7 @@ struct BadArgs {
 
 // Runs `exe` with `args` in `dir`; captures its exit status, stdout and stderr.
 inline Outcome RunProgram(const std::string& exe, const std::vector<std::string>& args,
-                   const std::string& dir) {
+                          const std::string& dir) {
   std::string cmd = "cd " + ShellQuote(dir) + " && " + ShellQuote(exe);
   for (const auto& a : args) cmd += " " + ShellQuote(a);
   cmd += " >stdout.log 2>stderr.log";
@@ -166,8 +166,8 @@ inline double AlignedRecallAt1(const cv::Mat1f& d, int q0, int r0, int n, int to
 // (1 without such a rival, or when it is 0) of at most `threshold`, and, when `confirmed` is
 // given, confirmed (Match_consistency: AgreeingByBruteForce). Cells without a value (NaN, +inf)
 // are neither best matches nor rivals.
-inline int AcceptedByRatio(const cv::Mat1f& m, int first_query, int n, int window,
-                           float threshold, const std::vector<bool>* confirmed = nullptr) {
+inline int AcceptedByRatio(const cv::Mat1f& m, int first_query, int n, int window, float threshold,
+                           const std::vector<bool>* confirmed = nullptr) {
   int accepted = 0;
   for (int q = first_query; q < first_query + n; ++q) {
     if (confirmed != nullptr && !(*confirmed)[q - first_query]) continue;
@@ -220,7 +220,6 @@ inline std::vector<bool> AgreeingByBruteForce(const cv::Mat1f& m, int first_quer
 inline bool OneLine(const std::string& s) {
   return !s.empty() && s.back() == '\n' && s.find('\n') == s.size() - 1;
 }
-
 
 // The number after "key": in a JSON text (the first occurrence), NaN when absent.
 inline double JsonNumber(const std::string& json, const std::string& key, std::size_t from = 0) {

@@ -1,14 +1,14 @@
 // End-to-end evaluation: Test_OpenABLE with ground truth, openable_evaluate on saved
 // matrices, every input error of the issue, and the figures on real datasets checked against
 // the independent numpy implementation in tests/tools/evaluate_reference.py.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <opencv2/imgcodecs.hpp>
 #include <regex>
 #include <sstream>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/io/json.h"
 #include "OpenABLE/io/npy.h"
@@ -40,8 +40,8 @@ TEST(Evaluation, SampleRunAgainstAlignedTruthWritesEveryFile) {
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_NE(o.out.find("AUC"), std::string::npos) << o.out;
   EXPECT_NE(o.out.find("ABLE AP"), std::string::npos) << o.out;
-  for (const char* f : {"eval.json", "eval_per_query.csv", "eval_ablep.csv", "eval_pr.png",
-                        "eval_overlay.png"})
+  for (const char* f :
+       {"eval.json", "eval_per_query.csv", "eval_ablep.csv", "eval_pr.png", "eval_overlay.png"})
     EXPECT_TRUE(fs::exists(dir + "/out/" + f)) << f;
 
   // R@1 computed here from the matrix, by brute force, against the JSON.
@@ -84,11 +84,11 @@ TEST(Evaluation, OpenableEvaluateComparesRunsInOneFigureAndAgreesWithTheRun) {
                        dir)
                 .status,
             0);
-  const Outcome o = RunProgram(testing::OpenableEvaluateExe(),
-                               {"--matrix", "out/matrix.npy", "--label", "LDB", "--matrix",
-                                "out/hog.npy", "--label", "HOG", "--reference-frames", "300",
-                                "--gt-type", "aligned", "--output", "out/cmp"},
-                               dir);
+  const Outcome o = RunProgram(
+      testing::OpenableEvaluateExe(),
+      {"--matrix", "out/matrix.npy", "--label", "LDB", "--matrix", "out/hog.npy", "--label", "HOG",
+       "--reference-frames", "300", "--gt-type", "aligned", "--output", "out/cmp"},
+      dir);
   ASSERT_EQ(o.status, 0) << o.err;
   for (const char* f : {"cmp.json", "cmp_pr.png", "cmp_LDB_per_query.csv", "cmp_HOG_per_query.csv",
                         "cmp_LDB_overlay.png", "cmp_HOG_ablep.csv"})
@@ -104,16 +104,17 @@ TEST(Evaluation, OpenableEvaluateComparesRunsInOneFigureAndAgreesWithTheRun) {
 // evaluation's files, and the JSON records the protocols.
 TEST(Evaluation, RunWithEveryProtocolWritesTheirCurves) {
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram(
-      testing::TestOpenableExe(),
-      {SampleConfig(dir, "Ground_truth_type: aligned\nEvaluation_protocol: all\n"
-                         "Evaluation_name: out/eval\n"),
-       "--quiet"},
-      dir);
+  const Outcome o =
+      RunProgram(testing::TestOpenableExe(),
+                 {SampleConfig(dir,
+                               "Ground_truth_type: aligned\nEvaluation_protocol: all\n"
+                               "Evaluation_name: out/eval\n"),
+                  "--quiet"},
+                 dir);
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_NE(o.out.find("vpr_tutorial    "), std::string::npos) << o.out;
-  for (const char* f : {"eval.json", "eval_vpr_bench.csv", "eval_vpr_tutorial.csv",
-                        "eval_per_query.csv"})
+  for (const char* f :
+       {"eval.json", "eval_vpr_bench.csv", "eval_vpr_tutorial.csv", "eval_per_query.csv"})
     EXPECT_TRUE(fs::exists(dir + "/out/" + f)) << f;
   const std::string json = ReadAll(dir + "/out/eval.json");
   EXPECT_NE(json.find("\"protocols\": \"openable,vpr_bench,vpr_tutorial\""), std::string::npos);
@@ -128,13 +129,13 @@ TEST(Evaluation, RunWithEveryProtocolWritesTheirCurves) {
 TEST(Evaluation, OpenableEvaluateScoresAMatrixAsVprBenchAndVprTutorialDo) {
   const std::string dir = testing::TempDir();
   const std::string data = testing::SourceDir() + "/tests/data/reference_protocols/";
-  const Outcome o = RunProgram(
-      testing::OpenableEvaluateExe(),
-      {"--matrix", data + "gardens_point_hog.npy", "--label", "HOG", "--layout",
-       "query_reference", "--gt-type", "vpr_bench", "--ground-truth",
-       data + "vpr_bench_gardens_point_ground_truth_new.npy", "--tolerance", "0", "--protocol",
-       "all", "--output", "out/e"},
-      dir);
+  const Outcome o =
+      RunProgram(testing::OpenableEvaluateExe(),
+                 {"--matrix", data + "gardens_point_hog.npy", "--label", "HOG", "--layout",
+                  "query_reference", "--gt-type", "vpr_bench", "--ground-truth",
+                  data + "vpr_bench_gardens_point_ground_truth_new.npy", "--tolerance", "0",
+                  "--protocol", "all", "--output", "out/e"},
+                 dir);
   ASSERT_EQ(o.status, 0) << o.err;
   for (const char* row : {"HOG                openable", "HOG                vpr_bench",
                           "HOG                vpr_tutorial"})
@@ -172,8 +173,11 @@ TEST(Evaluation, OpenableEvaluateWarnsWhenTheMatrixLooksLikeASimilarity) {
   const cv::Mat1f similarity = 1.0f - m;
   testing::WriteBytes(dir + "/similarity.npy", EncodeNpy(similarity));
   const std::vector<std::string> truth = {
-      "--layout", "query_reference", "--gt-type", "vpr_bench", "--ground-truth",
-      data + "vpr_bench_gardens_point_ground_truth_new.npy", "--tolerance", "0", "--json"};
+      "--layout",       "query_reference",
+      "--gt-type",      "vpr_bench",
+      "--ground-truth", data + "vpr_bench_gardens_point_ground_truth_new.npy",
+      "--tolerance",    "0",
+      "--json"};
   std::vector<std::string> args = {"--matrix", data + "gardens_point_hog.npy"};
   args.insert(args.end(), truth.begin(), truth.end());
   const Outcome plain = RunProgram(testing::OpenableEvaluateExe(), args, dir);
@@ -216,8 +220,7 @@ TEST(Evaluation, RunSaysWhenNoQueryHasATruePlace) {
   const std::string line =
       "no query has a true place among its candidates (240 queries; 2 pairs of the ground truth "
       "over the evaluated block, 2 of them closer than the exclusion (60 frames))";
-  EXPECT_NE(o.err.find("Test_OpenABLE: warning: evaluation: " + line), std::string::npos)
-      << o.err;
+  EXPECT_NE(o.err.find("Test_OpenABLE: warning: evaluation: " + line), std::string::npos) << o.err;
   EXPECT_TRUE(OneLine(o.err)) << o.err;
   EXPECT_NE(o.out.find("  warning: " + line), std::string::npos) << o.out;
 }
@@ -228,9 +231,10 @@ TEST(Evaluation, RunSaysWhenNoQueryHasATruePlace) {
 // and the figures are then those of a run made with that setting.
 TEST(Evaluation, SavedMatrixIsEvaluatedWithItsRunsSettingsUnlessOverridden) {
   const std::string dir = testing::TempDir();
-  const std::string config = SampleConfig(
-      dir, "Ground_truth_type: aligned\nEvaluation_name: out/run\nMatch_score: ratio\n"
-           "Match_threshold: 0.9\nMatch_consistency: 1\nTolerance: 3\n");
+  const std::string config =
+      SampleConfig(dir,
+                   "Ground_truth_type: aligned\nEvaluation_name: out/run\nMatch_score: ratio\n"
+                   "Match_threshold: 0.9\nMatch_consistency: 1\nTolerance: 3\n");
   ASSERT_EQ(RunProgram(testing::TestOpenableExe(), {config, "--quiet"}, dir).status, 0);
   ASSERT_TRUE(fs::exists(dir + "/out/matrix.npy.json"));
   const Outcome o = RunProgram(testing::OpenableEvaluateExe(),
@@ -256,8 +260,8 @@ TEST(Evaluation, SavedMatrixIsEvaluatedWithItsRunsSettingsUnlessOverridden) {
             0);
   const Outcome d = RunProgram(
       testing::OpenableEvaluateExe(),
-      {"--matrix", "out/matrix.npy", "--set", "Match_score=distance", "--set",
-       "Match_threshold=-1", "--set", "Match_consistency=0", "--output", "out/overridden"},
+      {"--matrix", "out/matrix.npy", "--set", "Match_score=distance", "--set", "Match_threshold=-1",
+       "--set", "Match_consistency=0", "--output", "out/overridden"},
       dir);
   ASSERT_EQ(d.status, 0) << d.err;
   EXPECT_NE(d.err.find("openable_evaluate: note: Match_score \"distance\" as given here, not "
@@ -348,20 +352,23 @@ TEST(Evaluation, SavedMatrixSettingsThatDoNotFitTheirMatrixAreRefused) {
   };
   // Beside another run's matrix.
   fs::copy_file(dir + "/out/small.npy.json", settings, fs::copy_options::overwrite_existing);
-  refused("matrix \"out/matrix.npy\": 600x600, but its settings file \"out/matrix.npy.json\" "
-          "was written with a 80x80 matrix (traversals of 80 frames)");
+  refused(
+      "matrix \"out/matrix.npy\": 600x600, but its settings file \"out/matrix.npy.json\" "
+      "was written with a 80x80 matrix (traversals of 80 frames)");
   // Edited: the first traversal made shorter, the reference frames with it (500 frames in all).
   edited([](openable::Json& j) {
     j["traversals"][0]["frames"] = 200;
     j["reference_frames"] = 200;
     j["python_evaluate"]["reference_frames"] = 200;
   });
-  refused("a 600x600 matrix of 500 frames in all; expected a square matrix of as many rows as "
-          "frames");
+  refused(
+      "a 600x600 matrix of 500 frames in all; expected a square matrix of as many rows as "
+      "frames");
   // Edited: the reference frames alone.
   edited([](openable::Json& j) { j["reference_frames"] = 200; });
-  refused("\"reference_frames\" 200 with 2 traversals; expected 300 (the first traversal's "
-          "frames)");
+  refused(
+      "\"reference_frames\" 200 with 2 traversals; expected 300 (the first traversal's "
+      "frames)");
   // Edited: the reference frames of Python's keywords alone.
   edited([](openable::Json& j) { j["python_evaluate"]["reference_frames"] = 100; });
   refused("\"python_evaluate\" has reference_frames 100, the file 300; expected one value");
@@ -371,12 +378,14 @@ TEST(Evaluation, SavedMatrixSettingsThatDoNotFitTheirMatrixAreRefused) {
     j["traversals"][0]["frames"] = j["traversals"][1]["frames"] = 200;
     j["reference_frames"] = j["python_evaluate"]["reference_frames"] = 200;
   });
-  refused("matrix \"out/matrix.npy\": 600x600, but its settings file \"out/matrix.npy.json\" "
-          "was written with a 400x400 matrix (traversals of 200 and 200 frames)");
+  refused(
+      "matrix \"out/matrix.npy\": 600x600, but its settings file \"out/matrix.npy.json\" "
+      "was written with a 400x400 matrix (traversals of 200 and 200 frames)");
   // Edited: a frame range that cannot hold the traversals' frames.
   edited([](openable::Json& j) { j["evaluation_keys"]["Final_image"] = "100"; });
-  refused("a traversal of 300 frames within Initial_image 0 and Final_image 100; expected at "
-          "most 100");
+  refused(
+      "a traversal of 300 frames within Initial_image 0 and Final_image 100; expected at "
+      "most 100");
   // Restored: evaluated.
   std::ofstream(settings) << original;
   const Outcome o = RunProgram(testing::OpenableEvaluateExe(), {"--matrix", "out/matrix.npy"}, dir);
@@ -405,10 +414,13 @@ TEST_P(BadTruthInputs, OneLineNonZeroExitNoOutput) {
     std::ofstream(dir + "/xy.csv") << "0,0\n1,0\n2,0\n";
     std::ofstream(dir + "/near.csv") << "3,1\n";
     // A pickle (protocol 2) that would call posix.system("touch pwned") if unpickled.
-    const std::string pickle("\x80\x02" "cposix\nsystem\n" "X\x0b\x00\x00\x00touch pwned"
-                             "\x85R.", 35);
-    std::ofstream(dir + "/evil.npy", std::ios::binary)
-        << NpyHeaderOf("'|O'", "(10, 2)") << pickle;
+    const std::string pickle(
+        "\x80\x02"
+        "cposix\nsystem\n"
+        "X\x0b\x00\x00\x00touch pwned"
+        "\x85R.",
+        35);
+    std::ofstream(dir + "/evil.npy", std::ios::binary) << NpyHeaderOf("'|O'", "(10, 2)") << pickle;
     std::ofstream(dir + "/numeric.npy", std::ios::binary) << EncodeNpy(cv::Mat1f(3, 4, 1.f));
   }
   std::vector<std::string> args = {"--matrix", "m.txt", "--output", "out/e"};
@@ -450,14 +462,14 @@ INSTANTIATE_TEST_SUITE_P(
         BadTruth{"UnknownProtocol",
                  {"--gt-type", "aligned", "--reference-frames", "10", "--protocol", "recall"},
                  "Evaluation_protocol: \"recall\" is not valid"},
-        BadTruth{"PickleThatRunsCode",
-                 {"--gt-type", "vpr_bench", "--reference-frames", "10", "--ground-truth",
-                  "evil.npy"},
-                 "posix.system"},
-        BadTruth{"NumericMatrixAsVprBenchFile",
-                 {"--gt-type", "vpr_bench", "--reference-frames", "10", "--ground-truth",
-                  "numeric.npy"},
-                 "numeric.npy"},
+        BadTruth{
+            "PickleThatRunsCode",
+            {"--gt-type", "vpr_bench", "--reference-frames", "10", "--ground-truth", "evil.npy"},
+            "posix.system"},
+        BadTruth{
+            "NumericMatrixAsVprBenchFile",
+            {"--gt-type", "vpr_bench", "--reference-frames", "10", "--ground-truth", "numeric.npy"},
+            "numeric.npy"},
         BadTruth{"SoftGroundTruthOfAnotherType",
                  {"--gt-type", "aligned", "--reference-frames", "10", "--ground-truth-soft",
                   "numeric.npy"},

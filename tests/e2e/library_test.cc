@@ -1,14 +1,14 @@
 // The library's batch path (OpenABLE/online/online.h, OpenABLE/evaluation/) gives what
 // Test_OpenABLE gives from a configuration, on real KITTI 00 frames 0-1699: the same normalised
 // sequence matrix and the same evaluation figures. docs/library.md quotes this code.
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/OpenABLE.h"
 #include "tests/e2e/e2e_support.h"

@@ -1,14 +1,14 @@
 // Test_OpenABLE runs with the match score, Sequence_partial, SAD, contrast enhancement and
 // descriptor fusion: their files against the tested library pieces, and their evaluation
 // against the independent numpy reference (tests/tools/evaluate_reference.py) on real data.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "matching/contrast.h"
 #include "matching/normalize.h"
@@ -24,11 +24,16 @@ using namespace e2e;  // NOLINT: the e2e helpers are this file's vocabulary
 // The bundled sample: 300 summer frames (reference) then 300 winter frames (queries).
 std::vector<std::string> Sample(const std::string& descriptor, int length) {
   return {"--quiet",
-          "--set", "Images_path=" + testing::SampleDir() + "/summer",
-          "--set", "Images_path_2=" + testing::SampleDir() + "/winter",
-          "--set", "Image_descriptor=" + descriptor,
-          "--set", "Image_sequences=" + std::to_string(length),
-          "--set", "Npy_name=m.npy"};
+          "--set",
+          "Images_path=" + testing::SampleDir() + "/summer",
+          "--set",
+          "Images_path_2=" + testing::SampleDir() + "/winter",
+          "--set",
+          "Image_descriptor=" + descriptor,
+          "--set",
+          "Image_sequences=" + std::to_string(length),
+          "--set",
+          "Npy_name=m.npy"};
 }
 
 cv::Mat1f RunMatrix(const std::string& dir, std::vector<std::string> args) {
@@ -89,8 +94,8 @@ TEST(SeqSlamBaseline, SadWithContrastEnhancementIsTheEnhancedSadMatrix) {
 TEST(SequencePartial, SkippedCellsInEveryExport) {
   const std::string dir = testing::TempDir();
   std::vector<std::string> args = Sample("LDB", 10);
-  args.insert(args.end(), {"--set", "Sequence_partial=skip", "--set", "Txt_name=m.txt",
-                           "--set", "Ground_truth_type=aligned", "--set", "Evaluation_name=eval"});
+  args.insert(args.end(), {"--set", "Sequence_partial=skip", "--set", "Txt_name=m.txt", "--set",
+                           "Ground_truth_type=aligned", "--set", "Evaluation_name=eval"});
   args.erase(args.begin());  // not --quiet: the report is read below
   const Outcome o = RunProgram(testing::TestOpenableExe(), args, dir);
   ASSERT_EQ(o.status, 0) << o.err;
@@ -130,9 +135,9 @@ TEST(SequencePartial, SkippedCellsInEveryExport) {
 TEST(MatchScore, RatioEvaluationOfTheSampleAgreesWithTheReference) {
   const std::string dir = testing::TempDir();
   std::vector<std::string> args = Sample("HOG", 10);
-  args.insert(args.end(), {"--set", "Match_score=ratio", "--set", "Match_score_window=7",
-                           "--set", "Sequence_partial=skip", "--set", "Ground_truth_type=aligned",
-                           "--set", "Evaluation_name=eval", "--set", "Match_threshold=0.8"});
+  args.insert(args.end(), {"--set", "Match_score=ratio", "--set", "Match_score_window=7", "--set",
+                           "Sequence_partial=skip", "--set", "Ground_truth_type=aligned", "--set",
+                           "Evaluation_name=eval", "--set", "Match_threshold=0.8"});
   const Outcome o = RunProgram(testing::TestOpenableExe(), args, dir);
   ASSERT_EQ(o.status, 0) << o.err;
   const std::string json = ReadAll(dir + "/eval.json");
@@ -167,7 +172,8 @@ TEST(MatchScore, ReportCountsTheAcceptedBestMatches) {
   // Count independently: each winter frame's best summer frame and its ratio (window 10).
   const cv::Mat1f m = ReadNpy(dir + "/m.npy");
   const int accepted = AcceptedByRatio(m, 300, 300, 10, 0.9f);
-  EXPECT_NE(o.out.find("accepted: " + std::to_string(accepted) + " of 300 best matches with "
+  EXPECT_NE(o.out.find("accepted: " + std::to_string(accepted) +
+                       " of 300 best matches with "
                        "ratio score <= 0.9 (Match_threshold)"),
             std::string::npos)
       << o.out;

@@ -4,15 +4,15 @@
 // byte outside a well-formed UTF-8 sequence as \xNN (docs/output_formats.md, "Names that are
 // not UTF-8"). Validity is checked by an independent reader (FirstInvalidUtf8Byte,
 // tests/test_support.h) and the shown names are written out by hand.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"

@@ -1,11 +1,11 @@
 // The presets of config/presets/ run end to end on the bundled sample as a user runs them
 // (Test_OpenABLE <preset> --set Images_path=...), and what they report is checked against the
 // matrix they wrote.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
@@ -87,8 +87,7 @@ TEST(Presets, LoopClosureRunsOnTheSample) {
 // holds every key the program knows, with the value in effect (no key missing or unknown).
 TEST(Presets, AreCompleteConfigurations) {
   for (const std::string& name : {Preset("across_conditions"), Preset("loop_closure"),
-                                  Preset("auto"),
-                                  testing::SourceDir() + "/config/Config.txt"}) {
+                                  Preset("auto"), testing::SourceDir() + "/config/Config.txt"}) {
     const Outcome o =
         RunProgram(testing::TestOpenableExe(), {name, "--print-config"}, testing::TempDir());
     ASSERT_EQ(o.status, 0) << name << o.err;

@@ -1,10 +1,10 @@
 // End-to-end runs of Test_OpenABLE with a stereo camera (Camera_type 1) on the real EuRoC
 // pairs, and its stereo input errors (one line, exit 1).
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "tests/e2e/e2e_support.h"
 #include "tests/test_support.h"
@@ -17,9 +17,7 @@ using namespace e2e;  // NOLINT: the e2e helpers are this file's vocabulary
 
 std::string EurocDir() { return testing::DatasetsDir() + "/euroc_stereo_pairs"; }
 
-bool OneLine(const std::string& s) {
-  return !s.empty() && s.find('\n') == s.size() - 1;
-}
+bool OneLine(const std::string& s) { return !s.empty() && s.find('\n') == s.size() - 1; }
 
 // <dir>/left, <dir>/right with EuRoC pairs [0, left) and [0, right), the calibration converted
 // into <dir>/calibration.yaml, and a Config.txt for them.

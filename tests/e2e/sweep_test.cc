@@ -1,13 +1,13 @@
 // openable_sweep on the bundled sample: each run's figures equal those of the same single run
 // of Test_OpenABLE, the ranking follows the chosen figure, frames are described once per
 // description setting, and bad --vary values stop it before any work with one line.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "OpenABLE/io/json.h"
 #include "tests/e2e/e2e_support.h"
@@ -21,15 +21,23 @@ using namespace e2e;  // NOLINT: the e2e helpers are this file's vocabulary
 std::vector<std::string> SampleArgs() {
   return {testing::SourceDir() + "/config/Config.txt",
           "--quiet",
-          "--set", "Images_path=" + testing::SampleDir() + "/summer",
-          "--set", "Images_path_2=" + testing::SampleDir() + "/winter",
-          "--set", "Ground_truth_type=aligned",
-          "--set", "Evaluation_name=",
-          "--set", "Txt_name=", "--set", "Npy_name=", "--set", "Png_name="};
+          "--set",
+          "Images_path=" + testing::SampleDir() + "/summer",
+          "--set",
+          "Images_path_2=" + testing::SampleDir() + "/winter",
+          "--set",
+          "Ground_truth_type=aligned",
+          "--set",
+          "Evaluation_name=",
+          "--set",
+          "Txt_name=",
+          "--set",
+          "Npy_name=",
+          "--set",
+          "Png_name="};
 }
 
-std::vector<std::string> With(std::vector<std::string> args,
-                              const std::vector<std::string>& more) {
+std::vector<std::string> With(std::vector<std::string> args, const std::vector<std::string>& more) {
   args.insert(args.end(), more.begin(), more.end());
   return args;
 }
@@ -70,8 +78,13 @@ TEST(Sweep, FiguresEqualTheSingleRunsAndAreRanked) {
   EXPECT_EQ(JsonNumber(json, "descriptions"), 2);
   EXPECT_EQ(JsonNumber(json, "frame_reads"), 1);
 
-  const char* metrics[] = {"auc", "recall_at_100p", "max_f1", "recall_at_1", "recall_at_5",
-                           "average_precision_percent", "unanswered_queries"};
+  const char* metrics[] = {"auc",
+                           "recall_at_100p",
+                           "max_f1",
+                           "recall_at_1",
+                           "recall_at_5",
+                           "average_precision_percent",
+                           "unanswered_queries"};
   int compared = 0;
   for (const std::string d : {"LDB", "HOG"})
     for (const std::string l : {"1", "5"})

@@ -1,5 +1,12 @@
 // End-to-end runs of the Test_OpenABLE program: the files it writes, the figures in them, and
 // every input error of the issue (one line, non-zero exit, no output left behind).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/mount.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -8,19 +15,11 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 #include <set>
 #include <sstream>
 #include <string>
-
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/mount.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "OpenABLE/io/frame_source.h"
 #include "config/config.h"
@@ -54,7 +53,6 @@ std::string SampleConfig(const std::string& dir, const std::string& extra = "") 
   return path;
 }
 
-
 // Approximate_search with the default engine, auto, builds the index it stands for (IVF for
 // binary rows, HNSW for float rows): the kept matches are those of a run naming that engine,
 // and the report names the index.
@@ -66,12 +64,12 @@ TEST(TestOpenABLE, ApproximateRunWithTheAutoEngineUsesAndNamesTheResolvedIndex) 
     const std::string dir = testing::TempDir();
     const std::string config = SampleConfig(dir);
     const auto run = [&](const std::string& engine, const std::string& name) {
-      return RunProgram(testing::TestOpenableExe(),
-                        {config, "--set", "Image_descriptor=" + descriptor, "--set",
-                         "Approximate_search=1", "--set", "Approximate_engine=" + engine, "--set",
-                         "Matches_name=out/" + name + ".csv", "--set", "Txt_name=", "--set",
-                         "Npy_name=", "--set", "Png_name="},
-                        dir);
+      return RunProgram(
+          testing::TestOpenableExe(),
+          {config, "--set", "Image_descriptor=" + descriptor, "--set", "Approximate_search=1",
+           "--set", "Approximate_engine=" + engine, "--set", "Matches_name=out/" + name + ".csv",
+           "--set", "Txt_name=", "--set", "Npy_name=", "--set", "Png_name="},
+          dir);
     };
     const Outcome automatic = run("auto", "auto"), named = run(resolved, "named");
     ASSERT_EQ(automatic.status, 0) << automatic.err << automatic.out;
@@ -154,8 +152,8 @@ TEST(TestOpenABLE, SampleRunWritesEveryOutputAndFindsTheSeasonDiagonal) {
 // the dynamic loader's own log (LD_DEBUG=files) must not name it.
 TEST(TestOpenABLE, PngRunDoesNotLoadImgcodecs) {
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram("/usr/bin/env", {"LD_DEBUG=files", testing::TestOpenableExe(),
-                                                SampleConfig(dir)}, dir);
+  const Outcome o = RunProgram(
+      "/usr/bin/env", {"LD_DEBUG=files", testing::TestOpenableExe(), SampleConfig(dir)}, dir);
   ASSERT_EQ(o.status, 0) << o.out;
   ASSERT_NE(o.err.find("file=libopencv_core"), std::string::npos)
       << "the loader's log is missing, so the test cannot see what was loaded";
@@ -166,12 +164,11 @@ TEST(TestOpenABLE, PngRunDoesNotLoadImgcodecs) {
 
 TEST(TestOpenABLE, OverridesRangeAndSingleSequence) {
   const std::string dir = testing::TempDir();
-  const Outcome o =
-      RunProgram(testing::TestOpenableExe(),
-                 {SampleConfig(dir), "--set", "Images_path_2=", "--set", "Final_image=50", "--set",
-                  "Initial_image=10", "--set", "Image_sequences=1", "--set", "Exclusion=10",
-                  "--quiet"},
-                 dir);
+  const Outcome o = RunProgram(
+      testing::TestOpenableExe(),
+      {SampleConfig(dir), "--set", "Images_path_2=", "--set", "Final_image=50", "--set",
+       "Initial_image=10", "--set", "Image_sequences=1", "--set", "Exclusion=10", "--quiet"},
+      dir);
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_EQ(o.err, "");  // --quiet: no progress, and no warning
   const cv::Mat1f m = ReadNpy(dir + "/out/matrix.npy");
@@ -195,8 +192,9 @@ TEST(TestOpenABLE, OverridesRangeAndSingleSequence) {
 // and no matrix, and its best matches equal those the dense run writes from its matrix.
 TEST(TestOpenABLE, AutoModeSwitchesToBoundedAndAgreesWithDense) {
   const std::string dir = testing::TempDir();
-  const std::vector<std::string> common = {SampleConfig(dir), "--set", "Ground_truth_type=",
-                                           "--set", "Evaluation_name=", "--set", "Best_matches=3"};
+  const std::vector<std::string> common = {
+      SampleConfig(dir),  "--set", "Ground_truth_type=", "--set",
+      "Evaluation_name=", "--set", "Best_matches=3"};
   std::vector<std::string> bounded = common;
   for (const char* a : {"--set", "Memory_limit=0.0001", "--set", "Matches_name=bounded.csv"})
     bounded.push_back(a);
@@ -232,8 +230,8 @@ TEST(TestOpenABLE, AutoModeSwitchesToBoundedAndAgreesWithDense) {
 
 TEST(TestOpenABLE, BoundedModeNeedsAMatchesFile) {
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram(testing::TestOpenableExe(),
-                               {SampleConfig(dir), "--set", "Matrix_mode=2"}, dir);
+  const Outcome o =
+      RunProgram(testing::TestOpenableExe(), {SampleConfig(dir), "--set", "Matrix_mode=2"}, dir);
   EXPECT_EQ(o.status, 1);
   EXPECT_TRUE(OneLine(o.err)) << o.err;
   EXPECT_NE(o.err.find("Test_OpenABLE: error: Matches_name: empty, but Matrix_mode 2 (bounded) "
@@ -264,13 +262,13 @@ TEST(TestOpenABLE, WithoutGroundTruthTheReportAndTheMatchesFileShowTheAcceptedMa
   const std::string dir = testing::TempDir();
   const std::string preset = testing::SourceDir() + "/config/presets/across_conditions.txt";
   const auto run = [&](const std::string& matches) {
-    return RunProgram(testing::TestOpenableExe(),
-                      {preset, "--set", "Images_path=" + testing::SampleDir() + "/summer",
-                       "--set", "Images_path_2=" + testing::SampleDir() + "/winter", "--set",
-                       "Npy_name=out/m.npy", "--set", "Png_name=", "--set",
-                       "Report_name=out/report.html", "--set", "Report_examples=3", "--set",
-                       "Matches_name=out/" + matches},
-                      dir);
+    return RunProgram(
+        testing::TestOpenableExe(),
+        {preset, "--set", "Images_path=" + testing::SampleDir() + "/summer", "--set",
+         "Images_path_2=" + testing::SampleDir() + "/winter", "--set", "Npy_name=out/m.npy",
+         "--set", "Png_name=", "--set", "Report_name=out/report.html", "--set", "Report_examples=3",
+         "--set", "Matches_name=out/" + matches},
+        dir);
   };
   const Outcome o = run("matches.csv");
   ASSERT_EQ(o.status, 0) << o.err << o.out;
@@ -386,11 +384,10 @@ TEST(TestOpenABLE, WithoutGroundTruthTheReportAndTheMatchesFileShowTheAcceptedMa
 // A bounded run keeps no matrix: no report, and a note says so.
 TEST(TestOpenABLE, ABoundedRunWritesNoReportAndSaysSo) {
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram(
-      testing::TestOpenableExe(),
-      {SampleConfig(dir), "--quiet", "--set", "Matrix_mode=2", "--set", "Matches_name=out/k.csv",
-       "--set", "Report_name=out/report.html"},
-      dir);
+  const Outcome o = RunProgram(testing::TestOpenableExe(),
+                               {SampleConfig(dir), "--quiet", "--set", "Matrix_mode=2", "--set",
+                                "Matches_name=out/k.csv", "--set", "Report_name=out/report.html"},
+                               dir);
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_NE(o.err.find("note: Report_name: not written: the run is bounded"), std::string::npos)
       << o.err;
@@ -403,9 +400,8 @@ TEST(TestOpenABLE, ABoundedRunWritesNoReportAndSaysSo) {
 // each a real key (so its default is shown).
 TEST(TestOpenABLE, EveryProgramsHelpFitsAScreen) {
   const std::string dir = testing::TempDir();
-  for (const std::string& exe :
-       {testing::TestOpenableExe(), testing::OpenableSweepExe(), testing::OpenableSnapsExe(),
-        testing::OpenableEvaluateExe()}) {
+  for (const std::string& exe : {testing::TestOpenableExe(), testing::OpenableSweepExe(),
+                                 testing::OpenableSnapsExe(), testing::OpenableEvaluateExe()}) {
     const Outcome o = RunProgram(exe, {"--help"}, dir);
     ASSERT_EQ(o.status, 0) << exe << "\n" << o.err;
     EXPECT_EQ(o.err, "") << exe;
@@ -432,12 +428,12 @@ TEST(TestOpenABLE, EveryProgramsHelpFitsAScreen) {
 // loop-closure preset verifies): description, matching, sequences, verification, export.
 TEST(TestOpenABLE, TimingsListEveryStageWithVerification) {
   const std::string dir = testing::TempDir();
-  const Outcome o = RunProgram(
-      testing::TestOpenableExe(),
-      {testing::SourceDir() + "/config/presets/loop_closure.txt", "--quiet", "--set",
-       "Images_path=" + testing::SampleDir() + "/summer", "--set", "Npy_name=", "--set",
-       "Png_name="},
-      dir);
+  const Outcome o =
+      RunProgram(testing::TestOpenableExe(),
+                 {testing::SourceDir() + "/config/presets/loop_closure.txt", "--quiet", "--set",
+                  "Images_path=" + testing::SampleDir() + "/summer", "--set", "Npy_name=", "--set",
+                  "Png_name="},
+                 dir);
   ASSERT_EQ(o.status, 0) << o.err;
   const size_t timings = o.out.find("Timings (wall clock):\n");
   ASSERT_NE(timings, std::string::npos) << o.out;
@@ -514,8 +510,8 @@ TEST(TestOpenABLE, VideoModeReadsFrames) {
 // the output folder.
 struct BadInput {
   const char* name;
-  std::vector<std::string> sets;   // overrides on the sample configuration
-  std::string expect;              // text the error line must contain
+  std::vector<std::string> sets;  // overrides on the sample configuration
+  std::string expect;             // text the error line must contain
 };
 
 // Named in test listings and CTest by its case name rather than by its bytes.
@@ -741,8 +737,8 @@ TEST(TestOpenABLE, NordlandWinterVsSummerBeatsTheOriginal) {
   const cv::Mat1f m = ReadNpy(dir + "/out/matrix.npy");
   ASSERT_EQ(m.rows, 3576);
   const double r1 = AlignedRecallAt1(m, 1788, 0, 1788, 2);
-  std::cout << "[ nordland ] winter vs summer, LDB global 64x64, L=10: R@1 (+-2) = " << r1
-            << "\n" << o.out;
+  std::cout << "[ nordland ] winter vs summer, LDB global 64x64, L=10: R@1 (+-2) = " << r1 << "\n"
+            << o.out;
   EXPECT_GE(r1, 0.355);
 }
 
@@ -899,7 +895,8 @@ TEST(TestOpenABLE, SigtermDuringARunLeavesNoOutput) {
   EXPECT_EQ(WEXITSTATUS(status), 143);
   const std::string e = ReadAll(err);
   EXPECT_NE(e.find("Test_OpenABLE: interrupted by SIGTERM (temporary files removed)\n"),
-            std::string::npos) << e;
+            std::string::npos)
+      << e;
   EXPECT_TRUE(FilesUnder(dir + "/out").empty()) << FilesUnder(dir + "/out").front();
 }
 
@@ -935,14 +932,14 @@ TEST(TestOpenABLE, OutputsAtTheSameFileAreRefusedBeforeWork) {
       {"Evaluation_name=evalfolder", "Png_name=", "Evaluation_name", "is a folder"},
   };
   for (const auto& c : cases) {
-    const Outcome o = RunProgram(
-        testing::TestOpenableExe(),
-        {testing::SourceDir() + "/config/Config.txt", "--set",
-         "Images_path=" + testing::SampleDir() + "/summer", "--set",
-         "Images_path_2=" + testing::SampleDir() + "/winter", "--set", "Txt_name=",
-         "--set", "Npy_name=", "--set", "Png_name=", "--set", "Evaluation_name=", "--set",
-         "Threshold=0.4", "--set", c[0], "--set", c[1]},
-        dir);
+    const Outcome o =
+        RunProgram(testing::TestOpenableExe(),
+                   {testing::SourceDir() + "/config/Config.txt", "--set",
+                    "Images_path=" + testing::SampleDir() + "/summer", "--set",
+                    "Images_path_2=" + testing::SampleDir() + "/winter", "--set",
+                    "Txt_name=", "--set", "Npy_name=", "--set", "Png_name=", "--set",
+                    "Evaluation_name=", "--set", "Threshold=0.4", "--set", c[0], "--set", c[1]},
+                   dir);
     EXPECT_EQ(o.status, 1) << c[0] << " " << o.err;
     EXPECT_TRUE(OneLine(o.err)) << o.err;
     EXPECT_NE(o.err.find(c[2]), std::string::npos) << o.err;

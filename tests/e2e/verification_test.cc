@@ -2,7 +2,6 @@
 // 100-199), as one short sequence. The loops file is read back and its answers scored here,
 // independently of the evaluation, and the online detector must give the batch run's loops.
 #include <map>
-
 #include <opencv2/videoio.hpp>
 #include <sstream>
 
@@ -77,14 +76,38 @@ Revisit MakeRevisit(const std::string& dir) {
 
 std::vector<std::string> RunArgs(const Revisit& r, const std::string& dir) {
   return {testing::SourceDir() + "/config/Config.txt",
-          "--set", "Images_path=" + r.folder, "--set", "Images_path_2=",
-          "--set", "Txt_name=", "--set", "Npy_name=", "--set", "Png_name=",
-          "--set", "Threshold=-1", "--set", "Image_descriptor=LDB",
-          "--set", "Image_sequences=1", "--set", "Ground_truth_type=pairs",
-          "--set", "Ground_truth=" + r.pairs, "--set", "Ground_truth_base=0",
-          "--set", "Exclusion=" + std::to_string(kExclusion),
-          "--set", "Tolerance=" + std::to_string(kTolerance), "--set", "Verification=1",
-          "--set", "Loops_name=" + dir + "/loops.csv", "--set", "Evaluation_name=" + dir + "/e"};
+          "--set",
+          "Images_path=" + r.folder,
+          "--set",
+          "Images_path_2=",
+          "--set",
+          "Txt_name=",
+          "--set",
+          "Npy_name=",
+          "--set",
+          "Png_name=",
+          "--set",
+          "Threshold=-1",
+          "--set",
+          "Image_descriptor=LDB",
+          "--set",
+          "Image_sequences=1",
+          "--set",
+          "Ground_truth_type=pairs",
+          "--set",
+          "Ground_truth=" + r.pairs,
+          "--set",
+          "Ground_truth_base=0",
+          "--set",
+          "Exclusion=" + std::to_string(kExclusion),
+          "--set",
+          "Tolerance=" + std::to_string(kTolerance),
+          "--set",
+          "Verification=1",
+          "--set",
+          "Loops_name=" + dir + "/loops.csv",
+          "--set",
+          "Evaluation_name=" + dir + "/e"};
 }
 
 struct LoopLine {
@@ -225,8 +248,8 @@ TEST(Verification, BoundedModeChecksTheSameBestMatches) {
   ASSERT_EQ(RunProgram(testing::TestOpenableExe(), dense, dir).status, 0);
   fs::rename(dir + "/loops.csv", dir + "/dense.csv");
   std::vector<std::string> bounded = RunArgs(r, dir);
-  for (const char* a : {"Matrix_mode=2", "Best_matches=50", "Evaluation_name=",
-                               "Ground_truth_type=", "Verification_candidates=1"})
+  for (const char* a : {"Matrix_mode=2", "Best_matches=50",
+                        "Evaluation_name=", "Ground_truth_type=", "Verification_candidates=1"})
     bounded.insert(bounded.end(), {"--set", a});
   bounded.insert(bounded.end(), {"--set", "Matches_name=" + dir + "/matches.csv"});
   const Outcome o = RunProgram(testing::TestOpenableExe(), bounded, dir);
@@ -270,11 +293,10 @@ TEST(Verification, RefusedSettingsNameTheKeyAndWriteNothing) {
   }
   // The half-size calibration fits, and gives the essential matrix.
   std::vector<std::string> args = RunArgs(r, dir);
-  for (const std::string& a : {std::string("--set"),
-                               "Verification_calibration=" + kitti + "/calib.txt",
-                               std::string("--set"),
-                               std::string("Verification_calibration_scale=0.5"),
-                               std::string("--set"), std::string("Verification_candidates=1")})
+  for (const std::string& a :
+       {std::string("--set"), "Verification_calibration=" + kitti + "/calib.txt",
+        std::string("--set"), std::string("Verification_calibration_scale=0.5"),
+        std::string("--set"), std::string("Verification_candidates=1")})
     args.push_back(a);
   const Outcome o = RunProgram(testing::TestOpenableExe(), args, dir);
   ASSERT_EQ(o.status, 0) << o.err;
@@ -283,8 +305,8 @@ TEST(Verification, RefusedSettingsNameTheKeyAndWriteNothing) {
   // A run without queries (every frame within Exclusion of the first) and the consistency off
   // is not refused: it verifies nothing.
   std::vector<std::string> none = RunArgs(r, dir);
-  for (const char* a : {"Exclusion=500", "Verification_consistency=0",
-                               "Ground_truth_type=", "Evaluation_name="})
+  for (const char* a :
+       {"Exclusion=500", "Verification_consistency=0", "Ground_truth_type=", "Evaluation_name="})
     none.insert(none.end(), {"--set", a});
   const Outcome empty = RunProgram(testing::TestOpenableExe(), none, dir);
   ASSERT_EQ(empty.status, 0) << empty.err;
@@ -295,18 +317,18 @@ TEST(Verification, VideoFramesCannotBeReadAgain) {
   const std::string dir = testing::TempDir();
   const std::string video = dir + "/v.avi";
   {
-    cv::VideoWriter writer(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10,
-                           cv::Size(64, 48), false);
+    cv::VideoWriter writer(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10, cv::Size(64, 48),
+                           false);
     ASSERT_TRUE(writer.isOpened());
     for (int i = 0; i < 120; ++i) writer.write(cv::Mat1b(48, 64, static_cast<uchar>(2 * i)));
   }
-  const Outcome o = RunProgram(
-      testing::TestOpenableExe(),
-      {testing::SourceDir() + "/config/Config.txt", "--set", "Frame_mode=1", "--set",
-       "Video_path_1=" + video, "--set", "Verification=1", "--set", "Txt_name=" + dir + "/m.txt",
-       "--set", "Npy_name=", "--set", "Png_name=", "--set", "Evaluation_name=",
-       "--set", "Ground_truth_type="},
-      dir);
+  const Outcome o =
+      RunProgram(testing::TestOpenableExe(),
+                 {testing::SourceDir() + "/config/Config.txt", "--set", "Frame_mode=1", "--set",
+                  "Video_path_1=" + video, "--set", "Verification=1", "--set",
+                  "Txt_name=" + dir + "/m.txt", "--set", "Npy_name=", "--set", "Png_name=", "--set",
+                  "Evaluation_name=", "--set", "Ground_truth_type="},
+                 dir);
   EXPECT_EQ(o.status, 1);
   EXPECT_TRUE(e2e::OneLine(o.err)) << o.err;
   EXPECT_NE(o.err.find("Verification: 1"), std::string::npos) << o.err;

@@ -1,10 +1,10 @@
 // The registry of ground-truth formats (GroundTruthFormats, ground_truth.h): every format
 // parses from its name, is named in the messages, and is either a pose format or a
 // loader; the lists users see are made from it.
+#include <gtest/gtest.h>
+
 #include <set>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "tests/test_support.h"
@@ -26,8 +26,8 @@ TEST(GroundTruthFormats, EachParsesFromItsNameAndIsOneKindOfFormat) {
     // The list of the messages names it (the key's help: tests/config/option_table_test.cc).
     EXPECT_NE(GroundTruthFormatList().find(f.name), std::string::npos);
   }
-  EXPECT_EQ(names, (std::set<std::string>{"matrix", "pairs", "aligned", "kitti", "tum",
-                                          "positions", "vpr_bench", "vpr_tutorial"}));
+  EXPECT_EQ(names, (std::set<std::string>{"matrix", "pairs", "aligned", "kitti", "tum", "positions",
+                                          "vpr_bench", "vpr_tutorial"}));
 }
 
 TEST(GroundTruthFormats, NamedConstantsAreTheRegistrysEntries) {

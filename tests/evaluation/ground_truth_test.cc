@@ -27,7 +27,6 @@ namespace openable {
 namespace {
 
 using openable::testing::DatasetsDir;
-using openable::testing::SourceDir;
 using openable::testing::ExpectInputError;
 using openable::testing::InputErrorMessage;
 using openable::testing::Q;
@@ -37,8 +36,6 @@ using openable::testing::TempDir;
 using openable::testing::WriteBytes;
 using Matches = std::vector<std::vector<int>>;
 using namespace std::string_literals;
-
-
 
 // Matches of `n` queries from a map query -> references (queries not named have none).
 Matches M(int n, const std::map<int, std::vector<int>>& m) {
@@ -113,10 +110,10 @@ TEST(GroundTruthMatrix, LoopClosureIsSymmetricAndDropsTheDiagonal) {
   const std::string path = TempDir() + "/gt.txt";
   // (2,0), (0,3) and its mirror (3,0), the diagonal cell (1,1).
   WriteBytes(path,
-            "0 0 0 1\n"
-            "0 1 0 0\n"
-            "1 0 0 0\n"
-            "1 0 0 0\n");
+             "0 0 0 1\n"
+             "0 1 0 0\n"
+             "1 0 0 0\n"
+             "1 0 0 0\n");
   const GroundTruth gt = LoadLoop(Options(GroundTruthType::kMatrix, path), 4);
   EXPECT_EQ(gt.matches, M(4, {{2, {0}}, {3, {0}}}));
   EXPECT_EQ(gt.references, 4);
@@ -130,11 +127,11 @@ TEST(GroundTruthMatrix, BlockOrWholeMatrixOfTwoTraversals) {
   // 3 reference frames then 2 query frames: the block is rows 3-4, columns 0-2.
   const EvaluationLayout layout = EvaluationLayout::TwoTraversals(3, 2);
   WriteBytes(dir + "/whole.txt",
-            "0 0 0 0 1\n"
-            "0 0 0 0 0\n"
-            "0 0 0 1 0\n"
-            "0 1 0 0 0\n"
-            "0 0 1 0 1\n");
+             "0 0 0 0 1\n"
+             "0 0 0 0 0\n"
+             "0 0 0 1 0\n"
+             "0 1 0 0 0\n"
+             "0 0 1 0 1\n");
   GroundTruth gt =
       LoadGroundTruth(Options(GroundTruthType::kMatrix, dir + "/whole.txt"), layout, 5, 5);
   EXPECT_EQ(gt.matches, M(2, {{0, {1}}, {1, {2}}}));
@@ -296,11 +293,10 @@ TEST(GroundTruthPairs, IndicesBeyondTenToTheFifteenAreRefused) {
     const char* name;
     int base, first_frame;
   };
-  for (const Case& c : {Case{"pairs_int64_min_1based.txt", 1, 0},
-                        Case{"pairs_int64_from_frame_3.txt", 0, 3}}) {
+  for (const Case& c :
+       {Case{"pairs_int64_min_1based.txt", 1, 0}, Case{"pairs_int64_from_frame_3.txt", 0, 3}}) {
     const std::string path = TempDir() + "/" + c.name;
-    const std::string input =
-        ReadBytes(SourceDir() + "/tests/fuzz/corpus/ground_truth/" + c.name);
+    const std::string input = ReadBytes(SourceDir() + "/tests/fuzz/corpus/ground_truth/" + c.name);
     WriteBytes(path, input.substr(1));
     GroundTruthOptions o = Options(GroundTruthType::kPairs, path);
     o.base = c.base;
@@ -328,11 +324,11 @@ TEST(GroundTruthPairs, FirstFrameShiftsAndDropsPairsOutsideTheRange) {
   const std::string path = TempDir() + "/pairs.txt";
   // Frames 10..14 of the source are rows 0..4.
   WriteBytes(path,
-            "12,10\n"
-            "11,14\n"
-            "15,12\n"    // 15 is after the range: dropped
-            "12,3\n"     // 3 is before it: dropped
-            "11,11\n");  // diagonal: dropped
+             "12,10\n"
+             "11,14\n"
+             "15,12\n"    // 15 is after the range: dropped
+             "12,3\n"     // 3 is before it: dropped
+             "11,11\n");  // diagonal: dropped
   GroundTruthOptions o = Options(GroundTruthType::kPairs, path);
   o.first_frame = 10;
   const GroundTruth gt = LoadLoop(o, 5);
@@ -506,10 +502,10 @@ TEST(PosesTum, QuaternionHeadingExcludesOppositeViews) {
   // Same spot: facing +z; facing -z (180 degrees about y); 0.5 m away turned by 30 degrees
   // about y. (A quaternion that is not of unit norm is refused, as SNAPS refuses it.)
   WriteBytes(path,
-            "# timestamp tx ty tz qx qy qz qw\n"
-            "1305031102.175304 1 2 3 0 0 0 1\n"
-            "1305031102.211214 1 2 3 0 1 0 0\n"
-            "1305031102.243211 1.5 2 3 0 0.25881904510252074 0 0.9659258262890683\n");
+             "# timestamp tx ty tz qx qy qz qw\n"
+             "1305031102.175304 1 2 3 0 0 0 1\n"
+             "1305031102.211214 1 2 3 0 1 0 0\n"
+             "1305031102.243211 1.5 2 3 0 0.25881904510252074 0 0.9659258262890683\n");
   const std::vector<FramePose> poses = ReadPoses(path, GroundTruthType::kTum);
   ASSERT_EQ(poses.size(), 3u);
   EXPECT_EQ(poses[2].position, Eigen::Vector3d(1.5, 2, 3));
@@ -600,7 +596,8 @@ TEST(PosesErrors, MalformedFilesNameFileAndLine) {
   // A frame number before the 12 numbers: the evaluation has no format for keyframes (one pose
   // per frame), so the message names none.
   WriteBytes(dir + "/ids.txt", "0 1 0 0 0 0 1 0 0 0 0 1 0\n");
-  const std::string ids = InputErrorMessage([&] { ReadPoses(dir + "/ids.txt", GroundTruthType::kKitti); });
+  const std::string ids =
+      InputErrorMessage([&] { ReadPoses(dir + "/ids.txt", GroundTruthType::kKitti); });
   EXPECT_NE(ids.find("13 numbers; expected 12"), std::string::npos) << ids;
   EXPECT_EQ(ids.find("kitti-id"), std::string::npos) << ids;
   // The checks SNAPS applies to the same files (one reader, pose_file.h): a matrix that is not
@@ -713,9 +710,8 @@ TEST(GroundTruthVprBench, BadFilesAndLayoutsAreOneLineNamingTheFile) {
   testing::ExpectInputError(
       [&] { LoadQueryReference(Options(GroundTruthType::kVprBench, hand), 6, 9); },
       {"VPR-Bench ground truth \"" + hand + "\": 7 queries; expected 6"});
-  testing::ExpectInputError(
-      [&] { LoadLoop(Options(GroundTruthType::kVprBench, hand), 9); },
-      {"Ground_truth_type: vpr_bench needs two traversals"});
+  testing::ExpectInputError([&] { LoadLoop(Options(GroundTruthType::kVprBench, hand), 9); },
+                            {"Ground_truth_type: vpr_bench needs two traversals"});
   // gt_lists.npy's last row names reference -5.
   const std::string lists = SourceDir() + "/tests/data/npy_objects/gt_lists.npy";
   testing::ExpectInputError(
@@ -745,9 +741,8 @@ TEST(GroundTruthMissingFiles, EveryFormatNamesTheFileItLookedFor) {
     if (message.find("Ground_truth_2") != std::string::npos) {
       GroundTruthOptions o = Options(GroundTruthType(f.name), absent);
       o.path_2 = absent;
-      ExpectInputError(
-          [&] { LoadGroundTruth(o, EvaluationLayout::TwoTraversals(3, 3), 6, 6); },
-          {Q(absent), "does not exist"});
+      ExpectInputError([&] { LoadGroundTruth(o, EvaluationLayout::TwoTraversals(3, 3), 6, 6); },
+                       {Q(absent), "does not exist"});
       continue;
     }
     EXPECT_NE(message.find(std::string(f.label) + " " + Q(absent) + " does not exist"),
@@ -778,8 +773,8 @@ TEST(GroundTruthVprTutorial, MatricesAreDatabaseByQueries) {
                             {"Ground_truth_soft: ", "expected Ground_truth_type vpr_tutorial"});
   // A zip64 archive holding GThard = eye(3) and no GTsoft.
   const GroundTruth eye = LoadQueryReference(
-      Options(GroundTruthType::kVprTutorial, SourceDir() + "/tests/data/npy_objects/zip64.npz"),
-      3, 3);
+      Options(GroundTruthType::kVprTutorial, SourceDir() + "/tests/data/npy_objects/zip64.npz"), 3,
+      3);
   EXPECT_EQ(eye.matches, (std::vector<std::vector<int>>{{0}, {1}, {2}}));
   EXPECT_TRUE(eye.soft.empty());
 }
@@ -841,13 +836,14 @@ TEST(GroundTruthVprBench, ListsLongerThanTheRunCanUseAreRefusedBeforeTheyAreMade
   // A (3, 2) object array as Python 2 pickles it (protocol 2), row q = [q, range(0, n)]: the
   // range made for row 0, memoised, and named again by rows 1 and 2.
   const auto rows_naming_one_range = [](std::uint16_t n) {
-    std::string p = "\x80\x02"
-                    "cnumpy.core.multiarray\n_reconstruct\ncnumpy\nndarray\nK\x00\x85U\x01"
-                    "b\x87R(K\x01K\x03K\x02\x86"
-                    "cnumpy\ndtype\nU\x02O8K\x00K\x01\x87R(K\x03U\x01|NNNJ\xff\xff\xff\xffJ\xff"
-                    "\xff\xff\xffK?tb\x89]("
-                    "K\x00"
-                    "c__builtin__\nxrange\nK\x00M"s;
+    std::string p =
+        "\x80\x02"
+        "cnumpy.core.multiarray\n_reconstruct\ncnumpy\nndarray\nK\x00\x85U\x01"
+        "b\x87R(K\x01K\x03K\x02\x86"
+        "cnumpy\ndtype\nU\x02O8K\x00K\x01\x87R(K\x03U\x01|NNNJ\xff\xff\xff\xffJ\xff"
+        "\xff\xff\xffK?tb\x89]("
+        "K\x00"
+        "c__builtin__\nxrange\nK\x00M"s;
     p += static_cast<char>(n & 0xff);
     p += static_cast<char>(n >> 8);
     p += "\x86Rq\x01K\x01h\x01K\x02h\x01"

@@ -55,7 +55,6 @@ void ExpectMatrix(const cv::Mat1f& m, const std::vector<std::vector<float>>& exp
   }
 }
 
-
 // ---------------------------------------------------------------------------------------------
 // .npy
 

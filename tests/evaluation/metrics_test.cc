@@ -282,7 +282,6 @@ TEST(EvaluationOptions, CheckNamesTheKey) {
     EXPECT_NE(testing::CheckError<EvaluationOptions>(change).find(key), std::string::npos) << key;
 }
 
-
 // --- The ratio score ---------------------------------------------------------------------------
 
 // The query-reference block above with the ratio, window 1: q0 best c1 0.10, rivals c3 0.7 and
@@ -437,7 +436,8 @@ TEST(PerQueryRatio, WindowAsLargeAsTheReferencesIsAnError) {
 cv::Mat1f AlignedSimilarity() {
   cv::Mat1f s(6, 6);
   for (int q = 0; q < 6; ++q)
-    for (int c = 0; c < 6; ++c) s(q, c) = q == c ? 0.9f : 0.1f * static_cast<float>(1 + (q + c) % 6);
+    for (int c = 0; c < 6; ++c)
+      s(q, c) = q == c ? 0.9f : 0.1f * static_cast<float>(1 + (q + c) % 6);
   return s;
 }
 
@@ -468,9 +468,9 @@ TEST(EvaluationWarnings, ASimilarityGivenAsDistancesLooksReversed) {
   EXPECT_NE(w[0].find("similarity"), std::string::npos) << w[0];
   EXPECT_EQ(w[0].find('\n'), std::string::npos);
   // The distances themselves: nothing to warn about.
-  EXPECT_TRUE(EvaluationWarnings(distances, layout, truth, o,
-                                 EvaluatePerQuery(distances, layout, truth, o))
-                  .empty());
+  EXPECT_TRUE(
+      EvaluationWarnings(distances, layout, truth, o, EvaluatePerQuery(distances, layout, truth, o))
+          .empty());
 }
 
 TEST(EvaluationWarnings, APoorMatrixIsNotCalledReversed) {

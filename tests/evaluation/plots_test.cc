@@ -7,12 +7,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 namespace openable {
 namespace {
@@ -124,18 +123,17 @@ TEST(PrPlot, SecondSeriesInTheAblePPanelHasTheSecondColour) {
   EXPECT_FALSE(ColourAround(img, PlotPixel(1, 0.45, 0.9), kOrange));
   EXPECT_FALSE(ColourAround(img, PlotPixel(1, 0.45, 0.7), kBlue));
   // Series a has no ABLE-P points: nothing blue in the upper half of that plot area.
-  EXPECT_EQ(CountColour(img, {kPanelWidth + kPlotLeft + 2, kPlotTop + 2, kPlotWidth - 4,
-                              kPlotHeight / 2},
-                        kBlue),
-            0);
+  EXPECT_EQ(
+      CountColour(img, {kPanelWidth + kPlotLeft + 2, kPlotTop + 2, kPlotWidth - 4, kPlotHeight / 2},
+                  kBlue),
+      0);
 }
 
 TEST(PrPlot, EmptyCurveDrawsNothing) {
   const cv::Mat3b img = RenderPrPlot({{"empty", {}, {}}, {"b", KnownCurve(), {}}}, "", 7);
   // Nothing blue above the legend (lower left) in the plot area.
-  EXPECT_EQ(CountColour(img, {kPlotLeft + 2, kPlotTop + 2, kPlotWidth - 4, kPlotHeight - 120},
-                        kBlue),
-            0);
+  EXPECT_EQ(
+      CountColour(img, {kPlotLeft + 2, kPlotTop + 2, kPlotWidth - 4, kPlotHeight - 120}, kBlue), 0);
   // But the legend still has its (blue) line sample.
   EXPECT_GT(CountColour(img, {kPlotLeft, kPlotTop + kPlotHeight - 120, 80, 120}, kBlue), 10);
   // And the second series is drawn in orange.
@@ -293,9 +291,8 @@ TEST(Overlay, OneByOneBlock) {
   r.best_distance = {0.25f};
   r.score = r.best_distance;
   r.correct = {1};
-  const cv::Mat3b img =
-      RenderOverlay(cv::Mat1f(1, 1, 0.25f), EvaluationLayout::QueryReference(1, 1),
-                    Truth({{0}}, 1), r, 0.5);
+  const cv::Mat3b img = RenderOverlay(
+      cv::Mat1f(1, 1, 0.25f), EvaluationLayout::QueryReference(1, 1), Truth({{0}}, 1), r, 0.5);
   EXPECT_EQ(img.cols, kOverlayAxisLeft + 600);
   EXPECT_GT(img.rows, kOverlayAxisTop + 600);
   EXPECT_EQ(At(img, 0, 0), kGreen);

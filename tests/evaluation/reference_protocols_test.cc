@@ -7,11 +7,10 @@
 
 #include <cmath>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/evaluation/ground_truth.h"
@@ -110,9 +109,9 @@ TEST(VprTutorialProtocol, HandMadeMatrixGivesTheFiguresOfVprTutorial) {
 TEST(VprTutorialProtocol, SoftGroundTruthFromNpyOrNpzGivesTheFiguresOfVprTutorial) {
   const cv::Mat1f d = ReadMatrixFile(DataDir() + "hand_distances.npy");
   const auto layout = EvaluationLayout::QueryReference(d.rows, d.cols);
-  for (const auto& [hard, soft] : {std::pair<std::string, std::string>{"hand_gt_hard.npy",
-                                                                       "hand_gt_soft.npy"},
-                                   {"hand_gt.npz", ""}}) {
+  for (const auto& [hard, soft] :
+       {std::pair<std::string, std::string>{"hand_gt_hard.npy", "hand_gt_soft.npy"},
+        {"hand_gt.npz", ""}}) {
     SCOPED_TRACE(hard);
     const GroundTruth gt = Load(GroundTruthType::kVprTutorial, hard, layout, soft);
     // make.py's two soft cells beyond GThard: (reference 4, query 1) and (reference 0, query 3).

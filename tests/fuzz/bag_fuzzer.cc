@@ -10,9 +10,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "OpenABLE/io/frame_source.h"
 #include "tests/fuzz/frame_check.h"

@@ -4,9 +4,8 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace openable::fuzz {
 

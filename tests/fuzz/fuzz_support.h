@@ -1,13 +1,13 @@
 // Helpers of the libFuzzer targets.
 #pragma once
 
+#include <unistd.h>
+
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
-
-#include <unistd.h>
 
 #include "OpenABLE/base/error.h"
 
@@ -31,8 +31,7 @@ bool Refuses(F f, const std::string& named = "") {
     const bool one_line = message.find_first_of("\n\r") == std::string::npos;
     if (!one_line || (!named.empty() && message.find(named) == std::string::npos)) {
       std::fprintf(stderr, "InputError %s: %s\n",
-                   one_line ? ("without " + named).c_str() : "of several lines",
-                   message.c_str());
+                   one_line ? ("without " + named).c_str() : "of several lines", message.c_str());
       std::abort();
     }
     return true;

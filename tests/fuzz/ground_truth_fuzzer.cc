@@ -31,10 +31,12 @@ using openable::fuzz::Refuses;
 
 void Load(const GroundTruthOptions& options, const EvaluationLayout& layout,
           const std::string& path) {
-  Refuses([&] {
-    openable::LoadGroundTruth(options, layout, layout.row_offset + layout.queries,
-                              layout.col_offset + layout.references);
-  }, path);
+  Refuses(
+      [&] {
+        openable::LoadGroundTruth(options, layout, layout.row_offset + layout.queries,
+                                  layout.col_offset + layout.references);
+      },
+      path);
 }
 
 }  // namespace
@@ -50,8 +52,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   options.min_frame_gap = 2;
   if (choice <= 2) {
     const int base = choice - 1;
-    if (Refuses([&] { openable::ReadPairsFile(path, base, "ground truth pairs"); }, path))
-      return 0;
+    if (Refuses([&] { openable::ReadPairsFile(path, base, "ground truth pairs"); }, path)) return 0;
     options.type = GroundTruthType::kPairs;
     options.base = base;
     options.first_frame = (data[0] >> 4) & 3;
@@ -70,9 +71,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         options.frame_times.push_back(poses[i].time + 0.01 * (i % 3));
     Load(options, EvaluationLayout::LoopClosure(frames), path);
   } else {
-    Refuses([&] {
-      openable::ReadPoseFile(path, openable::PoseFileFormat::kKittiWithId, "trajectory");
-    }, path);
+    Refuses(
+        [&] { openable::ReadPoseFile(path, openable::PoseFileFormat::kKittiWithId, "trajectory"); },
+        path);
   }
   return 0;
 }

@@ -6,9 +6,8 @@
 // Built with -DOPENABLE_BUILD_FUZZERS=ON (clang); see docs/robustness.md.
 #include <cstddef>
 #include <cstdint>
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "OpenABLE/io/frame_source.h"
 #include "tests/fuzz/frame_check.h"
@@ -22,8 +21,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string bytes = openable::fuzz::Bytes(data, size);
   cv::Mat frame;
-  if (openable::fuzz::Refuses([&] { frame = openable::DecodeImageBytes(bytes, "fuzz"); }))
-    return 0;
+  if (openable::fuzz::Refuses([&] { frame = openable::DecodeImageBytes(bytes, "fuzz"); })) return 0;
   openable::fuzz::CheckFrame(frame, "image_fuzzer");
   return 0;
 }

@@ -1,23 +1,22 @@
 // libFuzzer target: arbitrary bytes as a saved online map (the file of OnlineDetector::SaveMap,
 // OpenABLE/online/map_file.h), written to a temporary file. ReadMapFile reads the bytes as
 // they are; then the same bytes with their checksums made right (format version 2: each
-// section's CRC-32 named by the table, then the table's own (versions 2 and 3); version 1: the last 8 bytes, the
-// FNV-1a of the rest), so that mutations reach the sections behind the checksums, go through
-// ReadMapFile and OnlineDetector::LoadMap into the detector whose settings the map names
+// section's CRC-32 named by the table, then the table's own (versions 2 and 3); version 1: the last
+// 8 bytes, the FNV-1a of the rest), so that mutations reach the sections behind the checksums, go
+// through ReadMapFile and OnlineDetector::LoadMap into the detector whose settings the map names
 // (tests/fuzz/map_detectors.h), and, when it loads, one more frame is searched among the
 // loaded ones (and verified against their saved features). The expected outcomes are a loaded
 // map or one InputError line naming the file (and for the frame added, a refusal of a frame of
 // another size than the map's); any other exception, a crash or a sanitizer report is a
 // finding. Built with -DOPENABLE_BUILD_FUZZERS=ON (clang); see docs/robustness.md.
+#include <libdeflate.h>
+
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <string>
-
 #include <opencv2/core.hpp>
-
-#include <libdeflate.h>
+#include <string>
 
 #include "OpenABLE/base/hash.h"
 #include "OpenABLE/base/strings.h"
@@ -52,7 +51,8 @@ bool FixChecksums(std::string& b) {
     return true;
   }
   const std::uint64_t count = Le(b, 20, 4);
-  const std::size_t table_end = 24 + static_cast<std::size_t>(std::min<std::uint64_t>(count, 1u << 16)) * 32;
+  const std::size_t table_end =
+      24 + static_cast<std::size_t>(std::min<std::uint64_t>(count, 1u << 16)) * 32;
   if (count > (1u << 16) || table_end + 4 > b.size()) return false;
   for (std::size_t e = 24; e < table_end; e += 32) {
     const std::uint64_t offset = Le(b, e + 8, 8), bytes = Le(b, e + 16, 8);

@@ -4,8 +4,8 @@
 // the restricted pickle reader of OpenABLE/io/npy_objects.h), as a .npz archive (every
 // member listed and read by NpzMember, then decoded as a matrix) and as the settings file
 // beside a matrix (DecodeMatrixSettings, OpenABLE/evaluation/saved_settings.h, checked against
-// the decoded matrix by CheckMatrixFitsSettings), then written to a temporary file whose extension the
-// first byte chooses (modulo 4: .npy, .txt, .csv, .png) and read by ReadMatrixFile
+// the decoded matrix by CheckMatrixFitsSettings), then written to a temporary file whose extension
+// the first byte chooses (modulo 4: .npy, .txt, .csv, .png) and read by ReadMatrixFile
 // (OpenABLE/evaluation/matrix_file.h: the .npy reader, the text reader, or an image through
 // OpenCV's codecs). A .npy file must read as the same matrix as its bytes decode to. The
 // expected outcomes are a matrix or one InputError line (naming the file for ReadMatrixFile);
@@ -16,10 +16,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "OpenABLE/evaluation/matrix_file.h"
 #include "OpenABLE/evaluation/saved_settings.h"

@@ -3,6 +3,11 @@
 // detectors of tests/fuzz/map_detectors.h and small bags with the topic "/image".
 //   build_fuzz/tests/fuzz/write_seeds tests/fuzz/corpus
 // The other seeds are written by hand or by NumPy (docs/robustness.md, "Fuzz targets").
+#include <rosbag/bag.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <sensor_msgs/Image.h>
+#include <std_msgs/String.h>
+
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
@@ -10,15 +15,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <string>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
-#include <rosbag/bag.h>
-#include <sensor_msgs/CompressedImage.h>
-#include <sensor_msgs/Image.h>
-#include <std_msgs/String.h>
+#include <string>
+#include <vector>
 
 #include "OpenABLE/io/image_codec.h"
 #include "OpenABLE/online/online.h"

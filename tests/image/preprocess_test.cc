@@ -1,10 +1,10 @@
 // Illumination invariance (Eq. 6, 7 of the OpenABLE paper).
 #include "OpenABLE/image/preprocess.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <filesystem>
-
-#include <gtest/gtest.h>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/io/frame_source.h"

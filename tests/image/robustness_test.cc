@@ -1,9 +1,9 @@
 // Side-window multilayer fusion and noise injection (OpenABLE/image/robustness.h).
 #include "OpenABLE/image/robustness.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 
 #include "OpenABLE/base/error.h"
@@ -151,7 +151,7 @@ TEST(SideWindow, StepEdgeStaysSharpWhereABoxFilterBlursIt) {
   EXPECT_EQ(cv::norm(out, im, cv::NORM_INF), 0);  // every pixel unchanged: the edge is sharp
   cv::Mat blurred = im.clone();
   for (int r : {1, 2, 3}) cv::blur(blurred, blurred, cv::Size(2 * r + 1, 2 * r + 1));
-  EXPECT_GT(std::abs(blurred.at<uchar>(10, 9) - 40), 30);   // the box filter blurs the edge
+  EXPECT_GT(std::abs(blurred.at<uchar>(10, 9) - 40), 30);  // the box filter blurs the edge
   EXPECT_GT(std::abs(blurred.at<uchar>(10, 10) - 200), 30);
 }
 
@@ -211,10 +211,14 @@ TEST(Noise, SaltAndPepperFractionMatchesTheKey) {
   for (int y = 0; y < noisy.rows; ++y)
     for (int x = 0; x < noisy.cols; ++x) {
       const cv::Vec3f v = noisy.at<cv::Vec3f>(y, x);
-      if (v == cv::Vec3f(1, 1, 1)) ++salt;
-      else if (v == cv::Vec3f(0, 0, 0)) ++pepper;
-      else if (v == cv::Vec3f(0.4f, 0.5f, 0.6f)) continue;
-      else ++other;
+      if (v == cv::Vec3f(1, 1, 1))
+        ++salt;
+      else if (v == cv::Vec3f(0, 0, 0))
+        ++pepper;
+      else if (v == cv::Vec3f(0.4f, 0.5f, 0.6f))
+        continue;
+      else
+        ++other;
     }
   EXPECT_EQ(other, 0);
   // 60000 pixels, p = 0.1: sd of the fraction = 0.0012.
@@ -225,7 +229,7 @@ TEST(Noise, SaltAndPepperFractionMatchesTheKey) {
 TEST(Noise, OverexposureMultipliesAndSaturates) {
   cv::Mat frame(1, 4, CV_32FC1);
   frame.at<float>(0, 0) = 0.1f, frame.at<float>(0, 1) = 0.3f, frame.at<float>(0, 2) = 0.6f,
-  frame.at<float>(0, 3) = 1.0f;
+                     frame.at<float>(0, 3) = 1.0f;
   NoiseOptions o;
   o.overexposure = 1.0;
   const cv::Mat out = AddNoise(frame, o, 1);
@@ -309,8 +313,7 @@ TEST(Noise, DescribeSequenceIsIndependentOfThreadsAndDiffersByFrame) {
   EXPECT_EQ(cv::norm(one, four, cv::NORM_INF), 0);
   // Frame i equals AddNoise with its own state, then grey, then fusion.
   for (int i : {0, 17}) {
-    const cv::Mat grey =
-        ToGray8(AddNoise(src.Read(i), opt.preprocess.noise, NoiseState(5, 0, i)));
+    const cv::Mat grey = ToGray8(AddNoise(src.Read(i), opt.preprocess.noise, NoiseState(5, 0, i)));
     const cv::Mat fused = SideWindowFusion(grey, {1, 2});
     cv::Mat expect;
     fused.reshape(1, 1).convertTo(expect, CV_32F);

@@ -30,9 +30,9 @@ namespace openable {
 namespace {
 
 namespace fs = std::filesystem;
-using openable::testing::TempDir;
 using openable::testing::ExpectInputError;
 using openable::testing::Q;
+using openable::testing::TempDir;
 using openable::testing::WriteBytes;
 
 // ---------------------------------------------------------------------------------------------
@@ -71,7 +71,6 @@ cv::Mat Noise(int width, int height, int type, std::uint64_t seed) {
   rng.fill(m, cv::RNG::UNIFORM, 0, 256);
   return m;
 }
-
 
 // ---------------------------------------------------------------------------------------------
 // NaturalLess
@@ -199,8 +198,8 @@ class ListImagesTest : public ::testing::Test {
 TEST_F(ListImagesTest, ExtensionFilterInNaturalOrder) {
   // Case-sensitive natural order: 'I' (0x49) comes before 'i' (0x69).
   // The dangling link broken.png is listed: a frame the user meant, named when read.
-  const std::vector<std::string> pngs = {P("IMG3.PNG"),  P("broken.png"), P("img1.png"),
-                                         P("img2.png"),  P("img10.png"),  P("link5.png")};
+  const std::vector<std::string> pngs = {P("IMG3.PNG"), P("broken.png"), P("img1.png"),
+                                         P("img2.png"), P("img10.png"),  P("link5.png")};
   EXPECT_EQ(ListImages(dir_, "png"), pngs);
   EXPECT_EQ(ListImages(dir_, ".png"), pngs);
   EXPECT_EQ(ListImages(dir_, "PNG"), pngs);
@@ -210,8 +209,8 @@ TEST_F(ListImagesTest, ExtensionFilterInNaturalOrder) {
 }
 
 TEST_F(ListImagesTest, EmptyExtensionKeepsEverySupportedImage) {
-  const std::vector<std::string> all = {P("IMG3.PNG"),  P("broken.png"), P("img1.png"),
-                                        P("img2.png"),  P("img10.png"),  P("link5.png"),
+  const std::vector<std::string> all = {P("IMG3.PNG"), P("broken.png"), P("img1.png"),
+                                        P("img2.png"), P("img10.png"),  P("link5.png"),
                                         P("photo.jpg")};
   EXPECT_EQ(ListImages(dir_, ""), all);
 }
@@ -504,9 +503,9 @@ TEST(ReadImageFile, OpenCVAndOpenImageIOPathsAgree) {
   cv::randu(grey16, 0, 65536);
   cv::Mat rgba = Noise(30, 20, CV_8UC4, 21);
   std::vector<std::pair<std::string, cv::Mat>> files = {
-      {"grey.png", Noise(30, 20, CV_8UC1, 11)}, {"grey16.png", grey16},
+      {"grey.png", Noise(30, 20, CV_8UC1, 11)},   {"grey16.png", grey16},
       {"colour.png", Noise(30, 20, CV_8UC3, 12)}, {"rgba.png", rgba},
-      {"grey.pgm", Noise(30, 20, CV_8UC1, 13)},  {"grey16.pgm", grey16},
+      {"grey.pgm", Noise(30, 20, CV_8UC1, 13)},   {"grey16.pgm", grey16},
       {"colour.ppm", Noise(30, 20, CV_8UC3, 14)}, {"colour.bmp", Noise(30, 20, CV_8UC3, 15)},
       {"colour.jpg", Noise(30, 20, CV_8UC3, 16)}};
   for (const auto& [name, image] : files) {
@@ -520,8 +519,9 @@ TEST(ReadImageFile, OpenCVAndOpenImageIOPathsAgree) {
     // JPEG: both decode with libjpeg, possibly with different IDCT or upsampling settings.
     // 16-bit PNM: OpenImageIO reads it through float and loses one step at the top
     // (65535 -> 65534); OpenCV is exact, as checked against the written values below.
-    const double tolerance =
-        name == "colour.jpg" ? 3.0 / 255.0 : name == "grey16.pgm" ? 1.0 / 65535 + 1e-7 : 1e-6;
+    const double tolerance = name == "colour.jpg"   ? 3.0 / 255.0
+                             : name == "grey16.pgm" ? 1.0 / 65535 + 1e-7
+                                                    : 1e-6;
     EXPECT_LE(cv::norm(fast, reference, cv::NORM_INF), tolerance) << name;
     if (name == "colour.jpg") continue;
     cv::Mat expected = image;
@@ -545,7 +545,8 @@ TEST(ReadImageFile, PngWithBadCrcIsRefusedQuietly) {
   WriteBytes(path, bytes);
   ::testing::internal::CaptureStderr();
   ExpectInputError([&] { ReadImageFile(path); },
-                   {"image " + Q(path) + " cannot be decoded: damaged PNG: the checksum (CRC) "
+                   {"image " + Q(path) +
+                    " cannot be decoded: damaged PNG: the checksum (CRC) "
                     "of its IDAT chunk does not match its data"});
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
 }

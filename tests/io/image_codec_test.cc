@@ -2,22 +2,20 @@
 // (libdeflate) against OpenCV's own codecs.
 #include "OpenABLE/io/image_codec.h"
 
+#include <gtest/gtest.h>
 #include <png.h>
 
-#include <gtest/gtest.h>
-
 #include <algorithm>
-#include <iterator>
-#include <fstream>
-#include <filesystem>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <string>
-#include <vector>
-
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 #include "OpenABLE/base/error.h"
 #include "tests/test_support.h"
@@ -111,8 +109,8 @@ TEST(DecodePng, SamePixelsAsOpenCvForEveryLayout) {
     cases.push_back({"OpenCV " + cv::typeToString(type), bytes, false});
   }
   std::vector<unsigned char> bilevel;
-  ASSERT_TRUE(cv::imencode(".png", Random(9, 21, CV_8UC1, 5) > 128, bilevel,
-                           {cv::IMWRITE_PNG_BILEVEL, 1}));
+  ASSERT_TRUE(
+      cv::imencode(".png", Random(9, 21, CV_8UC1, 5) > 128, bilevel, {cv::IMWRITE_PNG_BILEVEL, 1}));
   cases.push_back({"1-bit grey", bilevel, false});
   const int w = 19, h = 11;
   cv::RNG rng(4);
@@ -121,22 +119,28 @@ TEST(DecodePng, SamePixelsAsOpenCvForEveryLayout) {
     for (auto& b : v) b = static_cast<unsigned char>(rng.uniform(0, max));
     return v;
   };
-  cases.push_back({"palette", LibpngFile(w, h, 8, PNG_COLOR_TYPE_PALETTE, false,
-                                         bytes_of(w * h, 16)), false});
-  cases.push_back({"palette + tRNS", LibpngFile(w, h, 8, PNG_COLOR_TYPE_PALETTE, false,
-                                                bytes_of(w * h, 16), true), false});
-  cases.push_back({"4-bit grey", LibpngFile(w, h, 4, PNG_COLOR_TYPE_GRAY, false,
-                                            bytes_of((w + 1) / 2 * h, 256)), false});
-  cases.push_back({"2-bit grey", LibpngFile(w, h, 2, PNG_COLOR_TYPE_GRAY, false,
-                                            bytes_of((w + 3) / 4 * h, 256)), false});
-  cases.push_back({"grey + alpha 8", LibpngFile(w, h, 8, PNG_COLOR_TYPE_GRAY_ALPHA, false,
-                                                bytes_of(w * h * 2, 256)), true});
-  cases.push_back({"grey + alpha 16", LibpngFile(w, h, 16, PNG_COLOR_TYPE_GRAY_ALPHA, false,
-                                                 bytes_of(w * h * 4, 256)), true});
-  cases.push_back({"interlaced RGB", LibpngFile(w, h, 8, PNG_COLOR_TYPE_RGB, true,
-                                                bytes_of(w * h * 3, 256)), false});
-  cases.push_back({"interlaced 16-bit grey", LibpngFile(w, h, 16, PNG_COLOR_TYPE_GRAY, true,
-                                                        bytes_of(w * h * 2, 256)), false});
+  cases.push_back(
+      {"palette", LibpngFile(w, h, 8, PNG_COLOR_TYPE_PALETTE, false, bytes_of(w * h, 16)), false});
+  cases.push_back({"palette + tRNS",
+                   LibpngFile(w, h, 8, PNG_COLOR_TYPE_PALETTE, false, bytes_of(w * h, 16), true),
+                   false});
+  cases.push_back({"4-bit grey",
+                   LibpngFile(w, h, 4, PNG_COLOR_TYPE_GRAY, false, bytes_of((w + 1) / 2 * h, 256)),
+                   false});
+  cases.push_back({"2-bit grey",
+                   LibpngFile(w, h, 2, PNG_COLOR_TYPE_GRAY, false, bytes_of((w + 3) / 4 * h, 256)),
+                   false});
+  cases.push_back({"grey + alpha 8",
+                   LibpngFile(w, h, 8, PNG_COLOR_TYPE_GRAY_ALPHA, false, bytes_of(w * h * 2, 256)),
+                   true});
+  cases.push_back({"grey + alpha 16",
+                   LibpngFile(w, h, 16, PNG_COLOR_TYPE_GRAY_ALPHA, false, bytes_of(w * h * 4, 256)),
+                   true});
+  cases.push_back({"interlaced RGB",
+                   LibpngFile(w, h, 8, PNG_COLOR_TYPE_RGB, true, bytes_of(w * h * 3, 256)), false});
+  cases.push_back({"interlaced 16-bit grey",
+                   LibpngFile(w, h, 16, PNG_COLOR_TYPE_GRAY, true, bytes_of(w * h * 2, 256)),
+                   false});
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     cv::Mat got;
@@ -151,8 +155,8 @@ TEST(DecodePng, SamePixelsAsOpenCvForEveryLayout) {
 // each layout of 8-bit samples, sizes from one pixel to rows longer than zlib's fast loop
 // needs, one IDAT chunk and many, against OpenCV's decoder (libpng).
 TEST(DecodePng, EveryFilterOfEightBitLayoutsAsOpenCv) {
-  const int kFilters[] = {PNG_FILTER_NONE, PNG_FILTER_SUB, PNG_FILTER_UP, PNG_FILTER_AVG,
-                          PNG_FILTER_PAETH, PNG_ALL_FILTERS};
+  const int kFilters[] = {PNG_FILTER_NONE, PNG_FILTER_SUB,   PNG_FILTER_UP,
+                          PNG_FILTER_AVG,  PNG_FILTER_PAETH, PNG_ALL_FILTERS};
   const int kColours[] = {PNG_COLOR_TYPE_GRAY, PNG_COLOR_TYPE_GRAY_ALPHA, PNG_COLOR_TYPE_RGB,
                           PNG_COLOR_TYPE_RGB_ALPHA};
   const cv::Size kSizes[] = {{1, 1}, {3, 2}, {64, 32}, {301, 7}};
@@ -169,11 +173,11 @@ TEST(DecodePng, EveryFilterOfEightBitLayoutsAsOpenCv) {
           std::vector<unsigned char> data(static_cast<std::size_t>(size.area()) * channels);
           for (std::size_t i = 0; i < data.size(); ++i)
             data[i] = static_cast<unsigned char>((i * 7 / 3) % 256 + rng.uniform(0, 9));
-          SCOPED_TRACE("colour " + std::to_string(colour) + " size " +
-                       std::to_string(size.width) + "x" + std::to_string(size.height) +
-                       " filters " + std::to_string(filters) + " idat " + std::to_string(idat));
-          const std::vector<unsigned char> bytes = LibpngFile(
-              size.width, size.height, 8, colour, false, data, false, filters, idat);
+          SCOPED_TRACE("colour " + std::to_string(colour) + " size " + std::to_string(size.width) +
+                       "x" + std::to_string(size.height) + " filters " + std::to_string(filters) +
+                       " idat " + std::to_string(idat));
+          const std::vector<unsigned char> bytes =
+              LibpngFile(size.width, size.height, 8, colour, false, data, false, filters, idat);
           cv::Mat got;
           std::string why;
           ASSERT_TRUE(DecodePng(bytes, got, why)) << why;
@@ -195,11 +199,13 @@ TEST(DecodePng, ImageDataThatIsNotTheImagesIsRefused) {
   const auto file_of = [&](const std::vector<unsigned char>& filtered) {
     const std::vector<unsigned char> png = LibpngFile(w, h, 8, PNG_COLOR_TYPE_GRAY, false, data);
     const std::size_t idat = 8 + 25;  // after the signature and the IHDR chunk
-    const std::size_t length = (std::size_t{png[idat]} << 24) |
-                               (std::size_t{png[idat + 1]} << 16) |
+    const std::size_t length = (std::size_t{png[idat]} << 24) | (std::size_t{png[idat + 1]} << 16) |
                                (std::size_t{png[idat + 2]} << 8) | png[idat + 3];
     const std::size_t n = filtered.size();
-    std::vector<unsigned char> zlib = {0x78, 0x01, 0x01, static_cast<unsigned char>(n & 0xFF),
+    std::vector<unsigned char> zlib = {0x78,
+                                       0x01,
+                                       0x01,
+                                       static_cast<unsigned char>(n & 0xFF),
                                        static_cast<unsigned char>(n >> 8),
                                        static_cast<unsigned char>(~n & 0xFF),
                                        static_cast<unsigned char>((~n >> 8) & 0xFF)};
@@ -252,8 +258,8 @@ TEST(DecodePng, RealFramesAsOpenCv) {
   const std::string root = testing::DatasetsDir();
   if (!std::filesystem::is_directory(root)) GTEST_SKIP() << "no ../shared/datasets";
   int compared = 0;
-  for (const char* folder : {"kitti00_first1700", "euroc_stereo_pairs", "nordland_trimmed",
-                             "sussex_panoramas"}) {
+  for (const char* folder :
+       {"kitti00_first1700", "euroc_stereo_pairs", "nordland_trimmed", "sussex_panoramas"}) {
     std::vector<std::string> files;
     for (const auto& e : std::filesystem::recursive_directory_iterator(root + "/" + folder))
       if (e.path().extension() == ".png") files.push_back(e.path().string());

@@ -344,7 +344,8 @@ TEST(NpyObjects, HostileStructuresAreRefused) {
   std::string doubling = "]K\x05\x61q\x00\x30"s;
   for (int k = 0; k < 40; ++k) doubling += "](h\x00h\x00\x65q\x00\x30"s;
   ExpectInputError([&] { DecodeNpyObjects(ObjectNpy(doubling + "(h\x00l"s, 1), "h"); },
-                   {"h: the array unfolds into ", " values or more (lists referred to from "
+                   {"h: the array unfolds into ",
+                    " values or more (lists referred to from "
                     "several places count at each); expected at most 20000000"});
   // A range of 10^9 numbers (refused before any is made); the limit holds for all the ranges of
   // a file together: two of 500,001 numbers.
@@ -357,15 +358,16 @@ TEST(NpyObjects, HostileStructuresAreRefused) {
   std::string ranges = "(";
   for (int k = 0; k < 2; ++k) ranges += "c__builtin__\nxrange\nJ\x21\xa1\x07\x00\x85R"s;
   ExpectInputError([&] { DecodeNpyObjects(ObjectNpy(ranges + "l", 2), "h"); },
-                   {"h: REDUCE at byte", "make 500001 + 500001 numbers in all; expected at "
+                   {"h: REDUCE at byte",
+                    "make 500001 + 500001 numbers in all; expected at "
                     "most 1000000"});
   // 11 object arrays built from one list of a million elements: 11 million elements.
   std::string arrays = "(" + ObjectArrayOps(1000000, "(" + std::string(1000000, 'N') + "lq\x01");
   for (int k = 1; k < 11; ++k) arrays += ObjectArrayOps(1000000, "h\x01");
-  ExpectInputError(
-      [&] { DecodeNpyObjects(ObjectNpy(arrays + "l", 11), "h"); },
-      {"h: BUILD at byte", "the arrays hold 10000000 + 1000000 elements in all; expected at most "
-       "10000000"});
+  ExpectInputError([&] { DecodeNpyObjects(ObjectNpy(arrays + "l", 11), "h"); },
+                   {"h: BUILD at byte",
+                    "the arrays hold 10000000 + 1000000 elements in all; expected at most "
+                    "10000000"});
   // Integers beyond 64 bits.
   ExpectInputError(
       [] {
@@ -506,8 +508,8 @@ TEST(Npz, TruncatedAndDamagedArchives) {
 
 // A bool .npy of rows x cols, eye-like (cell (i, i) true).
 std::string BoolNpy(int rows, int cols) {
-  std::string data = NpyHeaderOf("'|b1'", "(" + std::to_string(rows) + ", " +
-                                               std::to_string(cols) + ")");
+  std::string data =
+      NpyHeaderOf("'|b1'", "(" + std::to_string(rows) + ", " + std::to_string(cols) + ")");
   for (int i = 0; i < rows; ++i)
     for (int j = 0; j < cols; ++j) data += static_cast<char>(i == j ? 1 : 0);
   return data;
@@ -518,7 +520,8 @@ std::string BoolNpy(int rows, int cols) {
 TEST(Npz, ReadsArchivesOfTheTestWriter) {
   const std::string eye = BoolNpy(3, 3);
   for (const bool deflate : {false, true}) {
-    const std::string zip = ZipArchive({{"GThard.npy", eye, deflate}, {"GTsoft.npy", "x", deflate}});
+    const std::string zip =
+        ZipArchive({{"GThard.npy", eye, deflate}, {"GTsoft.npy", "x", deflate}});
     EXPECT_EQ(NpzMemberNames(zip, "z"), (std::vector<std::string>{"GThard.npy", "GTsoft.npy"}));
     EXPECT_EQ(NpzMember(zip, "GThard", "z"), eye);
     EXPECT_EQ(NpzMember(zip, "GTsoft.npy", "z"), "x");
@@ -553,11 +556,15 @@ TEST(Npz, MemberLargerThanTheCallerExpectsIsRefusedBeforeInflating) {
   // Within the limit, but the data inflate to more than declared: damaged, the buffer is the
   // declared size. Stored members must declare their real size.
   ExpectInputError(
-      [] { NpzMember(ZipArchive({{"GThard.npy", std::string(5000, 'a'), true, 100}}), "GThard", "z"); },
+      [] {
+        NpzMember(ZipArchive({{"GThard.npy", std::string(5000, 'a'), true, 100}}), "GThard", "z");
+      },
       {"z: member \"GThard.npy\": damaged deflate data (they do not inflate to the 100 bytes "
        "announced)"});
   ExpectInputError(
-      [] { NpzMember(ZipArchive({{"GThard.npy", "abcd", false, 100}}), "GThard", "z"); },
+      [] {
+        NpzMember(ZipArchive({{"GThard.npy", "abcd", false, 100}}), "GThard", "z");
+      },
       {"z: member \"GThard.npy\" is stored with sizes that differ (4 and 100 bytes)"});
 }
 
@@ -566,9 +573,9 @@ TEST(Npz, ArchivesThatMeanSomethingElseToNumpyAreRefused) {
   const std::string hard = BoolNpy(2, 2), other = BoolNpy(3, 3);
   // Two members of one name: np.load reads the last, this reader would read the first.
   const std::string twice = ZipArchive({{"GThard.npy", hard}, {"GThard.npy", other}});
-  for (const auto& read : std::vector<std::function<void()>>{
-           [&] { NpzMemberNames(twice, Q("GT.npz")); },
-           [&] { NpzMember(twice, "GThard", Q("GT.npz")); }}) {
+  for (const auto& read :
+       std::vector<std::function<void()>>{[&] { NpzMemberNames(twice, Q("GT.npz")); },
+                                          [&] { NpzMember(twice, "GThard", Q("GT.npz")); }}) {
     ExpectInputError(read, {Q("GT.npz") + ": the archive holds two members named "
                                           "\"GThard.npy\" (entries 1 and 2 of its central "
                                           "directory); expected one member of each name (NumPy "
@@ -584,13 +591,18 @@ TEST(Npz, ArchivesThatMeanSomethingElseToNumpyAreRefused) {
       {"z: the archive holds two members named \"GTsoft.npy\" (entries 1 and 3"});
   // "GThard" and "GThard.npy": np.load's key "GThard" reads the first, this reader the second.
   ExpectInputError(
-      [&] { NpzMember(ZipArchive({{"GThard", other}, {"GThard.npy", hard}}), "GThard", "z"); },
+      [&] {
+        NpzMember(ZipArchive({{"GThard", other}, {"GThard.npy", hard}}), "GThard", "z");
+      },
       {"z: the archive holds members named \"GThard\" and \"GThard.npy\", which np.load takes "
        "for one (entries 1 and 2"});
   // An entry the end record does not count: zipfile reads it, and it may be a second GThard.
   ExpectInputError(
-      [&] { NpzMemberNames(ZipArchive({{"GThard.npy", hard}, {"GThard.npy", other}}, 1), "z"); },
-      {"z: damaged ZIP archive: its central directory holds ", " bytes after the 1 members its "
+      [&] {
+        NpzMemberNames(ZipArchive({{"GThard.npy", hard}, {"GThard.npy", other}}, 1), "z");
+      },
+      {"z: damaged ZIP archive: its central directory holds ",
+       " bytes after the 1 members its "
        "end record announces"});
   // A local header that names another file (zipfile refuses it).
   ZipEntry renamed{"GThard.npy", hard};
@@ -598,9 +610,12 @@ TEST(Npz, ArchivesThatMeanSomethingElseToNumpyAreRefused) {
   ExpectInputError([&] { NpzMember(ZipArchive({renamed}), "GThard.npy", "z"); },
                    {"z: member \"GThard.npy\": its local header at byte 0 names another file"});
   // An archive appended to other bytes: zipfile moves every offset by their length.
-  ExpectInputError([&] { NpzMemberNames(ZipArchive({{"GThard.npy", hard}}, -1, "prefix"), "z"); },
-                   {"z: damaged ZIP archive: its central directory ends at byte ",
-                    "its end record is at byte ", "expected them to meet"});
+  ExpectInputError(
+      [&] {
+        NpzMemberNames(ZipArchive({{"GThard.npy", hard}}, -1, "prefix"), "z");
+      },
+      {"z: damaged ZIP archive: its central directory ends at byte ", "its end record is at byte ",
+       "expected them to meet"});
 }
 
 // An archive without members (np.savez of nothing: 22 bytes) says so.
@@ -629,7 +644,9 @@ TEST(NpyObjects, CallersLimitsAreAppliedBeforeTheWorkIsDone) {
       [&] { DecodeNpyObjects(ObjectNpy("(K\x01l"s, 1, "(100, 2)"), "h", limits); },
       {"h: shape (100, 2) holds 200 elements; expected at most 100 (the run's 3 queries)"});
   ExpectInputError(
-      [&] { DecodeNpyObjects(NpyHeaderOf("'<i8'", "(101,)") + std::string(808, '\0'), "h", limits); },
+      [&] {
+        DecodeNpyObjects(NpyHeaderOf("'<i8'", "(101,)") + std::string(808, '\0'), "h", limits);
+      },
       {"h: shape (101,) holds 101 elements; expected at most 100"});
   // A range of 10^9 numbers: refused with the caller's limit, before any number is made.
   ExpectInputError(
@@ -637,24 +654,28 @@ TEST(NpyObjects, CallersLimitsAreAppliedBeforeTheWorkIsDone) {
         DecodeNpyObjects(ObjectNpy("(cbuiltins\nrange\nK\x00J\x00\xca\x9a\x3b\x86Rl"s, 1), "h",
                          limits);
       },
-      {"h: REDUCE at byte ", ": the range objects make 1000000000 numbers in all; expected at "
-                              "most 100 (the run's 3 queries)"});
+      {"h: REDUCE at byte ",
+       ": the range objects make 1000000000 numbers in all; expected at "
+       "most 100 (the run's 3 queries)"});
   // A range longer than one list may be, however few the numbers in all.
   NpyObjectLimits one_list;
   one_list.range = 59;
   one_list.expected = "a query's references";
   ExpectInputError(
       [&] { DecodeNpyObjects(ObjectNpy("(cbuiltins\nrange\nK\x3c\x85Rl"s, 1), "h", one_list); },
-      {"h: REDUCE at byte ", ": range(0, 60, 1) makes 60 numbers; expected at most 59 in one "
-                              "list (a query's references)"});
+      {"h: REDUCE at byte ",
+       ": range(0, 60, 1) makes 60 numbers; expected at most 59 in one "
+       "list (a query's references)"});
   one_list.range = 60;
   EXPECT_EQ(DecodeNpyObjects(ObjectNpy("(cbuiltins\nrange\nK\x3c\x85Rl"s, 1), "h", one_list)
-                .items[0]->items.size(),
+                .items[0]
+                ->items.size(),
             60u);
   // A range of 60 numbers held by 2 elements: 1 + 2 x 61 = 123 values once unfolded.
   const std::string memoised = "(cbuiltins\nrange\nK\x3c\x85Rq\x01h\x01l"s;
   ExpectInputError([&] { DecodeNpyObjects(ObjectNpy(memoised, 2), "h", limits); },
-                   {"h: the array unfolds into ", " values or more (lists referred to from "
+                   {"h: the array unfolds into ",
+                    " values or more (lists referred to from "
                     "several places count at each); expected at most 100 (the run's 3 queries)"});
   limits.values = 123;
   const NpyObjects read = DecodeNpyObjects(ObjectNpy(memoised, 2), "h", limits);
@@ -663,16 +684,16 @@ TEST(NpyObjects, CallersLimitsAreAppliedBeforeTheWorkIsDone) {
   EXPECT_EQ(read.items[1]->items.size(), 60u);
   // A numeric array inside the pickle (protocol 5's _frombuffer) counts its elements.
   limits.values = 10;
-  const std::string buffer =
-      "(cnumpy.core.numeric\n_frombuffer\n(B\x58\x00\x00\x00"s + std::string(88, '\0') +
-      "cnumpy\ndtype\nX\x02\x00\x00\x00i8\x85RK\x0b\x85X\x01\x00\x00\x00"
-      "CtRl"s;
+  const std::string buffer = "(cnumpy.core.numeric\n_frombuffer\n(B\x58\x00\x00\x00"s +
+                             std::string(88, '\0') +
+                             "cnumpy\ndtype\nX\x02\x00\x00\x00i8\x85RK\x0b\x85X\x01\x00\x00\x00"
+                             "CtRl"s;
   // Without a limit it is read: eleven zeros.
-  ASSERT_EQ(Ints(*DecodeNpyObjects(ObjectNpy(buffer, 1), "h").items[0]),
-            Ints64(11, 0));
+  ASSERT_EQ(Ints(*DecodeNpyObjects(ObjectNpy(buffer, 1), "h").items[0]), Ints64(11, 0));
   ExpectInputError([&] { DecodeNpyObjects(ObjectNpy(buffer, 1), "h", limits); },
-                   {"h: REDUCE at byte ", ": the arrays hold 11 elements in all; expected at "
-                                          "most 10"});
+                   {"h: REDUCE at byte ",
+                    ": the arrays hold 11 elements in all; expected at "
+                    "most 10"});
 }
 
 // The matrix fuzzer's seeds (tests/fuzz/corpus/matrix; the first byte chooses the extension
@@ -715,8 +736,9 @@ TEST(NpyObjects, MatrixFuzzerSeedsAreReadOrRefusedInOneLine) {
       {"npz_local_name_differs.npz", "its local header at byte 0 names another file"},
       {"npz_declared_4gb.npz", "holds 4294967294 bytes once inflated"},
       {"npz_empty.npz", "is an empty ZIP archive (no member)"},
-      {"objects_memoised_range.npy", "the range objects make 2000000 numbers in all; expected "
-                                     "at most 1000000"},
+      {"objects_memoised_range.npy",
+       "the range objects make 2000000 numbers in all; expected "
+       "at most 1000000"},
   };
   for (const auto& [seed, part] : expected) {
     ASSERT_EQ(refusals.count(seed), 1u) << seed << " is not in " << corpus;

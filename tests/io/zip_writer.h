@@ -46,10 +46,10 @@ struct ZipEntry {
   ZipEntry(std::string n, std::string d, bool deflated = true, std::int64_t declared_size = -1)
       : name(std::move(n)), data(std::move(d)), deflate(deflated), declared(declared_size) {}
   std::string name;
-  std::string data;           // the member's bytes once inflated
-  bool deflate = true;        // method 8 (stored deflate blocks), else 0 (stored)
+  std::string data;            // the member's bytes once inflated
+  bool deflate = true;         // method 8 (stored deflate blocks), else 0 (stored)
   std::int64_t declared = -1;  // the uncompressed size the headers declare (-1: data's size)
-  std::string local_name;     // the local header's name (empty: `name`)
+  std::string local_name;      // the local header's name (empty: `name`)
 };
 
 namespace zip_internal {
@@ -67,8 +67,8 @@ inline std::string ZipArchive(const std::vector<ZipEntry>& entries, int announce
   std::string local, directory;
   for (const ZipEntry& e : entries) {
     const std::string stored = e.deflate ? StoredDeflate(e.data) : e.data;
-    const std::uint64_t size = e.declared >= 0 ? static_cast<std::uint64_t>(e.declared)
-                                               : e.data.size();
+    const std::uint64_t size =
+        e.declared >= 0 ? static_cast<std::uint64_t>(e.declared) : e.data.size();
     const std::string& local_name = e.local_name.empty() ? e.name : e.local_name;
     const std::uint64_t offset = local.size();
     Put(local, 0x04034b50, 4);
@@ -100,8 +100,8 @@ inline std::string ZipArchive(const std::vector<ZipEntry>& entries, int announce
     Put(directory, offset, 4);
     directory += e.name;
   }
-  const std::uint64_t count = announced >= 0 ? static_cast<std::uint64_t>(announced)
-                                             : entries.size();
+  const std::uint64_t count =
+      announced >= 0 ? static_cast<std::uint64_t>(announced) : entries.size();
   std::string end;
   Put(end, 0x06054b50, 4);
   Put(end, 0, 4);  // disks

@@ -534,14 +534,15 @@ TEST(ApproximateIndex, BinaryIvfScansItsCellsWithExactDistances) {
     ApproximateOptions all = EngineOptions("ivf"), one = all;
     all.nprobe = 65536;
     one.nprobe = 1;
-    ExpectSameLists(NaiveNearest(refs, queries, all.k), ApproximateIndex(refs, all).Search(queries));
+    ExpectSameLists(NaiveNearest(refs, queries, all.k),
+                    ApproximateIndex(refs, all).Search(queries));
     const CandidateLists lists = ApproximateIndex(refs, one).Search(queries);
     for (int q = 0; q < queries.rows; ++q) {
       const std::vector<Candidate>& list = lists[static_cast<size_t>(q)];
       ASSERT_FALSE(list.empty());
       for (std::size_t i = 0; i < list.size(); ++i) {
-        EXPECT_EQ(list[i].distance, cv::norm(queries.row(q), refs.row(list[i].reference),
-                                             cv::NORM_HAMMING));
+        EXPECT_EQ(list[i].distance,
+                  cv::norm(queries.row(q), refs.row(list[i].reference), cv::NORM_HAMMING));
         if (i > 0) {
           EXPECT_TRUE(list[i - 1].distance < list[i].distance ||
                       (list[i - 1].distance == list[i].distance &&
@@ -630,8 +631,7 @@ TEST(ApproximateIndex, RejectsBadFaissOptions) {
       {with([](ApproximateOptions& o) { o.engine = "annoy"; }),
        "engine = \"annoy\", expected one of flann, hnsw, ivf, binary_ivf or auto"},
       {with([](ApproximateOptions& o) { o.hnsw_m = 2; }), "hnsw_m = 2, expected 4..128"},
-      {with([](ApproximateOptions& o) { o.hnsw_ef_construction = 0; }),
-       "hnsw_ef_construction = 0"},
+      {with([](ApproximateOptions& o) { o.hnsw_ef_construction = 0; }), "hnsw_ef_construction = 0"},
       {with([](ApproximateOptions& o) { o.ef_search = 0; }), "ef_search = 0, expected 1..100000"},
       {with([](ApproximateOptions& o) { o.ivf_lists = -1; }), "ivf_lists = -1"},
       {with([](ApproximateOptions& o) { o.nprobe = 0; }), "nprobe = 0, expected 1..65536"},
@@ -661,8 +661,7 @@ TEST(ApproximateIndex, FaissEnginesNeedFaissInTheBuild) {
       CheckEngineAvailable(engine, "Approximate_engine");
       ADD_FAILURE() << "accepted without FAISS";
     } catch (const InputError& e) {
-      EXPECT_EQ(std::string(e.what()).rfind("Approximate_engine: " + engine, 0), 0u)
-          << e.what();
+      EXPECT_EQ(std::string(e.what()).rfind("Approximate_engine: " + engine, 0), 0u) << e.what();
     }
     EXPECT_THROW(ApproximateIndex(RandomBytes(10, 32, 161), EngineOptions(engine)), InputError);
   }

@@ -1,16 +1,15 @@
 #include "matching/blas.h"
 
 #include <dlfcn.h>
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdlib>
-#include <string>
+#include <opencv2/core.hpp>
 #include <random>
+#include <string>
 #include <thread>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/core.hpp>
 
 #include "matching/distances.h"
 
@@ -33,8 +32,9 @@ bool KernelsRunHere() {
 }
 
 #define SKIP_UNLESS_KERNELS_RUN_HERE()                                                  \
-  if (!KernelsRunHere()) GTEST_SKIP() << "this CPU cannot run OpenBLAS's " \
-                                      << std::getenv("OPENBLAS_CORETYPE") << " kernels"
+  if (!KernelsRunHere())                                                                \
+  GTEST_SKIP() << "this CPU cannot run OpenBLAS's " << std::getenv("OPENBLAS_CORETYPE") \
+               << " kernels"
 
 cv::Mat1f Normal(int rows, int cols, unsigned seed, float offset = 0.0f) {
   std::mt19937 rng(seed);

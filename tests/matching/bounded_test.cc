@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <cstring>
+#include <limits>
 #include <numeric>
 #include <random>
 
@@ -60,52 +60,53 @@ void ExpectSame(const std::vector<Match>& a, const std::vector<Match>& b, float 
 TEST(BoundedMatches, EqualsBruteForceSelectionOfTheDenseMatrix) {
   const cv::Mat d = RandomBinary(150, 32, 3);
   for (const SequencePartial partial : {SequencePartial::kScale, SequencePartial::kAhead})
-  for (int traversals : {1, 2}) {
-    const std::vector<int> starts = traversals == 1 ? std::vector<int>{0} : std::vector<int>{0, 70};
-    const MatchBlock block = BlockOf(starts, d.rows);
-    KeepRules rules;
-    rules.best = 4;
-    rules.band = 2;
-    rules.exclusion = 10;
-    rules.one_traversal = block.one_traversal;
-    for (int L : {1, 3, 8}) {
-      for (auto dir : {SequenceDirection::kForward, SequenceDirection::kReverse,
-                       SequenceDirection::kBoth}) {
-        SCOPED_TRACE("traversals " + std::to_string(traversals) + " L " + std::to_string(L) +
-                     " direction " + std::to_string(static_cast<int>(dir)) + " partial " +
-                     EnumName(partial));
-        // Dense: the block of the full matrix, with sums restricted to the block's traversals.
-        cv::Mat1f full = HammingDistances(d);
-        SequenceDistancesInPlace(full, L, starts, starts, dir, 0, partial);
-        std::vector<Match> expected;
-        float block_max = 0;
-        for (int q = 0; q < block.query_count; ++q) {
-          const int row = block.query_first + q;
-          for (int j = 0; j < block.reference_count; ++j)
-            if (std::isfinite(full(row, block.reference_first + j)))
-              block_max = std::max(block_max, full(row, block.reference_first + j));
-          for (const Match& m : SortedRow(full, row, q, block.reference_first,
-                                          block.reference_count, rules))
-            expected.push_back(m);
-        }
-        // Whole rows, and (along diagonals) tiles of 2 L or 12 columns rounded to blocks of
-        // four: many tile edges, with sums and ahead cells reaching across them.
-        for (const int tile : {-1, 9}) {
-          SCOPED_TRACE("tile " + std::to_string(tile));
-          BoundedOptions options;
-          options.sequence_length = L;
-          options.direction = dir;
-          options.partial = partial;
-          options.range_rows = 7;  // many ranges, each starting L - 1 rows early
-          options.tile_columns = tile;
-          float max_distance = 0;
-          const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
-          EXPECT_FLOAT_EQ(max_distance, block_max);
-          ExpectSame(got, expected, 1.0f / block_max);
+    for (int traversals : {1, 2}) {
+      const std::vector<int> starts =
+          traversals == 1 ? std::vector<int>{0} : std::vector<int>{0, 70};
+      const MatchBlock block = BlockOf(starts, d.rows);
+      KeepRules rules;
+      rules.best = 4;
+      rules.band = 2;
+      rules.exclusion = 10;
+      rules.one_traversal = block.one_traversal;
+      for (int L : {1, 3, 8}) {
+        for (auto dir :
+             {SequenceDirection::kForward, SequenceDirection::kReverse, SequenceDirection::kBoth}) {
+          SCOPED_TRACE("traversals " + std::to_string(traversals) + " L " + std::to_string(L) +
+                       " direction " + std::to_string(static_cast<int>(dir)) + " partial " +
+                       EnumName(partial));
+          // Dense: the block of the full matrix, with sums restricted to the block's traversals.
+          cv::Mat1f full = HammingDistances(d);
+          SequenceDistancesInPlace(full, L, starts, starts, dir, 0, partial);
+          std::vector<Match> expected;
+          float block_max = 0;
+          for (int q = 0; q < block.query_count; ++q) {
+            const int row = block.query_first + q;
+            for (int j = 0; j < block.reference_count; ++j)
+              if (std::isfinite(full(row, block.reference_first + j)))
+                block_max = std::max(block_max, full(row, block.reference_first + j));
+            for (const Match& m :
+                 SortedRow(full, row, q, block.reference_first, block.reference_count, rules))
+              expected.push_back(m);
+          }
+          // Whole rows, and (along diagonals) tiles of 2 L or 12 columns rounded to blocks of
+          // four: many tile edges, with sums and ahead cells reaching across them.
+          for (const int tile : {-1, 9}) {
+            SCOPED_TRACE("tile " + std::to_string(tile));
+            BoundedOptions options;
+            options.sequence_length = L;
+            options.direction = dir;
+            options.partial = partial;
+            options.range_rows = 7;  // many ranges, each starting L - 1 rows early
+            options.tile_columns = tile;
+            float max_distance = 0;
+            const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
+            EXPECT_FLOAT_EQ(max_distance, block_max);
+            ExpectSame(got, expected, 1.0f / block_max);
+          }
         }
       }
     }
-  }
 }
 
 // The hand-worked example of Match_consistency (tests/evaluation/metrics_test.cc) on the
@@ -174,8 +175,8 @@ TEST(BoundedMatches, VectorDescriptorsWithSequencesEqualTheDenseMatrix) {
   KeepRules rules;
   rules.best = 3;
   rules.one_traversal = false;
-  for (auto dir : {SequenceDirection::kForward, SequenceDirection::kReverse,
-                   SequenceDirection::kBoth}) {
+  for (auto dir :
+       {SequenceDirection::kForward, SequenceDirection::kReverse, SequenceDirection::kBoth}) {
     SCOPED_TRACE(static_cast<int>(dir));
     cv::Mat1f full = L2Distances(d);
     SequenceDistancesInPlace(full, 6, starts, starts, dir);
@@ -228,15 +229,14 @@ TEST(ApproximateMatches, FindsPlantedDuplicatesWithExactScores) {
         ApproximateMatches(d, block, rules, {}, approximate, max_distance);
     int found = 0;
     for (const Match& m : got) {
-      const float exact = static_cast<float>(HammingDistance(
-          d.ptr<std::uint8_t>(n + m.query), d.ptr<std::uint8_t>(m.reference), 32));
+      const float exact = static_cast<float>(
+          HammingDistance(d.ptr<std::uint8_t>(n + m.query), d.ptr<std::uint8_t>(m.reference), 32));
       EXPECT_NEAR(m.distance * max_distance, exact, 1e-3);
       if (m.rank == 1 && m.reference == m.query) ++found;
     }
     EXPECT_GE(found, 0.95 * n);
   }
 }
-
 
 // Sequence_partial skip and ahead, the ratio score and the L1 distance of SAD rows: the fused
 // run against the dense matrix of the tested pieces, selected and scored by brute force (empty
@@ -245,71 +245,69 @@ TEST(ApproximateMatches, FindsPlantedDuplicatesWithExactScores) {
 TEST(BoundedMatches, SkipAndAheadCellsAndRatioScoresEqualBruteForce) {
   const cv::Mat d = RandomBinary(120, 64, 9);
   for (const SequencePartial partial : {SequencePartial::kSkip, SequencePartial::kAhead})
-  for (int traversals : {1, 2}) {
-    const std::vector<int> starts =
-        traversals == 1 ? std::vector<int>{0} : std::vector<int>{0, 50};
-    const MatchBlock block = BlockOf(starts, d.rows);
-    KeepRules rules;
-    rules.best = 3;
-    rules.exclusion = 10;
-    rules.one_traversal = block.one_traversal;
-    rules.score = MatchScore::kRatio;
-    rules.score_window = 4;
-    for (auto dir : {SequenceDirection::kForward, SequenceDirection::kReverse,
-                     SequenceDirection::kBoth}) {
-      const int L = 6;
-      SCOPED_TRACE("traversals " + std::to_string(traversals) + " partial " +
-                   EnumName(partial) + " direction " + std::to_string(static_cast<int>(dir)));
-      cv::Mat1f full = L1Distances(d);
-      SequenceDistancesInPlace(full, L, starts, starts, dir, 0, partial);
-      float block_max = 0;
-      std::vector<Match> expected;
-      for (int q = 0; q < block.query_count; ++q) {
-        const int row = block.query_first + q;
-        std::vector<std::pair<float, int>> all;
-        for (int j = 0; j < block.reference_count; ++j) {
-          const float v = full(row, block.reference_first + j);
-          if (!std::isfinite(v)) continue;
-          block_max = std::max(block_max, v);
-          if (!rules.one_traversal || j <= q - rules.exclusion) all.emplace_back(v, j);
+    for (int traversals : {1, 2}) {
+      const std::vector<int> starts =
+          traversals == 1 ? std::vector<int>{0} : std::vector<int>{0, 50};
+      const MatchBlock block = BlockOf(starts, d.rows);
+      KeepRules rules;
+      rules.best = 3;
+      rules.exclusion = 10;
+      rules.one_traversal = block.one_traversal;
+      rules.score = MatchScore::kRatio;
+      rules.score_window = 4;
+      for (auto dir :
+           {SequenceDirection::kForward, SequenceDirection::kReverse, SequenceDirection::kBoth}) {
+        const int L = 6;
+        SCOPED_TRACE("traversals " + std::to_string(traversals) + " partial " + EnumName(partial) +
+                     " direction " + std::to_string(static_cast<int>(dir)));
+        cv::Mat1f full = L1Distances(d);
+        SequenceDistancesInPlace(full, L, starts, starts, dir, 0, partial);
+        float block_max = 0;
+        std::vector<Match> expected;
+        for (int q = 0; q < block.query_count; ++q) {
+          const int row = block.query_first + q;
+          std::vector<std::pair<float, int>> all;
+          for (int j = 0; j < block.reference_count; ++j) {
+            const float v = full(row, block.reference_first + j);
+            if (!std::isfinite(v)) continue;
+            block_max = std::max(block_max, v);
+            if (!rules.one_traversal || j <= q - rules.exclusion) all.emplace_back(v, j);
+          }
+          std::sort(all.begin(), all.end());
+          for (int r = 0; r < std::min<int>(rules.best, static_cast<int>(all.size())); ++r) {
+            float rival = std::numeric_limits<float>::infinity();
+            for (const auto& [v, j] : all)
+              if (std::abs(j - all[r].second) > rules.score_window) rival = std::min(rival, v);
+            const float ratio = std::isfinite(rival) && rival > 0 ? all[r].first / rival : 1.0f;
+            expected.push_back({q, all[r].second, all[r].first, r + 1, ratio});
+          }
         }
-        std::sort(all.begin(), all.end());
-        for (int r = 0; r < std::min<int>(rules.best, static_cast<int>(all.size())); ++r) {
-          float rival = std::numeric_limits<float>::infinity();
-          for (const auto& [v, j] : all)
-            if (std::abs(j - all[r].second) > rules.score_window) rival = std::min(rival, v);
-          const float ratio =
-              std::isfinite(rival) && rival > 0 ? all[r].first / rival : 1.0f;
-          expected.push_back({q, all[r].second, all[r].first, r + 1, ratio});
+        for (const int tile : {-1, 5}) {
+          SCOPED_TRACE("tile " + std::to_string(tile));
+          BoundedOptions options;
+          options.metric = Metric::kL1;
+          options.sequence_length = L;
+          options.direction = dir;
+          options.partial = partial;
+          options.range_rows = 7;
+          options.tile_columns = tile;  // along diagonals: tiles of 2 L = 12 columns
+          float max_distance = 0;
+          const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
+          EXPECT_FLOAT_EQ(max_distance, block_max);
+          ExpectSame(got, expected, 1.0f / block_max);
+          for (size_t k = 0; k < got.size() && k < expected.size(); ++k)
+            EXPECT_NEAR(got[k].score, expected[k].score, 1e-5) << k;
+          // The first L - 1 queries of a traversal have no complete sequence along diagonals.
+          if (dir == SequenceDirection::kForward && traversals == 2) {
+            const auto first = std::min_element(got.begin(), got.end(),
+                                                [](auto& a, auto& b) { return a.query < b.query; });
+            ASSERT_NE(first, got.end());
+            // skip: none before L - 1; ahead: the first query is answered.
+            EXPECT_EQ(first->query, partial == SequencePartial::kSkip ? L - 1 : 0);
+          }
         }
-      }
-      for (const int tile : {-1, 5}) {
-      SCOPED_TRACE("tile " + std::to_string(tile));
-      BoundedOptions options;
-      options.metric = Metric::kL1;
-      options.sequence_length = L;
-      options.direction = dir;
-      options.partial = partial;
-      options.range_rows = 7;
-      options.tile_columns = tile;  // along diagonals: tiles of 2 L = 12 columns
-      float max_distance = 0;
-      const std::vector<Match> got = BoundedMatches(d, block, rules, options, max_distance);
-      EXPECT_FLOAT_EQ(max_distance, block_max);
-      ExpectSame(got, expected, 1.0f / block_max);
-      for (size_t k = 0; k < got.size() && k < expected.size(); ++k)
-        EXPECT_NEAR(got[k].score, expected[k].score, 1e-5) << k;
-      // The first L - 1 queries of a traversal have no complete sequence along diagonals.
-      if (dir == SequenceDirection::kForward && traversals == 2) {
-        const auto first = std::min_element(got.begin(), got.end(), [](auto& a, auto& b) {
-          return a.query < b.query;
-        });
-        ASSERT_NE(first, got.end());
-        // skip: none before L - 1; ahead: the first query is answered.
-        EXPECT_EQ(first->query, partial == SequencePartial::kSkip ? L - 1 : 0);
-      }
       }
     }
-  }
 }
 
 }  // namespace

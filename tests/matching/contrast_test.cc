@@ -2,13 +2,13 @@
 // cell by cell here.
 #include "matching/contrast.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 namespace openable {
 namespace {
@@ -54,9 +54,9 @@ TEST(ContrastEnhancement, MatchesTheDefinitionWithTraversalsAndEmptyCells) {
   std::mt19937 rng(9);
   std::uniform_int_distribution<int> bits(0, 256), chance(0, 19);
   cv::Mat1f d(37, 90);
-  for (float& v : d) v = chance(rng) == 0 ? std::numeric_limits<float>::infinity()
-                                          : static_cast<float>(bits(rng));
-  d.row(5).setTo(42.0f);  // a uniform row: every cell 0 before the shift
+  for (float& v : d)
+    v = chance(rng) == 0 ? std::numeric_limits<float>::infinity() : static_cast<float>(bits(rng));
+  d.row(5).setTo(42.0f);                        // a uniform row: every cell 0 before the shift
   const std::vector<int> starts = {0, 40, 41};  // a one-frame traversal too
   for (int window : {1, 3, 10, 200})
     for (int threads : {1, 2, 3}) {
@@ -79,7 +79,6 @@ TEST(ContrastEnhancement, MatchesTheDefinitionWithTraversalsAndEmptyCells) {
   cv::Mat1f bad = d.clone();
   EXPECT_THROW(EnhanceContrast(bad, 0), std::logic_error);
 }
-
 
 // Without the shift: every cell the same z-score, the smallest returned; and no z-score of a
 // window of 2R + 1 values below -sqrt(2R) (Samuelson's inequality), the shift a map uses before

@@ -1,13 +1,12 @@
 #include "matching/distances.h"
 
-#include <bitset>
-#include <cmath>
-#include <cstdlib>
-#include <random>
-
 #include <gtest/gtest.h>
 
+#include <bitset>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <random>
 
 #include "tests/matching/random_rows.h"
 
@@ -38,28 +37,29 @@ class HammingWidths : public ::testing::TestWithParam<int> {};
 TEST_P(HammingWidths, MatrixMatchesBruteForce) {
   const int width = GetParam();
   const cv::Mat a = RandomBytes(37, width, 1 + width), b = RandomBytes(23, width, 99 + width);
-  for (HammingKernel kernel : {HammingKernel::kPortable, HammingKernel::kPopcnt,
-                               HammingKernel::kAvx2, HammingKernel::kAvx512,
-                               HammingKernel::kAuto}) {
-  if (!ForceHammingKernel(kernel)) {  // the CPU lacks it: said, not hidden
-    std::printf("[ SKIPPED  ] Hamming kernel %d: this CPU lacks it\n", static_cast<int>(kernel));
-    continue;
-  }
-  SCOPED_TRACE(HammingKernelName());
-  for (int threads : {1, 2, 3}) {
-    const cv::Mat1f cross = HammingDistances(a, b, threads);
-    ASSERT_EQ(cross.rows, 37);
-    ASSERT_EQ(cross.cols, 23);
-    for (int i = 0; i < a.rows; ++i)
-      for (int j = 0; j < b.rows; ++j)
-        ASSERT_EQ(cross(i, j), BitCount(a, i, b, j)) << i << "," << j;
-    const cv::Mat1f self = HammingDistances(a, cv::Mat(), threads);
-    for (int i = 0; i < a.rows; ++i)
-      for (int j = 0; j < a.rows; ++j) ASSERT_EQ(self(i, j), BitCount(a, i, a, j)) << i << "," << j;
-    for (int i = 0; i < a.rows; ++i)
-      EXPECT_EQ(HammingDistance(a.ptr<std::uint8_t>(i), b.ptr<std::uint8_t>(0), width),
-                BitCount(a, i, b, 0));
-  }
+  for (HammingKernel kernel :
+       {HammingKernel::kPortable, HammingKernel::kPopcnt, HammingKernel::kAvx2,
+        HammingKernel::kAvx512, HammingKernel::kAuto}) {
+    if (!ForceHammingKernel(kernel)) {  // the CPU lacks it: said, not hidden
+      std::printf("[ SKIPPED  ] Hamming kernel %d: this CPU lacks it\n", static_cast<int>(kernel));
+      continue;
+    }
+    SCOPED_TRACE(HammingKernelName());
+    for (int threads : {1, 2, 3}) {
+      const cv::Mat1f cross = HammingDistances(a, b, threads);
+      ASSERT_EQ(cross.rows, 37);
+      ASSERT_EQ(cross.cols, 23);
+      for (int i = 0; i < a.rows; ++i)
+        for (int j = 0; j < b.rows; ++j)
+          ASSERT_EQ(cross(i, j), BitCount(a, i, b, j)) << i << "," << j;
+      const cv::Mat1f self = HammingDistances(a, cv::Mat(), threads);
+      for (int i = 0; i < a.rows; ++i)
+        for (int j = 0; j < a.rows; ++j)
+          ASSERT_EQ(self(i, j), BitCount(a, i, a, j)) << i << "," << j;
+      for (int i = 0; i < a.rows; ++i)
+        EXPECT_EQ(HammingDistance(a.ptr<std::uint8_t>(i), b.ptr<std::uint8_t>(0), width),
+                  BitCount(a, i, b, 0));
+    }
   }
   ForceHammingKernel(HammingKernel::kAuto);
 }
@@ -73,7 +73,7 @@ TEST(HammingKernel, TheBestKernelOfTheCpuIsChosen) {
   const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
                       __builtin_cpu_supports("avx512vl") &&
                       __builtin_cpu_supports("avx512vpopcntdq");
-  const std::string expected = avx512                              ? "avx512"
+  const std::string expected = avx512                             ? "avx512"
                                : __builtin_cpu_supports("avx2")   ? "avx2"
                                : __builtin_cpu_supports("popcnt") ? "popcnt"
                                                                   : "portable";
@@ -140,7 +140,6 @@ TEST(L2Distances, HandWorkedValues) {
   EXPECT_FLOAT_EQ(cross(0, 0), 10.f);
   EXPECT_FLOAT_EQ(cross(1, 0), 5.f);
 }
-
 
 // --- L1 (SAD rows) ---------------------------------------------------------------------------
 

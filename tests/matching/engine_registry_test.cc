@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "matching/distances.h"
 #include "matching/search/approximate.h"
 #include "matching/search/approximate_engine.h"
-#include "matching/distances.h"
 
 namespace openable {
 namespace {

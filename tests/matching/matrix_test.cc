@@ -1,10 +1,10 @@
 #include "matching/matrix.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "matching/normalize.h"
 #include "tests/matching/random_rows.h"
@@ -48,13 +48,10 @@ TEST(FusedSequenceMatrix, IsTheTwoPassMatrixBitForBit) {
   const std::vector<Case> cases = {
       {&rows, Metric::kHamming, 1, SequenceDirection::kForward, SequencePartial::kAhead, {}},
       {&rows, Metric::kHamming, 10, SequenceDirection::kForward, SequencePartial::kAhead, {}},
-      {&rows, Metric::kHamming, 10, SequenceDirection::kForward, SequencePartial::kAhead,
-       {0, 420}},
-      {&rows, Metric::kHamming, 7, SequenceDirection::kReverse, SequencePartial::kSkip,
-       {0, 350}},
+      {&rows, Metric::kHamming, 10, SequenceDirection::kForward, SequencePartial::kAhead, {0, 420}},
+      {&rows, Metric::kHamming, 7, SequenceDirection::kReverse, SequencePartial::kSkip, {0, 350}},
       {&rows, Metric::kHamming, 5, SequenceDirection::kBoth, SequencePartial::kScale, {}},
-      {&rows, Metric::kHamming, 30, SequenceDirection::kBoth, SequencePartial::kAhead,
-       {0, 333}},
+      {&rows, Metric::kHamming, 30, SequenceDirection::kBoth, SequencePartial::kAhead, {0, 333}},
       {&sad, Metric::kL1, 4, SequenceDirection::kForward, SequencePartial::kAhead, {0, 100}},
       {&extremes, Metric::kL1, 80, SequenceDirection::kForward, SequencePartial::kScale, {}},
   };
@@ -64,8 +61,8 @@ TEST(FusedSequenceMatrix, IsTheTwoPassMatrixBitForBit) {
                              std::to_string(static_cast<int>(c.partial)) + ", " +
                              std::to_string(c.starts.size()) + " traversal starts";
     float largest = -1.0f;
-    const cv::Mat1f one = FusedSequenceMatrix(*c.rows, c.metric, c.L, c.direction, c.partial,
-                                              c.starts, 2, largest);
+    const cv::Mat1f one =
+        FusedSequenceMatrix(*c.rows, c.metric, c.L, c.direction, c.partial, c.starts, 2, largest);
     const cv::Mat1f two = TwoPasses(*c.rows, c.metric, c.L, c.direction, c.partial, c.starts);
     ASSERT_EQ(one.size(), two.size()) << what;
     for (int i = 0; i < one.rows; ++i)
@@ -81,8 +78,8 @@ TEST(FusedSequenceMatrix, IsTheTwoPassMatrixBitForBit) {
   const int L = 10;
   const cv::Mat1f one = FusedSequenceMatrix(rows, Metric::kHamming, L, SequenceDirection::kForward,
                                             SequencePartial::kAhead, {}, 1, largest);
-  for (const auto& [q, j] : std::vector<std::pair<int, int>>{{9, 9}, {100, 37}, {699, 0},
-                                                             {3, 500}, {650, 651}})
+  for (const auto& [q, j] :
+       std::vector<std::pair<int, int>>{{9, 9}, {100, 37}, {699, 0}, {3, 500}, {650, 651}})
     EXPECT_EQ(one(q, j), SequenceCellDistance(rows, q, rows, j, L, false)) << q << "," << j;
 }
 

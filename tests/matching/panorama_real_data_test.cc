@@ -1,7 +1,7 @@
 // Panoramas (Camera_type 2) on real data: ../shared/datasets/sussex_panoramas.
-#include <filesystem>
-
 #include <gtest/gtest.h>
+
+#include <filesystem>
 #include <opencv2/core.hpp>
 
 #include "OpenABLE/describe/describe.h"

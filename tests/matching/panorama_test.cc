@@ -1,10 +1,10 @@
 #include "matching/panorama.h"
 
+#include <gtest/gtest.h>
+
 #include <bitset>
 #include <cmath>
 #include <random>
-
-#include <gtest/gtest.h>
 
 namespace openable {
 namespace {
@@ -79,13 +79,12 @@ TEST_P(PanoramaDistancesTest, EqualsTheDirectDefinition) {
           << "cell " << i << "," << j;
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    All, PanoramaDistancesTest,
-    ::testing::Combine(::testing::Values(CV_8U, CV_32F),
-                       ::testing::Values(PanoramaMatching::kAligned,
-                                         PanoramaMatching::kCrossCorrelation,
-                                         PanoramaMatching::kCircular),
-                       ::testing::Values(1, 2, 4, 5)));
+INSTANTIATE_TEST_SUITE_P(All, PanoramaDistancesTest,
+                         ::testing::Combine(::testing::Values(CV_8U, CV_32F),
+                                            ::testing::Values(PanoramaMatching::kAligned,
+                                                              PanoramaMatching::kCrossCorrelation,
+                                                              PanoramaMatching::kCircular),
+                                            ::testing::Values(1, 2, 4, 5)));
 
 // A row whose strips are turned by s strips is at distance 0 by cross-correlation and by the
 // circular comparison, not by the aligned one.
@@ -93,7 +92,8 @@ TEST(PanoramaDistances, TurnedRowIsFoundByCrossCorrelationAndCircular) {
   const int n = 6, w = 4;
   cv::Mat rows = RandomRows(2, n * w, CV_8U, 3);
   for (int k = 0; k < n; ++k)
-    rows.row(0).colRange(((k + 2) % n) * w, ((k + 2) % n + 1) * w)
+    rows.row(0)
+        .colRange(((k + 2) % n) * w, ((k + 2) % n + 1) * w)
         .copyTo(rows.row(1).colRange(k * w, (k + 1) * w));
   EXPECT_EQ(PanoramaDistances(rows, n, PanoramaMatching::kCrossCorrelation)(1, 0), 0.0f);
   EXPECT_EQ(PanoramaDistances(rows, n, PanoramaMatching::kCircular)(1, 0), 0.0f);
@@ -101,12 +101,12 @@ TEST(PanoramaDistances, TurnedRowIsFoundByCrossCorrelationAndCircular) {
 }
 
 TEST(PanoramaDistances, RejectsWidthNotAMultipleOfStrips) {
-  EXPECT_THROW(PanoramaDistances(cv::Mat(3, 10, CV_8U, cv::Scalar(0)), 3,
-                                 PanoramaMatching::kCircular),
-               std::invalid_argument);
-  EXPECT_THROW(PanoramaDistances(cv::Mat(3, 10, CV_8U, cv::Scalar(0)), 0,
-                                 PanoramaMatching::kCircular),
-               std::invalid_argument);
+  EXPECT_THROW(
+      PanoramaDistances(cv::Mat(3, 10, CV_8U, cv::Scalar(0)), 3, PanoramaMatching::kCircular),
+      std::invalid_argument);
+  EXPECT_THROW(
+      PanoramaDistances(cv::Mat(3, 10, CV_8U, cv::Scalar(0)), 0, PanoramaMatching::kCircular),
+      std::invalid_argument);
 }
 
 }  // namespace

@@ -2,9 +2,8 @@
 #pragma once
 
 #include <cstdint>
-#include <random>
-
 #include <opencv2/core.hpp>
+#include <random>
 
 namespace openable::matching_test {
 

@@ -3,13 +3,13 @@
 // and on random rows; sparse candidates agree with dense rows.
 #include "matching/score.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <limits>
 #include <random>
 #include <utility>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 namespace openable {
 namespace {

@@ -1,13 +1,13 @@
 #include "matching/sequence.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
-#include <cmath>
 #include <atomic>
+#include <cmath>
 #include <limits>
 #include <random>
 #include <stdexcept>
-
-#include <gtest/gtest.h>
 
 #include "OpenABLE/base/threading.h"
 
@@ -63,8 +63,8 @@ TEST(SequenceDistances, LengthOneIsTheInput) {
 
 TEST(SequenceDistances, HandWorkedThreeByThree) {
   cv::Mat1f d = (cv::Mat1f(3, 3) << 1, 2, 3, 4, 5, 6, 7, 8, 9);
-  const cv::Mat1f s = SequenceDistances(d, 2, {}, {}, SequenceDirection::kForward, 0,
-                                        SequencePartial::kScale);
+  const cv::Mat1f s =
+      SequenceDistances(d, 2, {}, {}, SequenceDirection::kForward, 0, SequencePartial::kScale);
   // (2,2): d(2,2) + d(1,1) = 9 + 5; (1,2): 6 + 2; (2,1): 8 + 4;
   // (0,0): one term, 1 scaled by 2/1; (2,0): 7 * 2.
   EXPECT_FLOAT_EQ(s(2, 2), 14.f);
@@ -77,8 +77,8 @@ TEST(SequenceDistances, HandWorkedThreeByThree) {
 TEST(SequenceDistances, MatchesNaiveLoopForSeveralLengths) {
   const cv::Mat1f d = Random(41, 33, 3);
   for (int L : {1, 2, 3, 5, 10, 40, 60}) {
-    const cv::Mat1f fast = SequenceDistances(d, L, {}, {}, SequenceDirection::kForward, 0,
-                                             SequencePartial::kScale);
+    const cv::Mat1f fast =
+        SequenceDistances(d, L, {}, {}, SequenceDirection::kForward, 0, SequencePartial::kScale);
     const cv::Mat1f slow = NaiveSequence(d, L, {0}, {0});
     for (int i = 0; i < d.rows; ++i)
       for (int j = 0; j < d.cols; ++j)
@@ -91,8 +91,8 @@ TEST(SequenceDistances, SumsNeverCrossTraversals) {
   const cv::Mat1f d = Random(45, 45, 4);
   const std::vector<int> starts = {0, 20};
   for (int L : {1, 4, 10, 25}) {
-    const cv::Mat1f fast = SequenceDistances(d, L, starts, starts, SequenceDirection::kForward,
-                                             0, SequencePartial::kScale);
+    const cv::Mat1f fast = SequenceDistances(d, L, starts, starts, SequenceDirection::kForward, 0,
+                                             SequencePartial::kScale);
     const cv::Mat1f slow = NaiveSequence(d, L, starts, starts);
     for (int i = 0; i < d.rows; ++i)
       for (int j = 0; j < d.cols; ++j)
@@ -117,15 +117,15 @@ TEST(SequenceDistances, ReverseAndBothMatchNaiveLoops) {
       SequenceDistancesInPlace(in_place, L, rows, cols, SequenceDirection::kReverse, threads,
                                scale);
       EXPECT_LE(cv::norm(in_place, rev, cv::NORM_INF), 1e-3) << "L=" << L << " t=" << threads;
-      EXPECT_LE(cv::norm(SequenceDistances(d, L, rows, cols, SequenceDirection::kForward, threads,
-                                           scale),
-                         fwd, cv::NORM_INF),
-                1e-3)
+      EXPECT_LE(
+          cv::norm(SequenceDistances(d, L, rows, cols, SequenceDirection::kForward, threads, scale),
+                   fwd, cv::NORM_INF),
+          1e-3)
           << "L=" << L << " t=" << threads;
-      EXPECT_LE(cv::norm(SequenceDistances(d, L, rows, cols, SequenceDirection::kBoth, threads,
-                                           scale),
-                         both, cv::NORM_INF),
-                1e-3)
+      EXPECT_LE(
+          cv::norm(SequenceDistances(d, L, rows, cols, SequenceDirection::kBoth, threads, scale),
+                   both, cv::NORM_INF),
+          1e-3)
           << "L=" << L << " t=" << threads;
     }
   }
@@ -245,8 +245,8 @@ TEST(SequenceDistances, AheadMatchesTheNaiveRule) {
   // (1, 0) sums (1,0), (2,1), (3,2) = 5 + 10 + 15; (0, 2) has a diagonal of two cells: +inf;
   // (3, 3) sums its own three.
   const cv::Mat1f h = (cv::Mat1f(4, 4) << 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16);
-  const cv::Mat1f s = SequenceDistances(h, 3, {}, {}, SequenceDirection::kForward, 1,
-                                        SequencePartial::kAhead);
+  const cv::Mat1f s =
+      SequenceDistances(h, 3, {}, {}, SequenceDirection::kForward, 1, SequencePartial::kAhead);
   EXPECT_FLOAT_EQ(s(0, 1), 21.f);
   EXPECT_FLOAT_EQ(s(1, 0), 30.f);
   EXPECT_EQ(s(0, 2), inf);
@@ -260,8 +260,8 @@ TEST(SequenceDistances, FillAheadCellsCompletesASkipSweep) {
   const cv::Mat1f d = Random(45, 300, 13);
   const std::vector<int> rows = {0, 20}, cols = {0, 120, 250};
   for (const bool reverse : {false, true}) {
-    const SequenceDirection dir = reverse ? SequenceDirection::kReverse
-                                          : SequenceDirection::kForward;
+    const SequenceDirection dir =
+        reverse ? SequenceDirection::kReverse : SequenceDirection::kForward;
     cv::Mat1f skip = SequenceDistances(d, 10, rows, cols, dir, 2, SequencePartial::kSkip);
     FillAheadCells(skip, 10, rows, cols, reverse);
     const cv::Mat1f ahead = SequenceDistances(d, 10, rows, cols, dir, 2, SequencePartial::kAhead);
@@ -279,8 +279,8 @@ TEST(SequenceDistances, CellDistanceAheadEqualsTheMatrix) {
   cv::Mat1f single(30, 25);
   for (int q = 0; q < 30; ++q)
     for (int j = 0; j < 25; ++j)
-      single(q, j) = static_cast<float>(cv::norm(queries.row(q), references.row(j),
-                                                 cv::NORM_HAMMING));
+      single(q, j) =
+          static_cast<float>(cv::norm(queries.row(q), references.row(j), cv::NORM_HAMMING));
   for (const bool reverse : {false, true}) {
     const cv::Mat1f s = SequenceDistances(
         single, 7, {}, {}, reverse ? SequenceDirection::kReverse : SequenceDirection::kForward, 1,
@@ -351,7 +351,6 @@ TEST(SequenceDistances, AnInterruptCheckStopsTheSumsWithinTheirRows) {
   EXPECT_GT(cv::norm(whole.rowRange(7990, 8000), before.rowRange(7990, 8000), cv::NORM_INF), 0.0);
 }
 
-
 // Row by row, with the query rows one traversal and the columns in sessions: the cells of the
 // naive definition (scaled or skipped), exactly for integer distances.
 TEST(SequenceRowSums, EqualTheNaiveDefinitionRowByRow) {
@@ -360,14 +359,15 @@ TEST(SequenceRowSums, EqualTheNaiveDefinitionRowByRow) {
       cv::Mat1f d = Random(40, 33, 7 + L);
       for (auto& v : d) v = std::round(v);  // integers: the double sums are exact
       const std::vector<int> cols = {0, 9, 20};
-      const cv::Mat1f want = NaiveSequence(d, L, {}, cols, false,
-                                           partial == SequencePartial::kSkip);
+      const cv::Mat1f want =
+          NaiveSequence(d, L, {}, cols, false, partial == SequencePartial::kSkip);
       SequenceRowSums rows(L, partial);
       for (int i = 0; i < d.rows; ++i) {
         std::vector<float> row(d.ptr<float>(i), d.ptr<float>(i) + d.cols);
         rows.Push(row.data(), d.cols, cols);
         for (int j = 0; j < d.cols; ++j)
-          EXPECT_EQ(row[static_cast<size_t>(j)], want(i, j)) << "L " << L << " cell " << i << ", " << j;
+          EXPECT_EQ(row[static_cast<size_t>(j)], want(i, j))
+              << "L " << L << " cell " << i << ", " << j;
       }
       EXPECT_EQ(rows.Rows(), d.rows);
       // Restart: the next row is the first of another traversal, as a matrix of its own.
@@ -386,8 +386,8 @@ TEST(SequenceRowSums, EqualTheNaiveDefinitionRowByRow) {
 TEST(SequenceRowSums, GiveTheSweepsFloats) {
   const cv::Mat1f d = Random(60, 50, 3);
   const std::vector<int> cols = {0, 25};
-  const cv::Mat1f sweep = SequenceDistances(d, 7, {}, cols, SequenceDirection::kForward, 2,
-                                            SequencePartial::kScale);
+  const cv::Mat1f sweep =
+      SequenceDistances(d, 7, {}, cols, SequenceDirection::kForward, 2, SequencePartial::kScale);
   SequenceRowSums rows(7);
   for (int i = 0; i < d.rows; ++i) {
     std::vector<float> row(d.ptr<float>(i), d.ptr<float>(i) + d.cols);

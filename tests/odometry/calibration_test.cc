@@ -2,19 +2,21 @@
 // values worked out by hand, and malformed files.
 #include "OpenABLE/odometry/calibration.h"
 
-#include <filesystem>
-
 #include <gtest/gtest.h>
+
+#include <filesystem>
 
 #include "tests/test_support.h"
 
 namespace openable::odometry {
 namespace {
 
-const char kP0[] = "P0: 7.188560000000e+02 0 6.071928000000e+02 0 0 7.188560000000e+02 "
-                   "1.852157000000e+02 0 0 0 1 0\n";
-const char kP1[] = "P1: 7.188560000000e+02 0 6.071928000000e+02 -3.861448000000e+02 0 "
-                   "7.188560000000e+02 1.852157000000e+02 0 0 0 1 0\n";
+const char kP0[] =
+    "P0: 7.188560000000e+02 0 6.071928000000e+02 0 0 7.188560000000e+02 "
+    "1.852157000000e+02 0 0 0 1 0\n";
+const char kP1[] =
+    "P1: 7.188560000000e+02 0 6.071928000000e+02 -3.861448000000e+02 0 "
+    "7.188560000000e+02 1.852157000000e+02 0 0 0 1 0\n";
 
 TEST(ReadKittiCalibration, HalvesTheRealKitti00Calibration) {
   const std::string path = testing::DatasetsDir() + "/kitti00_first1700/calib.txt";

@@ -2,10 +2,10 @@
 // options, the constant-velocity fallback, and KITTI 00 frames 0-199 against the ground truth.
 #include "OpenABLE/odometry/mono_odometry.h"
 
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <filesystem>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/snaps/trajectory.h"
@@ -21,8 +21,7 @@ using namespace odometry_test;  // NOLINT: the synthetic room is this file's voc
 // R_truth^T R_estimate and angle (degrees) between the translations.
 void ExpectClosePose(const Eigen::Isometry3d& estimate, const Eigen::Isometry3d& truth,
                      double max_rotation_deg, double max_direction_deg) {
-  const double rotation =
-      Degrees(RotationAngle(truth.linear().transpose() * estimate.linear()));
+  const double rotation = Degrees(RotationAngle(truth.linear().transpose() * estimate.linear()));
   const double direction = Degrees(std::acos(std::clamp(
       truth.translation().normalized().dot(estimate.translation().normalized()), -1.0, 1.0)));
   std::printf("rotation error %.3f deg, translation direction error %.3f deg\n", rotation,
@@ -47,8 +46,7 @@ void CheckTwoViews(const std::string& features, double ransac_px, double max_dir
   EXPECT_TRUE(p0.isApprox(Eigen::Isometry3d::Identity()));
   EXPECT_EQ(mono.last().note, "first frame");
   const double length = second.translation().norm();
-  const Eigen::Isometry3d p1 =
-      mono.Step(room.Render(kIntrinsics, kSize, second), length);
+  const Eigen::Isometry3d p1 = mono.Step(room.Render(kIntrinsics, kSize, second), length);
   EXPECT_TRUE(mono.last().ok) << mono.last().note;
   EXPECT_GT(mono.last().inliers, 100);
   EXPECT_NEAR(p1.translation().norm(), length, 1e-9);
@@ -64,10 +62,10 @@ TEST(MonoOdometry, UnknownStepLengthGivesUnitSteps) {
   const SyntheticRoom room(7);
   MonoOdometry mono(kIntrinsics, MonoOdometryOptions());
   mono.Step(room.Render(kIntrinsics, kSize, Eigen::Isometry3d::Identity()), -1);
-  const Eigen::Isometry3d p = mono.Step(
-      room.Render(kIntrinsics, kSize,
-                  Pose(1.0, Eigen::Vector3d::UnitY(), Eigen::Vector3d(0.0, 0.0, 0.5))),
-      -1);
+  const Eigen::Isometry3d p =
+      mono.Step(room.Render(kIntrinsics, kSize,
+                            Pose(1.0, Eigen::Vector3d::UnitY(), Eigen::Vector3d(0.0, 0.0, 0.5))),
+                -1);
   EXPECT_NEAR(p.translation().norm(), 1.0, 1e-9);
   EXPECT_GT(p.translation().z(), 0.99);  // forward
 }
@@ -119,8 +117,11 @@ TEST(MonoOdometryOptions, CheckNamesTheField) {
   expect([](MonoOdometryOptions& o) { o.ransac_confidence = 1; }, "ransac_confidence");
   expect([](MonoOdometryOptions& o) { o.min_inliers = 4; }, "min_inliers");
   EXPECT_NO_THROW(MonoOdometryOptions().Check());
-  testing::ExpectInputError([] { MonoOdometry(Intrinsics{0, 1, 1, 1}, MonoOdometryOptions()); },
-                            {"fx"});
+  testing::ExpectInputError(
+      [] {
+        MonoOdometry(Intrinsics{0, 1, 1, 1}, MonoOdometryOptions());
+      },
+      {"fx"});
 }
 
 // KITTI 00 frames 0-199 (145 m), half-size left frames, each step's length from the ground

@@ -3,14 +3,14 @@
 // against their ground-truth body poses.
 #include "OpenABLE/odometry/stereo_odometry.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 
 #include "OpenABLE/odometry/mono_odometry.h"
 #include "OpenABLE/stereo/calibration.h"
@@ -47,11 +47,11 @@ void CheckTwoPairs(StereoOdometryOptions options) {
   ASSERT_TRUE(stereo.last().ok) << stereo.last().note;
   const double rotation = Degrees(RotationAngle(second.linear().transpose() * p1.linear()));
   const double position = (p1.translation() - second.translation()).norm();
-  std::printf("%s %s wls %d: %d inliers of %d, rotation error %.3f deg, position error %.3f m, "
-              "%.3f s\n",
-              options.matcher.c_str(), options.features.c_str(), options.wls_filter,
-              stereo.last().inliers, stereo.last().matches, rotation, position,
-              stereo.last().seconds);
+  std::printf(
+      "%s %s wls %d: %d inliers of %d, rotation error %.3f deg, position error %.3f m, "
+      "%.3f s\n",
+      options.matcher.c_str(), options.features.c_str(), options.wls_filter, stereo.last().inliers,
+      stereo.last().matches, rotation, position, stereo.last().seconds);
   EXPECT_GT(stereo.last().inliers, 50);
   EXPECT_LT(rotation, 0.3);
   EXPECT_LT(position, 0.03 + 0.03 * second.translation().norm());
@@ -164,10 +164,10 @@ TEST(StereoOdometry, EurocPairs3To2AgreeWithTheGroundTruth) {
   StereoOdometry stereo(intrinsics, baseline, StereoOdometryOptions());
   Eigen::Isometry3d pose;
   for (const int i : {3, 2}) {  // time order: image 3 (t = 400.26 s), then image 2 (400.76 s)
-    const cv::Mat left = cv::imread(EurocDir() + "/left_img_" + std::to_string(i) + ".png",
-                                    cv::IMREAD_GRAYSCALE);
-    const cv::Mat right = cv::imread(EurocDir() + "/right_img_" + std::to_string(i) + ".png",
-                                     cv::IMREAD_GRAYSCALE);
+    const cv::Mat left =
+        cv::imread(EurocDir() + "/left_img_" + std::to_string(i) + ".png", cv::IMREAD_GRAYSCALE);
+    const cv::Mat right =
+        cv::imread(EurocDir() + "/right_img_" + std::to_string(i) + ".png", cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(left.empty());
     ASSERT_FALSE(right.empty());
     cv::Mat left_rectified, right_rectified;
@@ -209,10 +209,11 @@ TEST(StereoOdometry, EurocPairs3To2AgreeWithTheGroundTruth) {
   const Eigen::Vector3d true_direction = (rect * truth.translation()).normalized();
   const double direction = Degrees(
       std::acos(std::clamp(true_direction.dot(pose.translation().normalized()), -1.0, 1.0)));
-  std::printf("EuRoC 3->2: %d inliers of %d; angle %.2f deg (truth %.2f), length %.3f m "
-              "(truth %.3f), direction error %.1f deg\n",
-              stereo.last().inliers, stereo.last().matches, angle, true_angle, length,
-              true_length, direction);
+  std::printf(
+      "EuRoC 3->2: %d inliers of %d; angle %.2f deg (truth %.2f), length %.3f m "
+      "(truth %.3f), direction error %.1f deg\n",
+      stereo.last().inliers, stereo.last().matches, angle, true_angle, length, true_length,
+      direction);
   // Tolerances: rotation angle within 1 degree, length within 3 cm, direction within 10 degrees.
   EXPECT_NEAR(angle, true_angle, 1.0);
   EXPECT_NEAR(length, true_length, 0.03);

@@ -6,10 +6,9 @@
 // (INTER_AREA) against aliasing.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
-
-#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -19,7 +18,7 @@ namespace openable::odometry_test {
 
 class SyntheticRoom {
  public:
-  static constexpr int kTile = 1024;            // texture pixels per plane side
+  static constexpr int kTile = 1024;             // texture pixels per plane side
   static constexpr double kPixelsPerMetre = 20;  // texture resolution
 
   explicit SyntheticRoom(std::uint64_t seed) {
@@ -54,12 +53,13 @@ class SyntheticRoom {
     cv::Mat1f map_x(size.height * s, size.width * s), map_y(size.height * s, size.width * s);
     const Eigen::Vector3d origin = pose.translation();
     // Planes n . X = c, with the two world axes giving the texture coordinates.
-    struct Plane { int axis; double c; int u_axis, v_axis; };
-    const std::array<Plane, 5> planes = {{{2, 25.0, 0, 1},
-                                          {1, 2.0, 0, 2},
-                                          {1, -4.0, 0, 2},
-                                          {0, -5.0, 2, 1},
-                                          {0, 5.0, 2, 1}}};
+    struct Plane {
+      int axis;
+      double c;
+      int u_axis, v_axis;
+    };
+    const std::array<Plane, 5> planes = {
+        {{2, 25.0, 0, 1}, {1, 2.0, 0, 2}, {1, -4.0, 0, 2}, {0, -5.0, 2, 1}, {0, 5.0, 2, 1}}};
     for (int y = 0; y < map_x.rows; ++y) {
       for (int x = 0; x < map_x.cols; ++x) {
         const double u = (x + 0.5) / s - 0.5, v = (y + 0.5) / s - 0.5;
@@ -81,8 +81,7 @@ class SyntheticRoom {
         const Eigen::Vector3d point = origin + best * ray;
         map_x(y, x) = static_cast<float>(hit * kTile + kTile / 2 +
                                          kPixelsPerMetre * point[planes[hit].u_axis]);
-        map_y(y, x) =
-            static_cast<float>(kTile / 2 + kPixelsPerMetre * point[planes[hit].v_axis]);
+        map_y(y, x) = static_cast<float>(kTile / 2 + kPixelsPerMetre * point[planes[hit].v_axis]);
       }
     }
     cv::Mat big, out;

@@ -1,11 +1,11 @@
 // The index engines that the online detector's tests run with, one test of a TEST_P each.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <ostream>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "matching/search/approximate.h"
 #include "matching/search/engine_registry.h"

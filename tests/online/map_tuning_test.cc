@@ -5,6 +5,8 @@
 // on the same frames, kept in the map, and refused trust on unrelated traversals. The bundled
 // Nordland sample (300 summer and 300 winter frames) and, when present, the shared Nordland
 // seasons.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -12,8 +14,6 @@
 #include <limits>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/progress.h"
@@ -100,8 +100,7 @@ TEST(MapSearch, QueryGivesTheBatchScaleMatrixCellByCell) {
       const cv::Mat rows = d->Descriptors();
       const int r = static_cast<int>(summer.size()), q = static_cast<int>(winter.size());
       OnlineDetector::QueryMatrix matrix;
-      const std::vector<OnlineResult> results =
-          d->Query(Rows(rows, r, q), {"summer"}, {}, &matrix);
+      const std::vector<OnlineResult> results = d->Query(Rows(rows, r, q), {"summer"}, {}, &matrix);
       ASSERT_EQ(matrix.frames.size(), static_cast<size_t>(r));
       EXPECT_EQ(matrix.frames.front(), 0);
       const Metric metric = descriptor == "LDB" ? Metric::kHamming : Metric::kL2;
@@ -303,7 +302,8 @@ TEST(MapTuning, FusedSearchIsTheWeightedSumOfEachDescriptorOverItsLargest) {
   cv::minMaxLoc(dl, nullptr, &ml);
   cv::Mat1f fused = w[0] * dh / mh + w[1] * dl / ml;
   cv::Mat1f want = fused(cv::Rect(0, n, n, n)).clone();
-  SequenceDistancesInPlace(want, 5, {}, {}, SequenceDirection::kForward, 0, SequencePartial::kScale);
+  SequenceDistancesInPlace(want, 5, {}, {}, SequenceDirection::kForward, 0,
+                           SequencePartial::kScale);
   // The packed rows of the map: HOG's floats then LDB's bytes, frame by frame.
   const cv::Mat packed = d->Descriptors();
   ASSERT_EQ(packed.cols, 1764 * 4 + 32);
@@ -359,8 +359,9 @@ TEST(MapTuning, TunedMapsKeepTheirSettings) {
   const auto d = TwoSessions(o, ReadFolder(SeasonDir("summer"), 0, 200),
                              ReadFolder(SeasonDir("winter"), 0, 200));
   OnlineDetector::TuneOptions t;
-  t.candidates = "Image_descriptor=SAD Contrast_enhancement=1 Image_sequences=10,20 | "
-                 "Image_descriptor=LDB Image_sequences=10";
+  t.candidates =
+      "Image_descriptor=SAD Contrast_enhancement=1 Image_sequences=10,20 | "
+      "Image_descriptor=LDB Image_sequences=10";
   const MapTuning tuning = d->Tune(t);
   const std::string path = testing::TempDir() + "/tuned.map";
   d->SaveMap(path);

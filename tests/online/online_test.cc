@@ -4,16 +4,16 @@
 // with ties to the earlier frame.
 #include "OpenABLE/online/online.h"
 
+#include <gtest/gtest.h>
+
 #include <bitset>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "matching/bounded.h"
@@ -202,8 +202,8 @@ TEST_P(OnlineDetectorEngine, SearchesBlocksBeyondTheExactLimit) {
     if (e.candidates[0].accepted) {
       // The frames that matter: those whose exact best match is a loop the detector accepts.
       ++loops;
-      loops_found += std::abs(a.candidates[0].frame - e.candidates[0].frame) <= 5 &&
-                     a.candidates[0].accepted;
+      loops_found +=
+          std::abs(a.candidates[0].frame - e.candidates[0].frame) <= 5 && a.candidates[0].accepted;
     }
   }
   std::printf(
@@ -265,8 +265,8 @@ TEST(OnlineDetector, DistanceMatrixIsTheNormalisedBruteForce) {
   OnlineOptions options;
   const cv::Mat rows = DescribeImages(frames, options);
   float max_distance = 0;
-  const cv::Mat1f m = DistanceMatrix(rows, 3, SequenceDirection::kForward, {}, 0, &max_distance,
-                                     {}, SequencePartial::kScale);
+  const cv::Mat1f m = DistanceMatrix(rows, 3, SequenceDirection::kForward, {}, 0, &max_distance, {},
+                                     SequencePartial::kScale);
   double largest = 0;
   for (int i = 0; i < rows.rows; ++i)
     for (int j = 0; j < rows.rows; ++j) {
@@ -295,13 +295,14 @@ TEST(OnlineDetector, BadOptionsAndFramesAreOneLineErrors) {
   ExpectInputError(
       [&] { OnlineDetector d(with([](OnlineOptions& o) { o.descriptor.name = "D-LDB"; })); },
       {"OnlineOptions.descriptor", "D-LDB", "stereo"});
-  ExpectInputError([&] { OnlineDetector d(with([](OnlineOptions& o) { o.descriptor.name = "SURF"; })); },
-                   {"SURF"});
+  ExpectInputError(
+      [&] { OnlineDetector d(with([](OnlineOptions& o) { o.descriptor.name = "SURF"; })); },
+      {"SURF"});
   ExpectInputError([&] { OnlineDetector d(with([](OnlineOptions& o) { o.sequence_length = 0; })); },
                    {"OnlineOptions.sequence_length", "0", "1..1000"});
-  ExpectInputError([&] {
-    OnlineDetector d(with([](OnlineOptions& o) { o.threshold = std::nan(""); }));
-  }, {"OnlineOptions.threshold", ">= 0"});
+  ExpectInputError(
+      [&] { OnlineDetector d(with([](OnlineOptions& o) { o.threshold = std::nan(""); })); },
+      {"OnlineOptions.threshold", ">= 0"});
   ExpectInputError([&] { OnlineDetector d(with([](OnlineOptions& o) { o.exclusion = 0; })); },
                    {"OnlineOptions.exclusion", "0"});
   ExpectInputError(

@@ -1,6 +1,7 @@
 // Saved maps of the online detector (OnlineDetector::SaveMap / LoadMap): a detector that
 // loads yesterday's map gives every later frame the candidates the detector that saved it
 // gives, on real KITTI 00 frames, with each index engine; the file is checked on loading.
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 
 #include <cerrno>
@@ -11,12 +12,10 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <tuple>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/hash.h"
@@ -158,9 +157,11 @@ TEST(SavedMap, FloatMapKeepsItsNormalisation) {
     for (size_t i = 0; i < a.candidates.size(); ++i) {
       EXPECT_EQ(a.candidates[i].frame, b.candidates[i].frame) << "frame " << q;
       EXPECT_NEAR(a.candidates[i].distance, b.candidates[i].distance,
-                  1e-6 * a.candidates[i].distance) << "frame " << q;
+                  1e-6 * a.candidates[i].distance)
+          << "frame " << q;
       EXPECT_NEAR(a.candidates[i].normalized, b.candidates[i].normalized,
-                  1e-6 * a.candidates[i].normalized) << "frame " << q;
+                  1e-6 * a.candidates[i].normalized)
+          << "frame " << q;
     }
   }
 }
@@ -397,7 +398,7 @@ TEST(SavedMap, FuzzerSeedWithVerificationSearchesAndVerifies) {
   OnlineDetector detector(fuzz::MapDetectorOptions(fuzz::MapKind::kVerifying));
   EXPECT_EQ(detector.LoadMap(MapSeed("verifying.map")).frames, 3);
   const OnlineResult r = detector.AddFrame(fuzz::MapFrame(0));
-  ASSERT_EQ(r.candidates.size(), 1u);  // the three frames are one place (score_window 10)
+  ASSERT_EQ(r.candidates.size(), 1u);   // the three frames are one place (score_window 10)
   EXPECT_EQ(r.candidates[0].frame, 0);  // the same image
   // 6 of its 10 features pass the ratio test: too few for the fundamental matrix, the
   // homography fits them.
@@ -439,7 +440,6 @@ TEST(SavedMap, InconsistentFeaturesAreRefused) {
                    {narrow, "frame 1", "descriptors of 16 CV_8UC1", "expected 32 CV_8UC1 (ORB)"});
   EXPECT_EQ(detector.Size(), 0);
 }
-
 
 // A copy of the map at `good`, written to `path`, whose setting `key` is `value`.
 void WriteWithSetting(const std::string& good, const std::string& key, const std::string& value,
@@ -523,8 +523,7 @@ TEST(SavedMap, MapsOfGivenRowsWithAbsurdSettingsAreOneLine) {
   EXPECT_EQ(reopened.RowWidth(), 8);
   for (const auto& [key, value, expected] :
        std::vector<std::tuple<std::string, std::string, std::string>>{
-           {"row_width", "2000000000", "2000000000"},
-           {"description", "grid", "expected global"}}) {
+           {"row_width", "2000000000", "2000000000"}, {"description", "grid", "expected global"}}) {
     const std::string path = testing::TempDir() + "/given_" + key + ".map";
     WriteWithSetting(good, key, value, path);
     ExpectInputError([&] { OnlineDetector other(MapOptions(path)); }, {path, expected});

@@ -3,17 +3,17 @@
 // a saved map gives the loops of the map built in one go; queries equal a brute-force search
 // written here from the definition of the sequence distance; merges and appends refuse what
 // does not fit, leaving the maps as they were.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <string>
-#include <vector>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/hash.h"
@@ -54,7 +54,8 @@ OnlineOptions SessionOptions(const std::string& engine) {
 int Bits(const cv::Mat& a, int i, const cv::Mat& b, int j) {
   int bits = 0;
   for (int k = 0; k < a.cols; ++k)
-    bits += __builtin_popcount(static_cast<unsigned>(a.at<std::uint8_t>(i, k) ^ b.at<std::uint8_t>(j, k)));
+    bits += __builtin_popcount(
+        static_cast<unsigned>(a.at<std::uint8_t>(i, k) ^ b.at<std::uint8_t>(j, k)));
   return bits;
 }
 
@@ -290,7 +291,8 @@ TEST(MappedMap, FirstVersionIsOneSession) {
     put(1, 4);
     const std::string settings =
         "openable 0\nframes 12\nrow_width 32\nrow_type CV_8U\nunit 256\ndescriptor LDB\n"
-        "description global\npatch_size 64\nldb_bits 256\ngrid_x 1\ngrid_y 1\n" + extra;
+        "description global\npatch_size 64\nldb_bits 256\ngrid_x 1\ngrid_y 1\n" +
+        extra;
     put(settings.size(), 8);
     f += settings;
     put(rows.total(), 8);
@@ -314,20 +316,19 @@ TEST(MappedMap, FirstVersionIsOneSession) {
   EXPECT_EQ(cv::norm(d.Descriptors(), rows, cv::NORM_INF), 0);
 }
 
-
 // Session times: ISO 8601 UTC with real dates (leap years by the Gregorian rule).
 TEST(SessionTimes, AreIsoUtcTimesOfRealDates) {
-  for (const std::string good : {"2026-11-29T09:30:00Z", "2024-02-29T00:00:00Z",
-                                 "2000-02-29T23:59:59Z", "2026-12-31T23:59:60Z",
-                                 "2026-01-01T00:00:00.125Z"})
+  for (const std::string good :
+       {"2026-11-29T09:30:00Z", "2024-02-29T00:00:00Z", "2000-02-29T23:59:59Z",
+        "2026-12-31T23:59:60Z", "2026-01-01T00:00:00.125Z"})
     EXPECT_NO_THROW(CheckSessionTime(good, "time")) << good;
-  for (const std::string& bad : std::vector<std::string>{"", "yesterday", "2026-11-29", "2026-11-29T09:30:00", "2026-11-29 09:30:00Z",
-        "2023-02-29T00:00:00Z", "1900-02-29T00:00:00Z", "2026-04-31T00:00:00Z",
-        "2026-13-01T00:00:00Z", "2026-00-10T00:00:00Z", "2026-11-29T24:00:00Z",
-        "2026-11-29T09:60:00Z", "2026-11-29T09:30:00.Z", "2026-11-29T09:30:00+01:00",
-        "+2026-11-29T09:30:00Z", std::string(100000, '1')})
-    ExpectInputError([&] { CheckSessionTime(bad, "--time"); },
-                     {"--time", "YYYY-MM-DDTHH:MM:SSZ"});
+  for (const std::string& bad : std::vector<std::string>{
+           "", "yesterday", "2026-11-29", "2026-11-29T09:30:00", "2026-11-29 09:30:00Z",
+           "2023-02-29T00:00:00Z", "1900-02-29T00:00:00Z", "2026-04-31T00:00:00Z",
+           "2026-13-01T00:00:00Z", "2026-00-10T00:00:00Z", "2026-11-29T24:00:00Z",
+           "2026-11-29T09:60:00Z", "2026-11-29T09:30:00.Z", "2026-11-29T09:30:00+01:00",
+           "+2026-11-29T09:30:00Z", std::string(100000, '1')})
+    ExpectInputError([&] { CheckSessionTime(bad, "--time"); }, {"--time", "YYYY-MM-DDTHH:MM:SSZ"});
   OnlineDetector d((OnlineOptions()));
   ExpectInputError([&] { d.StartSession("s", "tomorrow"); }, {"session time", "tomorrow"});
   EXPECT_TRUE(d.Sessions().empty());

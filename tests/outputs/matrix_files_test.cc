@@ -1,24 +1,24 @@
-#include "OpenABLE/base/output_batch.h"
-#include "OpenABLE/io/npy.h"
 #include "OpenABLE/outputs/matrix_files.h"
-#include "OpenABLE/reports/figures.h"
+
+#include <gtest/gtest.h>
 
 #include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <limits>
-#include <thread>
-#include <vector>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-
-#include <gtest/gtest.h>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <thread>
+#include <vector>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/output_batch.h"
+#include "OpenABLE/io/npy.h"
+#include "OpenABLE/reports/figures.h"
 #include "tests/test_support.h"
 
 namespace openable {
@@ -33,9 +33,9 @@ TEST(ColorMaps, MatchTheOriginalTable) {
   // table (docs/output_formats.md).
   const float s = 0.25f;
   const cv::Vec3f expected[12] = {
-      {s, s, s},     {0, 0, s},      {0, s, 0},     {s, 0, 0},
-      {0.75f, 0.75f, s}, {0.75f, s, 0.75f}, {s, 0.75f, 0.75f}, {0, s, 1},
-      {1, 0.75f, s}, {0.4980f * s, 0.7804f * s, s}, {0.75f, s, 1}, {0, 0.625f, s}};
+      {s, s, s},         {0, 0, s},         {0, s, 0}, {s, 0, 0},     {0.75f, 0.75f, s},
+      {0.75f, s, 0.75f}, {s, 0.75f, 0.75f}, {0, s, 1}, {1, 0.75f, s}, {0.4980f * s, 0.7804f * s, s},
+      {0.75f, s, 1},     {0, 0.625f, s}};
   for (int map = 0; map < 12; ++map)
     for (int k = 0; k < 3; ++k) EXPECT_FLOAT_EQ(ColorOf(s, map)[k], expected[map][k]) << map;
   EXPECT_THROW(ColorOf(s, 12), std::logic_error);
@@ -59,8 +59,8 @@ TEST(Npy, HeaderAndDataFollowTheFormat) {
   EXPECT_EQ(bytes.substr(0, 6), std::string("\x93NUMPY", 6));
   EXPECT_EQ(bytes[6], 1);
   EXPECT_EQ(bytes[7], 0);
-  const size_t header_len = static_cast<unsigned char>(bytes[8]) |
-                            (static_cast<unsigned char>(bytes[9]) << 8);
+  const size_t header_len =
+      static_cast<unsigned char>(bytes[8]) | (static_cast<unsigned char>(bytes[9]) << 8);
   EXPECT_EQ((10 + header_len) % 64, 0u);
   const std::string header = bytes.substr(10, header_len);
   EXPECT_EQ(header.back(), '\n');
@@ -83,8 +83,7 @@ TEST(Npy, NumpyReadsIt) {
   for (int k = 0; k < 8; ++k) m(k / 2, k % 2) = static_cast<float>(k) / 8.f;
   const std::string path = testing::TempDir() + "/m.npy";
   std::ofstream(path, std::ios::binary) << EncodeNpy(m);
-  const std::string cmd = std::string(python) +
-                          " -c \"import numpy as n; a=n.load('" + path +
+  const std::string cmd = std::string(python) + " -c \"import numpy as n; a=n.load('" + path +
                           "'); assert a.dtype==n.float32 and a.shape==(4,2) and "
                           "abs(a[3,1]-7/8)<1e-7 and abs(a[1,0]-2/8)<1e-7\"";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
@@ -147,7 +146,8 @@ TEST(OutputBatch, TwoOutputsAtOneFileAreRefused) {
     }
     EXPECT_FALSE(fs::exists(first));
   }
-  EXPECT_NO_THROW(CheckDistinctOutputs({{"Txt_name", dir + "/a.txt"}, {"Npy_name", dir + "/a.npy"}}));
+  EXPECT_NO_THROW(
+      CheckDistinctOutputs({{"Txt_name", dir + "/a.txt"}, {"Npy_name", dir + "/a.npy"}}));
   EXPECT_THROW(CheckDistinctOutputs({{"Txt_name", dir + "/a"}, {"Npy_name", dir + "/./a"}}),
                InputError);
 }
@@ -454,4 +454,3 @@ TEST(EncodeMatches, AcceptedAndConfirmedColumnsAreTheRankOneVerdicts) {
 
 }  // namespace
 }  // namespace openable
-

@@ -1,14 +1,15 @@
 // The registry of a run's outputs (OpenABLE/outputs/run_outputs.h): the files checked before a
 // run (PlannedOutputs) are the files WriteOutputs writes, in its order; a bounded run notes the
 // files it cannot write.
+#include "OpenABLE/outputs/run_outputs.h"
+
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <gtest/gtest.h>
-
-#include "OpenABLE/outputs/run_outputs.h"
 #include "OpenABLE/run/result.h"
 #include "config/config.h"
 #include "matching/normalize.h"

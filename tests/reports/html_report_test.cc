@@ -1,5 +1,7 @@
 #include "OpenABLE/reports/html_report.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -8,11 +10,9 @@
 #include <string>
 #include <vector>
 
-#include <gtest/gtest.h>
-
-#include "OpenABLE/io/image_codec.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/report.h"
+#include "OpenABLE/io/image_codec.h"
 #include "OpenABLE/io/json.h"
 #include "OpenABLE/reports/html_explorer.h"
 #include "config/config.h"
@@ -74,8 +74,8 @@ TEST(HtmlReport, ConfidentWrongMatchesAreTheWrongAnswersByIncreasingDistance) {
   std::stable_sort(wrong.begin(), wrong.end(),
                    [](const Expected& a, const Expected& b) { return a.distance < b.distance; });
   ASSERT_GE(wrong.size(), 6u);
-  const std::vector<ReportCase> cases = ConfidentWrongMatches(
-      f.evaluation.runs[0], f.evaluation.truths[0], f.matrix, 100, 5);
+  const std::vector<ReportCase> cases =
+      ConfidentWrongMatches(f.evaluation.runs[0], f.evaluation.truths[0], f.matrix, 100, 5);
   ASSERT_EQ(cases.size(), 5u);
   for (std::size_t k = 0; k < cases.size(); ++k) {
     EXPECT_EQ(cases[k].query, wrong[k].query) << k;
@@ -84,8 +84,7 @@ TEST(HtmlReport, ConfidentWrongMatchesAreTheWrongAnswersByIncreasingDistance) {
     EXPECT_FALSE(cases[k].correct);
     EXPECT_EQ(cases[k].true_place, wrong[k].query);  // aligned: query i is reference i
   }
-  EXPECT_TRUE(ConfidentWrongMatches(f.evaluation.runs[0], f.evaluation.truths[0], f.matrix, 100,
-                                    0)
+  EXPECT_TRUE(ConfidentWrongMatches(f.evaluation.runs[0], f.evaluation.truths[0], f.matrix, 100, 0)
                   .empty());
 }
 
@@ -106,12 +105,12 @@ TEST(HtmlReport, MissesAreThePositiveQueriesNotFoundAtTheThreshold) {
     EXPECT_EQ(cases[k].correct, missed[k].correct) << k;
   }
   // Right answers above the threshold are misses too (the queries with q % 3 == 2).
-  EXPECT_TRUE(std::any_of(cases.begin(), cases.end(), [](const ReportCase& c) { return c.correct; }));
+  EXPECT_TRUE(
+      std::any_of(cases.begin(), cases.end(), [](const ReportCase& c) { return c.correct; }));
 }
 
 std::string Base64Decode(const std::string& text) {
-  const std::string digits =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  const std::string digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   unsigned value = 0;
   int bits = 0;
@@ -211,7 +210,8 @@ TEST(HtmlReport, WithoutFramesTheCasesAreNamedAndTheReasonGiven) {
   EXPECT_NE(page.find("Frames are named, not shown: no frames given"), std::string::npos);
   EXPECT_NE(page.find("row "), std::string::npos);
   int images = 0;
-  for (std::size_t at = page.find("<img "); at != std::string::npos; at = page.find("<img ", at + 1))
+  for (std::size_t at = page.find("<img "); at != std::string::npos;
+       at = page.find("<img ", at + 1))
     ++images;
   EXPECT_EQ(images, 3);  // the PR figure, the overlay, the explorer's matrix
 }
@@ -315,9 +315,9 @@ TEST(HtmlReport, ExplorerCodesAndGroupsOfCells) {
   EXPECT_EQ(cell_cols, 1);
   ASSERT_EQ(values.rows, (rows + 2) / 3);
   ASSERT_EQ(values.cols, cols);
-  EXPECT_EQ(values(0, 0), 255);                     // rows 0-2 of column 0 have no value
-  EXPECT_EQ(values(1, 0), ExploreCode(0.25f));      // rows 3-5: 0, 0.25, 0.5
-  EXPECT_EQ(values(1, 2), ExploreCode(0.45f));      // plus 0.2
+  EXPECT_EQ(values(0, 0), 255);                                // rows 0-2 of column 0 have no value
+  EXPECT_EQ(values(1, 0), ExploreCode(0.25f));                 // rows 3-5: 0, 0.25, 0.5
+  EXPECT_EQ(values(1, 2), ExploreCode(0.45f));                 // plus 0.2
   EXPECT_EQ(values(values.rows - 1, 1), ExploreCode(0.225f));  // the last group: 2 rows (0.1, 0.35)
 }
 
@@ -415,16 +415,14 @@ struct BlockFixture {
 
 TEST(HtmlReport, WithoutGroundTruthTheRunsAnswersAndAcceptedFramesAreShown) {
   const BlockFixture f;
-  const ReportAnswers answers =
-      AnswersForReport(f.matrix, EvaluationLayout::QueryReference(30, 50), "LDB L=1", "a map",
-                       f.options);
+  const ReportAnswers answers = AnswersForReport(f.matrix, EvaluationLayout::QueryReference(30, 50),
+                                                 "LDB L=1", "a map", f.options);
   // Accepted (distance <= 0.3) by brute force, most confident first.
   std::vector<int> accepted;
   for (int q = 0; q < 30; ++q)
     if (f.expected[q].best >= 0 && f.expected[q].distance <= 0.3f) accepted.push_back(q);
-  std::stable_sort(accepted.begin(), accepted.end(), [&](int a, int b) {
-    return f.expected[a].distance < f.expected[b].distance;
-  });
+  std::stable_sort(accepted.begin(), accepted.end(),
+                   [&](int a, int b) { return f.expected[a].distance < f.expected[b].distance; });
   ASSERT_EQ(accepted.size(), 23u);  // 24 with the place, less query 4
   ReportInput input = f.Input(answers);
   int reads = 0;
@@ -440,7 +438,7 @@ TEST(HtmlReport, WithoutGroundTruthTheRunsAnswersAndAcceptedFramesAreShown) {
   const std::string page = EncodeHtmlReport(input);
 
   EXPECT_EQ(Sections(page), (std::vector<std::string>{"settings", "operating-point", "matrix",
-                                                       "explore", "accepted"}));
+                                                      "explore", "accepted"}));
   // It says there is no ground truth, and how to get figures.
   EXPECT_NE(page.find("<b>No ground truth.</b>"), std::string::npos);
   EXPECT_NE(page.find("Ground_truth_type"), std::string::npos);
@@ -463,9 +461,9 @@ TEST(HtmlReport, WithoutGroundTruthTheRunsAnswersAndAcceptedFramesAreShown) {
   EXPECT_EQ(CaseQueries(page, "accepted-doubtful"), doubtful);
   // Each row shows the query's frame beside its matched frame, by name, with its distance.
   for (const int q : confident) {
-    const std::size_t row = page.find("<tr data-query=\"" + std::to_string(q) +
-                                      "\" data-reference=\"" +
-                                      std::to_string(f.expected[q].best) + "\">");
+    const std::size_t row =
+        page.find("<tr data-query=\"" + std::to_string(q) + "\" data-reference=\"" +
+                  std::to_string(f.expected[q].best) + "\">");
     ASSERT_NE(row, std::string::npos) << q;
     const std::string text = page.substr(row, page.find("</tr>", row) - row);
     EXPECT_NE(text.find("query-" + std::to_string(q) + ".png"), std::string::npos) << text;
@@ -530,8 +528,8 @@ TEST(HtmlReport, WithoutGroundTruthARunThatAcceptsNothingSaysWhy) {
 
 TEST(HtmlReport, WithoutGroundTruthAnswersThatDoNotFitAreRefused) {
   const BlockFixture f;
-  ReportAnswers answers = AnswersForReport(f.matrix, EvaluationLayout::QueryReference(30, 50),
-                                           "x", "y", f.options);
+  ReportAnswers answers =
+      AnswersForReport(f.matrix, EvaluationLayout::QueryReference(30, 50), "x", "y", f.options);
   ReportInput input = f.Input(answers);
   input.matrices.clear();
   EXPECT_THROW(EncodeHtmlReport(input), std::logic_error);
@@ -558,8 +556,8 @@ TEST(HtmlReport, FiguresShowTheOperatingPointAndTheReferenceProtocols) {
   Fixture base;
   Evaluation evaluation;
   evaluation.settings = EvaluationSettingsFrom(config);
-  EvaluateMatrix(evaluation, base.matrix, EvaluationLayout::TwoTraversals(kFrames, kFrames),
-                 "LDB", "test");
+  EvaluateMatrix(evaluation, base.matrix, EvaluationLayout::TwoTraversals(kFrames, kFrames), "LDB",
+                 "test");
   // By brute force: answers with distance <= 0.55, and the right ones among them.
   int accepted = 0, right = 0;
   for (const Expected& e : BruteForce(base.matrix))
@@ -575,7 +573,7 @@ TEST(HtmlReport, FiguresShowTheOperatingPointAndTheReferenceProtocols) {
   input.frames.missing = "none";
   const std::string page = EncodeHtmlReport(input);
   EXPECT_EQ(Sections(page), (std::vector<std::string>{"settings", "figures", "pr", "matrix",
-                                                       "explore", "wrong-matches", "misses"}));
+                                                      "explore", "wrong-matches", "misses"}));
   EXPECT_EQ(page.find("No ground truth"), std::string::npos);
   EXPECT_EQ(Cell(page, "operating-point-table", 5), std::to_string(accepted));
   EXPECT_EQ(Cell(page, "operating-point-table", 7), std::to_string(accepted));

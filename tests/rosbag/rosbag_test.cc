@@ -1,24 +1,24 @@
 // ROS 1 bags as input (Frame_mode 3, OpenBag): bags written here with Debian's rosbag_storage
 // from real frames of ../shared/datasets, read back by Test_OpenABLE and compared with the same
 // frames read from their folders.
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <string>
-#include <utility>
-#include <vector>
-
-#include <Eigen/Geometry>
-#include <boost/make_shared.hpp>
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <rosbag/bag.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <std_msgs/String.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <boost/make_shared.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "OpenABLE/io/frame_source.h"
 #include "tests/e2e/e2e_support.h"
@@ -121,16 +121,15 @@ TEST(RosBag, Kitti300FramesGiveTheFolderMatrixBitForBit) {
     WriteTopic(bag, "/kitti/camera_gray_left/image_raw", frames, "mono8", times);
     WriteTopic(bag, "/kitti/camera_gray_left/image_png", frames, "compressed", times);
   }
-  const std::vector<std::string> common = {"--set", "Image_sequences=10", "--set", "Png_name=",
-                                           "--set", "Ground_truth_type="};
+  const std::vector<std::string> common = {
+      "--set", "Image_sequences=10", "--set", "Png_name=", "--set", "Ground_truth_type="};
   auto run = [&](const std::string& npy, const std::vector<std::string>& args) {
     return MatrixOf(dir, args, common, npy);
   };
-  const std::string folder = run("folder.npy", {"--set", "Images_path=" + Kitti() + "/image_0",
-                                                "--set", "Final_image=300"});
-  const std::string raw = run("raw.npy", {"--set", "Frame_mode=3", "--set",
-                                          "Bag_path=kitti.bag", "--set",
-                                          "Bag_topic=/kitti/camera_gray_left/image_raw",
+  const std::string folder = run(
+      "folder.npy", {"--set", "Images_path=" + Kitti() + "/image_0", "--set", "Final_image=300"});
+  const std::string raw = run("raw.npy", {"--set", "Frame_mode=3", "--set", "Bag_path=kitti.bag",
+                                          "--set", "Bag_topic=/kitti/camera_gray_left/image_raw",
                                           "--set", "Timestamps_name=times.txt"});
   const std::string png = run("png.npy", {"--set", "Frame_mode=3", "--set", "Bag_path=kitti.bag",
                                           "--set", "Bag_topic=/kitti/camera_gray_left/image_png"});
@@ -198,9 +197,9 @@ TEST(RosBag, SecondTraversalFromATopicOrABag) {
     rosbag::Bag other(dir + "/winter.bag", rosbag::bagmode::Write);
     WriteTopic(other, "/cam", winter, "bgr8", times);
   }
-  const std::vector<std::string> common = {"--set", "Image_sequences=5", "--set", "Png_name=",
-                                           "--set", "Final_image=60", "--set",
-                                           "Ground_truth_type="};
+  const std::vector<std::string> common = {
+      "--set", "Image_sequences=5", "--set", "Png_name=",
+      "--set", "Final_image=60",    "--set", "Ground_truth_type="};
   auto run = [&](const std::string& npy, const std::vector<std::string>& args) {
     return MatrixOf(dir, args, common, npy);
   };
@@ -210,10 +209,9 @@ TEST(RosBag, SecondTraversalFromATopicOrABag) {
   const std::string topics =
       run("topics.npy", {"--set", "Frame_mode=3", "--set", "Bag_path=both.bag", "--set",
                          "Bag_topic=/summer", "--set", "Bag_topic_2=/winter"});
-  const std::string bags =
-      run("bags.npy", {"--set", "Frame_mode=3", "--set", "Bag_path=both.bag", "--set",
-                       "Bag_topic=/summer", "--set", "Bag_path_2=winter.bag", "--set",
-                       "Bag_topic_2=/cam"});
+  const std::string bags = run("bags.npy", {"--set", "Frame_mode=3", "--set", "Bag_path=both.bag",
+                                            "--set", "Bag_topic=/summer", "--set",
+                                            "Bag_path_2=winter.bag", "--set", "Bag_topic_2=/cam"});
   ASSERT_GT(folders.size(), 120u * 120u * 4u);
   EXPECT_TRUE(folders == topics);
   EXPECT_TRUE(folders == bags);
@@ -242,15 +240,17 @@ TEST(RosBag, StereoPairsFromTwoTopicsGiveTheFoldersMatrix) {
     WriteTopic(bag, "/cam1/short", std::vector<std::string>(right.begin(), right.begin() + 3),
                "mono8", times);
   }
-  const std::vector<std::string> common = {
-      "--set", "Camera_type=1", "--set", "Calibration_path=calibration.yaml", "--set",
-      "Image_descriptor=D-LDB", "--set", "Ldb_bits=1386", "--set", "Png_name=", "--set",
-      "Ground_truth_type="};
+  const std::vector<std::string> common = {"--set", "Camera_type=1",
+                                           "--set", "Calibration_path=calibration.yaml",
+                                           "--set", "Image_descriptor=D-LDB",
+                                           "--set", "Ldb_bits=1386",
+                                           "--set", "Png_name=",
+                                           "--set", "Ground_truth_type="};
   auto run = [&](const std::string& npy, const std::vector<std::string>& args) {
     return MatrixOf(dir, args, common, npy);
   };
-  const std::string folders = run("folders.npy", {"--set", "Images_path_left=left", "--set",
-                                                  "Images_path_right=right"});
+  const std::string folders =
+      run("folders.npy", {"--set", "Images_path_left=left", "--set", "Images_path_right=right"});
   const std::string topics =
       run("topics.npy", {"--set", "Frame_mode=3", "--set", "Bag_path=stereo.bag", "--set",
                          "Bag_topic=/cam0/image_raw", "--set", "Bag_topic_right=/cam1/image_raw"});
@@ -306,14 +306,14 @@ TEST(RosBag, TumGroundTruthAssociatesByTime) {
       for (int b = 0; b < 3; ++b) r(a, b) = p(a, b);
     const Eigen::Quaterniond q(r);
     const double x = q.x(), y = q.y(), z = q.z(), w = q.w();
-    tum << all_times[i] + 0.004 << " " << p(0, 3) << " " << p(1, 3) << " " << p(2, 3) << " "
-        << x << " " << y << " " << z << " " << w << "\n";
+    tum << all_times[i] + 0.004 << " " << p(0, 3) << " " << p(1, 3) << " " << p(2, 3) << " " << x
+        << " " << y << " " << z << " " << w << "\n";
   }
   tum.close();
   head.close();
   const std::vector<std::string> common = {
-      "--set", "Frame_mode=3", "--set", "Bag_path=kitti.bag", "--set", "Bag_topic=/cam",
-      "--set", "Image_sequences=3", "--set", "Png_name=", "--set", "Exclusion=5",
+      "--set", "Frame_mode=3",          "--set", "Bag_path=kitti.bag",  "--set", "Bag_topic=/cam",
+      "--set", "Image_sequences=3",     "--set", "Png_name=",           "--set", "Exclusion=5",
       "--set", "Ground_truth_radius=5", "--set", "Ground_truth_axes=xz"};
   auto evaluate = [&](const std::string& name, const std::vector<std::string>& truth) {
     std::vector<std::string> args = common;
@@ -322,10 +322,10 @@ TEST(RosBag, TumGroundTruthAssociatesByTime) {
     Written(dir, args);
     return ReadAll(dir + "/" + name + "_per_query.csv");
   };
-  const std::string by_line = evaluate("line", {"--set", "Ground_truth_type=kitti", "--set",
-                                                "Ground_truth=truth_kitti.txt"});
-  const std::string by_time = evaluate("time", {"--set", "Ground_truth_type=tum", "--set",
-                                                "Ground_truth=truth_tum.txt"});
+  const std::string by_line = evaluate(
+      "line", {"--set", "Ground_truth_type=kitti", "--set", "Ground_truth=truth_kitti.txt"});
+  const std::string by_time =
+      evaluate("time", {"--set", "Ground_truth_type=tum", "--set", "Ground_truth=truth_tum.txt"});
   EXPECT_EQ(by_line, by_time);
   // Not vacuous: the loops of KITTI 00 are there.
   const std::string json = ReadAll(dir + "/time.json");
@@ -334,15 +334,18 @@ TEST(RosBag, TumGroundTruthAssociatesByTime) {
   EXPECT_GT(std::stoi(json.substr(positive + 20)), 5) << json.substr(positive, 40);
   // SNAPS on the TUM trajectory of every frame: the loops of the bag's saved matrix map to the
   // poses by time through Timestamps_name (pose 10 i for row i), not to pose i.
-  Written(dir, {"--set", "Frame_mode=3", "--set", "Bag_path=kitti.bag", "--set",
-                "Bag_topic=/cam", "--set", "Image_sequences=3", "--set", "Png_name=", "--set",
-                "Npy_name=m.npy", "--set", "Timestamps_name=times.txt"});
+  Written(dir, {"--set", "Frame_mode=3", "--set", "Bag_path=kitti.bag", "--set", "Bag_topic=/cam",
+                "--set", "Image_sequences=3", "--set", "Png_name=", "--set", "Npy_name=m.npy",
+                "--set", "Timestamps_name=times.txt"});
   auto snaps_loops = [&](const std::string& prefix, bool by_time) {
-    std::vector<std::string> args = {
-        "--set", "Snaps_trajectory=truth_tum.txt", "--set", "Snaps_trajectory_format=tum",
-        "--set", "Snaps_loops=matrix", "--set", "Snaps_loops_file=m.npy", "--set",
-        "Snaps_matrix_threshold=0.6", "--set", "Snaps_frame_distance=50", "--set",
-        "Snaps_corrector=discounted", "--set", "Snaps_output_name=" + prefix};
+    std::vector<std::string> args = {"--set", "Snaps_trajectory=truth_tum.txt",
+                                     "--set", "Snaps_trajectory_format=tum",
+                                     "--set", "Snaps_loops=matrix",
+                                     "--set", "Snaps_loops_file=m.npy",
+                                     "--set", "Snaps_matrix_threshold=0.6",
+                                     "--set", "Snaps_frame_distance=50",
+                                     "--set", "Snaps_corrector=discounted",
+                                     "--set", "Snaps_output_name=" + prefix};
     if (by_time) args.insert(args.end(), {"--set", "Snaps_frame_times=times.txt"});
     const Outcome o = RunProgram(testing::OpenableSnapsExe(), args, dir);
     EXPECT_EQ(o.status, 0) << o.err;
@@ -367,12 +370,12 @@ TEST(RosBag, TumGroundTruthAssociatesByTime) {
   }
 
   // 4 ms off is outside a 3 ms tolerance: the frame is named.
-  const Outcome o = RunProgram(
-      testing::TestOpenableExe(),
-      {"--set", "Frame_mode=3", "--set", "Bag_path=kitti.bag", "--set", "Bag_topic=/cam",
-       "--set", "Ground_truth_type=tum", "--set", "Ground_truth=truth_tum.txt", "--set",
-       "Ground_truth_time_tolerance=0.003", "--set", "Npy_name=out/m.npy"},
-      dir);
+  const Outcome o =
+      RunProgram(testing::TestOpenableExe(),
+                 {"--set", "Frame_mode=3", "--set", "Bag_path=kitti.bag", "--set", "Bag_topic=/cam",
+                  "--set", "Ground_truth_type=tum", "--set", "Ground_truth=truth_tum.txt", "--set",
+                  "Ground_truth_time_tolerance=0.003", "--set", "Npy_name=out/m.npy"},
+                 dir);
   EXPECT_EQ(o.status, 1);
   // The frames' times are known once they are read: progress lines come first, then the one
   // error line, last.
@@ -416,11 +419,11 @@ TEST(RosBag, BadBagsAreOneLineNamingBagAndTopic) {
       {"absent.bag", "/cam0/image_raw", "Bag_path: bag \"absent.bag\" does not exist"},
   };
   for (const Case& c : cases) {
-    const Outcome o = RunProgram(testing::TestOpenableExe(),
-                                 {"--set", "Frame_mode=3", "--set", "Bag_path=" + c.bag, "--set",
-                                  "Bag_topic=" + c.topic, "--set", "Npy_name=out/m.npy", "--set",
-                                  "Ground_truth_type="},
-                                 dir);
+    const Outcome o = RunProgram(
+        testing::TestOpenableExe(),
+        {"--set", "Frame_mode=3", "--set", "Bag_path=" + c.bag, "--set", "Bag_topic=" + c.topic,
+         "--set", "Npy_name=out/m.npy", "--set", "Ground_truth_type="},
+        dir);
     EXPECT_EQ(o.status, 1) << c.bag << " " << o.err;
     EXPECT_TRUE(OneLine(o.err)) << o.err;
     EXPECT_NE(o.err.find(c.expected), std::string::npos) << o.err;
@@ -436,8 +439,7 @@ TEST(RosBag, BadBagsAreOneLineNamingBagAndTopic) {
                                 "Timestamps_name=t.txt", "--set", "Ground_truth_type="},
                                dir);
   EXPECT_EQ(t.status, 1);
-  EXPECT_NE(t.err.find("Timestamps_name: \"t.txt\" with Frame_mode 0"), std::string::npos)
-      << t.err;
+  EXPECT_NE(t.err.find("Timestamps_name: \"t.txt\" with Frame_mode 0"), std::string::npos) << t.err;
 }
 
 // Messages that state the condition that failed: a topic that mixes two message types (each
@@ -554,10 +556,9 @@ TEST(RosBag, DamagedBagsAreRefusedBeforeRosbagStorageReadsThem) {
   };
   for (const auto& [name, defect] : cases) {
     const std::string path = FuzzBag(name);
-    testing::ExpectInputError(
-        [&] { OpenBag(path, "/image", 0, -1, "Bag_path", "Bag_topic"); },
-        {"Bag_path: bag " + testing::Q(path) + " cannot be read (" + defect,
-         "expected a complete ROS 1 bag of format 2.0"});
+    testing::ExpectInputError([&] { OpenBag(path, "/image", 0, -1, "Bag_path", "Bag_topic"); },
+                              {"Bag_path: bag " + testing::Q(path) + " cannot be read (" + defect,
+                               "expected a complete ROS 1 bag of format 2.0"});
   }
   // Not bags of format 2.0, and a bag without index.
   const std::string dir = testing::TempDir();
@@ -566,8 +567,7 @@ TEST(RosBag, DamagedBagsAreRefusedBeforeRosbagStorageReadsThem) {
   std::string unindexed = ReadAll(FuzzBag("mono8.bag"));
   unindexed.replace(unindexed.find("index_pos=") + 10, 8, std::string(8, '\0'));
   std::ofstream(dir + "/unindexed.bag", std::ios::binary) << unindexed;
-  for (const auto& [name, defect] :
-       std::vector<std::pair<std::string, std::string>>{
+  for (const auto& [name, defect] : std::vector<std::pair<std::string, std::string>>{
            {"old.bag", "it is a bag of format \"1.2\"; OpenABLE reads format 2.0"},
            {"text.bag", "it is not a ROS 1 bag"},
            {"unindexed.bag", "it has no index: a recording cut short (rosbag reindex"}})
@@ -580,8 +580,8 @@ TEST(RosBag, DamagedBagsAreRefusedBeforeRosbagStorageReadsThem) {
 // in one line, its bytes escaped.
 TEST(RosBag, TextOfTheBagIsEscapedInMessages) {
   const std::string path = FuzzBag("datatype_with_control_characters.bag");
-  const std::string message = testing::InputErrorMessage(
-      [&] { OpenBag(path, "/image", 0, -1, "Bag_path", "Bag_topic"); });
+  const std::string message =
+      testing::InputErrorMessage([&] { OpenBag(path, "/image", 0, -1, "Bag_path", "Bag_topic"); });
   EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   EXPECT_NE(message.find("Bag_topic: topic \"/image\" of bag " + testing::Q(path) + " holds s"),
             std::string::npos)
@@ -592,9 +592,9 @@ TEST(RosBag, TextOfTheBagIsEscapedInMessages) {
 // The bags rosbag_storage writes pass the walk, whatever their chunks' compression and the
 // messages' encodings: every frame of the fuzzer's seeds is read, with its time.
 TEST(RosBag, FuzzerSeedsWrittenByRosbagAreRead) {
-  for (const std::string name : {"mono8.bag", "mono8_bz2.bag", "mono8_lz4.bag",
-                                 "mono8_full_definitions.bag", "rgb8.bag", "bgra8.bag",
-                                 "mono16_big_endian.bag", "rgb16.bag", "png.bag"}) {
+  for (const std::string name :
+       {"mono8.bag", "mono8_bz2.bag", "mono8_lz4.bag", "mono8_full_definitions.bag", "rgb8.bag",
+        "bgra8.bag", "mono16_big_endian.bag", "rgb16.bag", "png.bag"}) {
     const auto source = OpenBag(FuzzBag(name), "/image", 0, -1, "Bag_path", "Bag_topic");
     ASSERT_GE(source->Size(), 1) << name;
     for (int i = 0; i < source->Size(); ++i) {

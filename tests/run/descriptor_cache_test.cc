@@ -1,5 +1,8 @@
 // The descriptor cache (OpenABLE/run/descriptor_cache.h): its hash, which keys change the
 // cache key, hits and misses, damaged files repaired, rows identical bit for bit.
+#include "OpenABLE/run/descriptor_cache.h"
+
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -7,15 +10,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <set>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <set>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/describe/describe.h"
 #include "OpenABLE/io/frame_source.h"
-#include "OpenABLE/run/descriptor_cache.h"
 #include "config/config.h"
 #include "descriptors/registry.h"
 #include "tests/test_support.h"
@@ -26,7 +26,6 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string ReadAll(const std::string& path) { return testing::ReadBytes(path); }
-
 
 // --- The descriptor cache --------------------------------------------------------------------
 
@@ -42,19 +41,60 @@ TEST(Fnv1a64, SpecificationVectors) {
 // Keys that do not change a frame's row (inputs, outputs, matching, evaluation, tools). A key
 // added to the configuration table must be put here or in DescriptionKeys(): otherwise this
 // test fails, so a setting that changes rows cannot be left out of the cache key silently.
-const std::set<std::string> kNotDescription = {
-    "Frame_mode", "Images_path", "Images_path_2", "Images_path_left", "Images_path_right",
-    "Calibration_path", "Images_format", "Video_path_1", "Video_path_2", "Initial_image",
-    "Final_image", "Skip_unreadable", "Txt_name", "Npy_name", "Png_name", "Png_threshold_name",
-    "Matrix_color", "Show_images", "Panorama_matching", "Image_sequences", "Threshold",
-    "Threads", "Sequence_direction", "Matrix_mode", "Memory_limit", "Best_matches",
-    "Band_width", "Matches_name", "Approximate_search", "Approximate_engine",
-    "Approximate_checks", "Approximate_ef_search", "Approximate_nprobe",
-    "Descriptor_cache", "Sequence_partial", "Match_score", "Match_score_window",
-    "Match_threshold", "Match_consistency", "Auto", "Auto_candidates", "Auto_min_consistency",
-    "Contrast_enhancement", "Contrast_window", "Fusion_weights",
-    "Loops_name", "Bag_path", "Bag_topic", "Bag_topic_right", "Bag_path_2", "Bag_topic_2",
-    "Timestamps_name", "Descriptors_path", "Descriptors_path_2"};
+const std::set<std::string> kNotDescription = {"Frame_mode",
+                                               "Images_path",
+                                               "Images_path_2",
+                                               "Images_path_left",
+                                               "Images_path_right",
+                                               "Calibration_path",
+                                               "Images_format",
+                                               "Video_path_1",
+                                               "Video_path_2",
+                                               "Initial_image",
+                                               "Final_image",
+                                               "Skip_unreadable",
+                                               "Txt_name",
+                                               "Npy_name",
+                                               "Png_name",
+                                               "Png_threshold_name",
+                                               "Matrix_color",
+                                               "Show_images",
+                                               "Panorama_matching",
+                                               "Image_sequences",
+                                               "Threshold",
+                                               "Threads",
+                                               "Sequence_direction",
+                                               "Matrix_mode",
+                                               "Memory_limit",
+                                               "Best_matches",
+                                               "Band_width",
+                                               "Matches_name",
+                                               "Approximate_search",
+                                               "Approximate_engine",
+                                               "Approximate_checks",
+                                               "Approximate_ef_search",
+                                               "Approximate_nprobe",
+                                               "Descriptor_cache",
+                                               "Sequence_partial",
+                                               "Match_score",
+                                               "Match_score_window",
+                                               "Match_threshold",
+                                               "Match_consistency",
+                                               "Auto",
+                                               "Auto_candidates",
+                                               "Auto_min_consistency",
+                                               "Contrast_enhancement",
+                                               "Contrast_window",
+                                               "Fusion_weights",
+                                               "Loops_name",
+                                               "Bag_path",
+                                               "Bag_topic",
+                                               "Bag_topic_right",
+                                               "Bag_path_2",
+                                               "Bag_topic_2",
+                                               "Timestamps_name",
+                                               "Descriptors_path",
+                                               "Descriptors_path_2"};
 
 bool Perturb(Config& c, const std::string& key) {
   const std::string v = ConfigValueText(c, key);
@@ -85,20 +125,39 @@ TEST(DescriptorCacheKey, TheDescriptionKeysAreTheRowStructsKeysInTheTablesOrder)
   // The keys, in this order, make the settings text whose hash names a cache file: the same
   // list as when it was written by hand, and the network's keys (Model_*), which enter the
   // text of a network's rows only, so the caches of earlier runs stay valid.
-  EXPECT_EQ(DescriptionKeys(),
-            (std::vector<std::string>{
-                "Camera_type", "Description_type", "Patch_size", "Grid_x", "Grid_y",
-                "Panoramas", "Illumination_invariance", "Alpha", "Lambda_red", "Lambda_green",
-                "Lambda_blue", "Image_descriptor", "Ldb_bits", "Sad_patch", "Model_path",
-                "Model_input_size", "Model_channels", "Model_mean", "Model_std",
-                "Model_normalize", "Model_batch", "Side_window", "Side_window_radii",
-                "Noise_gaussian", "Noise_salt_pepper", "Noise_overexposure", "Noise_seed"}));
+  EXPECT_EQ(DescriptionKeys(), (std::vector<std::string>{"Camera_type",
+                                                         "Description_type",
+                                                         "Patch_size",
+                                                         "Grid_x",
+                                                         "Grid_y",
+                                                         "Panoramas",
+                                                         "Illumination_invariance",
+                                                         "Alpha",
+                                                         "Lambda_red",
+                                                         "Lambda_green",
+                                                         "Lambda_blue",
+                                                         "Image_descriptor",
+                                                         "Ldb_bits",
+                                                         "Sad_patch",
+                                                         "Model_path",
+                                                         "Model_input_size",
+                                                         "Model_channels",
+                                                         "Model_mean",
+                                                         "Model_std",
+                                                         "Model_normalize",
+                                                         "Model_batch",
+                                                         "Side_window",
+                                                         "Side_window_radii",
+                                                         "Noise_gaussian",
+                                                         "Noise_salt_pepper",
+                                                         "Noise_overexposure",
+                                                         "Noise_seed"}));
   // The text of a hand-crafted descriptor's rows is what it was before networks.
   const std::string ldb = DescriptionSettingsText(Config(), "LDB", 32, CV_8U);
   EXPECT_EQ(ldb.find("Model_"), std::string::npos) << ldb;
-  EXPECT_NE(DescriptionSettingsText(Config(), "ONNX (weights 0123:10)", 32, CV_32F).find(
-                "Model_path: "),
-            std::string::npos);
+  EXPECT_NE(
+      DescriptionSettingsText(Config(), "ONNX (weights 0123:10)", 32, CV_32F).find("Model_path: "),
+      std::string::npos);
 }
 
 TEST(DescriptorCacheKey, EveryKeyIsClassifiedAndEveryDescriptionKeyChangesTheKey) {
@@ -114,8 +173,9 @@ TEST(DescriptorCacheKey, EveryKeyIsClassifiedAndEveryDescriptionKeyChangesTheKey
         key.rfind("Evaluation_", 0) == 0 || key.rfind("Report_", 0) == 0)
       continue;  // evaluation keys
     ASSERT_TRUE(described.count(key))
-        << key << " is new: add it to DescriptionKeys() (descriptor_cache.cc) if it changes "
-                  "descriptor rows, else to kNotDescription here";
+        << key
+        << " is new: add it to DescriptionKeys() (descriptor_cache.cc) if it changes "
+           "descriptor rows, else to kNotDescription here";
     Config changed = base;
     ASSERT_TRUE(Perturb(changed, key)) << key;
     if (key.rfind("Model_", 0) == 0) {  // a network's keys: in the text of its rows only
@@ -168,8 +228,8 @@ DescribedSequence Describe(const Fixture& f, DescriptorCache* cache) {
 }
 
 std::unique_ptr<DescriptorCache> OpenCache(const Fixture& f, std::vector<std::string>& w) {
-  return DescriptorCache::Open(f.cache, "settings", f.describer->RowWidth(),
-                               f.describer->RowType(), w);
+  return DescriptorCache::Open(f.cache, "settings", f.describer->RowWidth(), f.describer->RowType(),
+                               w);
 }
 
 bool SameBytes(const cv::Mat& a, const cv::Mat& b) {

@@ -1,6 +1,10 @@
 // Interrupted runs (OpenABLE/base/interrupt.h) and write errors leave no output that looks
 // complete: temporaries removed on signals, commits deferred until a batch is whole, write
-// errors named, old sets restored, stale temporaries swept (OutputBatch, OpenABLE/base/output_batch.h).
+// errors named, old sets restored, stale temporaries swept (OutputBatch,
+// OpenABLE/base/output_batch.h).
+#include "OpenABLE/base/interrupt.h"
+
+#include <gtest/gtest.h>
 #include <sys/mount.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -11,13 +15,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 #include <set>
 
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
-
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/base/interrupt.h"
 #include "OpenABLE/base/output_batch.h"
 #include "OpenABLE/describe/describe.h"
 #include "OpenABLE/io/frame_source.h"
@@ -139,10 +140,9 @@ TEST(OutputBatch, FailedRenameRestoresTheWholeOldSet) {
     EXPECT_NE(std::string(e.what()).find("Png_name"), std::string::npos) << e.what();
   }
   EXPECT_EQ(ReadAll(dir + "/a.txt"), "old a");  // restored from its backup
-  EXPECT_FALSE(fs::exists(dir + "/b.npy"));      // did not exist before: removed
+  EXPECT_FALSE(fs::exists(dir + "/b.npy"));     // did not exist before: removed
   // No backup left.
-  for (const std::string& f : Entries(dir))
-    EXPECT_EQ(f.find(".old-"), std::string::npos) << f;
+  for (const std::string& f : Entries(dir)) EXPECT_EQ(f.find(".old-"), std::string::npos) << f;
 }
 
 TEST(OutputBatch, StaleTemporariesOfDeadRunsAreRemoved) {
@@ -158,8 +158,8 @@ TEST(OutputBatch, StaleTemporariesOfDeadRunsAreRemoved) {
     batch.Stage("Npy_name", dir + "/m.npy", "x");
     batch.Commit();
   }
-  EXPECT_EQ(Entries(dir), (std::vector<std::string>{alive.substr(1), ".other.npy.tmp-99999999-0",
-                                                    "m.npy"}));
+  EXPECT_EQ(Entries(dir),
+            (std::vector<std::string>{alive.substr(1), ".other.npy.tmp-99999999-0", "m.npy"}));
 }
 
 }  // namespace

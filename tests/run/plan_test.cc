@@ -1,15 +1,16 @@
 // The run plan (OpenABLE/run/plan.h): the check phase reads no frame, refuses a bad source
 // before any work, decides the mode from the frame counts, and the compute phase runs the plan
 // as it is.
-#include <filesystem>
-#include <string>
+#include "OpenABLE/run/plan.h"
 
 #include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/progress.h"
 #include "OpenABLE/run/pipeline.h"
-#include "OpenABLE/run/plan.h"
 #include "config/config.h"
 #include "tests/test_support.h"
 

@@ -1,9 +1,9 @@
 #include "OpenABLE/snaps/discounted.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <stdexcept>
-
-#include <gtest/gtest.h>
 
 namespace openable::snaps {
 namespace {
@@ -30,7 +30,7 @@ TEST(Discounted, GammaAtZeroAndClamp) {
   for (const int alpha : {1, 2, 7}) EXPECT_DOUBLE_EQ(DiscountGamma(0, alpha), 1 - std::exp(-3.0));
   EXPECT_GT(DiscountGamma(149, 2), 0.0);
   EXPECT_NEAR(DiscountGamma(150, 2), 0.0, 1e-15);  // 3 - 0.01 * 2 * 150 = 0
-  EXPECT_EQ(DiscountGamma(200, 2), 0.0);            // would be 1 - e = -1.72
+  EXPECT_EQ(DiscountGamma(200, 2), 0.0);           // would be 1 - e = -1.72
   EXPECT_EQ(DiscountGamma(1000, 1), 0.0);
   EXPECT_LT(DiscountGamma(50, 3), DiscountGamma(50, 1));  // more loops, faster decay
   EXPECT_THROW(DiscountGamma(0, 0), std::invalid_argument);

@@ -1,10 +1,10 @@
 // SNAPS's search on real frames: KITTI 00, frames 0-1699 (../shared/datasets; skipped when
 // absent), the ground-truth poses as the trajectory.
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-
-#include <gtest/gtest.h>
 
 #include "OpenABLE/snaps/loops.h"
 #include "tests/test_support.h"

@@ -1,10 +1,10 @@
 #include "OpenABLE/snaps/loop_search.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <functional>
 #include <stdexcept>
-
-#include <gtest/gtest.h>
 
 namespace openable::snaps {
 namespace {
@@ -77,8 +77,7 @@ TEST(LoopSearch, NotWithinFrameDistance) {
 TEST(LoopSearch, YawLimit) {
   for (const double yaw : {15.0, -12.0, 8.0, -9.5}) {
     LoopSearch search = Driven();
-    EXPECT_EQ(search.Step(60, Pose(0, 10, yaw), Noise(10)).has_value(), std::abs(yaw) <= 10)
-        << yaw;
+    EXPECT_EQ(search.Step(60, Pose(0, 10, yaw), Noise(10)).has_value(), std::abs(yaw) <= 10) << yaw;
   }
 }
 

@@ -1,11 +1,11 @@
 #include "OpenABLE/snaps/loops.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "OpenABLE/app/snaps_chain.h"
 #include "OpenABLE/io/json.h"
@@ -93,8 +93,11 @@ TEST(LoopsFromMatrix, KeyframesAndInitialOffset) {
 TEST(LoopsFromMatrix, NotSquare) {
   const std::string path = TempDir() + "/r.txt";
   WriteBytes(path, "0 1 2\n1 0 2\n");
-  ExpectInputError([&] { LoopsFromMatrix(path, WithIds({0, 1}), Options()); },
-                   {Q(path), "2x3", "not square"});
+  ExpectInputError(
+      [&] {
+        LoopsFromMatrix(path, WithIds({0, 1}), Options());
+      },
+      {Q(path), "2x3", "not square"});
 }
 
 TEST(IndexOfFrame, ExactOrNearestWithinTolerance) {
@@ -147,9 +150,9 @@ TEST(LoopsFromCsv, Errors) {
   struct Case {
     std::string text, part;
   };
-  for (const Case& c : {Case{"4,1\nfive,1\n", "\"five\""}, Case{"4,1\n\n3,x2\n", "\"x2\""},
-                        Case{"9,1\n", "frame 9 outside"}, Case{"4\n", "1 value"},
-                        Case{"-4,1\n", "frame -4"}}) {
+  for (const Case& c :
+       {Case{"4,1\nfive,1\n", "\"five\""}, Case{"4,1\n\n3,x2\n", "\"x2\""},
+        Case{"9,1\n", "frame 9 outside"}, Case{"4\n", "1 value"}, Case{"-4,1\n", "frame -4"}}) {
     const std::string path = dir + "/bad.csv";
     WriteBytes(path, c.text);
     const std::string line =

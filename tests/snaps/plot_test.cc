@@ -1,11 +1,11 @@
 // Top view of trajectories: size, colours where the trajectories are, equal aspect.
 #include "OpenABLE/snaps/plot.h"
 
-#include <cmath>
-#include <string>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 #include <opencv2/imgcodecs.hpp>
+#include <string>
 
 #include "tests/test_support.h"
 

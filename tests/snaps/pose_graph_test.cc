@@ -1,7 +1,8 @@
 // Pose-graph correction: synthetic squares with injected drift, the robust kernel against a
 // wrong loop, and the SO-DSO trajectories of KITTI 00 and 06 with their ground-truth loops.
-#include "OpenABLE/snaps/loops.h"
 #include "OpenABLE/snaps/pose_graph.h"
+
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
@@ -12,9 +13,8 @@
 #include <string>
 #include <vector>
 
-#include <gtest/gtest.h>
-
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/snaps/loops.h"
 #include "OpenABLE/snaps/trajectory.h"
 #include "tests/test_support.h"
 
@@ -167,10 +167,11 @@ TEST(CorrectPoseGraph, RobustKernelLimitsAWrongLoop) {
   const double moved_huber = MeanDistance(huber, clean);
   const double moved_none = MeanDistance(none, clean);
   const double moved_cauchy = MeanDistance(cauchy, clean);
-  std::printf("wrong loop: input %.3f m from the truth, clean %.3f m; the wrong pairs move it "
-              "%.3f m (huber), %.3f m (cauchy), %.3f m (no kernel)\n",
-              MeanDistance(drifting, truth), MeanDistance(clean, truth), moved_huber,
-              moved_cauchy, moved_none);
+  std::printf(
+      "wrong loop: input %.3f m from the truth, clean %.3f m; the wrong pairs move it "
+      "%.3f m (huber), %.3f m (cauchy), %.3f m (no kernel)\n",
+      MeanDistance(drifting, truth), MeanDistance(clean, truth), moved_huber, moved_cauchy,
+      moved_none);
   EXPECT_LT(MeanDistance(clean, truth), MeanDistance(drifting, truth));
   EXPECT_GT(moved_none, 1.0);
   EXPECT_LT(moved_huber, 0.3 * moved_none);
@@ -181,8 +182,11 @@ TEST(CorrectPoseGraph, OptionsAndIndicesAreChecked) {
   const Trajectory t = Square(1);
   PoseGraphOptions options;
   options.loop_weight = -1;
-  ExpectInputError([&] { CorrectPoseGraph(t, {{100, 0, 1}}, options); },
-                   {"loop_weight", "-1", "> 0"});
+  ExpectInputError(
+      [&] {
+        CorrectPoseGraph(t, {{100, 0, 1}}, options);
+      },
+      {"loop_weight", "-1", "> 0"});
   options = PoseGraphOptions();
   options.max_iterations = 0;
   ExpectInputError([&] { options.Check(); }, {"max_iterations", ">= 1"});
@@ -199,9 +203,9 @@ TEST(CorrectPoseGraph, OptionsAndIndicesAreChecked) {
 void CorrectSoDso(const std::string& sequence, const std::string& pairs_file) {
   const std::string root = DatasetsDir() + "/kitti_trajectories";
   OPENABLE_REQUIRE_PATH(root);
-  const Trajectory vo = ReadTrajectory(root + "/vo_so_dso/seq" + sequence +
-                                           "/poses_history_file.txt",
-                                       TrajectoryFormat::kKittiWithId, true);
+  const Trajectory vo =
+      ReadTrajectory(root + "/vo_so_dso/seq" + sequence + "/poses_history_file.txt",
+                     TrajectoryFormat::kKittiWithId, true);
   const Trajectory truth =
       ReadTrajectory(root + "/poses/" + sequence + ".txt", TrajectoryFormat::kKitti);
   const std::vector<int> association = AssociateWithTruth(vo, truth, 0, "truth");
@@ -219,16 +223,17 @@ void CorrectSoDso(const std::string& sequence, const std::string& pairs_file) {
   const TrajectoryError before_aligned = AbsoluteTrajectoryError(vo, truth, association, true);
   const TrajectoryError after_aligned =
       AbsoluteTrajectoryError(corrected, truth, association, true);
-  std::printf("KITTI %s SO-DSO: %d keyframes, %d of %d ground-truth loop pairs on keyframes\n"
-              "  unaligned: mean %.2f -> %.2f m (%+.1f %%), rmse %.2f -> %.2f m, max %.2f -> %.2f\n"
-              "  aligned:   mean %.2f -> %.2f m (%+.1f %%), rmse %.2f -> %.2f m\n"
-              "  solver: %d steps, cost %.4g -> %.4g, %.3f s, converged %d\n",
-              sequence.c_str(), vo.Size(), static_cast<int>(loops.size()), total, before.mean,
-              after.mean, -100 * (1 - after.mean / before.mean), before.rmse, after.rmse,
-              before.max, after.max, before_aligned.mean, after_aligned.mean,
-              -100 * (1 - after_aligned.mean / before_aligned.mean), before_aligned.rmse,
-              after_aligned.rmse, report.iterations, report.initial_cost, report.final_cost,
-              report.seconds, report.converged ? 1 : 0);
+  std::printf(
+      "KITTI %s SO-DSO: %d keyframes, %d of %d ground-truth loop pairs on keyframes\n"
+      "  unaligned: mean %.2f -> %.2f m (%+.1f %%), rmse %.2f -> %.2f m, max %.2f -> %.2f\n"
+      "  aligned:   mean %.2f -> %.2f m (%+.1f %%), rmse %.2f -> %.2f m\n"
+      "  solver: %d steps, cost %.4g -> %.4g, %.3f s, converged %d\n",
+      sequence.c_str(), vo.Size(), static_cast<int>(loops.size()), total, before.mean, after.mean,
+      -100 * (1 - after.mean / before.mean), before.rmse, after.rmse, before.max, after.max,
+      before_aligned.mean, after_aligned.mean,
+      -100 * (1 - after_aligned.mean / before_aligned.mean), before_aligned.rmse,
+      after_aligned.rmse, report.iterations, report.initial_cost, report.final_cost, report.seconds,
+      report.converged ? 1 : 0);
   // What the model minimises: the loop pairs' positions meet (mean gap down by half at least).
   const auto mean_gap = [&loops](const Trajectory& t) {
     double sum = 0;

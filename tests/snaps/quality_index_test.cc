@@ -1,10 +1,10 @@
 #include "OpenABLE/snaps/quality_index.h"
 
-#include <cmath>
-#include <stdexcept>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 #include <opencv2/core.hpp>
+#include <stdexcept>
 
 namespace openable::snaps {
 namespace {

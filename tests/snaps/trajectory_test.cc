@@ -2,12 +2,12 @@
 // files written here with values computed by hand.
 #include "OpenABLE/snaps/trajectory.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <random>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "OpenABLE/base/error.h"
 #include "tests/test_support.h"
@@ -106,8 +106,7 @@ TEST(ReadTrajectory, NearlyOrthonormalRotationIsRepaired) {
   EXPECT_NEAR(r.determinant(), 1, 1e-14);
   // ... and it writes back to itself.
   const std::string again = Write("near2.txt", EncodeTrajectory(t));
-  EXPECT_EQ(ReadTrajectory(again, TrajectoryFormat::kKitti).poses[0].matrix(),
-            t.poses[0].matrix());
+  EXPECT_EQ(ReadTrajectory(again, TrajectoryFormat::kKitti).poses[0].matrix(), t.poses[0].matrix());
 }
 
 TEST(EncodeTrajectory, KittiRoundTripIsExact) {
@@ -232,9 +231,11 @@ TEST(AssociateWithTruth, ByFrameId) {
                    {"Ground_truth", "frame 7", "pose 2", "0 .. 5"});
   // A ground truth with gaps: frame 3 missing.
   const Trajectory gappy = Line(TrajectoryFormat::kKittiWithId, {0, 2, 4});
-  ExpectInputError([&] { AssociateWithTruth(Line(TrajectoryFormat::kKitti, {0, 1, 2, 3}), gappy,
-                                            0, "gt"); },
-                   {"gt", "frame 1", "0 .. 4"});
+  ExpectInputError(
+      [&] {
+        AssociateWithTruth(Line(TrajectoryFormat::kKitti, {0, 1, 2, 3}), gappy, 0, "gt");
+      },
+      {"gt", "frame 1", "0 .. 4"});
 }
 
 TEST(AssociateWithTruth, ByNearestTimestampWithinTolerance) {
@@ -243,8 +244,7 @@ TEST(AssociateWithTruth, ByNearestTimestampWithinTolerance) {
   const Trajectory estimate = Line(TrajectoryFormat::kTum, {0, 1, 2}, {0.04, 0.26, 0.5});
   EXPECT_EQ(AssociateWithTruth(estimate, truth, 0.05, "k"), (std::vector<int>{0, 3, 5}));
   ExpectInputError([&] { AssociateWithTruth(estimate, truth, 0.03, "Ground_truth"); },
-                   {"Ground_truth", "timestamp 0.04 (pose 0)", "within 0.03 s",
-                    "0 .. 0.5"});
+                   {"Ground_truth", "timestamp 0.04 (pose 0)", "within 0.03 s", "0 .. 0.5"});
   const Trajectory late = Line(TrajectoryFormat::kTum, {0, 1}, {0.2, 0.58});
   ExpectInputError([&] { AssociateWithTruth(late, truth, 0.05, "gt"); }, {"gt", "pose 1"});
 }

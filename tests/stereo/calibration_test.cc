@@ -2,13 +2,13 @@
 // the test helper (tests/tools/euroc_calibration.h).
 #include "OpenABLE/stereo/calibration.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "tests/test_support.h"
 #include "tests/tools/euroc_calibration.h"
@@ -22,8 +22,8 @@ std::string EurocDir() { return testing::DatasetsDir() + "/euroc_stereo_pairs"; 
 
 // One opencv-matrix node as OpenCV writes it.
 std::string MatrixNode(const std::string& key, int rows, int cols, const std::string& data) {
-  return key + ": !!opencv-matrix\n   rows: " + std::to_string(rows) + "\n   cols: " +
-         std::to_string(cols) + "\n   dt: d\n   data: [ " + data + " ]\n";
+  return key + ": !!opencv-matrix\n   rows: " + std::to_string(rows) +
+         "\n   cols: " + std::to_string(cols) + "\n   dt: d\n   data: [ " + data + " ]\n";
 }
 
 // A valid calibration (EuRoC-like numbers), each node replaceable or removable ("" removes).
@@ -64,11 +64,11 @@ TEST(StereoCalibration, LoadsEveryKey) {
 }
 
 TEST(StereoCalibration, AcceptsRowVectorsAndDefaultsTheRenderingKeys) {
-  const StereoCalibration c = LoadStereoCalibration(Write(CalibrationText(
-      {{"DL", MatrixNode("DL", 1, 5, "0.1, 0.2, 0.3, 0.4, 0.5")},
-       {"T", MatrixNode("T", 1, 3, "-537.2, 1., 2.")},
-       {"colormap", ""},
-       {"use_log", ""}})));
+  const StereoCalibration c = LoadStereoCalibration(
+      Write(CalibrationText({{"DL", MatrixNode("DL", 1, 5, "0.1, 0.2, 0.3, 0.4, 0.5")},
+                             {"T", MatrixNode("T", 1, 3, "-537.2, 1., 2.")},
+                             {"colormap", ""},
+                             {"use_log", ""}})));
   EXPECT_DOUBLE_EQ(c.left_distortion[4], 0.5);
   EXPECT_DOUBLE_EQ(c.translation[0], -537.2);
   EXPECT_DOUBLE_EQ(c.translation[2], 2.0);

@@ -2,13 +2,13 @@
 // EuRoC pairs checked against sparse ORB correspondences and the room's depths.
 #include "OpenABLE/stereo/disparity.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <iostream>
-#include <vector>
-
-#include <gtest/gtest.h>
 #include <opencv2/features2d.hpp>
+#include <vector>
 
 #include "OpenABLE/stereo/rectification.h"
 #include "OpenABLE/stereo/stereo_source.h"

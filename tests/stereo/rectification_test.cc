@@ -2,13 +2,13 @@
 // point lies on the same row of the left and the right image.
 #include "OpenABLE/stereo/rectification.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <iostream>
-#include <vector>
-
-#include <gtest/gtest.h>
 #include <opencv2/features2d.hpp>
+#include <vector>
 
 #include "OpenABLE/stereo/calibration.h"
 #include "tests/stereo/stereo_test_util.h"

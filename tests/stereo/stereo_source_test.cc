@@ -1,11 +1,11 @@
 // The stereo frame source (OpenABLE/stereo/stereo_source.h), and D-LDB over its frames.
 #include "OpenABLE/stereo/stereo_source.h"
 
+#include <gtest/gtest.h>
+
 #include <cstdint>
 #include <filesystem>
 #include <iostream>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "OpenABLE/describe/describe.h"
@@ -70,8 +70,8 @@ TEST(StereoSource, MissingFolderAndUnfittingCalibration) {
   // A calibration for 640x480 images: principal point (319.5, 239.5) outside 160x120.
   const StereoCalibration big = LoadStereoCalibration(IdealCalibrationFile(cv::Size(640, 480)));
   ExpectInputError([&] { OpenStereoFolders(dir + "/left", dir + "/right", "png", 0, -1, big); },
-                   {"Calibration_path: ", "does not fit the images", "160x120",
-                    "about 639x479", testing::Q(dir + "/left/f0.png")});
+                   {"Calibration_path: ", "does not fit the images", "160x120", "about 639x479",
+                    testing::Q(dir + "/left/f0.png")});
 }
 
 TEST(StereoSource, FramesHoldTheRectifiedLeftImageAndTheDisparity) {

@@ -2,11 +2,10 @@
 #pragma once
 
 #include <filesystem>
-#include <string>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 #include "OpenABLE/stereo/calibration.h"
 #include "tests/test_support.h"

@@ -6,9 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 namespace openable::testing {
 
@@ -28,9 +27,9 @@ struct BruteFigures {
 // candidates of q are columns c <= q - exclusion; otherwise every column. `truth[q]`: its true
 // columns. ratio: the best distance over the smallest finite candidate distance more than
 // `window` columns away (1 without one or when it is 0).
-inline BruteFigures BrutePerQuery(const cv::Mat1f& block, const std::vector<std::vector<int>>& truth,
-                                  bool loop, int exclusion, int tolerance, bool ratio,
-                                  int window) {
+inline BruteFigures BrutePerQuery(const cv::Mat1f& block,
+                                  const std::vector<std::vector<int>>& truth, bool loop,
+                                  int exclusion, int tolerance, bool ratio, int window) {
   BruteFigures f;
   f.queries.resize(static_cast<size_t>(block.rows));
   for (int q = 0; q < block.rows; ++q) {
@@ -66,10 +65,9 @@ inline BruteFigures BrutePerQuery(const cv::Mat1f& block, const std::vector<std:
   std::vector<const BruteQuery*> order;
   for (const BruteQuery& b : f.queries)
     if (b.answered) order.push_back(&b);
-  std::stable_sort(order.begin(), order.end(),
-                   [](const BruteQuery* a, const BruteQuery* b) {
-                     return static_cast<float>(a->score) < static_cast<float>(b->score);
-                   });
+  std::stable_sort(order.begin(), order.end(), [](const BruteQuery* a, const BruteQuery* b) {
+    return static_cast<float>(a->score) < static_cast<float>(b->score);
+  });
   int tp = 0, fp = 0;
   double previous = 0;
   for (size_t i = 0; i < order.size();) {

@@ -13,17 +13,16 @@
 //   DL, DR = [k1 k2 p1 p2 0] (no k3 in EuRoC's model).
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace openable::testing {
 
 struct EurocCamera {
   cv::Matx44d body_from_sensor;  // T_BS
   double fu = 0, fv = 0, cu = 0, cv = 0;
-  cv::Vec4d distortion;          // k1 k2 p1 p2
+  cv::Vec4d distortion;  // k1 k2 p1 p2
 };
 
 // Reads one EuRoC sensor file; returns false when it cannot be read.

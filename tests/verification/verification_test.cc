@@ -1,18 +1,18 @@
 // Geometric verification on scenes rendered in code from known poses, and temporal consistency
 // on hand-made candidates. Expected inlier counts come from the true epipolar geometry of the
 // poses (F = K^-T [t]x R K^-1), not from the code under test.
+#include "OpenABLE/verification/verification.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <random>
-
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 #include "OpenABLE/base/error.h"
-#include "OpenABLE/verification/verification.h"
 #include "matching/score.h"
 
 namespace openable {
@@ -21,7 +21,7 @@ namespace {
 constexpr double kFocal = 500, kCx = 320, kCy = 240;
 
 struct Patch {
-  cv::Vec3d point;  // world position of the patch's centre
+  cv::Vec3d point;    // world position of the patch's centre
   cv::Mat1b texture;  // 6 x 6 random grey levels
 };
 
@@ -79,8 +79,8 @@ cv::Matx33d TrueFundamental(const cv::Matx33d& r, const cv::Vec3d& t) {
 
 // Matches (after the ratio test, as PairVerifier makes them) within `threshold` pixels of their
 // true epipolar lines in both views (the symmetric error OpenCV's RANSAC thresholds).
-int TrueInliers(const FrameFeatures& a, const FrameFeatures& b, const cv::Matx33d& f,
-                double ratio, double threshold) {
+int TrueInliers(const FrameFeatures& a, const FrameFeatures& b, const cv::Matx33d& f, double ratio,
+                double threshold) {
   cv::BFMatcher matcher(cv::NORM_HAMMING);
   std::vector<std::vector<cv::DMatch>> knn;
   matcher.knnMatch(a.descriptors, b.descriptors, knn, 2);
@@ -89,10 +89,10 @@ int TrueInliers(const FrameFeatures& a, const FrameFeatures& b, const cv::Matx33
     if (m.size() < 2 || !(m[0].distance < ratio * m[1].distance)) continue;
     const cv::Point2f p = a.points[m[0].queryIdx], q = b.points[m[0].trainIdx];
     const cv::Vec3d line2 = f * cv::Vec3d(p.x, p.y, 1), line1 = f.t() * cv::Vec3d(q.x, q.y, 1);
-    const double d2 = std::abs(line2[0] * q.x + line2[1] * q.y + line2[2]) /
-                      std::hypot(line2[0], line2[1]);
-    const double d1 = std::abs(line1[0] * p.x + line1[1] * p.y + line1[2]) /
-                      std::hypot(line1[0], line1[1]);
+    const double d2 =
+        std::abs(line2[0] * q.x + line2[1] * q.y + line2[2]) / std::hypot(line2[0], line2[1]);
+    const double d1 =
+        std::abs(line1[0] * p.x + line1[1] * p.y + line1[2]) / std::hypot(line1[0], line1[1]);
     inliers += std::max(d1, d2) <= threshold ? 1 : 0;
   }
   return inliers;
@@ -115,8 +115,8 @@ TEST(PairVerifier, RoomFromTwoKnownPosesIsVerifiedWithTheTrueInliers) {
   const FrameFeatures a = verifier.Extract(first), b = verifier.Extract(second);
   ASSERT_GT(a.points.size(), 300u);
   const PairCheck check = verifier.Verify(a, b);
-  const int expected = TrueInliers(a, b, TrueFundamental(r, t), Options().ratio,
-                                   Options().ransac_threshold);
+  const int expected =
+      TrueInliers(a, b, TrueFundamental(r, t), Options().ratio, Options().ransac_threshold);
   ASSERT_GT(expected, 100);
   EXPECT_TRUE(check.verified);
   EXPECT_EQ(check.model, GeometricModel::kFundamental);
@@ -133,8 +133,8 @@ TEST(PairVerifier, CalibratedRoomUsesTheEssentialMatrix) {
   const FrameFeatures a = verifier.Extract(Render(scene, cv::Matx33d::eye(), {0, 0, 0}));
   const FrameFeatures b = verifier.Extract(Render(scene, r, t));
   const PairCheck check = verifier.Verify(a, b);
-  const int expected = TrueInliers(a, b, TrueFundamental(r, t), Options().ratio,
-                                   Options().ransac_threshold);
+  const int expected =
+      TrueInliers(a, b, TrueFundamental(r, t), Options().ratio, Options().ransac_threshold);
   EXPECT_TRUE(check.verified);
   EXPECT_EQ(check.model, GeometricModel::kEssential);
   EXPECT_NEAR(check.inliers, expected, 0.08 * expected);
@@ -290,9 +290,14 @@ TEST(TemporalConsistency, HandMadeSequence) {
 TEST(DistinctBest, TakesTheBestPlacesApartByMoreThanTheWindow) {
   // (distance, frame): the best at 40, its neighbours 41 and 38 are the same place; next 10,
   // then 52 (12 from 40), then 90; a non-finite cell is never taken.
-  const std::vector<std::pair<float, int>> cells = {
-      {0.2f, 40}, {0.21f, 41}, {0.25f, 38}, {0.3f, 10}, {0.35f, 52},
-      {0.5f, 90}, {std::numeric_limits<float>::infinity(), 70}, {0.3f, 9}};
+  const std::vector<std::pair<float, int>> cells = {{0.2f, 40},
+                                                    {0.21f, 41},
+                                                    {0.25f, 38},
+                                                    {0.3f, 10},
+                                                    {0.35f, 52},
+                                                    {0.5f, 90},
+                                                    {std::numeric_limits<float>::infinity(), 70},
+                                                    {0.3f, 9}};
   const std::vector<std::size_t> best = DistinctBest(cells, 4, 10);
   ASSERT_EQ(best.size(), 4u);
   // Ties (0.3 at 10 and at 9): the lower frame first, and 10 is then its neighbour.
