@@ -12,13 +12,15 @@
 # without the packages Debian only recommends) and builds the program the demo runs,
 # Test_OpenABLE (`cmake --build build` adds openable_evaluate, openable_sweep and
 # openable_snaps), not the tests, benchmarks or the Python module. The optional parts, each its packages and what they build:
-#   tests     GoogleTest and Google Benchmark: the test suite and benchmarks
+#   tests     GoogleTest, Google Benchmark and clang-format: the test suite (its formatting
+#             check among them) and benchmarks
 #   python    pybind11, NumPy, the Python headers, pip/setuptools/wheel/venv: the module
 #             openable and `pip install .` (docs/python.md)
 #   mpi       Open MPI: runs over several processes (docs/distributed.md)
 #   faiss     FAISS: approximate search (docs/matching.md)
 #   rosbag    rosbag_storage and sensor_msgs: ROS 1 bags (docs/cameras.md)
-#   chromium  Chromium: the tests that open the HTML report (docs/output_formats.md)
+#   chromium  Chromium and python3-websocket (its DevTools protocol): the tests that open the
+#             HTML report (docs/output_formats.md)
 #   fuzz      clang and libFuzzer: the fuzzers of tests/fuzz/ (docs/robustness.md)
 # A part left out is reported by the configuration ("... not built") and a run that needs it
 # says it is not built in. OPENABLE_JOBS sets the compile jobs (default: every CPU).
@@ -41,13 +43,13 @@ core=(cmake g++ make ninja-build libopencv-dev libeigen3-dev libopenblas-dev lib
 all_parts=(tests python mpi faiss rosbag chromium fuzz)
 part_packages() {
   case "$1" in
-    tests) echo libgtest-dev libgmock-dev libbenchmark-dev ;;
+    tests) echo libgtest-dev libgmock-dev libbenchmark-dev clang-format ;;
     python) echo python3-numpy python3-dev pybind11-dev python3-pip python3-setuptools \
                  python3-wheel python3-venv ;;
     mpi) echo libopenmpi-dev openmpi-bin ;;
     faiss) echo libfaiss-dev ;;
     rosbag) echo librosbag-dev libsensor-msgs-dev ;;
-    chromium) echo chromium ;;
+    chromium) echo chromium python3-websocket ;;
     fuzz) echo clang libclang-rt-14-dev ;;
     *) return 1 ;;
   esac

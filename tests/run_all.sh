@@ -24,24 +24,13 @@ done_step "Test suite"
 # suppressions (tests/sanitizers/) cover third-party code only; each one says why.
 # fast_unwind_on_malloc=0: full allocation stacks through the (frame-pointer-less) Debian
 # libraries, so that the LSan suppressions, which name third-party frames, match.
-# Leak checking: on in the fuzzers below, off for the suite (detect_leaks=0 for ctest only):
-# in CI, GCC 12's LeakSanitizer crashed in its own thread-suspending tracer ("Tracer caught
-# signal 11 ... LeakSanitizer has encountered a fatal error") at the exit of a test that had
-# passed (StereoOdometry.RecoversItWithBlockMatchingAndOrbToo, OpenCV worker threads alive),
-# which fails the test for a fault of the tool, not of the code (docs/robustness.md).
+# Leak checking is on in the fuzzers and off for the suite, whose GCC LeakSanitizer can crash in
+# its own tracer at the exit of a test that passed (docs/robustness.md, "Leak checking").
 export ASAN_OPTIONS="detect_leaks=1:fast_unwind_on_malloc=0:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$root/tests/sanitizers/ubsan.supp"
 export LSAN_OPTIONS="suppressions=$root/tests/sanitizers/lsan.supp:print_suppressions=0"
 echo "== Sanitized suite (ASan + UBSan) in build_asan"
-# -g1 (line tables only): sanitizer reports keep every frame's function, file and line, and the
-# tree builds in 10 instead of 14 minutes on 2 cores (full -g debug information of the
-# OpenCV-heavy sources is most of the difference). -O1, as the AddressSanitizer documentation
-# suggests for reasonable speed: on the Intel Xeon of 2026-11-26 the tree built in 439 s and
-# the suite ran in 468 s, against 653 s and 511 s with -O2.
-# A new tree is generated for Ninja with the libraries and programs as unity builds, as
-# examples/setup.sh does for ./build (the tests stay file by file): with Make and every source
-# on its own the sanitized build took about 10 of CI's 37 minutes. An existing tree keeps its
-# generator (CMake cannot change it).
+# -O1 -g1, unity builds for Ninja: docs/robustness.md, "Running them".
 asan_settings=()
 [ -f build_asan/CMakeCache.txt ] || asan_settings+=(-G Ninja -DOPENABLE_UNITY_BUILD=ON)
 cmake -S . -B build_asan "${asan_settings[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -51,25 +40,9 @@ cmake -S . -B build_asan "${asan_settings[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo
       -DOPENABLE_BUILD_BENCHMARKS=OFF
 cmake --build build_asan -j"$jobs"
 done_step "Sanitized build"
-# Two tests are left out of the sanitized suite: the KITTI monocular SNAPS chain (1700 frames of
-# odometry, an OpenABLE run and both corrections) takes 5 minutes under ASan, a sixth of CI's
-# time; its parts run sanitized in MonoOdometry.KittiFrames0To199StayCloseToTheGroundTruth and
-# the other SnapsChain tests, and the whole of it in the normal suite above. The auto mode on
-# night-like Gardens Point frames (an auto run and a sweep of 30 settings over 400 frames)
-# takes 26 s under ASan, with CI within a minute of its 30; the auto mode runs sanitized in
-# the other Auto tests. Four more real-data checks of figures take 25 to 75 s each under ASan;
-# the code they run stays sanitized elsewhere: the monocular odometry over KITTI frames 0-199
-# (MonoOdometry's two-view, featureless-frame and determinism tests), the online detector
-# against the batch run with verification (the OnlineDetector tests on KITTI frames and the
-# other Verification tests), the library's batch path against Test_OpenABLE (the OnlineDetector
-# matrix test and every Test_OpenABLE test), and SO-DSO corrected with the KITTI 00 pairs
-# (CorrectPoseGraphKitti.SoDso00 and the same program on sequence 06). The tests of
-# examples/setup.sh (install.*) run no compiled code of the project. Five more whole-program
-# checks of 16 to 29 s each under ASan, to keep CI near its 30 minutes: the descriptor cache's
-# resumed run (the DescriptorCache tests sanitize the cache), the sweep's figures against single
-# runs (Sweep.RanksByTheChosenFigure), openable_snaps' report on KITTI 00 (the SO-DSO run on
-# sequence 06), the auto mode's run against the plain run (the other Auto tests), and the
-# Nordland evaluation (the Gardens Point one runs the same code).
+# Eleven slow real-data tests are left out of the sanitized suite; each runs in the normal suite
+# above and the code it runs is sanitized in smaller tests (docs/robustness.md lists which).
+# The install.* tests run no compiled code of the project.
 (cd build_asan && ASAN_OPTIONS="${ASAN_OPTIONS/detect_leaks=1/detect_leaks=0}" \
    ctest --output-on-failure -j"$jobs" --timeout 2400 \
          -E '^(install\..*|TestOpenABLE\.DescriptorCacheResumeIsBitIdentical|Sweep\.FiguresEqualTheSingleRunsAndAreRanked|SoDsoReport\.SignedChangesAReadingAndAHintForTheConvention|Auto\.TheRunOfTheChoiceIsThePlainRunOfItsSettingsByteForByte|EvaluationOnDatasets\.NordlandWinterAgainstSummer|SnapsChain\.KittiMonocularOdometryLoopsFromOpenableAndCorrection|Auto\.NightLikeGardensPointIsWithinTheBestOfTheSweep|MonoOdometry\.KittiFrames0To199StayCloseToTheGroundTruth|Verification\.OnlineDetectorGivesTheBatchRunsLoops|Library\.BatchPathGivesTestOpenablesMatrixAndFigures|Kitti/SoDso\.CorrectsWithGroundTruthPairsAndWritesWhatItReports/seq00)( |$)')
@@ -86,8 +59,6 @@ if ! command -v clang++ > /dev/null ||
   echo "== Fuzzers skipped: clang++ with libFuzzer is not available (examples/setup.sh --all installs it)"
   exit 0
 fi
-# A new fuzz tree is a Ninja tree with unity builds too, as build_asan above: with clang on 2
-# cores the fuzzers built in 130 s against about 180 s with Make, file by file.
 fuzz_settings=()
 [ -f build_fuzz/CMakeCache.txt ] || fuzz_settings+=(-G Ninja -DOPENABLE_UNITY_BUILD=ON)
 CXX=clang++ cmake -S . -B build_fuzz "${fuzz_settings[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -97,11 +68,8 @@ cmake --build build_fuzz -j"$jobs" --target fuzzers
 # with its corpus tests/fuzz/corpus/<name>/.
 mapfile -t fuzzers < build_fuzz/tests/fuzz/fuzzers.txt
 echo "== Fuzzers (${fuzz_seconds} s each, two at a time) in build_fuzz: ${fuzzers[*]}"
-# LeakSanitizer's own fault: its thread-suspending tracer can crash during the leak check at
-# the end of a run whose inputs all passed ("Tracer caught signal 11" then "LeakSanitizer has
-# encountered a fatal error", with no report of ASan, UBSan or libFuzzer; seen once in the
-# image fuzzer, whose OpenCV and OpenImageIO threads are alive at exit, in a clean-clone CI run
-# of 2026-11-27, as GCC's tracer did in the suite above). Such a run is made once more, so that
+# LeakSanitizer's tracer can crash at the exit of a fuzzer run whose inputs all passed, with no
+# report of ASan, UBSan or libFuzzer (docs/robustness.md): such a run is made once more, so that
 # the leak check still runs; a real finding fails as before.
 lsan_tool_fault() {
   grep -aq 'LeakSanitizer has encountered a fatal error' "$1" &&

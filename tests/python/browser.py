@@ -1,111 +1,25 @@
 """Drives Debian's Chromium, headless, through its DevTools protocol, for the tests of pages the
 toolbox writes (the HTML report). Chromium listens on 127.0.0.1 on a port it chooses
 (--remote-debugging-port=0) and writes it to DevToolsActivePort in its profile folder; the
-protocol runs over a WebSocket.
-
-The WebSocket client is written here because Python's standard library has none and the tests
-use Debian's packages only (python3-websocket is not a dependency of the project): an RFC 6455
-handshake, masked text frames out, frames in (fragments joined, pings answered). Enough for one
-connection to a local browser, nothing more.
+protocol runs over a WebSocket, through Debian's python3-websocket (the module websocket of
+websocket-client). Without that module a Browser skips the tests that open one, as they are
+skipped without Chromium.
 """
-import base64
-import hashlib
 import json
 import os
 import shutil
-import socket
-import struct
 import subprocess
 import tempfile
 import time
-import urllib.parse
+import unittest
 import urllib.request
 
+try:
+    import websocket
+except ImportError:
+    websocket = None
+
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-_GUID = "258EAFA5-E914-47DA-95CA-C5AB0DC85B11"  # RFC 6455, section 1.3
-
-
-class WebSocket:
-    def __init__(self, url, timeout=30):
-        parts = urllib.parse.urlsplit(url)
-        self.sock = socket.create_connection((parts.hostname, parts.port), timeout=timeout)
-        key = base64.b64encode(os.urandom(16)).decode()
-        path = parts.path + ("?" + parts.query if parts.query else "")
-        self.sock.sendall(("GET %s HTTP/1.1\r\nHost: %s:%d\r\nUpgrade: websocket\r\n"
-                           "Connection: Upgrade\r\nSec-WebSocket-Key: %s\r\n"
-                           "Sec-WebSocket-Version: 13\r\n\r\n"
-                           % (path, parts.hostname, parts.port, key)).encode())
-        head = b""
-        while b"\r\n\r\n" not in head:
-            chunk = self.sock.recv(4096)
-            if not chunk:
-                raise ConnectionError("WebSocket handshake: connection closed")
-            head += chunk
-        head, self.buffer = head.split(b"\r\n\r\n", 1)
-        lines = head.decode("latin-1").split("\r\n")
-        if " 101 " not in lines[0] + " ":
-            raise ConnectionError("WebSocket handshake refused: " + lines[0])
-        accept = base64.b64encode(hashlib.sha1((key + _GUID).encode()).digest()).decode()
-        headers = dict(l.split(":", 1) for l in lines[1:] if ":" in l)
-        headers = {k.strip().lower(): v.strip() for k, v in headers.items()}
-        if headers.get("sec-websocket-accept") != accept:
-            raise ConnectionError("WebSocket handshake: wrong Sec-WebSocket-Accept")
-
-    def _read(self, n):
-        while len(self.buffer) < n:
-            chunk = self.sock.recv(max(65536, n - len(self.buffer)))
-            if not chunk:
-                raise ConnectionError("WebSocket closed by the browser")
-            self.buffer += chunk
-        out, self.buffer = self.buffer[:n], self.buffer[n:]
-        return out
-
-    def _send_frame(self, opcode, payload):
-        header = bytes([0x80 | opcode])  # FIN, no fragments
-        n = len(payload)
-        if n < 126:
-            header += bytes([0x80 | n])  # client frames are masked
-        elif n < 1 << 16:
-            header += bytes([0x80 | 126]) + struct.pack(">H", n)
-        else:
-            header += bytes([0x80 | 127]) + struct.pack(">Q", n)
-        mask = os.urandom(4)
-        masked = bytes(b ^ mask[i % 4] for i, b in enumerate(payload))
-        self.sock.sendall(header + mask + masked)
-
-    def send(self, text):
-        self._send_frame(0x1, text.encode())
-
-    def recv(self):
-        """The next text message (fragments joined)."""
-        message = b""
-        while True:
-            b0, b1 = self._read(2)
-            opcode, n = b0 & 0x0F, b1 & 0x7F
-            if n == 126:
-                n = struct.unpack(">H", self._read(2))[0]
-            elif n == 127:
-                n = struct.unpack(">Q", self._read(8))[0]
-            mask = self._read(4) if b1 & 0x80 else None
-            payload = self._read(n)
-            if mask:
-                payload = bytes(b ^ mask[i % 4] for i, b in enumerate(payload))
-            if opcode == 0x9:  # ping
-                self._send_frame(0xA, payload)
-                continue
-            if opcode == 0x8:
-                raise ConnectionError("WebSocket closed by the browser")
-            if opcode in (0x0, 0x1, 0x2):
-                message += payload
-                if b0 & 0x80:
-                    return message.decode()
-
-    def close(self):
-        try:
-            self._send_frame(0x8, b"")
-        except OSError:
-            pass
-        self.sock.close()
 
 
 class Browser:
@@ -113,6 +27,10 @@ class Browser:
     page's console messages, uncaught exceptions and log entries in `console`."""
 
     def __init__(self, folder, width=1400, height=1000):
+        if websocket is None:
+            raise unittest.SkipTest("python3-websocket is not installed (apt-get install "
+                                    "python3-websocket): the DevTools protocol runs over a "
+                                    "WebSocket")
         self.profile = tempfile.mkdtemp(prefix="chromium_", dir=str(folder))
         self.process = subprocess.Popen(
             [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
@@ -126,7 +44,10 @@ class Browser:
             with urllib.request.urlopen("http://127.0.0.1:%d/json/list" % port, timeout=10) as r:
                 targets = json.load(r)
             page = [t for t in targets if t.get("type") == "page"][0]
-            self.ws = WebSocket(page["webSocketDebuggerUrl"])
+            # No Origin header: Chromium refuses DevTools connections that name an origin it
+            # was not started to allow (--remote-allow-origins).
+            self.ws = websocket.create_connection(page["webSocketDebuggerUrl"], timeout=30,
+                                                  suppress_origin=True)
             for domain in ("Page", "Runtime", "Log"):
                 self.call(domain + ".enable")
         except Exception:
@@ -162,13 +83,20 @@ class Browser:
             self.console.append("log.%s: %s" % (entry["level"], entry["text"]))
         self.events.append(message)
 
+    def _receive(self):
+        """The next message of the browser: a command's result or an event."""
+        text = self.ws.recv()
+        if not text:  # a close frame (recv answers it)
+            raise ConnectionError("WebSocket closed by the browser")
+        return json.loads(text)
+
     def call(self, method, **params):
         """Sends one command and returns its result; events that arrive meanwhile are kept."""
         self.next_id += 1
         ident = self.next_id
         self.ws.send(json.dumps({"id": ident, "method": method, "params": params}))
         while True:
-            message = json.loads(self.ws.recv())
+            message = self._receive()
             if message.get("id") == ident:
                 if "error" in message:
                     raise AssertionError("%s: %s" % (method, message["error"]))
@@ -181,7 +109,7 @@ class Browser:
             if message.get("method") == method:
                 return message
         while time.time() < deadline:
-            message = json.loads(self.ws.recv())
+            message = self._receive()
             self._record(message)
             if message.get("method") == method:
                 return message
@@ -215,7 +143,10 @@ class Browser:
 
     def close(self):
         if self.ws:
-            self.ws.close()
+            try:
+                self.ws.close()
+            except (OSError, websocket.WebSocketException):
+                pass
         if self.process.poll() is None:
             self.process.terminate()
             try:

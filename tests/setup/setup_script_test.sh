@@ -14,9 +14,9 @@ for p in cmake g++ make ninja-build libopencv-dev libeigen3-dev libopenblas-dev 
          openimageio-tools libpng-dev zlib1g-dev libdeflate-dev libjpeg-dev nlohmann-json3-dev; do
   has "$demo" "$p" || fail "the demo's packages lack $p: $demo"
 done
-optional=(libgtest-dev libgmock-dev libbenchmark-dev python3-numpy python3-dev pybind11-dev
-          python3-pip python3-setuptools python3-wheel python3-venv chromium clang
-          libclang-rt-14-dev libopenmpi-dev openmpi-bin libfaiss-dev librosbag-dev
+optional=(libgtest-dev libgmock-dev libbenchmark-dev clang-format python3-numpy python3-dev pybind11-dev
+          python3-pip python3-setuptools python3-wheel python3-venv chromium python3-websocket
+          clang libclang-rt-14-dev libopenmpi-dev openmpi-bin libfaiss-dev librosbag-dev
           libsensor-msgs-dev)
 for p in "${optional[@]}"; do
   has "$demo" "$p" && fail "the demo installs the optional $p"
