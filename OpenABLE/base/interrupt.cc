@@ -6,6 +6,7 @@
 #include <atomic>
 #include <csignal>
 #include <cstring>
+#include <string>
 
 namespace openable {
 namespace {
@@ -96,6 +97,18 @@ void SetInterruptNote(const std::string& note) {
   std::memcpy(g_notes[next], note.data(), n);
   g_notes[next][n] = '\0';
   g_note.store(next, std::memory_order_release);
+}
+
+namespace {
+std::string g_note_on_commit;  // read and written outside the handler only
+}  // namespace
+
+void SetInterruptNoteOnCommit(const std::string& note) { g_note_on_commit = note; }
+
+std::string TakeInterruptNoteOnCommit() {
+  std::string note;
+  note.swap(g_note_on_commit);
+  return note;
 }
 
 int RegisterTemporary(const std::string& path) {

@@ -28,6 +28,12 @@ void SilenceInterruptMessage();
 // unchanged" before a file is replaced and "route.map holds session winter" after. Empty: no
 // note. Call from one thread at a time (the handler reads it without a lock).
 void SetInterruptNote(const std::string& note);
+// The note the next OutputBatch::Commit sets once its files are in place, while signals are
+// still deferred: an interruption just after a file was replaced never reports its old state.
+// A commit that fails drops it.
+void SetInterruptNoteOnCommit(const std::string& note);
+// The note of SetInterruptNoteOnCommit, taken (empty when none): for OutputBatch::Commit.
+std::string TakeInterruptNoteOnCommit();
 
 // Registers a file to remove if the process is interrupted. Returns a slot for
 // UnregisterTemporary, or -1 when every slot is taken (the file is then only removed by the

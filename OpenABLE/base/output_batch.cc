@@ -237,6 +237,7 @@ class CommitLocks {
 
 void OutputBatch::Commit() {
   InterruptDeferral defer;  // a signal now acts after the renames (or their undoing)
+  const std::string note = TakeInterruptNoteOnCommit();
   const std::vector<std::string> folders = FoldersOf(Paths());
   for (const std::string& folder : folders) SyncFolder(folder);
   const CommitLocks locks(folders);
@@ -285,6 +286,7 @@ void OutputBatch::Commit() {
     if (!d.backup.empty()) ::unlink(d.backup.c_str());
   for (const std::string& folder : folders) SyncFolder(folder);
   items_.clear();
+  if (!note.empty()) SetInterruptNote(note);  // before a deferred signal acts
 }
 
 std::vector<std::string> OutputBatch::Paths() const {
