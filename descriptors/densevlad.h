@@ -1,20 +1,10 @@
 // DenseVLAD: a training-free global descriptor that survives a change of viewpoint and of light
 // (Torii, Arandjelovic, Sivic, Okutomi, Pajdla, "24/7 place recognition by view synthesis",
-// CVPR 2015; the aggregation of Jegou et al., CVPR 2010, with the intra-normalisation of
-// Arandjelovic and Zisserman, "All about VLAD", CVPR 2013).
-//
-// A frame is shrunk to at most kWidth pixels wide (its aspect kept), described densely by
-// RootSIFT (SIFT on a grid of kStep pixels at the Scales() of the frame, each descriptor
-// L1-normalised and square-rooted: Arandjelovic and Zisserman, CVPR 2012), and the descriptors
-// aggregated by VLAD over a vocabulary of kCentres visual words: for each word, the sum of the
-// residuals of the descriptors nearest to it, L2-normalised per word, then as a whole. Rows are
-// kCentres x 128 floats matched by L2.
-//
-// The vocabulary is learnt from the run's own reference traversal (Learn), with no ground
-// truth: k-means over RootSIFT descriptors of frames spread over it. Torii et al. also whiten
-// the VLAD vectors by a PCA learnt on thousands of images; a run's reference traversal holds a
-// few hundred frames, from which a whitening is not estimated reliably, so it is left out
-// (docs/descriptors.md).
+// CVPR 2015; VLAD of Jegou et al., CVPR 2010, intra-normalised as in Arandjelovic and Zisserman,
+// "All about VLAD", CVPR 2013): dense RootSIFT on the shrunk frame at Scales(), aggregated over
+// kCentres visual words learnt from the run's own reference traversal (Learn, no ground truth);
+// rows of kCentres x 128 floats matched by L2. Torii et al.'s PCA whitening is left out: a few
+// hundred frames cannot estimate it. docs/descriptors.md, "DenseVLAD".
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -1,36 +1,9 @@
-// LDB, Local Difference Binary, as the global descriptor of a square grey patch.
-//
-// Papers: X. Yang and K.-T. Cheng, "LDB: An Ultra-Fast Feature for Scalable Augmented Reality
-// on Mobile Devices", ISMAR 2012, and "Local Difference Binary for Ultrafast and Distinctive
-// Feature Description", IEEE T-PAMI 36(1):188-194, 2014; as ABLE uses it (Arroyo et al.,
-// ITSC 2016, Eq. 1-4, and IV 2014: 64 x 64 patch, 32-byte strings). Written here from those
-// descriptions, not from any code.
-//
-// Taken from the papers:
-//  - the patch is divided into n x n grids of cells at several levels (multiple gridding);
-//  - each cell gives three features from an integral image: the average intensity I_avg and the
-//    horizontal and vertical gradients G_x, G_y of the cell (OpenABLE Eq. 2);
-//  - every pair of cells of a level gives one binary test per feature, tau = 1 when
-//    f(i) < f(j) and 0 otherwise (OpenABLE Eq. 1); the tests are packed into a bit string
-//    (Eq. 3) matched with the Hamming distance (Eq. 4);
-//  - a subset of the tests is kept (the papers select bits; ABLE keeps 256 bits = 32 bytes).
-//
-// Chosen here (the papers leave these open or rely on a detector this toolbox does not use):
-//  - levels n = 2, 3, 4, 5, all four; cell (r, c) of level n covers rows
-//    [floor(r S / n), floor((r + 1) S / n)) and the same for columns (S = patch side);
-//  - G_x = mean of the right half minus mean of the left half, split at the integer column
-//    midpoint (x0 + x1) / 2; G_y likewise with the bottom and top halves. Means rather than sums,
-//    so that cells of unequal size compare fairly. Features are computed in double precision;
-//  - the keypoint is the patch centre, with no orientation and no scale estimation, and no
-//    smoothing beyond the cell averaging (ABLE describes a patch resized from the whole image);
-//  - canonical test order: level 2, 3, 4, 5; within a level the cell pairs (i, j), i < j, in
-//    lexicographic order of row-major cell indices; within a pair I_avg, G_x, G_y. This gives
-//    3 x (6 + 36 + 120 + 300) = 1386 tests;
-//  - bit selection is not learnt (the T-PAMI paper selects bits with AdaBoost on training
-//    patches): kRandom keeps a fixed pseudo-random subset, kCoarseFirst the first tests of the
-//    canonical order (see LdbSelection);
-//  - packing: selected test k goes to byte k / 8, bit k % 8 (least significant bit first);
-//    the unused high bits of the last byte are 0.
+// LDB (X. Yang and K.-T. Cheng, ISMAR 2012 and IEEE T-PAMI 36(1):188-194, 2014) as the global
+// descriptor of a square grey patch, as ABLE uses it (Arroyo et al., ITSC 2016, Eq. 1-4, and
+// IV 2014), written from those descriptions: cell means and gradients on 2x2 to 5x5 grids, one
+// test per cell pair and feature (1386 in canonical order), a subset kept, Hamming distance.
+// Bits are not selected by AdaBoost as in T-PAMI (no training set ships) but by LdbSelection.
+// Cells, test order and packing: docs/descriptors.md, "LDB".
 #pragma once
 
 #include <cstdint>

@@ -1,20 +1,10 @@
-// ORB, BRISK and SIFT from OpenCV's features2d module (OpenCV 4.6), each used as the global
-// descriptor of the patch: one keypoint at the patch centre ((S - 1) / 2, (S - 1) / 2), angle 0,
-// with a scale chosen so that the descriptor covers the patch.
-//
-// Papers: E. Rublee et al., "ORB: an efficient alternative to SIFT or SURF", ICCV 2011;
-// S. Leutenegger, M. Chli and R. Siegwart, "BRISK: Binary Robust Invariant Scalable Keypoints",
-// ICCV 2011; D. G. Lowe, "Distinctive Image Features from Scale-Invariant Keypoints", IJCV 2004.
-// The descriptors themselves are OpenCV's; what is chosen here is how they see the patch.
-//
-// Common to the three: the patch is padded by S / 2 + 1 pixels on each side with
-// cv::BORDER_REFLECT_101 before compute(), so that OpenCV never drops the keypoint for lying
-// near the border, and any sample that falls slightly outside the patch reads a reflection of
-// it rather than a constant. No detector is run, and the scale is not estimated. Describe()
-// throws std::logic_error when OpenCV drops the keypoint or returns an unexpected width.
-//
-// Changed from the original OpenABLE: it silently forced a 128-pixel patch for ORB; here ORB
-// takes the configured patch size like every other descriptor.
+// ORB, BRISK and SIFT from OpenCV's features2d module (OpenCV 4.6; Rublee et al., ICCV 2011;
+// Leutenegger, Chli and Siegwart, ICCV 2011; Lowe, IJCV 2004), each the global descriptor of the
+// patch: one keypoint at the patch centre ((S - 1) / 2, (S - 1) / 2), angle 0, a scale chosen so
+// that the descriptor covers the patch. The patch is padded by S / 2 + 1 pixels with
+// cv::BORDER_REFLECT_101 so that OpenCV never drops the keypoint and samples just outside read a
+// reflection. Describe() throws std::logic_error when OpenCV drops the keypoint or returns an
+// unexpected width. docs/descriptors.md, "ORB, BRISK, SIFT (OpenCV)".
 #pragma once
 
 #include <memory>
@@ -48,9 +38,8 @@ class OrbDescriptor final : public Descriptor {
 // f = 30^(i / 64), i = 0..63, reached for size = 7.2 f. We take the scale whose outer ring of
 // sample points (radius 9.18 f) is nearest the circle inscribed in the patch (radius S / 2), and
 // pass exactly that size, so the pattern spans the patch without falling between two scales.
-// For S = 64: i = 23, f = 3.39, outer ring radius 31.1 px; with its Gaussian smoothing
-// (sigma 1.87 f) the pattern reads pixels up to about 6 px into the reflected border (measured
-// by perturbing single pixels). Below S = 19 the smallest scale (radius 9.18 px) is used.
+// For S = 64: i = 23, f = 3.39, outer ring radius 31.1 px. Below S = 19 the smallest scale
+// (radius 9.18 px) is used.
 //
 // Orientation: OpenCV's BRISK::compute() always re-estimates the keypoint orientation from the
 // pattern's long-distance pairs and overwrites the given angle; this option cannot be turned
@@ -59,9 +48,9 @@ class OrbDescriptor final : public Descriptor {
 // short-pair tests are unchanged (with the default dMin = 8.2 this pattern reproduces
 // cv::BRISK::create() bit for bit).
 //
-// The cv::BRISK object costs about 30 ms and 46 MB to build (look-up tables for 64 scales x
-// 1024 rotations), so instances are kept in a small pool owned by this object: one per thread
-// describing at the same time, created on demand and released with the descriptor.
+// The cv::BRISK object is costly to build (look-up tables for 64 scales x 1024 rotations), so
+// instances are kept in a small pool owned by this object: one per thread describing at the
+// same time, created on demand and released with the descriptor.
 class BriskDescriptor final : public Descriptor {
  public:
   // Throws InputError naming Patch_size when options.patch_size < 16.
@@ -87,10 +76,8 @@ class BriskDescriptor final : public Descriptor {
 // the keypoint size is S / 6 and the grid spans the patch exactly (16-pixel cells at S = 64).
 // Trilinear interpolation lets pixels up to half a cell (S / 8) beyond the grid contribute, with
 // weights falling from 1/2 to 0; these read the reflected border, so the descriptor depends only
-// on the patch. (Measured at S = 64: with unrelated texture around the patch instead of its
-// reflection, the descriptor changes by 0.32 of its L2 norm; with size S / 8, whose whole
-// support fits inside the patch, by 0.01.) The keypoint is on octave 0, layer 0 of SIFT's
-// pyramid: the patch at its own resolution, smoothed by SIFT's base sigma 1.6.
+// on the patch. The keypoint is on octave 0, layer 0 of SIFT's pyramid: the patch at its own
+// resolution, smoothed by SIFT's base sigma 1.6.
 class SiftDescriptor final : public Descriptor {
  public:
   // Throws InputError naming Patch_size when options.patch_size < 16.

@@ -1,24 +1,10 @@
 // Whether a query's best match is confirmed by the best match of another query whose sequence
-// shares no frame with it: the evidence, without ground truth, that the answer follows the
-// route. Two traversals of a route (or one traversal revisiting a stretch) give best matches
-// that advance with the queries: if query q's answer is reference b(q), query p's should be
-// near b(q) - (q - p) (b(q) + (q - p) when the reference was driven the other way). A wrong
-// answer rarely has such a partner: the best matches of unrelated sequences fall anywhere.
-//
-// Independence matters. With sequences of L frames, consecutive queries share L - 1 of their
-// L single-frame distances, so their best matches move together whether right or wrong; only
-// a partner whose window of frames is disjoint from q's is evidence. Query q's window is frames
-// q - L + 1 .. q (clipped at its traversal's start), or, for the first L - 1 queries with
-// Sequence_partial ahead, frames 0 .. L - 1 (matching/sequence.h). The partner of q is the
-// nearest query at least Gap() frames back whose window ends before q's starts; a query
-// without one (the first ones of a traversal) takes the nearest such query forward instead.
-// A pair agrees when their answers differ by the frames between them within +-Tolerance().
-//
-// Used by the criteria that rank settings without ground truth
-// (OpenABLE/evaluation/unsupervised.h: consistency is the share of queries whose answer agrees
-// with its partner's) and by the acceptance of best matches (Match_consistency: an accepted
-// match needs its partners to agree), in the same way, so that a run's accepted matches are
-// the answers the criterion counted as confirmed.
+// shares no frame with it: the evidence, without ground truth, that the answer follows the route
+// (a right answer's partner lands near b(q) - (q - p); unrelated best matches fall anywhere).
+// The partner must be independent because consecutive queries share L - 1 of their L terms and
+// move together whether right or wrong. Used alike by the criteria without ground truth
+// (OpenABLE/evaluation/unsupervised.h) and by Match_consistency, so a run's accepted matches are
+// the answers the criterion counted as confirmed. docs/evaluation.md, "Without ground truth".
 #pragma once
 
 #include <cstdint>
@@ -59,8 +45,10 @@ struct AgreementOptions {
 std::vector<std::uint8_t> AgreeingAnswers(const std::vector<int>& best,
                                           const AgreementOptions& options);
 
-// The partner of query q among `queries` queries (see above), or -1 when there is none: the
-// nearest p <= q - Gap() whose window ends before q's starts, else the nearest such p forward.
+// The partner of query q among `queries` queries, or -1 when there is none: the nearest
+// p <= q - Gap() whose window ends before q's starts, else the nearest such p forward. Query
+// q's window is frames q - L + 1 .. q (clipped at its traversal's start), or 0 .. L - 1 for
+// the first L - 1 queries with kAhead.
 // With queries = q + 1 (online: no later query is known) only the one back.
 int AgreementPartner(int q, int queries, const AgreementOptions& options);
 

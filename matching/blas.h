@@ -1,15 +1,10 @@
 // The one place OpenABLE calls a BLAS: the float matrix products of the L2 distance matrices
-// (HOG, SIFT, the descriptors of the sub-panoramas), on Debian's OpenBLAS, which picks its
-// kernels for the CPU at run time (AVX-512 on the machines of docs/benchmarks.md), where a
-// product compiled with the project (Eigen's) is built for the baseline instruction set.
-//
-// OpenBLAS is found on first use (dlopen of libopenblas.so.0; OpenCV's LAPACK has usually
-// loaded it already). An OpenBLAS older than the CPU (Debian 12's 0.3.21 on Intel Xeon model
-// 207) does not recognise it and runs its SSE3 kernels ("Prescott"), four times slower than
-// its AVX-512 ones there. OpenABLE then runs OpenBLAS's start-up choice again with OpenBLAS's
-// own setting OPENBLAS_CORETYPE naming the kernels of the CPU's instruction sets (SkylakeX
-// for AVX-512, Haswell for AVX2 and FMA), unless the user has set that variable. The kernels
-// are those of the whole process (one OpenBLAS: numpy in the same Python process too).
+// (HOG, SIFT, sub-panoramas), on Debian's OpenBLAS (dlopen of libopenblas.so.0 on first use),
+// which picks its kernels for the CPU at run time where Eigen would be built for the baseline
+// instruction set. An OpenBLAS older than the CPU (Debian 12's 0.3.21 on Intel Xeon model 207)
+// falls back to its slow SSE3 ("Prescott") kernels; OpenABLE then has it choose again with
+// OPENBLAS_CORETYPE naming the CPU's (SkylakeX, Haswell) unless the user set that variable. The
+// kernels are the whole process's (numpy's too). docs/benchmarks.md, "Matching kernels".
 #pragma once
 
 #include <string>

@@ -1,15 +1,10 @@
 // Local contrast enhancement of a single-frame distance matrix, as SeqSLAM does it (Milford and
-// Wyeth, "SeqSLAM: Visual Route-Based Navigation for Sunny Summer Days and Stormy Winter
-// Nights", ICRA 2012, Sec. III-B): a query's distances to the references are put on a common
-// footing with its distances to the nearby references, so that a query that looks alike to
-// everything (a dark tunnel, fog) no longer wins every sequence.
-//
+// Wyeth, ICRA 2012, Sec. III-B), so that a query that looks alike to everything (a dark tunnel,
+// fog) no longer wins every sequence:
 //   D'(i, j) = (D(i, j) - mean_k D(i, k)) / std_k D(i, k),   k in [j - R, j + R]
-//
-// over the columns k of the traversal of j (a window is clipped at its traversal's ends), the
-// standard deviation being the population one; D' = 0 where the window's values are all
-// equal. The matrix is then shifted so that its smallest value is 0 (the sequence sums and
-// Eq. 5 expect distances >= 0; a constant shift does not change which cell of a row is best).
+// over the columns of the traversal of j (windows clipped at its ends; population standard
+// deviation; D' = 0 where the window is constant), then shifted so the smallest value is 0, as
+// the sequence sums and Eq. 5 expect (a constant shift changes no row's best cell).
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -655,9 +655,9 @@ bool ForceHammingKernel(HammingKernel kernel) {
 
 namespace {
 
-// L2 matrices are computed in tiles of kL2Tile x kL2Tile cells (512: on the Intel Xeon of
-// docs/benchmarks.md the HOG matrix took 150 ms against 190 ms with tiles of 256, the packing
-// of operands by OpenBLAS being shared by more cells), each by one product on one thread
+// L2 matrices are computed in tiles of kL2Tile x kL2Tile cells (512 rather than 256: OpenBLAS's
+// packing of operands is shared by more cells; docs/benchmarks.md, "Matching kernels"), each by
+// one product on one thread
 // (MultiplyTransposed) and turned into distances while it is in cache. A cell's float depends
 // only on the product it comes from, and every path computes a cell in the same product: the
 // tile of its row blocks (I, J) counted from the first row of each operand, and for a

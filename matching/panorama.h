@@ -1,25 +1,9 @@
-// Distances between panoramas described as n sub-panoramas (ABLE-P, Arroyo et al., IV 2014).
-//
-// A panoramic frame is cut into n equal-width vertical strips (sub-panoramas) and each strip is
-// described on its own; the row of a frame is the n strip descriptors concatenated (Eq. 1 of
-// ABLE-P). Three ways to compare two such rows v_i, v_j (strip k of v_i is v_{i,k}):
-//
-//  - kAligned (Eq. 2): the plain distance of the concatenated rows, strip k against strip k.
-//    Hamming: sum over k of bits(v_{i,k} XOR v_{j,k}). L2: the Euclidean norm of the whole row.
-//    A place seen again in the same direction is found; one seen in the opposite direction
-//    (the panorama turned by half a revolution) is not.
-//  - kCrossCorrelation (Eq. 3, 4, Algorithm 1): C_{k,l} = d(v_{i,k}, v_{j,l}) for every pair of
-//    strips, and M(i, j) = min over k, l of C_{k,l}: the best single pair of strips. Finds a place
-//    whatever the heading, as the paper proposes.
-//  - kCircular (chosen here, beyond the paper): the panorama turned by s strips, the best s:
-//    M(i, j) = min over s of D_s with D_s the aligned distance of v_i against v_j with its
-//    strips circularly shifted by s (Hamming: sum over k of d(v_{i,k}, v_{j,(k+s) mod n});
-//    L2: sqrt of the sum of squared strip distances). It keeps the whole panorama in the
-//    comparison, as the aligned distance does, and is exactly the aligned distance at s = 0.
-//    A revisit in the opposite direction is a shift of n/2 strips when n is even.
-//
-// Every variant is symmetric with a zero diagonal. Costs n^2 (cross-correlation and circular)
-// single-strip distance matrices; the aligned variant costs one.
+// Distances between panoramas described as n sub-panoramas (ABLE-P, Arroyo et al., IV 2014):
+// the row of a frame is its n strip descriptors concatenated (Eq. 1). kAligned compares strip k
+// with strip k (Eq. 2); kCrossCorrelation takes the best single pair of strips, whatever the
+// heading (Eq. 3, 4, Algorithm 1); kCircular, beyond the paper, the best circular shift of the
+// whole panorama, so no single uniform strip can tie two places. Every variant is symmetric with
+// a zero diagonal; the last two cost n^2 single-strip matrices. docs/matching.md, "Panoramas".
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -1,35 +1,9 @@
-// Sequence matching (ABLE; SeqSLAM's idea of comparing sequences of frames instead of single
-// frames): the distance between the place of frame i and the place of frame j is the sum of
-// the L single-frame distances along the diagonal that ends at (i, j):
-//
-//   forward:  S(i, j) = sum_{k = 0 .. L-1} D(i - k, j - k)   (both routes driven the same way)
-//   reverse:  S(i, j) = sum_{k = 0 .. L-1} D(i - k, j + k)   (anti-diagonals: the reference
-//                                                            route driven the other way)
-//
-// L = 1 gives single images back, as the paper says (the original summed L + 1 terms).
-//
-// Traversals: the frames of a run may be several traversals concatenated (a query route after
-// a reference route). A sum never crosses from one traversal into another: the terms that
-// would leave the traversal of i, or of j, do not exist.
-//
-// Early frames: where only c < L terms exist (the first L - 1 frames of a traversal; for
-// anti-diagonals, also the last L - 1 frames of the reference traversal), SequencePartial says
-// what the cell holds: kAhead (the default) takes the window of L frames that starts where the
-// diagonal enters both traversals, i.e. the cell L - 1 - c steps further along the diagonal,
-// looking ahead where it cannot look back (a centred window at a traversal's start, as SeqSLAM's
-// centred sequences), so every cell is a sum of L terms and none wins more often for having
-// fewer; a diagonal holding fewer than L frames in all has no such window and its cells are
-// +inf. kScale scales the sum of the c terms by L / c, i.e. the mean distance along the
-// available part of the diagonal times L (leaving the short sums unscaled would make early
-// frames look similar to everything; scaled, their few terms still make them noisier than the
-// rest, and some become attractors). kSkip, the rule of OpenSeqSLAM, makes the cell +inf: it
-// is no candidate at all, and the first L - 1 queries of a traversal get no answer
-// (docs/matching.md compares the three).
-//
-// Cost: one pass over the matrix whatever L is. Row i is obtained from row i - 1 by the running
-// sum S(i, j) = S(i - 1, j -+ 1) + D(i, j) - D(i - L, j -+ L), kept in double precision, with
-// the last L rows of D kept aside so that the matrix can be overwritten in place. Columns are
-// split between threads, which meet once per row.
+// Sequence matching (ABLE; SeqSLAM's comparison of sequences of frames instead of single
+// frames): S(i, j) = sum_{k = 0 .. L-1} D(i - k, j - k) forward, D(i - k, j + k) reverse (the
+// reference route driven the other way). L = 1 gives single images, as the paper says (the
+// original summed L + 1 terms). A sum never crosses from one traversal into another; the cells
+// with fewer than L terms follow SequencePartial. One pass over the matrix whatever L (running
+// sums in double, in place). docs/matching.md, "Sequences".
 #pragma once
 
 #include <limits>
@@ -48,8 +22,8 @@ OPENABLE_ENUM_NAMES(SequenceDirection, "forward", "reverse", "both")
 // ..." otherwise (a ValueError in Python); `what` names the argument ("traversal_starts").
 void CheckTraversalStarts(const std::vector<int>& starts, int n, const char* what);
 
-// A cell with fewer than L terms (see above): scaled up to L terms, skipped (+inf), or the
-// window of L frames ahead of it along its diagonal.
+// A cell with fewer than L terms (docs/matching.md, "Early frames"): scaled up to L terms, skipped
+// (+inf), or the window of L frames ahead of it along its diagonal.
 enum class SequencePartial { kScale, kSkip, kAhead };
 OPENABLE_ENUM_NAMES(SequencePartial, "scale", "skip", "ahead")
 

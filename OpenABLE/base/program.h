@@ -21,9 +21,9 @@ int RunProgram(const std::string& program, const std::function<int()>& body);
 
 // For programs that describe frames one after the other (Test_OpenABLE, openable_sweep): every
 // frame passes through buffers of several MB (a 960x540 colour frame as float is 6 MB), which
-// glibc serves with mmap and returns at free, so each frame paid for fresh zeroed pages (63% of
-// a Gardens Point run was page faults in the kernel). Keeping blocks up to 256 MB on the heap
-// lets them be reused (Gardens Point 3.0 s -> 1.1 s). Call first in main.
+// glibc serves with mmap and returns at free, so each frame paid for fresh zeroed pages.
+// Keeping blocks up to 256 MB on the heap lets them be reused (docs/benchmarks.md, "End-to-end
+// run times and start-up"). Call first in main.
 void KeepFrameBuffersOnTheHeap();
 
 }  // namespace openable

@@ -51,15 +51,10 @@ std::string SizeText(const Size& size) {
 // CSV files and the terminal (Quoted() and the programs' report, note and error lines); files
 // are still opened by their real names.
 //
-// Escapes rather than U+FFFD: the replacement character makes names that differ only in their
-// invalid bytes look the same ("caf\xe9.png" and "caf\xe8.png" would both read "caf<U+FFFD>.png",
-// "\xe2\x82" and "\xe2" both one U+FFFD), while escapes keep every name distinct and tell the
-// user the real bytes to type (printf 'caf\xe9.png'). They are the escapes Quoted() already
-// writes for control bytes, and what Python's bytes.decode("utf-8", "backslashreplace") gives.
-// nlohmann-json's error_handler_t cannot write them (it refuses, drops, or writes U+FFFD per
-// ill-formed subsequence), so the JSON writer applies this function before nlohmann escapes
-// the string. A backslash in a valid name is kept as it is (valid names come out unchanged), so
-// a valid name holding the text "\xe9" reads like one holding the byte E9: such names are rare.
+// Escapes rather than U+FFFD keep names that differ only in their invalid bytes distinct and
+// give the user the bytes to type (docs/output_formats.md, "Names that are not UTF-8").
+// nlohmann-json cannot write them, so the JSON writer applies this function before nlohmann
+// escapes the string.
 std::string ToValidUtf8(std::string_view s);
 
 // For a message about a path that was not found: " (relative to the working directory

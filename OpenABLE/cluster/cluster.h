@@ -1,19 +1,10 @@
 // A run spread over several processes: `mpirun -np K Test_OpenABLE Config.txt` runs the same
-// program and configuration K times (on one machine or many) and Open MPI connects them.
-// Each process describes its share of the frames, the descriptor rows are gathered on every
-// process (32 B a frame for LDB), each process computes its share of the query rows (with the
-// L - 1 rows before it, which the sequence sums read), and process 0 gathers the result, then
-// evaluates and writes the outputs as a single process does: the outputs are the same
-// (docs/distributed.md).
-//
-// Started without mpirun, or by mpirun with one process, a program is one process and never
-// loads MPI. Open MPI lives in the run-time module libopenable_mpi.so (module_api.h), built when
-// CMake finds libopenmpi-dev.
-//
-// Failures: a step that can fail on one process only (reading its share of the frames) runs
-// through Agree: every process learns of the failure and throws the same error, which process 0
-// prints in one line naming the process. Output of the other processes (progress, notes, the
-// report) is silenced: process 0 speaks for the run.
+// program and configuration K times and Open MPI connects them. Each process describes its share
+// of the frames, the rows are gathered on every process, each computes its share of the query
+// rows, and process 0 gathers the result and writes the outputs a single process writes. A step
+// that can fail on one process only goes through Agree, so every process throws the same error;
+// only process 0 speaks. Without mpirun MPI is never loaded (module libopenable_mpi.so,
+// module_api.h). docs/distributed.md.
 #pragma once
 
 #include <cstdint>

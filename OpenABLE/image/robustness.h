@@ -1,30 +1,10 @@
-// Robustness to sensor noise and light: side-window multilayer pixel fusion, a
-// preprocessing of the grey image before description, and noise injection into frames for
-// robustness studies.
-//
-// Side-window fusion follows Algorithm 1 and Eq. 6 of "A Variable Radius Side Window Direct
-// SLAM Method Based on Semantic Information" (side window strategy after Yin et al., CVPR 2019).
-// From the paper:
-//   - the (2r+1) x (2r+1) square S around each pixel p_i is divided into eight side windows
-//     U, D, L, R, NW, NE, SW, SE of radius r, the pixel lying on a side (U, D, L, R: half
-//     squares, (r+1) x (2r+1)) or on a corner (NW, NE, SW, SE: quarter squares, (r+1) x (r+1));
-//   - q_n is the mean of the pixels of window n; the output is q_s with
-//     s = argmin_n |q_n - p_i| (L1 distance, Eq. 6);
-//   - layers are stacked like a CNN (the output of one layer is the input of the next).
-// Chosen here (the paper leaves these open):
-//   - every window contains the centre pixel (Yin et al.'s definition; the paper's Fig. 2 puts
-//     p_i "on the side or corner of the window");
-//   - each layer reads only its input image (all pixels of a layer are computed from the same
-//     input, not updated in place);
-//   - one radius per layer (Algorithm 1 takes one r; Algorithm 2 varies it between layers: the
-//     first half small, the second half larger. Its semantic part, YOLO on semistatic
-//     objects, is not implemented);
-//   - near the image border a window is clipped to the image and its mean is over the pixels
-//     inside (the clipped window always holds p_i);
-//   - ties (|q_n - p_i| within 1e-9 of the smallest) go to the first window in the order
-//     U, D, L, R, NW, NE, SW, SE (the order of Eq. 6);
-//   - values stay real (double) between layers and are rounded to 8 bits (half up) at the end.
-// Each layer is O(pixels): box sums from an integral image.
+// Robustness to sensor noise and light: side-window multilayer pixel fusion, a preprocessing of
+// the grey image before description (Algorithm 1 and Eq. 6 of "A Variable Radius Side Window
+// Direct SLAM Method Based on Semantic Information"; side windows after Yin et al., CVPR 2019),
+// which smooths along edges but never across them; and noise injection into frames for
+// robustness studies. Each fusion layer is O(pixels), from an integral image. The readings where
+// the paper is open (windows hold p, clipping, ties, rounding): docs/descriptors.md, "Noise
+// injection and side-window fusion".
 #pragma once
 
 #include <cstdint>

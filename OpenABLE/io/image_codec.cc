@@ -169,11 +169,9 @@ struct CompressorDeleter {
   void operator()(libdeflate_compressor* c) const { libdeflate_free_compressor(c); }
 };
 
-// libdeflate's level for the PNG files. On the 3,576 x 3,576 colour image of a Nordland matrix
-// (Matrix_color 4; docs/benchmarks.md, "Exports"), on one thread, level 1 wrote 10.81 MB in
-// about 0.35-0.38 times the time of zlib's level 1 with the run-length strategy (21.35 MB, how
-// the files were written before); levels 2, 3 and 4 took 1.7 to 2.9 times as long as level 1
-// for files 4-6% smaller.
+// libdeflate's level for the PNG files: level 1 writes files half the size of zlib's level 1 in
+// a fraction of its time, and higher levels cost much more time for files a few percent
+// smaller (docs/benchmarks.md, "Exports").
 constexpr int kDeflateLevel = 1;
 
 // ---------------------------------------------------------------------------------------------
@@ -239,8 +237,8 @@ bool JpegHasEnd(const std::vector<unsigned char>& bytes) {
 }
 
 // Frames are resized to Patch_size before they are described, so an image of hundreds of
-// megapixels only costs time and memory (4 bytes a pixel once converted to float; a 20000 x
-// 20000 PNG took 10 s and 2 GB per frame): such images are refused before decoding.
+// megapixels only costs time and memory (4 bytes a pixel once converted to float;
+// docs/robustness.md, "Image sizes"): such images are refused before decoding.
 constexpr std::uint64_t kMaxPixels = 100'000'000;
 
 void CheckPixelCount(std::uint64_t width, std::uint64_t height) {
@@ -398,10 +396,9 @@ bool Unfilter(unsigned char* data, int rows, std::size_t row_bytes, int bpp) {
 // decoded with its image data decompressed whole by libdeflate and the rows unfiltered here,
 // rather than by libpng, which inflates into a buffer of one row at a time: rows shorter than
 // 258 bytes (64 x 32 frames, the size Nordland is commonly used at) keep zlib's inflate out of
-// its fast loop, and inflate took a fifth of a bounded run over 200,000 such frames
-// (docs/benchmarks.md, "PNG frames decoded whole"). The pixels are libpng's: alpha dropped,
-// BGR order. The five filters are undone here because libpng offers no call that unfilters a
-// buffer it did not inflate itself. Returns false, leaving the file to libpng, for any other
+// its fast loop (docs/benchmarks.md, "PNG frames decoded whole"). The pixels are libpng's: alpha
+// dropped, BGR order. The five filters are undone here because libpng offers no call that unfilters
+// a buffer it did not inflate itself. Returns false, leaving the file to libpng, for any other
 // layout, a chunk whose CRC does not match, an unknown critical chunk, or image data that is not
 // exactly the image's: libpng then decodes the file or gives its own reason.
 bool DecodeWholeStream(const std::vector<unsigned char>& bytes, cv::Mat& image) {
@@ -550,8 +547,8 @@ std::string EncodePngFile(const cv::Mat& image, int threads) {
   // One zlib stream of all the rows, compressed on one thread: libdeflate compresses a whole
   // buffer into a complete stream whose last block is marked final, and offers no flush, so
   // bands compressed apart could not be joined into the one stream that PNG allows (zlib's
-  // sync flush made that possible). On 2 cores it is still faster than zlib on both, and
-  // leaves the other core to the exports that run meanwhile (docs/benchmarks.md, "Exports").
+  // sync flush made that possible). It still beats zlib on two cores, and leaves the other
+  // core to the exports that run meanwhile (docs/benchmarks.md, "Exports").
   const std::unique_ptr<libdeflate_compressor, CompressorDeleter> compressor(
       libdeflate_alloc_compressor(kDeflateLevel));
   if (compressor == nullptr) throw std::runtime_error("PNG encoder: libdeflate cannot start");

@@ -1,10 +1,11 @@
 // Image files as bytes, without OpenCV's imgcodecs for the common cases: recognising PNG, JPEG,
 // PGM/PPM and BMP from their first bytes; checking a PNG's chunks and a JPEG's end before
 // decoding; decoding PNG with libpng and JPEG with libjpeg in the program; writing PNG with
-// libdeflate. imgcodecs brings GDAL, GDCM, OpenEXR and about 120 other shared libraries that every
-// run would load at start-up (about 80 ms on the development machines), while the frames of
-// almost every data set are PNG or JPEG; other formats load imgcodecs on first use
-// (module_loader.h). Frame sources (frame_source.h) read files and hand their bytes here.
+// libdeflate. imgcodecs brings GDAL, GDCM, OpenEXR and over a hundred other shared libraries
+// that every run would load at start-up (docs/benchmarks.md, "Start-up without imgcodecs"),
+// while the frames of almost every data set are PNG or JPEG; other formats load imgcodecs on
+// first use (module_loader.h). Frame sources (frame_source.h) read files and hand their bytes
+// here.
 #pragma once
 
 #include <opencv2/core.hpp>

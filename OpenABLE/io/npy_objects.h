@@ -1,14 +1,9 @@
-// NumPy files that hold Python objects, and .npz archives.
-//
-// An object array (dtype '|O') is stored in a .npy file as a pickle. Such files come with
-// place-recognition benchmarks: VPR-Bench's ground_truth_new.npy is a (Q, 2) object array whose
-// rows are [query index, list of true reference indices]. Unpickling runs whatever callables a
-// file names, so DecodeNpyObjects does not unpickle: a small interpreter reads the opcodes plain
-// data use and calls none but the few NumPy and builtin constructors that make arrays, dtypes,
-// numbers, bytes and ranges; a file naming anything else is refused.
-//
-// A .npz file (np.savez, np.savez_compressed) is a ZIP archive of .npy members: VPR_Tutorial's
-// GT.npz holds the boolean matrices GThard.npy and GTsoft.npy.
+// NumPy files that hold Python objects, and .npz archives. An object array (dtype '|O') is a
+// pickle, as in VPR-Bench's ground_truth_new.npy ((Q, 2): query index, list of true references).
+// Unpickling runs whatever callables a file names, so DecodeNpyObjects does not unpickle: a small
+// interpreter reads the opcodes plain data use and calls only the few NumPy and builtin
+// constructors of arrays, dtypes, numbers, bytes and ranges; anything else is refused. A .npz
+// (np.savez) is a ZIP of .npy members, as VPR_Tutorial's GT.npz (GThard.npy, GTsoft.npy).
 #pragma once
 
 #include <cstdint>

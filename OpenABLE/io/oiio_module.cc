@@ -124,8 +124,8 @@ void ReadUnguarded(const std::string& path, const std::string& oiio_name, cv::Ma
   }
 
   // 8- and 16-bit files are read as stored and converted to float by OpenCV afterwards:
-  // OpenImageIO's own conversion to float costs more than decoding (measured: 6.8 ms against
-  // 2.3 ms for a 960x540 JPEG).
+  // OpenImageIO's own conversion to float costs more than decoding (docs/benchmarks.md,
+  // "End-to-end run times and start-up").
   const OIIO::TypeDesc::BASETYPE base = static_cast<OIIO::TypeDesc::BASETYPE>(spec.format.basetype);
   const bool uniform = spec.channelformats.empty();
   int stored_depth = CV_32F;

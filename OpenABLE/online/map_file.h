@@ -1,36 +1,9 @@
-// The file of a saved online map (OnlineDetector::SaveMap / LoadMap, openable_map,
-// docs/output_formats.md, "Saved maps"): the settings the map was made with, its sessions,
-// every frame's descriptor row, the index blocks, and the local features kept for
-// verification.
-//
-// Version 2 (written now) is laid out to be used where it lies once memory-mapped: a table of
-// sections, each at a 64-byte aligned offset with its own CRC-32, so that opening a map of ten
-// million places reads only the small sections (header, settings, sessions) and the index
-// structure, while the rows and the blocks are used in place and their checksums are computed
-// in the background (or before returning, MapReadOptions::check_in_background = false).
-//
-// Version 3 adds the rows of a map of several descriptors (one rows section per descriptor,
-// settings "channels", "channel_widths", "channel_types") and the image file of each frame;
-// the settings of a tuned map are settings lines too (tuned_*).
-//
-// Layout, integers little-endian:
-//   16 bytes  signature "OpenABLE-map\r\n\x1a\n" (the \r\n and \x1a catch a file mangled by a
-//             text-mode copy, as PNG's signature does)
-//   u32       format version (3)
-//   u32       section count S
-//   S x 32    sections: u32 kind, u32 a, u64 offset, u64 bytes, u32 CRC-32, u32 b
-//   u32       CRC-32 of every byte above
-//   sections, each at a multiple of 64 bytes, zero bytes between them:
-//     kind 1  settings: text lines "key value"
-//     kind 2  sessions: text lines "first<TAB>frames<TAB>time<TAB>name", in frame order
-//     kind 3  descriptor rows of descriptor a (0, 1, ... in order): frames x row bytes, row
-//             after row
-//     kind 4  one index block over rows [a, a + b): the engine's saved index
-//     kind 6  (optional) the image file of each frame, a line each ("" when not known)
-//     kind 5  local features, each frame: u32 points, 2 f32 a point, i32 rows, i32 cols,
-//             i32 OpenCV type, the descriptor bytes
-// Version 2 (one descriptor, no files) and version 1 (one session, no table, one FNV-1a 64 checksum
-// at the end) is still read: its frames become one session named "default".
+// The file of a saved online map (OnlineDetector::SaveMap / LoadMap, openable_map): the settings
+// the map was made with, its sessions, every frame's descriptor rows and image file, the index
+// blocks, and the local features kept for verification. Version 3 is a table of sections, each
+// 64-byte aligned with its own CRC-32, so that a memory-mapped map of millions of places reads
+// only its small sections when opened and uses rows and blocks where they lie, checking them in
+// the background. Versions 1 and 2 are still read. Layout: docs/output_formats.md, "Saved maps".
 #pragma once
 
 #include <cstdint>

@@ -1,19 +1,9 @@
-// SNAPS's trajectory correction (Sec. III-C, Eq. 6): when frame N closes a loop with a
-// reference frame, the positions of frames N-K..N are pulled towards the reference, the more
-// the closer they are to N ("discount factor").
-//
-// Reading of Eq. 6 (the paper is ambiguous in three places):
-//  - It writes x_s^new = Q * gamma * delta_x. Taken literally, every updated position would
-//    become a small vector near the origin; the only reading that makes sense is an increment,
-//    x_s <- x_s + Q * gamma * delta_x (so frame N moves by ~0.95 Q of the gap to the
-//    reference), and that is what is implemented.
-//  - gamma = 1 - 1 / exp(3 - alpha * 0.01 * s') is 1 - e^-3 = 0.9502 at s' = 0 and turns
-//    negative once 3 - 0.01 alpha s' < 0, i.e. s' > 300 / alpha (it would push frames away from
-//    the reference); gamma is clamped at 0 there.
-//  - Only positions are corrected: Eq. 6 has no rotation term, so rotations stay as they are.
-// delta = p_ref - p_N is taken before any position moves; s runs over [max(0, N-K), N].
-// alpha = number of loops closed so far, this one included (alpha >= 1): the more loops, the
-// faster gamma decays (Fig. 2).
+// SNAPS's trajectory correction (Sec. III-C, Eq. 6): when frame N closes a loop with a reference
+// frame, the positions of frames N-K..N are pulled towards the reference, the more the closer
+// they are to N ("discount factor"). Where the paper is ambiguous: the update is read as an
+// increment x_s <- x_s + Q gamma delta_x (read literally, every position would collapse near
+// the origin), gamma is clamped at 0 where Eq. 6 turns it negative, and only positions move
+// (Eq. 6 has no rotation term). docs/snaps.md, "Discounted update (Eq. 6)".
 #pragma once
 
 #include <Eigen/Geometry>

@@ -1,28 +1,11 @@
 // Geometric verification and temporal consistency of loop candidates: a candidate pair of
-// frames is accepted only when local features of the two images agree with one rigid scene
-// seen from two poses, and (optionally) when the queries before it also found verified loops
-// at neighbouring references. This is the check DLoopDetector (Galvez-Lopez and Tardos) and
-// LFM-LCD (../shared/papers/004) put after the global descriptor: it needs no learned model,
+// frames is accepted only when local features (ORB or SIFT, Lowe's ratio test) agree with one
+// rigid scene seen from two poses (fundamental or essential matrix by RANSAC, with a homography
+// for the degenerate views of a still robot or a pure rotation), and optionally when the queries
+// before it also found verified loops nearby. This is the check DLoopDetector (Galvez-Lopez and
+// Tardos) and LFM-LCD (../shared/papers/004) put after the global descriptor: no learned model,
 // and a wrong place rarely shows dozens of features consistent with one epipolar geometry.
-//
-// Per pair (PairVerifier::Verify):
-//  1. features of each frame: ORB or SIFT (OpenCV), at most max_features;
-//  2. matches: two nearest neighbours by brute force, Lowe's ratio test;
-//  3. RANSAC: the fundamental matrix (uncalibrated), or the essential matrix when a
-//     calibration is given; the inliers are the matches within ransac_threshold pixels of
-//     their epipolar line;
-//  4. fallback: when the epipolar model fails or finds fewer than min_inliers inliers, a
-//     homography by RANSAC. Identical views and pure rotations make the epipolar geometry
-//     degenerate (the translation is zero: any epipole fits), which is where DLoopDetector's
-//     users saw true loops of a robot standing still rejected; a homography describes them.
-//  The pair is verified when the model kept has at least min_inliers inliers.
-//
-// Temporal consistency (ContinueStreaks): queries are taken in frame order; a verified
-// candidate's streak is 1 plus the longest streak of the previous query's verified candidates
-// whose reference lies within `tolerance` frames of its own (0 when the previous query is not
-// the previous frame). A candidate is accepted when its streak exceeds `consistency`: the
-// previous `consistency` queries also had verified loops to neighbouring references, as
-// DLoopDetector's islands require.
+// Steps: docs/verification.md, "What happens, per query".
 #pragma once
 
 #include <cstdint>
@@ -138,7 +121,10 @@ struct QueryVerification {
 };
 
 // Sets the streaks, `accepted` and `answer` of `current` from `previous` (the query before it,
-// or nullptr), as the top of this file explains.
+// or nullptr). A verified candidate's streak is 1 plus the longest streak of the previous
+// query's verified candidates whose reference lies within `tolerance` frames of its own (0 when
+// the previous query is not the previous frame); it is accepted when its streak exceeds
+// `consistency`, as DLoopDetector's islands require.
 void ContinueStreaks(const QueryVerification* previous, QueryVerification& current, int consistency,
                      int tolerance);
 

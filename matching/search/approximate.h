@@ -1,18 +1,10 @@
 // Approximate candidate search for very large reference sets: the k nearest references of each
-// query found by one of the engines of matching/search/engine_registry.h (FAISS's HNSW graphs and
-// inverted files, faiss_engines.h; OpenCV's FLANN, flann_engine.h), and the exact search they
-// are measured against.
-//
-// FAISS (libfaiss-dev, with OpenMP and BLAS) is compiled into the run-time module
-// libopenable_faiss.so (matching/search/faiss_module.cc, OpenABLE/base/module_loader.h), loaded
-// when the first FAISS index is built: a run that uses FLANN or exact search does not load libgomp,
-// BLAS or LAPACK. A build configured without FAISS refuses the engines that need it
-// (CheckEngineAvailable).
-//
-// Every distance returned is exact, recomputed for the pair after the search by RowDistance
-// (matching/distances.h): the number of differing bits, or the Euclidean (not squared) distance
-// summed in double precision and rounded to float. Exact and approximate results therefore give
-// equal distances for equal pairs, and recall can compare them with ==.
+// query found by an engine of matching/search/engine_registry.h (FAISS's HNSW and inverted
+// files, OpenCV's FLANN), and the exact search they are measured against. FAISS lives in the
+// module libopenable_faiss.so, loaded when the first FAISS index is built; a build without FAISS
+// refuses its engines (CheckEngineAvailable). Every distance returned is exact, recomputed by
+// RowDistance (matching/distances.h) after the search, so exact and approximate results give
+// equal distances for equal pairs and recall can compare them with ==.
 #pragma once
 
 #include <cstdint>
@@ -64,11 +56,11 @@ struct ApproximateRange {
 // (k...Range) is written only here: Check() refuses values outside it, and the option table
 // gives its keys the same bounds.
 //
-// Defaults, from bench/bench_approximate.cc on Nordland winter queries against 50,000 summer
-// and distractor references (docs/benchmarks.md): LSH 12 tables of 20-bit keys probed at level
-// 2 (FLANN's usual setting for binary descriptors) finds the exact nearest LDB row for ~80 %
-// of queries; 4 k-d trees with 512 checks give HOG ~14x the speed of exact search while the
-// share of queries matched to the right place drops by ~2 points (128 checks: ~7 points).
+// Defaults, chosen with bench/bench_approximate.cc on Nordland winter queries against 50,000
+// summer and distractor references: LSH 12 tables of 20-bit keys probed at level 2 (FLANN's
+// usual setting for binary descriptors), and 4 k-d trees with 512 checks, where HOG gains most
+// of the speed for little loss of place recall (docs/benchmarks.md, "Approximate search
+// (FLANN): recall and speed").
 struct ApproximateOptions {
   // The engine: a name of ApproximateEngineNames() (any case); auto, the default, the engine
   // the table chooses for the rows' kind (ResolvedEngine).

@@ -1,16 +1,9 @@
-// The engines of approximate search (ApproximateIndex, matching/search/approximate.h) by name: the
-// values of ApproximateOptions::engine, of the key Approximate_engine, of the online detector's
-// engine and of bench_online's --engine. Every list of them that users see (the key's help and
-// its Markdown reference, error messages, the Python docstrings) is made here from the one
-// table of engines in engine_registry.cc, as the descriptors' names come from
-// descriptors/registry.cc.
-//
-// Besides the engines, the name "auto" (the default) stands for the engine chosen for the
-// rows' kind (ResolvedEngine).
-//
-// Adding an engine: its own files (an ApproximateEngineEntry and an EngineIndex, see
-// matching/search/approximate_engine.h and flann_engine.cc), one line in the table of
-// engine_registry.cc, its source in matching/CMakeLists.txt, its row in docs/matching.md.
+// The engines of approximate search (ApproximateIndex, matching/search/approximate.h) by name:
+// the values of ApproximateOptions::engine, of the key Approximate_engine, of the online
+// detector and of bench_online's --engine, plus "auto" (the default: the engine for the rows'
+// kind, ResolvedEngine). Every list users see (help, Markdown reference, errors, Python
+// docstrings) is made from the one table in engine_registry.cc, as descriptors' names come from
+// descriptors/registry.cc. Adding an engine: docs/matching.md, "Adding an engine".
 #pragma once
 
 #include <string>

@@ -126,7 +126,7 @@ void IncrementalIndex::Update(int searchable, bool background) {
     // Rows added at once (a map loaded, AddToMap): the blocks the binary counter of block
     // sizes ends with, each built once from its rows, rather than every block of block_frames
     // and every merge on the way, which indexed each row about log2(rows / block_frames)
-    // times (most of the 471 s that 1,000,000 rows took). A block is an index over its rows
+    // times (docs/benchmarks.md, "Large maps"). A block is an index over its rows
     // alone, so the blocks are those the merges would have made. The blocks already built
     // that the final layout keeps (its leading ones) stay.
     const int unit = s.options.block_frames;

@@ -1,13 +1,9 @@
 // A growing set of descriptor rows searched for the candidates of each new row: the map of the
-// online loop detector (OpenABLE/online/online.h).
-//
-// Rows are appended one by one. While the searchable rows number at most exact_limit, every
-// one is a candidate (an exact scan); beyond, rows are indexed by the engine of
-// options.approximate (matching/search/approximate.h, matching/search/engine_registry.h) in blocks
-// of block_frames rows merged as they grow (sizes block_frames x 2^m, at most one of each, like a
-// binary counter), and only the newest unindexed rows (fewer than block_frames) are scanned
-// exactly. Merges of two blocks are built on a background thread while the two old blocks go
-// on being searched, so that no row waits for a large index build.
+// online loop detector (OpenABLE/online/online.h). Up to exact_limit searchable rows every one
+// is scanned exactly; beyond, rows are indexed by options.approximate's engine in blocks of
+// block_frames rows merged like a binary counter (sizes block_frames x 2^m, at most one of
+// each), and only the newest unindexed rows are scanned exactly. Merges are built on a
+// background thread while the old blocks go on being searched, so no row waits for a build.
 #pragma once
 
 #include <cstdint>
