@@ -30,9 +30,8 @@ namespace {
 // The module's settings of an index of `options` over `refs`: the one place FaissSettings are
 // made, every field from ApproximateOptions or the rows.
 //
-// openable_matching reaches the FAISS module through ModuleSymbol (openable_io, linked
-// PRIVATE: openable_io does not depend on this library, so there is no cycle) rather than a
-// table of functions handed in by its callers: every caller (the pipeline, the online
+// openable_matching reaches the FAISS module through ModuleSymbol (base/module_loader.h) rather
+// than a table of functions handed in by its callers: every caller (the pipeline, the online
 // detector, the Python module, the benchmarks) then gets FAISS alike without wiring it.
 FaissSettings SettingsOf(const ApproximateOptions& o, const cv::Mat& refs, bool hnsw) {
   FaissSettings s{};
@@ -53,8 +52,8 @@ std::unique_ptr<FaissIndex> BuildFaiss(const ApproximateOptions& o, const cv::Ma
                                        bool hnsw) {
   // FAISS trains IVF cells by float k-means on OpenBLAS, spread over its OpenMP threads, each
   // calling sgemm: OpenBLAS then runs this CPU's kernels (on a CPU newer than Debian's OpenBLAS
-  // it ran its SSE3 ones: 36 % of building a 100,000-row map, in sgemm_kernel_PRESCOTT) on one
-  // thread (its own threads competed with FAISS's for the cores).
+  // it ran its slow SSE3 ones; docs/benchmarks.md, "Large maps") on one thread (its own
+  // threads competed with FAISS's for the cores).
   const BlasOnOneThread one_thread;
   const auto build =
       reinterpret_cast<OpenableFaissBuild>(ModuleSymbol("faiss", "openable_faiss_build"));
