@@ -93,9 +93,9 @@ int main(int argc, char** argv) {
     else if (a == "--consistency")
       options.consistency = std::stoi(next());
     else if (a == "--score")
-      options.score = openable::ParseEnum<openable::MatchScore>(next(), "--score");
+      options.score.kind = openable::ParseEnum<openable::MatchScore>(next(), "--score");
     else if (a == "--score-window")
-      options.score_window = std::stoi(next());
+      options.score.window = std::stoi(next());
     else if (a == "--heading-limit")
       heading_limit = std::stod(next());
     else if (a == "--prefill")
@@ -219,7 +219,7 @@ int main(int argc, char** argv) {
         "frames searched with %s index blocks (%d blocks at the end, merges %s), memory "
         "%.1f MB\n",
         options.descriptor.name.c_str(), options.sequence_length, options.exclusion,
-        openable::EnumName(options.score).c_str(), options.Threshold(), options.consistency,
+        openable::EnumName(options.score.kind).c_str(), options.Threshold(), options.consistency,
         prefill, detector.Size(), options.exact_limit, approximate_frames,
         options.approximate.engine.c_str(), detector.Blocks(),
         options.background_merges ? "in the background" : "in AddFrame",

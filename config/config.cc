@@ -208,16 +208,11 @@ void AddDescriptionKeys(OptionTable& t, Config& c) {
         "Peak spectral response of the green channel, nm; see Lambda_red.");
   t.Add("Lambda_blue", kDescription, c.preprocess, c.preprocess.lambda_blue, 0, 2000,
         "Peak spectral response of the blue channel, nm; see Lambda_red.");
-  t.Add("Image_descriptor", kDescription, c.descriptor, c.descriptor.name,
-        "LDB, D-LDB (LDB of the grey and of the disparity image; needs Camera_type 1), ORB, "
-        "BRISK, BRIEF, FREAK (binary, Hamming distance), SIFT, HOG (vector, L2 distance) or SAD "
-        "(SeqSLAM's patch-normalised thumbnail, sum of absolute differences; Sad_patch), "
-        "DenseVLAD (dense RootSIFT aggregated by VLAD over a vocabulary learnt from the frames "
-        "of Images_path, no ground truth; robust to a change of viewpoint and of light; float "
-        "rows, L2 distance; not in maps or the online detector), or ONNX (a network of the "
-        "user's, Model_path; float rows, L2 distance). Several "
-        "names joined by + or , (HOG+LDB) fuse their matrices (Fusion_weights). SURF is not "
-        "available (non-free, absent from Debian's OpenCV).",
+  // The names and their help come from the descriptors' registry.
+  static const std::string descriptor_help =
+      "Any case: " + DescriptorHelp() +
+      ". Several names joined by + or , (HOG+LDB) fuse their matrices (Fusion_weights).";
+  t.Add("Image_descriptor", kDescription, c.descriptor, c.descriptor.name, descriptor_help.c_str(),
         false);
   t.Add("Image_sequences", kDescription, c.matching, c.matching.sequence_length, 1, 100000,
         "Sequence length L: the distance of two places sums L single-frame distances along the "
@@ -277,13 +272,13 @@ void AddDescriptionKeys(OptionTable& t, Config& c) {
       "nor a best match, and is written as the largest value of the matrix in Txt_name and "
       "the PNGs and as +inf in Npy_name (docs/matching.md compares the three).");
   t.AddEnumName(
-      "Match_score", kDescription, c.matching, c.matching.score,
+      "Match_score", kDescription, c.matching, c.matching.score.kind,
       "How confident a query's best match is, for Match_threshold, the per-query evaluation "
       "(PR curve, AUC, R@100P, F1), the score column of Matches_name: distance (its "
       "normalised distance) or ratio (its distance over the smallest distance of the query's "
       "other candidates more than Match_score_window frames away: Lowe's ratio test, as "
       "SeqSLAM uses it; 1 without such a rival). docs/evaluation.md defines both.");
-  t.Add("Match_score_window", kDescription, c.matching, c.matching.score_window, 0, 100000,
+  t.Add("Match_score_window", kDescription, c.matching, c.matching.score.window, 0, 100000,
         "Frames on each side of a best match whose cells are not its rivals for the ratio "
         "score (they show the same place); smaller than the reference traversal.");
   t.Add("Match_threshold", kDescription, c.matching, c.matching.match_threshold, -1, 1,
@@ -468,13 +463,13 @@ void AddEvaluationKeys(OptionTable& t, Config& c) {
   t.Add("Vicinity", kEvaluation, c.evaluation, c.evaluation.protocol.vicinity, 0, kNoLimit,
         "ABLE-P protocol: a detected cell is a true positive when a ground-truth loop lies within"
         " this many frames of it in both directions (7 in the ABLE-P paper).");
+  // The protocols and their help come from their table (evaluation/protocols.h).
+  static const std::string protocol_help =
+      "Protocols reported: " + EvaluationProtocolsHelp() +
+      ", several joined by commas, or all. Each computes its figures as that code does "
+      "(docs/evaluation.md); Tolerance widens every ground truth.";
   t.AddEnumName("Evaluation_protocol", kEvaluation, c.evaluation, c.evaluation.protocol.protocols,
-                &ParseEvaluationProtocols, &EvaluationProtocolsValue,
-                "Protocols reported: openable (the toolbox's own: per query and ABLE-P), "
-                "vpr_bench (VPR-Bench's AUC-PR, R@100P, extended precision and RecallRate@N), "
-                "vpr_tutorial (VPR_Tutorial's multi- and single-match AUC and R@100P, R@K), "
-                "several joined by commas, or all. Each computes its figures as that code does "
-                "(docs/evaluation.md); Tolerance widens every ground truth.");
+                &ParseEvaluationProtocols, &EvaluationProtocolsValue, protocol_help.c_str());
   t.Add("Evaluation_name", kEvaluation, c.evaluation, c.evaluation.name,
         "Output prefix of the evaluation: <name>.json (figures and settings), "
         "<name>_per_query.csv and <name>_ablep.csv (curves), <name>_pr.png (precision-recall "

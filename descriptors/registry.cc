@@ -30,22 +30,28 @@ std::unique_ptr<Descriptor> Make(const DescriptorOptions& options) {
 struct Entry {
   const char* name;
   Factory create;
+  const char* help;  // what it is and how its rows are compared, for Image_descriptor's help
 };
 
 // The one table of descriptors, in the order shown to users.
 const Entry kDescriptors[] = {
-    {"LDB", &Make<LdbDescriptor>},      // descriptors/ldb.h
-    {"D-LDB", &Make<DldbDescriptor>},   // descriptors/dldb.h (2-channel patch: grey, disparity)
-    {"ORB", &Make<OrbDescriptor>},      // descriptors/opencv_descriptors.h
-    {"BRISK", &Make<BriskDescriptor>},  // descriptors/opencv_descriptors.h
-    {"BRIEF", &Make<BriefDescriptor>},  // descriptors/brief.h
-    {"FREAK", &Make<FreakDescriptor>},  // descriptors/freak.h
-    {"SIFT", &Make<SiftDescriptor>},    // descriptors/opencv_descriptors.h
-    {"HOG", &Make<HogDescriptor>},      // descriptors/hog.h
-    {"SAD", &Make<SadDescriptor>},      // descriptors/sad.h (SeqSLAM; byte values, L1 distance)
-    // descriptors/densevlad.h (dense RootSIFT + VLAD, its vocabulary learnt from the reference)
-    {"DENSEVLAD", &Make<DenseVladDescriptor>},
-    {"ONNX", &Make<OnnxDescriptor>},  // descriptors/onnx.h (a network of the user's; Model_path)
+    {"LDB", &Make<LdbDescriptor>, "binary, Hamming distance"},  // descriptors/ldb.h
+    {"D-LDB", &Make<DldbDescriptor>,                            // descriptors/dldb.h
+     "LDB of the grey and of the disparity image; binary, Hamming distance; needs Camera_type 1"},
+    {"ORB", &Make<OrbDescriptor>, "binary, Hamming distance"},  // opencv_descriptors.h
+    {"BRISK", &Make<BriskDescriptor>, "binary, Hamming distance"},
+    {"BRIEF", &Make<BriefDescriptor>, "binary, Hamming distance"},  // descriptors/brief.h
+    {"FREAK", &Make<FreakDescriptor>, "binary, Hamming distance"},  // descriptors/freak.h
+    {"SIFT", &Make<SiftDescriptor>, "float rows, L2 distance"},     // opencv_descriptors.h
+    {"HOG", &Make<HogDescriptor>, "float rows, L2 distance"},       // descriptors/hog.h
+    {"SAD", &Make<SadDescriptor>,                                   // descriptors/sad.h
+     "SeqSLAM's patch-normalised thumbnail, sum of absolute differences; Sad_patch"},
+    {"DENSEVLAD", &Make<DenseVladDescriptor>,  // descriptors/densevlad.h
+     "dense RootSIFT aggregated by VLAD over a vocabulary learnt from the frames of "
+     "Images_path, no ground truth; robust to a change of viewpoint and of light; float rows, "
+     "L2 distance; not in maps or the online detector"},
+    {"ONNX", &Make<OnnxDescriptor>,  // descriptors/onnx.h
+     "a network of the user's, Model_path; float rows, L2 distance"},
 };
 
 struct Unavailable {
@@ -103,6 +109,15 @@ std::vector<std::string> RegisteredDescriptorNames() {
     names.emplace_back(e.name);
   }
   return names;
+}
+
+std::string DescriptorHelp() {
+  std::string text;
+  for (const Entry& e : kDescriptors)
+    text += (text.empty() ? "" : ", ") + std::string(e.name) + " (" + e.help + ")";
+  for (const Unavailable& u : kUnavailable)
+    text += ". " + std::string(u.name) + " is not available: " + u.reason;
+  return text;
 }
 
 std::vector<std::pair<std::string, std::string>> UnavailableDescriptors() {

@@ -13,6 +13,10 @@ namespace openable {
 // Names that CreateDescriptor accepts, in the order shown to users.
 std::vector<std::string> RegisteredDescriptorNames();
 
+// Each registered name with what it is and how its rows are compared, then the unavailable
+// names with their reasons: the help of Image_descriptor and of Python's descriptor_names().
+std::string DescriptorHelp();
+
 // Names the original OpenABLE knew that this build cannot provide, each with the reason
 // (SURF: patented, absent from Debian's OpenCV).
 std::vector<std::pair<std::string, std::string>> UnavailableDescriptors();

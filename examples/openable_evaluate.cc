@@ -51,7 +51,7 @@ const char* kUsage =
     "  --exclusion N           one sequence: candidates N frames back or more (100) [Exclusion]\n"
     "  --vicinity N            ABLE-P temporal vicinity (7) [Vicinity]\n"
     "  --first-frame N         frame number of row 0 in pairs and pose files [Initial_image]\n"
-    "  --protocol LIST         openable, vpr_bench, vpr_tutorial, a comma list, or all\n"
+    "  --protocol LIST         @PROTOCOLS@, a comma list, or all\n"
     "                          [Evaluation_protocol]\n"
     "  --output PREFIX         write the files [Evaluation_name]\n"
     "  --report FILE.html      one self-contained HTML page: settings, figures, the matrix with\n"
@@ -78,6 +78,7 @@ const char* kUsage =
 std::string Usage() {
   std::string usage = kUsage;
   usage.replace(usage.find("@FORMATS@"), 9, openable::GroundTruthFormatList(", "));
+  usage.replace(usage.find("@PROTOCOLS@"), 11, openable::EvaluationProtocolNames());
   return usage;
 }
 

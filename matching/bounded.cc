@@ -57,8 +57,8 @@ class SlicedKeep {
 
   // Cells kept per query: KeepRules::best, more for the ratio score.
   static int KeptCells(const KeepRules& rules) {
-    return rules.score == MatchScore::kRatio ? std::max(rules.best, 2 * rules.score_window + 2)
-                                             : rules.best;
+    return rules.score.kind == MatchScore::kRatio ? std::max(rules.best, 2 * rules.score.window + 2)
+                                                  : rules.best;
   }
 
   // Columns [c0, c1) of the row, s[0] being column c0.
@@ -107,12 +107,11 @@ class SlicedKeep {
     const int ranked = std::min(rules_->best, static_cast<int>(heap_.size()));
     std::vector<std::pair<float, int>> candidates;
     const auto score = [&](float v, int j) {
-      if (rules_->score == MatchScore::kDistance) return v;
+      if (rules_->score.kind == MatchScore::kDistance) return v;
       // Among the kept cells and the match itself (in its own window: never its rival).
       candidates.assign(heap_.begin(), heap_.end());
       candidates.push_back({v, j});
-      return ScoreOfCandidate(candidates, candidates.size() - 1, rules_->score,
-                              rules_->score_window);
+      return ScoreOfCandidate(candidates, candidates.size() - 1, rules_->score);
     };
     for (int r = 0; r < ranked; ++r)
       out.push_back(
@@ -689,10 +688,11 @@ std::vector<std::uint8_t> AcceptedMatches(const std::vector<Match>& matches, int
   return out;
 }
 
-void NormalizeMatches(std::vector<Match>& matches, float max_distance, MatchScore score) {
+void NormalizeMatches(std::vector<Match>& matches, float max_distance,
+                      const MatchScoreOptions& score) {
   if (max_distance > 0.0f)
     for (Match& k : matches) k.distance /= max_distance;
-  if (score == MatchScore::kDistance)
+  if (score.kind == MatchScore::kDistance)
     for (Match& k : matches) k.score = k.distance;
 }
 

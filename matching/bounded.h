@@ -1,18 +1,11 @@
 // Memory-bounded matching (Matrix_mode 2, or auto when the dense matrix would not fit): the
-// matrix is never held. Each thread takes ranges of query rows and, row by row, computes the
-// distances, the sequence sums over a ring of the last L + 1 rows and the row's kept matches:
-// the Best_matches smallest distances of every query and the cells of the band
-// |i - j| <= Band_width. Memory: per thread about (L + 5) rows of references x 4 bytes, plus
-// the kept matches, whatever the number of queries.
-//
-// Rows and columns: with two traversals, the queries are the frames of the second
-// (Images_path_2) and the references those of the first (Images_path), and only that block is
-// computed; with one traversal every frame is matched against every frame, and the k best of
-// frame q are taken among frames at least Exclusion frames earlier (as the evaluation does).
-//
-// Distances are normalised (Eq. 5) by the largest distance computed. Where every cell is
-// computed the same matches come from the dense matrix (MatchesFromMatrix), which the tests
-// use as the reference.
+// matrix is never held. Each thread takes ranges of query rows and computes, row by row, the
+// distances, the sequence sums over a ring of the last rows and the row's kept matches (the
+// Best_matches smallest of each query, and the band |i - j| <= Band_width), in memory that does
+// not grow with the number of queries. Rows and columns as the evaluation's (one traversal:
+// candidates at least Exclusion frames earlier); Eq. 5 divides by the largest distance computed.
+// Where every cell is computed, the matches equal MatchesFromMatrix's on the dense matrix.
+// docs/matching.md, "Dense and bounded modes".
 #pragma once
 
 #include <cstdint>
@@ -44,8 +37,7 @@ struct KeepRules {
   int band = -1;        // |i - j| <= band (Band_width); -1 none
   int exclusion = 100;  // one traversal: candidates at least this many frames earlier, >= 1
   bool one_traversal = true;
-  MatchScore score = MatchScore::kDistance;  // the score of each kept match (Match_score)
-  int score_window = 10;                     // its rivals' window, frames (Match_score_window)
+  MatchScoreOptions score;  // the score of each kept match (Match_score, Match_score_window)
 
   // Throws InputError naming the key (Best_matches, Band_width, Exclusion) of a bad value.
   void Check() const;
@@ -107,7 +99,8 @@ struct BoundedOptions {
 
 // Divides the distances by `max_distance` (Eq. 5; nothing when it is 0) and, for
 // MatchScore::kDistance, sets the scores to the normalised distances.
-void NormalizeMatches(std::vector<Match>& matches, float max_distance, MatchScore score);
+void NormalizeMatches(std::vector<Match>& matches, float max_distance,
+                      const MatchScoreOptions& score);
 
 // Computes the block range by range from the descriptors (CV_8U: Hamming or L1 as
 // options.metric says, CV_32F: L2) and keeps the matches; `max_distance` receives the Eq. 5

@@ -19,7 +19,7 @@ void MatchingOptions::Check() const {
     throw InputError("Threshold: " + FormatNumber(threshold) +
                      " is not valid; expected -1 (disabled) or a number in [0, 1]");
   CheckIntRange("Threads", threads, 0, 1024);
-  CheckIntRange("Match_score_window", score_window, 0, 100000);
+  score.Check();
   if (match_threshold != -1.0 && !(match_threshold >= 0.0 && match_threshold <= 1.0))
     throw InputError("Match_threshold: " + FormatNumber(match_threshold) +
                      " is not valid; expected -1 (none) or a number in [0, 1]");

@@ -25,9 +25,8 @@ struct MatchingOptions {
   PanoramaMatching panorama_matching = PanoramaMatching::kCrossCorrelation;  // panoramic frames
   double threshold = -1.0;  // theta of Eq. 9: -1 (no thresholded matrix) or a number in [0, 1]
   int threads = 0;          // worker threads for description and matching, 0..1024, 0 = all
-  // The confidence of a best match (matching/score.h) and its rivals' window, frames (>= 0).
-  MatchScore score = MatchScore::kDistance;
-  int score_window = 10;
+  // The confidence of a best match and its rivals' window (matching/score.h).
+  MatchScoreOptions score;
   // A query's best match is accepted when its score is <= this; -1: no threshold (in [0, 1]).
   double match_threshold = -1.0;
   // n: an accepted best match also needs the best matches of n independent queries (one

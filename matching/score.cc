@@ -5,6 +5,9 @@
 #include <cstdlib>
 #include <numeric>
 
+#include "OpenABLE/base/error.h"
+#include "OpenABLE/base/option_checks.h"
+
 namespace openable {
 namespace {
 
@@ -23,8 +26,22 @@ int BestCandidate(const float* distances, int count) {
   return best;
 }
 
-float ScoreOfCandidate(const float* distances, int count, int best, MatchScore score, int window) {
-  if (score == MatchScore::kDistance) return distances[best];
+void MatchScoreOptions::Check() const { CheckIntRange("Match_score_window", window, 0, 100000); }
+
+void MatchScoreOptions::CheckRivals(int references, const std::string& where) const {
+  if (kind == MatchScore::kRatio && window >= references)
+    throw InputError("Match_score_window: " + std::to_string(window) +
+                     " frames is not smaller than the " + std::to_string(references) +
+                     " frames of the reference traversal" +
+                     (where.empty() ? "" : " (" + where + ")") +
+                     "; expected a window that leaves rivals outside it for Match_score ratio "
+                     "(10 frames is typical), or Match_score distance");
+}
+
+float ScoreOfCandidate(const float* distances, int count, int best,
+                       const MatchScoreOptions& score) {
+  const int window = score.window;
+  if (score.kind == MatchScore::kDistance) return distances[best];
   float rival = std::numeric_limits<float>::infinity();
   for (int c = 0; c < count; ++c)
     if (std::abs(c - best) > window && distances[c] < rival) rival = distances[c];
@@ -32,9 +49,10 @@ float ScoreOfCandidate(const float* distances, int count, int best, MatchScore s
 }
 
 float ScoreOfCandidate(const std::vector<std::pair<float, int>>& candidates, std::size_t best,
-                       MatchScore score, int window) {
+                       const MatchScoreOptions& score) {
   const auto [distance, frame] = candidates[best];
-  if (score == MatchScore::kDistance) return distance;
+  const int window = score.window;
+  if (score.kind == MatchScore::kDistance) return distance;
   float rival = std::numeric_limits<float>::infinity();
   for (const auto& [d, f] : candidates)
     if (std::abs(f - frame) > window && d < rival) rival = d;

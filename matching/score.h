@@ -1,20 +1,14 @@
-// How confident a best match is: the match score (the key Match_score). Every place that ranks
-// or accepts matches (the per-query evaluation, the bounded mode's matches file, the online
-// detector) scores a query's candidates through these functions.
-//
-//  - distance: the candidate's own distance (smaller = more confident), as ABLE does.
-//  - ratio: the candidate's distance divided by the smallest distance of the query's other
-//    candidates outside a window of +-`window` frames around it, in the same reference
-//    traversal: Lowe's ratio test, as SeqSLAM and the place-recognition literature use it. A
-//    right match stands out from every other place (ratio well below 1); a wrong one often has
-//    a rival elsewhere in the route as close as itself (ratio near 1). The window keeps the
-//    frames next to the candidate, which show the same place, from counting as rivals.
-//    Conventions: no candidate outside the window, or a rival at distance 0, gives 1 (nothing
-//    to tell the match from); non-finite distances (sequence cells skipped at the start of a
-//    traversal, matching/sequence.h) are never candidates nor rivals.
+// How confident a best match is: the match score (the key Match_score), through which every
+// place that ranks or accepts matches (evaluation, the bounded mode's matches file, the online
+// detector) scores a query's candidates. distance: the candidate's own distance, as ABLE does.
+// ratio: Lowe's ratio test, as SeqSLAM uses it: the distance over the smallest of the query's
+// other candidates outside +-`window` frames (the frames next to a match show the same place);
+// no such rival, or one at distance 0, gives 1; non-finite distances are never candidates nor
+// rivals. docs/evaluation.md, "The match score".
 #pragma once
 
 #include <limits>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -25,15 +19,32 @@ namespace openable {
 enum class MatchScore { kDistance, kRatio };
 OPENABLE_ENUM_NAMES(MatchScore, "distance", "ratio")
 
+// The score of best matches (Match_score) and the window of its rivals (Match_score_window):
+// the one struct of these settings, held by every option struct that scores matches (the run's
+// MatchingOptions, the bounded mode's KeepRules, the evaluation, the criteria without ground
+// truth, the online detector, the report) and copied whole between them.
+struct MatchScoreOptions {
+  MatchScore kind = MatchScore::kDistance;
+  int window = 10;  // frames, 0..100000
+
+  // Throws InputError naming Match_score_window when the window is out of range.
+  void Check() const;
+  // Throws InputError naming Match_score_window when, with the ratio, the window leaves no
+  // rival among `references` frames; `where` names them in the message (may be empty).
+  void CheckRivals(int references, const std::string& where) const;
+
+  bool operator==(const MatchScoreOptions& o) const { return kind == o.kind && window == o.window; }
+};
+
 // The score of candidate `best` of a row of `count` candidate distances (columns 0 .. count-1
 // are the candidates, column = frame of the reference traversal).
-float ScoreOfCandidate(const float* distances, int count, int best, MatchScore score, int window);
+float ScoreOfCandidate(const float* distances, int count, int best, const MatchScoreOptions& score);
 
 // The same over sparse candidates: (distance, frame) pairs of one query (any order; an
 // approximate search's candidates), candidate `best` an index into `candidates`. Rivals are the
 // other candidates given; a rival the search did not return cannot count.
 float ScoreOfCandidate(const std::vector<std::pair<float, int>>& candidates, std::size_t best,
-                       MatchScore score, int window);
+                       const MatchScoreOptions& score);
 
 // The best candidate of a row: the smallest finite distance, the lowest column on ties; -1
 // when no distance is finite.

@@ -50,9 +50,9 @@ std::string FormatRunReport(const Config& config, const RunOutcome& outcome) {
       << (c.matching.contrast_enhancement
               ? ", contrast enhancement +-" + std::to_string(c.matching.contrast_window)
               : std::string())
-      << ", score " << EnumName(c.matching.score)
-      << (c.matching.score == MatchScore::kRatio
-              ? " (window +-" + std::to_string(c.matching.score_window) + ")"
+      << ", score " << EnumName(c.matching.score.kind)
+      << (c.matching.score.kind == MatchScore::kRatio
+              ? " (window +-" + std::to_string(c.matching.score.window) + ")"
               : std::string())
       << "\n";
   if (!r.camera.empty()) out << "  camera: " << r.camera << "\n";
@@ -92,7 +92,7 @@ std::string FormatRunReport(const Config& config, const RunOutcome& outcome) {
         << " cells below";
   if (r.accepted_queries >= 0) {
     out << "\n  accepted: " << r.accepted_queries << " of " << r.answered_queries
-        << " best matches with " << EnumName(c.matching.score)
+        << " best matches with " << EnumName(c.matching.score.kind)
         << " score <= " << c.matching.match_threshold << " (Match_threshold)";
     if (c.matching.match_consistency > 0)
       out << " confirmed by " << c.matching.match_consistency

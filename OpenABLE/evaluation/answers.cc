@@ -62,11 +62,7 @@ QueryAnswers AnswersOfMatrix(const cv::Mat1f& matrix, const EvaluationLayout& la
     throw std::logic_error("AnswersOfMatrix: the layout does not fit a " +
                            std::to_string(matrix.rows) + " x " + std::to_string(matrix.cols) +
                            " matrix");
-  if (options.score == MatchScore::kRatio && options.score_window >= layout.references)
-    throw InputError("Match_score_window: " + std::to_string(options.score_window) +
-                     " frames is not smaller than the " + std::to_string(layout.references) +
-                     " frames of the reference traversal; expected a smaller window (no rival "
-                     "would remain outside it)");
+  options.score.CheckRivals(layout.references, "");
   const int nq = layout.queries;
   QueryAnswers a = NoAnswers(nq);
   std::vector<std::uint8_t> has_candidates(static_cast<std::size_t>(nq), 0);
@@ -80,7 +76,7 @@ QueryAnswers AnswersOfMatrix(const cv::Mat1f& matrix, const EvaluationLayout& la
       if (best < 0) continue;
       a.best[q] = best;
       a.distance[q] = row[best];
-      a.score[q] = ScoreOfCandidate(row, end, best, options.score, options.score_window);
+      a.score[q] = ScoreOfCandidate(row, end, best, options.score);
     }
   });
   for (int q = 0; q < nq; ++q) {

@@ -49,7 +49,7 @@ void AcceptAnswers(const std::vector<int>& best, const std::vector<float>& score
 // The answers of the block `layout` of `matrix` (normalised, M'): each query's best candidate
 // (the smallest finite distance among its candidates, the lowest column on ties; with one
 // sequence the frames at least options.exclusion back), scored by options.score and
-// options.score_window, accepted and confirmed by AcceptAnswers. The best matches and scores
+// options.score.window, accepted and confirmed by AcceptAnswers. The best matches and scores
 // are those EvaluatePerQuery finds. Throws std::logic_error when the layout does not fit the
 // matrix, InputError when a ratio's window leaves no rival (Match_score_window).
 QueryAnswers AnswersOfMatrix(const cv::Mat1f& matrix, const EvaluationLayout& layout,

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "OpenABLE/base/error.h"
+#include "OpenABLE/base/option_checks.h"
 #include "OpenABLE/base/strings.h"
 #include "OpenABLE/evaluation/answers.h"
 
@@ -199,11 +200,12 @@ void EvaluationOptions::Check() const {
   if (vicinity < 0)
     throw InputError("Vicinity: " + std::to_string(vicinity) +
                      " is negative; expected a number of frames >= 0");
-  if (able_thresholds < 2)
-    throw std::logic_error("EvaluationOptions: able_thresholds must be >= 2");
-  if (score_window < 0)
-    throw InputError("Match_score_window: " + std::to_string(score_window) +
-                     " is negative; expected a number of frames >= 0");
+  CheckIntAtLeast("able_thresholds", able_thresholds, 2);
+  score.Check();
+  if (!(accept_threshold == -1.0 || accept_threshold >= 0.0))
+    RefuseOption("Match_threshold", FormatNumber(accept_threshold), "-1 (none) or a number >= 0");
+  CheckIntRange("Match_consistency", accept_consistency, 0, 1000);
+  CheckIntAtLeast("Image_sequences", agreement.sequence_length, 1);
 }
 
 PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout& layout,
@@ -212,11 +214,7 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
   const int nq = layout.queries;
   PerQueryResult r;
   NoAnswers(r, nq);
-  if (options.score == MatchScore::kRatio && options.score_window >= layout.references)
-    throw InputError("Match_score_window: " + std::to_string(options.score_window) +
-                     " frames is not smaller than the " + std::to_string(layout.references) +
-                     " frames of the reference traversal; expected a smaller window (no rival "
-                     "would remain outside it)");
+  options.score.CheckRivals(layout.references, "");
   std::vector<std::uint8_t> has_candidates(nq, 0);
   std::vector<std::array<std::uint8_t, 3>> correct_at_n(nq, {0, 0, 0});
   std::vector<std::int64_t> outside(nq, 0);
@@ -245,7 +243,7 @@ PerQueryResult EvaluatePerQuery(const cv::Mat1f& matrix, const EvaluationLayout&
       if (top.empty()) continue;  // no finite candidate: no answer
       r.best[q] = top.front().second;
       r.best_distance[q] = top.front().first;
-      r.score[q] = ScoreOfCandidate(row, end, r.best[q], options.score, options.score_window);
+      r.score[q] = ScoreOfCandidate(row, end, r.best[q], options.score);
       if (t.empty()) continue;
       r.correct[q] = NearTruth(t, r.best[q], options.tolerance) ? 1 : 0;
       correct_at_n[q] = HitsAtN(

@@ -10,7 +10,7 @@
 
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/layout.h"
-#include "OpenABLE/evaluation/reference_protocols.h"
+#include "OpenABLE/evaluation/protocols.h"
 #include "matching/agreement.h"
 #include "matching/score.h"
 
@@ -22,9 +22,8 @@ struct EvaluationOptions {
   int vicinity = 7;           // ABLE-P protocol: temporal vicinity, frames
   int able_thresholds = 100;  // ABLE-P protocol: thresholds evenly spaced in [0, 1]
   // Per-query protocol: what ranks and accepts a query's best match (matching/score.h): its
-  // distance, or the ratio to the best rival outside +-score_window frames (>= 0).
-  MatchScore score = MatchScore::kDistance;
-  int score_window = 10;
+  // distance, or the ratio to the best rival outside +-window frames.
+  MatchScoreOptions score;
   // Per-query protocol: the operating point a user chose (Match_threshold): answers with a
   // score <= accept_threshold are accepted; -1: none.
   double accept_threshold = -1.0;
@@ -39,7 +38,8 @@ struct EvaluationOptions {
   // files and figures need them); VPR-Bench's and VPR_Tutorial's when chosen.
   EvaluationProtocols protocols;
 
-  // Throws InputError naming Tolerance, Exclusion, Vicinity or Match_score_window.
+  // Throws InputError naming the key of a value out of range (Tolerance, Exclusion, Vicinity,
+  // Match_score_window, Match_threshold, Match_consistency, Image_sequences; able_thresholds).
   void Check() const;
 };
 

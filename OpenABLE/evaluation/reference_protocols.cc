@@ -10,6 +10,8 @@
 
 #include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
+#include "OpenABLE/evaluation/report.h"
+#include "OpenABLE/io/json.h"
 
 namespace openable {
 namespace {
@@ -290,36 +292,110 @@ VprTutorialResult EvaluateVprTutorial(const cv::Mat1f& normalized, const Evaluat
   return r;
 }
 
-EvaluationProtocols ParseEvaluationProtocols(const std::string& text) {
-  const std::string all = Trim(Lower(text));
-  if (all == "all") return {true, true, true};
-  EvaluationProtocols p{false, false, false};
-  for (const std::string& name : SplitTrimmed(all, ',')) {
-    if (name == "openable") {
-      p.openable = true;
-    } else if (name == "vpr_bench") {
-      p.vpr_bench = true;
-    } else if (name == "vpr_tutorial") {
-      p.vpr_tutorial = true;
-    } else {
-      throw InputError("Evaluation_protocol: " + Quoted(text) + " is not valid" +
-                       (name == all ? std::string() : " (" + Quoted(name) + ")") +
-                       "; expected openable, vpr_bench, vpr_tutorial, several of them joined by "
-                       "commas, or all");
-    }
-  }
-  return p;
+namespace {
+
+// The n-th value (from 1) of a list of recalls, NaN past its end.
+double AtN(const std::vector<double>& recalls, int n) {
+  return n >= 1 && static_cast<std::size_t>(n) <= recalls.size()
+             ? recalls[static_cast<std::size_t>(n - 1)]
+             : kNaN;
 }
 
-std::string EvaluationProtocolsText(const EvaluationProtocols& p) {
-  std::string out;
-  auto add = [&](bool on, const char* name) {
-    if (on) out += (out.empty() ? "" : ",") + std::string(name);
-  };
-  add(p.openable, "openable");
-  add(p.vpr_bench, "vpr_bench");
-  add(p.vpr_tutorial, "vpr_tutorial");
-  return out;
+// A row of the "By protocol" table: AUC, R@100P, R@1, R@5, R@10.
+void SetRow(ProtocolFigures& f, double auc, double at_100p, double at_1, double at_5,
+            double at_10) {
+  f.auc = auc;
+  f.recall_at_100p = at_100p;
+  f.recall_at_1 = at_1;
+  f.recall_at_5 = at_5;
+  f.recall_at_10 = at_10;
+}
+
+}  // namespace
+
+ProtocolFigures VprBenchFigures(const cv::Mat1f& normalized, const EvaluationLayout& layout,
+                                const GroundTruth& truth, int tolerance) {
+  const VprBenchResult r = EvaluateVprBench(normalized, layout, truth, tolerance);
+  ProtocolFigures f;
+  SetRow(f, r.auc_pr, r.recall_at_100p, AtN(r.recall_at_n, 1), AtN(r.recall_at_n, 5),
+         AtN(r.recall_at_n, 10));
+  f.more = "EP " + FigureText(r.extended_precision) + "; " + std::to_string(r.queries) +
+           " queries, " + std::to_string(r.queries_with_truth) + " with a true reference";
+  nlohmann::ordered_json& o = f.json;
+  o["auc_pr"] = json::Number(r.auc_pr);
+  o["recall_at_100p"] = json::Number(r.recall_at_100p);
+  o["extended_precision"] = json::Number(r.extended_precision);
+  nlohmann::ordered_json& at_n = o["recall_at_n"] = nlohmann::ordered_json::array();
+  for (double v : r.recall_at_n) at_n.push_back(json::Number(v));
+  o["queries"] = r.queries;
+  o["queries_with_truth"] = r.queries_with_truth;
+  o["right_best_matches"] = r.right_best_matches;
+  // Python's dict: the figures as doubles (NaN stays NaN) and the curve.
+  f.details = {{"auc_pr", r.auc_pr},
+               {"recall_at_100p", r.recall_at_100p},
+               {"extended_precision", r.extended_precision},
+               {"recall_at_n", r.recall_at_n},
+               {"precision", r.precision},
+               {"recall", r.recall},
+               {"queries", r.queries},
+               {"queries_with_truth", r.queries_with_truth},
+               {"right_best_matches", r.right_best_matches}};
+  // The curve in the reference code's order.
+  f.csv = "precision,recall\n";
+  for (std::size_t k = 0; k < r.precision.size(); ++k)
+    f.csv += CsvNumber(r.precision[k]) + "," + CsvNumber(r.recall[k]) + "\n";
+  return f;
+}
+
+ProtocolFigures VprTutorialFigures(const cv::Mat1f& normalized, const EvaluationLayout& layout,
+                                   const GroundTruth& truth, int tolerance) {
+  const VprTutorialResult t = EvaluateVprTutorial(normalized, layout, truth, tolerance);
+  ProtocolFigures f;
+  // recall_at_k holds K = 1, 5, 10 in its positions 1, 2, 3.
+  SetRow(f, t.auc_multi, t.recall_at_100p_multi, AtN(t.recall_at_k, 1), AtN(t.recall_at_k, 2),
+         AtN(t.recall_at_k, 3));
+  const std::string single = t.single ? "single-match AUC " + FigureText(t.auc_single) +
+                                            ", R@100P " + FigureText(t.recall_at_100p_single)
+                                      : std::string("single-match: not with GTsoft");
+  f.more = "multi-match; " + single + (t.soft ? "; GTsoft cells ignored" : "");
+  nlohmann::ordered_json& o = f.json;
+  o["soft_ground_truth"] = t.soft;
+  o["multi"] = {{"auc", json::Number(t.auc_multi)},
+                {"recall_at_100p", json::Number(t.recall_at_100p_multi)}};
+  if (t.single)
+    o["single"] = {{"auc", json::Number(t.auc_single)},
+                   {"recall_at_100p", json::Number(t.recall_at_100p_single)}};
+  else
+    o["single"] = nullptr;
+  nlohmann::ordered_json& at_k = o["recall_at_k"] = nlohmann::ordered_json::object();
+  for (std::size_t k = 0; k < t.k.size() && k < t.recall_at_k.size(); ++k)
+    at_k[std::to_string(t.k[k])] = json::Number(t.recall_at_k[k]);
+  o["queries_with_truth"] = t.queries_with_truth;
+  // Python's dict (recall_at_k's keys, whole numbers, become ints there).
+  nlohmann::ordered_json& d = f.details;
+  d["auc_multi"] = t.auc_multi;
+  d["recall_at_100p_multi"] = t.recall_at_100p_multi;
+  d["precision_multi"] = t.precision_multi;
+  d["recall_multi"] = t.recall_multi;
+  if (t.single) {
+    d["auc_single"] = t.auc_single;
+    d["recall_at_100p_single"] = t.recall_at_100p_single;
+    d["precision_single"] = t.precision_single;
+    d["recall_single"] = t.recall_single;
+  }
+  nlohmann::ordered_json& k_of = d["recall_at_k"] = nlohmann::ordered_json::object();
+  for (std::size_t k = 0; k < t.k.size() && k < t.recall_at_k.size(); ++k)
+    k_of[std::to_string(t.k[k])] = t.recall_at_k[k];
+  d["soft_ground_truth"] = t.soft;
+  d["queries_with_truth"] = t.queries_with_truth;
+  // The multi-match points, then the single-match ones.
+  f.csv = "matching,precision,recall\n";
+  for (std::size_t k = 0; k < t.precision_multi.size(); ++k)
+    f.csv += "multi," + CsvNumber(t.precision_multi[k]) + "," + CsvNumber(t.recall_multi[k]) + "\n";
+  for (std::size_t k = 0; k < t.precision_single.size(); ++k)
+    f.csv +=
+        "single," + CsvNumber(t.precision_single[k]) + "," + CsvNumber(t.recall_single[k]) + "\n";
+  return f;
 }
 
 }  // namespace openable

@@ -16,6 +16,7 @@
 
 #include "OpenABLE/evaluation/ground_truth.h"
 #include "OpenABLE/evaluation/layout.h"
+#include "OpenABLE/evaluation/protocols.h"
 
 namespace openable {
 
@@ -74,20 +75,11 @@ VprBenchResult EvaluateVprBench(const cv::Mat1f& normalized, const EvaluationLay
 VprTutorialResult EvaluateVprTutorial(const cv::Mat1f& normalized, const EvaluationLayout& layout,
                                       const GroundTruth& truth, int tolerance);
 
-// The protocols an evaluation reports (Evaluation_protocol): the toolbox's own (per query and
-// ABLE-P), VPR-Bench's, VPR_Tutorial's, any of them.
-struct EvaluationProtocols {
-  bool openable = true;
-  bool vpr_bench = false;
-  bool vpr_tutorial = false;
-  bool operator==(const EvaluationProtocols& o) const {
-    return openable == o.openable && vpr_bench == o.vpr_bench && vpr_tutorial == o.vpr_tutorial;
-  }
-};
-// "openable", "vpr_bench", "vpr_tutorial", several joined by commas, or "all"
-// (case-insensitive). Throws InputError naming Evaluation_protocol otherwise.
-EvaluationProtocols ParseEvaluationProtocols(const std::string& text);
-// The canonical text: "openable", "openable,vpr_bench", ...
-std::string EvaluationProtocolsText(const EvaluationProtocols& protocols);
+// Their entries of the table of protocols (protocols.h): the figures above as every report
+// reads them.
+ProtocolFigures VprBenchFigures(const cv::Mat1f& normalized, const EvaluationLayout& layout,
+                                const GroundTruth& truth, int tolerance);
+ProtocolFigures VprTutorialFigures(const cv::Mat1f& normalized, const EvaluationLayout& layout,
+                                   const GroundTruth& truth, int tolerance);
 
 }  // namespace openable

@@ -42,51 +42,6 @@ Json PerQueryJson(const PerQueryResult& q) {
   return o;
 }
 
-Json VprBenchJson(const VprBenchResult& r) {
-  Json o;
-  o["auc_pr"] = json::Number(r.auc_pr);
-  o["recall_at_100p"] = json::Number(r.recall_at_100p);
-  o["extended_precision"] = json::Number(r.extended_precision);
-  Json& at_n = o["recall_at_n"] = Json::array();
-  for (double v : r.recall_at_n) at_n.push_back(json::Number(v));
-  o["queries"] = r.queries;
-  o["queries_with_truth"] = r.queries_with_truth;
-  o["right_best_matches"] = r.right_best_matches;
-  return o;
-}
-
-Json VprTutorialJson(const VprTutorialResult& r) {
-  Json o;
-  o["soft_ground_truth"] = r.soft;
-  o["multi"] = {{"auc", json::Number(r.auc_multi)},
-                {"recall_at_100p", json::Number(r.recall_at_100p_multi)}};
-  if (r.single)
-    o["single"] = {{"auc", json::Number(r.auc_single)},
-                   {"recall_at_100p", json::Number(r.recall_at_100p_single)}};
-  else
-    o["single"] = nullptr;
-  Json& at_k = o["recall_at_k"] = Json::object();
-  for (std::size_t k = 0; k < r.k.size() && k < r.recall_at_k.size(); ++k)
-    at_k[std::to_string(r.k[k])] = json::Number(r.recall_at_k[k]);
-  o["queries_with_truth"] = r.queries_with_truth;
-  return o;
-}
-
-// "-" for a figure that is not defined (NaN), else %.3f.
-std::string Figure(double v) {
-  if (!std::isfinite(v)) return "-";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3f", v);
-  return b;
-}
-
-// The n-th value (from 1) of a list of recalls, NaN past its end.
-double AtN(const std::vector<double>& recalls, int n) {
-  return n >= 1 && static_cast<std::size_t>(n) <= recalls.size()
-             ? recalls[static_cast<std::size_t>(n - 1)]
-             : std::numeric_limits<double>::quiet_NaN();
-}
-
 // The table of each run under each protocol chosen, when a reference protocol is.
 void FormatProtocolTable(std::ostringstream& o, const EvaluationSettings& s,
                          const std::vector<EvaluatedRun>& runs) {
@@ -102,9 +57,10 @@ void FormatProtocolTable(std::ostringstream& o, const EvaluationSettings& s,
   if (!widened.empty()) o << "  (" << widened << ")\n";
   for (const ProtocolRow& r : rows) {
     std::snprintf(line, sizeof line, "  %-18s %-13s %7s %7s %6s %6s %6s  %s\n",
-                  r.label.substr(0, 18).c_str(), r.protocol.c_str(), Figure(r.auc).c_str(),
-                  Figure(r.recall_at_100p).c_str(), Figure(r.recall_at_1).c_str(),
-                  Figure(r.recall_at_5).c_str(), Figure(r.recall_at_10).c_str(), r.more.c_str());
+                  r.label.substr(0, 18).c_str(), r.protocol.c_str(), FigureText(r.auc).c_str(),
+                  FigureText(r.recall_at_100p).c_str(), FigureText(r.recall_at_1).c_str(),
+                  FigureText(r.recall_at_5).c_str(), FigureText(r.recall_at_10).c_str(),
+                  r.more.c_str());
     o << line;
   }
 }
@@ -115,7 +71,7 @@ std::vector<ProtocolRow> ProtocolRows(const EvaluationSettings& s,
                                       const std::vector<EvaluatedRun>& runs) {
   std::vector<ProtocolRow> rows;
   const EvaluationProtocols& p = s.options.protocols;
-  if (!p.vpr_bench && !p.vpr_tutorial) return rows;
+  if (p.reference.empty()) return rows;
   for (const EvaluatedRun& r : runs) {
     const PerQueryResult& q = r.verified ? r.per_query_unverified : r.per_query;
     if (p.openable) {
@@ -125,24 +81,9 @@ std::vector<ProtocolRow> ProtocolRows(const EvaluationSettings& s,
       rows.push_back({r.label, "openable", q.auc, q.recall_at_100p, q.recall_at_1, q.recall_at_5,
                       q.recall_at_10, more});
     }
-    if (r.has_vpr_bench) {
-      const VprBenchResult& b = r.vpr_bench;
-      rows.push_back({r.label, "vpr_bench", b.auc_pr, b.recall_at_100p, AtN(b.recall_at_n, 1),
-                      AtN(b.recall_at_n, 5), AtN(b.recall_at_n, 10),
-                      "EP " + Figure(b.extended_precision) + "; " + std::to_string(b.queries) +
-                          " queries, " + std::to_string(b.queries_with_truth) +
-                          " with a true reference"});
-    }
-    if (r.has_vpr_tutorial) {
-      const VprTutorialResult& t = r.vpr_tutorial;
-      const std::string single = t.single ? "single-match AUC " + Figure(t.auc_single) +
-                                                ", R@100P " + Figure(t.recall_at_100p_single)
-                                          : std::string("single-match: not with GTsoft");
-      // recall_at_k holds K = 1, 5, 10 in its positions 1, 2, 3.
-      rows.push_back({r.label, "vpr_tutorial", t.auc_multi, t.recall_at_100p_multi,
-                      AtN(t.recall_at_k, 1), AtN(t.recall_at_k, 2), AtN(t.recall_at_k, 3),
-                      "multi-match; " + single + (t.soft ? "; GTsoft cells ignored" : "")});
-    }
+    for (const ProtocolFigures& f : r.reference)
+      rows.push_back({r.label, f.protocol, f.auc, f.recall_at_100p, f.recall_at_1, f.recall_at_5,
+                      f.recall_at_10, f.more});
   }
   return rows;
 }
@@ -154,23 +95,6 @@ std::string ProtocolToleranceNote(const EvaluationSettings& s) {
            " widens the file's true references by +-" + std::to_string(s.options.tolerance) +
            " frames; Tolerance 0 takes them as the reference code does";
   return "";
-}
-
-std::string EncodeVprBenchCsv(const VprBenchResult& r) {
-  std::string out = "precision,recall\n";
-  for (std::size_t k = 0; k < r.precision.size(); ++k)
-    out += CsvNumber(r.precision[k]) + "," + CsvNumber(r.recall[k]) + "\n";
-  return out;
-}
-
-std::string EncodeVprTutorialCsv(const VprTutorialResult& r) {
-  std::string out = "matching,precision,recall\n";
-  for (std::size_t k = 0; k < r.precision_multi.size(); ++k)
-    out += "multi," + CsvNumber(r.precision_multi[k]) + "," + CsvNumber(r.recall_multi[k]) + "\n";
-  for (std::size_t k = 0; k < r.precision_single.size(); ++k)
-    out +=
-        "single," + CsvNumber(r.precision_single[k]) + "," + CsvNumber(r.recall_single[k]) + "\n";
-  return out;
 }
 
 std::string CsvNumber(double v) { return std::isfinite(v) ? FormatNumber(v, 9) : "null"; }
@@ -201,8 +125,8 @@ Json EvaluationSettingsJson(const EvaluationSettings& s) {
   o["tolerance"] = s.options.tolerance;
   o["exclusion"] = s.options.exclusion;
   o["vicinity"] = s.options.vicinity;
-  o["match_score"] = EnumName(s.options.score);
-  o["match_score_window"] = s.options.score_window;
+  o["match_score"] = EnumName(s.options.score.kind);
+  o["match_score_window"] = s.options.score.window;
   o["match_threshold"] = json::Number(s.options.accept_threshold);
   o["match_consistency"] = s.options.accept_consistency;
   o["accept_none"] = s.options.accept_none;
@@ -226,8 +150,7 @@ void AddEvaluatedRunJson(Json& o, const EvaluatedRun& r) {
   o["able_p"] = {{"average_precision_percent", json::Number(r.able_p.average_precision)},
                  {"candidate_cells", r.able_p.candidate_cells},
                  {"truth_cells", r.able_p.truth_cells}};
-  if (r.has_vpr_bench) o["vpr_bench"] = VprBenchJson(r.vpr_bench);
-  if (r.has_vpr_tutorial) o["vpr_tutorial"] = VprTutorialJson(r.vpr_tutorial);
+  for (const ProtocolFigures& f : r.reference) o[f.protocol] = f.json;
 }
 
 Json EvaluationJson(const EvaluationSettings& s, const std::vector<EvaluatedRun>& runs,
@@ -268,8 +191,8 @@ std::string FormatEvaluationTable(const EvaluationSettings& s,
     << s.options.tolerance << " frames";
   if (!runs.empty() && runs[0].layout.kind == EvaluationLayout::Kind::kLoopClosure)
     o << ", candidates at least " << s.options.exclusion << " frames back";
-  if (s.options.score == MatchScore::kRatio)
-    o << "; score: ratio to the best rival beyond +-" << s.options.score_window << " frames";
+  if (s.options.score.kind == MatchScore::kRatio)
+    o << "; score: ratio to the best rival beyond +-" << s.options.score.window << " frames";
   o << "; ABLE-P vicinity " << s.options.vicinity << "\n";
   if (!s.options.protocols.openable) {
     FormatProtocolTable(o, s, runs);

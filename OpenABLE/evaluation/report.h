@@ -28,12 +28,9 @@ struct EvaluatedRun {
   PerQueryResult per_query;
   PerQueryResult per_query_unverified;
   AblePResult able_p;
-  // The matrix (never the verified answers) under the protocols of VPR-Bench and VPR_Tutorial,
-  // when Evaluation_protocol names them.
-  bool has_vpr_bench = false;
-  VprBenchResult vpr_bench;
-  bool has_vpr_tutorial = false;
-  VprTutorialResult vpr_tutorial;
+  // The matrix (never the verified answers) under each reference protocol Evaluation_protocol
+  // names (protocols.h), in the table's order.
+  std::vector<ProtocolFigures> reference;
   // What makes the figures say little about the matrix, one line each (EvaluationWarnings, on
   // the matrix's own answers): printed by the programs on stderr and under the table.
   std::vector<std::string> warnings;
@@ -47,11 +44,6 @@ struct EvaluationSettings {
 
 // "threshold,precision,recall,f1,tp,fp" then one line per point, 9 significant digits.
 std::string EncodeCurveCsv(const std::vector<CurvePoint>& curve);
-// The curves of the reference protocols: "precision,recall" then one line per point, in the
-// reference code's order (VPR-Bench: "precision,recall"; VPR_Tutorial: "matching,precision,
-// recall" with the multi-match points, then the single-match ones).
-std::string EncodeVprBenchCsv(const VprBenchResult& r);
-std::string EncodeVprTutorialCsv(const VprTutorialResult& r);
 
 // A number of the CSV files: 9 significant digits (FormatNumber), "null" when it is not finite.
 std::string CsvNumber(double value);

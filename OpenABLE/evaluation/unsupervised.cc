@@ -2,9 +2,16 @@
 
 #include <stdexcept>
 
+#include "OpenABLE/base/option_checks.h"
 #include "matching/score.h"
 
 namespace openable {
+
+void UnsupervisedOptions::Check() const {
+  CheckIntAtLeast("Image_sequences", agreement.sequence_length, 1);
+  CheckIntAtLeast("Exclusion", exclusion, 1);
+  score.Check();
+}
 
 UnsupervisedFigures UnsupervisedCriteria(const cv::Mat1f& matrix, const EvaluationLayout& layout,
                                          const UnsupervisedOptions& options) {
@@ -26,7 +33,7 @@ UnsupervisedFigures UnsupervisedCriteria(const cv::Mat1f& matrix, const Evaluati
     if (best < 0) continue;
     ++out.answered;
     out.best[q] = best;
-    out.ratio[q] = ScoreOfCandidate(row, end, best, MatchScore::kRatio, options.score_window);
+    out.ratio[q] = ScoreOfCandidate(row, end, best, {MatchScore::kRatio, options.score.window});
     margin += 1.0 - out.ratio[q];
   }
   out.agrees = AgreeingAnswers(out.best, options.agreement);

@@ -1,23 +1,9 @@
-// Criteria computed from a distance matrix alone, with no ground truth: how distinct the best
-// matches are, how consistent the best matches of independent queries are, and the combined
-// criterion that openable_sweep's --rank-by and the auto mode (Auto 1) rank settings by
-// (docs/evaluation.md, "Without ground truth", gives the formulas and the measurements that
-// chose them).
-//
-// Over the queries of the evaluated block (EvaluationLayout: the query-reference block of two
-// traversals, or one sequence whose candidates lie Exclusion frames back), each query q with
-// candidates has an answer b(q), its best candidate (matching/score.h), and the ratio r(q) of
-// its distance to its best rival more than Match_score_window frames away:
-//
-//   distinctiveness = (1 / Q) sum_q (1 - r(q))     (a query without an answer adds 0)
-//   consistency     = (1 / Q) sum_q a(q)           (a(q) = 1 when b(q) agrees with its
-//                                                  independent partner's, matching/agreement.h)
-//   agreement       = (10 consistency + distinctiveness) / 11
-//
-// Q counts the queries with candidates. Distinctiveness alone is fooled by a matrix whose best
-// matches all fall on a few columns (each can be far below the rest of its row); consistency
-// is not (answers stuck on one place never advance with the queries). Consistency decides and
-// distinctiveness breaks its near-ties: many settings confirm every answer on easy data.
+// Criteria computed from a distance matrix alone, with no ground truth: distinctiveness of the
+// best matches, consistency of the best matches of independent queries (matching/agreement.h),
+// and agreement = (10 consistency + distinctiveness) / 11, by which openable_sweep's --rank-by
+// and the auto mode (Auto 1) rank settings. Consistency decides because distinctiveness alone is
+// fooled by best matches stuck on a few columns; distinctiveness breaks its near-ties. Formulas
+// and the measurements that chose them: docs/evaluation.md, "Without ground truth".
 #pragma once
 
 #include <cstdint>
@@ -27,6 +13,7 @@
 #include "OpenABLE/base/enum_names.h"
 #include "OpenABLE/evaluation/layout.h"
 #include "matching/agreement.h"
+#include "matching/score.h"
 
 namespace openable {
 
@@ -36,7 +23,11 @@ OPENABLE_ENUM_NAMES(UnsupervisedCriterion, "distinctiveness", "consistency", "ag
 struct UnsupervisedOptions {
   AgreementOptions agreement;  // L, Sequence_partial and Sequence_direction of the matrix
   int exclusion = 100;         // one sequence: candidates at least this many frames back
-  int score_window = 10;       // the ratio's window (Match_score_window), >= 0
+  // Its window: distinctiveness is the ratio score (its kind is not used).
+  MatchScoreOptions score;
+
+  // Throws InputError naming Image_sequences, Exclusion or Match_score_window.
+  void Check() const;
 };
 
 struct UnsupervisedFigures {

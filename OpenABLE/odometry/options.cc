@@ -37,11 +37,13 @@ void StereoOdometryOptions::Check() const {
     RefuseOption("Odometry_matcher (" + o + ".matcher)", Quoted(matcher), "sgbm or bm");
   CheckNumberAtLeast(o + ".wls_lambda", wls_lambda, 0, true);
   CheckNumberAtLeast(o + ".wls_sigma", wls_sigma, 0, true);
-  if (num_disparities < 16 || num_disparities > 256 || num_disparities % 16 != 0)
-    RefuseOption("Odometry_num_disparities (" + o + ".num_disparities)",
-                 std::to_string(num_disparities), "a multiple of 16 in [16, 256]");
-  if (block_size % 2 != 1 || block_size > 11 || block_size < (m == "BM" ? 5 : 1))
-    RefuseOption(o + ".block_size", std::to_string(block_size), "odd, 1-11 (sgbm) or 5-11 (bm)");
+  const int range = disparity.num_disparities, block = disparity.block_size;
+  if (range < 16 || range > 256 || range % 16 != 0)
+    RefuseOption("Odometry_num_disparities (" + o + ".disparity.num_disparities)",
+                 std::to_string(range), "a multiple of 16 in [16, 256]");
+  if (block % 2 != 1 || block > 11 || block < (m == "BM" ? 5 : 1))
+    RefuseOption(o + ".disparity.block_size", std::to_string(block),
+                 "odd, 1-11 (sgbm) or 5-11 (bm)");
   CheckFeatures(o, *this);
   CheckNumberAtLeast("Odometry_max_depth (" + o + ".max_depth)", max_depth, 1);
   CheckNumberAtLeast("Odometry_ransac_threshold (" + o + ".pnp_reprojection_px)",
@@ -76,7 +78,7 @@ StereoOdometryOptions OdometryOptions::Stereo() const {
   StereoOdometryOptions o = WithSharedKeys(*this, StereoOdometryOptions());
   o.matcher = matcher;
   o.wls_filter = wls_filter;
-  o.num_disparities = num_disparities;
+  o.disparity.num_disparities = num_disparities;
   o.max_depth = max_depth;
   if (ransac_threshold > 0) o.pnp_reprojection_px = ransac_threshold;
   return o;

@@ -17,17 +17,9 @@
 namespace openable::odometry {
 namespace {
 
-// The disparity options of OpenABLE/stereo with this odometry's range and block.
-DisparityOptions SgbmOptions(const StereoOdometryOptions& o) {
-  DisparityOptions d;
-  d.num_disparities = o.num_disparities;
-  d.block_size = o.block_size;
-  return d;
-}
-
 cv::Ptr<cv::StereoMatcher> LeftMatcher(const StereoOdometryOptions& o) {
-  if (Upper(o.matcher) == "BM") return cv::StereoBM::create(o.num_disparities, o.block_size);
-  const DisparityOptions d = SgbmOptions(o);
+  const DisparityOptions& d = o.disparity;
+  if (Upper(o.matcher) == "BM") return cv::StereoBM::create(d.num_disparities, d.block_size);
   const int area = d.block_size * d.block_size;
   return cv::StereoSGBM::create(0, d.num_disparities, d.block_size, 8 * area, 32 * area,
                                 d.disp12_max_diff, 63, d.uniqueness_ratio, d.speckle_window_size,
@@ -43,7 +35,7 @@ cv::Mat1f OdometryDisparity(const cv::Mat& left, const cv::Mat& right,
       left.empty())
     throw std::logic_error("OdometryDisparity: expected two CV_8UC1 images of one size");
   const bool bm = Upper(o.matcher) == "BM";
-  if (!bm && !o.wls_filter) return ComputeDisparity(left, right, SgbmOptions(o));
+  if (!bm && !o.wls_filter) return ComputeDisparity(left, right, o.disparity);
 
   const cv::Ptr<cv::StereoMatcher> left_matcher = LeftMatcher(o);
   cv::Mat left_raw, result;  // CV_16S, disparity x 16
@@ -63,7 +55,7 @@ cv::Mat1f OdometryDisparity(const cv::Mat& left, const cv::Mat& right,
   cv::Mat1f disparity;
   result.convertTo(disparity, CV_32F, 1.0 / 16.0);
   disparity.setTo(0.0f, disparity <= 0.0f);
-  const int band = std::min(o.num_disparities, disparity.cols);
+  const int band = std::min(o.disparity.num_disparities, disparity.cols);
   disparity.colRange(0, band).setTo(0.0f);
   return disparity;
 }

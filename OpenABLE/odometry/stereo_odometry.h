@@ -21,6 +21,7 @@
 #include "OpenABLE/odometry/calibration.h"
 #include "OpenABLE/odometry/features.h"
 #include "OpenABLE/odometry/step_stats.h"
+#include "OpenABLE/stereo/disparity.h"
 
 namespace openable::odometry {
 
@@ -35,11 +36,16 @@ struct StereoOdometryOptions : FeatureOptions {
   // WLS smoothness (lambda, > 0; 8000 is OpenCV's usual value) and edge sensitivity to the
   // image (sigma_color, > 0; 1.5 likewise).
   double wls_lambda = 8000, wls_sigma = 1.5;
-  // Disparities searched, pixels, a multiple of 16 in [16, 256]. 64 suits 620-752 pixel wide
-  // frames (KITTI half size: a point at 2.7 m; EuRoC: 0.8 m); scale it with the image width.
-  int num_disparities = 64;
-  // Matched block side, pixels, odd, 1-11 for sgbm, 5-11 for bm.
-  int block_size = 5;
+  // The disparity search (OpenABLE/stereo/disparity.h; bm uses its range and block only):
+  // num_disparities a multiple of 16 in [16, 256], 64 here, which suits 620-752 pixel wide
+  // frames (KITTI half size: a point at 2.7 m; EuRoC: 0.8 m); block_size odd, 1-11 for sgbm,
+  // 5-11 for bm.
+  DisparityOptions disparity = [] {
+    DisparityOptions d;
+    d.num_disparities = 64;
+    d.block_size = 5;
+    return d;
+  }();
   // Metres, >= 1: points farther than this (in the previous frame) are not used in PnP.
   double max_depth = 80;
   // RANSAC of PnP: inlier reprojection error, pixels (> 0); iterations (>= 1); confidence (0, 1).

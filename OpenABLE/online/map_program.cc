@@ -253,7 +253,7 @@ void SetSearchKey(const Config& c, const std::string& key, OnlineOptions& o) {
   } else if (key == "Match_score") {
     o.score = m.score;
   } else if (key == "Match_score_window") {
-    o.score_window = m.score_window;
+    o.score.window = m.score.window;
   } else if (key == "Match_threshold") {
     o.threshold = m.match_threshold;  // -1: the score's default
   } else if (key == "Match_consistency") {
@@ -417,8 +417,9 @@ std::string SearchText(const OnlineOptions& o) {
   }
   if (o.contrast_enhancement)
     text += ", contrast enhancement +-" + std::to_string(o.contrast_window);
-  text += ", L = " + std::to_string(o.sequence_length) + ", " + EnumName(o.score) + " score";
-  if (o.score == MatchScore::kRatio) text += " (window +-" + std::to_string(o.score_window) + ")";
+  text += ", L = " + std::to_string(o.sequence_length) + ", " + EnumName(o.score.kind) + " score";
+  if (o.score.kind == MatchScore::kRatio)
+    text += " (window +-" + std::to_string(o.score.window) + ")";
   text += " <= " + FormatNumber(o.Threshold());
   if (o.consistency > 0)
     text += ", confirmed by " + std::to_string(o.consistency) + " earlier independent quer" +
@@ -534,8 +535,8 @@ int Add(const Arguments& a) {
                   d->AddImagesToMap(images, names);
                 });
   }
+  SetInterruptNoteOnCommit(path + " holds session " + Quoted(a.sessions[0]));
   d->SaveMap(path);
-  SetInterruptNote(path + " holds session " + Quoted(a.sessions[0]));
   if (!a.quiet) {
     std::cout << (exists ? "Appended" : "Created") << " session " << Quoted(a.sessions[0]) << ": "
               << d->Size() - before << " frames; " << path << " holds " << d->Size()
@@ -657,8 +658,8 @@ int Merge(const Arguments& a) {
   const auto lock = LockForWriting(a.output, a.quiet);
   std::unique_ptr<OnlineDetector> d = Open(a.positional[0], OnlineOptions());
   d->AppendMap(a.positional[1]);
+  SetInterruptNoteOnCommit(a.output + " written");
   d->SaveMap(a.output);
-  SetInterruptNote(a.output + " written");
   if (!a.quiet)
     std::cout << "Wrote " << a.output << ": " << d->Size() << " frames in " << d->Sessions().size()
               << " sessions.\n";
@@ -701,8 +702,8 @@ int Tune(const Arguments& a) {
   const MapTuning tuning = d->Tune(t, [&](const std::string& line) {
     if (log) std::cerr << line << "\n";
   });
+  SetInterruptNoteOnCommit(path + " holds the tuned settings");
   d->SaveMap(path);
-  SetInterruptNote(path + " holds the tuned settings");
   if (a.json) {
     std::cout << json::Dump({{"map", path}, {"tuning", TuningJson(tuning)}});
     return 0;
@@ -865,7 +866,7 @@ std::vector<std::string> WriteQueryOutputs(const std::string& prefix, const Conf
           std::to_string(o.exact_limit) + " frames");
     Config c = config;
     c.matching.score = o.score;
-    c.matching.score_window = o.score_window;
+    c.matching.score.window = o.score.window;
     c.matching.match_threshold = o.Threshold();
     c.matching.match_consistency = 0;
     evaluation.settings = EvaluationSettingsFrom(c);
@@ -908,7 +909,7 @@ std::vector<std::string> WriteQueryOutputs(const std::string& prefix, const Conf
       answers.source = a.positional[0];
       answers.layout = layout;
       answers.score = o.score;
-      answers.score_window = o.score_window;
+      answers.score.window = o.score.window;
       answers.threshold = o.Threshold();
       answers.consistency = o.consistency;
       answers.untrusted = d.UsesTuning() && !d.Tuning().reliable;

@@ -90,8 +90,7 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
   // sequence for every query (Sequence_partial ahead), so that both choose alike from the same
   // frames: judged with the shorter sums the search gives the first L - 1 frames of a
   // traversal (scale), long sequences lose to short ones on short traversals for their first
-  // frames alone (on the bundled sample, SAD with contrast enhancement and L = 40 fell from
-  // consistency 0.873 to 0.680, below LDB's 0.703, though its R@1 is 0.933 against 0.833).
+  // frames alone (docs/benchmarks.md, "Maps: settings chosen from their sessions").
   const std::vector<std::string> channels = Channels();
   Config base;
   base.descriptor = options.descriptor;
@@ -100,7 +99,7 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
   base.description.grid_x = options.grid_x;
   base.description.grid_y = options.grid_y;
   base.matching.partial = SequencePartial::kAhead;
-  base.matching.score_window = options.score_window;
+  base.matching.score.window = options.score.window;
   const auto held = [&](const Config& c) {
     for (const std::string& name : DescriptorList(c.descriptor.name))
       if (std::find(channels.begin(), channels.end(), Upper(name)) == channels.end()) return false;
@@ -190,7 +189,7 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
   search.contrast_enhancement = m.contrast_enhancement;
   search.contrast_window = m.contrast_window;
   search.sequence_length = m.sequence_length;
-  search.score = MatchScore::kRatio;
+  search.score.kind = MatchScore::kRatio;
   search.threshold =
       t.threshold >= 0 ? t.threshold : OnlineOptions::DefaultThreshold(MatchScore::kRatio);
   search.consistency = 1;

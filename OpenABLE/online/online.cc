@@ -93,9 +93,9 @@ void OnlineOptions::Check() const {
           "1..1000");
   Require(std::isfinite(threshold), "threshold", std::to_string(threshold),
           "a number >= 0, or < 0 for the score's default");
-  Require(score == MatchScore::kDistance || score == MatchScore::kRatio, "score",
-          std::to_string(static_cast<int>(score)), "distance or ratio");
-  Require(score_window >= 0, "score_window", std::to_string(score_window),
+  Require(score.kind == MatchScore::kDistance || score.kind == MatchScore::kRatio, "score",
+          std::to_string(static_cast<int>(score.kind)), "distance or ratio");
+  Require(score.window >= 0, "score_window", std::to_string(score.window),
           ">= 0 (frames on each side of a candidate that are not its rivals)");
   Require(consistency >= 0 && consistency <= 1000, "consistency", std::to_string(consistency),
           "0..1000 (earlier independent queries that must agree; 0: off)");
@@ -888,7 +888,7 @@ void OnlineDetector::State::Choose(std::vector<std::pair<double, int>>& scored, 
   if (s.verifier) {
     std::vector<std::pair<float, int>> cells;
     for (const auto& [d, j] : scored) cells.emplace_back(static_cast<float>(d), j);
-    chosen = DistinctBest(cells, s.options.verification.candidates, s.options.score_window);
+    chosen = DistinctBest(cells, s.options.verification.candidates, s.options.score.window);
   } else {
     const size_t k = std::min(scored.size(), static_cast<size_t>(s.options.candidates));
     std::partial_sort(scored.begin(), scored.begin() + k, scored.end());
@@ -896,7 +896,7 @@ void OnlineDetector::State::Choose(std::vector<std::pair<double, int>>& scored, 
   }
   // The ratio's rivals: every candidate scored.
   std::vector<std::pair<float, int>> rivals;
-  if (s.options.score == MatchScore::kRatio)
+  if (s.options.score.kind == MatchScore::kRatio)
     for (const auto& [d, j] : scored) rivals.emplace_back(static_cast<float>(d), j);
   const double scale = s.options.sequence_length * unit_now;
   const double threshold = s.options.Threshold();
@@ -907,8 +907,8 @@ void OnlineDetector::State::Choose(std::vector<std::pair<double, int>>& scored, 
     c.session_frame = c.frame - s.sessions[static_cast<std::size_t>(c.session)].first;
     c.distance = scored[i].first;
     c.normalized = scale > 0 ? c.distance / scale : 0.0;
-    c.score = s.options.score == MatchScore::kRatio
-                  ? ScoreOfCandidate(rivals, i, MatchScore::kRatio, s.options.score_window)
+    c.score = s.options.score.kind == MatchScore::kRatio
+                  ? ScoreOfCandidate(rivals, i, s.options.score)
                   : c.normalized;
     c.accepted = c.score <= threshold && !s.Unreliable();
     r.candidates.push_back(c);
@@ -1165,8 +1165,8 @@ std::vector<std::pair<std::string, std::string>> SearchSettings(const OnlineOpti
           {"contrast_enhancement", o.contrast_enhancement ? "1" : "0"},
           {"contrast_window", std::to_string(o.contrast_window)},
           {"sequence_length", std::to_string(o.sequence_length)},
-          {"score", EnumName(o.score)},
-          {"score_window", std::to_string(o.score_window)},
+          {"score", EnumName(o.score.kind)},
+          {"score_window", std::to_string(o.score.window)},
           {"threshold", Exact(o.threshold)},
           {"consistency", std::to_string(o.consistency)}};
 }
@@ -1320,9 +1320,9 @@ void ReadSearch(const MapFile& map, const std::string& path, const std::string& 
   o.contrast_enhancement = map.Setting(prefix + "contrast_enhancement") == "1";
   ParseWhole(map, prefix + "contrast_window", path, o.contrast_window);
   ParseWhole(map, prefix + "sequence_length", path, o.sequence_length);
-  o.score = ParseEnum<MatchScore>(map.Setting(prefix + "score"),
-                                  path + ": setting \"" + prefix + "score\"");
-  ParseWhole(map, prefix + "score_window", path, o.score_window);
+  o.score.kind = ParseEnum<MatchScore>(map.Setting(prefix + "score"),
+                                       path + ": setting \"" + prefix + "score\"");
+  ParseWhole(map, prefix + "score_window", path, o.score.window);
   o.threshold = ParseNumber(map, prefix + "threshold", path);
   ParseWhole(map, prefix + "consistency", path, o.consistency);
 }
@@ -1679,7 +1679,6 @@ void OnlineDetector::UseTuning(const MapTuning& tuning) {
   search.contrast_window = t.contrast_window;
   search.sequence_length = t.sequence_length;
   search.score = t.score;
-  search.score_window = t.score_window;
   search.threshold = t.threshold;
   search.consistency = t.consistency;
   search.Check();

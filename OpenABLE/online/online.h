@@ -1,9 +1,6 @@
-// The library's two ways in for programs that do not go through Config.txt:
-//
-//  - OnlineDetector: a SLAM system feeds frames one by one and gets, for each, its loop
-//    candidates among earlier frames.
-//  - Batch helpers: describe a set of images, compute the normalised distance matrix (with
-//    sequences), as Test_OpenABLE does from a configuration.
+// The library's two ways in for programs that do not go through Config.txt: OnlineDetector (a
+// SLAM system feeds frames one by one and gets each one's loop candidates among earlier frames)
+// and batch helpers (describe images, compute the normalised matrix as Test_OpenABLE does).
 //
 //   #include <OpenABLE/OpenABLE.h>
 //   openable::OnlineOptions options;               // LDB, global, L = 1, exclusion 100
@@ -68,8 +65,7 @@ struct OnlineOptions {
   // distance, or the ratio of its distance to the best candidate more than score_window
   // frames away from it (the rivals are the candidates the search scored: every searchable
   // frame while exact, the approximate candidates beyond).
-  MatchScore score = MatchScore::kDistance;
-  int score_window = 10;  // >= 0
+  MatchScoreOptions score;
   // A candidate is accepted when its score is <= this threshold (see LoopCandidate); negative:
   // the default of the score, DefaultThreshold(score). Threshold() gives the one in use.
   double threshold = -1;
@@ -79,10 +75,8 @@ struct OnlineOptions {
   // its sequence, its best candidate the same number of frames back in the same session,
   // within the tolerance). Online there is no later query to confirm with, so the first
   // queries of a traversal (before a partner exists) are never accepted. 0: the score alone.
-  // The default, 1: on the shared Nordland seasons an untuned map of LDB rows accepted 2 best
-  // matches, 1 wrong, without it and none with it; on KITTI 00 frames 0-1699, one traversal
-  // with the distance score, 42 loops instead of 52, every one right either way
-  // (docs/benchmarks.md, "Maps").
+  // The default, 1, trades some right loops for fewer wrong ones (docs/benchmarks.md,
+  // "Confirmation by earlier queries: the default").
   int consistency = 1;
   // Search: exact (every earlier frame) while the searchable map holds at most exact_limit
   // frames; beyond, frames are indexed by approximate.engine (an engine of
@@ -118,7 +112,7 @@ struct OnlineOptions {
   static double DefaultThreshold(MatchScore score) {
     return score == MatchScore::kRatio ? 0.9 : 0.13;
   }
-  double Threshold() const { return threshold >= 0 ? threshold : DefaultThreshold(score); }
+  double Threshold() const { return threshold >= 0 ? threshold : DefaultThreshold(score.kind); }
   // Throws InputError naming the field, the value and what was expected.
   void Check() const;
 };

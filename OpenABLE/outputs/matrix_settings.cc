@@ -67,8 +67,8 @@ std::string EncodeMatrixSettings(const Config& config, const RunResult& result,
   py["heading_limit"] = json::Number(s.truth.heading_limit);
   py["min_frame_gap"] = s.truth.min_frame_gap;
   py["axes"] = s.truth.axes;
-  py["score"] = EnumName(s.options.score);
-  py["score_window"] = s.options.score_window;
+  py["score"] = EnumName(s.options.score.kind);
+  py["score_window"] = s.options.score.window;
   if (s.options.accept_threshold >= 0)
     py["accept_threshold"] = json::Number(s.options.accept_threshold);
   py["accept_consistency"] = s.options.accept_consistency;

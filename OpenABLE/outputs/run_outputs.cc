@@ -234,10 +234,9 @@ const std::vector<RunOutput>& RunOutputs() {
            out.emplace_back("Evaluation_name", prefix + suffix);
          for (const char* suffix : kEvaluationRunSuffixes)
            out.emplace_back("Evaluation_name", prefix + suffix);
-         const EvaluationProtocols& protocols = c.evaluation.protocol.protocols;
-         if (protocols.vpr_bench) out.emplace_back("Evaluation_name", prefix + kVprBenchSuffix);
-         if (protocols.vpr_tutorial)
-           out.emplace_back("Evaluation_name", prefix + kVprTutorialSuffix);
+         // Per run, each reference protocol's curve (its suffix in the table of protocols).
+         for (const std::string& name : c.evaluation.protocol.protocols.reference)
+           out.emplace_back("Evaluation_name", prefix + FindReferenceProtocol(name)->csv_suffix);
          return out;
        },
        [](const OutputInput& in) -> Stager {

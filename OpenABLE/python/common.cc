@@ -300,4 +300,82 @@ std::string TableDefault(const char* key) {
   return v;
 }
 
+std::string ArgumentNamesOf(const std::string& what) {
+  static const std::pair<const char*, const char*> kNames[] = {
+      {"Ground_truth_radius:", "radius:"},
+      {"Ground_truth_heading:", "heading_limit:"},
+      {"Ground_truth_min_gap:", "min_frame_gap:"},
+      {"Ground_truth_axes:", "axes:"},
+      {"Ground_truth_base:", "base:"},
+      {"Initial_image:", "first_frame:"},
+      {"Tolerance:", "tolerance:"},
+      {"Exclusion:", "exclusion:"},
+      {"Vicinity:", "vicinity:"},
+      {"Ground_truth_2:", "truth_file_2:"},
+      {"Ground_truth:", "truth_file:"},
+      {"Ground_truth_type:", "truth_type:"},
+      {"Match_score_window:", "score_window:"},
+      {"Match_threshold:", "accept_threshold:"},
+      {"Match_consistency:", "accept_consistency:"},
+      {"Image_sequences:", "sequence_length:"},
+      {"Evaluation_protocol:", "protocol:"},
+      {"Ground_truth_soft:", "truth_file_soft:"}};
+  const auto word = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_';
+  };
+  std::string message = what;
+  bool renamed = false;
+  for (const auto& [key_colon, name_colon] : kNames) {
+    const std::string key(key_colon, std::strlen(key_colon) - 1);
+    const std::string name(name_colon, std::strlen(name_colon) - 1);
+    for (std::size_t at = message.find(key); at != std::string::npos; at = message.find(key, at)) {
+      const std::size_t end = at + key.size();
+      if ((at > 0 && word(message[at - 1])) || (end < message.size() && word(message[end]))) {
+        at = end;
+        continue;
+      }
+      message.replace(at, key.size(), name);
+      at += name.size();
+      renamed = true;
+    }
+  }
+  return renamed ? message : std::string();
+}
+
+py::object JsonToPython(const nlohmann::ordered_json& v) {
+  switch (v.type()) {
+    case nlohmann::ordered_json::value_t::null:
+      return py::none();
+    case nlohmann::ordered_json::value_t::boolean:
+      return py::bool_(v.get<bool>());
+    case nlohmann::ordered_json::value_t::number_integer:
+      return py::int_(v.get<std::int64_t>());
+    case nlohmann::ordered_json::value_t::number_unsigned:
+      return py::int_(v.get<std::uint64_t>());
+    case nlohmann::ordered_json::value_t::number_float:
+      return py::float_(v.get<double>());
+    case nlohmann::ordered_json::value_t::string:
+      return py::str(v.get<std::string>());
+    case nlohmann::ordered_json::value_t::array: {
+      py::list out;
+      for (const auto& item : v) out.append(JsonToPython(item));
+      return std::move(out);
+    }
+    case nlohmann::ordered_json::value_t::object: {
+      py::dict out;
+      for (const auto& [key, item] : v.items()) {
+        const bool whole = !key.empty() && key.size() < 10 &&
+                           key.find_first_not_of("0123456789") == std::string::npos;
+        if (whole)
+          out[py::int_(std::stoi(key))] = JsonToPython(item);
+        else
+          out[py::str(key)] = JsonToPython(item);
+      }
+      return std::move(out);
+    }
+    default:
+      throw std::logic_error("JsonToPython: a value of no JSON type");
+  }
+}
+
 }  // namespace openable::python

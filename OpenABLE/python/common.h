@@ -7,12 +7,14 @@
 #include <pybind11/pybind11.h>
 
 #include <cstddef>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "OpenABLE/base/enum_names.h"
+#include "OpenABLE/base/error.h"
 #include "OpenABLE/base/strings.h"
 
 namespace openable::python {
@@ -107,5 +109,28 @@ void RegisterEvaluation(py::module_& m);
 void RegisterOnline(py::module_& m);
 void RegisterSnaps(py::module_& m);
 void RegisterSweep(py::module_& m);
+
+// A JSON value as Python objects: null -> None, numbers (NaN kept), strings, lists, dicts; an
+// object's keys that are whole numbers ("1", "5") become ints, as recall@K's K.
+py::object JsonToPython(const nlohmann::ordered_json& value);
+
+// The message of an InputError that names Config.txt keys, with the Python arguments' names
+// instead ("Ground_truth_radius: 0 ..." -> "radius: 0 ...", "(Ground_truth_type kitti)" ->
+// "(truth_type kitti)"), wherever in the line they stand; empty when it names none.
+std::string ArgumentNamesOf(const std::string& message);
+
+// Runs `f`, whose option structs' Check() name Config.txt keys; such an InputError is re-thrown
+// naming the Python arguments instead: the bindings validate through the same checks as the
+// programs.
+template <typename F>
+auto WithArgumentNames(F f) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    const std::string renamed = ArgumentNamesOf(e.what());
+    if (renamed.empty()) throw;
+    throw InputError(renamed);
+  }
+}
 
 }  // namespace openable::python

@@ -39,55 +39,6 @@ struct Result {
   GroundTruth truth;
 };
 
-// Runs `f`; an InputError that names Config.txt keys is re-thrown naming the Python arguments
-// instead ("Ground_truth_radius: 0 ..." -> "radius: 0 ...", "(Ground_truth_type kitti)" ->
-// "(truth_type kitti)"), wherever in the line they stand.
-template <typename F>
-auto WithArgumentNames(F f) {
-  static const std::pair<const char*, const char*> kNames[] = {
-      {"Ground_truth_radius:", "radius:"},
-      {"Ground_truth_heading:", "heading_limit:"},
-      {"Ground_truth_min_gap:", "min_frame_gap:"},
-      {"Ground_truth_axes:", "axes:"},
-      {"Ground_truth_base:", "base:"},
-      {"Initial_image:", "first_frame:"},
-      {"Tolerance:", "tolerance:"},
-      {"Exclusion:", "exclusion:"},
-      {"Vicinity:", "vicinity:"},
-      {"Ground_truth_2:", "truth_file_2:"},
-      {"Ground_truth:", "truth_file:"},
-      {"Ground_truth_type:", "truth_type:"},
-      {"Match_score_window:", "score_window:"},
-      {"Evaluation_protocol:", "protocol:"},
-      {"Ground_truth_soft:", "truth_file_soft:"}};
-  const auto word = [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_';
-  };
-  try {
-    return f();
-  } catch (const InputError& e) {
-    std::string message = e.what();
-    bool renamed = false;
-    for (const auto& [key_colon, name_colon] : kNames) {
-      const std::string key(key_colon, std::strlen(key_colon) - 1);
-      const std::string name(name_colon, std::strlen(name_colon) - 1);
-      for (std::size_t at = message.find(key); at != std::string::npos;
-           at = message.find(key, at)) {
-        const std::size_t end = at + key.size();
-        if ((at > 0 && word(message[at - 1])) || (end < message.size() && word(message[end]))) {
-          at = end;
-          continue;
-        }
-        message.replace(at, key.size(), name);
-        at += name.size();
-        renamed = true;
-      }
-    }
-    if (!renamed) throw;
-    throw InputError(message);
-  }
-}
-
 // InputError for a ground truth or protocol (`what`: 'truth_type: "vpr_bench"') that pairs a
 // query traversal with a reference one, given a square matrix evaluated as one sequence.
 [[noreturn]] void NeedsTwoTraversals(const std::string& what, int rows, int cols) {
@@ -466,9 +417,10 @@ point.)doc")
 }
 
 void RegisterEvaluationResult(py::module_& m) {
-  py::class_<Result>(m, "EvaluationResult", R"doc(The figures and curves of evaluate(): the
+  py::class_<Result> result(m, "EvaluationResult", R"doc(The figures and curves of evaluate(): the
 per-query best-match protocol (auc, recall_at_100p, max_f1, recall_at_1/5/10, curve) and the
-ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md defines each.)doc")
+ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md defines each.)doc");
+  result
       .def_property_readonly(
           "label", [](const Result& r) { return r.run.label; }, "The label given to evaluate().")
       .def_property_readonly(
@@ -494,7 +446,7 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
           "max_f1_threshold", [](const Result& r) { return r.run.per_query.max_f1_threshold; },
           "Score threshold of max_f1 (the first on ties).")
       .def_property_readonly(
-          "score", [](const Result& r) { return EnumName(r.settings.options.score); },
+          "score", [](const Result& r) { return EnumName(r.settings.options.score.kind); },
           "The match score that ranked and accepted the answers: \"distance\" or \"ratio\".")
       .def_property_readonly(
           "scores", [](const Result& r) { return ArrayOf(r.run.per_query.score); },
@@ -591,53 +543,6 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
           "truth_matches() -> numpy.ndarray\n\nThe ground truth used: int64 (P, 2) pairs "
           "(query row, reference column) in the block's indices (loop closure: later frame "
           "first).")
-      .def_property_readonly(
-          "vpr_bench",
-          [](const Result& r) -> py::object {
-            if (!r.run.has_vpr_bench) return py::none();
-            const VprBenchResult& b = r.run.vpr_bench;
-            py::dict d;
-            d["auc_pr"] = b.auc_pr;
-            d["recall_at_100p"] = b.recall_at_100p;
-            d["extended_precision"] = b.extended_precision;
-            d["recall_at_n"] = b.recall_at_n;
-            d["precision"] = b.precision;
-            d["recall"] = b.recall;
-            d["queries"] = b.queries;
-            d["queries_with_truth"] = b.queries_with_truth;
-            d["right_best_matches"] = b.right_best_matches;
-            return std::move(d);
-          },
-          "VPR-Bench's figures (protocol \"vpr_bench\"): dict with auc_pr, recall_at_100p, "
-          "extended_precision, recall_at_n (N = 1, 2, ...), the curve (precision, recall) and "
-          "counts; None when not asked for.")
-      .def_property_readonly(
-          "vpr_tutorial",
-          [](const Result& r) -> py::object {
-            if (!r.run.has_vpr_tutorial) return py::none();
-            const VprTutorialResult& t = r.run.vpr_tutorial;
-            py::dict d;
-            d["auc_multi"] = t.auc_multi;
-            d["recall_at_100p_multi"] = t.recall_at_100p_multi;
-            d["precision_multi"] = t.precision_multi;
-            d["recall_multi"] = t.recall_multi;
-            if (t.single) {
-              d["auc_single"] = t.auc_single;
-              d["recall_at_100p_single"] = t.recall_at_100p_single;
-              d["precision_single"] = t.precision_single;
-              d["recall_single"] = t.recall_single;
-            }
-            py::dict at_k;
-            for (std::size_t k = 0; k < t.k.size() && k < t.recall_at_k.size(); ++k)
-              at_k[py::int_(t.k[k])] = t.recall_at_k[k];
-            d["recall_at_k"] = at_k;
-            d["soft_ground_truth"] = t.soft;
-            d["queries_with_truth"] = t.queries_with_truth;
-            return std::move(d);
-          },
-          "VPR_Tutorial's figures (protocol \"vpr_tutorial\"): dict with auc_multi, "
-          "recall_at_100p_multi, their curve, the same for single-match (not with a GTsoft), "
-          "recall_at_k {1, 5, 10}; None when not asked for.")
       .def(
           "table", [](const Result& r) { return FormatEvaluationTable(r.settings, {r.run}); },
           "table() -> str\n\nThe table openable_evaluate prints: the figures of each protocol "
@@ -660,6 +565,22 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
                       p.recall_at_1, p.recall_at_5, p.recall_at_10, r.run.able_p.average_precision);
         return std::string(b);
       });
+  // One property per reference protocol of the table (evaluation/protocols.h): its figures and
+  // curves as a dict, None when the protocol was not asked for.
+  for (const ReferenceProtocol& protocol : ReferenceProtocols()) {
+    const std::string name = protocol.name;
+    static std::vector<std::string> docs;  // pybind11 keeps the pointer
+    docs.push_back(std::string(protocol.help) + " (protocol \"" + name +
+                   "\"): a dict of its figures and curves; None when not asked for.");
+    result.def_property_readonly(
+        protocol.name,
+        [name](const Result& r) -> py::object {
+          for (const ProtocolFigures& f : r.run.reference)
+            if (f.protocol == name) return JsonToPython(f.details);
+          return py::none();
+        },
+        docs.back().c_str());
+  }
 }
 
 void RegisterEvaluate(py::module_& m) {
@@ -703,26 +624,24 @@ void RegisterEvaluate(py::module_& m) {
         s.options.exclusion = exclusion;
         s.options.vicinity = vicinity;
         s.options.able_thresholds = able_thresholds;
-        s.options.score = ParseEnum<MatchScore>(score, "score");
-        s.options.score_window = score_window;
+        s.options.score.kind = ParseEnum<MatchScore>(score, "score");
+        s.options.score.window = score_window;
         if (!accept_threshold.is_none()) {
           s.options.accept_threshold = accept_threshold.cast<double>();
-          if (!(s.options.accept_threshold >= 0))
-            throw py::value_error("accept_threshold: expected None or a number >= 0");
+          // -1 is the struct's "none", which Python spells None.
+          if (s.options.accept_threshold == -1.0)
+            throw py::value_error(
+                "accept_threshold: -1 is not valid; expected None or a number >= 0");
         }
-        if (accept_consistency < 0)
-          throw py::value_error("accept_consistency: expected a number of partners >= 0");
-        if (sequence_length < 1) throw py::value_error("sequence_length: expected >= 1");
         s.options.accept_consistency = accept_consistency;
         s.options.agreement.sequence_length = sequence_length;
         s.options.agreement.partial = ParseEnum<SequencePartial>(partial, "partial");
         s.options.agreement.direction = ParseEnum<SequenceDirection>(direction, "direction");
-        if (able_thresholds < 2) throw py::value_error("able_thresholds: expected >= 2");
         WithArgumentNames([&] { s.options.Check(); });
         const EvaluationLayout layout =
             LayoutOf(layout_name, reference_frames, full_rows, full_cols);
         const bool loop = layout.kind == EvaluationLayout::Kind::kLoopClosure;
-        if (loop && (s.options.protocols.vpr_bench || s.options.protocols.vpr_tutorial))
+        if (loop && !s.options.protocols.reference.empty())
           NeedsTwoTraversals("protocol: \"" + protocol + "\"", full_rows, full_cols);
 
         const int given = (truth_matrix.is_none() ? 0 : 1) + (pairs.is_none() ? 0 : 1) +
@@ -858,15 +777,9 @@ void RegisterEvaluate(py::module_& m) {
               WithArgumentNames([&] { return EvaluatePerQuery(m, layout, gt, s.options); });
           run.warnings = EvaluationWarnings(m, layout, gt, s.options, run.per_query);
           run.able_p = EvaluateAbleP(m, layout, gt, s.options);
-          WithArgumentNames([&] {
-            if (s.options.protocols.vpr_bench) {
-              run.has_vpr_bench = true;
-              run.vpr_bench = EvaluateVprBench(m, layout, gt, s.options.tolerance);
-            }
-            if (s.options.protocols.vpr_tutorial) {
-              run.has_vpr_tutorial = true;
-              run.vpr_tutorial = EvaluateVprTutorial(m, layout, gt, s.options.tolerance);
-            }
+          run.reference = WithArgumentNames([&] {
+            return EvaluateReferenceProtocols(m, layout, gt, s.options.protocols,
+                                              s.options.tolerance);
           });
         }
         for (const std::string& w : result.run.warnings) Warn(w);
@@ -903,15 +816,13 @@ void RegisterUnsupervised(py::module_& m) {
         const MatView view = Matrix2D(matrix, Elements::kFloat32, "matrix");
         const EvaluationLayout layout =
             LayoutOf(layout_name, reference_frames, view.mat.rows, view.mat.cols);
-        if (sequence_length < 1) throw py::value_error("sequence_length: expected >= 1");
-        if (exclusion < 1) throw py::value_error("exclusion: expected >= 1");
-        if (score_window < 0) throw py::value_error("score_window: expected >= 0");
         UnsupervisedOptions o;
         o.agreement.sequence_length = sequence_length;
         o.agreement.partial = ParseEnum<SequencePartial>(partial, "partial");
         o.agreement.direction = ParseEnum<SequenceDirection>(direction, "direction");
         o.exclusion = exclusion;
-        o.score_window = score_window;
+        o.score.window = score_window;
+        WithArgumentNames([&] { o.Check(); });
         // evaluate's checks: +inf is a cell without a value, NaN is refused as damage.
         const cv::Mat1f checked = DistancesForEvaluation(cv::Mat1f(view.mat), "matrix");
         UnsupervisedFigures f;

@@ -11,15 +11,13 @@
 namespace openable::python {
 
 void RegisterImages(py::module_& m) {
-  m.def("descriptor_names", &RegisteredDescriptorNames,
-        R"doc(descriptor_names() -> list[str]
-
-Names of the descriptors this build provides, in the order shown to users:
-LDB, D-LDB, ORB, BRISK, BRIEF, FREAK (binary rows, uint8, matched with the Hamming
-distance), SIFT, HOG (vector rows, float32, matched with the L2 distance) and SAD (SeqSLAM's
-patch-normalised thumbnail: uint8 values, matched with the L1 distance). D-LDB needs a
-grey + disparity image (stereo) and is not usable through describe(). Names are
-case-insensitive wherever a descriptor is asked for.)doc");
+  // The names and what each is come from the descriptors' registry.
+  static const std::string names_doc =
+      "descriptor_names() -> list[str]\n\nNames of the descriptors this build provides, in the "
+      "order shown to users, any case wherever a descriptor is asked for: " +
+      DescriptorHelp() +
+      ". D-LDB needs a grey + disparity image (stereo) and is not usable through describe().";
+  m.def("descriptor_names", &RegisteredDescriptorNames, names_doc.c_str());
 
   m.def(
       "unavailable_descriptors",

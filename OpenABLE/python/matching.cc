@@ -316,10 +316,8 @@ void RegisterMatrices(py::module_& m) {
       "best_matches",
       [](const py::object& matrix, const std::string& score, int score_window) {
         const MatView view = Matrix2D(matrix, Elements::kFloat32, "matrix");
-        const MatchScore kind = ParseEnum<MatchScore>(score, "score");
-        if (score_window < 0)
-          throw py::value_error("score_window: " + std::to_string(score_window) +
-                                "; expected >= 0");
+        const MatchScoreOptions options{ParseEnum<MatchScore>(score, "score"), score_window};
+        WithArgumentNames([&] { options.Check(); });
         const cv::Mat1f d(view.mat);
         const int n = d.rows;
         py::array_t<int> best(n);
@@ -335,7 +333,7 @@ void RegisterMatrices(py::module_& m) {
             b(q) = c;
             dist(q) = c < 0 ? std::numeric_limits<float>::quiet_NaN() : row[c];
             sc(q) = c < 0 ? std::numeric_limits<float>::quiet_NaN()
-                          : ScoreOfCandidate(row, d.cols, c, kind, score_window);
+                          : ScoreOfCandidate(row, d.cols, c, options);
           }
         }
         return py::make_tuple(best, distance, scores);

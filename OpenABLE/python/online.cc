@@ -89,6 +89,16 @@ struct Detector {
   std::mutex mutex;
 };
 
+// A property that reads the detector under its lock: `getter` is a const member of
+// OnlineDetector.
+template <typename R>
+auto Locked(R (OnlineDetector::*getter)() const) {
+  return [getter](Detector& d) {
+    std::lock_guard<std::mutex> lock(d.mutex);
+    return ((*d.detector).*getter)();
+  };
+}
+
 py::tuple ResultTuple(const OnlineResult& r, bool verification) {
   py::list candidates;
   for (const LoopCandidate& c : r.candidates) {
@@ -232,14 +242,16 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
                      "Frame q's candidates are frames j <= q - exclusion (>= 1).")
       .def_readwrite("candidates", &O::candidates, "Candidates returned per frame (>= 1).")
       .def_property(
-          "score", [](const O& o) { return EnumName(o.score); },
-          [](O& o, const std::string& n) { o.score = ParseEnum<MatchScore>(n, "score"); },
+          "score", [](const O& o) { return EnumName(o.score.kind); },
+          [](O& o, const std::string& n) { o.score.kind = ParseEnum<MatchScore>(n, "score"); },
           "\"distance\" (a candidate's normalised distance) or \"ratio\" (its distance over "
           "that of the best candidate more than score_window frames away; 1 without one): "
           "what threshold accepts (Match_score).")
-      .def_readwrite("score_window", &O::score_window,
-                     "Frames on each side of a candidate that are not its rivals for the ratio "
-                     "score (>= 0; Match_score_window).")
+      .def_property(
+          "score_window", [](const O& o) { return o.score.window; },
+          [](O& o, int w) { o.score.window = w; },
+          "Frames on each side of a candidate that are not its rivals for the ratio "
+          "score (>= 0; Match_score_window).")
       .def_readwrite("threshold", &O::threshold,
                      "A candidate is accepted when its score is <= threshold; < 0 (the "
                      "default): the score's own default, 0.13 for the distance, 0.9 for the "
@@ -780,13 +792,8 @@ the map is damaged. Returns at once when no map was loaded or it was checked.)do
           py::arg("frame"),
           "session_of(frame) -> tuple[str, int]\n\nThe session holding map frame `frame` and "
           "the frame's number within it.")
-      .def_property_readonly(
-          "frame_size",
-          [](Detector& d) {
-            std::lock_guard<std::mutex> lock(d.mutex);
-            return d.detector->FrameSize();
-          },
-          "\"WxH\" of the map's frames (\"\" until the first image is added).");
+      .def_property_readonly("frame_size", Locked(&OnlineDetector::FrameSize),
+                             "\"WxH\" of the map's frames (\"\" until the first image is added).");
   c.def_static(
       "open",
       [](const py::object& path_object, const py::kwargs& kwargs) {
@@ -888,20 +895,8 @@ Raises:
 
 Waits for a merge of index blocks being built in the background (background_merges) and
 installs its index.)doc")
-      .def_property_readonly(
-          "size",
-          [](Detector& d) {
-            std::lock_guard<std::mutex> lock(d.mutex);
-            return d.detector->Size();
-          },
-          "Frames added so far.")
-      .def(
-          "__len__",
-          [](Detector& d) {
-            std::lock_guard<std::mutex> lock(d.mutex);
-            return d.detector->Size();
-          },
-          "Frames added so far.")
+      .def_property_readonly("size", Locked(&OnlineDetector::Size), "Frames added so far.")
+      .def("__len__", Locked(&OnlineDetector::Size), "Frames added so far.")
       .def_property_readonly(
           "row_width", [](Detector& d) { return d.detector->RowWidth(); },
           "Elements per descriptor row.")
@@ -926,20 +921,10 @@ installs its index.)doc")
           },
           "Read-only (size, row_width) array of the stored rows: a view of the detector's "
           "memory when it can be shared (later frames are not added to it).")
-      .def_property_readonly(
-          "memory_bytes",
-          [](Detector& d) {
-            std::lock_guard<std::mutex> lock(d.mutex);
-            return d.detector->MemoryBytes();
-          },
-          "Bytes held now: the rows plus, beyond exact_limit, the index blocks.")
-      .def_property_readonly(
-          "blocks",
-          [](Detector& d) {
-            std::lock_guard<std::mutex> lock(d.mutex);
-            return d.detector->Blocks();
-          },
-          "Index blocks in use (0 while the search is exact).")
+      .def_property_readonly("memory_bytes", Locked(&OnlineDetector::MemoryBytes),
+                             "Bytes held now: the rows plus, beyond exact_limit, the index blocks.")
+      .def_property_readonly("blocks", Locked(&OnlineDetector::Blocks),
+                             "Index blocks in use (0 while the search is exact).")
       .def_property_readonly(
           "channels", [](Detector& d) { return d.detector->Channels(); },
           "The descriptors the map describes every frame with (descriptor's, then "
@@ -952,11 +937,7 @@ installs its index.)doc")
           },
           "What tune() chose (a dict, kept in saved maps), or None when the map is not tuned.")
       .def_property_readonly(
-          "uses_tuning",
-          [](Detector& d) {
-            std::lock_guard<std::mutex> lock(d.mutex);
-            return d.detector->UsesTuning();
-          },
+          "uses_tuning", Locked(&OnlineDetector::UsesTuning),
           "Whether the search uses the tuned settings (an unreliable map then accepts "
           "nothing).")
       .def(

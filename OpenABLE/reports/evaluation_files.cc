@@ -75,10 +75,8 @@ void StageEvaluation(OutputBatch& batch, const std::string& key, const std::stri
     batch.Stage(key, stem + kEvaluationRunSuffixes[1], EncodeCurveCsv(run.able_p.curve));
     batch.Stage(key, stem + kEvaluationRunSuffixes[2],
                 EncodePng(RenderRunOverlay(evaluation, i, *matrices[i])));
-    if (run.has_vpr_bench)
-      batch.Stage(key, stem + kVprBenchSuffix, EncodeVprBenchCsv(run.vpr_bench));
-    if (run.has_vpr_tutorial)
-      batch.Stage(key, stem + kVprTutorialSuffix, EncodeVprTutorialCsv(run.vpr_tutorial));
+    for (const ProtocolFigures& f : run.reference)
+      batch.Stage(key, stem + FindReferenceProtocol(f.protocol)->csv_suffix, f.csv);
   }
   batch.Stage(key, prefix + kEvaluationSetSuffixes[1], EncodePng(RenderEvaluationPr(evaluation)));
 }

@@ -18,10 +18,6 @@ namespace openable {
 inline constexpr const char* kEvaluationSetSuffixes[] = {".json", "_pr.png"};
 inline constexpr const char* kEvaluationRunSuffixes[] = {"_per_query.csv", "_ablep.csv",
                                                          "_overlay.png"};
-// Per run, the curves of the reference protocols chosen (Evaluation_protocol vpr_bench,
-// vpr_tutorial).
-inline constexpr const char* kVprBenchSuffix = "_vpr_bench.csv";
-inline constexpr const char* kVprTutorialSuffix = "_vpr_tutorial.csv";
 
 // The figures of the evaluation's files, also shown by the HTML report (html_report.h): the
 // precision-recall figure of every run (<prefix>_pr.png), and run `i`'s ground truth and

@@ -633,7 +633,7 @@ std::string ExplorerSection(const ReportInput& input, const std::vector<ReportRu
     const EvaluationLayout& layout = run.layout;
     const cv::Mat1f& matrix = *run.matrix;
     const std::string n = std::to_string(i);
-    const std::string score_kind = run.score == MatchScore::kRatio ? "ratio" : "distance";
+    const std::string score_kind = run.score.kind == MatchScore::kRatio ? "ratio" : "distance";
 
     Json j;
     j["label"] = run.label;

@@ -45,7 +45,7 @@ struct ReportRun {
   std::string label, source;
   EvaluationLayout layout;
   const cv::Mat1f* matrix = nullptr;
-  MatchScore score = MatchScore::kDistance;
+  MatchScoreOptions score;  // Match_score and its window
   int exclusion = 100;
   // Per query: the answer, its distance and score, and at the operating point accepted
   // (score <= threshold) and confirmed (the run's matches; PerQueryResult::accepted with

@@ -168,7 +168,6 @@ ReportAnswers AnswersForReport(const cv::Mat1f& matrix, const EvaluationLayout& 
   r.source = source;
   r.layout = layout;
   r.score = options.score;
-  r.score_window = options.score_window;
   r.exclusion = options.exclusion;
   r.threshold = options.accept_threshold;
   r.consistency = options.accept_consistency;
@@ -353,9 +352,7 @@ std::string WorstCaseSections(const ReportInput& input) {
 }
 
 // "ratio" or "distance".
-std::string ScoreName(MatchScore score) {
-  return score == MatchScore::kRatio ? "ratio" : "distance";
-}
+std::string ScoreName(const MatchScoreOptions& score) { return EnumName(score.kind); }
 
 // "by 1 independent query" / "by n independent queries".
 std::string PartnersText(int n) {
@@ -505,8 +502,8 @@ std::string AcceptedSection(const ReportInput& input, const std::vector<ReportRu
         const int q = queries[k];
         t += "<tr data-query=\"" + std::to_string(q) + "\" data-reference=\"" +
              std::to_string(a.best[q]) + "\"><td>" + std::to_string(k + 1) + "<br>" +
-             (run.score == MatchScore::kRatio ? "ratio score " + Number(a.score[q], 4) + "<br>"
-                                              : std::string()) +
+             (run.score.kind == MatchScore::kRatio ? "ratio score " + Number(a.score[q], 4) + "<br>"
+                                                   : std::string()) +
              "distance " + Number(a.distance[q], 4) + "</td>" +
              FrameCell(frames, run.layout, true, q, "", "") +
              FrameCell(frames, run.layout, false, a.best[q], "", "") + "</tr>\n";
@@ -544,9 +541,9 @@ std::vector<std::pair<std::string, std::string>> ProtocolSettings(
   if (one_sequence) rows.push_back({"exclusion", std::to_string(r.exclusion) + " frames"});
   const ReportAnswers& a = input.answers[0];
   rows.push_back(
-      {"match score", ScoreName(r.score) + (r.score == MatchScore::kRatio
+      {"match score", ScoreName(r.score) + (r.score.kind == MatchScore::kRatio
                                                 ? " (rivals beyond &plusmn;" +
-                                                      std::to_string(a.score_window) + " frames)"
+                                                      std::to_string(r.score.window) + " frames)"
                                                 : std::string())});
   return rows;
 }

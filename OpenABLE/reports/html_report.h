@@ -1,32 +1,9 @@
 // The HTML report of a run or an evaluation (Report_name, openable_evaluate --report): one
-// self-contained page a person opens in a browser, offline: every image is embedded as a data
-// URI, no script or style sheet is fetched.
-//
-// With ground truth (ReportInput::evaluation) it shows the settings, the figures of each run,
-// the precision-recall figure, the matrix with the ground truth drawn over it, an interactive
-// explorer of each run (html_explorer.h), and for each run the frames of its worst cases side
-// by side, as VPR_Tutorial shows them:
-//
-//   most confident wrong matches  answered queries whose best match is wrong, most confident
-//                                 (lowest score) first: query, wrong match, true place
-//   misses                        queries with a true place that the run does not get right at
-//                                 its operating point (Match_threshold, else the max-F1
-//                                 threshold): unanswered, wrong, or right but not accepted;
-//                                 least confident first: query, best match, true place
-//
-// The true place shown is the query's ground-truth candidate with the smallest distance in
-// the matrix.
-//
-// Without ground truth (ReportInput::answers, evaluation null) nothing can be judged right or
-// wrong, and the page says so and how to get figures. It shows the settings, the operating
-// point of each run (queries answered, accepted by Match_threshold, confirmed by
-// Match_consistency, or UNRELIABLE when the auto mode accepted none), the matrix with the
-// accepted answers, the same explorer without precision and recall, and the frames of the
-// accepted matches a person checks by eye: the most and the least confident.
-//
-// Both pages share the code of the settings, the tables, the matrix and the explorer. A short
-// script at the end of the page checks that every embedded image decoded and says which did
-// not in the browser's console (docs/output_formats.md, "HTML report").
+// self-contained page a person opens in a browser, offline (every image a data URI, nothing
+// fetched). With ground truth it shows the settings, figures, precision-recall curve, matrix,
+// explorer (html_explorer.h) and each run's worst cases, as VPR_Tutorial shows them; without,
+// it says nothing can be judged and shows the operating point and the most and least confident
+// accepted matches to check by eye. Sections: docs/output_formats.md, "Report_name".
 #pragma once
 
 #include <cstdint>
@@ -103,13 +80,12 @@ struct ReportAnswers {
   std::string label;        // the run's name, e.g. "HOG L=10"
   std::string source;       // where the matrix came from, e.g. "Test_OpenABLE run"
   EvaluationLayout layout;  // the block of the matrix shown: rows queries, columns references
-  MatchScore score = MatchScore::kDistance;  // what the scores are (Match_score)
-  int score_window = 10;   // with the ratio: rivals beyond +- this many frames (shown only)
-  int exclusion = 100;     // one sequence (Kind::kLoopClosure): candidates this far back
-  double threshold = -1;   // Match_threshold: answers with a score <= it accepted; -1 none
-  int consistency = 0;     // Match_consistency n: confirmed by n independent queries; 0 none
-  bool untrusted = false;  // the auto mode could not trust its choice: nothing accepted
-  bool verified = false;   // the answers are geometric verification's (Verification 1)
+  MatchScoreOptions score;  // what the scores are (Match_score; the window is shown only)
+  int exclusion = 100;      // one sequence (Kind::kLoopClosure): candidates this far back
+  double threshold = -1;    // Match_threshold: answers with a score <= it accepted; -1 none
+  int consistency = 0;      // Match_consistency n: confirmed by n independent queries; 0 none
+  bool untrusted = false;   // the auto mode could not trust its choice: nothing accepted
+  bool verified = false;    // the answers are geometric verification's (Verification 1)
   // Per query row of the layout: best, distance, score, accepted, confirmed (answers.h;
   // confirmed = the run's matches, equal to accepted without Match_consistency).
   QueryAnswers answers;

@@ -28,7 +28,7 @@ EvaluationSettings EvaluationSettingsFrom(const Config& c) {
   s.truth.min_frame_gap =
       c.evaluation.min_frame_gap >= 0 ? c.evaluation.min_frame_gap : s.options.exclusion;
   s.options.score = c.matching.score;
-  s.options.score_window = c.matching.score_window;
+  s.options.score.window = c.matching.score.window;
   s.options.accept_threshold = c.matching.match_threshold;
   s.options.accept_consistency = c.matching.match_consistency;
   s.options.agreement = AgreementOf(c.matching);
@@ -77,14 +77,8 @@ void EvaluateMatrix(Evaluation& evaluation, const cv::Mat1f& normalized,
   }
   run.able_p = EvaluateAbleP(normalized, layout, truth, evaluation.settings.options);
   const EvaluationOptions& options = evaluation.settings.options;
-  if (options.protocols.vpr_bench) {
-    run.has_vpr_bench = true;
-    run.vpr_bench = EvaluateVprBench(normalized, layout, truth, options.tolerance);
-  }
-  if (options.protocols.vpr_tutorial) {
-    run.has_vpr_tutorial = true;
-    run.vpr_tutorial = EvaluateVprTutorial(normalized, layout, truth, options.tolerance);
-  }
+  run.reference =
+      EvaluateReferenceProtocols(normalized, layout, truth, options.protocols, options.tolerance);
   evaluation.runs.push_back(std::move(run));
   evaluation.truths.push_back(std::move(truth));
   evaluation.rejected.push_back(verified != nullptr ? verified->rejected

@@ -337,7 +337,7 @@ KeepRules KeepRulesOf(const Config& config, const MatchBlock& block) {
   KeepRules rules = config.scale.keep;
   rules.exclusion = config.evaluation.protocol.exclusion;
   rules.score = config.matching.score;
-  rules.score_window = config.matching.score_window;
+  rules.score.window = config.matching.score.window;
   rules.one_traversal = block.one_traversal;
   return rules;
 }

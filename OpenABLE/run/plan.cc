@@ -332,15 +332,8 @@ void CheckAgainstSources(const RunPlan& plan) {
             "frame, in the run's order");
       }
   // The ratio score needs rivals: its window must leave references outside it.
-  if (matching.score == MatchScore::kRatio) {
-    const int references = plan.sources.front()->Size();  // the reference traversal, or the one
-    if (matching.score_window >= references)
-      throw InputError("Match_score_window: " + std::to_string(matching.score_window) +
-                       " is not smaller than the reference traversal (" +
-                       std::to_string(references) + " frames of " + plan.specs.front().key +
-                       "); expected a window that leaves rivals outside it for Match_score "
-                       "ratio (10 frames is typical), or Match_score distance");
-  }
+  // The reference traversal, or the one traversal.
+  matching.score.CheckRivals(plan.sources.front()->Size(), plan.specs.front().key);
   if (!config.verification.enabled) return;
   // Frames of videos and bags have no file to read again.
   const SourceKind kind = plan.specs.front().kind;

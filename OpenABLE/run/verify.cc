@@ -129,12 +129,12 @@ std::vector<QueryVerification> VerificationCandidates(const Config& config,
       const float* row = result.normalized.ptr<float>(layout.row_offset + q) + layout.col_offset;
       cells.clear();
       for (int c = 0; c < end; ++c) cells.emplace_back(row[c], c);
-      const std::vector<std::size_t> chosen = DistinctBest(cells, v.candidates, m.score_window);
+      const std::vector<std::size_t> chosen = DistinctBest(cells, v.candidates, m.score.window);
       if (chosen.empty()) continue;
       // Scores of the chosen candidates only: ScoreOfCandidate is linear in the row.
       scores.assign(cells.size(), 0.0f);
       for (const std::size_t i : chosen)
-        scores[i] = ScoreOfCandidate(row, end, cells[i].second, m.score, m.score_window);
+        scores[i] = ScoreOfCandidate(row, end, cells[i].second, m.score);
       out.push_back(FromCandidates(q, cells, chosen, scores));
     }
     return out;
@@ -149,7 +149,7 @@ std::vector<QueryVerification> VerificationCandidates(const Config& config,
       cells.emplace_back(match->distance, match->reference);
       scores.push_back(match->score);
     }
-    const std::vector<std::size_t> chosen = DistinctBest(cells, v.candidates, m.score_window);
+    const std::vector<std::size_t> chosen = DistinctBest(cells, v.candidates, m.score.window);
     if (!chosen.empty()) out.push_back(FromCandidates(q, cells, chosen, scores));
   }
   return out;

@@ -314,7 +314,7 @@ AutoChoice JudgeCandidates(const AutoPlan& plan, double min_consistency,
     options.agreement = AgreementOf(m);
     options.agreement.partners = 1;
     options.exclusion = c.evaluation.protocol.exclusion;
-    options.score_window = m.score_window;
+    options.score.window = m.score.window;
     UnsupervisedFigures f = UnsupervisedCriteria(sums, layout, options);
     f.best.clear();
     f.ratio.clear();

@@ -278,7 +278,7 @@ SweepResult RunSweep(const Config& base, const SweepOptions& options, ProgressRe
     unsupervised.agreement = AgreementOf(config.matching);
     unsupervised.agreement.partners = 1;
     unsupervised.exclusion = config.evaluation.protocol.exclusion;
-    unsupervised.score_window = config.matching.score_window;
+    unsupervised.score.window = config.matching.score.window;
     run.unsupervised = UnsupervisedCriteria(result.normalized, layout, unsupervised);
     run.unsupervised.best.clear();
     run.unsupervised.ratio.clear();
@@ -336,8 +336,8 @@ std::string FormatSweepTable(const SweepResult& r) {
         r.axes.begin(), r.axes.end(), [](const SweepAxis& a) { return a.key == "Match_score"; });
     if (score_varied)
       o << "; score: each run's Match_score";
-    else if (s.options.score == MatchScore::kRatio)
-      o << "; score: ratio to the best rival beyond +-" << s.options.score_window << " frames";
+    else if (s.options.score.kind == MatchScore::kRatio)
+      o << "; score: ratio to the best rival beyond +-" << s.options.score.window << " frames";
     else
       o << "; score: distance";
     o << "; ABLE-P vicinity " << s.options.vicinity << "\n";

@@ -68,8 +68,7 @@ std::vector<Match> ApproximateMatches(const cv::Mat& descriptors, const MatchBlo
     std::sort(scored.begin(), scored.end());
     // Ratio scores among every candidate scored (the search's, not every reference's).
     std::vector<float> scores(std::min(scored.size(), static_cast<size_t>(k)));
-    for (size_t r = 0; r < scores.size(); ++r)
-      scores[r] = ScoreOfCandidate(scored, r, rules.score, rules.score_window);
+    for (size_t r = 0; r < scores.size(); ++r) scores[r] = ScoreOfCandidate(scored, r, rules.score);
     if (static_cast<int>(scored.size()) > k) scored.resize(static_cast<size_t>(k));
     auto& out = per_query[static_cast<size_t>(share_row)];
     for (size_t r = 0; r < scored.size(); ++r)

@@ -87,7 +87,8 @@ TEST(ConfigTable, OdometryKeysShowTheOdometrysLimits) {
   c.odometry.num_disparities = 40;  // in range, not a multiple of 16
   testing::ExpectInputError(
       [&] { c.odometry.Check(); },
-      {"Odometry_num_disparities (StereoOdometryOptions.num_disparities)", "a multiple of 16"});
+      {"Odometry_num_disparities (StereoOdometryOptions.disparity.num_disparities)",
+       "a multiple of 16"});
 }
 
 // Ground_truth_type's help describes every format of the registry (ground_truth.h).

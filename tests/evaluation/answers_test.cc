@@ -51,8 +51,8 @@ TEST(Answers, BestMatchesAndScoresAreThoseOfABruteForceReading) {
   for (const MatchScore kind : {MatchScore::kDistance, MatchScore::kRatio}) {
     SCOPED_TRACE(EnumName(kind));
     EvaluationOptions o;
-    o.score = kind;
-    o.score_window = 4;
+    o.score.kind = kind;
+    o.score.window = 4;
     o.accept_threshold = kind == MatchScore::kRatio ? 0.5 : 0.3;
     const QueryAnswers a = AnswersOfMatrix(m, EvaluationLayout::TwoTraversals(n, n), o);
     const testing::BruteFigures brute = testing::BrutePerQuery(
@@ -88,7 +88,7 @@ TEST(Answers, ConfirmationIsTheMatchesFilesRuleAndTheEvaluationsOperatingPoint) 
   const int n = 150;
   const cv::Mat1f m = TwoTraversals(n, 11);
   EvaluationOptions o;
-  o.score = MatchScore::kRatio;
+  o.score.kind = MatchScore::kRatio;
   o.accept_threshold = 0.6;
   o.accept_consistency = 1;
   o.agreement.sequence_length = 1;
@@ -162,8 +162,8 @@ TEST(Answers, BadInputIsRefused) {
   const cv::Mat1f m(4, 4, 0.5f);
   EvaluationOptions o;
   EXPECT_THROW(AnswersOfMatrix(m, EvaluationLayout::QueryReference(5, 4), o), std::logic_error);
-  o.score = MatchScore::kRatio;
-  o.score_window = 4;
+  o.score.kind = MatchScore::kRatio;
+  o.score.window = 4;
   EXPECT_THROW(AnswersOfMatrix(m, EvaluationLayout::QueryReference(4, 4), o), InputError);
   std::vector<std::uint8_t> accepted, confirmed;
   EXPECT_THROW(AcceptAnswers({1, 2}, {0.5f}, o, accepted, confirmed), std::logic_error);

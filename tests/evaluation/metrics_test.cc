@@ -291,8 +291,8 @@ TEST(EvaluationOptions, CheckNamesTheKey) {
 TEST(PerQueryRatio, HandWorkedQueryReferenceExample) {
   EvaluationOptions o;
   o.tolerance = 1;
-  o.score = MatchScore::kRatio;
-  o.score_window = 1;
+  o.score.kind = MatchScore::kRatio;
+  o.score.window = 1;
   const PerQueryResult r =
       EvaluatePerQuery(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
                        Truth({{1}, {4}, {}, {3}}, 5), o);
@@ -320,8 +320,8 @@ TEST(PerQueryRatio, SeparatesWhatTheDistanceCannot) {
   const GroundTruth t = Truth({{4}, {4}}, 5);
   const PerQueryResult by_distance = EvaluatePerQuery(m, layout, t, o);
   EXPECT_EQ(by_distance.recall_at_100p, 0.0);  // the wrong answer comes first
-  o.score = MatchScore::kRatio;
-  o.score_window = 1;
+  o.score.kind = MatchScore::kRatio;
+  o.score.window = 1;
   const PerQueryResult by_ratio = EvaluatePerQuery(m, layout, t, o);
   EXPECT_NEAR(by_ratio.recall_at_100p, 0.5, 1e-12);
   EXPECT_NEAR(by_ratio.auc, 0.5, 1e-12);
@@ -349,13 +349,13 @@ TEST(PerQueryRatio, RandomMatricesMatchBruteForce) {
       EvaluationOptions o;
       o.tolerance = 1;
       o.exclusion = 10;
-      o.score = ratio ? MatchScore::kRatio : MatchScore::kDistance;
-      o.score_window = trial % 5;
+      o.score.kind = ratio ? MatchScore::kRatio : MatchScore::kDistance;
+      o.score.window = trial % 5;
       const EvaluationLayout layout =
           loop ? EvaluationLayout::LoopClosure(n) : EvaluationLayout::QueryReference(n, n);
       const PerQueryResult r = EvaluatePerQuery(m, layout, Truth(truth, n), o);
       const testing::BruteFigures b =
-          testing::BrutePerQuery(m, truth, loop, o.exclusion, o.tolerance, ratio, o.score_window);
+          testing::BrutePerQuery(m, truth, loop, o.exclusion, o.tolerance, ratio, o.score.window);
       for (int q = 0; q < n; ++q) {
         const testing::BruteQuery& e = b.queries[q];
         ASSERT_EQ(r.best[q], e.best) << "trial " << trial << " q " << q;
@@ -415,8 +415,8 @@ TEST(PerQuery, OperatingPointIsTheCurveAtTheAcceptThreshold) {
 
 TEST(PerQueryRatio, WindowAsLargeAsTheReferencesIsAnError) {
   EvaluationOptions o;
-  o.score = MatchScore::kRatio;
-  o.score_window = 5;
+  o.score.kind = MatchScore::kRatio;
+  o.score.window = 5;
   try {
     EvaluatePerQuery(QueryReferenceBlock(), EvaluationLayout::QueryReference(4, 5),
                      Truth({{1}, {4}, {}, {3}}, 5), o);
@@ -424,7 +424,7 @@ TEST(PerQueryRatio, WindowAsLargeAsTheReferencesIsAnError) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("Match_score_window: 5"), std::string::npos) << e.what();
   }
-  o.score_window = -1;
+  o.score.window = -1;
   EXPECT_THROW(o.Check(), InputError);
 }
 

@@ -188,13 +188,52 @@ TEST(ReferenceProtocols, OneSequenceIsRefusedNamingTheKey) {
   EXPECT_THROW(EvaluateVprTutorial(d, layout, gt, 0), InputError);
 }
 
+// The table of protocols gives each protocol's figures as its reference code computes them:
+// the row every report shows, the JSON member and the curve file.
+TEST(ReferenceProtocols, TheTableGivesTheReferenceCodesFiguresToEveryReport) {
+  const cv::Mat1f d = ReadMatrixFile(DataDir() + "hand_distances.npy");
+  const auto layout = EvaluationLayout::QueryReference(d.rows, d.cols);
+  const GroundTruth gt = Load(GroundTruthType::kVprBench, "hand_ground_truth.npy", layout);
+  const std::vector<ProtocolFigures> f =
+      EvaluateReferenceProtocols(d, layout, gt, ParseEvaluationProtocols("all"), 0);
+  ASSERT_EQ(f.size(), ReferenceProtocols().size());
+  ASSERT_EQ(f[0].protocol, "vpr_bench");
+  const json& e = Expected()["hand"]["vpr_bench"];
+  ExpectFigure(f[0].auc, e["auc_pr"], "auc_pr");
+  ExpectFigure(f[0].recall_at_100p, e["recall_at_100p"], "recall_at_100p");
+  // The JSON keeps 9 significant digits.
+  EXPECT_NEAR(f[0].json["auc_pr"].get<double>(), e["auc_pr"].get<double>(), 1e-8);
+  EXPECT_EQ(f[0].json["right_best_matches"].get<int>(), e["right_best_matches"].get<int>());
+  // The curve file: a header, then one line per point of the reference code's curve.
+  std::istringstream csv(f[0].csv);
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "precision,recall");
+  std::size_t points = 0;
+  while (std::getline(csv, line)) {
+    ASSERT_LT(points, e["precision"].size());
+    EXPECT_NEAR(std::stod(line.substr(0, line.find(','))), e["precision"][points].get<double>(),
+                1e-8);
+    ++points;
+  }
+  EXPECT_EQ(points, e["precision"].size());
+  ASSERT_EQ(f[1].protocol, "vpr_tutorial");
+  EXPECT_EQ(f[1].csv.rfind("matching,precision,recall\n", 0), 0u);
+  for (const ReferenceProtocol& p : ReferenceProtocols())
+    EXPECT_EQ(std::string(p.csv_suffix), "_" + std::string(p.name) + ".csv");
+}
+
 TEST(EvaluationProtocolKey, ParsesNamesListsAndAll) {
-  EXPECT_EQ(ParseEvaluationProtocols("openable"), (EvaluationProtocols{true, false, false}));
-  EXPECT_EQ(ParseEvaluationProtocols("VPR_Bench"), (EvaluationProtocols{false, true, false}));
-  EXPECT_EQ(ParseEvaluationProtocols("openable, vpr_tutorial"),
-            (EvaluationProtocols{true, false, true}));
-  EXPECT_EQ(ParseEvaluationProtocols("all"), (EvaluationProtocols{true, true, true}));
-  EXPECT_EQ(EvaluationProtocolsText({true, true, true}), "openable,vpr_bench,vpr_tutorial");
+  using P = EvaluationProtocols;
+  EXPECT_EQ(ParseEvaluationProtocols("openable"), (P{true, {}}));
+  EXPECT_EQ(ParseEvaluationProtocols("VPR_Bench"), (P{false, {"vpr_bench"}}));
+  EXPECT_EQ(ParseEvaluationProtocols("openable, vpr_tutorial"), (P{true, {"vpr_tutorial"}}));
+  // The table's order, whatever the order given; a name given twice is one.
+  EXPECT_EQ(ParseEvaluationProtocols("vpr_tutorial,vpr_bench,vpr_tutorial"),
+            (P{false, {"vpr_bench", "vpr_tutorial"}}));
+  EXPECT_EQ(ParseEvaluationProtocols("all"), (P{true, {"vpr_bench", "vpr_tutorial"}}));
+  EXPECT_EQ(EvaluationProtocolsText({true, {"vpr_bench", "vpr_tutorial"}}),
+            "openable,vpr_bench,vpr_tutorial");
   for (const char* bad : {"", "vpr", "openable,,vpr_bench", "seqslam"}) {
     try {
       ParseEvaluationProtocols(bad);

@@ -61,7 +61,7 @@ UnsupervisedOptions Options(int L) {
   UnsupervisedOptions o;
   o.agreement.sequence_length = L;
   o.agreement.partial = SequencePartial::kScale;
-  o.score_window = 10;
+  o.score.window = 10;
   return o;
 }
 

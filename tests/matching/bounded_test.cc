@@ -253,8 +253,8 @@ TEST(BoundedMatches, SkipAndAheadCellsAndRatioScoresEqualBruteForce) {
       rules.best = 3;
       rules.exclusion = 10;
       rules.one_traversal = block.one_traversal;
-      rules.score = MatchScore::kRatio;
-      rules.score_window = 4;
+      rules.score.kind = MatchScore::kRatio;
+      rules.score.window = 4;
       for (auto dir :
            {SequenceDirection::kForward, SequenceDirection::kReverse, SequenceDirection::kBoth}) {
         const int L = 6;
@@ -277,7 +277,7 @@ TEST(BoundedMatches, SkipAndAheadCellsAndRatioScoresEqualBruteForce) {
           for (int r = 0; r < std::min<int>(rules.best, static_cast<int>(all.size())); ++r) {
             float rival = std::numeric_limits<float>::infinity();
             for (const auto& [v, j] : all)
-              if (std::abs(j - all[r].second) > rules.score_window) rival = std::min(rival, v);
+              if (std::abs(j - all[r].second) > rules.score.window) rival = std::min(rival, v);
             const float ratio = std::isfinite(rival) && rival > 0 ? all[r].first / rival : 1.0f;
             expected.push_back({q, all[r].second, all[r].first, r + 1, ratio});
           }

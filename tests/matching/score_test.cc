@@ -37,7 +37,7 @@ float BruteRatio(const std::vector<float>& row, int window, int* best_out = null
 
 float Dense(const std::vector<float>& row, MatchScore s, int window) {
   const int best = BestCandidate(row.data(), static_cast<int>(row.size()));
-  return ScoreOfCandidate(row.data(), static_cast<int>(row.size()), best, s, window);
+  return ScoreOfCandidate(row.data(), static_cast<int>(row.size()), best, {s, window});
 }
 
 TEST(MatchScore, HandWorkedRows) {
@@ -98,8 +98,8 @@ TEST(MatchScore, RandomRowsMatchBruteForceDenseAndSparse) {
     std::shuffle(sparse.begin(), sparse.end(), rng);
     size_t at = 0;
     while (sparse[at].second != best) ++at;
-    ASSERT_FLOAT_EQ(ScoreOfCandidate(sparse, at, MatchScore::kRatio, window), expected);
-    ASSERT_FLOAT_EQ(ScoreOfCandidate(sparse, at, MatchScore::kDistance, window), row[best]);
+    ASSERT_FLOAT_EQ(ScoreOfCandidate(sparse, at, {MatchScore::kRatio, window}), expected);
+    ASSERT_FLOAT_EQ(ScoreOfCandidate(sparse, at, {MatchScore::kDistance, window}), row[best]);
   }
 }
 

@@ -105,9 +105,11 @@ TEST(StereoOdometryOptions, CheckNamesTheField) {
   expect([](StereoOdometryOptions& o) { o.matcher = "census"; }, "matcher");
   expect([](StereoOdometryOptions& o) { o.wls_lambda = 0; }, "wls_lambda");
   expect([](StereoOdometryOptions& o) { o.wls_sigma = -1; }, "wls_sigma");
-  expect([](StereoOdometryOptions& o) { o.num_disparities = 60; }, "num_disparities");
-  expect([](StereoOdometryOptions& o) { o.block_size = 4; }, "block_size");
-  expect([](StereoOdometryOptions& o) { o.matcher = "bm", o.block_size = 3; }, "block_size");
+  expect([](StereoOdometryOptions& o) { o.disparity.num_disparities = 60; },
+         "disparity.num_disparities");
+  expect([](StereoOdometryOptions& o) { o.disparity.block_size = 4; }, "disparity.block_size");
+  expect([](StereoOdometryOptions& o) { o.matcher = "bm", o.disparity.block_size = 3; },
+         "disparity.block_size");
   expect([](StereoOdometryOptions& o) { o.features = "AKAZE"; }, "features");
   expect([](StereoOdometryOptions& o) { o.max_features = 0; }, "max_features");
   expect([](StereoOdometryOptions& o) { o.ratio_test = 2; }, "ratio_test");

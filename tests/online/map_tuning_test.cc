@@ -166,7 +166,7 @@ TEST(MapSearch, OnlineConfirmationIsItsDefinition) {
     for (const int L : {5, 20}) {
       OnlineOptions o;
       o.sequence_length = L;
-      o.score = MatchScore::kRatio;
+      o.score.kind = MatchScore::kRatio;
       o.consistency = partners;
       const auto d = TwoSessions(o, summer, winter);
       const int r = static_cast<int>(summer.size()), q = static_cast<int>(winter.size());
@@ -199,7 +199,7 @@ TEST(MapSearch, FramesAddedOneByOneAreConfirmedAlike) {
   const std::vector<cv::Mat> winter = ReadFolder(SeasonDir("winter"));
   OnlineOptions o;
   o.sequence_length = 10;
-  o.score = MatchScore::kRatio;
+  o.score.kind = MatchScore::kRatio;
   o.consistency = 1;
   OnlineDetector d(o);
   d.StartSession("summer");
@@ -258,7 +258,7 @@ TEST(MapTuning, ChoosesWhatTheAutoModeChoosesFromTheSameFrames) {
   const OnlineOptions& s = d->Options();
   EXPECT_EQ(s.sequence_length, choice.config.matching.sequence_length);
   EXPECT_EQ(s.contrast_enhancement, choice.config.matching.contrast_enhancement);
-  EXPECT_EQ(s.score, MatchScore::kRatio);
+  EXPECT_EQ(s.score.kind, MatchScore::kRatio);
   EXPECT_DOUBLE_EQ(s.Threshold(), 0.9);
   EXPECT_EQ(s.consistency, 1);
 

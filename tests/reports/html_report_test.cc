@@ -586,11 +586,13 @@ TEST(HtmlReport, FiguresShowTheOperatingPointAndTheReferenceProtocols) {
         << protocol;
     EXPECT_NE(text.find(protocol), std::string::npos);
   }
-  const VprBenchResult& b = evaluation.runs[0].vpr_bench;
+  ASSERT_EQ(evaluation.runs[0].reference.size(), 2u);
+  const ProtocolFigures& b = evaluation.runs[0].reference[0];
+  ASSERT_EQ(b.protocol, "vpr_bench");
   const std::size_t row = page.find("<tr data-protocol=\"vpr_bench\">");
-  EXPECT_NE(page.find("<td class=\"n\">" + FormatFixed(b.auc_pr, 4) + "</td>", row),
+  EXPECT_NE(page.find("<td class=\"n\">" + FormatFixed(b.auc, 4) + "</td>", row),
             std::string::npos);
-  EXPECT_NE(text.find(FormatFixed(b.auc_pr, 3)), std::string::npos);
+  EXPECT_NE(text.find(FormatFixed(b.auc, 3)), std::string::npos);
   // The text table's operating point names the right answers too.
   EXPECT_NE(text.find(std::to_string(accepted) + " answers, " + std::to_string(right) + " right"),
             std::string::npos)
