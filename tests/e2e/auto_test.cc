@@ -28,15 +28,6 @@ using namespace e2e;  // NOLINT: the e2e helpers are this file's vocabulary
 
 std::string AutoPreset() { return testing::SourceDir() + "/config/presets/auto.txt"; }
 
-// The text of a JSON string member (no escapes in the values read here).
-std::string JsonString(const std::string& json, const std::string& key, std::size_t from = 0) {
-  const std::string k = "\"" + key + "\": \"";
-  const auto p = json.find(k, from);
-  if (p == std::string::npos) return "";
-  const auto e = json.find('"', p + k.size());
-  return json.substr(p + k.size(), e - p - k.size());
-}
-
 std::vector<std::string> Words(const std::string& s) {
   std::istringstream in(s);
   std::vector<std::string> out;
@@ -81,13 +72,14 @@ TEST(Auto, TheRunOfTheChoiceIsThePlainRunOfItsSettingsByteForByte) {
   const Outcome automatic = RunProgram(testing::TestOpenableExe(), args, dir);
   ASSERT_EQ(automatic.status, 0) << automatic.err;
   const std::string json = automatic.out;
-  const std::string chosen = JsonString(json, "chosen");
-  ASSERT_FALSE(chosen.empty()) << json;
-  EXPECT_NE(json.find("\"reliable\": true"), std::string::npos) << json;
-  EXPECT_NE(json.find("\"criterion\": \"agreement\""), std::string::npos);
-  // Every candidate of the default list is there, each with its criteria.
   const Json report = Json::parse(json);
-  const Json& candidates = report.at("auto").at("candidates");
+  const Json& choice = report.at("auto");
+  const std::string chosen = choice.at("chosen").get<std::string>();
+  ASSERT_FALSE(chosen.empty()) << json;
+  EXPECT_EQ(choice.at("reliable"), true) << json;
+  EXPECT_EQ(choice.at("criterion"), "agreement");
+  // Every candidate of the default list is there, each with its criteria.
+  const Json& candidates = choice.at("candidates");
   EXPECT_EQ(candidates.size(), 18u);
   for (const Json& c : candidates)
     for (const char* key : {"settings", "consistency", "distinctiveness", "agreement"})
@@ -116,9 +108,10 @@ TEST(Auto, TheRunOfTheChoiceIsThePlainRunOfItsSettingsByteForByte) {
   ASSERT_GT(L, 0) << chosen;
   const cv::Mat1f m = ReadNpy(dir + "/out/m.npy");
   ASSERT_EQ(m.rows, 400);
-  const std::size_t rank1 = json.find("\"rank\": 1,");
-  ASSERT_NE(rank1, std::string::npos);
-  EXPECT_NEAR(JsonNumber(json, "consistency", rank1), BruteConsistency(m, 200, L), 1.0 / 200);
+  const auto rank1 = std::find_if(candidates.begin(), candidates.end(),
+                                  [](const Json& c) { return c.at("rank") == 1; });
+  ASSERT_NE(rank1, candidates.end()) << json;
+  EXPECT_NEAR(rank1->at("consistency").get<double>(), BruteConsistency(m, 200, L), 1.0 / 200);
   // What it accepted is right on the sample.
   const Json& run = report.at("evaluation").at("runs").at(0);
   EXPECT_EQ(run.at("per_query").at("accepted").at("precision"), 1.0);
@@ -144,8 +137,9 @@ TEST(Auto, UnrelatedTraversalsAreUnreliableAndAcceptNothing) {
                   "Report_name=out/report.html", "--set", "Matches_name=out/matches.csv", "--json"},
                  dir);
   ASSERT_EQ(o.status, 0) << o.err;
-  EXPECT_NE(o.out.find("\"reliable\": false"), std::string::npos) << o.out;
-  EXPECT_EQ(Json::parse(o.out).at("accepted").at("queries"), 0) << o.out;
+  const Json report = Json::parse(o.out);
+  EXPECT_EQ(report.at("auto").at("reliable"), false) << o.out;
+  EXPECT_EQ(report.at("accepted").at("queries"), 0) << o.out;
   EXPECT_TRUE(fs::exists(dir + "/out/m.npy"));  // the outputs are still written
   // The page says UNRELIABLE and accepts nothing; the matches file marks no best match.
   const std::string page = ReadAll(dir + "/out/report.html");
@@ -168,9 +162,9 @@ TEST(Auto, UnrelatedTraversalsAreUnreliableAndAcceptNothing) {
   EXPECT_NE(o.err.find("no candidate is consistent enough to be trusted"), std::string::npos)
       << o.err;
   // Every candidate's consistency is low, far from the threshold.
-  for (std::size_t p = o.out.find("\"consistency\": "); p != std::string::npos;
-       p = o.out.find("\"consistency\": ", p + 1))
-    EXPECT_LT(JsonNumber(o.out, "consistency", p), 0.3);
+  const Json& candidates = report.at("auto").at("candidates");
+  EXPECT_FALSE(candidates.empty()) << o.out;
+  for (const Json& c : candidates) EXPECT_LT(c.at("consistency").get<double>(), 0.3) << c.dump();
   // The text report names it.
   const Outcome text = RunProgram(testing::TestOpenableExe(),
                                   {AutoPreset(), "--quiet", "--set", "Images_path=a", "--set",
@@ -268,10 +262,10 @@ TEST(Auto, NightLikeGardensPointIsWithinTheBestOfTheSweep) {
   args.push_back("--json");
   const Outcome automatic = RunProgram(testing::TestOpenableExe(), args, dir);
   ASSERT_EQ(automatic.status, 0) << automatic.err;
-  EXPECT_NE(automatic.out.find("\"reliable\": true"), std::string::npos);
-  const double auc = JsonNumber(automatic.out, "auc");
   const Json report = Json::parse(automatic.out);
+  EXPECT_EQ(report.at("auto").at("reliable"), true);
   const Json& per_query = report.at("evaluation").at("runs").at(0).at("per_query");
+  const double auc = per_query.at("auc").get<double>();
   ASSERT_TRUE(per_query.contains("accepted")) << automatic.out;
   EXPECT_EQ(per_query.at("accepted").at("precision"), 1.0) << automatic.out;
 
@@ -293,11 +287,11 @@ TEST(Auto, NightLikeGardensPointIsWithinTheBestOfTheSweep) {
   sweep.insert(sweep.end(), pair.begin(), pair.end());
   const Outcome s = RunProgram(testing::OpenableSweepExe(), sweep, dir);
   ASSERT_EQ(s.status, 0) << s.err;
-  const std::string json = ReadAll(dir + "/s.json");
+  const Json swept = ReadJson(dir + "/s.json");
+  ASSERT_FALSE(swept.at("runs").empty());
   double best = 0;
-  for (std::size_t p = json.find("\"auc\": "); p != std::string::npos;
-       p = json.find("\"auc\": ", p + 1))
-    best = std::max(best, JsonNumber(json, "auc", p));
+  for (const Json& run : swept.at("runs"))
+    best = std::max(best, RunFigure(run, "auc").get<double>());
   EXPECT_GE(auc, best - 0.02) << "auto " << auc << ", best of the sweep " << best;
 }
 
@@ -317,11 +311,10 @@ TEST(Auto, SweepRanksWithoutGroundTruthAndRefusesOneFrame) {
   EXPECT_TRUE(fs::exists(dir + "/out/s.csv"));
   EXPECT_TRUE(fs::exists(dir + "/out/s.json"));
   EXPECT_FALSE(fs::exists(dir + "/out/s_pr.png"));  // no ground truth, no curve
-  const std::string json = ReadAll(dir + "/out/s.json");
+  const Json swept = ReadJson(dir + "/out/s.json");
   std::vector<double> agreement;
-  for (std::size_t p = json.find("\"agreement\": "); p != std::string::npos;
-       p = json.find("\"agreement\": ", p + 1))
-    agreement.push_back(JsonNumber(json, "agreement", p));
+  for (const Json& run : swept.at("runs"))
+    agreement.push_back(run.at("unsupervised").at("agreement").get<double>());
   ASSERT_EQ(agreement.size(), 4u);
   EXPECT_TRUE(std::is_sorted(agreement.rbegin(), agreement.rend()));
 

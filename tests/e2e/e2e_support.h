@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "OpenABLE/io/json.h"
 #include "tests/test_support.h"
 
 namespace openable {
@@ -221,12 +222,16 @@ inline bool OneLine(const std::string& s) {
   return !s.empty() && s.back() == '\n' && s.find('\n') == s.size() - 1;
 }
 
-// The number after "key": in a JSON text (the first occurrence), NaN when absent.
-inline double JsonNumber(const std::string& json, const std::string& key, std::size_t from = 0) {
-  const std::string k = "\"" + key + "\": ";
-  const auto p = json.find(k, from);
-  if (p == std::string::npos) return std::nan("");
-  return std::strtod(json.c_str() + p + k.size(), nullptr);
+// The JSON document in the file at `path`, parsed (nlohmann::json::parse throws, and so fails
+// the test, when the file is absent or not JSON).
+inline Json ReadJson(const std::string& path) { return Json::parse(ReadAll(path)); }
+
+// A figure of an evaluated run (an element of "runs" in an evaluation or a sweep document,
+// AddEvaluatedRunJson in OpenABLE/evaluation/report.cc): average_precision_percent from its
+// "able_p", any other from its "per_query".
+inline const Json& RunFigure(const Json& run, const std::string& key) {
+  return key == "average_precision_percent" ? run.at("able_p").at(key)
+                                            : run.at("per_query").at(key);
 }
 
 // Runs the reference on the matrix m.npy of a run in `dir` with `args` (the ground truth and

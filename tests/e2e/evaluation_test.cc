@@ -48,9 +48,10 @@ TEST(Evaluation, SampleRunAgainstAlignedTruthWritesEveryFile) {
   const cv::Mat1f m = ReadNpy(dir + "/out/matrix.npy");
   ASSERT_EQ(m.rows, 600);
   const double r1 = AlignedRecallAt1(m, 300, 0, 300, 2);
-  const std::string json = ReadAll(dir + "/out/eval.json");
-  EXPECT_NEAR(JsonNumber(json, "recall_at_1"), r1, 1e-6);
-  EXPECT_EQ(JsonNumber(json, "positive_queries"), 300);
+  const Json evaluation = ReadJson(dir + "/out/eval.json");
+  const Json& per_query = evaluation.at("runs").at(0).at("per_query");
+  EXPECT_NEAR(per_query.at("recall_at_1").get<double>(), r1, 1e-6);
+  EXPECT_EQ(per_query.at("positive_queries"), 300);
   // Every winter frame is positive, so the last point of the curve accepts all 300 answers:
   // its recall is R@1 again and its precision too.
   std::istringstream csv(ReadAll(dir + "/out/eval_per_query.csv"));
@@ -93,11 +94,13 @@ TEST(Evaluation, OpenableEvaluateComparesRunsInOneFigureAndAgreesWithTheRun) {
   for (const char* f : {"cmp.json", "cmp_pr.png", "cmp_LDB_per_query.csv", "cmp_HOG_per_query.csv",
                         "cmp_LDB_overlay.png", "cmp_HOG_ablep.csv"})
     EXPECT_TRUE(fs::exists(dir + "/out/" + f)) << f;
-  const std::string run = ReadAll(dir + "/out/run.json"), cmp = ReadAll(dir + "/out/cmp.json");
+  const Json run = ReadJson(dir + "/out/run.json"), cmp = ReadJson(dir + "/out/cmp.json");
+  // The run's figures are those of the comparison's first run (LDB); the second is HOG.
+  ASSERT_EQ(cmp.at("runs").size(), 2u);
   for (const char* key : {"auc", "recall_at_100p", "max_f1", "recall_at_1", "recall_at_10",
                           "average_precision_percent"})
-    EXPECT_EQ(JsonNumber(run, key), JsonNumber(cmp, key)) << key;
-  EXPECT_NE(cmp.find("\"label\": \"HOG\""), std::string::npos);
+    EXPECT_EQ(RunFigure(run.at("runs").at(0), key), RunFigure(cmp.at("runs").at(0), key)) << key;
+  EXPECT_EQ(cmp.at("runs").at(1).at("label"), "HOG");
 }
 
 // In a run: Evaluation_protocol all adds the two tables' rows and the two curve files to the
@@ -116,10 +119,10 @@ TEST(Evaluation, RunWithEveryProtocolWritesTheirCurves) {
   for (const char* f :
        {"eval.json", "eval_vpr_bench.csv", "eval_vpr_tutorial.csv", "eval_per_query.csv"})
     EXPECT_TRUE(fs::exists(dir + "/out/" + f)) << f;
-  const std::string json = ReadAll(dir + "/out/eval.json");
-  EXPECT_NE(json.find("\"protocols\": \"openable,vpr_bench,vpr_tutorial\""), std::string::npos);
+  const Json evaluation = ReadJson(dir + "/out/eval.json");
+  EXPECT_EQ(evaluation.at("settings").at("protocols"), "openable,vpr_bench,vpr_tutorial");
   // 300 winter queries, each with its summer frame: VPR-Bench and VPR_Tutorial count them all.
-  EXPECT_EQ(JsonNumber(json, "queries_with_truth", json.find("\"vpr_bench\"")), 300);
+  EXPECT_EQ(evaluation.at("runs").at(0).at("vpr_bench").at("queries_with_truth"), 300);
 }
 
 // A saved square matrix of queries x references scored three ways in one table, against
@@ -141,19 +144,18 @@ TEST(Evaluation, OpenableEvaluateScoresAMatrixAsVprBenchAndVprTutorialDo) {
                           "HOG                vpr_tutorial"})
     EXPECT_NE(o.out.find(row), std::string::npos) << row << "\n" << o.out;
   EXPECT_NE(o.out.find("3 ground-truth pairs dropped"), std::string::npos) << o.out;
-  const std::string json = ReadAll(dir + "/out/e.json");
-  const std::string expected = ReadAll(data + "expected.json");
-  const std::size_t real = expected.find("\"real\"");
-  const std::size_t tutorial = expected.find("\"vpr_tutorial\"", real);
-  const std::size_t bench_at = json.find("\"vpr_bench\": {");
-  const std::size_t tutorial_at = json.find("\"vpr_tutorial\": {");
-  ASSERT_NE(bench_at, std::string::npos) << json;
-  ASSERT_NE(tutorial_at, std::string::npos) << json;
+  const Json evaluation = ReadJson(dir + "/out/e.json");
+  const Json expected = ReadJson(data + "expected.json");
+  const Json& run = evaluation.at("runs").at(0);
+  ASSERT_TRUE(run.contains("vpr_bench")) << run.dump();
+  ASSERT_TRUE(run.contains("vpr_tutorial")) << run.dump();
   for (const char* key : {"auc_pr", "extended_precision", "recall_at_100p"})
-    EXPECT_NEAR(JsonNumber(json, key, bench_at), JsonNumber(expected, key, real), 1e-8) << key;
-  EXPECT_NEAR(JsonNumber(json, "auc", tutorial_at), JsonNumber(expected, "auc_multi", tutorial),
-              1e-8);
-  EXPECT_NE(json.find("\"protocols\": \"openable,vpr_bench,vpr_tutorial\""), std::string::npos);
+    EXPECT_NEAR(run.at("vpr_bench").at(key).get<double>(),
+                expected.at("real").at("vpr_bench").at(key).get<double>(), 1e-8)
+        << key;
+  EXPECT_NEAR(run.at("vpr_tutorial").at("multi").at("auc").get<double>(),
+              expected.at("real").at("vpr_tutorial").at("auc_multi").get<double>(), 1e-8);
+  EXPECT_EQ(evaluation.at("settings").at("protocols"), "openable,vpr_bench,vpr_tutorial");
   // The curves: VPR-Bench's points, then VPR_Tutorial's 101 multi- and 101 single-match ones.
   const std::string bench_csv = ReadAll(dir + "/out/e_vpr_bench.csv");
   EXPECT_EQ(bench_csv.rfind("precision,recall\n", 0), 0u);
@@ -183,19 +185,24 @@ TEST(Evaluation, OpenableEvaluateWarnsWhenTheMatrixLooksLikeASimilarity) {
   const Outcome plain = RunProgram(testing::OpenableEvaluateExe(), args, dir);
   ASSERT_EQ(plain.status, 0) << plain.err;
   EXPECT_EQ(plain.err.find("warning"), std::string::npos) << plain.err;
-  const double auc = JsonNumber(plain.out, "auc");
+  // The AUC of a run of the --json report (ProgramJson, OpenABLE/app/run_report.cc).
+  const auto auc_of = [](const std::string& report) {
+    return RunFigure(Json::parse(report).at("evaluation").at("runs").at(0), "auc").get<double>();
+  };
+  const double auc = auc_of(plain.out);
   ASSERT_GT(auc, 0.25);
 
   args = {"--matrix", "similarity.npy"};
   args.insert(args.end(), truth.begin(), truth.end());
   const Outcome reversed = RunProgram(testing::OpenableEvaluateExe(), args, dir);
   ASSERT_EQ(reversed.status, 0) << reversed.err;
-  EXPECT_LT(JsonNumber(reversed.out, "auc"), 0.1);
+  const double reversed_auc = auc_of(reversed.out);
+  EXPECT_LT(reversed_auc, 0.1);
   char expected[160];
   std::snprintf(expected, sizeof expected,
                 "openable_evaluate: warning: similarity: the ranking looks reversed: per-query "
                 "AUC %.3f with the smallest values as best matches, %.3f with the largest",
-                JsonNumber(reversed.out, "auc"), auc);
+                reversed_auc, auc);
   EXPECT_NE(reversed.err.find(expected), std::string::npos) << expected << "\n" << reversed.err;
   EXPECT_TRUE(OneLine(reversed.err)) << reversed.err;
   // The table says it too.
@@ -244,11 +251,13 @@ TEST(Evaluation, SavedMatrixIsEvaluatedWithItsRunsSettingsUnlessOverridden) {
                        "had (out/matrix.npy.json): "),
             std::string::npos)
       << o.err;
-  const std::string run = ReadAll(dir + "/out/run.json"), later = ReadAll(dir + "/out/later.json");
+  const Json run = ReadJson(dir + "/out/run.json"), later = ReadJson(dir + "/out/later.json");
+  const Json &run_run = run.at("runs").at(0), &later_run = later.at("runs").at(0);
   for (const char* key : {"auc", "recall_at_100p", "max_f1", "recall_at_1", "recall_at_10",
-                          "accepted", "tolerance", "average_precision_percent"})
-    EXPECT_EQ(JsonNumber(run, key), JsonNumber(later, key)) << key;
-  EXPECT_NE(later.find("\"match_score\": \"ratio\""), std::string::npos) << later;
+                          "accepted", "average_precision_percent"})
+    EXPECT_EQ(RunFigure(run_run, key), RunFigure(later_run, key)) << key;
+  EXPECT_EQ(run.at("settings").at("tolerance"), later.at("settings").at("tolerance"));
+  EXPECT_EQ(later.at("settings").at("match_score"), "ratio") << later.dump();
 
   // Overridden: the figures of a run made with the distance score, and a note.
   ASSERT_EQ(RunProgram(testing::TestOpenableExe(),
@@ -268,11 +277,12 @@ TEST(Evaluation, SavedMatrixIsEvaluatedWithItsRunsSettingsUnlessOverridden) {
                        "\"ratio\" as the matrix's run had it (out/matrix.npy.json)"),
             std::string::npos)
       << d.err;
-  const std::string distance = ReadAll(dir + "/out/distance.json");
-  const std::string overridden = ReadAll(dir + "/out/overridden.json");
+  const Json distance = ReadJson(dir + "/out/distance.json");
+  const Json overridden = ReadJson(dir + "/out/overridden.json");
+  const Json& distance_run = distance.at("runs").at(0);
   for (const char* key : {"auc", "recall_at_100p", "max_f1", "recall_at_1"})
-    EXPECT_EQ(JsonNumber(distance, key), JsonNumber(overridden, key)) << key;
-  EXPECT_NE(JsonNumber(distance, "auc"), JsonNumber(run, "auc"));
+    EXPECT_EQ(RunFigure(distance_run, key), RunFigure(overridden.at("runs").at(0), key)) << key;
+  EXPECT_NE(RunFigure(distance_run, "auc"), RunFigure(run_run, "auc"));
 }
 
 // Settings files that cannot be used: matrices whose runs disagree on a setting the command
@@ -488,7 +498,8 @@ TEST(EvaluationOnDatasets, NordlandWinterAgainstSummer) {
       {"Images_path=" + data + "/summer", "Images_path_2=" + data + "/winter", "Image_sequences=10",
        "Npy_name=m.npy", "Ground_truth_type=aligned", "Tolerance=2", "Evaluation_name=eval"},
       {"--reference-frames", "1788", "--aligned", "--tolerance", "2"});
-  EXPECT_GE(JsonNumber(ReadAll(dir + "/eval.json"), "recall_at_1"), 0.355);
+  EXPECT_GE(RunFigure(ReadJson(dir + "/eval.json").at("runs").at(0), "recall_at_1").get<double>(),
+            0.355);
 }
 
 TEST(EvaluationOnDatasets, GardensPointDayRightAgainstDayLeft) {

@@ -17,9 +17,10 @@
 namespace openable {
 namespace {
 
-using e2e::JsonNumber;
 using e2e::Outcome;
+using e2e::ReadJson;
 using e2e::ReadNpy;
+using e2e::RunFigure;
 
 TEST(Library, BatchPathGivesTestOpenablesMatrixAndFigures) {
   const std::string data = testing::DatasetsDir() + "/kitti00_first1700";
@@ -64,15 +65,17 @@ TEST(Library, BatchPathGivesTestOpenablesMatrixAndFigures) {
     for (int j = 0; j < 1700; ++j)
       worst = std::max(worst, double(std::abs(matrix(i, j) - cli(i, j))));
   EXPECT_LT(worst, 1e-6);
-  const std::string json = testing::ReadBytes(dir + "/eval.json");
-  EXPECT_NEAR(figures.auc, JsonNumber(json, "auc"), 1e-6);
-  EXPECT_NEAR(figures.recall_at_1, JsonNumber(json, "recall_at_1"), 1e-6);
-  EXPECT_NEAR(figures.max_f1, JsonNumber(json, "max_f1"), 1e-6);
-  EXPECT_NEAR(able_p.average_precision, JsonNumber(json, "average_precision_percent"), 1e-4);
+  const Json written = ReadJson(dir + "/eval.json");
+  const Json& run = written.at("runs").at(0);
+  EXPECT_NEAR(figures.auc, RunFigure(run, "auc").get<double>(), 1e-6);
+  EXPECT_NEAR(figures.recall_at_1, RunFigure(run, "recall_at_1").get<double>(), 1e-6);
+  EXPECT_NEAR(figures.max_f1, RunFigure(run, "max_f1").get<double>(), 1e-6);
+  EXPECT_NEAR(able_p.average_precision, RunFigure(run, "average_precision_percent").get<double>(),
+              1e-4);
   EXPECT_GT(figures.auc, 0.5);  // the loop of frames 1559-1641 is found
-  std::printf("library path: AUC %.3f, R@1 %.3f, ABLE-P AP %.2f %% (Test_OpenABLE: %s)\n",
+  std::printf("library path: AUC %.3f, R@1 %.3f, ABLE-P AP %.2f %% (Test_OpenABLE: AUC %s)\n",
               figures.auc, figures.recall_at_1, able_p.average_precision,
-              json.substr(json.find("\"auc\""), 20).c_str());
+              RunFigure(run, "auc").dump().c_str());
 }
 
 }  // namespace

@@ -119,16 +119,18 @@ TEST(SequencePartial, SkippedCellsInEveryExport) {
     }
   EXPECT_NE(o.out.find(std::to_string(empty) + " cells without a value"), std::string::npos)
       << o.out;
-  const std::string json = ReadAll(dir + "/eval.json");
-  EXPECT_EQ(JsonNumber(json, "unanswered_queries"), 9);
-  EXPECT_EQ(JsonNumber(json, "queries"), 300);
+  const Json evaluation = ReadJson(dir + "/eval.json");
+  const Json& run = evaluation.at("runs").at(0);
+  EXPECT_EQ(RunFigure(run, "unanswered_queries"), 9);
+  EXPECT_EQ(run.at("layout").at("queries"), 300);
   // openable_evaluate reads the NaN cells back as cells without a value.
   const Outcome e = RunProgram(testing::OpenableEvaluateExe(),
                                {"--matrix", "m.npy", "--reference-frames", "300", "--gt-type",
                                 "aligned", "--output", "again"},
                                dir);
   ASSERT_EQ(e.status, 0) << e.err;
-  EXPECT_EQ(JsonNumber(ReadAll(dir + "/again.json"), "auc"), JsonNumber(json, "auc"));
+  const Json again = ReadJson(dir + "/again.json");
+  EXPECT_EQ(RunFigure(again.at("runs").at(0), "auc"), RunFigure(run, "auc"));
 }
 
 // The ratio score on the sample (two traversals) and the skip rule, against the reference.
@@ -140,9 +142,9 @@ TEST(MatchScore, RatioEvaluationOfTheSampleAgreesWithTheReference) {
                            "Evaluation_name=eval", "--set", "Match_threshold=0.8"});
   const Outcome o = RunProgram(testing::TestOpenableExe(), args, dir);
   ASSERT_EQ(o.status, 0) << o.err;
-  const std::string json = ReadAll(dir + "/eval.json");
-  EXPECT_NE(json.find("\"match_score\": \"ratio\""), std::string::npos);
-  EXPECT_EQ(JsonNumber(json, "match_score_window"), 7);
+  const Json settings = ReadJson(dir + "/eval.json").at("settings");
+  EXPECT_EQ(settings.at("match_score"), "ratio");
+  EXPECT_EQ(settings.at("match_score_window"), 7);
   CheckAgainstReference(dir, {"--reference-frames", "300", "--aligned", "--tolerance", "2",
                               "--score", "ratio", "--score-window", "7"});
 }

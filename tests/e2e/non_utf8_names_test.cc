@@ -175,10 +175,10 @@ TEST(NonUtf8Names, EveryOutputOfARunIsValidUtf8AndShowsTheNamesByTheRule) {
   EXPECT_GT(cells, 0);
   EXPECT_GT(escaped, 0);
 
-  // The matrix's settings name the query folder by the rule, as JSON holds it.
-  EXPECT_NE(testing::ReadBytes(dir + "/out/m.npy.json")
-                .find("\"path\": \"" + JsonText(dir + "/" + kQueryFolderShown) + "\""),
-            std::string::npos);
+  // The matrix's settings name the query folder (the second traversal) by the rule.
+  const Json settings = ReadJson(dir + "/out/m.npy.json");
+  ASSERT_EQ(settings.at("traversals").size(), 2u) << settings.dump();
+  EXPECT_EQ(settings.at("traversals").at(1).at("path"), dir + "/" + kQueryFolderShown);
   // The files were read by their real names: 12 + 12 frames.
   EXPECT_EQ(ReadNpy(dir + "/out/m.npy").rows, 24);
 }
@@ -192,9 +192,9 @@ TEST(NonUtf8Names, JsonReportShowsTheFolderByTheRule) {
   const Outcome o = RunProgram(testing::TestOpenableExe(), args, dir);
   ASSERT_EQ(o.status, 0) << o.err;
   ExpectValidUtf8(o.out, "the JSON report");
-  EXPECT_NE(o.out.find("\"path\": \"" + JsonText(dir + "/" + kQueryFolderShown) + "\""),
-            std::string::npos)
-      << o.out;
+  const Json report = Json::parse(o.out);
+  ASSERT_EQ(report.at("traversals").size(), 2u) << o.out;
+  EXPECT_EQ(report.at("traversals").at(1).at("path"), dir + "/" + kQueryFolderShown) << o.out;
 }
 
 // A damaged frame whose name is not UTF-8: the one error line names it by the rule; with
@@ -247,7 +247,15 @@ TEST(NonUtf8Names, SweepCsvJsonAndTableShowTheFolderByTheRule) {
   ExpectValidUtf8(csv, "sweep.csv");
   ExpectValidUtf8(json, "sweep.json");
   EXPECT_NE(csv.find("," + dir + "/" + kQueryFolderShown + ","), std::string::npos) << csv;
-  EXPECT_NE(json.find(JsonText(dir + "/" + kQueryFolderShown)), std::string::npos) << json;
+  // The sweep's varied values and its run's settings name the folder by the rule.
+  const Json sweep = Json::parse(json);
+  const std::string shown = dir + "/" + kQueryFolderShown;
+  const Json& values = sweep.at("varied").at(0).at("values");
+  EXPECT_NE(std::find(values.begin(), values.end(), shown), values.end()) << json;
+  const Json& runs = sweep.at("runs");
+  EXPECT_TRUE(std::any_of(runs.begin(), runs.end(), [&](const Json& run) {
+    return run.at("settings").at("Images_path_2") == shown;
+  })) << json;
 }
 
 }  // namespace

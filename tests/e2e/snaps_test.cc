@@ -78,11 +78,11 @@ std::vector<std::pair<long, long>> ReadLoops(const std::string& path) {
   return loops;
 }
 
-// The first number after "key": in `json` from position `from`.
-double JsonNumber(const std::string& json, const std::string& key, size_t from = 0) {
-  const size_t k = json.find("\"" + key + "\":", from);
-  if (k == std::string::npos) return NAN;
-  return std::stod(json.substr(k + key.size() + 3));
+// The mean deviation (m) of the trajectory `name` ("input", "discounted", "pose_graph") that a
+// SNAPS document gives, `kind` "unaligned" or "aligned" (ChainJson,
+// OpenABLE/app/snaps_chain_report.cc).
+double MeanDeviationOf(const Json& snaps, const std::string& name, const std::string& kind) {
+  return snaps.at("errors").at(name).at(kind).at("mean_m").get<double>();
 }
 
 std::vector<std::string> SoDsoArgs(const std::string& seq, const std::string& out) {
@@ -144,14 +144,11 @@ TEST_P(SoDso, CorrectsWithGroundTruthPairsAndWritesWhatItReports) {
   ASSERT_EQ(discounted.size(), input.size());
   EXPECT_EQ(graph.begin()->first, input.begin()->first);
   EXPECT_EQ(graph.rbegin()->first, input.rbegin()->first);
-  const std::string json = ReadAll(dir + "/out/run.json");
+  const Json json = ReadJson(dir + "/out/run.json");
   const double in_mean = MeanDeviation(input, truth), graph_mean = MeanDeviation(graph, truth),
                disc_mean = MeanDeviation(discounted, truth);
-  const size_t errors = json.find("\"errors\"");
-  ASSERT_NE(errors, std::string::npos) << json;
-  auto mean_of = [&](const std::string& name) {
-    return JsonNumber(json, "mean_m", json.find("\"" + name + "\"", errors));
-  };
+  ASSERT_TRUE(json.contains("errors")) << json.dump();
+  auto mean_of = [&](const std::string& name) { return MeanDeviationOf(json, name, "unaligned"); };
   EXPECT_NEAR(mean_of("input"), in_mean, 1e-3);
   EXPECT_NEAR(mean_of("pose_graph"), graph_mean, 1e-3);
   EXPECT_NEAR(mean_of("discounted"), disc_mean, 1e-3);
@@ -179,12 +176,10 @@ TEST(SoDsoReport, SignedChangesAReadingAndAHintForTheConvention) {
   const std::string dir = testing::TempDir();
   const Outcome o = RunProgram(testing::OpenableSnapsExe(), SoDsoArgs("00", dir + "/out/run"), dir);
   ASSERT_EQ(o.status, 0) << o.err;
-  const std::string json = ReadAll(dir + "/out/run.json");
-  const size_t errors = json.find("\"errors\"");
-  ASSERT_NE(errors, std::string::npos);
+  const Json json = ReadJson(dir + "/out/run.json");
+  ASSERT_TRUE(json.contains("errors")) << json.dump();
   const auto mean_of = [&](const std::string& name, const char* kind) {
-    const size_t at = json.find("\"" + name + "\"", errors);
-    return JsonNumber(json, "mean_m", json.find(std::string("\"") + kind + "\"", at));
+    return MeanDeviationOf(json, name, kind);
   };
   const double in = mean_of("input", "unaligned"), graph = mean_of("pose_graph", "unaligned");
   const double in_aligned = mean_of("input", "aligned");
@@ -274,15 +269,12 @@ TEST(SnapsChain, KittiMonocularOdometryLoopsFromOpenableAndCorrection) {
   // The correction lowers the mean deviation (measured: 9.58 -> 6.72 m unaligned; aligned
   // 6.15 -> 2.08 m, the figure the report prints and the JSON holds).
   EXPECT_LT(after, 0.8 * before);
-  const std::string json = ReadAll(dir + "/out/chain.json");
-  const size_t errors = json.find("\"errors\"");
-  ASSERT_NE(errors, std::string::npos);
-  const double input_aligned =
-      JsonNumber(json, "mean_m", json.find("\"aligned\"", json.find("\"input\"", errors)));
-  const double graph_aligned =
-      JsonNumber(json, "mean_m", json.find("\"aligned\"", json.find("\"pose_graph\"", errors)));
+  const Json json = ReadJson(dir + "/out/chain.json");
+  ASSERT_TRUE(json.contains("errors")) << json.dump();
+  const double input_aligned = MeanDeviationOf(json, "input", "aligned");
+  const double graph_aligned = MeanDeviationOf(json, "pose_graph", "aligned");
   EXPECT_LT(graph_aligned, 0.5 * input_aligned);
-  EXPECT_NEAR(JsonNumber(json, "mean_m", json.find("\"pose_graph\"", errors)), after, 1e-3);
+  EXPECT_NEAR(MeanDeviationOf(json, "pose_graph", "unaligned"), after, 1e-3);
 }
 
 // Odometry inputs that cannot work: one line naming the key, exit 1, nothing written.

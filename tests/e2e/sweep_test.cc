@@ -47,21 +47,20 @@ Outcome RunSweep(const std::string& dir, const std::vector<std::string>& more) {
   return RunProgram(testing::OpenableSweepExe(), With(SampleArgs(), more), dir);
 }
 
-// The text of the sweep run whose varied settings are `settings` ({"Key": "value", ...} in the
-// order of the --vary options); empty when absent.
-std::string SweepRunJson(const std::string& json, const Json& settings) {
-  const Json sweep = Json::parse(json);
+// The sweep run whose varied settings are `settings` ({"Key": "value", ...} in the order of the
+// --vary options); null when absent.
+Json SweepRun(const Json& sweep, const Json& settings) {
   for (const Json& run : sweep.at("runs"))
-    if (run.at("settings") == settings) return json::Dump(run);
-  return "";
+    if (run.at("settings") == settings) return run;
+  return Json();
 }
 
-// `key`'s figure of each run of the sweep JSON, in the order the runs are listed (best first).
-std::vector<double> RankedFigures(const std::string& json, const std::string& key) {
+// `key`'s figure of each run of the sweep document, in the order the runs are listed (best
+// first): "rank", or a figure of the run's evaluation (RunFigure).
+std::vector<double> RankedFigures(const Json& sweep, const std::string& key) {
   std::vector<double> out;
-  for (std::size_t p = json.find("\"rank\": "); p != std::string::npos;
-       p = json.find("\"rank\": ", p + 1))
-    out.push_back(JsonNumber(json, key, p));
+  for (const Json& run : sweep.at("runs"))
+    out.push_back((key == "rank" ? run.at("rank") : RunFigure(run, key)).get<double>());
   return out;
 }
 
@@ -71,12 +70,12 @@ TEST(Sweep, FiguresEqualTheSingleRunsAndAreRanked) {
       RunSweep(dir, {"--vary", "Image_descriptor=LDB,HOG", "--vary", "Image_sequences=1,5",
                      "--vary", "Match_score=distance,ratio", "--output", "out/sweep"});
   ASSERT_EQ(sweep.status, 0) << sweep.err;
-  const std::string json = ReadAll(dir + "/out/sweep.json");
-  ASSERT_FALSE(json.empty());
+  const Json json = ReadJson(dir + "/out/sweep.json");
+  ASSERT_FALSE(json.at("runs").empty());
   EXPECT_TRUE(fs::exists(dir + "/out/sweep_pr.png"));
   // Frames described once per descriptor, not once per combination, and read once for both.
-  EXPECT_EQ(JsonNumber(json, "descriptions"), 2);
-  EXPECT_EQ(JsonNumber(json, "frame_reads"), 1);
+  EXPECT_EQ(json.at("descriptions"), 2);
+  EXPECT_EQ(json.at("frame_reads"), 1);
 
   const char* metrics[] = {"auc",
                            "recall_at_100p",
@@ -89,20 +88,20 @@ TEST(Sweep, FiguresEqualTheSingleRunsAndAreRanked) {
   for (const std::string d : {"LDB", "HOG"})
     for (const std::string l : {"1", "5"})
       for (const std::string s : {"distance", "ratio"}) {
-        const std::string run = SweepRunJson(
-            json, {{"Image_descriptor", d}, {"Image_sequences", l}, {"Match_score", s}});
-        ASSERT_FALSE(run.empty()) << d << " " << l << " " << s;
+        const Json run =
+            SweepRun(json, {{"Image_descriptor", d}, {"Image_sequences", l}, {"Match_score", s}});
+        ASSERT_FALSE(run.is_null()) << d << " " << l << " " << s;
         const Outcome single = RunProgram(
             testing::TestOpenableExe(),
             With(SampleArgs(), {"--set", "Image_descriptor=" + d, "--set", "Image_sequences=" + l,
                                 "--set", "Match_score=" + s, "--set", "Evaluation_name=one"}),
             dir);
         ASSERT_EQ(single.status, 0) << single.err;
-        const std::string one = ReadAll(dir + "/one.json");
+        const Json one = ReadJson(dir + "/one.json");
         for (const char* m : metrics) {
-          const double want = JsonNumber(one, m);
-          ASSERT_FALSE(std::isnan(want)) << m;
-          EXPECT_EQ(JsonNumber(run, m), want) << d << " L=" << l << " " << s << ": " << m;
+          const Json& want = RunFigure(one.at("runs").at(0), m);
+          ASSERT_TRUE(want.is_number()) << m << ": " << want.dump();
+          EXPECT_EQ(RunFigure(run, m), want) << d << " L=" << l << " " << s << ": " << m;
         }
         ++compared;
       }
@@ -110,6 +109,7 @@ TEST(Sweep, FiguresEqualTheSingleRunsAndAreRanked) {
 
   // Ranked by AUC, best first, ranks 1..8 in order; the CSV has the same rows.
   const std::vector<double> ranks = RankedFigures(json, "rank");
+  ASSERT_FALSE(ranks.empty());
   for (std::size_t i = 0; i < ranks.size(); ++i) EXPECT_EQ(ranks[i], static_cast<double>(i + 1));
   const std::vector<double> aucs = RankedFigures(json, "auc");
   ASSERT_EQ(aucs.size(), 8u);
@@ -131,11 +131,11 @@ TEST(Sweep, RanksByTheChosenFigure) {
   const Outcome sweep = RunSweep(dir, {"--vary", "Image_sequences=1,3,5", "--rank-by",
                                        "recall_at_1", "--best", "2", "--output", "r"});
   ASSERT_EQ(sweep.status, 0) << sweep.err;
-  const std::string json = ReadAll(dir + "/r.json");
+  const Json json = ReadJson(dir + "/r.json");
   const std::vector<double> r1 = RankedFigures(json, "recall_at_1");
   ASSERT_EQ(r1.size(), 3u);
   EXPECT_TRUE(std::is_sorted(r1.rbegin(), r1.rend()));
-  EXPECT_EQ(JsonNumber(json, "descriptions"), 1);
+  EXPECT_EQ(json.at("descriptions"), 1);
 }
 
 // Bad sweeps: one line naming the option, key and value, exit 1, nothing written, and no run

@@ -14,7 +14,6 @@
 namespace openable {
 namespace {
 
-using e2e::JsonNumber;
 using e2e::Outcome;
 using e2e::RunProgram;
 namespace fs = std::filesystem;
@@ -167,17 +166,19 @@ TEST(Verification, LoopsFileAgreesWithTheEvaluationOnKittiRevisit) {
     if (cv::norm(r.position[q] - r.position[answer[q]]) > 30) wrong.push_back(q);
   }
   ASSERT_GT(positives, 50);
-  const std::string json = e2e::ReadAll(dir + "/e.json");
-  const auto final_at = json.find("\"per_query\": {");
-  const auto unverified_at = json.find("\"per_query_unverified\": {");
-  ASSERT_NE(final_at, std::string::npos);
-  ASSERT_NE(unverified_at, std::string::npos);
-  EXPECT_EQ(JsonNumber(json, "positive_queries", final_at), positives);
-  EXPECT_EQ(JsonNumber(json, "matches", final_at), tp + fp);
-  EXPECT_NEAR(JsonNumber(json, "recall", final_at), static_cast<double>(tp) / positives, 1e-6);
-  EXPECT_NEAR(JsonNumber(json, "precision", final_at),
+  const Json evaluation = e2e::ReadJson(dir + "/e.json");
+  const Json& run = evaluation.at("runs").at(0);
+  ASSERT_TRUE(run.contains("per_query")) << run.dump();
+  ASSERT_TRUE(run.contains("per_query_unverified")) << run.dump();
+  // The figures of the verified answers.
+  const Json& final_figures = run.at("per_query");
+  const Json& accepted = final_figures.at("accepted");
+  EXPECT_EQ(final_figures.at("positive_queries"), positives);
+  EXPECT_EQ(accepted.at("matches"), tp + fp);
+  EXPECT_NEAR(accepted.at("recall").get<double>(), static_cast<double>(tp) / positives, 1e-6);
+  EXPECT_NEAR(accepted.at("precision").get<double>(),
               tp + fp > 0 ? static_cast<double>(tp) / (tp + fp) : 1.0, 1e-6);
-  EXPECT_EQ(JsonNumber(json, "unanswered_queries", final_at),
+  EXPECT_EQ(final_figures.at("unanswered_queries"),
             (190 - kExclusion) - static_cast<int>(answer.size()));
   // What verification is for: every accepted loop shows the same street, within 30 m in the
   // ground truth (two frames of a street share their view over that range: frames 50-99 drive
@@ -208,7 +209,7 @@ TEST(Verification, OnlineDetectorGivesTheBatchRunsLoops) {
   OnlineOptions options;
   options.descriptor.name = "LDB";
   options.exclusion = kExclusion;
-  options.score_window = config.matching.score_window;
+  options.score.window = config.matching.score.window;
   options.verification = config.verification;
   options.verification.tolerance = kTolerance;
   OnlineDetector detector(options);
