@@ -293,13 +293,13 @@ void AddDescriptionKeys(OptionTable& t, Config& c) {
         "answer advancing with the queries within +-max(3, gap / 10) frames (docs/evaluation.md"
         "). Checks an answer against independent evidence of the route, as DLoopDetector's "
         "islands do, with no local features. 0: the score alone.");
-  t.Add("Contrast_enhancement", kDescription, c.matching, c.matching.contrast_enhancement,
+  t.Add("Contrast_enhancement", kDescription, c.matching, c.matching.contrast.enabled,
         "1 applies SeqSLAM's local contrast enhancement to the single-frame distances, before "
         "sequences: each cell minus the mean of its row's cells within +-Contrast_window "
         "references of its traversal, over their standard deviation (0 where they are all "
         "equal), then the matrix shifted so that its smallest value is 0. Any descriptor; "
         "dense matrices only.");
-  t.Add("Contrast_window", kDescription, c.matching, c.matching.contrast_window, 1, 100000,
+  t.Add("Contrast_window", kDescription, c.matching, c.matching.contrast.window, 1, 100000,
         "References on each side of a cell that give its local mean and deviation "
         "(Contrast_enhancement).");
   t.Add("Fusion_weights", kDescription, c.matching, c.matching.fusion_weights,

@@ -6,9 +6,12 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "OpenABLE/base/option_checks.h"
 #include "OpenABLE/base/threading.h"
 
 namespace openable {
+
+void ContrastOptions::Check() const { CheckIntRange("Contrast_window", window, 1, 100000); }
 
 float EnhanceContrastUnshifted(cv::Mat1f& d, int window, const std::vector<int>& col_starts,
                                int threads) {

@@ -12,6 +12,20 @@
 
 namespace openable {
 
+// SeqSLAM's local contrast enhancement of the single-frame matrix (Contrast_enhancement,
+// Contrast_window): the one struct of these settings, held by the run's MatchingOptions and the
+// online detector's OnlineOptions.
+struct ContrastOptions {
+  bool enabled = false;
+  int window = 10;  // +-window references around each cell, 1..100000
+
+  // Throws InputError naming Contrast_window when the window is out of range.
+  void Check() const;
+  bool operator==(const ContrastOptions& o) const {
+    return enabled == o.enabled && window == o.window;
+  }
+};
+
 // Enhances `d` (rows: frames i, columns: frames j) in place with window `window` >= 1;
 // `col_starts` as in matching/sequence.h (the first column of each traversal, from 0; empty:
 // one traversal). Non-finite cells are left out of every mean and deviation and stay as they

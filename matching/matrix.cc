@@ -24,7 +24,7 @@ void MatchingOptions::Check() const {
     throw InputError("Match_threshold: " + FormatNumber(match_threshold) +
                      " is not valid; expected -1 (none) or a number in [0, 1]");
   CheckIntRange("Match_consistency", match_consistency, 0, 1000);
-  CheckIntRange("Contrast_window", contrast_window, 1, 100000);
+  contrast.Check();
   if (!fusion_weights.empty()) FusionWeights(-1);
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "matching/agreement.h"
+#include "matching/contrast.h"
 #include "matching/distances.h"
 #include "matching/panorama.h"
 #include "matching/score.h"
@@ -32,10 +33,8 @@ struct MatchingOptions {
   // n: an accepted best match also needs the best matches of n independent queries (one
   // sequence apart, matching/agreement.h) to agree with it; 0: the score alone (0..1000).
   int match_consistency = 0;
-  // SeqSLAM's local contrast enhancement of the single-frame matrix (contrast.h), over
-  // +-contrast_window references (1..100000).
-  bool contrast_enhancement = false;
-  int contrast_window = 10;
+  // SeqSLAM's local contrast enhancement of the single-frame matrix (matching/contrast.h).
+  ContrastOptions contrast;
   // Several descriptors fused (Image_descriptor "HOG+LDB"): the weight of each normalised
   // single-frame matrix, comma-separated, in the order of the names; empty: equal weights.
   std::string fusion_weights;

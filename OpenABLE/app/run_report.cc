@@ -47,8 +47,8 @@ std::string FormatRunReport(const Config& config, const RunOutcome& outcome) {
       << (c.matching.sequence_length > 1 && c.matching.partial != SequencePartial::kAhead
               ? std::string(" (") + EnumName(c.matching.partial) + " partial)"
               : std::string())
-      << (c.matching.contrast_enhancement
-              ? ", contrast enhancement +-" + std::to_string(c.matching.contrast_window)
+      << (c.matching.contrast.enabled
+              ? ", contrast enhancement +-" + std::to_string(c.matching.contrast.window)
               : std::string())
       << ", score " << EnumName(c.matching.score.kind)
       << (c.matching.score.kind == MatchScore::kRatio

@@ -247,11 +247,11 @@ void SetSearchKey(const Config& c, const std::string& key, OnlineOptions& o) {
   } else if (key == "Image_sequences") {
     o.sequence_length = m.sequence_length;
   } else if (key == "Contrast_enhancement") {
-    o.contrast_enhancement = m.contrast_enhancement;
+    o.contrast.enabled = m.contrast.enabled;
   } else if (key == "Contrast_window") {
-    o.contrast_window = m.contrast_window;
+    o.contrast.window = m.contrast.window;
   } else if (key == "Match_score") {
-    o.score = m.score;
+    o.score.kind = m.score.kind;
   } else if (key == "Match_score_window") {
     o.score.window = m.score.window;
   } else if (key == "Match_threshold") {
@@ -415,8 +415,7 @@ std::string SearchText(const OnlineOptions& o) {
     for (const double w : o.fusion_weights) text += " " + FormatNumber(w);
     text += ")";
   }
-  if (o.contrast_enhancement)
-    text += ", contrast enhancement +-" + std::to_string(o.contrast_window);
+  if (o.contrast.enabled) text += ", contrast enhancement +-" + std::to_string(o.contrast.window);
   text += ", L = " + std::to_string(o.sequence_length) + ", " + EnumName(o.score.kind) + " score";
   if (o.score.kind == MatchScore::kRatio)
     text += " (window +-" + std::to_string(o.score.window) + ")";

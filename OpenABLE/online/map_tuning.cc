@@ -186,8 +186,7 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
   const std::vector<std::string> chosen = DescriptorList(search.descriptor.name);
   search.fusion_weights =
       chosen.size() > 1 ? m.FusionWeights(static_cast<int>(chosen.size())) : std::vector<double>{};
-  search.contrast_enhancement = m.contrast_enhancement;
-  search.contrast_window = m.contrast_window;
+  search.contrast = m.contrast;
   search.sequence_length = m.sequence_length;
   search.score.kind = MatchScore::kRatio;
   search.threshold =
@@ -214,7 +213,7 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
     double largest = 0;
     cv::minMaxLoc(d, nullptr, &largest);
     tuning.units.push_back(largest);
-    if (search.contrast_enhancement) {
+    if (search.contrast.enabled) {
       const double w = chosen.size() > 1 ? search.fusion_weights[k] : 1.0;
       if (fused.empty()) fused = cv::Mat1f::zeros(d.size());
       if (chosen.size() == 1)
@@ -225,8 +224,8 @@ MapTuning OnlineDetector::Tune(const TuneOptions& t,
   }
   if (chosen.size() == 1) tuning.units.clear();
   tuning.shift = 0;
-  if (search.contrast_enhancement) {
-    const float smallest = EnhanceContrastUnshifted(fused, search.contrast_window, {0, references});
+  if (search.contrast.enabled) {
+    const float smallest = EnhanceContrastUnshifted(fused, search.contrast.window, {0, references});
     tuning.shift = std::isfinite(smallest) ? -smallest : 0.0;
   }
 

@@ -85,8 +85,8 @@ void OnlineOptions::Check() const {
   Require(grid_y >= 1 && grid_y <= 64, "grid_y", std::to_string(grid_y), "1..64");
   Require(sequence_length >= 1 && sequence_length <= 1000, "sequence_length",
           std::to_string(sequence_length), "1..1000");
-  Require(contrast_window >= 1 && contrast_window <= 100000, "contrast_window",
-          std::to_string(contrast_window), "1..100000");
+  Require(contrast.window >= 1 && contrast.window <= 100000, "contrast_window",
+          std::to_string(contrast.window), "1..100000");
   Require(exclusion >= 1, "exclusion", std::to_string(exclusion),
           ">= 1 (frames between a frame and its earliest candidate)");
   Require(candidates >= 1 && candidates <= 1000, "candidates", std::to_string(candidates),
@@ -352,7 +352,7 @@ struct OnlineDetector::State {
   // Whether the search scans every frame (no index blocks in use, or contrast enhancement).
   bool Exact() const {
     const IncrementalIndex* index = Index();
-    return options.contrast_enhancement || index == nullptr || index->Blocks() == 0;
+    return options.contrast.enabled || index == nullptr || index->Blocks() == 0;
   }
   int SessionOf(int frame) const {
     auto it = std::upper_bound(sessions.begin(), sessions.end(), frame,
@@ -475,7 +475,7 @@ void OnlineDetector::State::SetSearch() {
   } else if (channels[static_cast<size_t>(search.front())].metric == Metric::kHamming) {
     unit = 8.0 * channels[static_cast<size_t>(search.front())].width;
   }
-  if (options.contrast_enhancement && shift < 0) shift = std::sqrt(2.0 * options.contrast_window);
+  if (options.contrast.enabled && shift < 0) shift = std::sqrt(2.0 * options.contrast.window);
   // Another search than the one the units or shift were chosen for needs its own.
   if (units.size() != search.size()) units.clear();
   // The running sums and the answers of the current traversal were of the search before.
@@ -611,8 +611,8 @@ cv::Mat1f OnlineDetector::State::SingleFrameRows(const RowsByChannel& queries, i
       col += n;
     }
   }
-  if (options.contrast_enhancement) {
-    EnhanceContrastUnshifted(out, options.contrast_window, columns.starts);
+  if (options.contrast.enabled) {
+    EnhanceContrastUnshifted(out, options.contrast.window, columns.starts);
     // The tuned shift leaves a few of the new distances below 0: they are the best matches of
     // their row's window, kept at 0.
     out += static_cast<float>(shift);
@@ -1162,8 +1162,8 @@ std::vector<std::pair<std::string, std::string>> FeatureSettings(const OnlineOpt
 std::vector<std::pair<std::string, std::string>> SearchSettings(const OnlineOptions& o) {
   return {{"descriptor", o.descriptor.name},
           {"fusion_weights", Numbers(o.fusion_weights)},
-          {"contrast_enhancement", o.contrast_enhancement ? "1" : "0"},
-          {"contrast_window", std::to_string(o.contrast_window)},
+          {"contrast_enhancement", o.contrast.enabled ? "1" : "0"},
+          {"contrast_window", std::to_string(o.contrast.window)},
           {"sequence_length", std::to_string(o.sequence_length)},
           {"score", EnumName(o.score.kind)},
           {"score_window", std::to_string(o.score.window)},
@@ -1317,8 +1317,8 @@ void ReadSearch(const MapFile& map, const std::string& path, const std::string& 
                 OnlineOptions& o) {
   o.descriptor.name = map.Setting(prefix + "descriptor");
   o.fusion_weights = ParseNumbers(map, prefix + "fusion_weights", path);
-  o.contrast_enhancement = map.Setting(prefix + "contrast_enhancement") == "1";
-  ParseWhole(map, prefix + "contrast_window", path, o.contrast_window);
+  o.contrast.enabled = map.Setting(prefix + "contrast_enhancement") == "1";
+  ParseWhole(map, prefix + "contrast_window", path, o.contrast.window);
   ParseWhole(map, prefix + "sequence_length", path, o.sequence_length);
   o.score.kind = ParseEnum<MatchScore>(map.Setting(prefix + "score"),
                                        path + ": setting \"" + prefix + "score\"");
@@ -1675,8 +1675,7 @@ void OnlineDetector::UseTuning(const MapTuning& tuning) {
   const OnlineOptions& t = tuning.search;
   search.descriptor.name = t.descriptor.name;
   search.fusion_weights = t.fusion_weights;
-  search.contrast_enhancement = t.contrast_enhancement;
-  search.contrast_window = t.contrast_window;
+  search.contrast = t.contrast;
   search.sequence_length = t.sequence_length;
   search.score = t.score;
   search.threshold = t.threshold;

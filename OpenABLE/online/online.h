@@ -25,6 +25,7 @@
 #include "OpenABLE/online/map_file.h"
 #include "OpenABLE/verification/verification.h"
 #include "descriptors/descriptor.h"
+#include "matching/contrast.h"
 #include "matching/distances.h"
 #include "matching/score.h"
 #include "matching/search/approximate.h"
@@ -57,10 +58,9 @@ struct OnlineOptions {
   // +-contrast_window frames of a session (matching/contrast.h; the keys Contrast_enhancement
   // and Contrast_window). It needs every distance of the query's row, so a map searched with
   // it is scanned exactly at any size (the index is not used).
-  bool contrast_enhancement = false;
-  int contrast_window = 10;  // >= 1
-  int exclusion = 100;       // frame q's candidates are frames j <= q - exclusion (>= 1)
-  int candidates = 5;        // candidates returned per frame (the k best), >= 1
+  ContrastOptions contrast;
+  int exclusion = 100;  // frame q's candidates are frames j <= q - exclusion (>= 1)
+  int candidates = 5;   // candidates returned per frame (the k best), >= 1
   // The confidence of a candidate (matching/score.h, the key Match_score): its normalised
   // distance, or the ratio of its distance to the best candidate more than score_window
   // frames away from it (the rivals are the candidates the search scored: every searchable

@@ -226,12 +226,16 @@ dict too: options["sequence_length"], options.keys(), options.to_dict().)doc");
       .def_readwrite("fusion_weights", &O::fusion_weights,
                      "One weight per name of a fused descriptor (\"HOG+LDB\"), > 0; []: equal "
                      "weights (Fusion_weights).")
-      .def_readwrite("contrast_enhancement", &O::contrast_enhancement,
-                     "SeqSLAM's local contrast enhancement of each query's distances over "
-                     "+-contrast_window frames of a session; the map is then scanned exactly "
-                     "(Contrast_enhancement).")
-      .def_readwrite("contrast_window", &O::contrast_window,
-                     "Frames on each side of the enhancement's window (>= 1).")
+      .def_property(
+          "contrast_enhancement", [](const O& o) { return o.contrast.enabled; },
+          [](O& o, bool on) { o.contrast.enabled = on; },
+          "SeqSLAM's local contrast enhancement of each query's distances over "
+          "+-contrast_window frames of a session; the map is then scanned exactly "
+          "(Contrast_enhancement).")
+      .def_property(
+          "contrast_window", [](const O& o) { return o.contrast.window; },
+          [](O& o, int w) { o.contrast.window = w; },
+          "Frames on each side of the enhancement's window (>= 1).")
       .def_property(
           "grid", [](const O& o) { return std::make_pair(o.grid_x, o.grid_y); },
           [](O& o, std::pair<int, int> g) { std::tie(o.grid_x, o.grid_y) = g; },

@@ -292,8 +292,8 @@ cv::Mat1f FusedSingleFrame(const std::vector<const cv::Mat1f*>& singles,
       if (largest > 0) cv::scaleAdd(*singles[k], weights[k] / largest, distances, distances);
     }
   }
-  if (matching.contrast_enhancement)
-    EnhanceContrast(distances, matching.contrast_window, starts, matching.threads);
+  if (matching.contrast.enabled)
+    EnhanceContrast(distances, matching.contrast.window, starts, matching.threads);
   return distances;
 }
 
@@ -551,7 +551,7 @@ void FinishNormalized(const Config& config, const std::vector<int>& starts, RunR
 // (the L2 matrices keep the tiles a run spread over processes computes the same way).
 bool OnePassFits(const RunPlan& plan, const SingleFrameStore* store) {
   return store == nullptr && !plan.Fused() && plan.strips == 1 &&
-         !plan.config.matching.contrast_enhancement && !Cluster::Get().Distributed() &&
+         !plan.config.matching.contrast.enabled && !Cluster::Get().Distributed() &&
          plan.head.descriptors.front().metric != Metric::kL2;
 }
 

@@ -433,7 +433,7 @@ void DecideMode(RunPlan& plan, PlanScope scope) {
                      result.mode_reason +
                      "; expected one descriptor, or Matrix_mode 1 (or 0 with a larger "
                      "Memory_limit)");
-  if (result.bounded && matching.contrast_enhancement)
+  if (result.bounded && matching.contrast.enabled)
     throw InputError("Contrast_enhancement: 1 needs the dense matrix, but the run is " +
                      result.mode_reason +
                      "; expected 0, or Matrix_mode 1 (or 0 with a larger "

@@ -301,8 +301,8 @@ AutoChoice JudgeCandidates(const AutoPlan& plan, double min_consistency,
     const Config& c = configs[i];
     const MatchingOptions& m = c.matching;
     const std::string key = SingleFrameKey(c, c.descriptor.name) + "\n" + m.fusion_weights + "\n" +
-                            std::to_string(m.contrast_enhancement) + " " +
-                            std::to_string(m.contrast_window);
+                            std::to_string(m.contrast.enabled) + " " +
+                            std::to_string(m.contrast.window);
     auto it = blocks.find(key);
     if (it == blocks.end()) {
       const cv::Mat1f single = SingleFrameMatrix(c, store, first_rows);

@@ -39,7 +39,7 @@ inline OnlineOptions MapDetectorOptions(MapKind kind) {
   } else if (kind == MapKind::kSeveral) {
     o.descriptor.patch_size = 16;
     o.kept_descriptors = "SAD";
-    o.contrast_enhancement = true;
+    o.contrast.enabled = true;
   } else {
     o.exclusion = 1;
     o.verification.enabled = true;

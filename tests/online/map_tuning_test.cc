@@ -257,7 +257,7 @@ TEST(MapTuning, ChoosesWhatTheAutoModeChoosesFromTheSameFrames) {
   // The search now is the chosen candidate's, with the presets' acceptance.
   const OnlineOptions& s = d->Options();
   EXPECT_EQ(s.sequence_length, choice.config.matching.sequence_length);
-  EXPECT_EQ(s.contrast_enhancement, choice.config.matching.contrast_enhancement);
+  EXPECT_EQ(s.contrast.enabled, choice.config.matching.contrast.enabled);
   EXPECT_EQ(s.score.kind, MatchScore::kRatio);
   EXPECT_DOUBLE_EQ(s.Threshold(), 0.9);
   EXPECT_EQ(s.consistency, 1);
@@ -368,7 +368,7 @@ TEST(MapTuning, TunedMapsKeepTheirSettings) {
   const OnlineOptions options = MapOptions(path);
   EXPECT_EQ(options.descriptor.name, d->Options().descriptor.name);
   EXPECT_EQ(options.sequence_length, d->Options().sequence_length);
-  EXPECT_EQ(options.contrast_enhancement, d->Options().contrast_enhancement);
+  EXPECT_EQ(options.contrast.enabled, d->Options().contrast.enabled);
   EXPECT_EQ(options.kept_descriptors.empty(), false);
   OnlineDetector loaded(options);
   loaded.LoadMap(path);

@@ -70,6 +70,22 @@ class OpenableMapTest(TempDirTestCase):
         self.assertEqual(info["sessions"][0]["time"], "2026-07-01T10:00:00Z")
         self.assertEqual(info["settings"]["frame_size"], "64x32")
 
+    def test_a_search_key_set_at_query_keeps_the_others_of_the_map(self):
+        # A map saved with the ratio score over +-7 frames: a query that sets only Match_score
+        # keeps the map's window (the two keys are one struct, set key by key).
+        saved = self.tmp / "window7.map"
+        run("openable_map", ["add", saved, "--images", SAMPLE / "summer", "--session", "summer",
+                             "--set", "Match_score=ratio", "--set", "Match_score_window=7",
+                             "--quiet"], self.tmp)
+        for given, expected in (("Match_score=ratio", "ratio score (window +-7)"),
+                                ("Match_score_window=4", "ratio score (window +-4)")):
+            done = run("openable_map", ["query", saved, "--images", SAMPLE / "winter", "--set",
+                                        given], self.tmp)
+            out = done.stdout + done.stderr  # the search line is on stderr
+            search = [line for line in out.splitlines() if line.startswith("search:")]
+            self.assertEqual(len(search), 1, out)
+            self.assertIn(expected, search[0])
+
     def test_query_equals_brute_force(self):
         done = run("openable_map", ["query", self.map, "--images", SAMPLE / "winter",
                                     "--session", "summer", "--set", "Image_sequences=%d" % L,
