@@ -21,9 +21,6 @@ struct ContrastOptions {
 
   // Throws InputError naming Contrast_window when the window is out of range.
   void Check() const;
-  bool operator==(const ContrastOptions& o) const {
-    return enabled == o.enabled && window == o.window;
-  }
 };
 
 // Enhances `d` (rows: frames i, columns: frames j) in place with window `window` >= 1;

@@ -32,8 +32,6 @@ struct MatchScoreOptions {
   // Throws InputError naming Match_score_window when, with the ratio, the window leaves no
   // rival among `references` frames; `where` names them in the message (may be empty).
   void CheckRivals(int references, const std::string& where) const;
-
-  bool operator==(const MatchScoreOptions& o) const { return kind == o.kind && window == o.window; }
 };
 
 // The score of candidate `best` of a row of `count` candidate distances (columns 0 .. count-1

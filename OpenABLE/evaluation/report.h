@@ -70,11 +70,11 @@ nlohmann::ordered_json EvaluationSettingsJson(const EvaluationSettings& settings
 void AddEvaluatedRunJson(nlohmann::ordered_json& object, const EvaluatedRun& run);
 
 // One row of the table of each run under each protocol chosen (FormatEvaluationTable's "By
-// protocol", the HTML report's figures): the run's label, the protocol ("openable",
-// "vpr_bench", "vpr_tutorial"), its AUC, R@100P and R@1/5/10 as that protocol defines them
-// (NaN where it leaves one undefined) and a few more figures as text. Rows only when
-// Evaluation_protocol names a reference protocol (vpr_bench or vpr_tutorial): per run, the
-// toolbox's own first (when chosen), then VPR-Bench's, then VPR_Tutorial's.
+// protocol", the HTML report's figures): the run's label, the protocol, its AUC, R@100P and
+// R@1/5/10 as that protocol defines them (NaN where it leaves one undefined) and a few more
+// figures as text. Rows only when Evaluation_protocol names a reference protocol: per run, the
+// toolbox's own first (when chosen), then each reference protocol in the order of their table
+// (protocols.h).
 struct ProtocolRow {
   std::string label, protocol;
   double auc = 0, recall_at_100p = 0, recall_at_1 = 0, recall_at_5 = 0, recall_at_10 = 0;
@@ -88,7 +88,7 @@ std::string ProtocolToleranceNote(const EvaluationSettings& settings);
 
 // A few lines for a terminal: the protocol settings, then one row per run with AUC, R@100P,
 // max F1 (threshold), R@1/5/10 and ABLE-P AP, the operating point (Match_threshold: answers
-// accepted, right, precision, recall); with VPR-Bench's or VPR_Tutorial's protocol, a
+// accepted, right, precision, recall); with a reference protocol (protocols.h), a
 // table of each run under each protocol chosen (AUC, R@100P, R@1/5/10 as each defines them);
 // last, each run's warnings ("  warning: ..."). Text that is not valid UTF-8 (the ground
 // truth's path, a label) is shown by ToValidUtf8.

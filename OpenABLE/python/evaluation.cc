@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <deque>
 #include <optional>
 #include <utility>
 
@@ -569,7 +570,7 @@ ABLE papers' cell protocol (average_precision, able_p_curve); docs/evaluation.md
   // curves as a dict, None when the protocol was not asked for.
   for (const ReferenceProtocol& protocol : ReferenceProtocols()) {
     const std::string name = protocol.name;
-    static std::vector<std::string> docs;  // pybind11 keeps the pointer
+    static std::deque<std::string> docs;  // pybind11 keeps the pointer: never moved
     docs.push_back(std::string(protocol.help) + " (protocol \"" + name +
                    "\"): a dict of its figures and curves; None when not asked for.");
     result.def_property_readonly(
